@@ -1,0 +1,129 @@
+//! The static part of a cloth: topology, rest lengths, masses, pins.
+
+use glam::{Vec2, Vec3};
+
+use crate::mesh::{ClothMesh, SpringKind};
+
+/// Springs as flat arrays (structure of arrays), in a deterministic order: the mesh's
+/// sorted unique edges first, then one bend spring per bend pair.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Springs {
+    pub a: Vec<u32>,
+    pub b: Vec<u32>,
+    /// Rest length, metres.
+    pub rest: Vec<f32>,
+    pub kind: Vec<SpringKind>,
+}
+
+impl Springs {
+    pub fn len(&self) -> usize {
+        self.a.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.a.is_empty()
+    }
+
+    /// How many springs are of `kind`.
+    pub fn count(&self, kind: SpringKind) -> usize {
+        self.kind.iter().filter(|&&k| k == kind).count()
+    }
+}
+
+/// Topology and rest state of a cloth, shared by every step. Pins are particles with
+/// inverse mass 0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClothModel {
+    pub rest_positions: Vec<Vec3>,
+    pub uvs: Vec<Vec2>,
+    pub triangles: Vec<[u32; 3]>,
+    pub springs: Springs,
+    /// Particle mass, kg (lumped from areal density by triangle area).
+    pub mass: Vec<f32>,
+    /// 1/mass, 1/kg; 0 for pinned particles.
+    pub inv_mass: Vec<f32>,
+    /// Pinned particle indices, sorted and unique.
+    pub pins: Vec<u32>,
+    /// Areal density the masses came from, kg/m².
+    pub density: f32,
+}
+
+impl ClothModel {
+    /// Builds a model from a mesh with areal density `density` (kg/m²): each triangle gives a
+    /// third of its mass to each corner. `pins` (out-of-range indices ignored) get inverse
+    /// mass 0.
+    pub fn new(mesh: &ClothMesh, density: f32, pins: &[u32]) -> Self {
+        let n = mesh.positions.len();
+        let mut springs = Springs::default();
+        let pairs = mesh
+            .edges
+            .iter()
+            .zip(&mesh.edge_kinds)
+            .map(|(e, &k)| (*e, k))
+            .chain(mesh.bend_pairs.iter().map(|&p| (p, SpringKind::Bend)));
+        for ([a, b], kind) in pairs {
+            springs.a.push(a);
+            springs.b.push(b);
+            springs
+                .rest
+                .push(mesh.positions[a as usize].distance(mesh.positions[b as usize]));
+            springs.kind.push(kind);
+        }
+        let mut model = Self {
+            rest_positions: mesh.positions.clone(),
+            uvs: mesh.uvs.clone(),
+            triangles: mesh.triangles.clone(),
+            springs,
+            mass: vec![0.0; n],
+            inv_mass: vec![0.0; n],
+            pins: Vec::new(),
+            density,
+        };
+        model.set_density(density);
+        model.set_pins(pins);
+        model
+    }
+
+    pub fn particle_count(&self) -> usize {
+        self.rest_positions.len()
+    }
+
+    /// Mesh edges (structural + shear springs), the count `info` reports as springs.
+    pub fn edge_count(&self) -> usize {
+        self.springs.len() - self.springs.count(SpringKind::Bend)
+    }
+
+    /// Recomputes masses from an areal density, kg/m².
+    pub fn set_density(&mut self, density: f32) {
+        self.density = density;
+        self.mass.iter_mut().for_each(|m| *m = 0.0);
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|i| self.rest_positions[i as usize]);
+            let third = density * 0.5 * (b - a).cross(c - a).length() / 3.0;
+            for &i in t {
+                self.mass[i as usize] += third;
+            }
+        }
+        let pins = std::mem::take(&mut self.pins);
+        self.set_pins(&pins);
+    }
+
+    /// Replaces the pin set; pinned particles get inverse mass 0, the rest 1/mass.
+    pub fn set_pins(&mut self, pins: &[u32]) {
+        let n = self.particle_count();
+        self.pins = pins.iter().copied().filter(|&p| (p as usize) < n).collect();
+        self.pins.sort_unstable();
+        self.pins.dedup();
+        for (w, &m) in self.inv_mass.iter_mut().zip(&self.mass) {
+            *w = if m > 0.0 { 1.0 / m } else { 0.0 };
+        }
+        for &p in &self.pins {
+            self.inv_mass[p as usize] = 0.0;
+        }
+    }
+
+    /// Total mass, kg.
+    pub fn total_mass(&self) -> f32 {
+        self.mass.iter().sum()
+    }
+}

@@ -1,0 +1,61 @@
+//! The dynamic part of a cloth: what changes every step.
+
+use glam::Vec3;
+
+use super::model::ClothModel;
+
+/// Positions, velocities, and the previous positions position-Verlet needs. Reset is a copy
+/// of the initial state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClothState {
+    /// Metres.
+    pub pos: Vec<Vec3>,
+    /// Metres per second.
+    pub vel: Vec<Vec3>,
+    /// Positions one step ago (metres); kept consistent by every integrator and collider so
+    /// switching integrators mid-run is seamless.
+    pub prev_pos: Vec<Vec3>,
+    /// Simulated time, seconds.
+    pub time: f64,
+}
+
+impl ClothState {
+    /// The model's rest shape, at rest.
+    pub fn at_rest(model: &ClothModel) -> Self {
+        Self {
+            pos: model.rest_positions.clone(),
+            vel: vec![Vec3::ZERO; model.particle_count()],
+            prev_pos: model.rest_positions.clone(),
+            time: 0.0,
+        }
+    }
+
+    /// True when every position and velocity is finite.
+    pub fn is_finite(&self) -> bool {
+        self.pos.iter().chain(&self.vel).all(|v| v.is_finite())
+    }
+
+    /// Largest particle speed, m/s.
+    pub fn max_speed(&self) -> f32 {
+        self.vel.iter().map(|v| v.length()).fold(0.0, f32::max)
+    }
+
+    /// Kinetic energy ½Σmv², joules (accumulated in f64).
+    pub fn kinetic_energy(&self, model: &ClothModel) -> f64 {
+        self.vel
+            .iter()
+            .zip(&model.mass)
+            .map(|(v, &m)| 0.5 * m as f64 * v.length_squared() as f64)
+            .sum()
+    }
+
+    /// Angular momentum about an axis through `origin` along unit `axis`, kg·m²/s.
+    pub fn angular_momentum(&self, model: &ClothModel, origin: Vec3, axis: Vec3) -> f64 {
+        self.pos
+            .iter()
+            .zip(&self.vel)
+            .zip(&model.mass)
+            .map(|((p, v), &m)| (m as f64) * ((*p - origin).cross(*v).dot(axis)) as f64)
+            .sum()
+    }
+}

@@ -1,0 +1,245 @@
+//! The `clothsim` command: the GUI by default, plus headless subcommands.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+
+use clothsim::mesh::{self, GridOrientation, GridSpec, SpringKind};
+use clothsim::scene::{SCENARIOS, Scene, Simulation};
+use clothsim::sim::IntegratorKind;
+
+#[derive(Parser)]
+#[command(
+    name = "clothsim",
+    version,
+    about = "Cloth simulator and viewer",
+    args_conflicts_with_subcommands = true
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Open the GUI with this OBJ file as the cloth (no subcommand: the GUI).
+    obj: Option<PathBuf>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Topology of an OBJ cloth: particles, triangles, springs by kind, bend pairs.
+    Info {
+        file: PathBuf,
+        /// Print one JSON object.
+        #[arg(long)]
+        json: bool,
+    },
+    /// List the built-in scenarios.
+    Scenes,
+    /// Run a scenario headless and print a summary.
+    Simulate {
+        #[command(flatten)]
+        run: RunArgs,
+        /// Print one JSON object.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Write a rectangular grid cloth as an OBJ file (quads: diagonals become shear springs).
+    Grid {
+        /// Quads along each side.
+        #[arg(long, default_value_t = 24)]
+        quads: u32,
+        /// Side length, metres.
+        #[arg(long, default_value_t = 1.0)]
+        size: f32,
+        /// Write triangles instead of quads.
+        #[arg(long)]
+        triangles: bool,
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+/// What every simulating subcommand takes.
+#[derive(clap::Args)]
+struct RunArgs {
+    /// Scenario name (see `clothsim scenes`).
+    #[arg(long, default_value = "hanging")]
+    scene: String,
+    /// Use this OBJ cloth instead of the scenario's default.
+    #[arg(long)]
+    obj: Option<PathBuf>,
+    /// Integrator: semi-implicit-euler or verlet.
+    #[arg(long)]
+    integrator: Option<IntegratorKind>,
+    /// Simulated seconds.
+    #[arg(long, default_value_t = 3.0)]
+    seconds: f64,
+    /// Frame time step, seconds.
+    #[arg(long)]
+    dt: Option<f32>,
+    /// Substeps per frame.
+    #[arg(long)]
+    substeps: Option<u32>,
+}
+
+impl RunArgs {
+    fn simulation(&self) -> Result<Simulation> {
+        let mut scene = match &self.obj {
+            Some(path) => Scene::with_obj(&self.scene, path)?,
+            None => Scene::builtin(&self.scene)?,
+        };
+        if let Some(k) = self.integrator {
+            scene.params.integrator = k;
+        }
+        if let Some(dt) = self.dt {
+            scene.params.dt = dt;
+        }
+        if let Some(s) = self.substeps {
+            scene.params.substeps = s;
+        }
+        scene.params.validate().map_err(anyhow::Error::msg)?;
+        if !(self.seconds.is_finite() && self.seconds >= 0.0) {
+            bail!(
+                "--seconds must be a finite number ≥ 0, got {}",
+                self.seconds
+            );
+        }
+        for w in &scene.warnings {
+            eprintln!("warning: {}: {w}", scene.cloth_name);
+        }
+        Ok(Simulation::new(scene))
+    }
+}
+
+fn main() {
+    env_logger::Builder::from_env(
+        env_logger::Env::default().default_filter_or("warn,wgpu_hal=off"),
+    )
+    .init();
+    if let Err(e) = run(Cli::parse()) {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        None => {
+            // Reserved for the GUI; until it exists, print help.
+            let _ = cli.obj;
+            use clap::CommandFactory;
+            Cli::command().print_help()?;
+            Ok(())
+        }
+        Some(Command::Info { file, json }) => info(&file, json),
+        Some(Command::Scenes) => {
+            for s in SCENARIOS {
+                println!("{:<16} {}", s.name, s.summary);
+            }
+            Ok(())
+        }
+        Some(Command::Simulate { run, json }) => simulate(&run, json),
+        Some(Command::Grid {
+            quads,
+            size,
+            triangles,
+            out,
+        }) => grid(quads, size, triangles, &out),
+    }
+}
+
+fn info(file: &std::path::Path, json: bool) -> Result<()> {
+    let build = mesh::load_obj(file)?;
+    let m = &build.mesh;
+    let structural = m.edge_count(SpringKind::Structural);
+    let shear = m.edge_count(SpringKind::Shear);
+    if json {
+        let v = serde_json::json!({
+            "file": file.display().to_string(),
+            "particles": m.positions.len(),
+            "triangles": m.triangles.len(),
+            "springs": m.edges.len(),
+            "structural": structural,
+            "shear": shear,
+            "bend_pairs": m.bend_pairs.len(),
+            "warnings": build.warnings,
+        });
+        println!("{v}");
+    } else {
+        for w in &build.warnings {
+            eprintln!("warning: {}: {w}", file.display());
+        }
+        println!("{}", file.display());
+        println!("  particles   {}", m.positions.len());
+        println!("  triangles   {}", m.triangles.len());
+        println!(
+            "  springs     {} (structural {structural}, shear {shear})",
+            m.edges.len()
+        );
+        println!("  bend pairs  {}", m.bend_pairs.len());
+    }
+    Ok(())
+}
+
+fn simulate(args: &RunArgs, json: bool) -> Result<()> {
+    let mut sim = args.simulation()?;
+    let summary = sim.run(args.seconds);
+    if json {
+        println!("{}", serde_json::to_string(&summary)?);
+    } else {
+        println!(
+            "scene {} with {} ({})",
+            summary.scene, summary.cloth, summary.integrator
+        );
+        println!(
+            "  {} particles, {} springs, {} bend pairs",
+            summary.particles, summary.springs, summary.bend_pairs
+        );
+        println!(
+            "  simulated {:.3} s in {} frames of {:.5} s × {} substeps, wall {:.3} s",
+            summary.simulated_seconds,
+            summary.frames,
+            summary.dt,
+            summary.substeps,
+            summary.wall_seconds
+        );
+        println!(
+            "  finite {}, max speed {:.4} m/s, kinetic energy {:.6} J",
+            summary.finite, summary.max_speed, summary.kinetic_energy
+        );
+        match summary.min_collider_distance {
+            Some(d) => println!("  closest particle to a collider surface: {d:.5} m"),
+            None => println!("  no colliders"),
+        }
+        if summary.refined_frames > 0 {
+            println!(
+                "  {} frame(s) were redone with more substeps",
+                summary.refined_frames
+            );
+        }
+    }
+    if let Some(e) = summary.error {
+        bail!(e);
+    }
+    Ok(())
+}
+
+fn grid(quads: u32, size: f32, triangles: bool, out: &std::path::Path) -> Result<()> {
+    if quads == 0 || !(size.is_finite() && size > 0.0) {
+        bail!("--quads must be ≥ 1 and --size a positive number of metres");
+    }
+    let mut soup =
+        GridSpec::square(quads, size, GridOrientation::Horizontal, glam::Vec3::ZERO).polygons();
+    if triangles {
+        let quads: Vec<u32> = soup.face_indices.clone();
+        soup.face_indices = quads
+            .chunks_exact(4)
+            .flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]])
+            .collect();
+        soup.face_arities = vec![3; quads.len() / 2];
+    }
+    std::fs::write(out, mesh::write_obj(&soup))
+        .with_context(|| format!("cannot write {}", out.display()))?;
+    println!("wrote {}", out.display());
+    Ok(())
+}
+

@@ -1,0 +1,57 @@
+//! Errors of OBJ import: one variant per kind of bad input.
+
+use std::path::PathBuf;
+
+/// Why an OBJ file could not become a cloth. Every message names the file, the line
+/// where known, and the problem.
+#[derive(Debug, thiserror::Error)]
+pub enum ObjError {
+    /// The file does not exist.
+    #[error("{path}: file not found")]
+    NotFound { path: PathBuf },
+    /// The file exists but could not be read (permissions, a directory, I/O failure).
+    #[error("{path}: cannot read file: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file is not UTF-8 text (for example a binary file).
+    #[error(
+        "{path}: not a text file (byte {offset} is not valid UTF-8 or is NUL); is this really an OBJ?"
+    )]
+    NotText { path: PathBuf, offset: usize },
+    /// A number or statement could not be parsed.
+    #[error("{path}:{line}: cannot parse {what}: `{text}`")]
+    Parse {
+        path: PathBuf,
+        line: usize,
+        what: &'static str,
+        text: String,
+    },
+    /// A number parsed but is NaN or infinite.
+    #[error(
+        "{path}:{line}: non-finite number `{text}` in a vertex position; positions must be finite metres"
+    )]
+    NonFinite {
+        path: PathBuf,
+        line: usize,
+        text: String,
+    },
+    /// A face refers to a vertex that does not exist.
+    #[error(
+        "{path}:{line}: face refers to vertex {index}, but the file defines {count} vertices (indices are 1-based)"
+    )]
+    IndexOutOfRange {
+        path: PathBuf,
+        line: usize,
+        index: i64,
+        count: usize,
+    },
+    /// Nothing to simulate: no faces, or every face was degenerate.
+    #[error("{path}: no usable triangles ({detail})")]
+    Empty { path: PathBuf, detail: String },
+    /// The parser rejected the file for a reason the validation pass did not find.
+    #[error("{path}: malformed OBJ: {detail}")]
+    Malformed { path: PathBuf, detail: String },
+}

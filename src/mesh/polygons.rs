@@ -1,0 +1,37 @@
+//! The common input of the topology builder: positions plus polygons, as an OBJ file
+//! or the grid generator describes them.
+
+use glam::{Vec2, Vec3};
+
+/// A polygon soup: positions (possibly repeated) and faces as index lists of any arity ≥ 3.
+///
+/// Faces are stored flat: `face_indices` holds the corners of every face one after the
+/// other and `face_arities[i]` says how many belong to face `i`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PolygonSoup {
+    /// Corner positions in metres.
+    pub positions: Vec<Vec3>,
+    /// Texture coordinates per position index, when the source has them.
+    pub uvs: Option<Vec<Vec2>>,
+    /// Corners of all faces, flat, indexing `positions`.
+    pub face_indices: Vec<u32>,
+    /// Number of corners of each face.
+    pub face_arities: Vec<u32>,
+}
+
+impl PolygonSoup {
+    /// Iterates over the faces as slices of position indices.
+    pub fn faces(&self) -> impl Iterator<Item = &[u32]> {
+        let mut start = 0usize;
+        self.face_arities.iter().map(move |&n| {
+            let face = &self.face_indices[start..start + n as usize];
+            start += n as usize;
+            face
+        })
+    }
+
+    /// Number of faces.
+    pub fn face_count(&self) -> usize {
+        self.face_arities.len()
+    }
+}
