@@ -1,0 +1,70 @@
+//! Frame time of the renderer: a 100 × 100-particle cloth with every overlay at 1280 × 720
+//! on the software adapter (Mesa llvmpipe on a machine without GPU), including readback.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+
+use clothsim::mesh::{GridOrientation, GridSpec, MeshBuild};
+use clothsim::render::{AdapterPreference, Offscreen, RenderOptions, scene_camera};
+use clothsim::scene::{Scene, Simulation};
+
+fn render(c: &mut Criterion) {
+    let mesh = GridSpec::square(99, 1.0, GridOrientation::Horizontal, glam::Vec3::ZERO)
+        .build()
+        .expect("valid grid");
+    let scene = Scene::with_cloth(
+        "sphere-drop",
+        MeshBuild {
+            mesh,
+            warnings: Vec::new(),
+        },
+        "grid 100x100",
+    )
+    .expect("registered");
+    let mut sim = Simulation::new(scene);
+    sim.run(1.0);
+    let camera = scene_camera(&sim);
+    let mut off = Offscreen::new(1280, 720, AdapterPreference::Software).expect("software adapter");
+    let mut group = c.benchmark_group("render/1280x720/100x100");
+    group.sample_size(10);
+    for (name, overlays) in [
+        ("mesh", ""),
+        ("all-overlays", "springs,bend,particles,wireframe"),
+    ] {
+        let options = RenderOptions::default()
+            .with_overlays(overlays)
+            .expect("known overlays");
+        group.bench_function(name, |b| {
+            b.iter(|| off.render(&sim, &camera, &options).expect("render"))
+        });
+    }
+    // Draw only (no readback): what the GUI pays per frame.
+    let options = RenderOptions::default()
+        .with_overlays("springs,bend,particles,wireframe")
+        .expect("known");
+    group.bench_function("all-overlays-no-readback", |b| {
+        b.iter(|| {
+            let frame = clothsim::render::FrameInput {
+                model: &sim.scene.model,
+                positions: &sim.state.pos,
+                colliders: sim.stepper().colliders(),
+                time: sim.state.time,
+            };
+            off.renderer.render(
+                &off.gpu.device,
+                &off.gpu.queue,
+                &off.target,
+                &camera,
+                &frame,
+                &options,
+            );
+            off.gpu
+                .device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .expect("poll");
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, render);
+criterion_main!(benches);

@@ -1,0 +1,57 @@
+//! A GPU buffer that is written in place every frame and reallocated only when it must grow.
+
+use wgpu::util::DeviceExt;
+
+pub struct GrowBuffer {
+    label: &'static str,
+    usage: wgpu::BufferUsages,
+    buffer: wgpu::Buffer,
+    /// Bytes written by the last [`GrowBuffer::write`].
+    len: u64,
+}
+
+impl GrowBuffer {
+    pub fn new(
+        device: &wgpu::Device,
+        label: &'static str,
+        usage: wgpu::BufferUsages,
+        capacity: u64,
+    ) -> Self {
+        let usage = usage | wgpu::BufferUsages::COPY_DST;
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: capacity.max(256),
+            usage,
+            mapped_at_creation: false,
+        });
+        Self {
+            label,
+            usage,
+            buffer,
+            len: 0,
+        }
+    }
+
+    /// Uploads `data`; reallocates (to twice the need) only when it does not fit. Returns
+    /// whether the buffer was reallocated.
+    pub fn write(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, data: &[u8]) -> bool {
+        let needed = data.len() as u64;
+        let grew = needed > self.buffer.size();
+        if grew {
+            self.buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(self.label),
+                contents: &[data, &vec![0u8; data.len()]].concat(),
+                usage: self.usage,
+            });
+        } else if needed > 0 {
+            queue.write_buffer(&self.buffer, 0, data);
+        }
+        self.len = needed;
+        grew
+    }
+
+    /// The written bytes.
+    pub fn slice(&self) -> wgpu::BufferSlice<'_> {
+        self.buffer.slice(..self.len.max(1).min(self.buffer.size()))
+    }
+}

@@ -1,0 +1,97 @@
+//! Headless adapter and device selection.
+
+use super::error::RenderError;
+
+/// A wgpu instance, adapter, device and queue made without any window.
+pub struct Gpu {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+}
+
+/// Which adapter to prefer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AdapterPreference {
+    /// The software (CPU) adapter, for reproducible images in tests; any adapter if none.
+    Software,
+    /// Whatever the system offers first (a GPU when there is one).
+    Any,
+}
+
+impl Gpu {
+    /// Creates a device without a display handle. The backend can be pinned with the
+    /// `WGPU_BACKEND` environment variable; unpinned, [`AdapterPreference::Software`] tries
+    /// the GL backend (Mesa's llvmpipe) first, then every backend.
+    ///
+    /// # Errors
+    /// [`RenderError::NoAdapter`] with what was tried, or [`RenderError::Device`].
+    pub fn headless(preference: AdapterPreference) -> Result<Gpu, RenderError> {
+        let from_env = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        let pinned = std::env::var_os("WGPU_BACKEND").is_some();
+        let mut attempts = Vec::new();
+        if preference == AdapterPreference::Software && !pinned {
+            // Golden images depend on the rasteriser: prefer Mesa's llvmpipe through GL.
+            let mut gl = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+            gl.backends = wgpu::Backends::GL;
+            attempts.push(gl);
+        }
+        attempts.push(from_env);
+        let mut failures = Vec::new();
+        for desc in attempts {
+            let backends = desc.backends;
+            let instance = wgpu::Instance::new(desc);
+            match Self::pick(&instance, preference) {
+                Ok(adapter) => return Self::open(instance, adapter),
+                Err(e) => failures.push(format!("{backends:?}: {e}")),
+            }
+        }
+        Err(RenderError::NoAdapter {
+            detail: failures.join("; "),
+        })
+    }
+
+    fn pick(
+        instance: &wgpu::Instance,
+        preference: AdapterPreference,
+    ) -> Result<wgpu::Adapter, wgpu::RequestAdapterError> {
+        let request = |force_fallback_adapter: bool| {
+            pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                force_fallback_adapter,
+                ..Default::default()
+            }))
+        };
+        match preference {
+            AdapterPreference::Software => request(true).or_else(|_| request(false)),
+            AdapterPreference::Any => request(false).or_else(|_| request(true)),
+        }
+    }
+
+    fn open(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu, RenderError> {
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("clothsim device"),
+            required_features: wgpu::Features::empty(),
+            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::Device(e.to_string()))?;
+        Ok(Gpu {
+            instance,
+            adapter,
+            device,
+            queue,
+        })
+    }
+
+    /// "name (backend, device type)" of the adapter in use.
+    pub fn describe(&self) -> String {
+        describe_adapter(&self.adapter)
+    }
+}
+
+/// "name (backend, device type)" of an adapter.
+pub fn describe_adapter(adapter: &wgpu::Adapter) -> String {
+    let info = adapter.get_info();
+    format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type)
+}

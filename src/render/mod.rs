@@ -1,0 +1,23 @@
+//! Rendering with wgpu. Everything is drawn into an offscreen [`RenderTarget`]; the GUI shows
+//! its texture, capture reads it back, golden tests compare it.
+
+mod buffer;
+mod camera;
+mod capture;
+mod device;
+mod error;
+mod geometry;
+mod offscreen;
+mod options;
+mod pipelines;
+mod renderer;
+mod target;
+
+pub use camera::OrbitCamera;
+pub use capture::{RgbaImage, padded_bytes_per_row, read_target, save_png, strip_row_padding};
+pub use device::{AdapterPreference, Gpu, describe_adapter};
+pub use error::RenderError;
+pub use offscreen::{Offscreen, scene_camera};
+pub use options::{RenderOptions, SpringColoring};
+pub use renderer::{CLEAR_COLOR, FrameInput, Renderer, kind_color, strain_color};
+pub use target::{COLOR_FORMAT, DEPTH_FORMAT, RenderTarget, supported_sample_count};

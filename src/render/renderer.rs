@@ -1,0 +1,444 @@
+//! The renderer: owns pipelines and GPU buffers and draws a cloth frame into a
+//! [`RenderTarget`]. GUI, PNG capture and golden tests all come through [`Renderer::render`].
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Quat, Vec3};
+use wgpu::util::DeviceExt;
+
+use crate::cloth::ClothModel;
+use crate::mesh::{SpringKind, vertex_normals};
+use crate::sim::Collider;
+
+use super::buffer::GrowBuffer;
+use super::camera::OrbitCamera;
+use super::geometry::{ClothVertex, ColorVertex, SolidVertex, ground_quad, uv_sphere};
+use super::options::{RenderOptions, SpringColoring};
+use super::pipelines::Pipelines;
+use super::target::RenderTarget;
+
+/// Background, sRGB-encoded (it is written to the target as is): linear (0.10, 0.11, 0.13).
+pub const CLEAR_COLOR: wgpu::Color = wgpu::Color {
+    r: 0.349,
+    g: 0.366,
+    b: 0.396,
+    a: 1.0,
+};
+
+/// Half the side of the drawn ground square, metres.
+const GROUND_HALF_SIZE: f32 = 6.0;
+/// Grid spacing on the ground, metres.
+const GROUND_GRID: f32 = 0.25;
+
+/// One frame's worth of simulation data to draw.
+pub struct FrameInput<'a> {
+    pub model: &'a ClothModel,
+    /// Current particle positions, metres.
+    pub positions: &'a [Vec3],
+    pub colliders: &'a [Collider],
+    /// Simulated time, seconds (turns spinning spheres).
+    pub time: f64,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GlobalsRaw {
+    view_proj: [[f32; 4]; 4],
+    eye: [f32; 4],
+    light_dir: [f32; 4],
+    viewport: [f32; 4],
+    front_color: [f32; 4],
+    back_color: [f32; 4],
+    options: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct SolidRaw {
+    model: [[f32; 4]; 4],
+    color: [f32; 4],
+    pattern: [f32; 4],
+}
+
+/// A static indexed mesh (collider geometry).
+struct StaticMesh {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    count: u32,
+}
+
+impl StaticMesh {
+    fn new(device: &wgpu::Device, label: &str, (v, i): (Vec<SolidVertex>, Vec<u32>)) -> Self {
+        let init = |contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        Self {
+            vertices: init(bytemuck::cast_slice(&v), wgpu::BufferUsages::VERTEX),
+            indices: init(bytemuck::cast_slice(&i), wgpu::BufferUsages::INDEX),
+            count: i.len() as u32,
+        }
+    }
+}
+
+/// Per-collider uniform slot; slots are created when a scene has more colliders than before.
+struct SolidSlot {
+    buffer: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+}
+
+pub struct Renderer {
+    pipelines: Pipelines,
+    sample_count: u32,
+    globals: wgpu::Buffer,
+    globals_bind_group: wgpu::BindGroup,
+    cloth_vertices: GrowBuffer,
+    cloth_indices: GrowBuffer,
+    /// The triangles last uploaded; indices are re-uploaded only when they change.
+    uploaded_triangles: Vec<[u32; 3]>,
+    lines: GrowBuffer,
+    line_vertices: u32,
+    points: GrowBuffer,
+    point_count: u32,
+    sphere: StaticMesh,
+    ground: StaticMesh,
+    solids: Vec<SolidSlot>,
+    // Scratch reused every frame.
+    normals: Vec<Vec3>,
+    cloth_scratch: Vec<ClothVertex>,
+    line_scratch: Vec<ColorVertex>,
+    point_scratch: Vec<ColorVertex>,
+}
+
+impl Renderer {
+    /// Builds pipelines for targets with `sample_count` samples.
+    pub fn new(device: &wgpu::Device, sample_count: u32) -> Self {
+        let pipelines = Pipelines::new(device, sample_count);
+        let globals = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("clothsim globals"),
+            size: std::mem::size_of::<GlobalsRaw>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let globals_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("clothsim globals"),
+            layout: &pipelines.globals_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: globals.as_entire_binding(),
+            }],
+        });
+        let vertex = wgpu::BufferUsages::VERTEX;
+        Self {
+            sample_count,
+            globals,
+            globals_bind_group,
+            cloth_vertices: GrowBuffer::new(device, "clothsim cloth vertices", vertex, 1 << 16),
+            cloth_indices: GrowBuffer::new(
+                device,
+                "clothsim cloth indices",
+                wgpu::BufferUsages::INDEX,
+                1 << 16,
+            ),
+            uploaded_triangles: Vec::new(),
+            lines: GrowBuffer::new(device, "clothsim lines", vertex, 1 << 16),
+            line_vertices: 0,
+            points: GrowBuffer::new(device, "clothsim points", vertex, 1 << 14),
+            point_count: 0,
+            sphere: StaticMesh::new(device, "clothsim sphere", uv_sphere(32, 64)),
+            ground: StaticMesh::new(device, "clothsim ground", ground_quad(GROUND_HALF_SIZE)),
+            solids: Vec::new(),
+            pipelines,
+            normals: Vec::new(),
+            cloth_scratch: Vec::new(),
+            line_scratch: Vec::new(),
+            point_scratch: Vec::new(),
+        }
+    }
+
+    pub fn sample_count(&self) -> u32 {
+        self.sample_count
+    }
+
+    /// Uploads the frame and draws it into `target`, submitting one command buffer.
+    pub fn render(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        target: &RenderTarget,
+        camera: &OrbitCamera,
+        frame: &FrameInput<'_>,
+        options: &RenderOptions,
+    ) {
+        if target.sample_count() != self.sample_count {
+            // Only when a target of another sample count is used; not per frame.
+            *self = Renderer::new(device, target.sample_count());
+        }
+        let (width, height) = target.size();
+        self.upload_globals(queue, camera, width, height, options);
+        self.upload_cloth(device, queue, frame);
+        self.upload_lines(device, queue, frame, options);
+        self.upload_points(device, queue, frame, options);
+        let solids = if options.colliders {
+            self.upload_solids(device, queue, frame)
+        } else {
+            Vec::new()
+        };
+
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("clothsim frame"),
+        });
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("clothsim frame"),
+                color_attachments: &[Some(target.color_attachment(CLEAR_COLOR))],
+                depth_stencil_attachment: Some(target.depth_attachment()),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_bind_group(0, &self.globals_bind_group, &[]);
+            pass.set_pipeline(&self.pipelines.collider);
+            for (slot, is_sphere) in solids {
+                let mesh = if is_sphere {
+                    &self.sphere
+                } else {
+                    &self.ground
+                };
+                pass.set_bind_group(1, &self.solids[slot].bind_group, &[]);
+                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..mesh.count, 0, 0..1);
+            }
+            if options.mesh && !self.uploaded_triangles.is_empty() {
+                pass.set_pipeline(&self.pipelines.cloth);
+                pass.set_vertex_buffer(0, self.cloth_vertices.slice());
+                pass.set_index_buffer(self.cloth_indices.slice(), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..self.uploaded_triangles.len() as u32 * 3, 0, 0..1);
+            }
+            if self.line_vertices > 0 {
+                pass.set_pipeline(&self.pipelines.lines);
+                pass.set_vertex_buffer(0, self.lines.slice());
+                pass.draw(0..self.line_vertices, 0..1);
+            }
+            if self.point_count > 0 {
+                pass.set_pipeline(&self.pipelines.points);
+                pass.set_vertex_buffer(0, self.points.slice());
+                pass.draw(0..6, 0..self.point_count);
+            }
+        }
+        queue.submit([encoder.finish()]);
+    }
+
+    fn upload_globals(
+        &self,
+        queue: &wgpu::Queue,
+        camera: &OrbitCamera,
+        width: u32,
+        height: u32,
+        options: &RenderOptions,
+    ) {
+        let raw = GlobalsRaw {
+            view_proj: camera
+                .view_projection(width as f32 / height as f32)
+                .to_cols_array_2d(),
+            eye: camera.eye().extend(1.0).into(),
+            light_dir: Vec3::new(0.4, 1.0, 0.6).normalize().extend(0.0).into(),
+            viewport: [width as f32, height as f32, options.particle_size, 0.0],
+            front_color: options.front_color.extend(1.0).into(),
+            back_color: options.back_color.extend(1.0).into(),
+            options: [
+                f32::from(u8::from(options.checker)),
+                options.checker_scale,
+                0.28,
+                0.0,
+            ],
+        };
+        queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&raw));
+    }
+
+    fn upload_cloth(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, frame: &FrameInput<'_>) {
+        let model = frame.model;
+        if self.uploaded_triangles != model.triangles {
+            self.uploaded_triangles.clone_from(&model.triangles);
+            self.cloth_indices
+                .write(device, queue, bytemuck::cast_slice(&model.triangles));
+        }
+        vertex_normals(frame.positions, &model.triangles, &mut self.normals);
+        self.cloth_scratch.clear();
+        self.cloth_scratch.extend(
+            frame
+                .positions
+                .iter()
+                .zip(&self.normals)
+                .zip(&model.uvs)
+                .map(|((p, n), uv)| ClothVertex {
+                    position: p.to_array(),
+                    normal: n.to_array(),
+                    uv: uv.to_array(),
+                }),
+        );
+        self.cloth_vertices
+            .write(device, queue, bytemuck::cast_slice(&self.cloth_scratch));
+    }
+
+    fn upload_lines(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        frame: &FrameInput<'_>,
+        options: &RenderOptions,
+    ) {
+        let s = &frame.model.springs;
+        let pos = frame.positions;
+        let lines = &mut self.line_scratch;
+        lines.clear();
+        let mut push = |a: u32, b: u32, color: [f32; 4]| {
+            lines.push(ColorVertex {
+                position: pos[a as usize].to_array(),
+                color,
+            });
+            lines.push(ColorVertex {
+                position: pos[b as usize].to_array(),
+                color,
+            });
+        };
+        if options.wireframe {
+            for i in 0..s.len() {
+                if s.kind[i] != SpringKind::Bend {
+                    push(s.a[i], s.b[i], [0.02, 0.02, 0.03, 0.85]);
+                }
+            }
+        }
+        if options.springs {
+            for i in 0..s.len() {
+                let kind = s.kind[i];
+                if !options.spring_kinds[kind.index()] {
+                    continue;
+                }
+                let color = match options.spring_coloring {
+                    SpringColoring::ByKind => kind_color(kind),
+                    SpringColoring::ByStrain => {
+                        let len = pos[s.a[i] as usize].distance(pos[s.b[i] as usize]);
+                        strain_color((len - s.rest[i]) / s.rest[i].max(1e-9))
+                    }
+                };
+                push(s.a[i], s.b[i], color);
+            }
+        }
+        self.line_vertices = self.line_scratch.len() as u32;
+        self.lines
+            .write(device, queue, bytemuck::cast_slice(&self.line_scratch));
+    }
+
+    fn upload_points(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        frame: &FrameInput<'_>,
+        options: &RenderOptions,
+    ) {
+        self.point_scratch.clear();
+        if options.particles {
+            let w = &frame.model.inv_mass;
+            self.point_scratch
+                .extend(frame.positions.iter().zip(w).map(|(p, &w)| ColorVertex {
+                    position: p.to_array(),
+                    color: if w == 0.0 {
+                        [1.0, 0.05, 0.05, 1.0]
+                    } else {
+                        [1.0, 0.85, 0.15, 1.0]
+                    },
+                }));
+        }
+        self.point_count = self.point_scratch.len() as u32;
+        self.points
+            .write(device, queue, bytemuck::cast_slice(&self.point_scratch));
+    }
+
+    /// Writes one uniform slot per collider; returns `(slot, is_sphere)` in draw order.
+    fn upload_solids(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        frame: &FrameInput<'_>,
+    ) -> Vec<(usize, bool)> {
+        while self.solids.len() < frame.colliders.len() {
+            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("clothsim solid"),
+                size: std::mem::size_of::<SolidRaw>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("clothsim solid"),
+                layout: &self.pipelines.solid_layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: buffer.as_entire_binding(),
+                }],
+            });
+            self.solids.push(SolidSlot { buffer, bind_group });
+        }
+        let mut draws = Vec::with_capacity(frame.colliders.len());
+        for (slot, collider) in frame.colliders.iter().enumerate() {
+            let raw = match *collider {
+                Collider::Sphere {
+                    center,
+                    radius,
+                    spin,
+                    ..
+                } => {
+                    let angle = spin.length() * frame.time as f32;
+                    let rotation =
+                        Quat::from_axis_angle(spin.try_normalize().unwrap_or(Vec3::Y), angle);
+                    SolidRaw {
+                        model: Mat4::from_scale_rotation_translation(
+                            Vec3::splat(radius),
+                            rotation,
+                            center,
+                        )
+                        .to_cols_array_2d(),
+                        color: [0.30, 0.42, 0.62, 1.0],
+                        pattern: [0.0, 0.0, 0.0, 0.0],
+                    }
+                }
+                Collider::Plane { point, normal, .. } => SolidRaw {
+                    model: Mat4::from_rotation_translation(
+                        Quat::from_rotation_arc(Vec3::Y, normal.normalize()),
+                        point,
+                    )
+                    .to_cols_array_2d(),
+                    color: [0.55, 0.56, 0.58, 1.0],
+                    pattern: [1.0, GROUND_GRID, 0.0, 0.0],
+                },
+            };
+            queue.write_buffer(&self.solids[slot].buffer, 0, bytemuck::bytes_of(&raw));
+            draws.push((slot, matches!(collider, Collider::Sphere { .. })));
+        }
+        draws
+    }
+}
+
+/// Linear RGBA of a spring kind.
+pub fn kind_color(kind: SpringKind) -> [f32; 4] {
+    match kind {
+        SpringKind::Structural => [0.15, 0.45, 1.0, 1.0],
+        SpringKind::Shear => [0.1, 0.8, 0.2, 1.0],
+        SpringKind::Bend => [1.0, 0.45, 0.05, 1.0],
+    }
+}
+
+/// Linear RGBA for a strain (relative extension): grey at 0, red at ≥ +10 %, blue at ≤ −10 %.
+pub fn strain_color(strain: f32) -> [f32; 4] {
+    let t = (strain / 0.1).clamp(-1.0, 1.0);
+    let grey = Vec3::splat(0.45);
+    let c = if t >= 0.0 {
+        grey.lerp(Vec3::new(1.0, 0.08, 0.02), t)
+    } else {
+        grey.lerp(Vec3::new(0.05, 0.3, 1.0), -t)
+    };
+    c.extend(1.0).into()
+}
