@@ -143,13 +143,11 @@ fn main() {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        None => {
-            // Reserved for the GUI; until it exists, print help.
-            let _ = cli.obj;
-            use clap::CommandFactory;
-            Cli::command().print_help()?;
-            Ok(())
-        }
+        None => clothsim::app::run(cli.obj).map_err(|e| {
+            anyhow::anyhow!(
+                "cannot open the window: {e}. Headless use: `clothsim --help` lists the subcommands"
+            )
+        }),
         Some(Command::Info { file, json }) => info(&file, json),
         Some(Command::Scenes) => {
             for s in SCENARIOS {

@@ -1,0 +1,77 @@
+//! Work kept off the UI thread: importing OBJ files and writing PNG files.
+
+use std::path::PathBuf;
+use std::sync::mpsc::{Receiver, Sender, channel};
+
+use crate::mesh::{MeshBuild, ObjError, load_obj};
+use crate::render::{RenderError, RgbaImage, save_png};
+
+/// One OBJ import running on a worker thread.
+pub struct ObjLoad {
+    pub path: PathBuf,
+    rx: Receiver<Result<MeshBuild, ObjError>>,
+}
+
+impl ObjLoad {
+    pub fn start(path: PathBuf) -> Self {
+        let (tx, rx) = channel();
+        let worker_path = path.clone();
+        std::thread::spawn(move || {
+            let _ = tx.send(load_obj(&worker_path));
+        });
+        Self { path, rx }
+    }
+
+    /// The result once the worker is done.
+    pub fn poll(&self) -> Option<Result<MeshBuild, ObjError>> {
+        self.rx.try_recv().ok()
+    }
+
+    /// Blocks until the worker is done (for tests and shutdown).
+    pub fn wait(&self) -> Option<Result<MeshBuild, ObjError>> {
+        self.rx.recv().ok()
+    }
+}
+
+/// A PNG writer thread: images are encoded and written in order, results come back.
+pub struct PngWriter {
+    tx: Sender<(RgbaImage, PathBuf)>,
+    rx: Receiver<(PathBuf, Result<(), RenderError>)>,
+    pending: usize,
+}
+
+impl Default for PngWriter {
+    fn default() -> Self {
+        let (tx, jobs) = channel::<(RgbaImage, PathBuf)>();
+        let (done, rx) = channel();
+        std::thread::spawn(move || {
+            for (image, path) in jobs {
+                let result = save_png(&image, &path);
+                if done.send((path, result)).is_err() {
+                    break;
+                }
+            }
+        });
+        Self { tx, rx, pending: 0 }
+    }
+}
+
+impl PngWriter {
+    pub fn submit(&mut self, image: RgbaImage, path: PathBuf) {
+        if self.tx.send((image, path)).is_ok() {
+            self.pending += 1;
+        }
+    }
+
+    /// Files written (or failed) since the last call.
+    pub fn finished(&mut self) -> Vec<(PathBuf, Result<(), RenderError>)> {
+        let done: Vec<_> = self.rx.try_iter().collect();
+        self.pending -= done.len().min(self.pending);
+        done
+    }
+
+    /// Images not yet written.
+    pub fn pending(&self) -> usize {
+        self.pending
+    }
+}

@@ -1,0 +1,464 @@
+//! The desktop application: state, actions, and the per-frame flow.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use crate::mesh::{self, MeshBuild};
+use crate::render::{OrbitCamera, RenderOptions, scene_camera};
+use crate::scene::{DEFAULT_CLOTH_NAME, DEFAULT_CLOTH_OBJ, Scene, Simulation};
+use crate::sim::{FrameOutcome, PhaseTimings};
+
+use super::background::{ObjLoad, PngWriter};
+use super::transport::{STEP_BUDGET_SECONDS, Transport};
+use super::viewport::{Viewport, camera_input};
+
+/// How serious a status message is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Level {
+    Info,
+    Warning,
+    Error,
+}
+
+/// A message shown in the status area.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Message {
+    pub level: Level,
+    pub text: String,
+}
+
+/// Smoothed per-frame statistics.
+#[derive(Clone, Debug, Default)]
+pub struct Stats {
+    /// UI frames per second.
+    pub fps: f64,
+    /// Milliseconds of simulation per simulated frame, by phase.
+    pub phase_ms: Vec<(&'static str, f64)>,
+    /// Simulated frames stepped in the last UI frame.
+    pub frames_last_update: u32,
+}
+
+/// The eframe application.
+pub struct ClothApp {
+    pub sim: Simulation,
+    /// The cloth in use, unplaced, so a scenario switch can place it again.
+    cloth: MeshBuild,
+    cloth_name: String,
+    pub transport: Transport,
+    pub camera: OrbitCamera,
+    pub options: RenderOptions,
+    render_state: Option<egui_wgpu::RenderState>,
+    viewport: Option<Viewport>,
+    loading: Option<ObjLoad>,
+    writer: PngWriter,
+    /// Where captures and recordings go.
+    pub capture_dir: PathBuf,
+    capture_requested: bool,
+    /// Next frame number while recording.
+    recording: Option<(PathBuf, u64)>,
+    captures: u64,
+    pub messages: Vec<Message>,
+    pub stats: Stats,
+    last_update: Option<Instant>,
+    /// Text of the "open OBJ" path field.
+    pub open_path: String,
+}
+
+impl ClothApp {
+    /// Creates the app on the GUI's wgpu device (`None` shows no 3D view, e.g. without a GPU
+    /// renderer), starting with `obj` if given.
+    pub fn new(render_state: Option<egui_wgpu::RenderState>, obj: Option<&Path>) -> Self {
+        let cloth = mesh::obj_from_str(DEFAULT_CLOTH_OBJ, DEFAULT_CLOTH_NAME).unwrap_or_else(|e| {
+            // The asset is compiled in and tested; this cannot fail at run time.
+            unreachable!("built-in cloth asset is invalid: {e}")
+        });
+        let scene = Scene::with_cloth("hanging", cloth.clone(), DEFAULT_CLOTH_NAME)
+            .unwrap_or_else(|e| unreachable!("{e}"));
+        let sim = Simulation::new(scene);
+        let camera = scene_camera(&sim);
+        let mut app = Self {
+            sim,
+            cloth,
+            cloth_name: DEFAULT_CLOTH_NAME.to_string(),
+            transport: Transport::default(),
+            camera,
+            options: RenderOptions::default(),
+            render_state,
+            viewport: None,
+            loading: None,
+            writer: PngWriter::default(),
+            capture_dir: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
+            capture_requested: false,
+            recording: None,
+            captures: 0,
+            messages: Vec::new(),
+            stats: Stats::default(),
+            last_update: None,
+            open_path: String::new(),
+        };
+        if app.render_state.is_none() {
+            app.message(
+                Level::Warning,
+                "no wgpu renderer: the 3D view and capture are unavailable".into(),
+            );
+        }
+        if let Some(path) = obj {
+            app.open_obj(path.to_path_buf());
+        }
+        app
+    }
+
+    pub fn message(&mut self, level: Level, text: String) {
+        match level {
+            Level::Error => log::error!("{text}"),
+            Level::Warning => log::warn!("{text}"),
+            Level::Info => log::info!("{text}"),
+        }
+        self.messages.push(Message { level, text });
+        if self.messages.len() > 50 {
+            self.messages.remove(0);
+        }
+    }
+
+    /// The last error message, if any.
+    pub fn last_error(&self) -> Option<&str> {
+        self.messages
+            .iter()
+            .rev()
+            .find(|m| m.level == Level::Error)
+            .map(|m| m.text.as_str())
+    }
+
+    pub fn cloth_name(&self) -> &str {
+        &self.cloth_name
+    }
+
+    pub fn is_loading(&self) -> bool {
+        self.loading.is_some()
+    }
+
+    /// Switches scenario, keeping the current cloth. Parameters and effects become the
+    /// scenario's; the camera frames the new scene.
+    pub fn set_scenario(&mut self, name: &str) {
+        match Scene::with_cloth(name, self.cloth.clone(), &self.cloth_name) {
+            Ok(scene) => {
+                self.sim = Simulation::new(scene);
+                self.camera = scene_camera(&self.sim);
+                self.recording = None;
+            }
+            Err(e) => self.message(Level::Error, e.to_string()),
+        }
+    }
+
+    /// Starts importing an OBJ in the background; the current cloth stays until it succeeds.
+    pub fn open_obj(&mut self, path: PathBuf) {
+        self.message(Level::Info, format!("loading {} …", path.display()));
+        self.loading = Some(ObjLoad::start(path));
+    }
+
+    /// Waits for a running import (tests, or when the caller must know the outcome).
+    pub fn finish_loading(&mut self) {
+        if let Some(load) = self.loading.take()
+            && let Some(result) = load.wait()
+        {
+            self.apply_loaded(&load.path, result);
+        }
+    }
+
+    fn poll_loading(&mut self) {
+        let Some(load) = &self.loading else { return };
+        let Some(result) = load.poll() else { return };
+        let path = load.path.clone();
+        self.loading = None;
+        self.apply_loaded(&path, result);
+    }
+
+    /// A new cloth keeps the scenario, its effects and the current parameters.
+    fn apply_loaded(&mut self, path: &Path, result: Result<MeshBuild, mesh::ObjError>) {
+        let build = match result {
+            Ok(b) => b,
+            Err(e) => {
+                self.message(Level::Error, format!("{e} — the current cloth is kept"));
+                return;
+            }
+        };
+        let name = path.display().to_string();
+        match Scene::with_cloth(self.sim.scene.scenario, build.clone(), &name) {
+            Ok(mut scene) => {
+                scene.params = self.sim.scene.params.clone();
+                scene.model.set_density(scene.params.density);
+                scene.effects = self.sim.scene.effects.clone();
+                for w in &scene.warnings {
+                    self.messages.push(Message {
+                        level: Level::Warning,
+                        text: format!("{name}: {w}"),
+                    });
+                }
+                let pins_enabled = self.sim.scene.pins_enabled;
+                scene.set_pins_enabled(pins_enabled);
+                self.message(
+                    Level::Info,
+                    format!(
+                        "loaded {name}: {} particles, {} triangles",
+                        scene.model.particle_count(),
+                        scene.model.triangles.len()
+                    ),
+                );
+                self.cloth = build;
+                self.cloth_name = name;
+                self.sim = Simulation::new(scene);
+                self.camera = scene_camera(&self.sim);
+            }
+            Err(e) => self.message(Level::Error, e.to_string()),
+        }
+    }
+
+    /// Back to the built-in cloth.
+    pub fn use_default_cloth(&mut self) {
+        if let Ok(build) = mesh::obj_from_str(DEFAULT_CLOTH_OBJ, DEFAULT_CLOTH_NAME) {
+            self.cloth = build;
+            self.cloth_name = DEFAULT_CLOTH_NAME.to_string();
+            let scenario = self.sim.scene.scenario;
+            self.set_scenario(scenario);
+        }
+    }
+
+    pub fn reset(&mut self) {
+        self.sim.reset();
+    }
+
+    /// Pauses and advances exactly one simulation frame.
+    pub fn step_once(&mut self) {
+        self.transport.pause();
+        self.advance(1);
+    }
+
+    /// Steps up to `frames` frames within the wall-clock budget; returns how many ran.
+    fn advance(&mut self, frames: u32) -> u32 {
+        let start = Instant::now();
+        let mut done = 0;
+        while done < frames {
+            match self.sim.step_frame() {
+                Ok(FrameOutcome::Stepped) => {}
+                Ok(FrameOutcome::Refined { from, to }) => self.message(
+                    Level::Warning,
+                    format!("the step diverged and was redone: substeps raised from {from} to {to} per frame"),
+                ),
+                Err(e) => {
+                    self.transport.pause();
+                    self.message(Level::Error, format!("{e} Paused."));
+                    break;
+                }
+            }
+            done += 1;
+            if start.elapsed().as_secs_f64() > STEP_BUDGET_SECONDS {
+                break;
+            }
+        }
+        if done > 0 {
+            let timings = self.sim.take_timings();
+            self.record_timings(timings, done);
+        }
+        done
+    }
+
+    fn record_timings(&mut self, timings: PhaseTimings, frames: u32) {
+        let new: Vec<(&'static str, f64)> = timings
+            .entries()
+            .iter()
+            .map(|(name, d)| (*name, d.as_secs_f64() * 1e3 / frames as f64))
+            .collect();
+        // Exponential smoothing so the numbers are readable; phases that stopped running vanish.
+        let old = std::mem::take(&mut self.stats.phase_ms);
+        self.stats.phase_ms = new
+            .into_iter()
+            .map(|(name, ms)| {
+                let prev = old.iter().find(|(n, _)| *n == name).map_or(ms, |(_, p)| *p);
+                (name, 0.8 * prev + 0.2 * ms)
+            })
+            .collect();
+    }
+
+    /// Captures the next drawn frame to a PNG in [`ClothApp::capture_dir`].
+    pub fn request_capture(&mut self) {
+        self.capture_requested = true;
+    }
+
+    /// Starts or stops writing every drawn frame to a new numbered folder.
+    pub fn toggle_recording(&mut self) {
+        if let Some((dir, n)) = self.recording.take() {
+            self.message(
+                Level::Info,
+                format!("recorded {n} frames to {}", dir.display()),
+            );
+            return;
+        }
+        let dir = next_free(&self.capture_dir, "clothsim-recording", "");
+        match std::fs::create_dir_all(&dir) {
+            Ok(()) => {
+                self.message(Level::Info, format!("recording to {}", dir.display()));
+                self.recording = Some((dir, 0));
+            }
+            Err(e) => self.message(
+                Level::Error,
+                format!("{}: cannot create folder: {e}", dir.display()),
+            ),
+        }
+    }
+
+    pub fn is_recording(&self) -> bool {
+        self.recording.is_some()
+    }
+
+    /// Images queued for writing.
+    pub fn pending_writes(&self) -> usize {
+        self.writer.pending()
+    }
+
+    /// Collects finished PNG writes into messages.
+    fn poll_writes(&mut self) {
+        let recording_dir = self.recording.as_ref().map(|(dir, _)| dir.clone());
+        for (path, result) in self.writer.finished() {
+            match result {
+                // Recorded frames are summarised when recording stops.
+                Ok(()) if recording_dir.as_ref().is_some_and(|d| path.starts_with(d)) => {}
+                Ok(()) => self.message(Level::Info, format!("saved {}", path.display())),
+                Err(e) => {
+                    self.recording = None;
+                    self.message(Level::Error, e.to_string());
+                }
+            }
+        }
+    }
+
+    /// Draws the 3D view into the available space and handles capture.
+    fn viewport_ui(&mut self, ui: &mut egui::Ui) {
+        let Some(rs) = self.render_state.clone() else {
+            ui.centered_and_justified(|ui| ui.label("No wgpu renderer: 3D view unavailable."));
+            return;
+        };
+        let size = ui.available_size();
+        let ppp = ui.ctx().pixels_per_point();
+        let (w, h) = (
+            ((size.x * ppp).round() as u32).max(1),
+            ((size.y * ppp).round() as u32).max(1),
+        );
+        if self.viewport.is_none() {
+            match Viewport::new(&rs, w, h) {
+                Ok(v) => self.viewport = Some(v),
+                Err(e) => {
+                    ui.label(format!("3D view unavailable: {e}"));
+                    return;
+                }
+            }
+        }
+        let Some(viewport) = self.viewport.as_mut() else {
+            return;
+        };
+        if let Err(e) = viewport.draw(&rs, w, h, &self.sim, &self.camera, &self.options) {
+            ui.label(format!("3D view: {e}"));
+            return;
+        }
+        let texture = viewport.texture();
+        let response = ui.add(
+            egui::Image::from_texture(egui::load::SizedTexture::new(texture, size))
+                .sense(egui::Sense::click_and_drag()),
+        );
+        if camera_input(ui, &response, &mut self.camera).reset {
+            self.camera = scene_camera(&self.sim);
+        }
+        let capture = std::mem::take(&mut self.capture_requested);
+        if capture || self.recording.is_some() {
+            match viewport.read(&rs) {
+                Ok(image) => {
+                    if capture {
+                        let path = next_free(&self.capture_dir, "clothsim-capture", ".png");
+                        self.captures += 1;
+                        self.writer.submit(image.clone(), path);
+                    }
+                    if let Some((dir, n)) = &mut self.recording {
+                        self.writer
+                            .submit(image, dir.join(format!("frame_{n:05}.png")));
+                        *n += 1;
+                    }
+                }
+                Err(e) => self.message(Level::Error, e.to_string()),
+            }
+        }
+    }
+
+    /// One UI frame: input, simulation, panels, viewport.
+    pub fn frame_ui(&mut self, ui: &mut egui::Ui) {
+        let now = Instant::now();
+        let wall_dt = self
+            .last_update
+            .map_or(0.0, |t| now.duration_since(t).as_secs_f64());
+        self.last_update = Some(now);
+        if wall_dt > 0.0 {
+            self.stats.fps = 0.9 * self.stats.fps + 0.1 / wall_dt;
+        }
+
+        let dropped: Vec<PathBuf> = ui.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_path_buf())
+                .collect()
+        });
+        if let Some(path) = dropped.into_iter().next() {
+            self.open_obj(path);
+        }
+        self.poll_loading();
+        self.poll_writes();
+
+        let due = self
+            .transport
+            .credit(wall_dt, self.sim.scene.params.dt as f64);
+        let done = if due > 0 { self.advance(due) } else { 0 };
+        self.transport.stepped(due, done);
+        self.stats.frames_last_update = done;
+
+        egui::Panel::top("transport").show(ui, |ui| super::controls::transport_bar(ui, self));
+        egui::Panel::bottom("status").show(ui, |ui| super::controls::status_bar(ui, self));
+        egui::Panel::left("controls")
+            .resizable(true)
+            .default_size(300.0)
+            .show(ui, |ui| super::controls::side_panel(ui, self));
+        egui::CentralPanel::no_frame().show(ui, |ui| self.viewport_ui(ui));
+
+        let hovering = ui.input(|i| !i.raw.hovered_files.is_empty());
+        if hovering {
+            super::controls::drop_hint(ui);
+        }
+        if self.transport.playing || self.loading.is_some() || self.writer.pending() > 0 {
+            ui.ctx().request_repaint();
+        } else {
+            ui.ctx().request_repaint_after(Duration::from_millis(250));
+        }
+    }
+
+    /// Frees GPU resources registered with egui.
+    pub fn shutdown(&mut self) {
+        if let (Some(v), Some(rs)) = (self.viewport.take(), &self.render_state) {
+            v.free(rs);
+        }
+    }
+}
+
+impl eframe::App for ClothApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.frame_ui(ui);
+    }
+
+    fn on_exit(&mut self) {
+        self.shutdown();
+    }
+}
+
+/// `dir/prefix-NNNN<suffix>` with the first number not yet taken.
+fn next_free(dir: &Path, prefix: &str, suffix: &str) -> PathBuf {
+    (1..)
+        .map(|n| dir.join(format!("{prefix}-{n:04}{suffix}")))
+        .find(|p| !p.exists())
+        .unwrap_or_else(|| dir.join(format!("{prefix}{suffix}")))
+}

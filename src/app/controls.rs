@@ -1,0 +1,354 @@
+//! The panels: transport bar, parameter side panel, status bar.
+
+use egui::{RichText, Slider};
+
+use crate::mesh::SpringKind;
+use crate::render::SpringColoring;
+use crate::scene::SCENARIOS;
+use crate::sim::{Collider, Effect, IntegratorKind};
+
+use super::cloth_app::{ClothApp, Level};
+
+pub fn transport_bar(ui: &mut egui::Ui, app: &mut ClothApp) {
+    ui.horizontal(|ui| {
+        let label = if app.transport.playing {
+            "Pause"
+        } else {
+            "Play"
+        };
+        if ui.button(label).on_hover_text("Space").clicked() {
+            if app.transport.playing {
+                app.transport.pause();
+            } else {
+                app.transport.playing = true;
+            }
+        }
+        if ui
+            .button("Step")
+            .on_hover_text("Pause and advance one frame")
+            .clicked()
+        {
+            app.step_once();
+        }
+        if ui.button("Reset").clicked() {
+            app.reset();
+        }
+        ui.separator();
+        ui.add(
+            Slider::new(&mut app.transport.speed, 0.05..=4.0)
+                .logarithmic(true)
+                .suffix("×")
+                .text("speed"),
+        );
+        ui.separator();
+        if ui.button("Capture PNG").clicked() {
+            app.request_capture();
+        }
+        let record = if app.is_recording() {
+            "Stop recording"
+        } else {
+            "Record"
+        };
+        if ui.button(record).clicked() {
+            app.toggle_recording();
+        }
+        if app.transport.behind {
+            ui.separator();
+            ui.label(
+                RichText::new("running slower than real time")
+                    .color(egui::Color32::from_rgb(230, 160, 40)),
+            );
+        }
+    });
+    if ui.input(|i| i.key_pressed(egui::Key::Space)) && !ui.ctx().egui_wants_keyboard_input() {
+        if app.transport.playing {
+            app.transport.pause();
+        } else {
+            app.transport.playing = true;
+        }
+    }
+}
+
+pub fn status_bar(ui: &mut egui::Ui, app: &mut ClothApp) {
+    ui.horizontal_wrapped(|ui| {
+        let sim = &app.sim;
+        ui.label(format!("{:.0} fps", app.stats.fps));
+        ui.separator();
+        ui.label(format!("t = {:.2} s", sim.state.time));
+        ui.separator();
+        ui.label(format!(
+            "{} particles · {} springs · {} bend",
+            sim.scene.model.particle_count(),
+            sim.scene.model.edge_count(),
+            sim.scene.model.springs.count(SpringKind::Bend)
+        ));
+        ui.separator();
+        ui.label(format!(
+            "KE {:.3e} J",
+            sim.state.kinetic_energy(&sim.scene.model)
+        ));
+        ui.separator();
+        let phases: Vec<String> = app
+            .stats
+            .phase_ms
+            .iter()
+            .map(|(n, ms)| format!("{n} {ms:.2}"))
+            .collect();
+        ui.label(format!(
+            "ms/frame: {}",
+            if phases.is_empty() {
+                "—".into()
+            } else {
+                phases.join(" · ")
+            }
+        ));
+        if app.is_loading() {
+            ui.separator();
+            ui.spinner();
+            ui.label("loading…");
+        }
+    });
+    if let Some(m) = app.messages.last().cloned() {
+        let color = match m.level {
+            Level::Info => ui.visuals().text_color(),
+            Level::Warning => egui::Color32::from_rgb(230, 160, 40),
+            Level::Error => egui::Color32::from_rgb(240, 80, 70),
+        };
+        ui.horizontal(|ui| {
+            ui.label(RichText::new(&m.text).color(color));
+            if ui.small_button("Dismiss").clicked() {
+                app.messages.clear();
+            }
+        });
+    }
+}
+
+pub fn drop_hint(ui: &mut egui::Ui) {
+    let rect = ui.ctx().content_rect();
+    ui.painter()
+        .rect_filled(rect, 0.0, egui::Color32::from_black_alpha(160));
+    ui.painter().text(
+        rect.center(),
+        egui::Align2::CENTER_CENTER,
+        "Drop an OBJ to use it as the cloth",
+        egui::FontId::proportional(24.0),
+        egui::Color32::WHITE,
+    );
+}
+
+pub fn side_panel(ui: &mut egui::Ui, app: &mut ClothApp) {
+    egui::ScrollArea::vertical().show(ui, |ui| {
+        scenario_section(ui, app);
+        solver_section(ui, app);
+        material_section(ui, app);
+        collider_section(ui, app);
+        render_section(ui, app);
+    });
+}
+
+fn scenario_section(ui: &mut egui::Ui, app: &mut ClothApp) {
+    ui.heading("Scenario");
+    let current = app.sim.scene.scenario;
+    for s in SCENARIOS {
+        if ui
+            .selectable_label(current == s.name, s.name)
+            .on_hover_text(s.summary)
+            .clicked()
+            && current != s.name
+        {
+            app.set_scenario(s.name);
+        }
+    }
+    ui.add_space(4.0);
+    ui.label(format!("Cloth: {}", app.cloth_name()));
+    ui.horizontal(|ui| {
+        ui.add(
+            egui::TextEdit::singleline(&mut app.open_path)
+                .hint_text("path/to/cloth.obj")
+                .desired_width(170.0),
+        );
+        if ui.button("Open").clicked() && !app.open_path.trim().is_empty() {
+            let path = std::path::PathBuf::from(app.open_path.trim());
+            app.open_obj(path);
+        }
+    });
+    ui.horizontal(|ui| {
+        ui.label(RichText::new("or drop an OBJ on the window").weak());
+        if ui.small_button("Default cloth").clicked() {
+            app.use_default_cloth();
+        }
+    });
+    let mut pins = app.sim.scene.pins_enabled;
+    if !app.sim.scene.pins.is_empty() && ui.checkbox(&mut pins, "Pins").changed() {
+        app.sim.scene.set_pins_enabled(pins);
+        for &p in &app.sim.scene.model.pins {
+            app.sim.state.vel[p as usize] = glam::Vec3::ZERO;
+        }
+    }
+    ui.separator();
+}
+
+fn solver_section(ui: &mut egui::Ui, app: &mut ClothApp) {
+    ui.heading("Solver");
+    let mut changed = false;
+    let params = &mut app.sim.scene.params;
+    for kind in IntegratorKind::ALL {
+        changed |= ui
+            .radio_value(&mut params.integrator, kind, kind.label())
+            .changed();
+    }
+    egui::Grid::new("solver").num_columns(2).show(ui, |ui| {
+        let label = ui.label("Time step");
+        changed |= ui
+            .add(
+                egui::DragValue::new(&mut params.dt)
+                    .range(1e-4..=0.1)
+                    .speed(1e-4)
+                    .suffix(" s")
+                    .max_decimals(5),
+            )
+            .labelled_by(label.id)
+            .changed();
+        ui.end_row();
+        let label = ui.label("Substeps");
+        changed |= ui
+            .add(egui::DragValue::new(&mut params.substeps).range(1..=2000))
+            .labelled_by(label.id)
+            .changed();
+        ui.end_row();
+        ui.label("Substep");
+        ui.label(format!("{:.3} ms", 1e3 * params.h()));
+        ui.end_row();
+    });
+    if changed {
+        app.sim.rebuild_stepper();
+    }
+    ui.separator();
+}
+
+fn material_section(ui: &mut egui::Ui, app: &mut ClothApp) {
+    ui.heading("Material");
+    let mut changed = false;
+    let mut density = app.sim.scene.params.density;
+    let params = &mut app.sim.scene.params;
+    for kind in SpringKind::ALL {
+        let k = kind.index();
+        let stiffness = Slider::new(&mut params.stiffness[k], 0.0..=5000.0)
+            .logarithmic(true)
+            .suffix(" N/m")
+            .text(format!("{} stiffness", kind.name()));
+        changed |= ui.add(stiffness).changed();
+        let damping = Slider::new(&mut params.damping[k], 0.0..=2.0)
+            .logarithmic(true)
+            .suffix(" N·s/m")
+            .text(format!("{} damping", kind.name()));
+        changed |= ui.add(damping).changed();
+    }
+    let density_slider = Slider::new(&mut density, 0.01..=5.0)
+        .logarithmic(true)
+        .suffix(" kg/m²")
+        .text("density");
+    ui.add(density_slider);
+    let gravity = Slider::new(&mut params.gravity.y, -30.0..=0.0)
+        .suffix(" m/s²")
+        .text("gravity");
+    changed |= ui.add(gravity).changed();
+    let air = Slider::new(&mut params.air_damping, 0.0..=5.0)
+        .suffix(" 1/s")
+        .text("air damping");
+    changed |= ui.add(air).changed();
+    if density != app.sim.scene.params.density {
+        app.sim.scene.set_density(density);
+        changed = true;
+    }
+    if changed {
+        app.sim.rebuild_stepper();
+    }
+    ui.separator();
+}
+
+fn collider_section(ui: &mut egui::Ui, app: &mut ClothApp) {
+    let mut changed = false;
+    let colliders = app.sim.scene.effects.iter_mut().filter_map(|e| match e {
+        Effect::Collider(c) => Some(c),
+        _ => None,
+    });
+    let mut any = false;
+    for collider in colliders {
+        if !any {
+            ui.heading("Colliders");
+            any = true;
+        }
+        match collider {
+            Collider::Sphere {
+                radius,
+                spin,
+                friction,
+                ..
+            } => {
+                ui.label("Sphere");
+                let mut rate = spin.length();
+                let axis = spin.try_normalize().unwrap_or(glam::Vec3::Y);
+                changed |= ui
+                    .add(Slider::new(radius, 0.05..=2.0).text("radius m"))
+                    .changed();
+                if ui
+                    .add(Slider::new(&mut rate, -10.0..=10.0).text("spin rad/s"))
+                    .changed()
+                {
+                    *spin = axis * rate;
+                    changed = true;
+                }
+                changed |= ui
+                    .add(Slider::new(friction, 0.0..=2.0).text("friction μ"))
+                    .changed();
+            }
+            Collider::Plane { friction, .. } => {
+                ui.label("Ground");
+                changed |= ui
+                    .add(Slider::new(friction, 0.0..=2.0).text("friction μ"))
+                    .changed();
+            }
+        }
+    }
+    if changed {
+        app.sim.rebuild_stepper();
+    }
+    if any {
+        ui.separator();
+    }
+}
+
+fn render_section(ui: &mut egui::Ui, app: &mut ClothApp) {
+    ui.heading("View");
+    let o = &mut app.options;
+    ui.checkbox(&mut o.mesh, "Mesh");
+    ui.checkbox(&mut o.checker, "Checker");
+    ui.checkbox(&mut o.wireframe, "Wireframe");
+    ui.checkbox(&mut o.springs, "Springs");
+    ui.add_enabled_ui(o.springs, |ui| {
+        ui.horizontal(|ui| {
+            ui.radio_value(&mut o.spring_coloring, SpringColoring::ByKind, "by kind");
+            ui.radio_value(
+                &mut o.spring_coloring,
+                SpringColoring::ByStrain,
+                "by strain",
+            );
+        });
+        ui.horizontal(|ui| {
+            for kind in SpringKind::ALL {
+                ui.checkbox(&mut o.spring_kinds[kind.index()], kind.name());
+            }
+        });
+    });
+    ui.checkbox(&mut o.particles, "Particles");
+    ui.checkbox(&mut o.colliders, "Colliders");
+    if ui
+        .button("Reset view")
+        .on_hover_text("or double-click the view")
+        .clicked()
+    {
+        app.camera = crate::render::scene_camera(&app.sim);
+    }
+    ui.label(RichText::new("drag: orbit · shift/middle-drag: pan · wheel: zoom").weak());
+}

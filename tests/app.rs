@@ -1,0 +1,163 @@
+//! The desktop app driven through its UI with egui_kittest on the software wgpu adapter:
+//! the same panels, viewport and capture path a user gets.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+
+use clothsim::app::ClothApp;
+use clothsim::mesh::{GridOrientation, GridSpec};
+
+fn harness() -> Harness<'static, ClothApp> {
+    let mut harness = Harness::builder()
+        .with_size([1280.0, 800.0])
+        .wgpu()
+        .build_eframe(|cc| {
+            let mut app = ClothApp::new(cc.wgpu_render_state.clone(), None);
+            // Deterministic: nothing advances unless a test asks.
+            app.transport.pause();
+            app
+        });
+    harness.run_steps(2);
+    harness
+}
+
+#[derive(Debug)]
+struct Dropped(PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+/// Drops `path` on the window, waits for the background import, and lets the UI catch up.
+fn drop_file(harness: &mut Harness<'static, ClothApp>, path: &Path) {
+    harness
+        .input_mut()
+        .dropped_files
+        .push(Arc::new(Dropped(path.to_path_buf())));
+    harness.run_steps(1);
+    assert!(
+        harness.state().is_loading(),
+        "a drop starts a background import"
+    );
+    harness.state_mut().finish_loading();
+    harness.run_steps(2);
+}
+
+#[test]
+fn switching_scenario_rebuilds_the_cloth() {
+    let mut harness = harness();
+    assert_eq!(harness.state().sim.scene.scenario, "hanging");
+    assert!(harness.state().sim.stepper().colliders().is_empty());
+    harness.get_by_label("sphere-drop").click();
+    harness.run_steps(2);
+    let sim = &harness.state().sim;
+    assert_eq!(sim.scene.scenario, "sphere-drop");
+    assert_eq!(sim.stepper().colliders().len(), 2, "sphere and ground");
+    assert!(sim.scene.model.pins.is_empty(), "sphere-drop pins nothing");
+    assert_eq!(sim.frames, 0, "a new scene starts from its initial state");
+}
+
+#[test]
+fn dropping_a_valid_obj_changes_the_particle_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("small.obj");
+    std::fs::write(
+        &path,
+        GridSpec::square(8, 0.6, GridOrientation::Horizontal, glam::Vec3::ZERO).to_obj(),
+    )
+    .unwrap();
+    let mut harness = harness();
+    harness.get_by_label("rotating-sphere").click();
+    harness.run_steps(1);
+    assert_eq!(harness.state().sim.scene.model.particle_count(), 625);
+    drop_file(&mut harness, &path);
+    let app = harness.state();
+    assert_eq!(app.sim.scene.model.particle_count(), 81);
+    assert_eq!(
+        app.sim.scene.scenario, "rotating-sphere",
+        "the new cloth keeps the scenario"
+    );
+    assert_eq!(app.sim.stepper().colliders().len(), 2, "and its effects");
+    assert!(app.cloth_name().ends_with("small.obj"));
+}
+
+#[test]
+fn dropping_a_malformed_obj_shows_an_error_and_keeps_the_cloth() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("broken.obj");
+    std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n").unwrap();
+    let mut harness = harness();
+    let before = harness.state().sim.scene.model.particle_count();
+    drop_file(&mut harness, &path);
+    let error = harness
+        .state()
+        .last_error()
+        .expect("an error message")
+        .to_string();
+    assert!(
+        error.contains("broken.obj") && error.contains(":4:"),
+        "{error}"
+    );
+    assert_eq!(harness.state().sim.scene.model.particle_count(), before);
+    // The user sees it.
+    harness.get_by_label_contains("broken.obj:4:");
+}
+
+#[test]
+fn pause_and_step_advances_exactly_one_frame() {
+    let mut harness = harness();
+    let dt = harness.state().sim.scene.params.dt as f64;
+    assert_eq!(harness.state().sim.frames, 0);
+    harness.get_by_label("Step").click();
+    harness.run_steps(3);
+    assert_eq!(harness.state().sim.frames, 1);
+    assert!((harness.state().sim.state.time - dt).abs() < 1e-9);
+    assert!(!harness.state().transport.playing);
+    harness.get_by_label("Step").click();
+    harness.run_steps(3);
+    assert_eq!(harness.state().sim.frames, 2);
+    harness.get_by_label("Reset").click();
+    harness.run_steps(1);
+    assert_eq!(harness.state().sim.frames, 0);
+    assert_eq!(harness.state().sim.state.time, 0.0);
+}
+
+#[test]
+fn capture_button_writes_a_png_of_the_view() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut harness = harness();
+    harness.state_mut().capture_dir = dir.path().to_path_buf();
+    harness.get_by_label("Capture PNG").click();
+    harness.run_steps(2);
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while harness.state().pending_writes() > 0 && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(20));
+        harness.run_steps(1);
+    }
+    let path = dir.path().join("clothsim-capture-0001.png");
+    let image = image::open(&path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgba8();
+    assert!(
+        image.width() > 400 && image.height() > 300,
+        "the viewport's size, got {:?}",
+        image.dimensions()
+    );
+    // The picture has the cloth in it: plenty of the red front colour.
+    let red = image
+        .pixels()
+        .filter(|p| p[0] > 120 && p[0] as i32 > p[2] as i32 + 50)
+        .count();
+    assert!(red > 2000, "only {red} cloth-coloured pixels");
+    harness.get_by_label_contains("saved");
+}
