@@ -43,12 +43,7 @@ fn render(c: &mut Criterion) {
         .expect("known");
     group.bench_function("all-overlays-no-readback", |b| {
         b.iter(|| {
-            let frame = clothsim::render::FrameInput {
-                model: &sim.scene.model,
-                positions: &sim.state.pos,
-                colliders: sim.stepper().colliders(),
-                time: sim.state.time,
-            };
+            let frame = clothsim::render::FrameInput::of(&sim);
             off.renderer.render(
                 &off.gpu.device,
                 &off.gpu.queue,

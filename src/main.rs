@@ -91,10 +91,10 @@ struct RunArgs {
     #[arg(long)]
     integrator: Option<IntegratorKind>,
     /// Simulated seconds.
-    #[arg(long, default_value_t = 3.0)]
+    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
     seconds: f64,
     /// Frame time step, seconds.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     dt: Option<f32>,
     /// Substeps per frame.
     #[arg(long)]

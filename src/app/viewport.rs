@@ -65,12 +65,7 @@ impl Viewport {
                 self.texture,
             );
         }
-        let frame = FrameInput {
-            model: &sim.scene.model,
-            positions: &sim.state.pos,
-            colliders: sim.stepper().colliders(),
-            time: sim.state.time,
-        };
+        let frame = FrameInput::of(sim);
         self.renderer
             .render(&rs.device, &rs.queue, &self.target, camera, &frame, options);
         Ok(())

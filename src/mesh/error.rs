@@ -10,11 +10,10 @@ pub enum ObjError {
     #[error("{path}: file not found")]
     NotFound { path: PathBuf },
     /// The file exists but could not be read (permissions, a directory, I/O failure).
-    #[error("{path}: cannot read file: {source}")]
+    #[error("{path}: cannot read file: {cause}")]
     Io {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// The file is not UTF-8 text (for example a binary file).
     #[error(

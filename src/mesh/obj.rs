@@ -24,7 +24,7 @@ pub fn read_obj(path: &Path) -> Result<PolygonSoup, ObjError> {
         },
         _ => ObjError::Io {
             path: path.to_path_buf(),
-            source,
+            cause: source,
         },
     })?;
     let text = match std::str::from_utf8(&bytes) {

@@ -50,12 +50,7 @@ impl Offscreen {
         camera: &OrbitCamera,
         options: &RenderOptions,
     ) -> Result<RgbaImage, RenderError> {
-        let frame = FrameInput {
-            model: &sim.scene.model,
-            positions: &sim.state.pos,
-            colliders: sim.stepper().colliders(),
-            time: sim.state.time,
-        };
+        let frame = FrameInput::of(sim);
         self.renderer.render(
             &self.gpu.device,
             &self.gpu.queue,

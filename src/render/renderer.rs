@@ -39,6 +39,18 @@ pub struct FrameInput<'a> {
     pub time: f64,
 }
 
+impl<'a> FrameInput<'a> {
+    /// The current frame of a running simulation.
+    pub fn of(sim: &'a crate::scene::Simulation) -> Self {
+        Self {
+            model: &sim.scene.model,
+            positions: &sim.state.pos,
+            colliders: sim.stepper().colliders(),
+            time: sim.state.time,
+        }
+    }
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct GlobalsRaw {

@@ -64,37 +64,89 @@ impl SimParams {
     /// # Errors
     /// A message naming the parameter and the allowed range.
     pub fn validate(&self) -> Result<(), String> {
-        let check = |name: &str, v: f32, ok: bool| {
-            if v.is_finite() && ok {
-                Ok(())
-            } else {
-                Err(format!("parameter `{name}` = {v} is out of range"))
+        // `(name, value, allowed, what is allowed)`; NaN and infinities are never allowed.
+        let checks = [
+            (
+                "dt",
+                self.dt,
+                self.dt > 0.0 && self.dt <= 1.0,
+                "0 < dt ≤ 1 s",
+            ),
+            ("gravity", self.gravity.length(), true, "finite"),
+            (
+                "air_damping",
+                self.air_damping,
+                self.air_damping >= 0.0,
+                "≥ 0 1/s",
+            ),
+            ("density", self.density, self.density > 0.0, "> 0 kg/m²"),
+            (
+                "collision_offset",
+                self.collision_offset,
+                self.collision_offset >= 0.0,
+                "≥ 0 m",
+            ),
+            (
+                "divergence_speed",
+                self.divergence_speed,
+                self.divergence_speed > 0.0,
+                "> 0 m/s",
+            ),
+        ];
+        for (name, value, ok, allowed) in checks {
+            if !(value.is_finite() && ok) {
+                return Err(format!(
+                    "parameter `{name}` = {value} is out of range ({allowed})"
+                ));
             }
-        };
-        check("dt", self.dt, self.dt > 0.0 && self.dt <= 1.0)?;
+        }
+        for (name, values, unit) in [
+            ("stiffness", self.stiffness, "N/m"),
+            ("damping", self.damping, "N·s/m"),
+        ] {
+            if let Some(v) = values.into_iter().find(|v| !(v.is_finite() && *v >= 0.0)) {
+                return Err(format!(
+                    "parameter `{name}` = {v} is out of range (≥ 0 {unit})"
+                ));
+            }
+        }
         if self.substeps == 0 || self.substeps > 100_000 {
             return Err(format!(
                 "parameter `substeps` = {} must be in 1..=100000",
                 self.substeps
             ));
         }
-        check("gravity", self.gravity.length(), true)?;
-        for k in 0..3 {
-            check("stiffness", self.stiffness[k], self.stiffness[k] >= 0.0)?;
-            check("damping", self.damping[k], self.damping[k] >= 0.0)?;
-        }
-        check("air_damping", self.air_damping, self.air_damping >= 0.0)?;
-        check("density", self.density, self.density > 0.0)?;
-        check(
-            "collision_offset",
-            self.collision_offset,
-            self.collision_offset >= 0.0,
-        )?;
-        check(
-            "divergence_speed",
-            self.divergence_speed,
-            self.divergence_speed > 0.0,
-        )?;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid() {
+        assert_eq!(SimParams::default().validate(), Ok(()));
+    }
+
+    #[test]
+    fn each_bad_value_is_named() {
+        type Spoil = fn(&mut SimParams);
+        let cases: [(&str, Spoil); 8] = [
+            ("dt", |p| p.dt = 0.0),
+            ("dt", |p| p.dt = f32::NAN),
+            ("substeps", |p| p.substeps = 0),
+            ("gravity", |p| p.gravity.y = f32::INFINITY),
+            ("stiffness", |p| p.stiffness[1] = -1.0),
+            ("damping", |p| p.damping[2] = f32::NAN),
+            ("density", |p| p.density = 0.0),
+            ("air_damping", |p| p.air_damping = -0.1),
+        ];
+        for (name, spoil) in cases {
+            let mut p = SimParams::default();
+            spoil(&mut p);
+            let err = p.validate().expect_err(name);
+            assert!(err.contains(&format!("`{name}`")), "{name}: {err}");
+        }
     }
 }
