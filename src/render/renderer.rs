@@ -118,6 +118,8 @@ pub struct Renderer {
     ground: StaticMesh,
     solids: Vec<SolidSlot>,
     // Scratch reused every frame.
+    /// `(slot, is_sphere)` of the colliders to draw, in order.
+    solid_draws: Vec<(usize, bool)>,
     normals: Vec<Vec3>,
     cloth_scratch: Vec<ClothVertex>,
     line_scratch: Vec<ColorVertex>,
@@ -162,6 +164,7 @@ impl Renderer {
             sphere: StaticMesh::new(device, "clothsim sphere", uv_sphere(32, 64)),
             ground: StaticMesh::new(device, "clothsim ground", ground_quad(GROUND_HALF_SIZE)),
             solids: Vec::new(),
+            solid_draws: Vec::new(),
             pipelines,
             normals: Vec::new(),
             cloth_scratch: Vec::new(),
@@ -193,11 +196,10 @@ impl Renderer {
         self.upload_cloth(device, queue, frame);
         self.upload_lines(device, queue, frame, options);
         self.upload_points(device, queue, frame, options);
-        let solids = if options.colliders {
-            self.upload_solids(device, queue, frame)
-        } else {
-            Vec::new()
-        };
+        self.solid_draws.clear();
+        if options.colliders {
+            self.upload_solids(device, queue, frame);
+        }
 
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("clothsim frame"),
@@ -213,7 +215,7 @@ impl Renderer {
             });
             pass.set_bind_group(0, &self.globals_bind_group, &[]);
             pass.set_pipeline(&self.pipelines.collider);
-            for (slot, is_sphere) in solids {
+            for &(slot, is_sphere) in &self.solid_draws {
                 let mesh = if is_sphere {
                     &self.sphere
                 } else {
@@ -370,13 +372,13 @@ impl Renderer {
             .write(device, queue, bytemuck::cast_slice(&self.point_scratch));
     }
 
-    /// Writes one uniform slot per collider; returns `(slot, is_sphere)` in draw order.
+    /// Writes one uniform slot per collider and lists them in `solid_draws`.
     fn upload_solids(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         frame: &FrameInput<'_>,
-    ) -> Vec<(usize, bool)> {
+    ) {
         while self.solids.len() < frame.colliders.len() {
             let buffer = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("clothsim solid"),
@@ -394,7 +396,6 @@ impl Renderer {
             });
             self.solids.push(SolidSlot { buffer, bind_group });
         }
-        let mut draws = Vec::with_capacity(frame.colliders.len());
         for (slot, collider) in frame.colliders.iter().enumerate() {
             let raw = match *collider {
                 Collider::Sphere {
@@ -428,9 +429,9 @@ impl Renderer {
                 },
             };
             queue.write_buffer(&self.solids[slot].buffer, 0, bytemuck::bytes_of(&raw));
-            draws.push((slot, matches!(collider, Collider::Sphere { .. })));
+            self.solid_draws
+                .push((slot, matches!(collider, Collider::Sphere { .. })));
         }
-        draws
     }
 }
 
