@@ -304,6 +304,18 @@ fn render(
     {
         bail!("--out-dir {}: not an existing directory", dir.display());
     }
+    // Fail before a long simulation, not after it.
+    if let Some(path) = out
+        && let Some(parent) = path.parent()
+        && !parent.as_os_str().is_empty()
+        && !parent.is_dir()
+    {
+        bail!(
+            "{}: the directory {} does not exist",
+            path.display(),
+            parent.display()
+        );
+    }
     let mut sim = args.simulation()?;
     let camera = scene_camera(&sim);
     let mut offscreen = Offscreen::new(width, height, AdapterPreference::Any)?;

@@ -1,0 +1,135 @@
+//! The `clothsim` binary's headless contract: JSON keys, exit codes, one-line errors.
+
+use std::process::{Command, Output};
+
+fn clothsim(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_clothsim"))
+        .args(args)
+        .env("RUST_LOG", "off")
+        .output()
+        .expect("the clothsim binary runs")
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON object on stdout")
+}
+
+#[test]
+fn info_json_counts_a_quad_grid() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("grid.obj");
+    let grid = clothsim(&[
+        "grid",
+        "--quads",
+        "16",
+        "--size",
+        "1",
+        "--out",
+        path.to_str().unwrap(),
+    ]);
+    assert!(grid.status.success());
+    let v = json(&clothsim(&["info", path.to_str().unwrap(), "--json"]));
+    assert_eq!(v["particles"], 289);
+    assert_eq!(v["triangles"], 512);
+    assert_eq!(v["springs"], 800);
+    assert_eq!(v["structural"], 544);
+    assert_eq!(v["shear"], 256);
+    assert_eq!(v["bend_pairs"], 736);
+}
+
+#[test]
+fn a_bad_file_is_one_line_on_stderr_naming_file_and_problem() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.obj");
+    std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap();
+    for file in [path.to_str().unwrap(), "/definitely/missing.obj"] {
+        let out = clothsim(&["info", file]);
+        assert!(!out.status.success(), "{file}: must fail");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr.trim_end().lines().count(), 1, "one line: {stderr}");
+        assert!(stderr.contains(file), "names the file: {stderr}");
+        assert!(out.stdout.is_empty());
+    }
+}
+
+#[test]
+fn simulate_json_has_the_documented_keys() {
+    let v = json(&clothsim(&[
+        "simulate",
+        "--scene",
+        "sphere-drop",
+        "--seconds",
+        "0.5",
+        "--json",
+    ]));
+    for key in [
+        "particles",
+        "springs",
+        "simulated_seconds",
+        "substeps",
+        "finite",
+        "max_speed",
+        "min_collider_distance",
+        "kinetic_energy",
+        "wall_seconds",
+    ] {
+        assert!(v.get(key).is_some(), "missing `{key}` in {v}");
+    }
+    assert_eq!(v["finite"], true);
+    assert!((v["simulated_seconds"].as_f64().unwrap() - 0.5).abs() < 1e-6);
+    assert!(
+        v["min_collider_distance"].as_f64().unwrap() > 0.0,
+        "nothing inside a collider"
+    );
+    // Without colliders the distance is null.
+    let hanging = json(&clothsim(&[
+        "simulate",
+        "--scene",
+        "hanging",
+        "--seconds",
+        "0.1",
+        "--json",
+    ]));
+    assert!(hanging["min_collider_distance"].is_null());
+}
+
+#[test]
+fn bad_arguments_fail_with_a_reason() {
+    for (args, expect) in [
+        (
+            &["simulate", "--scene", "nope"][..],
+            "unknown scenario `nope`",
+        ),
+        (&["simulate", "--dt", "-1"][..], "`dt`"),
+        (
+            &["simulate", "--integrator", "magic"][..],
+            "unknown integrator",
+        ),
+        (
+            &["render", "--out", "/no/such/dir/x.png", "--seconds", "0"][..],
+            "does not exist",
+        ),
+    ] {
+        let out = clothsim(args);
+        assert!(!out.status.success(), "{args:?} must fail");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(expect), "{args:?}: {stderr}");
+    }
+}
+
+#[test]
+fn scenes_lists_the_registry() {
+    let out = clothsim(&["scenes"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    for name in ["hanging", "sphere-drop", "rotating-sphere"] {
+        assert!(
+            text.lines().any(|l| l.starts_with(name)),
+            "{name} missing: {text}"
+        );
+    }
+}
