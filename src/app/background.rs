@@ -70,6 +70,21 @@ impl PngWriter {
         done
     }
 
+    /// Blocks until every submitted image is written (or failed); returns those results.
+    pub fn wait_all(&mut self) -> Vec<(PathBuf, Result<(), RenderError>)> {
+        let mut done = Vec::with_capacity(self.pending);
+        while self.pending > 0 {
+            match self.rx.recv() {
+                Ok(result) => {
+                    done.push(result);
+                    self.pending -= 1;
+                }
+                Err(_) => break,
+            }
+        }
+        done
+    }
+
     /// Images not yet written.
     pub fn pending(&self) -> usize {
         self.pending

@@ -315,10 +315,21 @@ impl ClothApp {
         self.writer.pending()
     }
 
+    /// Blocks until queued PNG files are written, then reports them (tests, shutdown).
+    pub fn finish_writes(&mut self) {
+        let done = self.writer.wait_all();
+        self.report_writes(done);
+    }
+
     /// Collects finished PNG writes into messages.
     fn poll_writes(&mut self) {
+        let done = self.writer.finished();
+        self.report_writes(done);
+    }
+
+    fn report_writes(&mut self, done: Vec<(PathBuf, Result<(), crate::render::RenderError>)>) {
         let recording_dir = self.recording.as_ref().map(|(dir, _)| dir.clone());
-        for (path, result) in self.writer.finished() {
+        for (path, result) in done {
             match result {
                 // Recorded frames are summarised when recording stops.
                 Ok(()) if recording_dir.as_ref().is_some_and(|d| path.starts_with(d)) => {}
@@ -437,8 +448,10 @@ impl ClothApp {
         }
     }
 
-    /// Frees GPU resources registered with egui.
+    /// Finishes queued PNG writes and frees GPU resources registered with egui.
     pub fn shutdown(&mut self) {
+        // Quitting right after a capture or while recording must not lose frames.
+        self.finish_writes();
         if let (Some(v), Some(rs)) = (self.viewport.take(), &self.render_state) {
             v.free(rs);
         }
