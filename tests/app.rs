@@ -162,3 +162,17 @@ fn capture_button_writes_a_png_of_the_view() {
     assert!(red > 2000, "only {red} cloth-coloured pixels");
     harness.get_by_label_contains("saved");
 }
+
+#[test]
+fn import_warnings_stay_visible_after_a_drop() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("twice.obj");
+    // Two quads, the second listed twice: it is dropped, and the user is told.
+    let obj =
+        "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nv 2 0 0\nv 2 0 1\nf 1 4 3 2\nf 2 3 6 5\nf 2 3 6 5\n";
+    std::fs::write(&path, obj).unwrap();
+    let mut harness = harness();
+    drop_file(&mut harness, &path);
+    assert_eq!(harness.state().sim.scene.model.particle_count(), 6);
+    harness.get_by_label_contains("duplicate triangle");
+}

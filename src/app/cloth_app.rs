@@ -68,10 +68,7 @@ impl ClothApp {
     /// Creates the app on the GUI's wgpu device (`None` shows no 3D view, e.g. without a GPU
     /// renderer), starting with `obj` if given.
     pub fn new(render_state: Option<egui_wgpu::RenderState>, obj: Option<&Path>) -> Self {
-        let cloth = mesh::obj_from_str(DEFAULT_CLOTH_OBJ, DEFAULT_CLOTH_NAME).unwrap_or_else(|e| {
-            // The asset is compiled in and tested; this cannot fail at run time.
-            unreachable!("built-in cloth asset is invalid: {e}")
-        });
+        let cloth = default_cloth();
         let scene = Scene::with_cloth("hanging", cloth.clone(), DEFAULT_CLOTH_NAME)
             .unwrap_or_else(|e| unreachable!("{e}"));
         let sim = Simulation::new(scene);
@@ -186,24 +183,22 @@ impl ClothApp {
         match Scene::with_cloth(self.sim.scene.scenario, build.clone(), &name) {
             Ok(mut scene) => {
                 scene.params = self.sim.scene.params.clone();
-                scene.model.set_density(scene.params.density);
+                scene.set_density(scene.params.density);
                 scene.effects = self.sim.scene.effects.clone();
-                for w in &scene.warnings {
-                    self.messages.push(Message {
-                        level: Level::Warning,
-                        text: format!("{name}: {w}"),
-                    });
-                }
-                let pins_enabled = self.sim.scene.pins_enabled;
-                scene.set_pins_enabled(pins_enabled);
-                self.message(
-                    Level::Info,
-                    format!(
-                        "loaded {name}: {} particles, {} triangles",
-                        scene.model.particle_count(),
-                        scene.model.triangles.len()
-                    ),
+                scene.set_pins_enabled(self.sim.scene.pins_enabled);
+                let mut text = format!(
+                    "loaded {name}: {} particles, {} triangles",
+                    scene.model.particle_count(),
+                    scene.model.triangles.len()
                 );
+                // Import notes (dropped faces and the like) stay visible with the result.
+                let level = if scene.warnings.is_empty() {
+                    Level::Info
+                } else {
+                    text += &format!(" ({})", scene.warnings.join("; "));
+                    Level::Warning
+                };
+                self.message(level, text);
                 self.cloth = build;
                 self.cloth_name = name;
                 self.sim = Simulation::new(scene);
@@ -215,12 +210,10 @@ impl ClothApp {
 
     /// Back to the built-in cloth.
     pub fn use_default_cloth(&mut self) {
-        if let Ok(build) = mesh::obj_from_str(DEFAULT_CLOTH_OBJ, DEFAULT_CLOTH_NAME) {
-            self.cloth = build;
-            self.cloth_name = DEFAULT_CLOTH_NAME.to_string();
-            let scenario = self.sim.scene.scenario;
-            self.set_scenario(scenario);
-        }
+        self.cloth = default_cloth();
+        self.cloth_name = DEFAULT_CLOTH_NAME.to_string();
+        let scenario = self.sim.scene.scenario;
+        self.set_scenario(scenario);
     }
 
     pub fn reset(&mut self) {
@@ -466,6 +459,13 @@ impl eframe::App for ClothApp {
     fn on_exit(&mut self) {
         self.shutdown();
     }
+}
+
+/// The built-in cloth. It is compiled in and checked by the test suite
+/// (`the_default_asset_is_a_24x24_quad_grid`), so parsing it cannot fail at run time.
+fn default_cloth() -> MeshBuild {
+    mesh::obj_from_str(DEFAULT_CLOTH_OBJ, DEFAULT_CLOTH_NAME)
+        .unwrap_or_else(|e| unreachable!("built-in cloth asset is invalid: {e}"))
 }
 
 /// `dir/prefix-NNNN<suffix>` with the first number not yet taken.
