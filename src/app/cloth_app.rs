@@ -34,8 +34,6 @@ pub struct Stats {
     pub fps: f64,
     /// Milliseconds of simulation per simulated frame, by phase.
     pub phase_ms: Vec<(&'static str, f64)>,
-    /// Simulated frames stepped in the last UI frame.
-    pub frames_last_update: u32,
 }
 
 /// The eframe application.
@@ -48,6 +46,8 @@ pub struct ClothApp {
     pub camera: OrbitCamera,
     pub options: RenderOptions,
     render_state: Option<egui_wgpu::RenderState>,
+    /// "name (backend, type)" of the adapter drawing the view, shown in the status bar.
+    adapter: Option<String>,
     viewport: Option<Viewport>,
     loading: Option<ObjLoad>,
     writer: PngWriter,
@@ -56,7 +56,6 @@ pub struct ClothApp {
     capture_requested: bool,
     /// Next frame number while recording.
     recording: Option<(PathBuf, u64)>,
-    captures: u64,
     pub messages: Vec<Message>,
     pub stats: Stats,
     last_update: Option<Instant>,
@@ -80,6 +79,9 @@ impl ClothApp {
             transport: Transport::default(),
             camera,
             options: RenderOptions::default(),
+            adapter: render_state
+                .as_ref()
+                .map(|rs| crate::render::describe_adapter(&rs.adapter)),
             render_state,
             viewport: None,
             loading: None,
@@ -87,7 +89,6 @@ impl ClothApp {
             capture_dir: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
             capture_requested: false,
             recording: None,
-            captures: 0,
             messages: Vec::new(),
             stats: Stats::default(),
             last_update: None,
@@ -124,6 +125,11 @@ impl ClothApp {
             .rev()
             .find(|m| m.level == Level::Error)
             .map(|m| m.text.as_str())
+    }
+
+    /// The adapter drawing the 3D view, if any.
+    pub fn adapter(&self) -> Option<&str> {
+        self.adapter.as_deref()
     }
 
     pub fn cloth_name(&self) -> &str {
@@ -368,7 +374,7 @@ impl ClothApp {
             egui::Image::from_texture(egui::load::SizedTexture::new(texture, size))
                 .sense(egui::Sense::click_and_drag()),
         );
-        if camera_input(ui, &response, &mut self.camera).reset {
+        if camera_input(ui, &response, &mut self.camera) {
             self.camera = scene_camera(&self.sim);
         }
         let capture = std::mem::take(&mut self.capture_requested);
@@ -377,7 +383,6 @@ impl ClothApp {
                 Ok(image) => {
                     if capture {
                         let path = next_free(&self.capture_dir, "clothsim-capture", ".png");
-                        self.captures += 1;
                         self.writer.submit(image.clone(), path);
                     }
                     if let Some((dir, n)) = &mut self.recording {
@@ -420,7 +425,6 @@ impl ClothApp {
             .credit(wall_dt, self.sim.scene.params.dt as f64);
         let done = if due > 0 { self.advance(due) } else { 0 };
         self.transport.stepped(due, done);
-        self.stats.frames_last_update = done;
 
         egui::Panel::top("transport").show(ui, |ui| super::controls::transport_bar(ui, self));
         egui::Panel::bottom("status").show(ui, |ui| super::controls::status_bar(ui, self));

@@ -72,7 +72,8 @@ pub fn transport_bar(ui: &mut egui::Ui, app: &mut ClothApp) {
 pub fn status_bar(ui: &mut egui::Ui, app: &mut ClothApp) {
     ui.horizontal_wrapped(|ui| {
         let sim = &app.sim;
-        ui.label(format!("{:.0} fps", app.stats.fps));
+        ui.label(format!("{:.0} fps", app.stats.fps))
+            .on_hover_text(app.adapter().unwrap_or("no renderer"));
         ui.separator();
         ui.label(format!("t = {:.2} s", sim.state.time));
         ui.separator();

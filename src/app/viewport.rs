@@ -88,18 +88,9 @@ impl Viewport {
     }
 }
 
-/// What the mouse asked the camera to do over the viewport this frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct CameraInput {
-    pub reset: bool,
-}
-
-/// Applies drag / scroll / double-click on `response` to `camera`.
-pub fn camera_input(
-    ui: &egui::Ui,
-    response: &egui::Response,
-    camera: &mut OrbitCamera,
-) -> CameraInput {
+/// Applies drag and scroll on `response` to `camera`; returns whether the user asked for
+/// the view to be reset (double-click).
+pub fn camera_input(ui: &egui::Ui, response: &egui::Response, camera: &mut OrbitCamera) -> bool {
     let height = response.rect.height().max(1.0);
     let shift = ui.input(|i| i.modifiers.shift);
     if response.dragged_by(egui::PointerButton::Middle)
@@ -119,7 +110,5 @@ pub fn camera_input(
             camera.zoom((-scroll * ZOOM_RATE).exp());
         }
     }
-    CameraInput {
-        reset: response.double_clicked(),
-    }
+    response.double_clicked()
 }

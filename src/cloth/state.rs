@@ -6,7 +6,7 @@ use super::model::ClothModel;
 
 /// Positions, velocities, and the previous positions position-Verlet needs. Reset is a copy
 /// of the initial state.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct ClothState {
     /// Metres.
     pub pos: Vec<Vec3>,

@@ -83,11 +83,6 @@ impl Gpu {
             queue,
         })
     }
-
-    /// "name (backend, device type)" of the adapter in use.
-    pub fn describe(&self) -> String {
-        describe_adapter(&self.adapter)
-    }
 }
 
 /// "name (backend, device type)" of an adapter.

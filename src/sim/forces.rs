@@ -67,28 +67,6 @@ impl Force {
             }
         }
     }
-
-    /// Potential energy stored by this force at `pos`, joules (gravity relative to y = 0).
-    pub fn potential_energy(&self, model: &ClothModel, pos: &[Vec3]) -> f64 {
-        match *self {
-            Force::Gravity(g) => pos
-                .iter()
-                .zip(&model.mass)
-                .map(|(p, &m)| -(m as f64) * g.dot(*p) as f64)
-                .sum(),
-            Force::Springs { stiffness, .. } => {
-                let s = &model.springs;
-                (0..s.len())
-                    .map(|i| {
-                        let stretch =
-                            pos[s.b[i] as usize].distance(pos[s.a[i] as usize]) - s.rest[i];
-                        0.5 * stiffness[s.kind[i].index()] as f64 * (stretch as f64).powi(2)
-                    })
-                    .sum()
-            }
-            Force::AirDamping(_) => 0.0,
-        }
-    }
 }
 
 /// The forces a scene uses, evaluated together. Only listed forces run.
@@ -111,13 +89,5 @@ impl ForceSet {
         for f in &self.forces {
             f.accumulate(model, pos, vel, acc);
         }
-    }
-
-    /// Total potential energy, joules.
-    pub fn potential_energy(&self, model: &ClothModel, pos: &[Vec3]) -> f64 {
-        self.forces
-            .iter()
-            .map(|f| f.potential_energy(model, pos))
-            .sum()
     }
 }

@@ -44,7 +44,8 @@ pub struct Stepper {
     offset: f32,
     divergence_speed: f32,
     timings: PhaseTimings,
-    backup: Option<ClothState>,
+    /// The frame's start state, restored when a try diverges.
+    backup: ClothState,
 }
 
 impl Stepper {
@@ -72,12 +73,8 @@ impl Stepper {
             offset: params.collision_offset,
             divergence_speed: params.divergence_speed,
             timings: PhaseTimings::default(),
-            backup: None,
+            backup: ClothState::default(),
         }
-    }
-
-    pub fn forces(&self) -> &ForceSet {
-        &self.forces
     }
 
     pub fn colliders(&self) -> &[Collider] {
@@ -124,8 +121,7 @@ impl Stepper {
         model: &ClothModel,
         state: &mut ClothState,
     ) -> Result<FrameOutcome, Diverged> {
-        let backup = self.backup.get_or_insert_with(|| state.clone());
-        backup.clone_from(state);
+        self.backup.clone_from(state);
         let first = self.substeps;
         for attempt in 0..=MAX_REFINEMENTS {
             for _ in 0..self.substeps {
@@ -141,9 +137,7 @@ impl Stepper {
                     }
                 });
             }
-            if let Some(b) = &self.backup {
-                state.clone_from(b);
-            }
+            state.clone_from(&self.backup);
             // A fresh integrator: its kept values belong to the discarded attempt.
             self.integrator = self.integrator.kind().build();
             if attempt < MAX_REFINEMENTS {

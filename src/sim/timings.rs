@@ -30,11 +30,6 @@ impl PhaseTimings {
         &self.entries
     }
 
-    /// Sum over phases.
-    pub fn total(&self) -> Duration {
-        self.entries.iter().map(|(_, d)| *d).sum()
-    }
-
     /// Returns the totals so far and starts again from zero.
     pub fn take(&mut self) -> PhaseTimings {
         std::mem::take(self)
