@@ -13,7 +13,7 @@ pub use grid::{GridOrientation, GridSpec};
 pub use normals::vertex_normals;
 pub use obj::{parse_obj, read_obj, write_obj};
 pub use polygons::PolygonSoup;
-pub use topology::{ClothMesh, MeshBuild, SpringKind, bounds, build_mesh};
+pub use topology::{ClothMesh, MeshBuild, SpringKind, bounds, build_mesh, thinnest_axis};
 pub use uv::planar_uvs;
 
 use std::path::Path;

@@ -237,6 +237,19 @@ pub fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
     })
 }
 
+/// Index (0 = x, 1 = y, 2 = z) of the smallest extent of the box `lo..hi`: the normal
+/// axis of a flat cloth. Ties go to the lower index.
+pub fn thinnest_axis(lo: Vec3, hi: Vec3) -> usize {
+    let ext = hi - lo;
+    if ext.x <= ext.y && ext.x <= ext.z {
+        0
+    } else if ext.y <= ext.z {
+        1
+    } else {
+        2
+    }
+}
+
 impl ClothMesh {
     /// Number of mesh edges of the given kind.
     pub fn edge_count(&self, kind: SpringKind) -> usize {

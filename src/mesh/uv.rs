@@ -2,7 +2,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::topology::bounds;
+use super::topology::{bounds, thinnest_axis};
 
 /// Planar projection onto the two largest extents of the bounding box, with one common
 /// scale so a checker stays square: the longer side maps to `[0, 1]`.
@@ -10,13 +10,7 @@ pub fn planar_uvs(positions: &[Vec3]) -> Vec<Vec2> {
     let (lo, hi) = bounds(positions);
     let ext = hi - lo;
     // Drop the thinnest axis.
-    let thin = if ext.x <= ext.y && ext.x <= ext.z {
-        0
-    } else if ext.y <= ext.z {
-        1
-    } else {
-        2
-    };
+    let thin = thinnest_axis(lo, hi);
     let (a, b) = match thin {
         0 => (1, 2),
         1 => (0, 2),

@@ -5,7 +5,7 @@ use std::path::Path;
 use glam::{Mat3, Vec3};
 
 use crate::cloth::{ClothModel, ClothState};
-use crate::mesh::{self, ClothMesh, GridOrientation, MeshBuild, bounds};
+use crate::mesh::{self, ClothMesh, GridOrientation, MeshBuild, bounds, thinnest_axis};
 use crate::sim::{Effect, SimParams};
 
 use super::error::SceneError;
@@ -135,14 +135,7 @@ fn lookup(name: &str) -> Result<&'static Scenario, SceneError> {
 /// Units are kept: an OBJ is read as metres.
 fn place(mesh: &mut ClothMesh, orientation: GridOrientation, center: Vec3) {
     let (lo, hi) = bounds(&mesh.positions);
-    let ext = hi - lo;
-    let thin = if ext.x <= ext.y && ext.x <= ext.z {
-        0
-    } else if ext.y <= ext.z {
-        1
-    } else {
-        2
-    };
+    let thin = thinnest_axis(lo, hi);
     // Columns are the images of x, y, z.
     let rotation = match (orientation, thin) {
         // Horizontal cloth stood up: −z (the back row) goes to +y (the top).
