@@ -193,7 +193,10 @@ impl Renderer {
         }
         let (width, height) = target.size();
         self.upload_globals(queue, camera, width, height, options);
-        self.upload_cloth(device, queue, frame);
+        // Normals and vertices are only worth computing when the surface is drawn.
+        if options.mesh {
+            self.upload_cloth(device, queue, frame);
+        }
         self.upload_lines(device, queue, frame, options);
         self.upload_points(device, queue, frame, options);
         self.solid_draws.clear();
