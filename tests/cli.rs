@@ -133,3 +133,68 @@ fn scenes_lists_the_registry() {
         );
     }
 }
+
+#[test]
+fn render_writes_an_image_or_a_numbered_sequence() {
+    let dir = tempfile::tempdir().unwrap();
+    let single = dir.path().join("one.png");
+    let out = clothsim(&[
+        "render",
+        "--scene",
+        "sphere-drop",
+        "--seconds",
+        "0.1",
+        "--size",
+        "192x128",
+        "--out",
+        single.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        image::open(&single).unwrap().to_rgba8().dimensions(),
+        (192, 128)
+    );
+
+    // 0.1 s at 60 frames per second is 6 frames; every 3rd, counting frame 0, makes 3 images.
+    let frames = dir.path().join("frames");
+    std::fs::create_dir(&frames).unwrap();
+    let args = [
+        "render",
+        "--scene",
+        "hanging",
+        "--seconds",
+        "0.1",
+        "--size",
+        "128x64",
+        "--every",
+        "3",
+        "--out-dir",
+    ];
+    let out = clothsim(&[&args[..], &[frames.to_str().unwrap()]].concat());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut names: Vec<String> = std::fs::read_dir(&frames)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["frame_00000.png", "frame_00001.png", "frame_00002.png"]
+    );
+    // The cloth moved between the first and the last frame.
+    let first = image::open(frames.join("frame_00000.png"))
+        .unwrap()
+        .to_rgba8();
+    let last = image::open(frames.join("frame_00002.png"))
+        .unwrap()
+        .to_rgba8();
+    assert_ne!(first, last);
+}

@@ -342,3 +342,29 @@ fn diverging_frame_is_rolled_back_and_refined() {
     }
     panic!("the guard never acted: {outcome:?}");
 }
+
+#[test]
+fn mass_is_lumped_from_areal_density() {
+    // One right triangle with legs 1 m and 2 m: area 1 m², so each corner gets ρ/3.
+    let mesh = clothsim::mesh::obj_from_str("v 0 0 0\nv 1 0 0\nv 0 0 2\nf 1 3 2\n", "t.obj")
+        .unwrap()
+        .mesh;
+    let model = ClothModel::new(&mesh, 0.3, &[]);
+    for (&m, &w) in model.mass.iter().zip(&model.inv_mass) {
+        assert!((m - 0.1).abs() < 1e-6, "corner mass {m}");
+        assert!((w - 10.0).abs() < 1e-4, "inverse mass {w}");
+    }
+    // The default cloth: 1 m² at the default 0.2 kg/m².
+    let mut scene = Scene::builtin("hanging").unwrap();
+    assert!((scene.model.total_mass() - 0.2).abs() < 1e-4);
+    // Changing the density rescales every mass and keeps the pins pinned.
+    scene.set_density(0.5);
+    assert!((scene.model.total_mass() - 0.5).abs() < 1e-4);
+    for &p in &scene.model.pins {
+        assert_eq!(scene.model.inv_mass[p as usize], 0.0);
+    }
+    assert_eq!(
+        scene.model.inv_mass.iter().filter(|&&w| w == 0.0).count(),
+        2
+    );
+}

@@ -296,3 +296,34 @@ fn row_padding_is_stripped() {
     assert_eq!(out[12], 100);
     assert!(!out.contains(&0xEE));
 }
+
+#[test]
+fn the_target_resizes_and_rejects_impossible_sizes() {
+    use clothsim::render::RenderTarget;
+    let mut off = offscreen();
+    let device = off.gpu.device.clone();
+    assert!(
+        !off.target.resize(&device, WIDTH, HEIGHT).unwrap(),
+        "same size: nothing to do"
+    );
+    assert!(off.target.resize(&device, 128, 64).unwrap());
+    assert_eq!(off.target.size(), (128, 64));
+    let sim = Simulation::new(Scene::builtin("sphere-drop").unwrap());
+    let image = off
+        .render(&sim, &scene_camera(&sim), &RenderOptions::default())
+        .unwrap();
+    assert_eq!(image.dimensions(), (128, 64));
+    assert!(
+        image.pixels().any(|p| !is_background(p.0)),
+        "the scene is drawn at the new size"
+    );
+    let samples = off.target.sample_count();
+    assert!(matches!(
+        RenderTarget::new(&device, 0, 64, samples),
+        Err(RenderError::BadSize { .. })
+    ));
+    assert!(matches!(
+        off.target.resize(&device, 64, 0),
+        Err(RenderError::BadSize { .. })
+    ));
+}

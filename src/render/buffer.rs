@@ -55,3 +55,35 @@ impl GrowBuffer {
         self.buffer.slice(..self.len.max(1).min(self.buffer.size()))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::{AdapterPreference, Gpu};
+
+    #[test]
+    fn reallocates_only_to_grow() {
+        let gpu = Gpu::headless(AdapterPreference::Software).expect("software adapter");
+        let (device, queue) = (&gpu.device, &gpu.queue);
+        let mut buffer = GrowBuffer::new(device, "test", wgpu::BufferUsages::VERTEX, 1024);
+        assert!(
+            !buffer.write(device, queue, &[1u8; 1024]),
+            "fits the initial allocation"
+        );
+        assert!(
+            !buffer.write(device, queue, &[2u8; 16]),
+            "shrinking never reallocates"
+        );
+        assert!(
+            buffer.write(device, queue, &[3u8; 4096]),
+            "growing reallocates"
+        );
+        let capacity = buffer.buffer.size();
+        assert!(capacity >= 8192, "with room to spare: {capacity}");
+        assert!(
+            !buffer.write(device, queue, &[4u8; 6000]),
+            "then fits again"
+        );
+        assert_eq!(buffer.buffer.size(), capacity);
+    }
+}
