@@ -37,12 +37,16 @@ impl egui::DroppedFile for Dropped {
     }
 }
 
-/// Drops `path` on the window, waits for the background import, and lets the UI catch up.
-fn drop_file(harness: &mut Harness<'static, ClothApp>, path: &Path) {
+/// Writes `text` as the file `name`, drops it on the window, waits for the background
+/// import, and lets the UI catch up.
+fn drop_obj(harness: &mut Harness<'static, ClothApp>, name: &str, text: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(name);
+    std::fs::write(&path, text).unwrap();
     harness
         .input_mut()
         .dropped_files
-        .push(Arc::new(Dropped(path.to_path_buf())));
+        .push(Arc::new(Dropped(path)));
     harness.run_steps(1);
     assert!(
         harness.state().is_loading(),
@@ -68,18 +72,12 @@ fn switching_scenario_rebuilds_the_cloth() {
 
 #[test]
 fn dropping_a_valid_obj_changes_the_particle_count() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("small.obj");
-    std::fs::write(
-        &path,
-        GridSpec::square(8, 0.6, GridOrientation::Horizontal, glam::Vec3::ZERO).to_obj(),
-    )
-    .unwrap();
     let mut harness = harness();
     harness.get_by_label("rotating-sphere").click();
     harness.run_steps(1);
     assert_eq!(harness.state().sim.scene.model.particle_count(), 625);
-    drop_file(&mut harness, &path);
+    let grid = GridSpec::square(8, 0.6, GridOrientation::Horizontal, glam::Vec3::ZERO);
+    drop_obj(&mut harness, "small.obj", &grid.to_obj());
     let app = harness.state();
     assert_eq!(app.sim.scene.model.particle_count(), 81);
     assert_eq!(
@@ -92,12 +90,13 @@ fn dropping_a_valid_obj_changes_the_particle_count() {
 
 #[test]
 fn dropping_a_malformed_obj_shows_an_error_and_keeps_the_cloth() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("broken.obj");
-    std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n").unwrap();
     let mut harness = harness();
     let before = harness.state().sim.scene.model.particle_count();
-    drop_file(&mut harness, &path);
+    drop_obj(
+        &mut harness,
+        "broken.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
+    );
     let error = harness
         .state()
         .last_error()
@@ -165,14 +164,49 @@ fn capture_button_writes_a_png_of_the_view() {
 
 #[test]
 fn import_warnings_stay_visible_after_a_drop() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("twice.obj");
     // Two quads, the second listed twice: it is dropped, and the user is told.
     let obj =
         "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nv 2 0 0\nv 2 0 1\nf 1 4 3 2\nf 2 3 6 5\nf 2 3 6 5\n";
-    std::fs::write(&path, obj).unwrap();
     let mut harness = harness();
-    drop_file(&mut harness, &path);
+    drop_obj(&mut harness, "twice.obj", obj);
     assert_eq!(harness.state().sim.scene.model.particle_count(), 6);
     harness.get_by_label_contains("duplicate triangle");
+}
+
+#[test]
+fn record_writes_a_numbered_frame_sequence() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut harness = harness();
+    harness.state_mut().capture_dir = dir.path().to_path_buf();
+    harness.state_mut().transport.playing = true;
+    harness.get_by_label("Record").click();
+    harness.run_steps(4);
+    assert!(harness.state().is_recording());
+    harness.get_by_label("Stop recording").click();
+    harness.run_steps(1);
+    assert!(!harness.state().is_recording());
+    harness.state_mut().finish_writes();
+    harness.run_steps(1);
+    // Frames still queued when recording stopped are written silently: the summary stays
+    // the message the user sees.
+    let app = harness.state();
+    assert!(
+        app.messages.iter().all(|m| !m.text.contains("frame_")),
+        "{:?}",
+        app.messages
+    );
+    assert!(app.messages.last().unwrap().text.starts_with("recorded"));
+    let folder = dir.path().join("clothsim-recording-0001");
+    let mut frames: Vec<String> = std::fs::read_dir(&folder)
+        .unwrap_or_else(|e| panic!("{}: {e}", folder.display()))
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    frames.sort();
+    assert!(
+        frames.len() >= 3,
+        "one image per drawn frame, got {frames:?}"
+    );
+    assert_eq!(frames[0], "frame_00000.png");
+    assert_eq!(frames[1], "frame_00001.png");
+    harness.get_by_label_contains("recorded");
 }

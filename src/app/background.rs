@@ -33,21 +33,37 @@ impl ObjLoad {
     }
 }
 
+/// A finished PNG write.
+pub struct Written {
+    pub path: PathBuf,
+    /// Whether the user wants a message for this file (a capture) or not (a recorded frame,
+    /// summarised when recording stops).
+    pub announce: bool,
+    pub result: Result<(), RenderError>,
+}
+
 /// A PNG writer thread: images are encoded and written in order, results come back.
 pub struct PngWriter {
-    tx: Sender<(RgbaImage, PathBuf)>,
-    rx: Receiver<(PathBuf, Result<(), RenderError>)>,
+    tx: Sender<(RgbaImage, PathBuf, bool)>,
+    rx: Receiver<Written>,
     pending: usize,
 }
 
 impl Default for PngWriter {
     fn default() -> Self {
-        let (tx, jobs) = channel::<(RgbaImage, PathBuf)>();
+        let (tx, jobs) = channel::<(RgbaImage, PathBuf, bool)>();
         let (done, rx) = channel();
         std::thread::spawn(move || {
-            for (image, path) in jobs {
+            for (image, path, announce) in jobs {
                 let result = save_png(&image, &path);
-                if done.send((path, result)).is_err() {
+                if done
+                    .send(Written {
+                        path,
+                        announce,
+                        result,
+                    })
+                    .is_err()
+                {
                     break;
                 }
             }
@@ -57,26 +73,27 @@ impl Default for PngWriter {
 }
 
 impl PngWriter {
-    pub fn submit(&mut self, image: RgbaImage, path: PathBuf) {
-        if self.tx.send((image, path)).is_ok() {
+    /// Queues `image` for `path`; `announce` is handed back with the result.
+    pub fn submit(&mut self, image: RgbaImage, path: PathBuf, announce: bool) {
+        if self.tx.send((image, path, announce)).is_ok() {
             self.pending += 1;
         }
     }
 
     /// Files written (or failed) since the last call.
-    pub fn finished(&mut self) -> Vec<(PathBuf, Result<(), RenderError>)> {
+    pub fn finished(&mut self) -> Vec<Written> {
         let done: Vec<_> = self.rx.try_iter().collect();
         self.pending -= done.len().min(self.pending);
         done
     }
 
     /// Blocks until every submitted image is written (or failed); returns those results.
-    pub fn wait_all(&mut self) -> Vec<(PathBuf, Result<(), RenderError>)> {
+    pub fn wait_all(&mut self) -> Vec<Written> {
         let mut done = Vec::with_capacity(self.pending);
         while self.pending > 0 {
             match self.rx.recv() {
-                Ok(result) => {
-                    done.push(result);
+                Ok(written) => {
+                    done.push(written);
                     self.pending -= 1;
                 }
                 Err(_) => break,

@@ -8,7 +8,7 @@ use crate::render::{OrbitCamera, RenderOptions, scene_camera};
 use crate::scene::{DEFAULT_CLOTH_NAME, DEFAULT_CLOTH_OBJ, Scene, Simulation};
 use crate::sim::{FrameOutcome, PhaseTimings};
 
-use super::background::{ObjLoad, PngWriter};
+use super::background::{ObjLoad, PngWriter, Written};
 use super::transport::{STEP_BUDGET_SECONDS, Transport};
 use super::viewport::{Viewport, camera_input};
 
@@ -326,13 +326,14 @@ impl ClothApp {
         self.report_writes(done);
     }
 
-    fn report_writes(&mut self, done: Vec<(PathBuf, Result<(), crate::render::RenderError>)>) {
-        let recording_dir = self.recording.as_ref().map(|(dir, _)| dir.clone());
-        for (path, result) in done {
-            match result {
+    fn report_writes(&mut self, done: Vec<Written>) {
+        for written in done {
+            match written.result {
+                Ok(()) if written.announce => {
+                    self.message(Level::Info, format!("saved {}", written.path.display()));
+                }
                 // Recorded frames are summarised when recording stops.
-                Ok(()) if recording_dir.as_ref().is_some_and(|d| path.starts_with(d)) => {}
-                Ok(()) => self.message(Level::Info, format!("saved {}", path.display())),
+                Ok(()) => {}
                 Err(e) => {
                     self.recording = None;
                     self.message(Level::Error, e.to_string());
@@ -383,11 +384,11 @@ impl ClothApp {
                 Ok(image) => {
                     if capture {
                         let path = next_free(&self.capture_dir, "clothsim-capture", ".png");
-                        self.writer.submit(image.clone(), path);
+                        self.writer.submit(image.clone(), path, true);
                     }
                     if let Some((dir, n)) = &mut self.recording {
                         self.writer
-                            .submit(image, dir.join(format!("frame_{n:05}.png")));
+                            .submit(image, dir.join(format!("frame_{n:05}.png")), false);
                         *n += 1;
                     }
                 }
