@@ -4,8 +4,9 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 
 use clothsim::mesh::{GridOrientation, GridSpec, MeshBuild};
-use clothsim::render::{AdapterPreference, Offscreen, RenderOptions, scene_camera};
+use clothsim::render::{AdapterPreference, Offscreen, RenderOptions};
 use clothsim::scene::{Scene, Simulation};
+use clothsim::view;
 
 fn render(c: &mut Criterion) {
     let mesh = GridSpec::square(99, 1.0, GridOrientation::Horizontal, glam::Vec3::ZERO)
@@ -13,7 +14,7 @@ fn render(c: &mut Criterion) {
         .expect("valid grid");
     let scene = Scene::with_cloth(
         "sphere-drop",
-        MeshBuild {
+        &MeshBuild {
             mesh,
             warnings: Vec::new(),
         },
@@ -22,8 +23,8 @@ fn render(c: &mut Criterion) {
     .expect("registered");
     let mut sim = Simulation::new(scene);
     sim.run(1.0);
-    let camera = scene_camera(&sim);
     let mut off = Offscreen::new(1280, 720, AdapterPreference::Software).expect("software adapter");
+    let camera = view::default_camera(&sim, off.aspect());
     let mut group = c.benchmark_group("render/1280x720/100x100");
     group.sample_size(10);
     for (name, overlays) in [
@@ -34,7 +35,10 @@ fn render(c: &mut Criterion) {
             .with_overlays(overlays)
             .expect("known overlays");
         group.bench_function(name, |b| {
-            b.iter(|| off.render(&sim, &camera, &options).expect("render"))
+            b.iter(|| {
+                off.render(&view::frame(&sim), &camera, &options)
+                    .expect("render")
+            })
         });
     }
     // Draw only (no readback): what the GUI pays per frame.
@@ -43,7 +47,7 @@ fn render(c: &mut Criterion) {
         .expect("known");
     group.bench_function("all-overlays-no-readback", |b| {
         b.iter(|| {
-            let frame = clothsim::render::FrameInput::of(&sim);
+            let frame = view::frame(&sim);
             off.renderer.render(
                 &off.gpu.device,
                 &off.gpu.queue,

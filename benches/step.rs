@@ -25,7 +25,7 @@ fn frame(c: &mut Criterion) {
         for kind in IntegratorKind::ALL {
             for n in [25u32, 50, 100] {
                 let mut scene =
-                    Scene::with_cloth(scenario.name, grid(n), "grid").expect("registered");
+                    Scene::with_cloth(scenario.name, &grid(n), "grid").expect("registered");
                 scene.params.integrator = kind;
                 let mut sim = Simulation::new(scene);
                 // Start from a moving, colliding state rather than the rest pose.

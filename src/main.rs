@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 use clothsim::mesh::{self, GridOrientation, GridSpec, SpringKind};
 use clothsim::scene::{SCENARIOS, Scene, Simulation};
 use clothsim::sim::IntegratorKind;
+use clothsim::view;
 
 #[derive(Parser)]
 #[command(
@@ -25,7 +26,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Topology of an OBJ cloth: particles, triangles, springs by kind, bend pairs.
+    /// Topology of an OBJ cloth: particles, triangles, edges, springs by kind.
     Info {
         file: PathBuf,
         /// Print one JSON object.
@@ -183,17 +184,17 @@ fn run(cli: Cli) -> Result<()> {
 fn info(file: &std::path::Path, json: bool) -> Result<()> {
     let build = mesh::load_obj(file)?;
     let m = &build.mesh;
-    let structural = m.edge_count(SpringKind::Structural);
-    let shear = m.edge_count(SpringKind::Shear);
+    let [structural, shear, bend] = SpringKind::ALL.map(|k| m.spring_count(k));
     if json {
         let v = serde_json::json!({
             "file": file.display().to_string(),
             "particles": m.positions.len(),
             "triangles": m.triangles.len(),
-            "springs": m.edges.len(),
+            "edges": m.edges.len(),
+            "springs": structural + shear + bend,
             "structural": structural,
             "shear": shear,
-            "bend_pairs": m.bend_pairs.len(),
+            "bend": bend,
             "warnings": build.warnings,
         });
         println!("{v}");
@@ -204,11 +205,11 @@ fn info(file: &std::path::Path, json: bool) -> Result<()> {
         println!("{}", file.display());
         println!("  particles   {}", m.positions.len());
         println!("  triangles   {}", m.triangles.len());
+        println!("  edges       {}", m.edges.len());
         println!(
-            "  springs     {} (structural {structural}, shear {shear})",
-            m.edges.len()
+            "  springs     {} (structural {structural}, shear {shear}, bend {bend})",
+            structural + shear + bend
         );
-        println!("  bend pairs  {}", m.bend_pairs.len());
     }
     Ok(())
 }
@@ -224,15 +225,16 @@ fn simulate(args: &RunArgs, json: bool) -> Result<()> {
             summary.scene, summary.cloth, summary.integrator
         );
         println!(
-            "  {} particles, {} springs, {} bend pairs",
-            summary.particles, summary.springs, summary.bend_pairs
+            "  {} particles, {} springs ({} structural, {} shear, {} bend)",
+            summary.particles, summary.springs, summary.structural, summary.shear, summary.bend
         );
         println!(
-            "  simulated {:.3} s in {} frames of {:.5} s × {} substeps, wall {:.3} s",
+            "  simulated {:.3} s in {} frames of {:.5} s × {} substeps (requested {}), wall {:.3} s",
             summary.simulated_seconds,
             summary.frames,
             summary.dt,
             summary.substeps,
+            summary.requested_substeps,
             summary.wall_seconds
         );
         println!(
@@ -263,12 +265,7 @@ fn grid(quads: u32, size: f32, triangles: bool, out: &std::path::Path) -> Result
     let mut soup =
         GridSpec::square(quads, size, GridOrientation::Horizontal, glam::Vec3::ZERO).polygons();
     if triangles {
-        let quads: Vec<u32> = soup.face_indices.clone();
-        soup.face_indices = quads
-            .chunks_exact(4)
-            .flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]])
-            .collect();
-        soup.face_arities = vec![3; quads.len() / 2];
+        soup = soup.triangulated();
     }
     std::fs::write(out, mesh::write_obj(&soup))
         .with_context(|| format!("cannot write {}", out.display()))?;
@@ -294,7 +291,7 @@ fn render(
     every: Option<u32>,
     out_dir: Option<&std::path::Path>,
 ) -> Result<()> {
-    use clothsim::render::{AdapterPreference, Offscreen, RenderOptions, save_png, scene_camera};
+    use clothsim::render::{AdapterPreference, Offscreen, RenderOptions, save_png};
     let (width, height) = parse_size(size)?;
     let options = RenderOptions::default()
         .with_overlays(overlay)
@@ -317,22 +314,22 @@ fn render(
         );
     }
     let mut sim = args.simulation()?;
-    let camera = scene_camera(&sim);
+    let camera = view::default_camera(&sim, width as f32 / height as f32);
     let mut offscreen = Offscreen::new(width, height, AdapterPreference::Any)?;
-    let frames = (args.seconds / sim.scene.params.dt as f64).round() as u64;
+    let frames = (args.seconds / sim.params().dt as f64).round() as u64;
     match (out, out_dir) {
         (Some(path), _) => {
             for _ in 0..frames {
                 sim.step_frame()?;
             }
-            let image = offscreen.render(&sim, &camera, &options)?;
+            let image = offscreen.render(&view::frame(&sim), &camera, &options)?;
             save_png(&image, path)?;
             println!(
                 "wrote {} ({}x{}, t = {:.3} s)",
                 path.display(),
                 width,
                 height,
-                sim.state.time
+                sim.state().time
             );
         }
         (None, Some(dir)) => {
@@ -348,7 +345,7 @@ fn render(
                     sim.step_frame()?;
                 }
                 if f % every == 0 {
-                    let image = offscreen.render(&sim, &camera, &options)?;
+                    let image = offscreen.render(&view::frame(&sim), &camera, &options)?;
                     save_png(&image, &dir.join(format!("frame_{written:05}.png")))?;
                     written += 1;
                     bar.inc(1);

@@ -59,15 +59,15 @@ fn drop_obj(harness: &mut Harness<'static, ClothApp>, name: &str, text: &str) {
 #[test]
 fn switching_scenario_rebuilds_the_cloth() {
     let mut harness = harness();
-    assert_eq!(harness.state().sim.scene.scenario, "hanging");
-    assert!(harness.state().sim.stepper().colliders().is_empty());
+    assert_eq!(harness.state().sim.scenario(), "hanging");
+    assert!(harness.state().sim.colliders().is_empty());
     harness.get_by_label("sphere-drop").click();
     harness.run_steps(2);
     let sim = &harness.state().sim;
-    assert_eq!(sim.scene.scenario, "sphere-drop");
-    assert_eq!(sim.stepper().colliders().len(), 2, "sphere and ground");
-    assert!(sim.scene.model.pins.is_empty(), "sphere-drop pins nothing");
-    assert_eq!(sim.frames, 0, "a new scene starts from its initial state");
+    assert_eq!(sim.scenario(), "sphere-drop");
+    assert_eq!(sim.colliders().len(), 2, "sphere and ground");
+    assert!(sim.model().pins.is_empty(), "sphere-drop pins nothing");
+    assert_eq!(sim.frames(), 0, "a new scene starts from its initial state");
 }
 
 #[test]
@@ -75,23 +75,24 @@ fn dropping_a_valid_obj_changes_the_particle_count() {
     let mut harness = harness();
     harness.get_by_label("rotating-sphere").click();
     harness.run_steps(1);
-    assert_eq!(harness.state().sim.scene.model.particle_count(), 625);
+    assert_eq!(harness.state().sim.model().particle_count(), 625);
     let grid = GridSpec::square(8, 0.6, GridOrientation::Horizontal, glam::Vec3::ZERO);
     drop_obj(&mut harness, "small.obj", &grid.to_obj());
     let app = harness.state();
-    assert_eq!(app.sim.scene.model.particle_count(), 81);
+    assert_eq!(app.sim.model().particle_count(), 81);
     assert_eq!(
-        app.sim.scene.scenario, "rotating-sphere",
+        app.sim.scenario(),
+        "rotating-sphere",
         "the new cloth keeps the scenario"
     );
-    assert_eq!(app.sim.stepper().colliders().len(), 2, "and its effects");
+    assert_eq!(app.sim.colliders().len(), 2, "and its effects");
     assert!(app.cloth_name().ends_with("small.obj"));
 }
 
 #[test]
 fn dropping_a_malformed_obj_shows_an_error_and_keeps_the_cloth() {
     let mut harness = harness();
-    let before = harness.state().sim.scene.model.particle_count();
+    let before = harness.state().sim.model().particle_count();
     drop_obj(
         &mut harness,
         "broken.obj",
@@ -106,7 +107,7 @@ fn dropping_a_malformed_obj_shows_an_error_and_keeps_the_cloth() {
         error.contains("broken.obj") && error.contains(":4:"),
         "{error}"
     );
-    assert_eq!(harness.state().sim.scene.model.particle_count(), before);
+    assert_eq!(harness.state().sim.model().particle_count(), before);
     // The user sees it.
     harness.get_by_label_contains("broken.obj:4:");
 }
@@ -114,20 +115,20 @@ fn dropping_a_malformed_obj_shows_an_error_and_keeps_the_cloth() {
 #[test]
 fn pause_and_step_advances_exactly_one_frame() {
     let mut harness = harness();
-    let dt = harness.state().sim.scene.params.dt as f64;
-    assert_eq!(harness.state().sim.frames, 0);
+    let dt = harness.state().sim.params().dt as f64;
+    assert_eq!(harness.state().sim.frames(), 0);
     harness.get_by_label("Step").click();
     harness.run_steps(3);
-    assert_eq!(harness.state().sim.frames, 1);
-    assert!((harness.state().sim.state.time - dt).abs() < 1e-9);
+    assert_eq!(harness.state().sim.frames(), 1);
+    assert!((harness.state().sim.state().time - dt).abs() < 1e-9);
     assert!(!harness.state().transport.playing);
     harness.get_by_label("Step").click();
     harness.run_steps(3);
-    assert_eq!(harness.state().sim.frames, 2);
+    assert_eq!(harness.state().sim.frames(), 2);
     harness.get_by_label("Reset").click();
     harness.run_steps(1);
-    assert_eq!(harness.state().sim.frames, 0);
-    assert_eq!(harness.state().sim.state.time, 0.0);
+    assert_eq!(harness.state().sim.frames(), 0);
+    assert_eq!(harness.state().sim.state().time, 0.0);
 }
 
 #[test]
@@ -169,7 +170,7 @@ fn import_warnings_stay_visible_after_a_drop() {
         "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nv 2 0 0\nv 2 0 1\nf 1 4 3 2\nf 2 3 6 5\nf 2 3 6 5\n";
     let mut harness = harness();
     drop_obj(&mut harness, "twice.obj", obj);
-    assert_eq!(harness.state().sim.scene.model.particle_count(), 6);
+    assert_eq!(harness.state().sim.model().particle_count(), 6);
     harness.get_by_label_contains("duplicate triangle");
 }
 

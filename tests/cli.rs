@@ -26,7 +26,7 @@ fn info_json_counts_a_quad_grid() {
     let grid = clothsim(&[
         "grid",
         "--quads",
-        "16",
+        "10",
         "--size",
         "1",
         "--out",
@@ -34,12 +34,35 @@ fn info_json_counts_a_quad_grid() {
     ]);
     assert!(grid.status.success());
     let v = json(&clothsim(&["info", path.to_str().unwrap(), "--json"]));
-    assert_eq!(v["particles"], 289);
-    assert_eq!(v["triangles"], 512);
-    assert_eq!(v["springs"], 800);
-    assert_eq!(v["structural"], 544);
-    assert_eq!(v["shear"], 256);
-    assert_eq!(v["bend_pairs"], 736);
+    assert_eq!(v["particles"], 121);
+    assert_eq!(v["triangles"], 200);
+    assert_eq!(v["edges"], 320);
+    assert_eq!(v["structural"], 220);
+    assert_eq!(v["shear"], 200);
+    assert_eq!(v["bend"], 180);
+    assert_eq!(v["springs"], 600);
+    // The same grid written as triangles has no quads: one diagonal per cell is an edge
+    // and the other only a bend pair.
+    let tris = dir.path().join("tris.obj");
+    let out = clothsim(&[
+        "grid",
+        "--quads",
+        "10",
+        "--triangles",
+        "--out",
+        tris.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let v = json(&clothsim(&["info", tris.to_str().unwrap(), "--json"]));
+    assert_eq!(
+        (v["edges"].clone(), v["shear"].clone()),
+        (320.into(), 0.into())
+    );
+    assert_eq!(
+        v["structural"], 320,
+        "every triangle side is a polygon side"
+    );
+    assert_eq!(v["bend"], 280);
 }
 
 #[test]

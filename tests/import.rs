@@ -80,11 +80,50 @@ fn quads_give_shear_diagonals_and_generator_matches_its_obj() {
     let generated = spec.build().unwrap();
     assert_eq!(generated.edge_count(SpringKind::Structural), 544);
     assert_eq!(generated.edge_count(SpringKind::Shear), 256);
+    assert_eq!(
+        generated.spring_count(SpringKind::Shear),
+        512,
+        "both diagonals"
+    );
+    assert_eq!(generated.spring_count(SpringKind::Bend), 480);
     let imported = obj_from_str(&spec.to_obj(), "grid.obj").unwrap().mesh;
     assert_eq!(
         generated, imported,
         "grid generator and its OBJ must give the same model"
     );
+}
+
+/// A quad's two diagonals are both shear springs, so shear stiffness is the same along
+/// both diagonal directions; bend pairs never repeat each other, an edge or a diagonal.
+#[test]
+fn a_10x10_quad_grid_has_both_diagonals_as_shear_and_unique_bends() {
+    let m = GridSpec::square(10, 1.0, GridOrientation::Horizontal, glam::Vec3::ZERO)
+        .build()
+        .unwrap();
+    assert_eq!(m.edges.len(), 320, "220 sides + 100 fan diagonals");
+    assert_eq!(m.spring_count(SpringKind::Structural), 220);
+    assert_eq!(m.spring_count(SpringKind::Shear), 200);
+    // Across each of the 90 interior rows and 90 interior columns of sides, one bend pair;
+    // across the 100 fan diagonals the pair would be the other diagonal, already a spring.
+    assert_eq!(m.spring_count(SpringKind::Bend), 180);
+    // As many shear springs along (1, 1) as along (1, −1).
+    let direction = |[a, b]: [u32; 2]| {
+        let d = m.positions[b as usize] - m.positions[a as usize];
+        (d.x * d.z).signum()
+    };
+    let shear: Vec<f32> = m
+        .springs()
+        .filter(|(_, k)| *k == SpringKind::Shear)
+        .map(|(s, _)| direction(s))
+        .collect();
+    assert_eq!(shear.iter().filter(|&&s| s > 0.0).count(), 100);
+    assert_eq!(shear.iter().filter(|&&s| s < 0.0).count(), 100);
+    // No particle pair carries two springs.
+    let mut pairs: Vec<[u32; 2]> = m.springs().map(|(p, _)| p).collect();
+    let total = pairs.len();
+    pairs.sort_unstable();
+    pairs.dedup();
+    assert_eq!(pairs.len(), total, "a pair with two springs");
 }
 
 #[test]

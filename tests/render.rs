@@ -9,10 +9,17 @@ use glam::Vec3;
 
 use clothsim::render::{
     AdapterPreference, CLEAR_COLOR, Offscreen, OrbitCamera, RenderError, RenderOptions, RgbaImage,
-    save_png, scene_camera,
+    save_png,
 };
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::Collider;
+use clothsim::view;
+
+/// Draws `sim` with its scene's default camera.
+fn render_default(off: &mut Offscreen, sim: &Simulation, options: &RenderOptions) -> RgbaImage {
+    let camera = view::default_camera(sim, off.aspect());
+    off.render(&view::frame(sim), &camera, options).unwrap()
+}
 
 /// Golden size: the width is a multiple of 64 so rows need no copy padding on any backend.
 const WIDTH: u32 = 320;
@@ -97,9 +104,7 @@ fn golden_scenarios() {
         ("rotating-sphere", 1.0),
     ] {
         let sim = simulate(name, seconds);
-        let image = off
-            .render(&sim, &scene_camera(&sim), &RenderOptions::default())
-            .unwrap();
+        let image = render_default(&mut off, &sim, &RenderOptions::default());
         check_golden(name, &image);
     }
 }
@@ -111,7 +116,7 @@ fn golden_every_overlay() {
     let options = RenderOptions::default()
         .with_overlays("springs,bend,particles,wireframe")
         .unwrap();
-    let image = off.render(&sim, &scene_camera(&sim), &options).unwrap();
+    let image = render_default(&mut off, &sim, &options);
     check_golden("hanging-overlays", &image);
 }
 
@@ -145,7 +150,7 @@ fn cloth_pixels_are_where_the_camera_says() {
         colliders: false,
         ..RenderOptions::default()
     };
-    let image = off.render(&sim, &above, &options).unwrap();
+    let image = off.render(&view::frame(&sim), &above, &options).unwrap();
     let (cx, cy) = above.project(centre, WIDTH, HEIGHT).unwrap();
     let front = pixel(&image, cx, cy);
     assert!(
@@ -174,7 +179,7 @@ fn cloth_pixels_are_where_the_camera_says() {
         pitch: -1.2,
         ..above
     };
-    let back = off.render(&sim, &below, &options).unwrap();
+    let back = off.render(&view::frame(&sim), &below, &options).unwrap();
     let p = pixel(&back, cx, cy);
     assert!(
         p[1] as i32 > p[2] as i32 + 25 && p[0] as i32 > p[2] as i32 + 25,
@@ -195,13 +200,10 @@ fn cloth_pixels_are_where_the_camera_says() {
 fn overlays_change_the_image() {
     let mut off = offscreen();
     let sim = simulate("hanging", 0.3);
-    let camera = scene_camera(&sim);
-    let plain = off
-        .render(&sim, &camera, &RenderOptions::default())
-        .unwrap();
+    let plain = render_default(&mut off, &sim, &RenderOptions::default());
     for overlay in ["springs", "strain", "particles", "wireframe"] {
         let options = RenderOptions::default().with_overlays(overlay).unwrap();
-        let image = off.render(&sim, &camera, &options).unwrap();
+        let image = render_default(&mut off, &sim, &options);
         let changed = plain
             .pixels()
             .zip(image.pixels())
@@ -216,12 +218,11 @@ fn overlays_change_the_image() {
 fn sphere_is_visible_in_sphere_drop() {
     let mut off = offscreen();
     let sim = Simulation::new(Scene::builtin("sphere-drop").unwrap());
-    let camera = scene_camera(&sim);
+    let camera = view::default_camera(&sim, off.aspect());
     let image = off
-        .render(&sim, &camera, &RenderOptions::default())
+        .render(&view::frame(&sim), &camera, &RenderOptions::default())
         .unwrap();
     let sphere = sim
-        .stepper()
         .colliders()
         .iter()
         .find_map(|c| match *c {
@@ -243,7 +244,7 @@ fn sphere_is_visible_in_sphere_drop() {
         colliders: false,
         ..RenderOptions::default()
     };
-    let bare = off.render(&sim, &camera, &options).unwrap();
+    let bare = off.render(&view::frame(&sim), &camera, &options).unwrap();
     assert!(is_background(pixel(&bare, x, y)));
 }
 
@@ -309,9 +310,7 @@ fn the_target_resizes_and_rejects_impossible_sizes() {
     assert!(off.target.resize(&device, 128, 64).unwrap());
     assert_eq!(off.target.size(), (128, 64));
     let sim = Simulation::new(Scene::builtin("sphere-drop").unwrap());
-    let image = off
-        .render(&sim, &scene_camera(&sim), &RenderOptions::default())
-        .unwrap();
+    let image = render_default(&mut off, &sim, &RenderOptions::default());
     assert_eq!(image.dimensions(), (128, 64));
     assert!(
         image.pixels().any(|p| !is_background(p.0)),
@@ -326,4 +325,58 @@ fn the_target_resizes_and_rejects_impossible_sizes() {
         off.target.resize(&device, 64, 0),
         Err(RenderError::BadSize { .. })
     ));
+}
+
+/// Pixels that differ from the background.
+fn cloth_mask(image: &RgbaImage) -> Vec<bool> {
+    image.pixels().map(|p| !is_background(p.0)).collect()
+}
+
+/// Story: the default camera used to frame a loose box around the start pose, so a swinging
+/// `hanging` cloth covered under 2 % of a 640×384 picture, in its top corner. It now frames
+/// where the cloth goes: over four seconds of swinging the cloth never leaves the picture,
+/// and it fills a good part of it.
+#[test]
+fn the_default_camera_keeps_the_swinging_cloth_in_view_and_large() {
+    let (w, h) = (640u32, 384u32);
+    let mut off = Offscreen::new(w, h, AdapterPreference::Software).unwrap();
+    let mut sim = Simulation::new(Scene::builtin("hanging").unwrap());
+    let camera = view::default_camera(&sim, off.aspect());
+    let options = RenderOptions {
+        colliders: false,
+        ..RenderOptions::default()
+    };
+    let (mut largest, mut top, mut bottom) = (0.0f64, h, 0u32);
+    for quarter in 1..=16 {
+        while sim.state().time < 0.25 * quarter as f64 - 1e-6 {
+            sim.step_frame().unwrap();
+        }
+        let image = off.render(&view::frame(&sim), &camera, &options).unwrap();
+        let mask = cloth_mask(&image);
+        let at = |x: u32, y: u32| mask[(y * w + x) as usize];
+        let t = sim.state().time;
+        let border =
+            (0..w).any(|x| at(x, 0) || at(x, h - 1)) || (0..h).any(|y| at(0, y) || at(w - 1, y));
+        assert!(
+            !border,
+            "t = {t:.2} s: the cloth touches the edge of the picture"
+        );
+        let covered = mask.iter().filter(|&&m| m).count() as f64 / mask.len() as f64;
+        largest = largest.max(covered);
+        for y in (0..h).filter(|&y| (0..w).any(|x| at(x, y))) {
+            top = top.min(y);
+            bottom = bottom.max(y);
+        }
+    }
+    assert!(
+        largest > 0.15,
+        "the cloth covers at most {:.1} % of the picture",
+        100.0 * largest
+    );
+    let span = (bottom - top) as f64 / h as f64;
+    assert!(
+        span > 0.6,
+        "over its motion the cloth spans only {:.0} % of the height",
+        100.0 * span
+    );
 }

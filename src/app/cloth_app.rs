@@ -4,9 +4,10 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use crate::mesh::{self, MeshBuild};
-use crate::render::{OrbitCamera, RenderOptions, scene_camera};
+use crate::render::{OrbitCamera, RenderOptions};
 use crate::scene::{DEFAULT_CLOTH_NAME, DEFAULT_CLOTH_OBJ, Scene, Simulation};
-use crate::sim::{FrameOutcome, PhaseTimings};
+use crate::sim::{Effect, FrameOutcome, PhaseTimings, SimParams};
+use crate::view;
 
 use super::background::{ObjLoad, PngWriter, Written};
 use super::transport::{STEP_BUDGET_SECONDS, Transport};
@@ -39,9 +40,11 @@ pub struct Stats {
 /// The eframe application.
 pub struct ClothApp {
     pub sim: Simulation,
-    /// The cloth in use, unplaced, so a scenario switch can place it again.
+    /// The cloth in use as imported (unplaced), so a scenario switch can place it again.
     cloth: MeshBuild,
     cloth_name: String,
+    /// Width / height of the 3D view when last drawn, for framing the camera.
+    view_aspect: f32,
     pub transport: Transport,
     pub camera: OrbitCamera,
     pub options: RenderOptions,
@@ -68,14 +71,15 @@ impl ClothApp {
     /// renderer), starting with `obj` if given.
     pub fn new(render_state: Option<egui_wgpu::RenderState>, obj: Option<&Path>) -> Self {
         let cloth = default_cloth();
-        let scene = Scene::with_cloth("hanging", cloth.clone(), DEFAULT_CLOTH_NAME)
+        let scene = Scene::with_cloth("hanging", &cloth, DEFAULT_CLOTH_NAME)
             .unwrap_or_else(|e| unreachable!("{e}"));
         let sim = Simulation::new(scene);
-        let camera = scene_camera(&sim);
+        let camera = view::default_camera(&sim, DEFAULT_ASPECT);
         let mut app = Self {
             sim,
             cloth,
             cloth_name: DEFAULT_CLOTH_NAME.to_string(),
+            view_aspect: DEFAULT_ASPECT,
             transport: Transport::default(),
             camera,
             options: RenderOptions::default(),
@@ -143,14 +147,32 @@ impl ClothApp {
     /// Switches scenario, keeping the current cloth. Parameters and effects become the
     /// scenario's; the camera frames the new scene.
     pub fn set_scenario(&mut self, name: &str) {
-        match Scene::with_cloth(name, self.cloth.clone(), &self.cloth_name) {
+        match Scene::with_cloth(name, &self.cloth, &self.cloth_name) {
             Ok(scene) => {
                 self.sim = Simulation::new(scene);
-                self.camera = scene_camera(&self.sim);
+                self.reset_camera();
                 self.recording = None;
             }
             Err(e) => self.message(Level::Error, e.to_string()),
         }
+    }
+
+    /// Frames the current scene with its default camera.
+    pub fn reset_camera(&mut self) {
+        self.camera = view::default_camera(&self.sim, self.view_aspect);
+    }
+
+    /// Applies edited parameters to the running simulation; a bad value is reported and
+    /// the previous parameters stay.
+    pub fn apply_params(&mut self, params: SimParams) {
+        if let Err(e) = self.sim.set_params(params) {
+            self.message(Level::Error, e.to_string());
+        }
+    }
+
+    /// Applies an edited effect list (collider settings) to the running simulation.
+    pub fn apply_effects(&mut self, effects: Vec<Effect>) {
+        self.sim.set_effects(effects);
     }
 
     /// Starts importing an OBJ in the background; the current cloth stays until it succeeds.
@@ -186,40 +208,42 @@ impl ClothApp {
             }
         };
         let name = path.display().to_string();
-        match Scene::with_cloth(self.sim.scene.scenario, build.clone(), &name) {
-            Ok(mut scene) => {
-                scene.params = self.sim.scene.params.clone();
-                scene.set_density(scene.params.density);
-                scene.effects = self.sim.scene.effects.clone();
-                scene.set_pins_enabled(self.sim.scene.pins_enabled);
-                let mut text = format!(
-                    "loaded {name}: {} particles, {} triangles",
-                    scene.model.particle_count(),
-                    scene.model.triangles.len()
-                );
-                // Import notes (dropped faces and the like) stay visible with the result.
-                let level = if scene.warnings.is_empty() {
-                    Level::Info
-                } else {
-                    text += &format!(" ({})", scene.warnings.join("; "));
-                    Level::Warning
-                };
-                self.message(level, text);
-                self.cloth = build;
-                self.cloth_name = name;
-                self.sim = Simulation::new(scene);
-                self.camera = scene_camera(&self.sim);
-            }
-            Err(e) => self.message(Level::Error, e.to_string()),
+        let scene = match Scene::with_cloth(self.sim.scenario(), &build, &name) {
+            Ok(scene) => scene,
+            Err(e) => return self.message(Level::Error, e.to_string()),
+        };
+        let mut sim = Simulation::new(scene);
+        // The current parameters were validated when they were set.
+        if let Err(e) = sim.set_params(self.sim.params().clone()) {
+            return self.message(Level::Error, e.to_string());
         }
+        sim.set_effects(self.sim.effects().to_vec());
+        sim.set_pins_enabled(self.sim.pins_enabled());
+        let mut text = format!(
+            "loaded {name}: {} particles, {} triangles",
+            sim.model().particle_count(),
+            sim.model().triangles.len()
+        );
+        // Import notes (dropped faces and the like) stay visible with the result.
+        let level = if sim.warnings().is_empty() {
+            Level::Info
+        } else {
+            text += &format!(" ({})", sim.warnings().join("; "));
+            Level::Warning
+        };
+        self.message(level, text);
+        self.cloth = build;
+        self.cloth_name = name;
+        self.sim = sim;
+        self.reset_camera();
     }
 
     /// Back to the built-in cloth.
     pub fn use_default_cloth(&mut self) {
         self.cloth = default_cloth();
         self.cloth_name = DEFAULT_CLOTH_NAME.to_string();
-        let scenario = self.sim.scene.scenario;
-        self.set_scenario(scenario);
+        let scenario = self.sim.scenario().to_string();
+        self.set_scenario(&scenario);
     }
 
     pub fn reset(&mut self) {
@@ -366,7 +390,9 @@ impl ClothApp {
         let Some(viewport) = self.viewport.as_mut() else {
             return;
         };
-        if let Err(e) = viewport.draw(&rs, w, h, &self.sim, &self.camera, &self.options) {
+        self.view_aspect = w as f32 / h as f32;
+        let frame = view::frame(&self.sim);
+        if let Err(e) = viewport.draw(&rs, w, h, &frame, &self.camera, &self.options) {
             ui.label(format!("3D view: {e}"));
             return;
         }
@@ -376,7 +402,7 @@ impl ClothApp {
                 .sense(egui::Sense::click_and_drag()),
         );
         if camera_input(ui, &response, &mut self.camera) {
-            self.camera = scene_camera(&self.sim);
+            self.camera = view::default_camera(&self.sim, self.view_aspect);
         }
         let capture = std::mem::take(&mut self.capture_requested);
         if capture || self.recording.is_some() {
@@ -421,9 +447,7 @@ impl ClothApp {
         self.poll_loading();
         self.poll_writes();
 
-        let due = self
-            .transport
-            .credit(wall_dt, self.sim.scene.params.dt as f64);
+        let due = self.transport.credit(wall_dt, self.sim.params().dt as f64);
         let done = if due > 0 { self.advance(due) } else { 0 };
         self.transport.stepped(due, done);
 
@@ -465,6 +489,9 @@ impl eframe::App for ClothApp {
         self.shutdown();
     }
 }
+
+/// Width / height assumed for framing before the 3D view was first drawn.
+const DEFAULT_ASPECT: f32 = 1.4;
 
 /// The built-in cloth. It is compiled in and checked by the test suite
 /// (`the_default_asset_is_a_24x24_quad_grid`), so parsing it cannot fail at run time.

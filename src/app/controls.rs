@@ -71,23 +71,20 @@ pub fn transport_bar(ui: &mut egui::Ui, app: &mut ClothApp) {
 
 pub fn status_bar(ui: &mut egui::Ui, app: &mut ClothApp) {
     ui.horizontal_wrapped(|ui| {
-        let sim = &app.sim;
+        let (sim, model) = (&app.sim, app.sim.model());
         ui.label(format!("{:.0} fps", app.stats.fps))
             .on_hover_text(app.adapter().unwrap_or("no renderer"));
         ui.separator();
-        ui.label(format!("t = {:.2} s", sim.state.time));
+        ui.label(format!("t = {:.2} s", sim.state().time));
         ui.separator();
         ui.label(format!(
-            "{} particles · {} springs · {} bend",
-            sim.scene.model.particle_count(),
-            sim.scene.model.edge_count(),
-            sim.scene.model.springs.count(SpringKind::Bend)
+            "{} particles · {} springs ({} bend)",
+            model.particle_count(),
+            model.springs.len(),
+            model.springs.count(SpringKind::Bend)
         ));
         ui.separator();
-        ui.label(format!(
-            "KE {:.3e} J",
-            sim.state.kinetic_energy(&sim.scene.model)
-        ));
+        ui.label(format!("KE {:.3e} J", sim.state().kinetic_energy(model)));
         ui.separator();
         let phases: Vec<String> = app
             .stats
@@ -149,7 +146,7 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut ClothApp) {
 
 fn scenario_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     ui.heading("Scenario");
-    let current = app.sim.scene.scenario;
+    let current = app.sim.scenario().to_string();
     for s in SCENARIOS {
         if ui
             .selectable_label(current == s.name, s.name)
@@ -179,20 +176,17 @@ fn scenario_section(ui: &mut egui::Ui, app: &mut ClothApp) {
             app.use_default_cloth();
         }
     });
-    let mut pins = app.sim.scene.pins_enabled;
-    if !app.sim.scene.pins.is_empty() && ui.checkbox(&mut pins, "Pins").changed() {
-        app.sim.scene.set_pins_enabled(pins);
-        for &p in &app.sim.scene.model.pins {
-            app.sim.state.vel[p as usize] = glam::Vec3::ZERO;
-        }
+    let mut pins = app.sim.pins_enabled();
+    if !app.sim.scenario_pins().is_empty() && ui.checkbox(&mut pins, "Pins").changed() {
+        app.sim.set_pins_enabled(pins);
     }
     ui.separator();
 }
 
 fn solver_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     ui.heading("Solver");
+    let mut params = app.sim.params().clone();
     let mut changed = false;
-    let params = &mut app.sim.scene.params;
     for kind in IntegratorKind::ALL {
         changed |= ui
             .radio_value(&mut params.integrator, kind, kind.label())
@@ -212,26 +206,35 @@ fn solver_section(ui: &mut egui::Ui, app: &mut ClothApp) {
             .changed();
         ui.end_row();
         let label = ui.label("Substeps");
-        changed |= ui
-            .add(egui::DragValue::new(&mut params.substeps).range(1..=2000))
-            .labelled_by(label.id)
-            .changed();
+        ui.horizontal(|ui| {
+            changed |= ui
+                .add(egui::DragValue::new(&mut params.substeps).range(1..=2000))
+                .labelled_by(label.id)
+                .changed();
+            let effective = app.sim.substeps();
+            if effective != params.substeps {
+                ui.label(
+                    RichText::new(format!("in effect: {effective}"))
+                        .color(egui::Color32::from_rgb(230, 160, 40)),
+                )
+                .on_hover_text("the stability guard raised the substeps after a diverging frame");
+            }
+        });
         ui.end_row();
         ui.label("Substep");
-        ui.label(format!("{:.3} ms", 1e3 * params.h()));
+        ui.label(format!("{:.3} ms", 1e3 * app.sim.substep_length()));
         ui.end_row();
     });
     if changed {
-        app.sim.rebuild_stepper();
+        app.apply_params(params);
     }
     ui.separator();
 }
 
 fn material_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     ui.heading("Material");
+    let mut params = app.sim.params().clone();
     let mut changed = false;
-    let mut density = app.sim.scene.params.density;
-    let params = &mut app.sim.scene.params;
     for kind in SpringKind::ALL {
         let k = kind.index();
         let stiffness = Slider::new(&mut params.stiffness[k], 0.0..=5000.0)
@@ -245,11 +248,11 @@ fn material_section(ui: &mut egui::Ui, app: &mut ClothApp) {
             .text(format!("{} damping", kind.name()));
         changed |= ui.add(damping).changed();
     }
-    let density_slider = Slider::new(&mut density, 0.01..=5.0)
+    let density = Slider::new(&mut params.density, 0.01..=5.0)
         .logarithmic(true)
         .suffix(" kg/m²")
         .text("density");
-    ui.add(density_slider);
+    changed |= ui.add(density).changed();
     let gravity = Slider::new(&mut params.gravity.y, -30.0..=0.0)
         .suffix(" m/s²")
         .text("gravity");
@@ -258,19 +261,16 @@ fn material_section(ui: &mut egui::Ui, app: &mut ClothApp) {
         .suffix(" 1/s")
         .text("air damping");
     changed |= ui.add(air).changed();
-    if density != app.sim.scene.params.density {
-        app.sim.scene.set_density(density);
-        changed = true;
-    }
     if changed {
-        app.sim.rebuild_stepper();
+        app.apply_params(params);
     }
     ui.separator();
 }
 
 fn collider_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     let mut changed = false;
-    let colliders = app.sim.scene.effects.iter_mut().filter_map(|e| match e {
+    let mut effects = app.sim.effects().to_vec();
+    let colliders = effects.iter_mut().filter_map(|e| match e {
         Effect::Collider(c) => Some(c),
         _ => None,
     });
@@ -313,7 +313,7 @@ fn collider_section(ui: &mut egui::Ui, app: &mut ClothApp) {
         }
     }
     if changed {
-        app.sim.rebuild_stepper();
+        app.apply_effects(effects);
     }
     if any {
         ui.separator();
@@ -349,7 +349,7 @@ fn render_section(ui: &mut egui::Ui, app: &mut ClothApp) {
         .on_hover_text("or double-click the view")
         .clicked()
     {
-        app.camera = crate::render::scene_camera(&app.sim);
+        app.reset_camera();
     }
     ui.label(RichText::new("drag: orbit · shift/middle-drag: pan · wheel: zoom").weak());
 }

@@ -4,10 +4,9 @@
 use egui_wgpu::RenderState;
 
 use crate::render::{
-    FrameInput, OrbitCamera, RenderError, RenderOptions, RenderTarget, Renderer, RgbaImage,
-    read_target, supported_sample_count,
+    Frame, OrbitCamera, RenderError, RenderOptions, RenderTarget, Renderer, RgbaImage, read_target,
+    supported_sample_count,
 };
-use crate::scene::Simulation;
 
 /// Radians of orbit per point dragged.
 const ORBIT_PER_POINT: f32 = 0.008;
@@ -41,7 +40,7 @@ impl Viewport {
         })
     }
 
-    /// Resizes the target to `width × height` pixels if needed and draws the simulation.
+    /// Resizes the target to `width × height` pixels if needed and draws the frame.
     ///
     /// # Errors
     /// [`RenderError::BadSize`].
@@ -50,7 +49,7 @@ impl Viewport {
         rs: &RenderState,
         width: u32,
         height: u32,
-        sim: &Simulation,
+        frame: &Frame<'_>,
         camera: &OrbitCamera,
         options: &RenderOptions,
     ) -> Result<(), RenderError> {
@@ -65,9 +64,8 @@ impl Viewport {
                 self.texture,
             );
         }
-        let frame = FrameInput::of(sim);
         self.renderer
-            .render(&rs.device, &rs.queue, &self.target, camera, &frame, options);
+            .render(&rs.device, &rs.queue, &self.target, camera, frame, options);
         Ok(())
     }
 

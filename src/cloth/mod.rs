@@ -1,7 +1,9 @@
 //! Cloth model (static) and state (per step).
 
+mod adjacency;
 mod model;
 mod state;
 
+pub use adjacency::Adjacency;
 pub use model::{ClothModel, Springs};
 pub use state::ClothState;

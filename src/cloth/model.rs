@@ -4,8 +4,10 @@ use glam::{Vec2, Vec3};
 
 use crate::mesh::{ClothMesh, SpringKind};
 
+use super::adjacency::Adjacency;
+
 /// Springs as flat arrays (structure of arrays), in a deterministic order: the mesh's
-/// sorted unique edges first, then one bend spring per bend pair.
+/// sorted unique edges first, then the quads' second diagonals, then the bend pairs.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Springs {
     pub a: Vec<u32>,
@@ -38,6 +40,10 @@ pub struct ClothModel {
     pub uvs: Vec<Vec2>,
     pub triangles: Vec<[u32; 3]>,
     pub springs: Springs,
+    /// How many unique edges the triangulated mesh has (the first springs).
+    pub mesh_edges: usize,
+    /// Which springs meet at each particle.
+    pub adjacency: Adjacency,
     /// Particle mass, kg (lumped from areal density by triangle area).
     pub mass: Vec<f32>,
     /// 1/mass, 1/kg; 0 for pinned particles.
@@ -55,13 +61,7 @@ impl ClothModel {
     pub fn new(mesh: &ClothMesh, density: f32, pins: &[u32]) -> Self {
         let n = mesh.positions.len();
         let mut springs = Springs::default();
-        let pairs = mesh
-            .edges
-            .iter()
-            .zip(&mesh.edge_kinds)
-            .map(|(e, &k)| (*e, k))
-            .chain(mesh.bend_pairs.iter().map(|&p| (p, SpringKind::Bend)));
-        for ([a, b], kind) in pairs {
+        for ([a, b], kind) in mesh.springs() {
             springs.a.push(a);
             springs.b.push(b);
             springs
@@ -70,10 +70,12 @@ impl ClothModel {
             springs.kind.push(kind);
         }
         let mut model = Self {
+            adjacency: Adjacency::new(n, &springs),
             rest_positions: mesh.positions.clone(),
             uvs: mesh.uvs.clone(),
             triangles: mesh.triangles.clone(),
             springs,
+            mesh_edges: mesh.edges.len(),
             mass: vec![0.0; n],
             inv_mass: vec![0.0; n],
             pins: Vec::new(),
@@ -84,13 +86,33 @@ impl ClothModel {
         model
     }
 
-    pub fn particle_count(&self) -> usize {
-        self.rest_positions.len()
+    /// A model of point masses joined by `springs`, without triangles (chains, oscillators,
+    /// tests). `mass` is per particle, kg; `pins` get inverse mass 0.
+    pub fn from_springs(
+        rest_positions: Vec<Vec3>,
+        springs: Springs,
+        mass: Vec<f32>,
+        pins: &[u32],
+    ) -> Self {
+        let n = rest_positions.len();
+        let mut model = Self {
+            adjacency: Adjacency::new(n, &springs),
+            uvs: vec![Vec2::ZERO; n],
+            triangles: Vec::new(),
+            mesh_edges: 0,
+            springs,
+            rest_positions,
+            inv_mass: vec![0.0; n],
+            mass,
+            pins: Vec::new(),
+            density: 0.0,
+        };
+        model.set_pins(pins);
+        model
     }
 
-    /// Mesh edges (structural + shear springs), the count `info` reports as springs.
-    pub fn edge_count(&self) -> usize {
-        self.springs.len() - self.springs.count(SpringKind::Bend)
+    pub fn particle_count(&self) -> usize {
+        self.rest_positions.len()
     }
 
     /// Recomputes masses from an areal density, kg/m².

@@ -4,17 +4,13 @@ use glam::Vec3;
 
 use super::model::ClothModel;
 
-/// Positions, velocities, and the previous positions position-Verlet needs. Reset is a copy
-/// of the initial state.
+/// Positions and velocities at a simulated time. Reset is a copy of the initial state.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ClothState {
     /// Metres.
     pub pos: Vec<Vec3>,
     /// Metres per second.
     pub vel: Vec<Vec3>,
-    /// Positions one step ago (metres); kept consistent by every integrator and collider so
-    /// switching integrators mid-run is seamless.
-    pub prev_pos: Vec<Vec3>,
     /// Simulated time, seconds.
     pub time: f64,
 }
@@ -25,7 +21,6 @@ impl ClothState {
         Self {
             pos: model.rest_positions.clone(),
             vel: vec![Vec3::ZERO; model.particle_count()],
-            prev_pos: model.rest_positions.clone(),
             time: 0.0,
         }
     }

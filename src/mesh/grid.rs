@@ -2,7 +2,11 @@
 
 use glam::{Vec2, Vec3};
 
+use std::path::Path;
+
+use super::error::ObjError;
 use super::polygons::PolygonSoup;
+use super::topology::{ClothMesh, build_mesh};
 
 /// The plane a generated grid lies in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -85,5 +89,13 @@ impl GridSpec {
     /// The grid as OBJ text (one `v` and `vt` per vertex, one quad `f` per cell).
     pub fn to_obj(&self) -> String {
         super::obj::write_obj(&self.polygons())
+    }
+
+    /// The grid's cloth topology (identical to importing [`GridSpec::to_obj`]).
+    ///
+    /// # Errors
+    /// [`ObjError::Empty`] when a size is zero or not finite.
+    pub fn build(&self) -> Result<ClothMesh, ObjError> {
+        Ok(build_mesh(&self.polygons(), Path::new("<grid>"))?.mesh)
     }
 }

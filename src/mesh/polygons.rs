@@ -34,4 +34,20 @@ impl PolygonSoup {
     pub fn face_count(&self) -> usize {
         self.face_arities.len()
     }
+
+    /// The same surface with every polygon fan-split into triangles (corner 0, k, k+1).
+    pub fn triangulated(&self) -> PolygonSoup {
+        let mut face_indices = Vec::with_capacity(self.face_indices.len() * 2);
+        for face in self.faces() {
+            for k in 1..face.len() - 1 {
+                face_indices.extend_from_slice(&[face[0], face[k], face[k + 1]]);
+            }
+        }
+        PolygonSoup {
+            positions: self.positions.clone(),
+            uvs: self.uvs.clone(),
+            face_arities: vec![3; face_indices.len() / 3],
+            face_indices,
+        }
+    }
 }

@@ -2,7 +2,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::topology::{bounds, thinnest_axis};
+use super::bounds::{bounds, thinnest_axis};
 
 /// Planar projection onto the two largest extents of the bounding box, with one common
 /// scale so a checker stays square: the longer side maps to `[0, 1]`.

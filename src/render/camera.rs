@@ -18,8 +18,8 @@ impl Default for OrbitCamera {
     fn default() -> Self {
         Self {
             target: Vec3::new(0.0, 0.7, 0.0),
-            yaw: 0.5,
-            pitch: 0.35,
+            yaw: 0.45,
+            pitch: 0.6,
             distance: 2.8,
             fov_y: 45f32.to_radians(),
         }
@@ -79,15 +79,47 @@ impl OrbitCamera {
         self.target += (right * dx + up * dy) * visible;
     }
 
-    /// Frames a bounding box: looks at its centre from a distance that fits it.
-    pub fn framing(lo: Vec3, hi: Vec3) -> Self {
-        let fov_y = Self::default().fov_y;
-        let radius = (0.5 * (hi - lo).length()).max(0.1);
-        Self {
-            target: 0.5 * (lo + hi),
-            distance: radius / (0.5 * fov_y).sin() * 1.1,
+    /// Frames `points` in a view of `aspect` = width / height from the default direction:
+    /// looks at the centre of their bounding box from the nearest distance at which every
+    /// point falls inside the central 90 % of the picture.
+    pub fn framing(points: &[Vec3], aspect: f32) -> Self {
+        let d = Self::default();
+        Self::framing_from(points, aspect, d.yaw, d.pitch)
+    }
+
+    /// As [`OrbitCamera::framing`], looking from `yaw` and `pitch` (radians).
+    pub fn framing_from(points: &[Vec3], aspect: f32, yaw: f32, pitch: f32) -> Self {
+        let (lo, hi) = points.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
+        let mut camera = Self {
+            target: if points.is_empty() {
+                Vec3::ZERO
+            } else {
+                0.5 * (lo + hi)
+            },
+            distance: 1.0,
+            yaw,
+            pitch,
             ..Self::default()
+        };
+        let back = (camera.eye() - camera.target).normalize();
+        let right = (-back).cross(Vec3::Y).normalize();
+        let up = right.cross(-back);
+        let tan_y = 0.9 * (0.5 * camera.fov_y).tan();
+        let tan_x = tan_y * aspect.max(1e-3);
+        let mut distance = MIN_DISTANCE;
+        for &p in points {
+            let o = p - camera.target;
+            // Depth from the eye is `distance − o·back`; the point fits when its offsets
+            // across the view are within the half-angles at that depth.
+            let toward = o.dot(back);
+            distance = distance
+                .max(toward + o.dot(right).abs() / tan_x)
+                .max(toward + o.dot(up).abs() / tan_y);
         }
+        camera.distance = distance.clamp(MIN_DISTANCE, MAX_DISTANCE);
+        camera
     }
 
     /// Projects a world point to pixel coordinates (origin top-left) in a `width × height`

@@ -66,3 +66,15 @@ pub fn ground_quad(half: f32) -> (Vec<SolidVertex>, Vec<u32>) {
         vec![0, 1, 2, 0, 2, 3],
     )
 }
+
+/// Unique edges `[a, b]` (`a < b`, sorted) of a triangle list, for the wireframe.
+pub fn triangle_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut edges: Vec<[u32; 2]> = triangles
+        .iter()
+        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+        .map(|[a, b]| [a.min(b), a.max(b)])
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+}

@@ -5,13 +5,14 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Quat, Vec3};
 use wgpu::util::DeviceExt;
 
-use crate::cloth::ClothModel;
 use crate::mesh::{SpringKind, vertex_normals};
-use crate::sim::Collider;
 
 use super::buffer::GrowBuffer;
 use super::camera::OrbitCamera;
-use super::geometry::{ClothVertex, ColorVertex, SolidVertex, ground_quad, uv_sphere};
+use super::frame::{Frame, Shape};
+use super::geometry::{
+    ClothVertex, ColorVertex, SolidVertex, ground_quad, triangle_edges, uv_sphere,
+};
 use super::options::{RenderOptions, SpringColoring};
 use super::pipelines::Pipelines;
 use super::target::RenderTarget;
@@ -28,28 +29,6 @@ pub const CLEAR_COLOR: wgpu::Color = wgpu::Color {
 const GROUND_HALF_SIZE: f32 = 6.0;
 /// Grid spacing on the ground, metres.
 const GROUND_GRID: f32 = 0.25;
-
-/// One frame's worth of simulation data to draw.
-pub struct FrameInput<'a> {
-    pub model: &'a ClothModel,
-    /// Current particle positions, metres.
-    pub positions: &'a [Vec3],
-    pub colliders: &'a [Collider],
-    /// Simulated time, seconds (turns spinning spheres).
-    pub time: f64,
-}
-
-impl<'a> FrameInput<'a> {
-    /// The current frame of a running simulation.
-    pub fn of(sim: &'a crate::scene::Simulation) -> Self {
-        Self {
-            model: &sim.scene.model,
-            positions: &sim.state.pos,
-            colliders: sim.stepper().colliders(),
-            time: sim.state.time,
-        }
-    }
-}
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -110,6 +89,8 @@ pub struct Renderer {
     cloth_indices: GrowBuffer,
     /// The triangles last uploaded; indices are re-uploaded only when they change.
     uploaded_triangles: Vec<[u32; 3]>,
+    /// Unique edges of those triangles, for the wireframe.
+    wire_edges: Vec<[u32; 2]>,
     lines: GrowBuffer,
     line_vertices: u32,
     points: GrowBuffer,
@@ -157,6 +138,7 @@ impl Renderer {
                 1 << 16,
             ),
             uploaded_triangles: Vec::new(),
+            wire_edges: Vec::new(),
             lines: GrowBuffer::new(device, "clothsim lines", vertex, 1 << 16),
             line_vertices: 0,
             points: GrowBuffer::new(device, "clothsim points", vertex, 1 << 14),
@@ -184,7 +166,7 @@ impl Renderer {
         queue: &wgpu::Queue,
         target: &RenderTarget,
         camera: &OrbitCamera,
-        frame: &FrameInput<'_>,
+        frame: &Frame<'_>,
         options: &RenderOptions,
     ) {
         if target.sample_count() != self.sample_count {
@@ -194,6 +176,7 @@ impl Renderer {
         let (width, height) = target.size();
         self.upload_globals(queue, camera, width, height, options);
         // Normals and vertices are only worth computing when the surface is drawn.
+        self.update_topology(device, queue, frame);
         if options.mesh {
             self.upload_cloth(device, queue, frame);
         }
@@ -276,21 +259,25 @@ impl Renderer {
         queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&raw));
     }
 
-    fn upload_cloth(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, frame: &FrameInput<'_>) {
-        let model = frame.model;
-        if self.uploaded_triangles != model.triangles {
-            self.uploaded_triangles.clone_from(&model.triangles);
+    /// Re-uploads indices and re-derives wireframe edges only when the triangles changed.
+    fn update_topology(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, frame: &Frame<'_>) {
+        if self.uploaded_triangles != frame.triangles {
+            self.uploaded_triangles = frame.triangles.to_vec();
+            self.wire_edges = triangle_edges(frame.triangles);
             self.cloth_indices
-                .write(device, queue, bytemuck::cast_slice(&model.triangles));
+                .write(device, queue, bytemuck::cast_slice(frame.triangles));
         }
-        vertex_normals(frame.positions, &model.triangles, &mut self.normals);
+    }
+
+    fn upload_cloth(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, frame: &Frame<'_>) {
+        vertex_normals(frame.positions, frame.triangles, &mut self.normals);
         self.cloth_scratch.clear();
         self.cloth_scratch.extend(
             frame
                 .positions
                 .iter()
                 .zip(&self.normals)
-                .zip(&model.uvs)
+                .zip(frame.uvs)
                 .map(|((p, n), uv)| ClothVertex {
                     position: p.to_array(),
                     normal: n.to_array(),
@@ -305,10 +292,10 @@ impl Renderer {
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        frame: &FrameInput<'_>,
+        frame: &Frame<'_>,
         options: &RenderOptions,
     ) {
-        let s = &frame.model.springs;
+        let s = &frame.springs;
         let pos = frame.positions;
         let lines = &mut self.line_scratch;
         lines.clear();
@@ -323,14 +310,12 @@ impl Renderer {
             });
         };
         if options.wireframe {
-            for i in 0..s.len() {
-                if s.kind[i] != SpringKind::Bend {
-                    push(s.a[i], s.b[i], [0.02, 0.02, 0.03, 0.85]);
-                }
+            for &[a, b] in &self.wire_edges {
+                push(a, b, [0.02, 0.02, 0.03, 0.85]);
             }
         }
         if options.springs {
-            for i in 0..s.len() {
+            for i in 0..s.a.len() {
                 let kind = s.kind[i];
                 if !options.spring_kinds[kind.index()] {
                     continue;
@@ -354,35 +339,30 @@ impl Renderer {
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        frame: &FrameInput<'_>,
+        frame: &Frame<'_>,
         options: &RenderOptions,
     ) {
         self.point_scratch.clear();
         if options.particles {
-            let w = &frame.model.inv_mass;
             self.point_scratch
-                .extend(frame.positions.iter().zip(w).map(|(p, &w)| ColorVertex {
+                .extend(frame.positions.iter().map(|p| ColorVertex {
                     position: p.to_array(),
-                    color: if w == 0.0 {
-                        [1.0, 0.05, 0.05, 1.0]
-                    } else {
-                        [1.0, 0.85, 0.15, 1.0]
-                    },
+                    color: [1.0, 0.85, 0.15, 1.0],
                 }));
+            for &p in frame.pinned {
+                if let Some(v) = self.point_scratch.get_mut(p as usize) {
+                    v.color = [1.0, 0.05, 0.05, 1.0];
+                }
+            }
         }
         self.point_count = self.point_scratch.len() as u32;
         self.points
             .write(device, queue, bytemuck::cast_slice(&self.point_scratch));
     }
 
-    /// Writes one uniform slot per collider and lists them in `solid_draws`.
-    fn upload_solids(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        frame: &FrameInput<'_>,
-    ) {
-        while self.solids.len() < frame.colliders.len() {
+    /// Writes one uniform slot per shape and lists them in `solid_draws`.
+    fn upload_solids(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, frame: &Frame<'_>) {
+        while self.solids.len() < frame.shapes.len() {
             let buffer = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("clothsim solid"),
                 size: std::mem::size_of::<SolidRaw>() as u64,
@@ -399,29 +379,23 @@ impl Renderer {
             });
             self.solids.push(SolidSlot { buffer, bind_group });
         }
-        for (slot, collider) in frame.colliders.iter().enumerate() {
-            let raw = match *collider {
-                Collider::Sphere {
+        for (slot, shape) in frame.shapes.iter().enumerate() {
+            let raw = match *shape {
+                Shape::Sphere {
                     center,
                     radius,
-                    spin,
-                    ..
-                } => {
-                    let angle = spin.length() * frame.time as f32;
-                    let rotation =
-                        Quat::from_axis_angle(spin.try_normalize().unwrap_or(Vec3::Y), angle);
-                    SolidRaw {
-                        model: Mat4::from_scale_rotation_translation(
-                            Vec3::splat(radius),
-                            rotation,
-                            center,
-                        )
-                        .to_cols_array_2d(),
-                        color: [0.30, 0.42, 0.62, 1.0],
-                        pattern: [0.0, 0.0, 0.0, 0.0],
-                    }
-                }
-                Collider::Plane { point, normal, .. } => SolidRaw {
+                    rotation,
+                } => SolidRaw {
+                    model: Mat4::from_scale_rotation_translation(
+                        Vec3::splat(radius),
+                        rotation,
+                        center,
+                    )
+                    .to_cols_array_2d(),
+                    color: [0.30, 0.42, 0.62, 1.0],
+                    pattern: [0.0, 0.0, 0.0, 0.0],
+                },
+                Shape::Plane { point, normal } => SolidRaw {
                     model: Mat4::from_rotation_translation(
                         Quat::from_rotation_arc(Vec3::Y, normal.normalize()),
                         point,
@@ -433,7 +407,7 @@ impl Renderer {
             };
             queue.write_buffer(&self.solids[slot].buffer, 0, bytemuck::bytes_of(&raw));
             self.solid_draws
-                .push((slot, matches!(collider, Collider::Sphere { .. })));
+                .push((slot, matches!(shape, Shape::Sphere { .. })));
         }
     }
 }

@@ -1,4 +1,4 @@
-//! Errors of building a scene.
+//! Errors of building a scene or changing a running simulation.
 
 use crate::mesh::ObjError;
 
@@ -8,6 +8,7 @@ pub enum SceneError {
     Obj(#[from] ObjError),
     #[error("unknown scenario `{name}`; available: {available}")]
     UnknownScenario { name: String, available: String },
-    #[error("invalid parameters: {0}")]
+    /// A parameter set was refused; the simulation keeps the parameters it had.
+    #[error("{0}; the previous parameters are kept")]
     Params(String),
 }

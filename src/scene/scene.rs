@@ -1,4 +1,5 @@
-//! A scene: a placed cloth, its parameters and the effects that act on it.
+//! A scene: a placed cloth, its parameters and the effects that act on it — everything a
+//! [`super::Simulation`] starts from.
 
 use std::path::Path;
 
@@ -6,7 +7,7 @@ use glam::{Mat3, Vec3};
 
 use crate::cloth::{ClothModel, ClothState};
 use crate::mesh::{self, ClothMesh, GridOrientation, MeshBuild, bounds, thinnest_axis};
-use crate::sim::{Effect, SimParams};
+use crate::sim::{Collider, Effect, SimParams};
 
 use super::error::SceneError;
 use super::registry::{PinRule, SCENARIOS, Scenario, ScenarioSetup, scenario};
@@ -16,22 +17,20 @@ pub const DEFAULT_CLOTH_OBJ: &str = include_str!("../../assets/cloth.obj");
 /// Name the default cloth goes by in messages.
 pub const DEFAULT_CLOTH_NAME: &str = "assets/cloth.obj";
 
-/// Everything needed to start (and reset) a simulation.
+/// Everything needed to start a simulation. A [`super::Simulation`] takes it over; from
+/// then on the simulation owns these values.
 #[derive(Clone, Debug)]
 pub struct Scene {
     /// Registry name of the scenario.
-    pub scenario: &'static str,
+    pub scenario: String,
     /// Where the cloth came from (a file path or the built-in asset).
     pub cloth_name: String,
-    /// The cloth's topology, placed for this scenario.
-    pub mesh: ClothMesh,
     pub model: ClothModel,
     pub initial: ClothState,
     pub params: SimParams,
     pub effects: Vec<Effect>,
-    /// The scenario's pins (applied while `pins_enabled`).
+    /// The scenario's pins (applied while pins are enabled).
     pub pins: Vec<u32>,
-    pub pins_enabled: bool,
     /// Notes from import (dropped faces and the like).
     pub warnings: Vec<String>,
 }
@@ -43,7 +42,7 @@ impl Scene {
     /// [`SceneError::UnknownScenario`].
     pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         let cloth = mesh::obj_from_str(DEFAULT_CLOTH_OBJ, DEFAULT_CLOTH_NAME)?;
-        Self::with_cloth(name, cloth, DEFAULT_CLOTH_NAME)
+        Self::with_cloth(name, &cloth, DEFAULT_CLOTH_NAME)
     }
 
     /// Builds a registered scenario with the cloth of an OBJ file.
@@ -52,14 +51,18 @@ impl Scene {
     /// [`SceneError::UnknownScenario`], or the file's [`mesh::ObjError`].
     pub fn with_obj(name: &str, path: &Path) -> Result<Scene, SceneError> {
         let cloth = mesh::load_obj(path)?;
-        Self::with_cloth(name, cloth, &path.display().to_string())
+        Self::with_cloth(name, &cloth, &path.display().to_string())
     }
 
     /// Builds a registered scenario around an already imported cloth.
     ///
     /// # Errors
     /// [`SceneError::UnknownScenario`].
-    pub fn with_cloth(name: &str, cloth: MeshBuild, cloth_name: &str) -> Result<Scene, SceneError> {
+    pub fn with_cloth(
+        name: &str,
+        cloth: &MeshBuild,
+        cloth_name: &str,
+    ) -> Result<Scene, SceneError> {
         let entry = lookup(name)?;
         Ok(Self::from_setup(entry, entry.setup(), cloth, cloth_name))
     }
@@ -68,10 +71,10 @@ impl Scene {
     pub fn from_setup(
         entry: &'static Scenario,
         setup: ScenarioSetup,
-        cloth: MeshBuild,
+        cloth: &MeshBuild,
         cloth_name: &str,
     ) -> Scene {
-        let mut mesh = cloth.mesh;
+        let mut mesh = cloth.mesh.clone();
         place(&mut mesh, setup.orientation, setup.center);
         let pins = match setup.pins {
             PinRule::None => Vec::new(),
@@ -80,40 +83,21 @@ impl Scene {
         let model = ClothModel::new(&mesh, setup.params.density, &pins);
         let initial = ClothState::at_rest(&model);
         Scene {
-            scenario: entry.name,
+            scenario: entry.name.to_string(),
             cloth_name: cloth_name.to_string(),
-            mesh,
             model,
             initial,
             params: setup.params,
             effects: setup.effects,
             pins,
-            pins_enabled: true,
-            warnings: cloth.warnings,
+            warnings: cloth.warnings.clone(),
         }
     }
 
-    /// Switches the scenario's pins on or off (rebuilds inverse masses).
-    pub fn set_pins_enabled(&mut self, enabled: bool) {
-        self.pins_enabled = enabled;
-        let pins = if enabled {
-            self.pins.clone()
-        } else {
-            Vec::new()
-        };
-        self.model.set_pins(&pins);
-    }
-
-    /// Applies a new areal density (kg/m²) to the masses.
-    pub fn set_density(&mut self, density: f32) {
-        self.params.density = density;
-        self.model.set_density(density);
-    }
-
-    /// The sphere collider, if the scene has one.
-    pub fn sphere_mut(&mut self) -> Option<&mut crate::sim::Collider> {
+    /// The sphere collider, if the scene has one (to adjust before simulating).
+    pub fn sphere_mut(&mut self) -> Option<&mut Collider> {
         self.effects.iter_mut().find_map(|e| match e {
-            Effect::Collider(c @ crate::sim::Collider::Sphere { .. }) => Some(c),
+            Effect::Collider(c @ Collider::Sphere { .. }) => Some(c),
             _ => None,
         })
     }

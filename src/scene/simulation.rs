@@ -1,78 +1,182 @@
-//! A running simulation: a scene, its current state and the stepper built from its effects.
-//! The GUI, the CLI and the tests all drive this one type.
+//! A running simulation: the one owner of the cloth's model and state, its parameters, its
+//! effects and the step backend. The GUI, the CLI and the tests change things only through
+//! it, and it tells the backend exactly what a change made stale.
 
-use std::time::Instant;
+use crate::cloth::{ClothModel, ClothState};
+use crate::sim::{
+    Collider, CpuStepper, Diverged, Effect, FrameOutcome, PhaseTimings, SimParams, StepBackend,
+    StepError, StepReport, StepStats, colliders_of,
+};
 
-use crate::cloth::ClothState;
-use crate::sim::{Diverged, FrameOutcome, PhaseTimings, Stepper};
-
+use super::error::SceneError;
 use super::scene::Scene;
 
-/// Scene + live state + stepper.
+/// Scene data, live state, parameters, effects and the backend that steps them.
 pub struct Simulation {
-    pub scene: Scene,
-    pub state: ClothState,
-    stepper: Stepper,
+    scenario: String,
+    cloth_name: String,
+    warnings: Vec<String>,
+    /// The scenario's pins, applied while `pins_enabled`.
+    scenario_pins: Vec<u32>,
+    pins_enabled: bool,
+    model: ClothModel,
+    initial: ClothState,
+    state: ClothState,
+    params: SimParams,
+    effects: Vec<Effect>,
+    backend: Box<dyn StepBackend>,
     /// Frames advanced since the last reset.
-    pub frames: u64,
-}
-
-/// A headless run's result, as `clothsim simulate --json` prints it.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct RunSummary {
-    pub scene: String,
-    pub cloth: String,
-    pub integrator: String,
-    pub particles: usize,
-    /// Mesh edges (structural + shear springs).
-    pub springs: usize,
-    pub bend_pairs: usize,
-    pub simulated_seconds: f64,
-    pub frames: u64,
-    pub dt: f32,
-    /// Substeps per frame at the end of the run (the guard may have raised them).
-    pub substeps: u32,
-    pub finite: bool,
-    /// m/s.
-    pub max_speed: f32,
-    /// Smallest signed particle-to-surface distance, metres; null without colliders.
-    pub min_collider_distance: Option<f32>,
-    /// Joules.
-    pub kinetic_energy: f64,
-    pub wall_seconds: f64,
-    /// Frames the guard had to redo with more substeps.
-    pub refined_frames: u64,
-    /// Set when the run stopped early because it diverged.
-    pub error: Option<String>,
+    frames: u64,
 }
 
 impl Simulation {
-    /// Starts the scene from its initial state.
+    /// Starts the scene from its initial state on the CPU backend.
     pub fn new(scene: Scene) -> Self {
-        let stepper = Stepper::new(&scene.params, &scene.effects);
+        let backend = Box::new(CpuStepper::new(&scene.model, &scene.params, &scene.effects));
+        Self::with_backend(scene, backend)
+    }
+
+    /// Starts the scene on the given backend (configured here with the scene's parameters).
+    pub fn with_backend(scene: Scene, mut backend: Box<dyn StepBackend>) -> Self {
+        backend.configure(&scene.model, &scene.params, &scene.effects);
         Self {
+            scenario: scene.scenario,
+            cloth_name: scene.cloth_name,
+            warnings: scene.warnings,
+            scenario_pins: scene.pins,
+            pins_enabled: true,
             state: scene.initial.clone(),
-            scene,
-            stepper,
+            initial: scene.initial,
+            model: scene.model,
+            params: scene.params,
+            effects: scene.effects,
+            backend,
             frames: 0,
         }
     }
 
-    /// Back to the initial state (parameters kept).
+    pub fn scenario(&self) -> &str {
+        &self.scenario
+    }
+
+    pub fn cloth_name(&self) -> &str {
+        &self.cloth_name
+    }
+
+    /// Notes from importing the cloth.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    pub fn model(&self) -> &ClothModel {
+        &self.model
+    }
+
+    pub fn state(&self) -> &ClothState {
+        &self.state
+    }
+
+    /// The state the simulation started from (and returns to on reset).
+    pub fn initial(&self) -> &ClothState {
+        &self.initial
+    }
+
+    pub fn params(&self) -> &SimParams {
+        &self.params
+    }
+
+    pub fn effects(&self) -> &[Effect] {
+        &self.effects
+    }
+
+    /// The colliders among the effects.
+    pub fn colliders(&self) -> Vec<Collider> {
+        colliders_of(&self.effects)
+    }
+
+    /// Frames advanced since the last reset.
+    pub fn frames(&self) -> u64 {
+        self.frames
+    }
+
+    /// Name of the step backend ("cpu", …).
+    pub fn backend_name(&self) -> &'static str {
+        self.backend.name()
+    }
+
+    /// Replaces the parameters of the running simulation. The state, the time, the
+    /// timings and the substeps the guard raised are kept (unless `substeps` itself changed);
+    /// a new density rescales the masses.
+    ///
+    /// # Errors
+    /// [`SceneError::Params`] naming the bad value; nothing changes then.
+    pub fn set_params(&mut self, params: SimParams) -> Result<(), SceneError> {
+        params.validate().map_err(SceneError::Params)?;
+        if params.density != self.params.density {
+            self.model.set_density(params.density);
+            self.backend.invalidate();
+        }
+        self.params = params;
+        self.backend
+            .configure(&self.model, &self.params, &self.effects);
+        Ok(())
+    }
+
+    /// Replaces the effect list (switches forces on or off, moves or retunes colliders).
+    pub fn set_effects(&mut self, effects: Vec<Effect>) {
+        self.effects = effects;
+        self.backend
+            .configure(&self.model, &self.params, &self.effects);
+    }
+
+    /// The scenario's pins (whether or not they are enabled).
+    pub fn scenario_pins(&self) -> &[u32] {
+        &self.scenario_pins
+    }
+
+    pub fn pins_enabled(&self) -> bool {
+        self.pins_enabled
+    }
+
+    /// Switches the scenario's pins on or off. Newly pinned particles stop where they are.
+    pub fn set_pins_enabled(&mut self, enabled: bool) {
+        self.pins_enabled = enabled;
+        let pins = if enabled {
+            self.scenario_pins.clone()
+        } else {
+            Vec::new()
+        };
+        self.model.set_pins(&pins);
+        for &p in &self.model.pins {
+            self.state.vel[p as usize] = glam::Vec3::ZERO;
+        }
+        self.backend.invalidate();
+    }
+
+    /// Changes the live state (a drag, a throw); the backend is told.
+    pub fn modify_state(&mut self, change: impl FnOnce(&mut ClothState)) {
+        change(&mut self.state);
+        self.backend.invalidate();
+    }
+
+    /// Substeps per frame in effect: the requested count, or more if the guard raised it.
+    pub fn substeps(&self) -> u32 {
+        self.backend.substeps()
+    }
+
+    /// The substep in effect, seconds.
+    pub fn substep_length(&self) -> f32 {
+        self.backend.substep_length()
+    }
+
+    /// Back to the initial state; parameters, effects and pins are kept.
     pub fn reset(&mut self) {
-        self.state.clone_from(&self.scene.initial);
+        self.state.clone_from(&self.initial);
+        for &p in &self.model.pins {
+            self.state.vel[p as usize] = glam::Vec3::ZERO;
+        }
         self.frames = 0;
-        self.rebuild_stepper();
-    }
-
-    /// Rebuilds the stepper after the scene's parameters or effects changed; the state is
-    /// kept, so changes apply live.
-    pub fn rebuild_stepper(&mut self) {
-        self.stepper = Stepper::new(&self.scene.params, &self.scene.effects);
-    }
-
-    pub fn stepper(&self) -> &Stepper {
-        &self.stepper
+        self.backend.invalidate();
     }
 
     /// Advances one frame (`params.dt`).
@@ -80,66 +184,27 @@ impl Simulation {
     /// # Errors
     /// [`Diverged`]: the state is left at the frame's start.
     pub fn step_frame(&mut self) -> Result<FrameOutcome, Diverged> {
-        let out = self.stepper.frame(&self.scene.model, &mut self.state)?;
+        let out = self.backend.frame(&self.model, &mut self.state)?;
         self.frames += 1;
         Ok(out)
     }
 
-    /// Advances one substep (`dt / substeps`) with no divergence guard; for tests and
-    /// tools that inspect every substep.
-    pub fn substep(&mut self) {
-        self.stepper.substep(&self.scene.model, &mut self.state);
+    /// Advances one substep with no divergence guard; for tests and tools that inspect
+    /// every substep.
+    ///
+    /// # Errors
+    /// The integrator's [`StepError`].
+    pub fn substep(&mut self) -> Result<StepReport, StepError> {
+        self.backend.substep(&self.model, &mut self.state)
     }
 
-    /// Timings since the last call, by phase.
+    /// Wall time per phase since the last call.
     pub fn take_timings(&mut self) -> PhaseTimings {
-        self.stepper.take_timings()
+        self.backend.take_timings()
     }
 
-    /// Runs headless for `seconds` of simulated time (whole frames) and summarises.
-    pub fn run(&mut self, seconds: f64) -> RunSummary {
-        let frames = (seconds / self.scene.params.dt as f64).round().max(0.0) as u64;
-        let start = Instant::now();
-        let mut refined = 0;
-        let mut error = None;
-        for _ in 0..frames {
-            match self.step_frame() {
-                Ok(FrameOutcome::Stepped) => {}
-                Ok(FrameOutcome::Refined { .. }) => refined += 1,
-                Err(e) => {
-                    error = Some(e.to_string());
-                    break;
-                }
-            }
-        }
-        let wall = start.elapsed().as_secs_f64();
-        let mut summary = self.summary(wall);
-        summary.refined_frames = refined;
-        summary.error = error;
-        summary
-    }
-
-    /// The current state's summary; `wall_seconds` as given.
-    pub fn summary(&self, wall_seconds: f64) -> RunSummary {
-        let model = &self.scene.model;
-        RunSummary {
-            scene: self.scene.scenario.to_string(),
-            cloth: self.scene.cloth_name.clone(),
-            integrator: self.scene.params.integrator.name().to_string(),
-            particles: model.particle_count(),
-            springs: model.edge_count(),
-            bend_pairs: model.springs.count(crate::mesh::SpringKind::Bend),
-            simulated_seconds: self.state.time,
-            frames: self.frames,
-            dt: self.scene.params.dt,
-            substeps: self.stepper.substeps(),
-            finite: self.state.is_finite(),
-            max_speed: self.state.max_speed(),
-            min_collider_distance: self.stepper.min_collider_distance(&self.state),
-            kinetic_energy: self.state.kinetic_energy(model),
-            wall_seconds,
-            refined_frames: 0,
-            error: None,
-        }
+    /// Work counters since the last call.
+    pub fn take_stats(&mut self) -> StepStats {
+        self.backend.take_stats()
     }
 }

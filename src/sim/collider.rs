@@ -26,13 +26,6 @@ pub enum Collider {
 }
 
 impl Collider {
-    pub fn name(&self) -> &'static str {
-        match self {
-            Collider::Sphere { .. } => "sphere",
-            Collider::Plane { .. } => "plane",
-        }
-    }
-
     /// Signed distance from `p` to the surface (metres, negative inside), the outward unit
     /// normal there, and the surface velocity there (m/s).
     pub fn surface(&self, p: Vec3) -> (f32, Vec3, Vec3) {
@@ -61,9 +54,10 @@ impl Collider {
     /// Pushes every free particle closer than `offset` to the surface out to `offset`, removes
     /// its approaching normal velocity (inelastic contact) and applies Coulomb friction: the
     /// tangential velocity relative to the surface shrinks by at most `friction` × the removed
-    /// normal speed. `h` is the substep (s), used to keep `prev_pos` consistent.
-    pub fn resolve(&self, model: &ClothModel, state: &mut ClothState, offset: f32, h: f32) {
+    /// normal speed. Returns how many particles it moved.
+    pub fn resolve(&self, model: &ClothModel, state: &mut ClothState, offset: f32) -> usize {
         let mu = self.friction();
+        let mut contacts = 0;
         for i in 0..state.pos.len() {
             if model.inv_mass[i] == 0.0 {
                 continue;
@@ -73,6 +67,7 @@ impl Collider {
             if depth <= 0.0 {
                 continue;
             }
+            contacts += 1;
             state.pos[i] += depth * n;
             let v_rel = state.vel[i] - v_surface;
             let vn = v_rel.dot(n);
@@ -86,8 +81,8 @@ impl Collider {
                 };
                 state.vel[i] = v_surface + keep * v_t;
             }
-            state.prev_pos[i] = state.pos[i] - h * state.vel[i];
         }
+        contacts
     }
 }
 
@@ -98,4 +93,15 @@ pub fn min_collider_distance(colliders: &[Collider], pos: &[Vec3]) -> Option<f32
         .iter()
         .flat_map(|c| pos.iter().map(move |&p| c.surface(p).0))
         .reduce(f32::min)
+}
+
+/// The colliders among `effects`, in order.
+pub fn colliders_of(effects: &[super::Effect]) -> Vec<Collider> {
+    effects
+        .iter()
+        .filter_map(|e| match e {
+            super::Effect::Collider(c) => Some(*c),
+            _ => None,
+        })
+        .collect()
 }

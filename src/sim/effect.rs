@@ -11,14 +11,3 @@ pub enum Effect {
     AirDamping,
     Collider(Collider),
 }
-
-impl Effect {
-    pub fn name(&self) -> &'static str {
-        match self {
-            Effect::Gravity => "gravity",
-            Effect::Springs => "springs",
-            Effect::AirDamping => "air damping",
-            Effect::Collider(c) => c.name(),
-        }
-    }
-}

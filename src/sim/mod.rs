@@ -1,18 +1,26 @@
 //! The CPU solver: forces, colliders, integrators and the stepper that composes them.
 //! Pure CPU code with no graphics dependency; deterministic.
 
+mod backend;
 mod collider;
+mod constraints;
+mod cpu_stepper;
 mod effect;
-mod forces;
+pub mod forces;
+mod guard;
 pub mod integrator;
 mod params;
-mod stepper;
+mod stats;
 mod timings;
 
-pub use collider::{Collider, min_collider_distance};
+pub use backend::StepBackend;
+pub use collider::{Collider, colliders_of, min_collider_distance};
+pub use constraints::DistanceConstraints;
+pub use cpu_stepper::CpuStepper;
 pub use effect::Effect;
-pub use forces::{Force, ForceSet};
-pub use integrator::{Integrator, IntegratorKind, StepContext};
-pub use params::SimParams;
-pub use stepper::{Diverged, FrameOutcome, Stepper};
+pub use forces::{Force, ForceSet, JacobianMode, SystemMatrix};
+pub use guard::{Diverged, FrameOutcome, MAX_REFINEMENTS};
+pub use integrator::{Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport};
+pub use params::{SimParams, SolverConfig};
+pub use stats::StepStats;
 pub use timings::PhaseTimings;

@@ -34,6 +34,29 @@ pub struct SimParams {
     pub collision_offset: f32,
     /// Speed above which a frame counts as diverged and is retried with more substeps, m/s.
     pub divergence_speed: f32,
+    /// How the integrators that solve something solve it.
+    #[serde(default)]
+    pub solver: SolverConfig,
+}
+
+/// The configuration integrators take: linear-solver tolerance and caps.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct SolverConfig {
+    /// Conjugate gradients stop when the residual is this fraction of the right-hand
+    /// side's norm (default 1e-4).
+    pub tolerance: f32,
+    /// Conjugate-gradient iteration cap per solve (default 200).
+    pub max_iterations: u32,
+}
+
+impl Default for SolverConfig {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-4,
+            max_iterations: 200,
+        }
+    }
 }
 
 impl Default for SimParams {
@@ -49,16 +72,12 @@ impl Default for SimParams {
             density: 0.2,
             collision_offset: 0.01,
             divergence_speed: 500.0,
+            solver: SolverConfig::default(),
         }
     }
 }
 
 impl SimParams {
-    /// Substep length `dt / substeps`, seconds.
-    pub fn h(&self) -> f32 {
-        self.dt / self.substeps.max(1) as f32
-    }
-
     /// Checks that every number is finite and in range.
     ///
     /// # Errors
@@ -109,6 +128,16 @@ impl SimParams {
                     "parameter `{name}` = {v} is out of range (≥ 0 {unit})"
                 ));
             }
+        }
+        let solver = &self.solver;
+        if !(solver.tolerance.is_finite() && solver.tolerance > 0.0 && solver.tolerance < 1.0) {
+            return Err(format!(
+                "parameter `solver.tolerance` = {} is out of range (0 < tolerance < 1)",
+                solver.tolerance
+            ));
+        }
+        if solver.max_iterations == 0 {
+            return Err("parameter `solver.max_iterations` must be ≥ 1".into());
         }
         if self.substeps == 0 || self.substeps > 100_000 {
             return Err(format!(

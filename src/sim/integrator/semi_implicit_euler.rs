@@ -2,7 +2,9 @@
 
 use glam::Vec3;
 
-use super::{Integrator, IntegratorKind, StepContext};
+use super::context::StepContext;
+use super::kind::IntegratorKind;
+use super::step::{Integrator, StepError, StepReport};
 use crate::cloth::ClothState;
 
 /// `v ← v + a(x, v)·h`, then `x ← x + v·h` with the new velocity.
@@ -16,10 +18,13 @@ impl Integrator for SemiImplicitEuler {
         IntegratorKind::SemiImplicitEuler
     }
 
-    fn step(&mut self, ctx: &mut StepContext<'_>, state: &mut ClothState, h: f32) {
-        ctx.acceleration(&state.pos, &state.vel, &mut self.acc);
-        let start = std::time::Instant::now();
-        state.prev_pos.copy_from_slice(&state.pos);
+    fn step(
+        &mut self,
+        ctx: &mut StepContext<'_>,
+        state: &mut ClothState,
+        h: f32,
+    ) -> Result<StepReport, StepError> {
+        ctx.accelerations(&state.pos, &state.vel, &mut self.acc);
         let particles = state.pos.iter_mut().zip(state.vel.iter_mut());
         for (((x, v), a), &w) in particles.zip(&self.acc).zip(&ctx.model.inv_mass) {
             if w != 0.0 {
@@ -28,6 +33,6 @@ impl Integrator for SemiImplicitEuler {
             }
         }
         state.time += h as f64;
-        ctx.timings.add("integrate", start.elapsed());
+        Ok(ctx.report())
     }
 }

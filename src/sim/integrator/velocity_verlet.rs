@@ -2,23 +2,24 @@
 
 use glam::Vec3;
 
-use super::{Integrator, IntegratorKind, StepContext};
+use super::context::StepContext;
+use super::kind::IntegratorKind;
+use super::step::{Integrator, StepError, StepReport};
 use crate::cloth::ClothState;
 
 /// `x ← x + v·h + ½a·h²`, `a' = a(x', v + a·h)`, `v ← v + ½(a + a')·h`.
 ///
 /// The end-of-step acceleration `a'` is kept for the next step, so a step costs one force
-/// evaluation. It is recomputed when the state is not the one it was computed for (another
-/// state, a reset, a changed particle count). Colliders change positions and velocities
-/// after the step; the kept `a'` then lags by that contact correction, which is of the
-/// order of the (already non-smooth) collision response itself.
+/// evaluation. It is dropped by [`Integrator::invalidate`] — after a contact changed
+/// velocities, a pin or density change, new parameters, a rollback — and then recomputed
+/// from the state as it is.
 #[derive(Default)]
 pub struct VelocityVerlet {
     acc: Vec<Vec3>,
     acc_next: Vec<Vec3>,
     predicted: Vec<Vec3>,
-    /// Simulated time the kept acceleration belongs to.
-    acc_time: Option<f64>,
+    /// Whether `acc` belongs to the current state.
+    kept: bool,
 }
 
 impl Integrator for VelocityVerlet {
@@ -26,13 +27,16 @@ impl Integrator for VelocityVerlet {
         IntegratorKind::Verlet
     }
 
-    fn step(&mut self, ctx: &mut StepContext<'_>, state: &mut ClothState, h: f32) {
-        if self.acc_time != Some(state.time) || self.acc.len() != state.pos.len() {
-            ctx.acceleration(&state.pos, &state.vel, &mut self.acc);
+    fn step(
+        &mut self,
+        ctx: &mut StepContext<'_>,
+        state: &mut ClothState,
+        h: f32,
+    ) -> Result<StepReport, StepError> {
+        if !self.kept || self.acc.len() != state.pos.len() {
+            ctx.accelerations(&state.pos, &state.vel, &mut self.acc);
         }
-        let start = std::time::Instant::now();
         let w = &ctx.model.inv_mass;
-        state.prev_pos.copy_from_slice(&state.pos);
         self.predicted.clear();
         self.predicted.extend_from_slice(&state.vel);
         let particles = state.pos.iter_mut().zip(&state.vel);
@@ -44,9 +48,7 @@ impl Integrator for VelocityVerlet {
                 *predicted += *a * h;
             }
         }
-        let mut elapsed = start.elapsed();
-        ctx.acceleration(&state.pos, &self.predicted, &mut self.acc_next);
-        let start = std::time::Instant::now();
+        ctx.accelerations(&state.pos, &self.predicted, &mut self.acc_next);
         let both = self.acc.iter().zip(&self.acc_next);
         for ((v, (a, a_next)), &w) in state.vel.iter_mut().zip(both).zip(w) {
             if w != 0.0 {
@@ -54,9 +56,12 @@ impl Integrator for VelocityVerlet {
             }
         }
         std::mem::swap(&mut self.acc, &mut self.acc_next);
+        self.kept = true;
         state.time += h as f64;
-        self.acc_time = Some(state.time);
-        elapsed += start.elapsed();
-        ctx.timings.add("integrate", elapsed);
+        Ok(ctx.report())
+    }
+
+    fn invalidate(&mut self) {
+        self.kept = false;
     }
 }

@@ -1,0 +1,43 @@
+//! What the renderer draws: a plain description of one frame, built by the caller. The
+//! renderer knows nothing of simulations or scenes.
+
+use glam::{Quat, Vec2, Vec3};
+
+use crate::mesh::SpringKind;
+
+/// Springs as parallel slices (`a[i]`–`b[i]`, rest length, kind).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SpringLines<'a> {
+    pub a: &'a [u32],
+    pub b: &'a [u32],
+    /// Rest lengths, metres (for colouring by strain).
+    pub rest: &'a [f32],
+    pub kind: &'a [SpringKind],
+}
+
+/// A solid to draw.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    /// A sphere turned by `rotation` (its stripes show a spin).
+    Sphere {
+        center: Vec3,
+        radius: f32,
+        rotation: Quat,
+    },
+    /// A ground plane through `point` with unit `normal`.
+    Plane { point: Vec3, normal: Vec3 },
+}
+
+/// One frame: the cloth, its springs and pins, and the solids around it.
+#[derive(Clone, Debug, Default)]
+pub struct Frame<'a> {
+    /// Particle positions, metres.
+    pub positions: &'a [Vec3],
+    /// One texture coordinate per particle.
+    pub uvs: &'a [Vec2],
+    pub triangles: &'a [[u32; 3]],
+    pub springs: SpringLines<'a>,
+    /// Indices of pinned particles.
+    pub pinned: &'a [u32],
+    pub shapes: Vec<Shape>,
+}

@@ -1,0 +1,99 @@
+//! Headless runs and their summary, as `clothsim simulate --json` prints it.
+
+use std::time::Instant;
+
+use crate::mesh::SpringKind;
+use crate::sim::{FrameOutcome, min_collider_distance};
+
+use super::simulation::Simulation;
+
+/// A headless run's result.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct RunSummary {
+    pub scene: String,
+    pub cloth: String,
+    pub integrator: String,
+    pub backend: String,
+    pub particles: usize,
+    /// Unique edges of the triangulated mesh.
+    pub edges: usize,
+    /// All springs (structural + shear + bend).
+    pub springs: usize,
+    pub structural: usize,
+    pub shear: usize,
+    pub bend: usize,
+    pub simulated_seconds: f64,
+    pub frames: u64,
+    pub dt: f32,
+    /// Substeps per frame in effect at the end of the run (the guard may have raised them).
+    pub substeps: u32,
+    /// Substeps per frame the parameters ask for.
+    pub requested_substeps: u32,
+    pub finite: bool,
+    /// m/s.
+    pub max_speed: f32,
+    /// Smallest signed particle-to-surface distance, metres; null without colliders.
+    pub min_collider_distance: Option<f32>,
+    /// Joules.
+    pub kinetic_energy: f64,
+    pub wall_seconds: f64,
+    /// Frames the guard had to redo with more substeps.
+    pub refined_frames: u64,
+    /// Set when the run stopped early because it diverged.
+    pub error: Option<String>,
+}
+
+impl Simulation {
+    /// Runs headless for `seconds` of simulated time (whole frames) and summarises.
+    pub fn run(&mut self, seconds: f64) -> RunSummary {
+        let frames = (seconds / self.params().dt as f64).round().max(0.0) as u64;
+        let start = Instant::now();
+        let mut refined = 0;
+        let mut error = None;
+        for _ in 0..frames {
+            match self.step_frame() {
+                Ok(FrameOutcome::Stepped) => {}
+                Ok(FrameOutcome::Refined { .. }) => refined += 1,
+                Err(e) => {
+                    error = Some(e.to_string());
+                    break;
+                }
+            }
+        }
+        let mut summary = self.summary(start.elapsed().as_secs_f64());
+        summary.refined_frames = refined;
+        summary.error = error;
+        summary
+    }
+
+    /// The current state's summary; `wall_seconds` as given.
+    pub fn summary(&self, wall_seconds: f64) -> RunSummary {
+        let model = self.model();
+        let state = self.state();
+        let count = |k| model.springs.count(k);
+        RunSummary {
+            scene: self.scenario().to_string(),
+            cloth: self.cloth_name().to_string(),
+            integrator: self.params().integrator.name().to_string(),
+            backend: self.backend_name().to_string(),
+            particles: model.particle_count(),
+            edges: model.mesh_edges,
+            springs: model.springs.len(),
+            structural: count(SpringKind::Structural),
+            shear: count(SpringKind::Shear),
+            bend: count(SpringKind::Bend),
+            simulated_seconds: state.time,
+            frames: self.frames(),
+            dt: self.params().dt,
+            substeps: self.substeps(),
+            requested_substeps: self.params().substeps,
+            finite: state.is_finite(),
+            max_speed: state.max_speed(),
+            min_collider_distance: min_collider_distance(&self.colliders(), &state.pos),
+            kinetic_energy: state.kinetic_energy(model),
+            wall_seconds,
+            refined_frames: 0,
+            error: None,
+        }
+    }
+}

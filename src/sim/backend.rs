@@ -1,0 +1,58 @@
+//! The step-backend seam: [`crate::scene::Simulation`] advances through this interface,
+//! whatever computes the steps (the CPU stepper today, a GPU stepper beside it).
+
+use crate::cloth::{ClothModel, ClothState};
+
+use super::effect::Effect;
+use super::guard::{Diverged, FrameOutcome};
+use super::integrator::{StepError, StepReport};
+use super::params::SimParams;
+use super::stats::StepStats;
+use super::timings::PhaseTimings;
+
+/// Something that advances a cloth state through time.
+pub trait StepBackend: Send {
+    /// Short name for the UI and reports ("cpu", "gpu").
+    fn name(&self) -> &'static str;
+
+    /// Applies new parameters and effects to the running backend, keeping what they do not
+    /// make stale (the substeps the guard raised stay unless the requested count changed;
+    /// timings and statistics stay).
+    fn configure(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]);
+
+    /// The state or the model changed outside stepping (reset, pins, density, a drag):
+    /// whatever was kept from earlier steps is dropped.
+    fn invalidate(&mut self);
+
+    /// One frame of `params.dt` seconds, under the stability guard.
+    ///
+    /// # Errors
+    /// [`Diverged`] when no try succeeded; `state` is then the frame's start state.
+    fn frame(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+    ) -> Result<FrameOutcome, Diverged>;
+
+    /// One substep without the guard (tests, tools that inspect every substep).
+    ///
+    /// # Errors
+    /// The integrator's [`StepError`].
+    fn substep(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+    ) -> Result<StepReport, StepError>;
+
+    /// Substeps per frame in effect (the guard may have raised the requested count).
+    fn substeps(&self) -> u32;
+
+    /// Length of the substep in effect, seconds.
+    fn substep_length(&self) -> f32;
+
+    /// Wall time per phase since the last call; resets it.
+    fn take_timings(&mut self) -> PhaseTimings;
+
+    /// Work counters since the last call; resets them.
+    fn take_stats(&mut self) -> StepStats;
+}

@@ -1,0 +1,75 @@
+//! One force term of a scene: a closed set, each variant in its own file.
+
+use glam::Vec3;
+
+use crate::cloth::ClothModel;
+
+use super::air_damping::AirDamping;
+use super::gravity::Gravity;
+use super::jacobian::{JacobianMode, SystemMatrix};
+use super::springs::SpringForce;
+
+/// A force term. Each yields forces in newtons and, for implicit methods, its derivatives.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Force {
+    Gravity(Gravity),
+    Springs(SpringForce),
+    AirDamping(AirDamping),
+}
+
+impl Force {
+    /// Adds this term's forces at `(pos, vel)` to `f`, newtons.
+    pub fn add_forces(&self, model: &ClothModel, pos: &[Vec3], vel: &[Vec3], f: &mut [Vec3]) {
+        match self {
+            Force::Gravity(g) => g.add_forces(&model.mass, f),
+            Force::Springs(s) => s.add_forces(&model.springs, pos, vel, f),
+            Force::AirDamping(d) => d.add_forces(&model.mass, vel, f),
+        }
+    }
+
+    /// Adds `(∂f/∂x)·u` to `out` (N/m × m).
+    pub fn add_df_dx(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        u: &[Vec3],
+        mode: JacobianMode,
+        out: &mut [Vec3],
+    ) {
+        if let Force::Springs(s) = self {
+            s.add_df_dx(&model.springs, pos, vel, u, mode, out);
+        }
+    }
+
+    /// Adds `(∂f/∂v)·u` to `out` (N·s/m × m/s).
+    pub fn add_df_dv(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        u: &[Vec3],
+        out: &mut [Vec3],
+    ) {
+        match self {
+            Force::Gravity(_) => {}
+            Force::Springs(s) => s.add_df_dv(&model.springs, pos, vel, u, out),
+            Force::AirDamping(d) => d.add_df_dv(&model.mass, u, out),
+        }
+    }
+
+    /// Adds this term's derivative blocks (definite form) to the implicit system.
+    pub fn add_to_system(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        sys: &mut SystemMatrix,
+    ) {
+        match self {
+            Force::Gravity(_) => {}
+            Force::Springs(s) => s.add_to_system(&model.springs, pos, vel, sys),
+            Force::AirDamping(d) => d.add_to_system(&model.mass, sys),
+        }
+    }
+}

@@ -1,0 +1,170 @@
+//! The forces a scene uses, evaluated together; accelerations are formed here and only here.
+
+use glam::Vec3;
+
+use crate::cloth::ClothModel;
+
+use super::super::constraints::DistanceConstraints;
+use super::super::effect::Effect;
+use super::super::params::SimParams;
+use super::air_damping::AirDamping;
+use super::force::Force;
+use super::gravity::Gravity;
+use super::jacobian::{JacobianMode, SystemMatrix};
+use super::springs::SpringForce;
+
+/// The scene's force terms, built from its effect list: an absent effect has no term.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ForceSet {
+    terms: Vec<Force>,
+}
+
+impl ForceSet {
+    /// The terms `effects` call for, with the strengths in `params`.
+    pub fn new(model: &ClothModel, params: &SimParams, effects: &[Effect]) -> Self {
+        let mut set = Self::default();
+        set.configure(model, params, effects);
+        set
+    }
+
+    /// A set of exactly these terms (tests, tools).
+    pub fn from_terms(terms: Vec<Force>) -> Self {
+        Self { terms }
+    }
+
+    /// Rebuilds the term list for `effects` and `params`, keeping the per-spring expansion
+    /// when the spring strengths did not change.
+    pub fn configure(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]) {
+        let old_springs = self.terms.iter().find_map(|t| match t {
+            Force::Springs(s) => Some(s.clone()),
+            _ => None,
+        });
+        self.terms.clear();
+        for effect in effects {
+            let term = match effect {
+                Effect::Gravity => Force::Gravity(Gravity { g: params.gravity }),
+                Effect::AirDamping => Force::AirDamping(AirDamping {
+                    rate: params.air_damping,
+                }),
+                Effect::Springs => {
+                    let mut s = old_springs.clone().unwrap_or_else(|| {
+                        SpringForce::new(&model.springs, params.stiffness, params.damping)
+                    });
+                    s.set_strengths(&model.springs, params.stiffness, params.damping);
+                    Force::Springs(s)
+                }
+                Effect::Collider(_) => continue,
+            };
+            self.terms.push(term);
+        }
+    }
+
+    pub fn terms(&self) -> &[Force] {
+        &self.terms
+    }
+
+    /// The spring term, if the scene has springs.
+    pub fn springs(&self) -> Option<&SpringForce> {
+        self.terms.iter().find_map(|t| match t {
+            Force::Springs(s) => Some(s),
+            _ => None,
+        })
+    }
+
+    /// The springs as distance constraints (empty without springs).
+    pub fn constraints(&self, model: &ClothModel) -> DistanceConstraints {
+        self.springs()
+            .map(|s| s.constraints(&model.springs))
+            .unwrap_or_default()
+    }
+
+    /// Writes the total force at `(pos, vel)` into `f` (resized), newtons. Terms selected
+    /// by `keep` only.
+    pub fn forces_where(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        keep: impl Fn(&Force) -> bool,
+        f: &mut Vec<Vec3>,
+    ) {
+        f.clear();
+        f.resize(pos.len(), Vec3::ZERO);
+        for term in self.terms.iter().filter(|t| keep(t)) {
+            term.add_forces(model, pos, vel, f);
+        }
+    }
+
+    /// Writes the total force at `(pos, vel)` into `f`, newtons.
+    pub fn forces(&self, model: &ClothModel, pos: &[Vec3], vel: &[Vec3], f: &mut Vec<Vec3>) {
+        self.forces_where(model, pos, vel, |_| true, f);
+    }
+
+    /// Writes the accelerations at `(pos, vel)` into `acc`: the total force times the inverse
+    /// mass, so pinned particles (inverse mass 0) get exactly zero.
+    pub fn accelerations(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        acc: &mut Vec<Vec3>,
+    ) {
+        self.forces(model, pos, vel, acc);
+        to_accelerations(&model.inv_mass, acc);
+    }
+
+    /// `(∂f/∂x)·u` of all terms into `out` (resized).
+    pub fn df_dx(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        u: &[Vec3],
+        mode: JacobianMode,
+        out: &mut Vec<Vec3>,
+    ) {
+        out.clear();
+        out.resize(pos.len(), Vec3::ZERO);
+        for term in &self.terms {
+            term.add_df_dx(model, pos, vel, u, mode, out);
+        }
+    }
+
+    /// `(∂f/∂v)·u` of all terms into `out` (resized).
+    pub fn df_dv(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        u: &[Vec3],
+        out: &mut Vec<Vec3>,
+    ) {
+        out.clear();
+        out.resize(pos.len(), Vec3::ZERO);
+        for term in &self.terms {
+            term.add_df_dv(model, pos, vel, u, out);
+        }
+    }
+
+    /// Assembles `A = M − h·∂f/∂v − h²·∂f/∂x` (definite form) and `(∂f/∂x)·v` at `(pos, vel)`.
+    pub fn assemble(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        h: f32,
+        sys: &mut SystemMatrix,
+    ) {
+        sys.begin(model, h);
+        for term in &self.terms {
+            term.add_to_system(model, pos, vel, sys);
+        }
+    }
+}
+
+/// Turns forces into accelerations in place: `a = f / m`, zero for pinned particles.
+pub fn to_accelerations(inv_mass: &[f32], f: &mut [Vec3]) {
+    for (a, &w) in f.iter_mut().zip(inv_mass) {
+        *a *= w;
+    }
+}

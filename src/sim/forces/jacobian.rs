@@ -1,0 +1,104 @@
+//! Force derivatives assembled into the implicit-Euler system
+//! `A = M − h·∂f/∂v − h²·∂f/∂x`, stored as 3×3 blocks: one per spring and one per particle.
+
+use glam::{Mat3, Vec3};
+
+use crate::cloth::{ClothModel, Springs};
+
+/// Which derivative a force term reports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JacobianMode {
+    /// The true derivative of the forces.
+    Exact,
+    /// The symmetric positive semi-definite approximation implicit solvers use (see
+    /// [`super::SpringForce::blocks`]).
+    Definite,
+}
+
+/// `A = M − h·∂f/∂v − h²·∂f/∂x` for one step of length `h`, plus `∂f/∂x·v` for the
+/// right-hand side. With [`JacobianMode::Definite`] blocks it is symmetric positive definite.
+///
+/// A spring `e = (a, b)` with blocks `K_x`, `K_v` contributes `S_e = h·K_v + h²·K_x`: `+S_e`
+/// to the diagonal blocks of `a` and `b` and `−S_e` to the off-diagonal blocks `(a, b)`,
+/// `(b, a)`. Per-particle terms (air damping) add to the diagonal only.
+#[derive(Clone, Debug, Default)]
+pub struct SystemMatrix {
+    /// Step length, seconds.
+    pub h: f32,
+    /// `S_e` per spring, kg.
+    pub spring: Vec<Mat3>,
+    /// Diagonal block per particle, kg.
+    pub diag: Vec<Mat3>,
+    /// `(∂f/∂x)·v` at the state the matrix was built at, N/s.
+    pub dfdx_v: Vec<Vec3>,
+}
+
+impl SystemMatrix {
+    /// Starts a new matrix `M` for a step of `h` seconds (no allocation once sized).
+    pub fn begin(&mut self, model: &ClothModel, h: f32) {
+        let (n, e) = (model.particle_count(), model.springs.len());
+        self.h = h;
+        self.spring.clear();
+        self.spring.resize(e, Mat3::ZERO);
+        self.diag.clear();
+        self.diag.extend(
+            model
+                .mass
+                .iter()
+                .map(|&m| Mat3::from_diagonal(Vec3::splat(m))),
+        );
+        self.dfdx_v.clear();
+        self.dfdx_v.resize(n, Vec3::ZERO);
+    }
+
+    /// Adds spring `e`'s blocks (`K_x = ∂f_a/∂x_b`, `K_v = ∂f_a/∂v_b`) at velocities `vel`.
+    pub fn add_spring(&mut self, springs: &Springs, e: usize, dx: Mat3, dv: Mat3, vel: &[Vec3]) {
+        let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
+        let s = self.h * dv + (self.h * self.h) * dx;
+        self.spring[e] += s;
+        self.diag[a] += s;
+        self.diag[b] += s;
+        let t = dx * (vel[b] - vel[a]);
+        self.dfdx_v[a] += t;
+        self.dfdx_v[b] -= t;
+    }
+
+    /// Adds a per-particle `∂f_p/∂v_p = d·I` (N·s/m).
+    pub fn add_dv_diagonal(&mut self, p: usize, d: f32) {
+        self.diag[p] -= Mat3::from_diagonal(Vec3::splat(self.h * d));
+    }
+
+    /// `out = A·u`, gathered per particle over `model.adjacency`.
+    pub fn apply(&self, model: &ClothModel, u: &[Vec3], out: &mut [Vec3]) {
+        let adj = &model.adjacency;
+        for (p, o) in out.iter_mut().enumerate() {
+            let mut sum = self.diag[p] * u[p];
+            for slot in adj.range(p) {
+                sum -= self.spring[adj.spring[slot] as usize] * u[adj.other[slot] as usize];
+            }
+            *o = sum;
+        }
+    }
+
+    /// The whole matrix, dense and row-major (`3n × 3n`), for tests on small systems.
+    pub fn dense(&self, springs: &Springs) -> Vec<Vec<f64>> {
+        let n = self.diag.len();
+        let mut m = vec![vec![0.0f64; 3 * n]; 3 * n];
+        let mut put = |i: usize, j: usize, block: Mat3, sign: f64| {
+            for r in 0..3 {
+                for c in 0..3 {
+                    m[3 * i + r][3 * j + c] += sign * block.col(c)[r] as f64;
+                }
+            }
+        };
+        for (p, &d) in self.diag.iter().enumerate() {
+            put(p, p, d, 1.0);
+        }
+        for (e, &s) in self.spring.iter().enumerate() {
+            let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
+            put(a, b, s, -1.0);
+            put(b, a, s, -1.0);
+        }
+        m
+    }
+}

@@ -1,0 +1,199 @@
+//! Hookean springs with a dashpot along the spring:
+//! `f_a = [k(|d| − l₀) + c·(v_b − v_a)·d̂] d̂`, `f_b = −f_a`, `d = x_b − x_a`.
+//!
+//! Besides the forces this gives their derivatives, per spring as the 3×3 blocks
+//! `K_x = ∂f_a/∂x_b` and `K_v = ∂f_a/∂v_b` (then `∂f_a/∂x_a = −K_x`, `∂f_b/∂x_b = −K_x`,
+//! `∂f_b/∂x_a = K_x`), and as matrix-free actions on a vector.
+
+use glam::{Mat3, Vec3};
+
+use crate::cloth::Springs;
+
+use super::jacobian::{JacobianMode, SystemMatrix};
+use crate::sim::constraints::DistanceConstraints;
+
+/// Springs with per-kind stiffness (N/m) and damping (N·s/m), expanded per spring.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpringForce {
+    stiffness: [f32; 3],
+    damping: [f32; 3],
+    /// Stiffness of each spring, N/m.
+    k: Vec<f32>,
+    /// Damping of each spring, N·s/m.
+    c: Vec<f32>,
+}
+
+/// The derivative blocks of one spring.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpringBlocks {
+    /// `∂f_a/∂x_b`, N/m.
+    pub dx: Mat3,
+    /// `∂f_a/∂v_b`, N·s/m.
+    pub dv: Mat3,
+}
+
+/// `u vᵀ`.
+fn outer(u: Vec3, v: Vec3) -> Mat3 {
+    Mat3::from_cols(u * v.x, u * v.y, u * v.z)
+}
+
+impl SpringForce {
+    /// Per-kind strengths expanded over `springs`.
+    pub fn new(springs: &Springs, stiffness: [f32; 3], damping: [f32; 3]) -> Self {
+        let mut s = Self {
+            stiffness,
+            damping,
+            k: Vec::new(),
+            c: Vec::new(),
+        };
+        s.expand(springs);
+        s
+    }
+
+    /// Changes the strengths; re-expands only when they or the spring count changed.
+    pub fn set_strengths(&mut self, springs: &Springs, stiffness: [f32; 3], damping: [f32; 3]) {
+        if (self.stiffness, self.damping, self.k.len()) != (stiffness, damping, springs.len()) {
+            self.stiffness = stiffness;
+            self.damping = damping;
+            self.expand(springs);
+        }
+    }
+
+    fn expand(&mut self, springs: &Springs) {
+        self.k = springs
+            .kind
+            .iter()
+            .map(|k| self.stiffness[k.index()])
+            .collect();
+        self.c = springs
+            .kind
+            .iter()
+            .map(|k| self.damping[k.index()])
+            .collect();
+    }
+
+    /// Adds every spring's force (N) to `f`.
+    pub fn add_forces(&self, springs: &Springs, pos: &[Vec3], vel: &[Vec3], f: &mut [Vec3]) {
+        for e in 0..springs.len() {
+            let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
+            let d = pos[b] - pos[a];
+            let len = d.length();
+            if len <= 1e-9 {
+                continue; // coincident ends: no defined direction
+            }
+            let n = d / len;
+            let s = self.k[e] * (len - springs.rest[e]) + self.c[e] * (vel[b] - vel[a]).dot(n);
+            f[a] += s * n;
+            f[b] -= s * n;
+        }
+    }
+
+    /// The derivative blocks of spring `e`.
+    ///
+    /// [`JacobianMode::Exact`] is the true derivative. [`JacobianMode::Definite`] is the
+    /// usual implicit-solver form: the transverse stiffness `k(1 − l₀/|d|)` of a compressed
+    /// spring is clamped to zero (it would be negative and make the system indefinite) and
+    /// the dashpot's dependence on the spring's direction is dropped, so `dx` is symmetric
+    /// positive semi-definite.
+    pub fn blocks(
+        &self,
+        springs: &Springs,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        e: usize,
+        mode: JacobianMode,
+    ) -> SpringBlocks {
+        let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
+        let d = pos[b] - pos[a];
+        let len = d.length();
+        if len <= 1e-9 {
+            return SpringBlocks {
+                dx: Mat3::ZERO,
+                dv: Mat3::ZERO,
+            };
+        }
+        let n = d / len;
+        let nn = outer(n, n);
+        let transverse = Mat3::IDENTITY - nn;
+        let (k, c) = (self.k[e], self.c[e]);
+        let stretch = 1.0 - springs.rest[e] / len;
+        let dx = match mode {
+            JacobianMode::Exact => {
+                let dv = vel[b] - vel[a];
+                let elastic = k * nn + (k * stretch) * transverse;
+                let viscous = (c / len) * (outer(n, transverse * dv) + dv.dot(n) * transverse);
+                elastic + viscous
+            }
+            JacobianMode::Definite => k * nn + (k * stretch.max(0.0)) * transverse,
+        };
+        SpringBlocks { dx, dv: c * nn }
+    }
+
+    /// Adds `(∂f/∂x)·u` to `out`, with the blocks of `mode`, computed on the fly.
+    pub fn add_df_dx(
+        &self,
+        springs: &Springs,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        u: &[Vec3],
+        mode: JacobianMode,
+        out: &mut [Vec3],
+    ) {
+        for e in 0..springs.len() {
+            let block = self.blocks(springs, pos, vel, e, mode).dx;
+            apply_pair(springs, e, block, u, out);
+        }
+    }
+
+    /// Adds `(∂f/∂v)·u` to `out` (the dashpots; exact in either mode).
+    pub fn add_df_dv(
+        &self,
+        springs: &Springs,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        u: &[Vec3],
+        out: &mut [Vec3],
+    ) {
+        for e in 0..springs.len() {
+            let block = self.blocks(springs, pos, vel, e, JacobianMode::Definite).dv;
+            apply_pair(springs, e, block, u, out);
+        }
+    }
+
+    /// Adds every spring's definite blocks to the implicit system.
+    pub fn add_to_system(
+        &self,
+        springs: &Springs,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        sys: &mut SystemMatrix,
+    ) {
+        for e in 0..springs.len() {
+            let b = self.blocks(springs, pos, vel, e, JacobianMode::Definite);
+            sys.add_spring(springs, e, b.dx, b.dv, vel);
+        }
+    }
+
+    /// The same springs as distance constraints for position-based methods: rest length
+    /// and compliance `1/k` (m/N). Springs of zero stiffness are no constraint and are left out.
+    pub fn constraints(&self, springs: &Springs) -> DistanceConstraints {
+        let mut out = DistanceConstraints::default();
+        for e in (0..springs.len()).filter(|&e| self.k[e] > 0.0) {
+            out.a.push(springs.a[e]);
+            out.b.push(springs.b[e]);
+            out.rest.push(springs.rest[e]);
+            out.compliance.push(1.0 / self.k[e]);
+            out.damping.push(self.c[e]);
+        }
+        out
+    }
+}
+
+/// One spring's share of a Jacobian–vector product: `out_a += B(u_b − u_a)`,
+/// `out_b −= B(u_b − u_a)`.
+fn apply_pair(springs: &Springs, e: usize, block: Mat3, u: &[Vec3], out: &mut [Vec3]) {
+    let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
+    let t = block * (u[b] - u[a]);
+    out[a] += t;
+    out[b] -= t;
+}

@@ -1,0 +1,110 @@
+//! What an integrator sees of the world: the model, the forces, its configuration, and a
+//! meter through which the stepper times and counts the work.
+
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+
+use crate::cloth::ClothModel;
+
+use super::super::forces::{Force, ForceSet};
+use super::super::params::SolverConfig;
+use super::step::StepReport;
+
+/// Work done inside one step, filled by [`StepContext`] and read by the stepper, which
+/// charges it to the phases.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepMeter {
+    pub force_evals: u32,
+    /// Wall time spent evaluating forces and their derivatives.
+    pub forces: Duration,
+    /// Wall time spent in linear solves / constraint projection.
+    pub solve: Duration,
+    pub solver_iterations: u32,
+    pub residual: Option<f32>,
+    pub converged: bool,
+}
+
+/// The model, the forces and the configuration of one step.
+pub struct StepContext<'a> {
+    pub model: &'a ClothModel,
+    pub forces: &'a ForceSet,
+    pub config: &'a SolverConfig,
+    meter: &'a mut StepMeter,
+}
+
+impl<'a> StepContext<'a> {
+    /// A context for one step; the meter starts from zero.
+    pub fn new(
+        model: &'a ClothModel,
+        forces: &'a ForceSet,
+        config: &'a SolverConfig,
+        meter: &'a mut StepMeter,
+    ) -> Self {
+        *meter = StepMeter {
+            converged: true,
+            ..StepMeter::default()
+        };
+        Self {
+            model,
+            forces,
+            config,
+            meter,
+        }
+    }
+
+    fn timed<R>(&mut self, f: impl FnOnce(&ClothModel, &ForceSet) -> R) -> R {
+        let start = Instant::now();
+        let out = f(self.model, self.forces);
+        self.meter.forces += start.elapsed();
+        self.meter.force_evals += 1;
+        out
+    }
+
+    /// Accelerations at `(pos, vel)` into `acc` (pinned particles get zero).
+    pub fn accelerations(&mut self, pos: &[Vec3], vel: &[Vec3], acc: &mut Vec<Vec3>) {
+        self.timed(|model, forces| forces.accelerations(model, pos, vel, acc));
+    }
+
+    /// Forces (N) at `(pos, vel)` of the terms `keep` selects, into `f`.
+    pub fn forces_where(
+        &mut self,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        keep: impl Fn(&Force) -> bool,
+        f: &mut Vec<Vec3>,
+    ) {
+        self.timed(|model, forces| forces.forces_where(model, pos, vel, keep, f));
+    }
+
+    /// Runs a linear solve or projection `f`, charging its time to the solve phase and
+    /// recording its iterations and final relative residual.
+    pub fn solve<R>(&mut self, f: impl FnOnce() -> (R, u32, Option<f32>, bool)) -> R {
+        let start = Instant::now();
+        let (out, iterations, residual, converged) = f();
+        self.meter.solve += start.elapsed();
+        self.meter.solver_iterations += iterations;
+        self.meter.residual = residual.or(self.meter.residual);
+        self.meter.converged &= converged;
+        out
+    }
+
+    /// Counts time spent in `f` as force work without counting an evaluation (assembling
+    /// derivatives, say).
+    pub fn derivative_work<R>(&mut self, f: impl FnOnce(&ClothModel, &ForceSet) -> R) -> R {
+        let start = Instant::now();
+        let out = f(self.model, self.forces);
+        self.meter.forces += start.elapsed();
+        out
+    }
+
+    /// What this step did so far.
+    pub fn report(&self) -> StepReport {
+        StepReport {
+            force_evals: self.meter.force_evals,
+            solver_iterations: self.meter.solver_iterations,
+            residual: self.meter.residual,
+            converged: self.meter.converged,
+        }
+    }
+}

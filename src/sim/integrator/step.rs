@@ -1,0 +1,59 @@
+//! The integrator interface: one substep in, a report or a typed failure out.
+
+use crate::cloth::ClothState;
+
+use super::context::StepContext;
+use super::kind::IntegratorKind;
+
+/// What one step cost.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepReport {
+    /// Force evaluations (each over every term and particle).
+    pub force_evals: u32,
+    /// Linear-solver iterations (implicit methods) or constraint sweeps (position-based).
+    pub solver_iterations: u32,
+    /// Final relative residual of the linear solve, when there was one.
+    pub residual: Option<f32>,
+    /// False when the linear solver stopped at its iteration cap above its tolerance.
+    pub converged: bool,
+}
+
+/// A step that could not be taken; the state must be treated as spoiled.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum StepError {
+    /// Conjugate gradients met a direction of non-positive curvature: the system matrix is
+    /// not positive definite.
+    #[error(
+        "the linear solve broke down after {iterations} iterations: the system is not positive definite"
+    )]
+    Breakdown { iterations: u32 },
+    /// The solve produced NaN or infinity.
+    #[error("the linear solve produced non-finite values after {iterations} iterations")]
+    NonFinite { iterations: u32 },
+}
+
+/// Advances a cloth state by one substep of `h` seconds.
+///
+/// Contract: afterwards `state.vel` holds the velocities at the new time, `state.time` is
+/// advanced by `h`, and particles with inverse mass 0 have not moved. Whatever an
+/// integrator keeps between steps (a last acceleration) is dropped by
+/// [`Integrator::invalidate`], which the stepper calls whenever the state, the model or the
+/// parameters change outside the integrator.
+pub trait Integrator: Send {
+    fn kind(&self) -> IntegratorKind;
+
+    /// One step.
+    ///
+    /// # Errors
+    /// [`StepError`] when the step's solve failed; the state is then spoiled and the
+    /// caller rolls back.
+    fn step(
+        &mut self,
+        ctx: &mut StepContext<'_>,
+        state: &mut ClothState,
+        h: f32,
+    ) -> Result<StepReport, StepError>;
+
+    /// Forgets what was kept from earlier steps.
+    fn invalidate(&mut self) {}
+}

@@ -1,0 +1,57 @@
+//! The glue between a running simulation and the renderer: the plain frame description of
+//! a simulation's current state and the camera that frames its scene. The renderer imports
+//! neither `sim` nor `scene`; callers (the app, the CLI, tests) build its input here.
+
+use glam::{Quat, Vec3};
+
+use crate::render::{Frame, OrbitCamera, Shape, SpringLines};
+use crate::scene::Simulation;
+use crate::sim::Collider;
+
+/// The frame to draw for `sim`'s current state.
+pub fn frame(sim: &Simulation) -> Frame<'_> {
+    let model = sim.model();
+    let springs = &model.springs;
+    Frame {
+        positions: &sim.state().pos,
+        uvs: &model.uvs,
+        triangles: &model.triangles,
+        springs: SpringLines {
+            a: &springs.a,
+            b: &springs.b,
+            rest: &springs.rest,
+            kind: &springs.kind,
+        },
+        pinned: &model.pins,
+        shapes: shapes(&sim.colliders(), sim.state().time),
+    }
+}
+
+/// The colliders as shapes to draw at simulated time `time` (spinning spheres turned).
+pub fn shapes(colliders: &[Collider], time: f64) -> Vec<Shape> {
+    colliders
+        .iter()
+        .map(|c| match *c {
+            Collider::Sphere {
+                center,
+                radius,
+                spin,
+                ..
+            } => Shape::Sphere {
+                center,
+                radius,
+                rotation: Quat::from_axis_angle(
+                    spin.try_normalize().unwrap_or(Vec3::Y),
+                    spin.length() * time as f32,
+                ),
+            },
+            Collider::Plane { point, normal, .. } => Shape::Plane { point, normal },
+        })
+        .collect()
+}
+
+/// The scene's default camera for a picture of `aspect` = width / height: it frames where
+/// the cloth goes over its motion ([`Simulation::motion_points`]).
+pub fn default_camera(sim: &Simulation, aspect: f32) -> OrbitCamera {
+    OrbitCamera::framing(&sim.motion_points(), aspect)
+}
