@@ -24,7 +24,9 @@
 pub mod app;
 pub mod cloth;
 pub mod mesh;
+pub mod output;
 pub mod render;
+pub mod report;
 pub mod scene;
 pub mod sim;
 pub mod view;

@@ -63,6 +63,31 @@ enum Command {
         #[arg(long)]
         out_dir: Option<PathBuf>,
     },
+    /// What accuracy costs in time: every integrator × step size against a reference;
+    /// writes accuracy.csv, accuracy.md and accuracy.png.
+    Accuracy {
+        /// Scenario name (see `clothsim scenes`).
+        #[arg(long, default_value = "hanging")]
+        scene: String,
+        /// Use this OBJ cloth instead of the scenario's default.
+        #[arg(long)]
+        obj: Option<PathBuf>,
+        /// Comma-separated integrators (default: all seven).
+        #[arg(long, value_delimiter = ',')]
+        integrators: Option<Vec<IntegratorKind>>,
+        /// Comma-separated step sizes in seconds (default: 1/60 s over 3, 6, … 384 substeps).
+        #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+        dts: Option<Vec<f64>>,
+        /// Simulated seconds of each run.
+        #[arg(long, default_value_t = 0.25, allow_negative_numbers = true)]
+        seconds: f64,
+        /// Largest acceptable max position error, as a fraction of the cloth's size.
+        #[arg(long, default_value_t = clothsim::report::DEFAULT_TOLERANCE, allow_negative_numbers = true)]
+        tolerance: f64,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Write a rectangular grid cloth as an OBJ file (quads: diagonals become shear springs).
     Grid {
         /// Quads along each side.
@@ -88,7 +113,7 @@ struct RunArgs {
     /// Use this OBJ cloth instead of the scenario's default.
     #[arg(long)]
     obj: Option<PathBuf>,
-    /// Integrator: semi-implicit-euler or verlet.
+    /// Integrator: explicit-euler, semi-implicit-euler, verlet, rk2, rk4, implicit-euler, xpbd.
     #[arg(long)]
     integrator: Option<IntegratorKind>,
     /// Simulated seconds.
@@ -136,8 +161,19 @@ fn main() {
         env_logger::Env::default().default_filter_or("warn,wgpu_hal=off"),
     )
     .init();
-    if let Err(e) = run(Cli::parse()) {
-        eprintln!("error: {e:#}");
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => e.exit(), // --help, --version
+        Err(e) => {
+            // One line, like every other error: clap's first line names the argument.
+            let text = e.render().to_string();
+            eprintln!("{}", text.lines().next().unwrap_or("error: bad arguments"));
+            std::process::exit(2);
+        }
+    };
+    if let Err(e) = run(cli) {
+        // `{:#}` joins the causes on one line; a message spanning lines is folded.
+        eprintln!("error: {}", format!("{e:#}").replace('\n', " "));
         std::process::exit(1);
     }
 }
@@ -172,6 +208,28 @@ fn run(cli: Cli) -> Result<()> {
             every,
             out_dir.as_deref(),
         ),
+        Some(Command::Accuracy {
+            scene,
+            obj,
+            integrators,
+            dts,
+            seconds,
+            tolerance,
+            out,
+        }) => {
+            let mut config = clothsim::report::SweepConfig {
+                seconds,
+                tolerance,
+                ..Default::default()
+            };
+            if let Some(list) = integrators {
+                config.integrators = list;
+            }
+            if let Some(list) = dts {
+                config.dts = list;
+            }
+            accuracy(&scene, obj.as_deref(), &config, &out)
+        }
         Some(Command::Grid {
             quads,
             size,
@@ -254,6 +312,44 @@ fn simulate(args: &RunArgs, json: bool) -> Result<()> {
     }
     if let Some(e) = summary.error {
         bail!(e);
+    }
+    Ok(())
+}
+
+fn accuracy(
+    scene: &str,
+    obj: Option<&std::path::Path>,
+    config: &clothsim::report::SweepConfig,
+    out: &std::path::Path,
+) -> Result<()> {
+    config.validate()?;
+    let scene = match obj {
+        Some(path) => Scene::with_obj(scene, path)?,
+        None => Scene::builtin(scene)?,
+    };
+    // Fail on an unusable output directory before a minute of work, not after it.
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("{}: cannot create the output directory", out.display()))?;
+    let bar = indicatif::ProgressBar::new(1);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} [{elapsed}]")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let report = clothsim::report::sweep(&scene, config, &mut |p| {
+        bar.set_length(p.total as u64);
+        bar.set_position(p.done as u64);
+        bar.set_message(p.what.clone());
+        true
+    })?;
+    bar.finish_and_clear();
+    let files = clothsim::report::write_report(&report, out)?;
+    println!(
+        "for a tolerance of {} of the cloth's size: {}",
+        config.tolerance,
+        clothsim::report::choice_sentence(&report)
+    );
+    for f in files {
+        println!("wrote {}", f.display());
     }
     Ok(())
 }

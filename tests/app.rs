@@ -211,3 +211,73 @@ fn record_writes_a_numbered_frame_sequence() {
     assert_eq!(frames[1], "frame_00001.png");
     harness.get_by_label_contains("recorded");
 }
+
+#[test]
+fn the_accuracy_window_sweeps_in_the_background_and_applies_its_choice() {
+    let mut harness = harness();
+    // Start from parameters that are not among the sweep's choices.
+    let mut params = harness.state().sim.params().clone();
+    params.integrator = clothsim::sim::IntegratorKind::Verlet;
+    params.substeps = 24;
+    harness.state_mut().sim.set_params(params).unwrap();
+    harness.get_by_label("Accuracy").click();
+    harness.run_steps(2);
+    assert!(harness.state().accuracy.open);
+    // A small sweep: the real one takes half a minute on this scene.
+    {
+        let app = harness.state_mut();
+        app.accuracy.config.integrators = vec![
+            clothsim::sim::IntegratorKind::SemiImplicitEuler,
+            clothsim::sim::IntegratorKind::ImplicitEuler,
+        ];
+        app.accuracy.config.dts = vec![1.0 / 60.0 / 6.0, 1.0 / 60.0 / 48.0];
+        app.accuracy.config.seconds = 0.25;
+        app.accuracy.config.samples = 3;
+        app.accuracy.config.bisection_steps = 0;
+        app.accuracy.tolerance = 0.5;
+    }
+    harness.get_by_label("Run sweep").click();
+    harness.run_steps(1);
+    assert!(
+        harness.state().accuracy.is_running(),
+        "the sweep runs in the background"
+    );
+    let frames = harness.state().sim.frames();
+    harness.state_mut().transport.playing = true;
+    harness.run_steps(3);
+    assert!(
+        harness.state().sim.frames() > frames || harness.state().accuracy.is_running(),
+        "the viewport keeps stepping while the sweep runs"
+    );
+    harness.state_mut().accuracy.wait();
+    harness.state_mut().transport.pause();
+    harness.run_steps(2);
+    let report = harness.state().accuracy.report.clone().expect("a report");
+    assert_eq!(report.points.len(), 4);
+    // With a tolerance of half the cloth's size every stable run qualifies, so the choice
+    // is the cheapest stable one.
+    let choice = harness
+        .state()
+        .accuracy
+        .choice()
+        .cloned()
+        .expect("a choice");
+    let cheapest = report
+        .points
+        .iter()
+        .filter(|p| p.stable)
+        .min_by(|a, b| a.wall_s_per_sim_s.total_cmp(&b.wall_s_per_sim_s))
+        .unwrap();
+    assert_eq!(&choice, cheapest);
+    harness.get_by_label("Apply").click();
+    harness.run_steps(2);
+    let params = harness.state().sim.params();
+    assert_eq!(params.integrator, choice.integrator);
+    assert_eq!(params.substeps, choice.substeps_per_frame.round() as u32);
+    assert_ne!(
+        (params.integrator, params.substeps),
+        (clothsim::sim::IntegratorKind::Verlet, 24),
+        "the choice replaced the parameters the sweep started from"
+    );
+    harness.get_by_label_contains("applied");
+}

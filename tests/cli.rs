@@ -221,3 +221,62 @@ fn render_writes_an_image_or_a_numbered_sequence() {
         .to_rgba8();
     assert_ne!(first, last);
 }
+
+#[test]
+fn accuracy_writes_its_three_files_and_names_its_choice() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("report");
+    let out = clothsim(&[
+        "accuracy",
+        "--integrators",
+        "semi-implicit-euler,implicit-euler",
+        "--dts",
+        "0.002,0.001",
+        "--seconds",
+        "0.05",
+        "--tolerance",
+        "0.05",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("for a tolerance of 0.05"), "{stdout}");
+    for name in ["accuracy.csv", "accuracy.md", "accuracy.png"] {
+        assert!(out_dir.join(name).is_file(), "{name} missing");
+    }
+    let csv = std::fs::read_to_string(out_dir.join("accuracy.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 2 * 2, "{csv}");
+}
+
+#[test]
+fn accuracy_refuses_bad_settings_before_working() {
+    for (args, expect) in [
+        (
+            &["accuracy", "--dts", "-0.001", "--out", "/tmp/x"][..],
+            "step size",
+        ),
+        (
+            &["accuracy", "--seconds", "0", "--out", "/tmp/x"][..],
+            "--seconds",
+        ),
+        (
+            &["accuracy", "--integrators", "magic", "--out", "/tmp/x"][..],
+            "unknown integrator",
+        ),
+        (
+            &["accuracy", "--out", "/proc/forbidden/report"][..],
+            "cannot create",
+        ),
+    ] {
+        let out = clothsim(args);
+        assert!(!out.status.success(), "{args:?} must fail");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(expect), "{args:?}: {stderr}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "one line: {stderr}");
+    }
+}

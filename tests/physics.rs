@@ -148,9 +148,17 @@ fn oscillator(kind: IntegratorKind, omega_h: f32, steps: usize) -> (Vec<f64>, f3
     (xs, h, m, k)
 }
 
+/// Every integrator but explicit Euler, whose amplitude grows by (1 + (ωh)²)^½ a step: over
+/// these 10 000 steps e^6 times, out of the spring's linear range.
+fn bounded_on_the_oscillator() -> impl Iterator<Item = IntegratorKind> {
+    IntegratorKind::ALL
+        .into_iter()
+        .filter(|&k| k != IntegratorKind::ExplicitEuler)
+}
+
 #[test]
 fn spring_mass_period_is_two_pi_sqrt_m_over_k() {
-    for kind in IntegratorKind::ALL {
+    for kind in bounded_on_the_oscillator() {
         let (xs, h, m, k) = oscillator(kind, 0.05, 10_000);
         // Upward zero crossings, linearly interpolated.
         let crossings: Vec<f64> = xs
@@ -172,11 +180,16 @@ fn spring_mass_period_is_two_pi_sqrt_m_over_k() {
 
 #[test]
 fn undamped_oscillator_energy_stays_within_one_percent() {
-    // Both integrators are symplectic; the energy they conserve is measured with the
-    // time-centred velocity (x[n+1] − x[n−1]) / 2h, identical for both, so a secular drift
-    // or a non-symplectic update would show, while the O(ωh) phase lag of a one-sided
-    // velocity does not.
-    for kind in IntegratorKind::ALL {
+    // Symplectic Euler and Verlet conserve a modified energy, RK4 loses only (ωh)⁶/72 a
+    // step; the others drift by design (explicit Euler and RK2 gain, implicit Euler and
+    // XPBD damp). The energy is measured with the time-centred velocity
+    // (x[n+1] − x[n−1]) / 2h, identical for all, so a secular drift or a non-symplectic
+    // update would show, while the O(ωh) phase lag of a one-sided velocity does not.
+    for kind in [
+        IntegratorKind::SemiImplicitEuler,
+        IntegratorKind::Verlet,
+        IntegratorKind::Rk4,
+    ] {
         let (xs, h, m, k) = oscillator(kind, 0.05, 10_000);
         let (h, m, k) = (h as f64, m as f64, k as f64);
         let energy = |n: usize| {
@@ -200,11 +213,38 @@ fn undamped_oscillator_energy_stays_within_one_percent() {
 /// that with margin while a real tunnelling (≥ cm) would fail.
 const PENETRATION_TOLERANCE: f32 = 1e-4;
 
+/// Substeps per frame each integrator needs on the contact scenes. Explicit Euler gains
+/// energy every step, so the spring damping must outpace it: that takes about eight times
+/// the default (the accuracy report's stability table shows the same).
+fn substeps_for(kind: IntegratorKind) -> u32 {
+    match kind {
+        IntegratorKind::ExplicitEuler => 384,
+        _ => 48,
+    }
+}
+
+/// A 12 × 12-quad, 1 m cloth (169 particles), so that every integrator runs quickly.
+fn coarse_cloth() -> clothsim::mesh::MeshBuild {
+    let mesh = clothsim::mesh::GridSpec::square(
+        12,
+        1.0,
+        clothsim::mesh::GridOrientation::Horizontal,
+        Vec3::ZERO,
+    )
+    .build()
+    .unwrap();
+    clothsim::mesh::MeshBuild {
+        mesh,
+        warnings: Vec::new(),
+    }
+}
+
 #[test]
 fn sphere_drop_never_penetrates_and_comes_to_rest() {
     for kind in IntegratorKind::ALL {
-        let mut scene = Scene::builtin("sphere-drop").unwrap();
+        let mut scene = Scene::with_cloth("sphere-drop", &coarse_cloth(), "grid").unwrap();
         scene.params.integrator = kind;
+        scene.params.substeps = substeps_for(kind);
         let Some(&mut Collider::Sphere { center, radius, .. }) = scene.sphere_mut() else {
             panic!("sphere-drop has a sphere")
         };

@@ -9,6 +9,7 @@ use crate::scene::{DEFAULT_CLOTH_NAME, DEFAULT_CLOTH_OBJ, Scene, Simulation};
 use crate::sim::{Effect, FrameOutcome, PhaseTimings, SimParams};
 use crate::view;
 
+use super::accuracy::AccuracyWindow;
 use super::background::{ObjLoad, PngWriter, Written};
 use super::transport::{STEP_BUDGET_SECONDS, Transport};
 use super::viewport::{Viewport, camera_input};
@@ -64,6 +65,8 @@ pub struct ClothApp {
     last_update: Option<Instant>,
     /// Text of the "open OBJ" path field.
     pub open_path: String,
+    /// The accuracy-versus-cost sweep of the current scene.
+    pub accuracy: AccuracyWindow,
 }
 
 impl ClothApp {
@@ -97,6 +100,7 @@ impl ClothApp {
             stats: Stats::default(),
             last_update: None,
             open_path: String::new(),
+            accuracy: AccuracyWindow::default(),
         };
         if app.render_state.is_none() {
             app.message(
@@ -458,15 +462,39 @@ impl ClothApp {
             .default_size(300.0)
             .show(ui, |ui| super::controls::side_panel(ui, self));
         egui::CentralPanel::no_frame().show(ui, |ui| self.viewport_ui(ui));
+        self.accuracy_ui(ui.ctx());
 
         let hovering = ui.input(|i| !i.raw.hovered_files.is_empty());
         if hovering {
             super::controls::drop_hint(ui);
         }
-        if self.transport.playing || self.loading.is_some() || self.writer.pending() > 0 {
+        let busy =
+            self.loading.is_some() || self.writer.pending() > 0 || self.accuracy.is_running();
+        if self.transport.playing || busy {
             ui.ctx().request_repaint();
         } else {
             ui.ctx().request_repaint_after(Duration::from_millis(250));
+        }
+    }
+
+    /// The Accuracy window: collects a finished sweep, starts one, applies a choice.
+    fn accuracy_ui(&mut self, ctx: &egui::Context) {
+        self.accuracy.poll();
+        if !self.accuracy.open {
+            return;
+        }
+        let (apply, start) = self.accuracy.ui(ctx, self.sim.params());
+        if start {
+            self.accuracy.start(self.sim.to_scene());
+        }
+        if let Some(params) = apply {
+            let text = format!(
+                "applied {} with {} substeps per frame",
+                params.integrator.label(),
+                params.substeps
+            );
+            self.apply_params(params);
+            self.message(Level::Info, text);
         }
     }
 

@@ -44,6 +44,13 @@ pub fn transport_bar(ui: &mut egui::Ui, app: &mut ClothApp) {
         if ui.button("Capture PNG").clicked() {
             app.request_capture();
         }
+        if ui
+            .button("Accuracy")
+            .on_hover_text("What accuracy costs: every integrator and step size on this scene")
+            .clicked()
+        {
+            app.accuracy.open = true;
+        }
         let record = if app.is_recording() {
             "Stop recording"
         } else {

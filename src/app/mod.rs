@@ -1,6 +1,7 @@
 //! The desktop app (eframe + egui): panels, 3D viewport, drag-and-drop, capture. Thin: it
 //! drives the library and never re-implements it.
 
+mod accuracy;
 mod background;
 mod cloth_app;
 mod controls;
@@ -8,6 +9,7 @@ mod transport;
 mod viewport;
 mod window;
 
+pub use accuracy::AccuracyWindow;
 pub use cloth_app::{ClothApp, Level, Message, Stats};
 pub use transport::Transport;
 pub use window::run;

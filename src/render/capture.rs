@@ -2,6 +2,8 @@
 
 use std::path::Path;
 
+use crate::output::write_atomically;
+
 use super::error::RenderError;
 use super::target::RenderTarget;
 
@@ -91,41 +93,13 @@ pub fn read_target(
 /// # Errors
 /// [`RenderError::MissingDirectory`] or [`RenderError::Write`].
 pub fn save_png(image: &RgbaImage, path: &Path) -> Result<(), RenderError> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
-    if !dir.is_dir() {
-        return Err(RenderError::MissingDirectory {
-            path: path.to_path_buf(),
-            dir,
-        });
-    }
-    let write_err = |detail: String| RenderError::Write {
-        path: path.to_path_buf(),
-        detail,
-    };
-    let file_name = path
-        .file_name()
-        .ok_or_else(|| write_err("the path names no file".into()))?
-        .to_string_lossy()
-        .into_owned();
-    let tmp = dir.join(format!(".{file_name}.{}.tmp", std::process::id()));
-    let write = || -> Result<(), String> {
-        use std::io::Write;
-        let file = std::fs::File::create(&tmp).map_err(|e| e.to_string())?;
-        let mut out = std::io::BufWriter::new(file);
+    write_atomically(path, |out| {
+        // `write_to` needs `Seek`: encode into memory first.
+        let mut png = std::io::Cursor::new(Vec::new());
         image
-            .write_to(&mut out, image::ImageFormat::Png)
+            .write_to(&mut png, image::ImageFormat::Png)
             .map_err(|e| e.to_string())?;
-        // Flush explicitly: a BufWriter dropped with an error would swallow it.
-        out.flush().map_err(|e| e.to_string())?;
-        out.get_ref().sync_all().map_err(|e| e.to_string())?;
-        std::fs::rename(&tmp, path).map_err(|e| e.to_string())
-    };
-    let result = write().map_err(write_err);
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+        out.write_all(png.get_ref()).map_err(|e| e.to_string())
+    })
+    .map_err(RenderError::from)
 }

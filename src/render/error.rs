@@ -28,3 +28,16 @@ pub enum RenderError {
         why: String,
     },
 }
+
+impl From<crate::output::OutputError> for RenderError {
+    fn from(e: crate::output::OutputError) -> Self {
+        match e {
+            crate::output::OutputError::MissingDirectory { path, dir } => {
+                RenderError::MissingDirectory { path, dir }
+            }
+            crate::output::OutputError::Write { path, detail } => {
+                RenderError::Write { path, detail }
+            }
+        }
+    }
+}

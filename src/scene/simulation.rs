@@ -4,8 +4,8 @@
 
 use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{
-    Collider, CpuStepper, Diverged, Effect, FrameOutcome, PhaseTimings, SimParams, StepBackend,
-    StepError, StepReport, StepStats, colliders_of,
+    Collider, CpuStepper, Diverged, Effect, ForceSet, FrameOutcome, PhaseTimings, SimParams,
+    StepBackend, StepError, StepReport, StepStats, colliders_of,
 };
 
 use super::error::SceneError;
@@ -102,6 +102,29 @@ impl Simulation {
     /// Name of the step backend ("cpu", …).
     pub fn backend_name(&self) -> &'static str {
         self.backend.name()
+    }
+
+    /// The simulation as a scene to start others from: its model (with the pins in force),
+    /// its initial state, and its current parameters and effects.
+    pub fn to_scene(&self) -> Scene {
+        Scene {
+            scenario: self.scenario.clone(),
+            cloth_name: self.cloth_name.clone(),
+            model: self.model.clone(),
+            initial: self.initial.clone(),
+            params: self.params.clone(),
+            effects: self.effects.clone(),
+            pins: self.scenario_pins.clone(),
+            warnings: self.warnings.clone(),
+        }
+    }
+
+    /// Total mechanical energy (kinetic plus the potential of the conservative forces),
+    /// joules.
+    pub fn energy(&self) -> f64 {
+        self.state.kinetic_energy(&self.model)
+            + ForceSet::new(&self.model, &self.params, &self.effects)
+                .potential_energy(&self.model, &self.state.pos)
     }
 
     /// Replaces the parameters of the running simulation. The state, the time, the

@@ -100,8 +100,8 @@ impl StepBackend for CpuStepper {
         if self.integrator.kind() != params.integrator {
             self.integrator = params.integrator.build();
         }
-        // New strengths make whatever the integrator kept stale.
-        self.integrator.invalidate();
+        // New strengths make whatever the integrator kept or derived stale.
+        self.integrator.forces_changed();
         self.solver = params.solver;
         self.dt = params.dt;
         self.offset = params.collision_offset;

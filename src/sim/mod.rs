@@ -2,6 +2,7 @@
 //! Pure CPU code with no graphics dependency; deterministic.
 
 mod backend;
+mod cg;
 mod collider;
 mod constraints;
 mod cpu_stepper;
@@ -14,6 +15,7 @@ mod stats;
 mod timings;
 
 pub use backend::StepBackend;
+pub use cg::{CgOutcome, ConjugateGradient};
 pub use collider::{Collider, colliders_of, min_collider_distance};
 pub use constraints::DistanceConstraints;
 pub use cpu_stepper::CpuStepper;

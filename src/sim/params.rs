@@ -48,6 +48,14 @@ pub struct SolverConfig {
     pub tolerance: f32,
     /// Conjugate-gradient iteration cap per solve (default 200).
     pub max_iterations: u32,
+    /// Newton iterations of implicit Euler per step (default 1: the linearised
+    /// Baraff–Witkin step; more refine it towards the exact backward-Euler step).
+    pub newton_iterations: u32,
+    /// Newton stops when the backward-Euler residual is this fraction of `‖h·f‖`
+    /// (default 1e-3).
+    pub newton_tolerance: f32,
+    /// Constraint sweeps per XPBD substep (default 1: small steps, one iteration).
+    pub xpbd_iterations: u32,
 }
 
 impl Default for SolverConfig {
@@ -55,6 +63,9 @@ impl Default for SolverConfig {
         Self {
             tolerance: 1e-4,
             max_iterations: 200,
+            newton_iterations: 1,
+            newton_tolerance: 1e-3,
+            xpbd_iterations: 1,
         }
     }
 }
@@ -136,8 +147,20 @@ impl SimParams {
                 solver.tolerance
             ));
         }
-        if solver.max_iterations == 0 {
-            return Err("parameter `solver.max_iterations` must be ≥ 1".into());
+        for (name, value) in [
+            ("solver.max_iterations", solver.max_iterations),
+            ("solver.newton_iterations", solver.newton_iterations),
+            ("solver.xpbd_iterations", solver.xpbd_iterations),
+        ] {
+            if !(1..=10_000).contains(&value) {
+                return Err(format!("parameter `{name}` = {value} must be in 1..=10000"));
+            }
+        }
+        if !(solver.newton_tolerance.is_finite() && solver.newton_tolerance > 0.0) {
+            return Err(format!(
+                "parameter `solver.newton_tolerance` = {} must be > 0",
+                solver.newton_tolerance
+            ));
         }
         if self.substeps == 0 || self.substeps > 100_000 {
             return Err(format!(

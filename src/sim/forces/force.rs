@@ -27,6 +27,15 @@ impl Force {
         }
     }
 
+    /// Potential energy at `pos`, joules; zero for dissipative terms.
+    pub fn potential_energy(&self, model: &ClothModel, pos: &[Vec3]) -> f64 {
+        match self {
+            Force::Gravity(g) => g.potential_energy(&model.mass, pos),
+            Force::Springs(s) => s.potential_energy(&model.springs, pos),
+            Force::AirDamping(_) => 0.0,
+        }
+    }
+
     /// Adds `(∂f/∂x)·u` to `out` (N/m × m).
     pub fn add_df_dx(
         &self,

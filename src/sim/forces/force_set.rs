@@ -113,6 +113,15 @@ impl ForceSet {
         to_accelerations(&model.inv_mass, acc);
     }
 
+    /// Potential energy of the conservative terms at `pos`, joules (relative to the rest
+    /// length of the springs and `x = 0` for gravity). Dissipative terms have none.
+    pub fn potential_energy(&self, model: &ClothModel, pos: &[Vec3]) -> f64 {
+        self.terms
+            .iter()
+            .map(|t| t.potential_energy(model, pos))
+            .sum()
+    }
+
     /// `(∂f/∂x)·u` of all terms into `out` (resized).
     pub fn df_dx(
         &self,

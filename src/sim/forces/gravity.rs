@@ -15,4 +15,12 @@ impl Gravity {
             *f += m * self.g;
         }
     }
+
+    /// `−Σ m·g·x`, joules.
+    pub fn potential_energy(&self, mass: &[f32], pos: &[Vec3]) -> f64 {
+        -pos.iter()
+            .zip(mass)
+            .map(|(p, &m)| m as f64 * self.g.dot(*p) as f64)
+            .sum::<f64>()
+    }
 }

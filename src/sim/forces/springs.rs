@@ -88,6 +88,17 @@ impl SpringForce {
         }
     }
 
+    /// `Σ ½k(|d| − l₀)²`, joules.
+    pub fn potential_energy(&self, springs: &Springs, pos: &[Vec3]) -> f64 {
+        (0..springs.len())
+            .map(|e| {
+                let d = pos[springs.b[e] as usize].distance(pos[springs.a[e] as usize]);
+                let stretch = (d - springs.rest[e]) as f64;
+                0.5 * self.k[e] as f64 * stretch * stretch
+            })
+            .sum()
+    }
+
     /// The derivative blocks of spring `e`.
     ///
     /// [`JacobianMode::Exact`] is the true derivative. [`JacobianMode::Definite`] is the

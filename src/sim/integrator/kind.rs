@@ -1,46 +1,97 @@
 //! The integrators a user can choose, by name.
 
+use super::explicit_euler::ExplicitEuler;
+use super::implicit_euler::ImplicitEuler;
+use super::rk2::Rk2;
+use super::rk4::Rk4;
 use super::semi_implicit_euler::SemiImplicitEuler;
 use super::step::Integrator;
 use super::velocity_verlet::VelocityVerlet;
+use super::xpbd::Xpbd;
 
 /// The integrators a user can choose.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum IntegratorKind {
+    /// Forward Euler: `x += v·h; v += a·h`, both from the start of the step. First order, one
+    /// force evaluation; gains energy every step.
+    ExplicitEuler,
     /// Symplectic Euler: `v += a·h; x += v·h`. First order, one force evaluation, bounded
     /// energy error for conservative forces.
     SemiImplicitEuler,
     /// Velocity Verlet: `x += v·h + ½a·h²; v += ½(a + a')·h`. Second order, symplectic, one
     /// force evaluation per step (the new acceleration is reused by the next step).
     Verlet,
+    /// Midpoint Runge–Kutta. Second order, two force evaluations.
+    Rk2,
+    /// Classical Runge–Kutta. Fourth order, four force evaluations.
+    Rk4,
+    /// Linearised backward Euler (Baraff–Witkin) solved by conjugate gradients. First order,
+    /// stable at any step for the springs; damps.
+    ImplicitEuler,
+    /// Extended position-based dynamics: springs as compliant distance constraints.
+    Xpbd,
 }
 
 impl IntegratorKind {
-    pub const ALL: [IntegratorKind; 2] =
-        [IntegratorKind::SemiImplicitEuler, IntegratorKind::Verlet];
+    pub const ALL: [IntegratorKind; 7] = [
+        IntegratorKind::ExplicitEuler,
+        IntegratorKind::SemiImplicitEuler,
+        IntegratorKind::Verlet,
+        IntegratorKind::Rk2,
+        IntegratorKind::Rk4,
+        IntegratorKind::ImplicitEuler,
+        IntegratorKind::Xpbd,
+    ];
 
     /// The name the CLI accepts and JSON prints.
     pub fn name(self) -> &'static str {
         match self {
+            IntegratorKind::ExplicitEuler => "explicit-euler",
             IntegratorKind::SemiImplicitEuler => "semi-implicit-euler",
             IntegratorKind::Verlet => "verlet",
+            IntegratorKind::Rk2 => "rk2",
+            IntegratorKind::Rk4 => "rk4",
+            IntegratorKind::ImplicitEuler => "implicit-euler",
+            IntegratorKind::Xpbd => "xpbd",
         }
     }
 
     /// Human-readable label for the UI.
     pub fn label(self) -> &'static str {
         match self {
+            IntegratorKind::ExplicitEuler => "Explicit Euler",
             IntegratorKind::SemiImplicitEuler => "Semi-implicit Euler",
             IntegratorKind::Verlet => "Velocity Verlet",
+            IntegratorKind::Rk2 => "RK2 (midpoint)",
+            IntegratorKind::Rk4 => "RK4",
+            IntegratorKind::ImplicitEuler => "Implicit Euler (CG)",
+            IntegratorKind::Xpbd => "XPBD",
+        }
+    }
+
+    /// Order of accuracy in the step (global error ∝ hᵖ).
+    pub fn order(self) -> u32 {
+        match self {
+            IntegratorKind::ExplicitEuler
+            | IntegratorKind::SemiImplicitEuler
+            | IntegratorKind::ImplicitEuler
+            | IntegratorKind::Xpbd => 1,
+            IntegratorKind::Verlet | IntegratorKind::Rk2 => 2,
+            IntegratorKind::Rk4 => 4,
         }
     }
 
     /// A fresh integrator of this kind.
     pub fn build(self) -> Box<dyn Integrator> {
         match self {
+            IntegratorKind::ExplicitEuler => Box::new(ExplicitEuler::default()),
             IntegratorKind::SemiImplicitEuler => Box::new(SemiImplicitEuler::default()),
             IntegratorKind::Verlet => Box::new(VelocityVerlet::default()),
+            IntegratorKind::Rk2 => Box::new(Rk2::default()),
+            IntegratorKind::Rk4 => Box::new(Rk4::default()),
+            IntegratorKind::ImplicitEuler => Box::new(ImplicitEuler::default()),
+            IntegratorKind::Xpbd => Box::new(Xpbd::default()),
         }
     }
 }

@@ -3,13 +3,23 @@
 //! configuration and a meter through [`StepContext`].
 
 mod context;
+mod explicit_euler;
+mod implicit_euler;
 mod kind;
+mod rk2;
+mod rk4;
 mod semi_implicit_euler;
 mod step;
 mod velocity_verlet;
+mod xpbd;
 
 pub use context::{StepContext, StepMeter};
+pub use explicit_euler::ExplicitEuler;
+pub use implicit_euler::ImplicitEuler;
 pub use kind::IntegratorKind;
+pub use rk2::Rk2;
+pub use rk4::Rk4;
 pub use semi_implicit_euler::SemiImplicitEuler;
 pub use step::{Integrator, StepError, StepReport};
 pub use velocity_verlet::VelocityVerlet;
+pub use xpbd::Xpbd;

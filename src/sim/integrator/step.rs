@@ -37,8 +37,9 @@ pub enum StepError {
 /// Contract: afterwards `state.vel` holds the velocities at the new time, `state.time` is
 /// advanced by `h`, and particles with inverse mass 0 have not moved. Whatever an
 /// integrator keeps between steps (a last acceleration) is dropped by
-/// [`Integrator::invalidate`], which the stepper calls whenever the state, the model or the
-/// parameters change outside the integrator.
+/// [`Integrator::invalidate`], which the stepper calls whenever the state or the model
+/// change outside the integrator, and by [`Integrator::forces_changed`] when the parameters
+/// do.
 pub trait Integrator: Send {
     fn kind(&self) -> IntegratorKind;
 
@@ -54,6 +55,13 @@ pub trait Integrator: Send {
         h: f32,
     ) -> Result<StepReport, StepError>;
 
-    /// Forgets what was kept from earlier steps.
+    /// Forgets what was kept from earlier steps: the state changed outside the integrator
+    /// (a contact, a rollback, a pin or density change, a drag).
     fn invalidate(&mut self) {}
+
+    /// The forces or their strengths changed: drops whatever was derived from them, and
+    /// whatever was kept from earlier steps.
+    fn forces_changed(&mut self) {
+        self.invalidate();
+    }
 }

@@ -1,0 +1,280 @@
+//! The Accuracy window: the same sweep as `clothsim accuracy`, for the current scene, on a
+//! background thread while the viewport keeps running; its plot, its table, and a button
+//! that applies the cheapest integrator and substeps for a typed tolerance.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{Receiver, channel};
+use std::sync::{Arc, Mutex};
+
+use egui::{Color32, RichText};
+use egui_plot::{HLine, Legend, Line, Plot, PlotPoints, Points};
+
+use crate::report::{
+    AccuracyReport, Progress, ReportError, SweepConfig, integrator_color, recommend, sweep,
+};
+use crate::scene::Scene;
+use crate::sim::{IntegratorKind, SimParams};
+
+/// A sweep running on its own thread.
+struct Job {
+    progress: Arc<Mutex<Progress>>,
+    cancel: Arc<AtomicBool>,
+    result: Receiver<Result<AccuracyReport, ReportError>>,
+}
+
+/// The window's state.
+pub struct AccuracyWindow {
+    pub open: bool,
+    /// The sweep the window runs (the CLI's defaults, on one thread).
+    pub config: SweepConfig,
+    job: Option<Job>,
+    pub report: Option<AccuracyReport>,
+    /// Tolerance the user typed, as a fraction of the cloth's size.
+    pub tolerance: f64,
+    pub error: Option<String>,
+}
+
+impl Default for AccuracyWindow {
+    fn default() -> Self {
+        Self {
+            open: false,
+            config: SweepConfig {
+                parallel_reference: false,
+                ..SweepConfig::default()
+            },
+            job: None,
+            report: None,
+            tolerance: crate::report::DEFAULT_TOLERANCE,
+            error: None,
+        }
+    }
+}
+
+impl AccuracyWindow {
+    /// Starts a sweep of `scene` in the background (one thread, so the viewport keeps a core).
+    pub fn start(&mut self, scene: Scene) {
+        let progress = Arc::new(Mutex::new(Progress {
+            done: 0,
+            total: 1,
+            what: "starting".into(),
+        }));
+        let cancel = Arc::new(AtomicBool::new(false));
+        let (tx, rx) = channel();
+        let config = SweepConfig {
+            tolerance: self.tolerance,
+            ..self.config.clone()
+        };
+        let (p, c) = (progress.clone(), cancel.clone());
+        std::thread::spawn(move || {
+            let result = sweep(&scene, &config, &mut |now| {
+                if let Ok(mut slot) = p.lock() {
+                    *slot = now.clone();
+                }
+                !c.load(Ordering::Relaxed)
+            });
+            let _ = tx.send(result);
+        });
+        self.error = None;
+        self.job = Some(Job {
+            progress,
+            cancel,
+            result: rx,
+        });
+    }
+
+    pub fn is_running(&self) -> bool {
+        self.job.is_some()
+    }
+
+    /// Asks a running sweep to stop.
+    pub fn cancel(&mut self) {
+        if let Some(job) = &self.job {
+            job.cancel.store(true, Ordering::Relaxed);
+        }
+    }
+
+    /// Collects a finished sweep.
+    pub fn poll(&mut self) {
+        let Some(job) = &self.job else { return };
+        if let Ok(result) = job.result.try_recv() {
+            match result {
+                Ok(report) => self.report = Some(report),
+                Err(e) => self.error = Some(e.to_string()),
+            }
+            self.job = None;
+        }
+    }
+
+    /// Waits for a running sweep (tests).
+    pub fn wait(&mut self) {
+        if let Some(job) = self.job.take() {
+            match job.result.recv() {
+                Ok(Ok(report)) => self.report = Some(report),
+                Ok(Err(e)) => self.error = Some(e.to_string()),
+                Err(e) => self.error = Some(e.to_string()),
+            }
+        }
+    }
+
+    /// The cheapest measured point within the typed tolerance.
+    pub fn choice(&self) -> Option<&crate::report::Point> {
+        let report = self.report.as_ref()?;
+        recommend(&report.points, &report.frontier, self.tolerance).map(|i| &report.points[i])
+    }
+
+    /// `params` with the chosen integrator and the substeps that give its step at `params.dt`.
+    pub fn applied(&self, params: &SimParams) -> Option<SimParams> {
+        let p = self.choice()?;
+        let substeps = (params.dt as f64 / p.dt).round().max(1.0) as u32;
+        Some(SimParams {
+            integrator: p.integrator,
+            substeps,
+            ..params.clone()
+        })
+    }
+
+    /// Draws the window; returns parameters to apply when the user asked for it, and
+    /// whether a sweep should start.
+    pub fn ui(&mut self, ctx: &egui::Context, params: &SimParams) -> (Option<SimParams>, bool) {
+        let mut apply = None;
+        let mut start = false;
+        let mut open = self.open;
+        egui::Window::new("Accuracy")
+            .open(&mut open)
+            .default_size([720.0, 560.0])
+            .show(ctx, |ui| {
+                ui.label("Error against a reference trajectory (RK4 at a very small step) and wall-clock cost, for every integrator and step size, on the current scene.");
+                ui.horizontal(|ui| {
+                    if let Some(job) = &self.job {
+                        let p = job.progress.lock().map(|p| p.clone()).unwrap_or(Progress { done: 0, total: 1, what: String::new() });
+                        ui.add(egui::ProgressBar::new(p.done as f32 / p.total.max(1) as f32).text(p.what).desired_width(380.0));
+                        if ui.button("Cancel").clicked() {
+                            self.cancel();
+                        }
+                    } else if ui.button("Run sweep").clicked() {
+                        start = true;
+                    }
+                });
+                if let Some(e) = &self.error {
+                    ui.label(RichText::new(e).color(Color32::from_rgb(240, 80, 70)));
+                }
+                ui.horizontal(|ui| {
+                    ui.label("Tolerance");
+                    let mut percent = self.tolerance * 100.0;
+                    if ui
+                        .add(egui::DragValue::new(&mut percent).range(1e-4..=100.0).speed(0.01).suffix(" % of cloth size"))
+                        .changed()
+                    {
+                        self.tolerance = percent / 100.0;
+                    }
+                    match self.choice() {
+                        Some(p) => {
+                            ui.label(format!("use {} at {:.0} substeps per frame", p.integrator.label(), params.dt as f64 / p.dt));
+                            if ui.button("Apply").clicked() {
+                                apply = self.applied(params);
+                            }
+                        }
+                        None if self.report.is_some() => {
+                            ui.label("no measured run is that accurate");
+                        }
+                        None => {}
+                    }
+                });
+                if let Some(report) = &self.report {
+                    plot(ui, report, self.tolerance);
+                    table(ui, report);
+                }
+            });
+        self.open = open;
+        (apply, start)
+    }
+}
+
+fn plot(ui: &mut egui::Ui, report: &AccuracyReport, tolerance: f64) {
+    let log = |x: f64| x.max(1e-300).log10();
+    Plot::new("accuracy plot")
+        .height(300.0)
+        .legend(Legend::default())
+        .x_axis_label("log10 of cost (wall s per simulated s)")
+        .y_axis_label("log10 of max error / cloth size")
+        .x_axis_formatter(|m, _| format!("1e{:.0}", m.value))
+        .y_axis_formatter(|m, _| format!("1e{:.0}", m.value))
+        .show(ui, |plot_ui| {
+            plot_ui.hline(HLine::new("tolerance", log(tolerance)).color(Color32::GRAY));
+            let frontier: Vec<[f64; 2]> = report
+                .frontier
+                .iter()
+                .map(|&i| {
+                    [
+                        log(report.points[i].wall_s_per_sim_s),
+                        log(report.points[i].max_error),
+                    ]
+                })
+                .collect();
+            plot_ui.line(
+                Line::new("frontier", PlotPoints::from(frontier))
+                    .width(6.0)
+                    .color(Color32::from_white_alpha(60)),
+            );
+            for kind in IntegratorKind::ALL {
+                let (r, g, b) = integrator_color(kind);
+                let color = Color32::from_rgb(r, g, b);
+                let mut mine: Vec<[f64; 2]> = report
+                    .points
+                    .iter()
+                    .filter(|p| p.integrator == kind && p.stable)
+                    .map(|p| [log(p.wall_s_per_sim_s), log(p.max_error)])
+                    .collect();
+                mine.sort_by(|a, b| a[0].total_cmp(&b[0]));
+                if !mine.is_empty() {
+                    plot_ui.line(
+                        Line::new(kind.name(), PlotPoints::from(mine.clone()))
+                            .color(color)
+                            .width(2.0),
+                    );
+                    plot_ui.points(
+                        Points::new(kind.name(), PlotPoints::from(mine))
+                            .color(color)
+                            .radius(3.0),
+                    );
+                }
+            }
+        });
+}
+
+fn table(ui: &mut egui::Ui, report: &AccuracyReport) {
+    egui::ScrollArea::vertical()
+        .max_height(200.0)
+        .show(ui, |ui| {
+            egui::Grid::new("accuracy table")
+                .striped(true)
+                .show(ui, |ui| {
+                    for head in [
+                        "integrator",
+                        "dt (s)",
+                        "max error",
+                        "stable",
+                        "cost (s/s)",
+                        "evals/step",
+                        "iters/step",
+                    ] {
+                        ui.label(RichText::new(head).strong());
+                    }
+                    ui.end_row();
+                    for p in &report.points {
+                        ui.label(p.integrator.name());
+                        ui.label(format!("{:.2e}", p.dt));
+                        ui.label(if p.max_error.is_finite() {
+                            format!("{:.2e}", p.max_error)
+                        } else {
+                            "—".into()
+                        });
+                        ui.label(if p.stable { "yes" } else { "no" });
+                        ui.label(format!("{:.2e}", p.wall_s_per_sim_s));
+                        ui.label(format!("{:.1}", p.force_evals_per_step));
+                        ui.label(format!("{:.1}", p.solver_iterations_per_step));
+                        ui.end_row();
+                    }
+                });
+        });
+}

@@ -1,0 +1,209 @@
+//! The report's picture: maximum error against cost on log–log axes, drawn with plotters.
+
+use plotters::prelude::*;
+
+use super::sweep::AccuracyReport;
+use crate::sim::IntegratorKind;
+
+/// Picture size, pixels.
+pub const PLOT_SIZE: (u32, u32) = (1200, 800);
+
+/// A colour per integrator, in `IntegratorKind::ALL` order.
+pub fn integrator_color(kind: IntegratorKind) -> (u8, u8, u8) {
+    const COLORS: [(u8, u8, u8); 7] = [
+        (214, 39, 40),
+        (31, 119, 180),
+        (44, 160, 44),
+        (255, 127, 14),
+        (148, 103, 189),
+        (140, 86, 75),
+        (23, 190, 207),
+    ];
+    let i = IntegratorKind::ALL
+        .iter()
+        .position(|&k| k == kind)
+        .unwrap_or(0);
+    COLORS[i % COLORS.len()]
+}
+
+fn register_font() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        // The font egui ships with: no system font lookup, the same text on every machine.
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            epaint_default_fonts::UBUNTU_LIGHT,
+        );
+    });
+}
+
+/// Draws the plot into an RGB buffer of [`PLOT_SIZE`].
+///
+/// # Errors
+/// A message from plotters.
+pub fn draw(report: &AccuracyReport) -> Result<Vec<u8>, String> {
+    register_font();
+    let (w, h) = PLOT_SIZE;
+    let mut buffer = vec![255u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        chart(&root, report)?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(buffer)
+}
+
+fn err(e: impl std::fmt::Display) -> String {
+    e.to_string()
+}
+
+fn chart(
+    root: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
+    report: &AccuracyReport,
+) -> Result<(), String> {
+    let finite = |x: f64| x.is_finite() && x > 0.0;
+    let costs: Vec<f64> = report
+        .points
+        .iter()
+        .map(|p| p.wall_s_per_sim_s)
+        .filter(|&c| finite(c))
+        .collect();
+    let floor = report.reference.check_max;
+    let errors: Vec<f64> = report
+        .points
+        .iter()
+        .filter(|p| p.stable)
+        .map(|p| p.max_error)
+        .chain([report.tolerance, floor])
+        .filter(|&e| finite(e))
+        .collect();
+    let (x_lo, x_hi) = range(&costs, 0.5, 2.0);
+    let (y_lo, y_hi) = range(&errors, 0.3, 20.0);
+    let mut chart = ChartBuilder::on(root)
+        .caption(
+            format!(
+                "What accuracy costs — {} ({} particles, {} s)",
+                report.scene, report.particles, report.seconds
+            ),
+            ("sans-serif", 30),
+        )
+        .margin(20)
+        .x_label_area_size(60)
+        .y_label_area_size(90)
+        .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("cost: wall-clock seconds per simulated second")
+        .y_desc("max position error / cloth size")
+        .x_label_formatter(&|x| format!("{x:.0e}"))
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .label_style(("sans-serif", 18))
+        .axis_desc_style(("sans-serif", 22))
+        .draw()
+        .map_err(err)?;
+    // The tolerance, and the reference's own uncertainty: errors below it are not resolved.
+    let tolerance = report.tolerance;
+    let dark_red = RGBColor(170, 20, 20);
+    chart
+        .draw_series(DashedLineSeries::new(
+            [(x_lo, tolerance), (x_hi, tolerance)],
+            14,
+            8,
+            dark_red.stroke_width(2),
+        ))
+        .map_err(err)?
+        .label(format!("tolerance {tolerance:.1e}"))
+        .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], dark_red.stroke_width(2)));
+    if finite(floor) {
+        let gray = RGBColor(90, 90, 90);
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(x_lo, floor), (x_hi, floor)],
+                4,
+                6,
+                gray.stroke_width(2),
+            ))
+            .map_err(err)?
+            .label("reference uncertainty (errors below are not resolved)")
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], gray.stroke_width(2)));
+    }
+    // The frontier, under the integrators' lines.
+    let frontier: Vec<(f64, f64)> = report
+        .frontier
+        .iter()
+        .map(|&i| {
+            (
+                report.points[i].wall_s_per_sim_s,
+                report.points[i].max_error,
+            )
+        })
+        .collect();
+    let shade = BLACK.mix(0.3);
+    chart
+        .draw_series(LineSeries::new(frontier, shade.stroke_width(10)))
+        .map_err(err)?
+        .label("frontier (cheapest for its accuracy)")
+        .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], shade.stroke_width(10)));
+    for kind in IntegratorKind::ALL {
+        let mine = |stable: bool| {
+            report.points.iter().filter(move |p| {
+                p.integrator == kind && p.stable == stable && finite(p.wall_s_per_sim_s)
+            })
+        };
+        let mut line: Vec<(f64, f64)> = mine(true)
+            .filter(|p| finite(p.max_error))
+            .map(|p| (p.wall_s_per_sim_s, p.max_error))
+            .collect();
+        let unstable: Vec<f64> = mine(false).map(|p| p.wall_s_per_sim_s).collect();
+        if line.is_empty() && unstable.is_empty() {
+            continue;
+        }
+        line.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (r, g, b) = integrator_color(kind);
+        let color = RGBColor(r, g, b);
+        chart
+            .draw_series(LineSeries::new(line.clone(), color.stroke_width(3)))
+            .map_err(err)?
+            .label(kind.name())
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(3)));
+        chart
+            .draw_series(line.iter().map(|&p| Circle::new(p, 6, color.filled())))
+            .map_err(err)?;
+        // Unstable runs have no meaningful error: a cross along the top edge, at their cost.
+        chart
+            .draw_series(
+                unstable
+                    .iter()
+                    .map(|&c| Cross::new((c, y_hi / 1.6), 8, color.stroke_width(3))),
+            )
+            .map_err(err)?;
+    }
+    chart
+        .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+        .map_err(err)?
+        .label("× along the top: an unstable run, at its cost")
+        .legend(|(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 20))
+        .position(SeriesLabelPosition::LowerLeft)
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// `(min · below, max · above)` of positive values, or a unit decade without any.
+fn range(values: &[f64], below: f64, above: f64) -> (f64, f64) {
+    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = values.iter().copied().fold(0.0, f64::max);
+    if lo.is_finite() && hi > 0.0 {
+        (lo * below, hi * above)
+    } else {
+        (1e-3, 1.0)
+    }
+}

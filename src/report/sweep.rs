@@ -1,0 +1,469 @@
+//! The accuracy-versus-cost sweep: every integrator at every step size against a reference
+//! trajectory, the largest stable step of each, and the cheapest choice within a tolerance.
+
+use crate::mesh::bbox_diagonal;
+use crate::scene::Scene;
+use crate::sim::IntegratorKind;
+
+use super::error::ReportError;
+use super::frontier::{frontier, recommend};
+use super::measure::{Record, Trajectory, position_error, run, undamped};
+
+/// What to sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepConfig {
+    pub integrators: Vec<IntegratorKind>,
+    /// Step sizes, seconds (each is adjusted so whole steps fill a sample interval).
+    pub dts: Vec<f64>,
+    /// Simulated seconds of each run.
+    pub seconds: f64,
+    /// Times along the trajectory at which positions are compared.
+    pub samples: u32,
+    /// Largest acceptable maximum position error, as a fraction of the cloth's size.
+    pub tolerance: f64,
+    /// Bisection steps when searching each integrator's largest stable step (0: none).
+    pub bisection_steps: u32,
+    /// Run the two reference trajectories side by side on two threads.
+    pub parallel_reference: bool,
+}
+
+/// The default sweep: a 1/60 s frame divided into 3 … 384 substeps (2.1 decades of step).
+pub const DEFAULT_SUBSTEPS: [u32; 8] = [3, 6, 12, 24, 48, 96, 192, 384];
+/// The default tolerance: every particle within 1 % of the cloth's size of the reference.
+pub const DEFAULT_TOLERANCE: f64 = 0.01;
+/// The reference takes RK4 at this fraction of the smallest swept step.
+pub const REFERENCE_REFINEMENT: f64 = 4.0;
+
+impl Default for SweepConfig {
+    fn default() -> Self {
+        Self {
+            integrators: IntegratorKind::ALL.to_vec(),
+            dts: DEFAULT_SUBSTEPS
+                .iter()
+                .map(|&n| 1.0 / (60.0 * n as f64))
+                .collect(),
+            // Long enough for the cloth to swing well down; short enough that the folding
+            // cloth has not yet turned chaotic (by 0.5 s halving the reference's own step
+            // moves it by 0.15 % of its size, the floor every method converges to).
+            seconds: 0.25,
+            // One comparison per 1/60 s frame.
+            samples: 15,
+            tolerance: DEFAULT_TOLERANCE,
+            bisection_steps: 6,
+            parallel_reference: true,
+        }
+    }
+}
+
+impl SweepConfig {
+    /// Checks that the sweep can run.
+    ///
+    /// # Errors
+    /// [`ReportError::Config`] naming the bad value.
+    pub fn validate(&self) -> Result<(), ReportError> {
+        let bad = |what: String| Err(ReportError::Config(what));
+        if self.integrators.is_empty() {
+            return bad("no integrators to sweep".into());
+        }
+        if self.dts.is_empty() {
+            return bad("no step sizes to sweep".into());
+        }
+        if let Some(dt) = self
+            .dts
+            .iter()
+            .find(|d| !(d.is_finite() && **d > 0.0 && **d <= 0.1))
+        {
+            return bad(format!("step size {dt} s is out of range (0 < dt ≤ 0.1 s)"));
+        }
+        if !(self.seconds.is_finite() && self.seconds > 0.0 && self.seconds <= 60.0) {
+            return bad(format!(
+                "--seconds {} is out of range (0 < T ≤ 60 s)",
+                self.seconds
+            ));
+        }
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
+            return bad(format!(
+                "--tolerance {} must be a positive number",
+                self.tolerance
+            ));
+        }
+        if self.samples == 0 {
+            return bad("at least one sample time is needed".into());
+        }
+        Ok(())
+    }
+}
+
+/// One integrator at one step size.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Point {
+    pub integrator: IntegratorKind,
+    /// The step taken, seconds.
+    pub dt: f64,
+    /// Steps taken over the run.
+    pub steps: u64,
+    /// The scene's frame time ÷ dt: the substeps per frame that give this step.
+    pub substeps_per_frame: f64,
+    /// Position error against the reference: the largest over sample times of the RMS over
+    /// particles, as a fraction of the cloth's size.
+    pub rms_error: f64,
+    /// The same for the maximum over particles.
+    pub max_error: f64,
+    /// Energy drift on the undamped scene: largest deviation of the total energy from its
+    /// start (gain or loss), as a fraction of the reference's peak kinetic energy.
+    pub energy_drift: f64,
+    /// Finite throughout, with energy bounded (it never gained more than the reference's
+    /// peak kinetic energy) and error below the cloth's size.
+    pub stable: bool,
+    /// Wall-clock seconds per simulated second.
+    pub wall_s_per_sim_s: f64,
+    pub force_evals_per_step: f64,
+    pub solver_iterations_per_step: f64,
+}
+
+/// The reference trajectory and how well it is converged.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Reference {
+    pub integrator: IntegratorKind,
+    /// Its step, seconds.
+    pub dt: f64,
+    /// RMS and maximum difference (fractions of the cloth's size) between the reference and
+    /// the same method at half its step.
+    pub check_rms: f64,
+    pub check_max: f64,
+    /// Peak kinetic energy of the undamped scene, joules: the scale of energy drift.
+    pub peak_kinetic: f64,
+}
+
+/// The largest step at which an integrator stayed stable.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct StableLimit {
+    pub integrator: IntegratorKind,
+    /// Largest stable step found, seconds; `None` when even the smallest probe was unstable.
+    pub dt: Option<f64>,
+    /// True when the search stopped at its upper bound (a sample interval) still stable.
+    pub at_upper_bound: bool,
+    /// Observed order: the slope of log error over log step between its two smallest stable
+    /// steps (where the error is above the reference's own).
+    pub observed_order: Option<f64>,
+}
+
+/// Everything the sweep measured.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct AccuracyReport {
+    pub scene: String,
+    pub particles: usize,
+    /// The cloth's size (bounding-box diagonal), metres: errors are fractions of it.
+    pub size: f64,
+    pub seconds: f64,
+    pub tolerance: f64,
+    pub reference: Reference,
+    pub points: Vec<Point>,
+    pub limits: Vec<StableLimit>,
+    /// Indices into `points`, cheapest first.
+    pub frontier: Vec<usize>,
+    /// Index into `points` of the cheapest one within the tolerance.
+    pub recommendation: Option<usize>,
+}
+
+impl AccuracyReport {
+    /// The recommended point, if any.
+    pub fn recommended(&self) -> Option<&Point> {
+        self.recommendation.map(|i| &self.points[i])
+    }
+}
+
+/// How far the sweep has got, for a progress bar. Return `false` from the callback to stop.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Progress {
+    pub done: usize,
+    pub total: usize,
+    pub what: String,
+}
+
+/// Counts work against a total and asks the caller whether to go on.
+struct Tracker<'a> {
+    done: usize,
+    total: usize,
+    callback: &'a mut dyn FnMut(&Progress) -> bool,
+}
+
+impl Tracker<'_> {
+    fn step(&mut self, what: String) -> Result<(), ReportError> {
+        self.done += 1;
+        let progress = Progress {
+            done: self.done.min(self.total),
+            total: self.total,
+            what,
+        };
+        if (self.callback)(&progress) {
+            Ok(())
+        } else {
+            Err(ReportError::Cancelled)
+        }
+    }
+}
+
+/// Measures one integrator at one step against `reference`.
+pub fn measure(
+    scene: &Scene,
+    config: &SweepConfig,
+    reference: (&Trajectory, &Reference),
+    integrator: IntegratorKind,
+    dt: f64,
+) -> Point {
+    let size = scene_size(scene);
+    let damped = run(
+        scene,
+        integrator,
+        dt,
+        config.seconds,
+        config.samples,
+        Record::Positions,
+    );
+    let energy = run(
+        &undamped(scene),
+        integrator,
+        dt,
+        config.seconds,
+        config.samples * 2,
+        Record::Energy,
+    );
+    let (rms, max) = position_error(&damped, reference.0);
+    let scale = reference.1.peak_kinetic.max(1e-12);
+    let energy_drift = energy.energy_deviation() / scale;
+    let bounded = energy.energy_growth() <= scale;
+    let (rms_error, max_error) = (rms / size, max / size);
+    Point {
+        integrator,
+        dt: damped.h,
+        steps: damped.steps,
+        substeps_per_frame: scene.params.dt as f64 / damped.h,
+        rms_error,
+        max_error,
+        energy_drift,
+        stable: damped.finite && energy.finite && bounded && max_error < 1.0,
+        wall_s_per_sim_s: damped.wall / config.seconds,
+        force_evals_per_step: damped.stats.force_evals_per_step(),
+        solver_iterations_per_step: damped.stats.solver_iterations_per_step(),
+    }
+}
+
+fn scene_size(scene: &Scene) -> f64 {
+    (bbox_diagonal(&scene.initial.pos) as f64).max(1e-9)
+}
+
+/// Runs the reference (RK4 at a quarter of the smallest swept step), its check at half
+/// that step, and the undamped run (RK4 at the smallest swept step) whose peak kinetic
+/// energy sets the scale of energy drift.
+fn reference(scene: &Scene, config: &SweepConfig) -> (Trajectory, Reference) {
+    let smallest = config.dts.iter().copied().fold(f64::INFINITY, f64::min);
+    let h = smallest / REFERENCE_REFINEMENT;
+    let (seconds, samples) = (config.seconds, config.samples);
+    let rk4 = IntegratorKind::Rk4;
+    let main = || run(scene, rk4, h, seconds, samples, Record::Positions);
+    let check = || run(scene, rk4, h / 2.0, seconds, samples, Record::Positions);
+    let (main, check) = if config.parallel_reference {
+        std::thread::scope(|s| {
+            let other = s.spawn(check);
+            let main = main();
+            (
+                main,
+                other
+                    .join()
+                    .unwrap_or_else(|e| std::panic::resume_unwind(e)),
+            )
+        })
+    } else {
+        (main(), check())
+    };
+    let energy = run(
+        &undamped(scene),
+        rk4,
+        smallest,
+        seconds,
+        samples * 2,
+        Record::Energy,
+    );
+    let size = scene_size(scene);
+    let (rms, max) = position_error(&check, &main);
+    let info = Reference {
+        integrator: rk4,
+        dt: main.h,
+        check_rms: rms / size,
+        check_max: max / size,
+        peak_kinetic: energy.peak_kinetic(),
+    };
+    (main, info)
+}
+
+/// Whether `integrator` stays stable (finite, energy bounded) on the undamped scene at `dt`.
+fn stable_at(
+    scene: &Scene,
+    config: &SweepConfig,
+    peak_kinetic: f64,
+    integrator: IntegratorKind,
+    dt: f64,
+) -> bool {
+    let energy = run(
+        scene,
+        integrator,
+        dt,
+        config.seconds,
+        config.samples * 2,
+        Record::Energy,
+    );
+    energy.finite && energy.energy_growth() <= peak_kinetic.max(1e-12)
+}
+
+/// Brackets the largest stable step from the swept points, widening the bracket by
+/// doubling or halving if needed, then bisects it geometrically.
+fn stable_limit(
+    scene: &Scene,
+    config: &SweepConfig,
+    peak_kinetic: f64,
+    integrator: IntegratorKind,
+    swept: &[&Point],
+    tracker: &mut Tracker<'_>,
+) -> Result<StableLimit, ReportError> {
+    let upper_bound = config.seconds / config.samples as f64;
+    let undamped = undamped(scene);
+    let probe = |dt: f64, tracker: &mut Tracker<'_>| -> Result<bool, ReportError> {
+        let ok = stable_at(&undamped, config, peak_kinetic, integrator, dt);
+        tracker.step(format!("{integrator}: stability at {dt:.2e} s"))?;
+        Ok(ok)
+    };
+    let mut lo = swept
+        .iter()
+        .filter(|p| p.stable)
+        .map(|p| p.dt)
+        .fold(None, |m: Option<f64>, d| Some(m.map_or(d, |m| m.max(d))));
+    let mut hi = swept
+        .iter()
+        .filter(|p| !p.stable && lo.is_none_or(|l| p.dt > l))
+        .map(|p| p.dt)
+        .fold(None, |m: Option<f64>, d| Some(m.map_or(d, |m| m.min(d))));
+    let mut budget = config.bisection_steps;
+    // Widen: upwards while stable, downwards while unstable.
+    while budget > 0 && hi.is_none() {
+        let Some(l) = lo else { break };
+        if l >= upper_bound {
+            break;
+        }
+        budget -= 1;
+        let next = (2.0 * l).min(upper_bound);
+        if probe(next, tracker)? {
+            lo = Some(next)
+        } else {
+            hi = Some(next)
+        }
+    }
+    while budget > 0 && lo.is_none() {
+        let Some(h) = hi else { break };
+        budget -= 1;
+        let next = h / 2.0;
+        if probe(next, tracker)? {
+            lo = Some(next)
+        } else {
+            hi = Some(next)
+        }
+    }
+    while budget > 0 {
+        let (Some(l), Some(h)) = (lo, hi) else { break };
+        budget -= 1;
+        let mid = (l * h).sqrt();
+        if probe(mid, tracker)? {
+            lo = Some(mid)
+        } else {
+            hi = Some(mid)
+        }
+    }
+    // Work not done because the bracket closed early still counts towards the total.
+    for _ in 0..budget {
+        tracker.step(format!("{integrator}: stability search done"))?;
+    }
+    Ok(StableLimit {
+        integrator,
+        dt: lo,
+        at_upper_bound: hi.is_none() && lo.is_some_and(|l| l >= upper_bound * 0.999),
+        observed_order: None,
+    })
+}
+
+/// Slope of log error over log step between the two smallest stable steps whose error is
+/// well above the reference check (otherwise the reference's own error would be measured).
+fn observed_order(points: &[&Point], reference: &Reference) -> Option<f64> {
+    let floor = 10.0 * reference.check_max;
+    let mut usable: Vec<&&Point> = points
+        .iter()
+        .filter(|p| p.stable && p.max_error > floor)
+        .collect();
+    usable.sort_by(|a, b| a.dt.total_cmp(&b.dt));
+    let (a, b) = (usable.first()?, usable.get(1)?);
+    Some((b.max_error / a.max_error).ln() / (b.dt / a.dt).ln())
+}
+
+/// Runs the whole sweep on `scene`, calling `progress` after every unit of work; it
+/// returns `false` to cancel.
+///
+/// # Errors
+/// [`ReportError::Config`] for a bad configuration, [`ReportError::Cancelled`].
+pub fn sweep(
+    scene: &Scene,
+    config: &SweepConfig,
+    progress: &mut dyn FnMut(&Progress) -> bool,
+) -> Result<AccuracyReport, ReportError> {
+    config.validate()?;
+    let per_integrator = config.dts.len() + config.bisection_steps as usize;
+    let mut tracker = Tracker {
+        done: 0,
+        total: 1 + config.integrators.len() * per_integrator,
+        callback: progress,
+    };
+    let (reference_run, reference) = reference(scene, config);
+    tracker.step(format!("reference: RK4 at {:.2e} s", reference.dt))?;
+    let mut points = Vec::new();
+    for &integrator in &config.integrators {
+        for &dt in &config.dts {
+            points.push(measure(
+                scene,
+                config,
+                (&reference_run, &reference),
+                integrator,
+                dt,
+            ));
+            tracker.step(format!("{integrator} at {dt:.2e} s"))?;
+        }
+    }
+    let mut limits = Vec::new();
+    for &integrator in &config.integrators {
+        let mine: Vec<&Point> = points
+            .iter()
+            .filter(|p| p.integrator == integrator)
+            .collect();
+        let mut limit = stable_limit(
+            scene,
+            config,
+            reference.peak_kinetic,
+            integrator,
+            &mine,
+            &mut tracker,
+        )?;
+        limit.observed_order = observed_order(&mine, &reference);
+        limits.push(limit);
+    }
+    let frontier = frontier(&points);
+    let recommendation = recommend(&points, &frontier, config.tolerance);
+    Ok(AccuracyReport {
+        scene: scene.scenario.clone(),
+        particles: scene.model.particle_count(),
+        size: scene_size(scene),
+        seconds: config.seconds,
+        tolerance: config.tolerance,
+        reference,
+        points,
+        limits,
+        frontier,
+        recommendation,
+    })
+}

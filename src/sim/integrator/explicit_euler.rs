@@ -1,0 +1,40 @@
+//! Explicit (forward) Euler.
+
+use glam::Vec3;
+
+use super::context::StepContext;
+use super::kind::IntegratorKind;
+use super::step::{Integrator, StepError, StepReport};
+use crate::cloth::ClothState;
+
+/// `x ← x + v·h`, `v ← v + a(x, v)·h`, both from the start of the step. First order; its
+/// energy grows by `1 + (ωh)²` per step on an undamped oscillator, so it is unstable for
+/// every step on undamped cloth and needs damping to survive at all.
+#[derive(Default)]
+pub struct ExplicitEuler {
+    acc: Vec<Vec3>,
+}
+
+impl Integrator for ExplicitEuler {
+    fn kind(&self) -> IntegratorKind {
+        IntegratorKind::ExplicitEuler
+    }
+
+    fn step(
+        &mut self,
+        ctx: &mut StepContext<'_>,
+        state: &mut ClothState,
+        h: f32,
+    ) -> Result<StepReport, StepError> {
+        ctx.accelerations(&state.pos, &state.vel, &mut self.acc);
+        let particles = state.pos.iter_mut().zip(state.vel.iter_mut());
+        for (((x, v), a), &w) in particles.zip(&self.acc).zip(&ctx.model.inv_mass) {
+            if w != 0.0 {
+                *x += *v * h;
+                *v += *a * h;
+            }
+        }
+        state.time += h as f64;
+        Ok(ctx.report())
+    }
+}

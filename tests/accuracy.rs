@@ -1,0 +1,192 @@
+//! The accuracy-versus-cost report: its files are complete and its choice holds up.
+
+use glam::Vec3;
+
+use clothsim::mesh::{GridOrientation, GridSpec, MeshBuild};
+use clothsim::report::{self, CSV_COLUMNS, SweepConfig};
+use clothsim::scene::Scene;
+use clothsim::sim::IntegratorKind;
+
+/// `hanging` with an 8 × 8-quad cloth: small enough for a sweep in a test.
+fn small_hanging() -> Scene {
+    let mesh = GridSpec::square(8, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
+        .build()
+        .unwrap();
+    Scene::with_cloth(
+        "hanging",
+        &MeshBuild {
+            mesh,
+            warnings: Vec::new(),
+        },
+        "grid",
+    )
+    .unwrap()
+}
+
+/// Three steps (1/60 s over 12, 24, 48 substeps), every integrator, 0.2 s.
+fn small_config() -> SweepConfig {
+    SweepConfig {
+        dts: [12.0, 24.0, 48.0]
+            .iter()
+            .map(|n| 1.0 / (60.0 * n))
+            .collect(),
+        seconds: 0.2,
+        samples: 4,
+        tolerance: 1e-3,
+        bisection_steps: 2,
+        ..SweepConfig::default()
+    }
+}
+
+#[test]
+fn the_report_has_every_row_a_decodable_plot_and_a_choice_that_holds() {
+    let scene = small_hanging();
+    let config = small_config();
+    let mut calls = 0;
+    let report = report::sweep(&scene, &config, &mut |p| {
+        calls += 1;
+        assert!(p.done <= p.total);
+        true
+    })
+    .unwrap();
+    // The reference, then every integrator at every step.
+    assert!(calls > 7 * 3, "progress reported {calls} times");
+    let dir = tempfile::tempdir().unwrap();
+    let files = report::write_report(&report, dir.path()).unwrap();
+    assert_eq!(files.len(), 3);
+
+    // The CSV: the header, then one row per integrator × step, every column filled.
+    let csv = std::fs::read_to_string(dir.path().join("accuracy.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next().unwrap(), CSV_COLUMNS.join(","));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), IntegratorKind::ALL.len() * config.dts.len());
+    for row in &rows {
+        assert_eq!(row.len(), CSV_COLUMNS.len(), "{row:?}");
+        assert!(row.iter().all(|cell| !cell.trim().is_empty()), "{row:?}");
+    }
+    for kind in IntegratorKind::ALL {
+        let mine = rows.iter().filter(|r| r[0] == kind.name()).count();
+        assert_eq!(mine, config.dts.len(), "{kind}");
+    }
+
+    // The plot decodes, at its size, and is not blank: the integrators' colours are in it.
+    let png = image::open(dir.path().join("accuracy.png"))
+        .unwrap()
+        .to_rgb8();
+    assert_eq!(png.dimensions(), report::PLOT_SIZE);
+    let (r, g, b) = report::integrator_color(IntegratorKind::Verlet);
+    let verlet = png.pixels().filter(|p| p.0 == [r, g, b]).count();
+    assert!(verlet > 100, "only {verlet} pixels of Verlet's colour");
+
+    // The Markdown names the choice.
+    let md = std::fs::read_to_string(dir.path().join("accuracy.md")).unwrap();
+    assert!(md.contains(&report::choice_sentence(&report)));
+
+    // The choice holds up when measured again, from scratch.
+    let chosen = report
+        .recommended()
+        .expect("a run within 0.1 % of the cloth's size")
+        .clone();
+    assert!(chosen.stable && chosen.max_error <= config.tolerance);
+    let again = report::sweep(
+        &scene,
+        &SweepConfig {
+            integrators: vec![chosen.integrator],
+            dts: vec![chosen.dt],
+            bisection_steps: 0,
+            ..config.clone()
+        },
+        &mut |_| true,
+    )
+    .unwrap();
+    let rerun = &again.points[0];
+    assert!(rerun.stable);
+    assert!(
+        rerun.max_error <= config.tolerance,
+        "rerun error {} above the tolerance {}",
+        rerun.max_error,
+        config.tolerance
+    );
+    // And it is the cheapest run within the tolerance: nothing cheaper was as accurate.
+    for p in report
+        .points
+        .iter()
+        .filter(|p| p.stable && p.max_error <= config.tolerance)
+    {
+        assert!(p.wall_s_per_sim_s >= chosen.wall_s_per_sim_s);
+    }
+}
+
+#[test]
+fn the_reference_is_far_more_accurate_than_the_runs_it_judges() {
+    let report = report::sweep(&small_hanging(), &small_config(), &mut |_| true).unwrap();
+    let worst_stable_error = report
+        .points
+        .iter()
+        .filter(|p| p.stable)
+        .map(|p| p.max_error)
+        .fold(0.0, f64::max);
+    assert!(report.reference.check_max < 0.01 * worst_stable_error);
+    // Explicit Euler blows up at 12 substeps on this undamped cloth; implicit Euler does not.
+    let at = |kind, n: f64| {
+        report
+            .points
+            .iter()
+            .find(|p| p.integrator == kind && (p.substeps_per_frame - n).abs() < 0.5)
+            .unwrap()
+            .stable
+    };
+    assert!(at(IntegratorKind::ImplicitEuler, 12.0));
+    let limit = |kind| {
+        report
+            .limits
+            .iter()
+            .find(|l| l.integrator == kind)
+            .unwrap()
+            .dt
+    };
+    let implicit = limit(IntegratorKind::ImplicitEuler).unwrap();
+    let symplectic = limit(IntegratorKind::SemiImplicitEuler).unwrap();
+    assert!(
+        implicit > symplectic,
+        "implicit {implicit} vs symplectic Euler {symplectic}"
+    );
+}
+
+#[test]
+fn a_cancelled_sweep_stops_and_says_so() {
+    let mut calls = 0;
+    let err = report::sweep(&small_hanging(), &small_config(), &mut |_| {
+        calls += 1;
+        calls < 3
+    })
+    .unwrap_err();
+    assert!(matches!(err, report::ReportError::Cancelled));
+    assert_eq!(calls, 3);
+}
+
+#[test]
+fn a_bad_sweep_is_refused_before_any_work() {
+    for config in [
+        SweepConfig {
+            dts: vec![],
+            ..SweepConfig::default()
+        },
+        SweepConfig {
+            dts: vec![-1e-3],
+            ..SweepConfig::default()
+        },
+        SweepConfig {
+            seconds: f64::NAN,
+            ..SweepConfig::default()
+        },
+        SweepConfig {
+            tolerance: 0.0,
+            ..SweepConfig::default()
+        },
+    ] {
+        let err = report::sweep(&small_hanging(), &config, &mut |_| panic!("no work")).unwrap_err();
+        assert!(matches!(err, report::ReportError::Config(_)), "{err}");
+    }
+}
