@@ -7,7 +7,7 @@ use std::sync::mpsc::{Receiver, channel};
 use std::sync::{Arc, Mutex};
 
 use egui::{Color32, RichText};
-use egui_plot::{HLine, Legend, Line, Plot, PlotPoints, Points};
+use egui_plot::{HLine, Legend, Line, LineStyle, Plot, PlotPoints, Points};
 
 use crate::report::{
     AccuracyReport, Progress, ReportError, SweepConfig, integrator_color, recommend, sweep,
@@ -200,7 +200,21 @@ fn plot(ui: &mut egui::Ui, report: &AccuracyReport, tolerance: f64) {
         .x_axis_formatter(|m, _| format!("1e{:.0}", m.value))
         .y_axis_formatter(|m, _| format!("1e{:.0}", m.value))
         .show(ui, |plot_ui| {
-            plot_ui.hline(HLine::new("tolerance", log(tolerance)).color(Color32::GRAY));
+            plot_ui.hline(
+                HLine::new("tolerance", log(tolerance))
+                    .color(Color32::from_rgb(220, 60, 50))
+                    .style(LineStyle::dashed_loose())
+                    .width(2.0),
+            );
+            let floor = report.reference.check_max;
+            if floor.is_finite() && floor > 0.0 {
+                plot_ui.hline(
+                    HLine::new("reference uncertainty", log(floor))
+                        .color(Color32::LIGHT_GRAY)
+                        .style(LineStyle::dotted_dense())
+                        .width(1.5),
+                );
+            }
             let frontier: Vec<[f64; 2]> = report
                 .frontier
                 .iter()

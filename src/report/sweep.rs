@@ -189,8 +189,7 @@ struct Tracker<'a> {
 }
 
 impl Tracker<'_> {
-    fn step(&mut self, what: String) -> Result<(), ReportError> {
-        self.done += 1;
+    fn report(&mut self, what: String) -> Result<(), ReportError> {
         let progress = Progress {
             done: self.done.min(self.total),
             total: self.total,
@@ -201,6 +200,17 @@ impl Tracker<'_> {
         } else {
             Err(ReportError::Cancelled)
         }
+    }
+
+    /// Says what is about to run (so a long unit does not look stuck).
+    fn begin(&mut self, what: String) -> Result<(), ReportError> {
+        self.report(what)
+    }
+
+    /// Counts a unit as done.
+    fn step(&mut self, what: String) -> Result<(), ReportError> {
+        self.done += 1;
+        self.report(what)
     }
 }
 
@@ -329,8 +339,9 @@ fn stable_limit(
     let upper_bound = config.seconds / config.samples as f64;
     let undamped = undamped(scene);
     let probe = |dt: f64, tracker: &mut Tracker<'_>| -> Result<bool, ReportError> {
+        tracker.begin(format!("{integrator}: stability at {dt:.2e} s"))?;
         let ok = stable_at(&undamped, config, peak_kinetic, integrator, dt);
-        tracker.step(format!("{integrator}: stability at {dt:.2e} s"))?;
+        tracker.step(format!("{integrator}: stability at {dt:.2e} s: done"))?;
         Ok(ok)
     };
     let mut lo = swept
