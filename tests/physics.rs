@@ -348,32 +348,6 @@ fn two_runs_are_bit_identical() {
 }
 
 #[test]
-fn diverging_frame_is_rolled_back_and_refined() {
-    let mut scene = Scene::builtin("hanging").unwrap();
-    // Far too stiff for 2 substeps: explicit integration blows up at once.
-    scene.params.stiffness = [4.0e4, 4.0e4, 4.0e4];
-    scene.params.substeps = 2;
-    let mut sim = Simulation::new(scene);
-    let mut outcome = None;
-    for _ in 0..30 {
-        match sim.step_frame() {
-            Ok(o) => outcome = Some(o),
-            Err(e) => {
-                assert!(sim.state().is_finite(), "rolled back to a finite state");
-                assert!(e.to_string().contains("rolled back"));
-                return;
-            }
-        }
-        if matches!(outcome, Some(FrameOutcome::Refined { .. })) {
-            assert!(sim.state().is_finite());
-            assert!(sim.substeps() > 2);
-            return;
-        }
-    }
-    panic!("the guard never acted: {outcome:?}");
-}
-
-#[test]
 fn mass_is_lumped_from_areal_density() {
     // One right triangle with legs 1 m and 2 m: area 1 m², so each corner gets ρ/3.
     let mesh = clothsim::mesh::obj_from_str("v 0 0 0\nv 1 0 0\nv 0 0 2\nf 1 3 2\n", "t.obj")
@@ -460,7 +434,7 @@ fn refined_hanging() -> Simulation {
     for _ in 0..120 {
         match sim.step_frame() {
             Ok(FrameOutcome::Refined { .. }) => return sim,
-            Ok(FrameOutcome::Stepped) => {}
+            Ok(_) => {}
             Err(e) => panic!("no refinement succeeded: {e}"),
         }
     }

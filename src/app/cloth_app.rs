@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 use crate::mesh::{self, MeshBuild};
 use crate::render::{OrbitCamera, RenderOptions};
 use crate::scene::{DEFAULT_CLOTH_NAME, DEFAULT_CLOTH_OBJ, Scene, Simulation};
-use crate::sim::{Effect, FrameOutcome, PhaseTimings, SimParams};
+use crate::sim::{Effect, GuardAction, PhaseTimings, SimParams};
 use crate::view;
 
 use super::accuracy::AccuracyWindow;
@@ -176,7 +176,9 @@ impl ClothApp {
 
     /// Applies an edited effect list (collider settings) to the running simulation.
     pub fn apply_effects(&mut self, effects: Vec<Effect>) {
-        self.sim.set_effects(effects);
+        for warning in self.sim.set_effects(effects) {
+            self.message(Level::Warning, warning);
+        }
     }
 
     /// Starts importing an OBJ in the background; the current cloth stays until it succeeds.
@@ -221,7 +223,7 @@ impl ClothApp {
         if let Err(e) = sim.set_params(self.sim.params().clone()) {
             return self.message(Level::Error, e.to_string());
         }
-        sim.set_effects(self.sim.effects().to_vec());
+        let _ = sim.set_effects(self.sim.effects().to_vec());
         sim.set_pins_enabled(self.sim.pins_enabled());
         let mut text = format!(
             "loaded {name}: {} particles, {} triangles",
@@ -265,17 +267,20 @@ impl ClothApp {
         let start = Instant::now();
         let mut done = 0;
         while done < frames {
-            match self.sim.step_frame() {
-                Ok(FrameOutcome::Stepped) => {}
-                Ok(FrameOutcome::Refined { from, to }) => self.message(
-                    Level::Warning,
-                    format!("the step diverged and was redone: substeps raised from {from} to {to} per frame"),
-                ),
-                Err(e) => {
-                    self.transport.pause();
-                    self.message(Level::Error, format!("{e} Paused."));
-                    break;
-                }
+            let outcome = self.sim.step_frame();
+            for event in self.sim.take_guard_events() {
+                let level = match event.action {
+                    GuardAction::Recovered => Level::Info,
+                    GuardAction::Refined | GuardAction::FellBack { .. } => Level::Warning,
+                    // The error below says it.
+                    GuardAction::GaveUp => continue,
+                };
+                self.message(level, format!("stability guard: {event}"));
+            }
+            if let Err(e) = outcome {
+                self.transport.pause();
+                self.message(Level::Error, format!("{e} Paused."));
+                break;
             }
             done += 1;
             if start.elapsed().as_secs_f64() > STEP_BUDGET_SECONDS {

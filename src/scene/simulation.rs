@@ -4,8 +4,9 @@
 
 use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{
-    Collider, CpuStepper, Diverged, Effect, ForceSet, FrameOutcome, PhaseTimings, SimParams,
-    StepBackend, StepError, StepReport, StepStats, colliders_of,
+    Collider, CpuStepper, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent, IntegratorKind,
+    PhaseTimings, SimParams, StepBackend, StepError, StepReport, StepStats, colliders_of,
+    small_sphere_warnings,
 };
 
 use super::error::SceneError;
@@ -39,10 +40,15 @@ impl Simulation {
     /// Starts the scene on the given backend (configured here with the scene's parameters).
     pub fn with_backend(scene: Scene, mut backend: Box<dyn StepBackend>) -> Self {
         backend.configure(&scene.model, &scene.params, &scene.effects);
+        let mut warnings = scene.warnings;
+        warnings.extend(small_sphere_warnings(
+            &colliders_of(&scene.effects),
+            &scene.model,
+        ));
         Self {
             scenario: scene.scenario,
             cloth_name: scene.cloth_name,
-            warnings: scene.warnings,
+            warnings,
             scenario_pins: scene.pins,
             pins_enabled: true,
             state: scene.initial.clone(),
@@ -146,10 +152,13 @@ impl Simulation {
     }
 
     /// Replaces the effect list (switches forces on or off, moves or retunes colliders).
-    pub fn set_effects(&mut self, effects: Vec<Effect>) {
+    /// Returns warnings about it (a sphere smaller than the particle spacing).
+    pub fn set_effects(&mut self, effects: Vec<Effect>) -> Vec<String> {
         self.effects = effects;
+        let warnings = small_sphere_warnings(&self.colliders(), &self.model);
         self.backend
             .configure(&self.model, &self.params, &self.effects);
+        warnings
     }
 
     /// The scenario's pins (whether or not they are enabled).
@@ -229,5 +238,15 @@ impl Simulation {
     /// Work counters since the last call.
     pub fn take_stats(&mut self) -> StepStats {
         self.backend.take_stats()
+    }
+
+    /// What the stability guard did since the last call.
+    pub fn take_guard_events(&mut self) -> Vec<GuardEvent> {
+        self.backend.take_guard_events()
+    }
+
+    /// The integrator in effect: the requested one, or the guard's fallback.
+    pub fn integrator_in_effect(&self) -> IntegratorKind {
+        self.backend.integrator()
     }
 }

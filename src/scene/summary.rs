@@ -3,7 +3,7 @@
 use std::time::Instant;
 
 use crate::mesh::SpringKind;
-use crate::sim::{FrameOutcome, min_collider_distance};
+use crate::sim::{FrameOutcome, GuardEvent, min_collider_distance};
 
 use super::simulation::Simulation;
 
@@ -37,8 +37,13 @@ pub struct RunSummary {
     /// Joules.
     pub kinetic_energy: f64,
     pub wall_seconds: f64,
-    /// Frames the guard had to redo with more substeps.
+    /// Frames the guard had to redo (with more substeps or the fallback integrator).
     pub refined_frames: u64,
+    /// The integrator in effect at the end (the guard's fallback may have replaced the
+    /// requested one).
+    pub integrator_in_effect: String,
+    /// Everything the stability guard did, in order.
+    pub guard_events: Vec<GuardEvent>,
     /// Set when the run stopped early because it diverged.
     pub error: Option<String>,
 }
@@ -50,10 +55,13 @@ impl Simulation {
         let start = Instant::now();
         let mut refined = 0;
         let mut error = None;
+        let mut events = Vec::new();
         for _ in 0..frames {
-            match self.step_frame() {
-                Ok(FrameOutcome::Stepped) => {}
-                Ok(FrameOutcome::Refined { .. }) => refined += 1,
+            let outcome = self.step_frame();
+            events.extend(self.take_guard_events());
+            match outcome {
+                Ok(FrameOutcome::Stepped | FrameOutcome::Recovered { .. }) => {}
+                Ok(FrameOutcome::Refined { .. } | FrameOutcome::FellBack { .. }) => refined += 1,
                 Err(e) => {
                     error = Some(e.to_string());
                     break;
@@ -62,6 +70,7 @@ impl Simulation {
         }
         let mut summary = self.summary(start.elapsed().as_secs_f64());
         summary.refined_frames = refined;
+        summary.guard_events = events;
         summary.error = error;
         summary
     }
@@ -93,6 +102,8 @@ impl Simulation {
             kinetic_energy: state.kinetic_energy(model),
             wall_seconds,
             refined_frames: 0,
+            integrator_in_effect: self.integrator_in_effect().name().to_string(),
+            guard_events: Vec::new(),
             error: None,
         }
     }

@@ -4,8 +4,8 @@
 use crate::cloth::{ClothModel, ClothState};
 
 use super::effect::Effect;
-use super::guard::{Diverged, FrameOutcome};
-use super::integrator::{StepError, StepReport};
+use super::guard::{Diverged, FrameOutcome, GuardEvent};
+use super::integrator::{IntegratorKind, StepError, StepReport};
 use super::params::SimParams;
 use super::stats::StepStats;
 use super::timings::PhaseTimings;
@@ -55,4 +55,10 @@ pub trait StepBackend: Send {
 
     /// Work counters since the last call; resets them.
     fn take_stats(&mut self) -> StepStats;
+
+    /// What the stability guard did since the last call.
+    fn take_guard_events(&mut self) -> Vec<GuardEvent>;
+
+    /// The integrator in effect (the guard's fallback may have replaced the requested one).
+    fn integrator(&self) -> IntegratorKind;
 }

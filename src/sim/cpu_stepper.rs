@@ -10,8 +10,11 @@ use super::backend::StepBackend;
 use super::collider::{Collider, colliders_of};
 use super::effect::Effect;
 use super::forces::ForceSet;
-use super::guard::{Diverged, FrameOutcome, MAX_REFINEMENTS};
-use super::integrator::{Integrator, StepContext, StepError, StepMeter, StepReport};
+use super::guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check};
+use super::guard_state::GuardState;
+use super::integrator::{
+    Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport,
+};
 use super::params::{SimParams, SolverConfig};
 use super::stats::StepStats;
 use super::timings::PhaseTimings;
@@ -23,18 +26,22 @@ pub struct CpuStepper {
     forces: ForceSet,
     colliders: Vec<Collider>,
     solver: SolverConfig,
+    gravity: glam::Vec3,
+    stiffness: [f32; 3],
     dt: f32,
     /// Substeps per frame the parameters ask for.
     requested: u32,
     /// Substeps per frame in effect (the guard may have raised them).
     substeps: u32,
     offset: f32,
-    divergence_speed: f32,
+    guard: GuardState,
     timings: PhaseTimings,
     stats: StepStats,
     meter: StepMeter,
-    /// The frame's start state, restored when a try diverges.
-    backup: ClothState,
+    /// The frame's start state, restored when nothing saves a frame.
+    frame_start: ClothState,
+    /// Positions at the start of the current substep: the paths colliders sweep.
+    substep_start: Vec<glam::Vec3>,
 }
 
 impl CpuStepper {
@@ -45,15 +52,18 @@ impl CpuStepper {
             forces: ForceSet::default(),
             colliders: Vec::new(),
             solver: params.solver,
+            gravity: params.gravity,
+            stiffness: params.stiffness,
             dt: params.dt,
             requested: 0,
             substeps: 1,
             offset: params.collision_offset,
-            divergence_speed: params.divergence_speed,
+            guard: GuardState::new(params.guard.clone()),
             timings: PhaseTimings::default(),
             stats: StepStats::default(),
             meter: StepMeter::default(),
-            backup: ClothState::default(),
+            frame_start: ClothState::default(),
+            substep_start: Vec::new(),
         };
         stepper.configure(model, params, effects);
         stepper
@@ -87,6 +97,139 @@ impl CpuStepper {
             .add("integrate", total.saturating_sub(m.forces + m.solve));
         result
     }
+
+    /// One frame at the substeps in effect, ending exactly at `end` (seconds); checked
+    /// against the guard's limits.
+    fn try_frame(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+        end: f64,
+    ) -> Result<(), Trouble> {
+        for _ in 0..self.substeps {
+            self.substep(model, state)?;
+        }
+        // Whole frames end on the frame clock, however the substeps' lengths rounded.
+        state.time = end;
+        let limits = self.guard.limits.as_ref().ok_or(Trouble::NonFinite)?;
+        match check(model, state, limits) {
+            Some(trouble) => Err(trouble),
+            None => Ok(()),
+        }
+    }
+
+    /// Replays from the rollback point to `end` at the substeps in effect.
+    fn replay(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+        end: f64,
+    ) -> Result<(), Trouble> {
+        let from = self
+            .guard
+            .checkpoint
+            .clone()
+            .unwrap_or_else(|| self.frame_start.clone());
+        state.clone_from(&from);
+        self.integrator.invalidate();
+        let frames = ((end - state.time) / self.dt as f64).round().max(1.0) as u32;
+        for k in 1..=frames {
+            let frame_end = if k == frames {
+                end
+            } else {
+                from.time + k as f64 * self.dt as f64
+            };
+            self.try_frame(model, state, frame_end)?;
+        }
+        Ok(())
+    }
+
+    fn record(&mut self, time: f64, reason: Option<&Trouble>, action: GuardAction, before: u32) {
+        self.guard.events.push(GuardEvent {
+            time,
+            reason: reason.map(ToString::to_string),
+            action,
+            substeps_before: before,
+            substeps_after: self.substeps,
+        });
+    }
+
+    /// A frame failed with `trouble`: roll back and redo it with more substeps, then with
+    /// the fallback integrator; else restore the frame's start.
+    fn rescue(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+        end: f64,
+        trouble: Trouble,
+    ) -> Result<FrameOutcome, Diverged> {
+        self.guard.failed_frame();
+        let before = self.substeps;
+        let mut last = trouble;
+        for _ in 0..self.guard.policy.max_refinements {
+            self.substeps = self.substeps.saturating_mul(2);
+            match self.replay(model, state, end) {
+                Ok(()) => {
+                    self.record(end, Some(&last), GuardAction::Refined, before);
+                    return Ok(FrameOutcome::Refined {
+                        from: before,
+                        to: self.substeps,
+                    });
+                }
+                Err(t) => last = t,
+            }
+        }
+        let tried = self.substeps;
+        let mut fallback = String::new();
+        if let Some(kind) = self.guard.policy.fallback
+            && kind != self.integrator.kind()
+        {
+            let original = std::mem::replace(&mut self.integrator, kind.build());
+            self.substeps = self.requested;
+            match self.replay(model, state, end) {
+                Ok(()) => {
+                    self.record(
+                        end,
+                        Some(&last),
+                        GuardAction::FellBack { integrator: kind },
+                        before,
+                    );
+                    return Ok(FrameOutcome::FellBack { integrator: kind });
+                }
+                Err(t) => {
+                    last = t;
+                    self.integrator = original;
+                    fallback = format!(", and with {}", kind.label());
+                }
+            }
+        }
+        state.clone_from(&self.frame_start);
+        self.integrator.invalidate();
+        self.substeps = before;
+        self.record(state.time, Some(&last), GuardAction::GaveUp, before);
+        Err(Diverged {
+            time: state.time,
+            reason: last.to_string(),
+            substeps: tried,
+            fallback,
+        })
+    }
+
+    /// After a healthy frame: maybe bring raised substeps back down.
+    fn maybe_recover(&mut self, end: f64) -> Option<FrameOutcome> {
+        if self.substeps <= self.requested || self.guard.good_frames < self.guard.recover_wait {
+            return None;
+        }
+        let before = self.substeps;
+        self.substeps = (self.substeps / 2).max(self.requested);
+        self.guard.good_frames = 0;
+        self.guard.stepped_down = true;
+        self.record(end, None, GuardAction::Recovered, before);
+        Some(FrameOutcome::Recovered {
+            from: before,
+            to: self.substeps,
+        })
+    }
 }
 
 impl StepBackend for CpuStepper {
@@ -103,9 +246,15 @@ impl StepBackend for CpuStepper {
         // New strengths make whatever the integrator kept or derived stale.
         self.integrator.forces_changed();
         self.solver = params.solver;
+        self.gravity = params.gravity;
+        self.stiffness = params.stiffness;
         self.dt = params.dt;
         self.offset = params.collision_offset;
-        self.divergence_speed = params.divergence_speed;
+        if self.guard.policy != params.guard {
+            self.guard = GuardState::new(params.guard.clone());
+        }
+        // Limits and rollback points belong to the old parameters.
+        self.guard.forget_history();
         let requested = params.substeps.max(1);
         if requested != self.requested {
             self.requested = requested;
@@ -115,6 +264,7 @@ impl StepBackend for CpuStepper {
 
     fn invalidate(&mut self) {
         self.integrator.invalidate();
+        self.guard.forget_history();
     }
 
     fn substep(
@@ -123,14 +273,17 @@ impl StepBackend for CpuStepper {
         state: &mut ClothState,
     ) -> Result<StepReport, StepError> {
         let h = self.substep_length();
+        if !self.colliders.is_empty() {
+            self.substep_start.clone_from(&state.pos);
+        }
         let report = self.integrate(model, state, h)?;
         self.stats.record(&report);
         if !self.colliders.is_empty() {
-            let (colliders, offset) = (&self.colliders, self.offset);
+            let (colliders, offset, start) = (&self.colliders, self.offset, &self.substep_start);
             let contacts = self.timings.time("collide", || {
                 colliders
                     .iter()
-                    .map(|c| c.resolve(model, state, offset))
+                    .map(|c| c.resolve(model, start, state, offset))
                     .sum::<usize>()
             });
             if contacts > 0 {
@@ -141,41 +294,52 @@ impl StepBackend for CpuStepper {
         Ok(report)
     }
 
-    /// If a try ends non-finite or faster than the divergence speed, or its solve fails,
-    /// the state is rolled back and the frame redone with twice the substeps, up to
-    /// [`MAX_REFINEMENTS`] times.
+    /// One frame under the guard: a frame that breaks a limit (non-finite, too fast, a
+    /// spring overstretched, too much kinetic energy, a failed solve) is rolled back to the
+    /// last checkpoint and redone with twice the substeps, up to `max_refinements` times,
+    /// then with the fallback integrator; raised substeps come back down after
+    /// `recover_after` healthy frames.
     fn frame(
         &mut self,
         model: &ClothModel,
         state: &mut ClothState,
     ) -> Result<FrameOutcome, Diverged> {
-        self.backup.clone_from(state);
-        let first = self.substeps;
-        for attempt in 0..=MAX_REFINEMENTS {
-            let stepped = (0..self.substeps).try_for_each(|_| self.substep(model, state).map(drop));
-            if stepped.is_ok() && state.is_finite() && state.max_speed() <= self.divergence_speed {
-                return Ok(if attempt == 0 {
-                    FrameOutcome::Stepped
-                } else {
-                    FrameOutcome::Refined {
-                        from: first,
-                        to: self.substeps,
-                    }
-                });
+        let end = state.time + self.dt as f64;
+        if !self.guard.policy.enabled {
+            for _ in 0..self.substeps {
+                // With the guard off a failed solve is all there is to report.
+                self.substep(model, state).map_err(|e| Diverged {
+                    time: state.time,
+                    reason: e.to_string(),
+                    substeps: self.substeps,
+                    fallback: String::new(),
+                })?;
             }
-            state.clone_from(&self.backup);
-            // What the integrator kept belongs to the discarded attempt.
-            self.integrator.invalidate();
-            if attempt < MAX_REFINEMENTS {
-                self.substeps *= 2;
-            }
+            state.time = end;
+            return Ok(FrameOutcome::Stepped);
         }
-        let failed = self.substeps;
-        self.substeps = first;
-        Err(Diverged {
-            time: state.time,
-            substeps: failed,
-        })
+        if self.guard.limits.is_none() {
+            let wind = 0.0;
+            self.guard.limits = Some(GuardLimits::derive(
+                &self.guard.policy,
+                model,
+                state,
+                self.gravity,
+                self.stiffness,
+                &self.colliders,
+                wind,
+            ));
+        }
+        self.frame_start.clone_from(state);
+        match self.try_frame(model, state, end) {
+            Ok(()) => {
+                let start = std::mem::take(&mut self.frame_start);
+                self.guard.healthy_frame(&start);
+                self.frame_start = start;
+                Ok(self.maybe_recover(end).unwrap_or(FrameOutcome::Stepped))
+            }
+            Err(trouble) => self.rescue(model, state, end, trouble),
+        }
     }
 
     fn substeps(&self) -> u32 {
@@ -192,5 +356,13 @@ impl StepBackend for CpuStepper {
 
     fn take_stats(&mut self) -> StepStats {
         std::mem::take(&mut self.stats)
+    }
+
+    fn take_guard_events(&mut self) -> Vec<GuardEvent> {
+        std::mem::take(&mut self.guard.events)
+    }
+
+    fn integrator(&self) -> IntegratorKind {
+        self.integrator.kind()
     }
 }

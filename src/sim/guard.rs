@@ -1,17 +1,329 @@
-//! The stability guard's vocabulary: what a frame did, and the error of one no try could save.
+//! The stability guard: what counts as a frame going wrong (limits derived from the scene),
+//! what the guard may do about it (a policy that is plain data), and the record it keeps.
 
-/// How many times a diverging frame is retried, each time with twice the substeps.
-pub const MAX_REFINEMENTS: u32 = 3;
+use glam::Vec3;
 
-/// A frame that could not be made stable.
+use crate::cloth::{ClothModel, ClothState};
+use crate::mesh::{SpringKind, bounds};
+
+use super::collider::Collider;
+use super::integrator::{IntegratorKind, StepError};
+
+/// What the guard may do. Part of [`super::SimParams`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GuardPolicy {
+    /// Off: frames are never checked, rolled back or refined (default on).
+    pub enabled: bool,
+    /// Particle speed limit, m/s. `None` (default) derives it from the scene: `headroom` ×
+    /// (free-fall speed over the scene's height + the fastest initial particle + the fastest
+    /// collider surface + the wind) + 1 m/s.
+    pub max_speed: Option<f32>,
+    /// Smallest limit on the relative extension of a spring (default 1: twice its rest
+    /// length; cloth stays within a few percent). The limit in force is raised to `headroom`
+    /// times the stretch of a structural spring carrying the whole cloth's weight, so soft
+    /// chains that really do stretch a lot are not mistaken for blow-ups.
+    pub max_strain: f32,
+    /// Safety factor on the speed and kinetic-energy limits derived from the scene (default 4).
+    pub headroom: f32,
+    /// How many times a failing frame is redone, each time with twice the substeps
+    /// (default 3: up to 8×).
+    pub max_refinements: u32,
+    /// The integrator tried, at the requested substeps, once every refinement failed
+    /// (default implicit Euler, stable at any step for the springs); `None` gives up instead.
+    pub fallback: Option<IntegratorKind>,
+    /// Healthy frames after which raised substeps are halved back towards the request
+    /// (default 60, one second at 60 fps; doubled each time a step back down fails soon).
+    pub recover_after: u32,
+    /// Frames a state must have stayed healthy before it becomes the rollback point
+    /// (default 6).
+    pub checkpoint_frames: u32,
+}
+
+impl Default for GuardPolicy {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            max_speed: None,
+            max_strain: 1.0,
+            headroom: 4.0,
+            max_refinements: 3,
+            fallback: Some(IntegratorKind::ImplicitEuler),
+            recover_after: 60,
+            checkpoint_frames: 6,
+        }
+    }
+}
+
+impl GuardPolicy {
+    /// Checks the policy's numbers.
+    ///
+    /// # Errors
+    /// A message naming the bad field.
+    pub fn validate(&self) -> Result<(), String> {
+        if let Some(v) = self.max_speed
+            && !(v.is_finite() && v > 0.0)
+        {
+            return Err(format!("parameter `guard.max_speed` = {v} must be > 0 m/s"));
+        }
+        for (name, v) in [
+            ("guard.max_strain", self.max_strain),
+            ("guard.headroom", self.headroom),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("parameter `{name}` = {v} must be > 0"));
+            }
+        }
+        if self.max_refinements > 10 {
+            return Err(format!(
+                "parameter `guard.max_refinements` = {} must be at most 10 (1024× the substeps)",
+                self.max_refinements
+            ));
+        }
+        if self.recover_after == 0 || self.checkpoint_frames == 0 {
+            return Err(
+                "parameters `guard.recover_after` and `guard.checkpoint_frames` must be ≥ 1".into(),
+            );
+        }
+        Ok(())
+    }
+}
+
+/// The limits a healthy frame stays within, derived from the scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GuardLimits {
+    /// m/s.
+    pub speed: f32,
+    /// Relative extension.
+    pub strain: f32,
+    /// Joules.
+    pub kinetic_energy: f64,
+}
+
+impl GuardLimits {
+    /// Limits for `state` of `model` under `gravity` with spring `stiffness` (per kind,
+    /// N/m), among `colliders`, with an ambient `wind` speed (m/s): the speeds and energy
+    /// the scene can reach by falling, being thrown or being dragged, and the stretch of a
+    /// structural spring carrying the whole weight, times the policy's headroom.
+    pub fn derive(
+        policy: &GuardPolicy,
+        model: &ClothModel,
+        state: &ClothState,
+        gravity: Vec3,
+        stiffness: [f32; 3],
+        colliders: &[Collider],
+        wind: f32,
+    ) -> Self {
+        let (lo, hi) = bounds(&state.pos);
+        let mut bottom = lo.y;
+        let mut surface = 0.0f32;
+        for c in colliders {
+            match *c {
+                Collider::Sphere {
+                    center,
+                    radius,
+                    spin,
+                    ..
+                } => {
+                    bottom = bottom.min(center.y - radius);
+                    surface = surface.max(spin.length() * radius);
+                }
+                Collider::Plane { point, .. } => bottom = bottom.min(point.y),
+            }
+        }
+        // The cloth can fall its own size plus down to the lowest thing below it.
+        let height = (hi - lo).length() + (lo.y - bottom).max(0.0);
+        let fall = (2.0 * gravity.length() * height).sqrt();
+        let pushed = state.max_speed() + surface + wind;
+        let speed = policy
+            .max_speed
+            .unwrap_or(policy.headroom * (fall + pushed) + 1.0);
+        let mass: f64 = model
+            .mass
+            .iter()
+            .zip(&model.inv_mass)
+            .filter(|(_, w)| **w > 0.0)
+            .map(|(m, _)| *m as f64)
+            .sum();
+        let available = state.kinetic_energy(model)
+            + mass * gravity.length() as f64 * height as f64
+            + 0.5 * mass * (pushed as f64).powi(2);
+        Self {
+            speed,
+            strain: policy.max_strain.max(
+                policy.headroom * weight_strain(model, stiffness, mass as f32 * gravity.length()),
+            ),
+            kinetic_energy: policy.headroom as f64 * available + 1e-9,
+        }
+    }
+}
+
+/// Relative stretch of the weakest structural spring (the smallest k·l) pulled by `weight`
+/// newtons; 0 without structural springs of positive stiffness.
+fn weight_strain(model: &ClothModel, stiffness: [f32; 3], weight: f32) -> f32 {
+    let s = &model.springs;
+    let k = stiffness[SpringKind::Structural.index()];
+    let weakest = (0..s.len())
+        .filter(|&e| s.kind[e] == SpringKind::Structural)
+        .map(|e| k * s.rest[e])
+        .fold(f32::INFINITY, f32::min);
+    if weakest.is_finite() && weakest > 0.0 {
+        weight / weakest
+    } else {
+        0.0
+    }
+}
+
+/// What went wrong in a frame.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Trouble {
+    NonFinite,
+    Speed { speed: f32, limit: f32 },
+    Strain { strain: f32, limit: f32 },
+    KineticEnergy { joules: f64, limit: f64 },
+    Solver { detail: String },
+}
+
+impl std::fmt::Display for Trouble {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Trouble::NonFinite => write!(f, "a position or velocity became non-finite"),
+            Trouble::Speed { speed, limit } => {
+                write!(
+                    f,
+                    "a particle reached {speed:.1} m/s (limit {limit:.1} m/s)"
+                )
+            }
+            Trouble::Strain { strain, limit } => write!(
+                f,
+                "a spring stretched by {:.0} % (limit {:.0} %)",
+                100.0 * strain,
+                100.0 * limit
+            ),
+            Trouble::KineticEnergy { joules, limit } => {
+                write!(
+                    f,
+                    "kinetic energy reached {joules:.3e} J (limit {limit:.3e} J)"
+                )
+            }
+            Trouble::Solver { detail } => write!(f, "{detail}"),
+        }
+    }
+}
+
+impl From<StepError> for Trouble {
+    fn from(e: StepError) -> Self {
+        Trouble::Solver {
+            detail: e.to_string(),
+        }
+    }
+}
+
+/// The first limit `state` breaks, if any.
+pub fn check(model: &ClothModel, state: &ClothState, limits: &GuardLimits) -> Option<Trouble> {
+    if !state.is_finite() {
+        return Some(Trouble::NonFinite);
+    }
+    let speed = state.max_speed();
+    if speed > limits.speed {
+        return Some(Trouble::Speed {
+            speed,
+            limit: limits.speed,
+        });
+    }
+    let s = &model.springs;
+    let strain = (0..s.len())
+        .map(|e| {
+            state.pos[s.a[e] as usize].distance(state.pos[s.b[e] as usize]) / s.rest[e].max(1e-12)
+                - 1.0
+        })
+        .fold(0.0f32, f32::max);
+    if strain > limits.strain {
+        return Some(Trouble::Strain {
+            strain,
+            limit: limits.strain,
+        });
+    }
+    let joules = state.kinetic_energy(model);
+    if joules > limits.kinetic_energy {
+        return Some(Trouble::KineticEnergy {
+            joules,
+            limit: limits.kinetic_energy,
+        });
+    }
+    None
+}
+
+/// What the guard did.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GuardAction {
+    /// Rolled back and redone with more substeps, which stay for now.
+    Refined,
+    /// Every refinement failed; redone with the fallback integrator, which stays.
+    FellBack { integrator: IntegratorKind },
+    /// After a run of healthy frames the substeps came back down.
+    Recovered,
+    /// Nothing helped: the state is the last good one and the run stops.
+    GaveUp,
+}
+
+/// One thing the guard did, for `simulate --json` and the app.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct GuardEvent {
+    /// Simulated time of the frame it happened in, seconds.
+    pub time: f64,
+    /// What went wrong (absent for a recovery).
+    pub reason: Option<String>,
+    pub action: GuardAction,
+    pub substeps_before: u32,
+    pub substeps_after: u32,
+}
+
+impl std::fmt::Display for GuardEvent {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let why = self.reason.as_deref().unwrap_or("");
+        let (a, b) = (self.substeps_before, self.substeps_after);
+        match &self.action {
+            GuardAction::Refined => write!(
+                f,
+                "t = {:.2} s: {why}; rolled back and redone with {b} substeps per frame (was {a})",
+                self.time
+            ),
+            GuardAction::FellBack { integrator } => write!(
+                f,
+                "t = {:.2} s: {why}; more substeps did not help, so the frame was redone with {} at {b} substeps",
+                self.time,
+                integrator.label()
+            ),
+            GuardAction::Recovered => write!(
+                f,
+                "t = {:.2} s: the trouble has passed; substeps back down from {a} to {b} per frame",
+                self.time
+            ),
+            GuardAction::GaveUp => write!(
+                f,
+                "t = {:.2} s: {why}; nothing saved the frame, the last good state is kept",
+                self.time
+            ),
+        }
+    }
+}
+
+/// A frame no try could make healthy; the state is left at the frame's start.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error(
-    "simulation diverged at t = {time:.3} s even with {substeps} substeps per frame; \
-     the state was rolled back to the last good frame. Lower the stiffness or the time step."
+    "the simulation diverged at t = {time:.3} s ({reason}) even with {substeps} substeps per \
+     frame{fallback}; the state was rolled back to the last good frame. Lower the stiffness, \
+     raise the substeps, or choose implicit Euler."
 )]
 pub struct Diverged {
     pub time: f64,
+    pub reason: String,
     pub substeps: u32,
+    /// ", and with the fallback integrator" when it was tried.
+    pub fallback: String,
 }
 
 /// What happened in a frame that succeeded.
@@ -19,6 +331,10 @@ pub struct Diverged {
 pub enum FrameOutcome {
     /// Advanced normally.
     Stepped,
-    /// The first try diverged; the frame was redone with more substeps, which now stay.
+    /// A try failed; the frame was redone with more substeps, which stay for now.
     Refined { from: u32, to: u32 },
+    /// Refinement failed; the frame was redone with the fallback integrator, which stays.
+    FellBack { integrator: IntegratorKind },
+    /// The substeps came back down towards the request after a run of healthy frames.
+    Recovered { from: u32, to: u32 },
 }

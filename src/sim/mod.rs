@@ -9,6 +9,7 @@ mod cpu_stepper;
 mod effect;
 pub mod forces;
 mod guard;
+mod guard_state;
 pub mod integrator;
 mod params;
 mod stats;
@@ -16,12 +17,14 @@ mod timings;
 
 pub use backend::StepBackend;
 pub use cg::{CgOutcome, ConjugateGradient};
-pub use collider::{Collider, colliders_of, min_collider_distance};
+pub use collider::{Collider, colliders_of, min_collider_distance, small_sphere_warnings};
 pub use constraints::DistanceConstraints;
 pub use cpu_stepper::CpuStepper;
 pub use effect::Effect;
 pub use forces::{Force, ForceSet, JacobianMode, SystemMatrix};
-pub use guard::{Diverged, FrameOutcome, MAX_REFINEMENTS};
+pub use guard::{
+    Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, GuardPolicy, Trouble, check,
+};
 pub use integrator::{Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport};
 pub use params::{SimParams, SolverConfig};
 pub use stats::StepStats;

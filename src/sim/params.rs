@@ -2,6 +2,7 @@
 
 use glam::Vec3;
 
+use super::guard::GuardPolicy;
 use super::integrator::IntegratorKind;
 
 /// Every tunable number of the solver. Units are SI; each field says how it affects
@@ -32,8 +33,9 @@ pub struct SimParams {
     pub density: f32,
     /// Collision thickness, metres: particles are kept this far outside collider surfaces.
     pub collision_offset: f32,
-    /// Speed above which a frame counts as diverged and is retried with more substeps, m/s.
-    pub divergence_speed: f32,
+    /// What the stability guard checks and may do.
+    #[serde(default)]
+    pub guard: GuardPolicy,
     /// How the integrators that solve something solve it.
     #[serde(default)]
     pub solver: SolverConfig,
@@ -82,7 +84,7 @@ impl Default for SimParams {
             air_damping: 0.5,
             density: 0.2,
             collision_offset: 0.01,
-            divergence_speed: 500.0,
+            guard: GuardPolicy::default(),
             solver: SolverConfig::default(),
         }
     }
@@ -116,12 +118,6 @@ impl SimParams {
                 self.collision_offset >= 0.0,
                 "≥ 0 m",
             ),
-            (
-                "divergence_speed",
-                self.divergence_speed,
-                self.divergence_speed > 0.0,
-                "> 0 m/s",
-            ),
         ];
         for (name, value, ok, allowed) in checks {
             if !(value.is_finite() && ok) {
@@ -140,6 +136,7 @@ impl SimParams {
                 ));
             }
         }
+        self.guard.validate()?;
         let solver = &self.solver;
         if !(solver.tolerance.is_finite() && solver.tolerance > 0.0 && solver.tolerance < 1.0) {
             return Err(format!(
