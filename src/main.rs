@@ -32,6 +32,8 @@ enum Command {
         /// Print one JSON object.
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        import: ImportArgs,
     },
     /// List the built-in scenarios.
     Scenes,
@@ -104,6 +106,28 @@ enum Command {
     },
 }
 
+/// How an OBJ cloth is imported.
+#[derive(clap::Args)]
+struct ImportArgs {
+    /// Weld corners closer than this fraction of the cloth's size (0: only identical ones).
+    #[arg(long, default_value_t = mesh::ImportOptions::default().weld_tolerance, allow_negative_numbers = true)]
+    weld_tolerance: f32,
+}
+
+impl ImportArgs {
+    fn options(&self) -> Result<mesh::ImportOptions> {
+        if !(self.weld_tolerance.is_finite() && (0.0..0.1).contains(&self.weld_tolerance)) {
+            bail!(
+                "--weld-tolerance must be a fraction of the cloth's size in 0..0.1, got {}",
+                self.weld_tolerance
+            );
+        }
+        Ok(mesh::ImportOptions {
+            weld_tolerance: self.weld_tolerance,
+        })
+    }
+}
+
 /// What every simulating subcommand takes.
 #[derive(clap::Args)]
 struct RunArgs {
@@ -125,12 +149,14 @@ struct RunArgs {
     /// Substeps per frame.
     #[arg(long)]
     substeps: Option<u32>,
+    #[command(flatten)]
+    import: ImportArgs,
 }
 
 impl RunArgs {
     fn simulation(&self) -> Result<Simulation> {
         let mut scene = match &self.obj {
-            Some(path) => Scene::with_obj(&self.scene, path)?,
+            Some(path) => Scene::with_obj_options(&self.scene, path, &self.import.options()?)?,
             None => Scene::builtin(&self.scene)?,
         };
         if let Some(k) = self.integrator {
@@ -185,7 +211,7 @@ fn run(cli: Cli) -> Result<()> {
                 "cannot open the window: {e}. Headless use: `clothsim --help` lists the subcommands"
             )
         }),
-        Some(Command::Info { file, json }) => info(&file, json),
+        Some(Command::Info { file, json, import }) => info(&file, json, &import.options()?),
         Some(Command::Scenes) => {
             for s in SCENARIOS {
                 println!("{:<16} {}", s.name, s.summary);
@@ -239,8 +265,8 @@ fn run(cli: Cli) -> Result<()> {
     }
 }
 
-fn info(file: &std::path::Path, json: bool) -> Result<()> {
-    let build = mesh::load_obj(file)?;
+fn info(file: &std::path::Path, json: bool, options: &mesh::ImportOptions) -> Result<()> {
+    let build = mesh::load_obj_with(file, options)?;
     let m = &build.mesh;
     let [structural, shear, bend] = SpringKind::ALL.map(|k| m.spring_count(k));
     if json {
@@ -303,11 +329,8 @@ fn simulate(args: &RunArgs, json: bool) -> Result<()> {
             Some(d) => println!("  closest particle to a collider surface: {d:.5} m"),
             None => println!("  no colliders"),
         }
-        if summary.refined_frames > 0 {
-            println!(
-                "  {} frame(s) were redone with more substeps",
-                summary.refined_frames
-            );
+        for event in &summary.guard_events {
+            println!("  stability guard: {event}");
         }
     }
     if let Some(e) = summary.error {

@@ -48,9 +48,16 @@ fn drop_obj(harness: &mut Harness<'static, ClothApp>, name: &str, text: &str) {
         .dropped_files
         .push(Arc::new(Dropped(path)));
     harness.run_steps(1);
+    // A drop starts a background import and says so. (A tiny file may already be done
+    // within the same UI frame, so "still loading" is not guaranteed.)
     assert!(
-        harness.state().is_loading(),
-        "a drop starts a background import"
+        harness
+            .state()
+            .messages
+            .iter()
+            .any(|m| m.text.starts_with("loading") && m.text.contains(name)),
+        "{:?}",
+        harness.state().messages
     );
     harness.state_mut().finish_loading();
     harness.run_steps(2);
@@ -280,4 +287,72 @@ fn the_accuracy_window_sweeps_in_the_background_and_applies_its_choice() {
         "the choice replaced the parameters the sweep started from"
     );
     harness.get_by_label_contains("applied");
+}
+
+#[test]
+fn a_bad_parameter_is_refused_and_the_simulation_keeps_its_own() {
+    let mut harness = harness();
+    let before = harness.state().sim.params().clone();
+    let mut bad = before.clone();
+    bad.dt = f32::NAN;
+    harness.state_mut().apply_params(bad);
+    harness.run_steps(1);
+    assert_eq!(harness.state().sim.params(), &before);
+    let error = harness
+        .state()
+        .last_error()
+        .expect("an error message")
+        .to_string();
+    assert!(error.contains("`dt`") && error.contains("kept"), "{error}");
+    harness.get_by_label_contains("`dt`");
+}
+
+#[test]
+fn a_failed_capture_is_reported_and_loses_nothing() {
+    let mut harness = harness();
+    harness.state_mut().capture_dir = std::path::PathBuf::from("/no/such/folder");
+    let particles = harness.state().sim.model().particle_count();
+    harness.get_by_label("Capture PNG").click();
+    harness.run_steps(2);
+    harness.state_mut().finish_writes();
+    harness.run_steps(1);
+    let error = harness
+        .state()
+        .last_error()
+        .expect("an error message")
+        .to_string();
+    assert!(
+        error.contains("/no/such/folder") && error.contains("does not exist"),
+        "{error}"
+    );
+    assert_eq!(harness.state().sim.model().particle_count(), particles);
+    // The app goes on: a capture to a good folder works.
+    let dir = tempfile::tempdir().unwrap();
+    harness.state_mut().capture_dir = dir.path().to_path_buf();
+    harness.get_by_label("Capture PNG").click();
+    harness.run_steps(2);
+    harness.state_mut().finish_writes();
+    assert!(dir.path().join("clothsim-capture-0001.png").is_file());
+}
+
+#[test]
+fn the_guard_acting_is_shown_to_the_user() {
+    let mut harness = harness();
+    let mut params = harness.state().sim.params().clone();
+    params.substeps = 12;
+    harness.state_mut().apply_params(params);
+    for _ in 0..3 {
+        harness.get_by_label("Step").click();
+        harness.run_steps(2);
+    }
+    let app = harness.state();
+    assert!(
+        app.messages
+            .iter()
+            .any(|m| m.text.starts_with("stability guard")),
+        "{:?}",
+        app.messages
+    );
+    assert!(app.sim.substeps() > 12);
+    harness.get_by_label_contains("stability guard");
 }

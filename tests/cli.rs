@@ -280,3 +280,89 @@ fn accuracy_refuses_bad_settings_before_working() {
         assert_eq!(stderr.trim_end().lines().count(), 1, "one line: {stderr}");
     }
 }
+
+/// Runs the binary, giving it at most ten seconds (a hang is a failure, not a wait).
+fn clothsim_bounded(args: &[&str]) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_clothsim"))
+        .args(args)
+        .env("RUST_LOG", "off")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    for _ in 0..100 {
+        if child.try_wait().unwrap().is_some() {
+            return child.wait_with_output().unwrap();
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    child.kill().unwrap();
+    panic!("clothsim {args:?} did not return");
+}
+
+/// Story: `clothsim info /dev/zero` never returned. Every bad input now ends promptly with
+/// one line naming it and a non-zero exit.
+#[test]
+fn every_bad_input_is_one_line_and_a_non_zero_exit() {
+    let dir = tempfile::tempdir().unwrap();
+    let big = dir.path().join("big.obj");
+    std::fs::write(&big, "v 0 0 0\nv 1e30 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    for (args, expect) in [
+        (vec!["info", "/dev/zero"], "/dev/zero: is a device"),
+        (vec!["info", big.to_str().unwrap()], "too large"),
+        (vec!["simulate", "--obj", "/dev/zero"], "is a device"),
+        (
+            vec!["info", "x.obj", "--weld-tolerance", "nan"],
+            "--weld-tolerance",
+        ),
+        (vec!["simulate", "--seconds", "inf"], "--seconds"),
+        (vec!["simulate", "--substeps", "0"], "substeps"),
+        (
+            vec!["render", "--size", "0x10", "--out", "/tmp/x.png"],
+            "--size",
+        ),
+        (
+            vec!["grid", "--quads", "0", "--out", "/tmp/x.obj"],
+            "--quads",
+        ),
+        (vec!["simulate", "--bogus"], "unexpected argument"),
+    ] {
+        let out = clothsim_bounded(&args);
+        assert!(!out.status.success(), "{args:?} must fail");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
+        assert!(stderr.contains(expect), "{args:?}: {stderr}");
+    }
+}
+
+#[test]
+fn simulate_json_records_what_the_guard_did() {
+    let v = json(&clothsim(&[
+        "simulate",
+        "--scene",
+        "hanging",
+        "--substeps",
+        "12",
+        "--seconds",
+        "0.5",
+        "--json",
+    ]));
+    let events = v["guard_events"].as_array().expect("guard_events");
+    let first = events.first().expect("the guard acted at 12 substeps");
+    for key in [
+        "time",
+        "reason",
+        "action",
+        "substeps_before",
+        "substeps_after",
+    ] {
+        assert!(first.get(key).is_some(), "missing `{key}` in {first}");
+    }
+    assert_eq!(first["action"], "refined");
+    assert_eq!(first["substeps_before"], 12);
+    assert_eq!(v["requested_substeps"], 12);
+    assert!(v["substeps"].as_u64().unwrap() > 12);
+    // A clean run records nothing.
+    let calm = json(&clothsim(&["simulate", "--seconds", "0.2", "--json"]));
+    assert_eq!(calm["guard_events"].as_array().unwrap().len(), 0);
+}

@@ -270,10 +270,146 @@ fn binary_file_is_not_text() {
 }
 
 #[test]
-fn a_directory_is_an_io_error() {
+fn a_directory_is_not_a_file() {
     let dir = tempfile::tempdir().unwrap();
     let e = mesh::load_obj(dir.path()).unwrap_err();
-    assert!(matches!(e, ObjError::Io { .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ObjError::NotAFile {
+                what: "a directory",
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
+
+/// Story: `clothsim info /dev/zero` never returned: the importer read without a bound.
+/// Devices and pipes are refused before a byte is read.
+#[test]
+fn devices_and_pipes_are_refused_before_reading() {
+    let e = mesh::load_obj(Path::new("/dev/zero")).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ObjError::NotAFile {
+                what: "a device",
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().starts_with("/dev/zero: is a device"), "{e}");
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("cloth.obj");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap();
+    assert!(made.success());
+    // Opening a pipe with no writer would block: it must not be opened at all.
+    let e = mesh::load_obj(&fifo).unwrap_err();
+    assert!(
+        matches!(e, ObjError::NotAFile { what: "a pipe", .. }),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_file_above_the_size_limit_is_refused_unread() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge.obj");
+    // A sparse file: 300 MiB long, nothing on disk, and nothing read.
+    std::fs::File::create(&path)
+        .unwrap()
+        .set_len(mesh::MAX_FILE_BYTES + 1)
+        .unwrap();
+    let e = mesh::load_obj(&path).unwrap_err();
+    assert!(matches!(e, ObjError::TooLarge { .. }), "{e}");
+    assert!(e.to_string().contains("huge.obj"), "{e}");
+}
+
+#[test]
+fn more_vertices_or_triangles_than_the_limits_are_refused_before_parsing() {
+    let vertices = "v 0 0 0\n".repeat(mesh::MAX_VERTICES + 1);
+    let e = obj_from_str(&vertices, "many.obj").unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ObjError::TooMany {
+                what: "vertices",
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let mut one_face = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\nf");
+    one_face += &" 1".repeat(mesh::MAX_TRIANGLES + 3);
+    let e = obj_from_str(&one_face, "fan.obj").unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ObjError::TooMany {
+                what: "triangles",
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
+
+/// Story: a coordinate such as 1e30 squared to infinity, every triangle came out with no
+/// area, and the user was told the file had "no usable triangles".
+#[test]
+fn coordinates_too_large_to_square_are_refused_as_such() {
+    let e = err("v 0 0 0\nv 1e30 0 0\nv 0 1 0\nf 1 2 3\n");
+    match &e {
+        ObjError::CoordinateTooLarge { line, text, .. } => {
+            assert_eq!((*line, text.as_str()), (2, "1e30"))
+        }
+        other => panic!("wrong variant: {other}"),
+    }
+    assert!(e.to_string().contains("too large"), "{e}");
+}
+
+/// Two triangles sharing an edge whose copies differ by one rounding unit.
+fn nearly_shared_edge() -> String {
+    let eps = f32::EPSILON; // one unit in the last place of 1.0
+    format!(
+        "v 0 0 0\nv 1 0 0\nv 0 0 1\nv {} 0 0\nv 0 0 {}\nv 1 0 1\nf 1 3 2\nf 4 5 6\n",
+        1.0 + eps,
+        1.0 + eps
+    )
+}
+
+/// Story: welding was exact to the bit, so two positions one rounding apart split the
+/// cloth in two, silently. Now they weld within a tolerance relative to the cloth's size,
+/// and a cloth that really is in pieces is reported.
+#[test]
+fn positions_one_rounding_apart_weld_and_pieces_are_reported() {
+    let build = obj_from_str(&nearly_shared_edge(), "edge.obj").unwrap();
+    assert_eq!(build.mesh.positions.len(), 4, "the shared edge welds");
+    assert_eq!(build.mesh.bend_pairs.len(), 1, "so the two triangles hinge");
+    assert!(build.warnings.is_empty(), "{:?}", build.warnings);
+    // With welding made exact again, the same file is two pieces, and says so.
+    let exact = mesh::ImportOptions {
+        weld_tolerance: 0.0,
+    };
+    let split = mesh::obj_from_str_with(&nearly_shared_edge(), "edge.obj", &exact).unwrap();
+    assert_eq!(split.mesh.positions.len(), 6);
+    let text = split.warnings.join("; ");
+    assert!(text.contains("2 disconnected pieces"), "{text}");
+    // A real feature a thousandth of the cloth's size apart never welds.
+    let apart = "v 0 0 0\nv 1 0 0\nv 0 0 1\nv 0.001 0 0\nv 1 0 1\nv 0 0.001 1\nf 1 3 2\nf 4 6 5\n";
+    assert_eq!(
+        obj_from_str(apart, "apart.obj")
+            .unwrap()
+            .mesh
+            .positions
+            .len(),
+        6
+    );
 }
 
 #[test]

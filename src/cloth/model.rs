@@ -32,6 +32,9 @@ impl Springs {
     }
 }
 
+/// Smallest particle mass, as a fraction of the mean particle mass.
+pub const MASS_FLOOR: f32 = 0.1;
+
 /// Topology and rest state of a cloth, shared by every step. Pins are particles with
 /// inverse mass 0.
 #[derive(Clone, Debug, PartialEq)]
@@ -115,7 +118,12 @@ impl ClothModel {
         self.rest_positions.len()
     }
 
-    /// Recomputes masses from an areal density, kg/m².
+    /// Recomputes masses from an areal density, kg/m²: each triangle gives a third of its
+    /// mass to each corner; then every particle is raised to at least [`MASS_FLOOR`] of the
+    /// mean particle mass and all are rescaled to keep the total ρ·A. (A vertex that only
+    /// sliver triangles touch would otherwise be so light that no step could follow its
+    /// spring's vibration; on a regular grid the lightest corner carries 1/6 of the mean,
+    /// above the floor, so nothing changes there.)
     pub fn set_density(&mut self, density: f32) {
         self.density = density;
         self.mass.iter_mut().for_each(|m| *m = 0.0);
@@ -125,6 +133,13 @@ impl ClothModel {
             for &i in t {
                 self.mass[i as usize] += third;
             }
+        }
+        let total: f32 = self.mass.iter().sum();
+        if total > 0.0 {
+            let floor = MASS_FLOOR * total / self.mass.len() as f32;
+            self.mass.iter_mut().for_each(|m| *m = m.max(floor));
+            let scale = total / self.mass.iter().sum::<f32>();
+            self.mass.iter_mut().for_each(|m| *m *= scale);
         }
         let pins = std::mem::take(&mut self.pins);
         self.set_pins(&pins);

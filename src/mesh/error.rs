@@ -9,7 +9,36 @@ pub enum ObjError {
     /// The file does not exist.
     #[error("{path}: file not found")]
     NotFound { path: PathBuf },
-    /// The file exists but could not be read (permissions, a directory, I/O failure).
+    /// The path is a directory, a device, a pipe or a socket: nothing was read.
+    #[error("{path}: is {what}, not a file; an OBJ must be a regular file")]
+    NotAFile { path: PathBuf, what: &'static str },
+    /// The file is larger than import reads; nothing was read.
+    #[error(
+        "{path}: the file has {bytes} bytes, more than the {limit} bytes import reads; is this really a cloth?"
+    )]
+    TooLarge {
+        path: PathBuf,
+        bytes: u64,
+        limit: u64,
+    },
+    /// More vertices or triangles than import builds; nothing was parsed.
+    #[error("{path}: {count} {what}, more than the {limit} import builds")]
+    TooMany {
+        path: PathBuf,
+        what: &'static str,
+        count: usize,
+        limit: usize,
+    },
+    /// A coordinate too large to simulate.
+    #[error(
+        "{path}:{line}: coordinate `{text}` is too large; positions must be within ±1e6 m (larger values lose all precision and overflow when squared)"
+    )]
+    CoordinateTooLarge {
+        path: PathBuf,
+        line: usize,
+        text: String,
+    },
+    /// The file exists but could not be read (permissions, I/O failure).
     #[error("{path}: cannot read file: {cause}")]
     Io {
         path: PathBuf,

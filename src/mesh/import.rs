@@ -3,15 +3,24 @@
 use std::path::Path;
 
 use super::error::ObjError;
-use super::obj::{parse_obj, read_obj};
-use super::topology::{MeshBuild, build_mesh};
+use super::obj::parse_obj;
+use super::read::read_obj;
+use super::topology::{ImportOptions, MeshBuild, build_mesh_with};
 
-/// Loads an OBJ file and builds its cloth topology.
+/// Loads an OBJ file and builds its cloth topology with the default [`ImportOptions`].
 ///
 /// # Errors
 /// Any [`ObjError`]: file problems, bad content, or no usable triangle.
 pub fn load_obj(path: &Path) -> Result<MeshBuild, ObjError> {
-    build_mesh(&read_obj(path)?, path)
+    load_obj_with(path, &ImportOptions::default())
+}
+
+/// As [`load_obj`], with `options`.
+///
+/// # Errors
+/// As [`load_obj`].
+pub fn load_obj_with(path: &Path, options: &ImportOptions) -> Result<MeshBuild, ObjError> {
+    build_mesh_with(&read_obj(path)?, path, options)
 }
 
 /// Builds the topology of OBJ text; `name` stands for the file in messages.
@@ -19,6 +28,18 @@ pub fn load_obj(path: &Path) -> Result<MeshBuild, ObjError> {
 /// # Errors
 /// As [`load_obj`], less the file-system errors.
 pub fn obj_from_str(text: &str, name: &str) -> Result<MeshBuild, ObjError> {
+    obj_from_str_with(text, name, &ImportOptions::default())
+}
+
+/// As [`obj_from_str`], with `options`.
+///
+/// # Errors
+/// As [`obj_from_str`].
+pub fn obj_from_str_with(
+    text: &str,
+    name: &str,
+    options: &ImportOptions,
+) -> Result<MeshBuild, ObjError> {
     let path = Path::new(name);
-    build_mesh(&parse_obj(text, path)?, path)
+    build_mesh_with(&parse_obj(text, path)?, path, options)
 }

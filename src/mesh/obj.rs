@@ -1,8 +1,8 @@
-//! OBJ reading (through `tobj`) and writing.
+//! OBJ parsing (through `tobj`) and writing.
 //!
-//! Reading validates once: a line scan finds unparsable or non-finite numbers and face
-//! indices out of range with their line numbers (tobj reports neither), then tobj parses.
-//! Only the given file is read: `mtllib` statements are ignored.
+//! Parsing validates once: a line scan ([`super::validate`]) finds unparsable, non-finite
+//! or out-of-range numbers and face indices with their line numbers (tobj reports neither),
+//! then tobj parses. Only the given text is read: `mtllib` statements are ignored.
 
 use std::io::BufReader;
 use std::path::Path;
@@ -11,39 +11,14 @@ use glam::{Vec2, Vec3};
 
 use super::error::ObjError;
 use super::polygons::PolygonSoup;
-
-/// Reads an OBJ file into a polygon soup.
-///
-/// # Errors
-/// [`ObjError::NotFound`], [`ObjError::Io`], [`ObjError::NotText`] for file problems, and the
-/// content errors of [`parse_obj`].
-pub fn read_obj(path: &Path) -> Result<PolygonSoup, ObjError> {
-    let bytes = std::fs::read(path).map_err(|source| match source.kind() {
-        std::io::ErrorKind::NotFound => ObjError::NotFound {
-            path: path.to_path_buf(),
-        },
-        _ => ObjError::Io {
-            path: path.to_path_buf(),
-            cause: source,
-        },
-    })?;
-    let text = match std::str::from_utf8(&bytes) {
-        Ok(text) => text,
-        Err(e) => {
-            return Err(ObjError::NotText {
-                path: path.to_path_buf(),
-                offset: e.valid_up_to(),
-            });
-        }
-    };
-    parse_obj(text, path)
-}
+use super::validate::validate;
 
 /// Parses OBJ text; `path` only names the source in error messages.
 ///
 /// # Errors
 /// [`ObjError::NotText`] (NUL bytes), [`ObjError::Parse`], [`ObjError::NonFinite`],
-/// [`ObjError::IndexOutOfRange`], [`ObjError::Empty`] (no faces), [`ObjError::Malformed`].
+/// [`ObjError::CoordinateTooLarge`], [`ObjError::IndexOutOfRange`], [`ObjError::TooMany`],
+/// [`ObjError::Empty`] (no faces), [`ObjError::Malformed`].
 pub fn parse_obj(text: &str, path: &Path) -> Result<PolygonSoup, ObjError> {
     validate(text, path)?;
     let options = tobj::LoadOptions {
@@ -108,98 +83,6 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<PolygonSoup, ObjError> {
         soup.uvs = Some(uvs);
     }
     Ok(soup)
-}
-
-/// The validation scan: checks every `v`, `vt`, `vn` and `f` statement and reports the
-/// first problem with its 1-based line number.
-fn validate(text: &str, path: &Path) -> Result<(), ObjError> {
-    if let Some(offset) = text.bytes().position(|b| b == 0) {
-        return Err(ObjError::NotText {
-            path: path.to_path_buf(),
-            offset,
-        });
-    }
-    let total_positions = text
-        .lines()
-        .filter(|l| l.split_whitespace().next() == Some("v"))
-        .count();
-    let mut positions_so_far = 0usize;
-    for (n, line) in text.lines().enumerate() {
-        let line_no = n + 1;
-        let mut words = line.split_whitespace();
-        let Some(keyword) = words.next() else {
-            continue;
-        };
-        let (what, needed) = match keyword {
-            "v" => ("vertex position", 3),
-            "vt" => ("texture coordinate", 2),
-            "vn" => ("normal", 3),
-            "f" => {
-                let corners: Vec<&str> = words.collect();
-                if corners.len() < 3 {
-                    return Err(ObjError::Parse {
-                        path: path.to_path_buf(),
-                        line: line_no,
-                        what: "face (needs at least 3 corners)",
-                        text: line.trim().to_string(),
-                    });
-                }
-                for corner in corners {
-                    let first = corner.split('/').next().unwrap_or("");
-                    let index: i64 = first.parse().map_err(|_| ObjError::Parse {
-                        path: path.to_path_buf(),
-                        line: line_no,
-                        what: "face vertex index",
-                        text: corner.to_string(),
-                    })?;
-                    // OBJ indices are 1-based; negative ones count back from the last vertex.
-                    let resolved = if index < 0 {
-                        positions_so_far as i64 + index
-                    } else {
-                        index - 1
-                    };
-                    if index == 0 || resolved < 0 || resolved >= total_positions as i64 {
-                        return Err(ObjError::IndexOutOfRange {
-                            path: path.to_path_buf(),
-                            line: line_no,
-                            index,
-                            count: total_positions,
-                        });
-                    }
-                }
-                continue;
-            }
-            _ => continue,
-        };
-        let values: Vec<&str> = words.collect();
-        if values.len() < needed {
-            return Err(ObjError::Parse {
-                path: path.to_path_buf(),
-                line: line_no,
-                what,
-                text: line.trim().to_string(),
-            });
-        }
-        for word in &values[..needed] {
-            let value: f32 = word.parse().map_err(|_| ObjError::Parse {
-                path: path.to_path_buf(),
-                line: line_no,
-                what,
-                text: word.to_string(),
-            })?;
-            if keyword == "v" && !value.is_finite() {
-                return Err(ObjError::NonFinite {
-                    path: path.to_path_buf(),
-                    line: line_no,
-                    text: word.to_string(),
-                });
-            }
-        }
-        if keyword == "v" {
-            positions_so_far += 1;
-        }
-    }
-    Ok(())
 }
 
 /// Writes a polygon soup as OBJ text (`v`, optional `vt`, and `f` lines).

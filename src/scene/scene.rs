@@ -50,7 +50,19 @@ impl Scene {
     /// # Errors
     /// [`SceneError::UnknownScenario`], or the file's [`mesh::ObjError`].
     pub fn with_obj(name: &str, path: &Path) -> Result<Scene, SceneError> {
-        let cloth = mesh::load_obj(path)?;
+        Self::with_obj_options(name, path, &mesh::ImportOptions::default())
+    }
+
+    /// As [`Scene::with_obj`], importing with `options`.
+    ///
+    /// # Errors
+    /// As [`Scene::with_obj`].
+    pub fn with_obj_options(
+        name: &str,
+        path: &Path,
+        options: &mesh::ImportOptions,
+    ) -> Result<Scene, SceneError> {
+        let cloth = mesh::load_obj_with(path, options)?;
         Self::with_cloth(name, &cloth, &path.display().to_string())
     }
 

@@ -34,7 +34,9 @@ fn dot(a: &[Vec3], b: &[Vec3]) -> f64 {
 
 impl ConjugateGradient {
     /// Solves `A·x = b` for the free particles (inverse mass > 0); pinned rows are held
-    /// at zero. Stops when `‖r‖ ≤ tolerance·‖b‖` or after `max_iterations`.
+    /// at zero. `x` is the starting guess when it has one entry per particle (a warm start
+    /// from the last step's solution), else zero. Stops when `‖r‖ ≤ tolerance·‖b‖` or after
+    /// `max_iterations`.
     ///
     /// # Errors
     /// [`StepError::Breakdown`] when a search direction has non-positive curvature (the
@@ -50,8 +52,15 @@ impl ConjugateGradient {
     ) -> Result<CgOutcome, StepError> {
         let n = b.len();
         let free = |i: usize| model.inv_mass[i] > 0.0;
-        x.clear();
-        x.resize(n, Vec3::ZERO);
+        if x.len() != n {
+            x.clear();
+            x.resize(n, Vec3::ZERO);
+        }
+        for (i, xi) in x.iter_mut().enumerate() {
+            if !free(i) || !xi.is_finite() {
+                *xi = Vec3::ZERO;
+            }
+        }
         self.precond.clear();
         self.precond.extend((0..n).map(|i| {
             if free(i) {
@@ -60,25 +69,37 @@ impl ConjugateGradient {
                 Mat3::ZERO
             }
         }));
-        self.r.clear();
-        self.r
-            .extend((0..n).map(|i| if free(i) { b[i] } else { Vec3::ZERO }));
-        let b_norm = dot(&self.r, &self.r).sqrt();
+        let b_norm = (0..n)
+            .filter(|&i| free(i))
+            .map(|i| b[i].length_squared() as f64)
+            .sum::<f64>()
+            .sqrt();
         if b_norm == 0.0 {
+            x.iter_mut().for_each(|xi| *xi = Vec3::ZERO);
             return Ok(CgOutcome {
                 iterations: 0,
                 residual: 0.0,
                 converged: true,
             });
         }
+        // r = b − A·x for the starting guess.
+        self.q.resize(n, Vec3::ZERO);
+        sys.apply(model, x, &mut self.q);
+        self.r.clear();
+        self.r.extend((0..n).map(|i| {
+            if free(i) {
+                b[i] - self.q[i]
+            } else {
+                Vec3::ZERO
+            }
+        }));
         self.z.clear();
         self.z
             .extend(self.precond.iter().zip(&self.r).map(|(m, r)| *m * *r));
         self.p.clone_from(&self.z);
-        self.q.resize(n, Vec3::ZERO);
         let mut rz = dot(&self.r, &self.z);
         let target = tolerance as f64 * b_norm;
-        let mut residual = b_norm;
+        let mut residual = dot(&self.r, &self.r).sqrt();
         let mut iterations = 0;
         while iterations < max_iterations && residual > target {
             iterations += 1;

@@ -25,6 +25,8 @@ pub struct ImplicitEuler {
     vel: Vec<Vec3>,
     pos: Vec<Vec3>,
     cg: ConjugateGradient,
+    /// Whether `dv` is the last step's solution, a warm start for this one's.
+    warm: bool,
 }
 
 impl ImplicitEuler {
@@ -104,10 +106,15 @@ impl Integrator for ImplicitEuler {
             }
             let (pos, vel, sys) = (&self.pos, &self.vel, &mut self.sys);
             ctx.derivative_work(|m, f| f.assemble(m, pos, vel, h, sys));
+            // A Newton correction starts from zero; the step's Δv is kept for the next step.
+            let step_dv = std::mem::take(&mut self.dv);
+            self.warm = false;
             self.solve(ctx)?;
             for (v, d) in self.vel.iter_mut().zip(&self.dv) {
                 *v += *d;
             }
+            self.dv = step_dv;
+            self.warm = true;
         }
         let particles = state.pos.iter_mut().zip(state.vel.iter_mut());
         for (((x, v), v_new), &w) in particles.zip(&self.vel).zip(&model.inv_mass) {
@@ -118,5 +125,10 @@ impl Integrator for ImplicitEuler {
         }
         state.time += h as f64;
         Ok(ctx.report())
+    }
+
+    /// The state changed outside: the last Δv is no longer a good guess.
+    fn invalidate(&mut self) {
+        self.warm = false;
     }
 }
