@@ -4,7 +4,7 @@
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 
 use clothsim::mesh::{GridOrientation, GridSpec, MeshBuild};
-use clothsim::scene::{SCENARIOS, Scene, Simulation};
+use clothsim::scene::{Scene, Simulation, scenarios};
 use clothsim::sim::IntegratorKind;
 
 /// A square grid with `n × n` particles.
@@ -19,13 +19,13 @@ fn grid(n: u32) -> MeshBuild {
 }
 
 fn frame(c: &mut Criterion) {
-    for scenario in SCENARIOS {
+    for scenario in scenarios() {
         let mut group = c.benchmark_group(format!("frame/{}", scenario.name));
         group.sample_size(10);
         for kind in IntegratorKind::ALL {
             for n in [25u32, 50, 100] {
                 let mut scene =
-                    Scene::with_cloth(scenario.name, &grid(n), "grid").expect("registered");
+                    Scene::with_cloth(&scenario.name, &grid(n), "grid").expect("registered");
                 scene.params.integrator = kind;
                 let mut sim = Simulation::new(scene);
                 // Start from a moving, colliding state rather than the rest pose.

@@ -6,7 +6,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 
 use clothsim::mesh::{self, GridOrientation, GridSpec, SpringKind};
-use clothsim::scene::{SCENARIOS, Scene, Simulation};
+use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::IntegratorKind;
 use clothsim::view;
 
@@ -35,15 +35,21 @@ enum Command {
         #[command(flatten)]
         import: ImportArgs,
     },
-    /// List the built-in scenarios.
-    Scenes,
-    /// Run a scenario headless and print a summary.
+    /// List the built-in scenes, or check scene files and list what they hold.
+    Scenes {
+        /// Scene files (.toml) to check; none lists the built-in scenes.
+        files: Vec<PathBuf>,
+    },
+    /// Run a scene headless and print a summary.
     Simulate {
         #[command(flatten)]
         run: RunArgs,
         /// Print one JSON object.
         #[arg(long)]
         json: bool,
+        /// Write the cloth as it is at the end as an OBJ file.
+        #[arg(long)]
+        export_obj: Option<PathBuf>,
     },
     /// Render the state after --seconds to a PNG, or every K frames to a numbered sequence.
     Render {
@@ -56,14 +62,17 @@ enum Command {
         #[arg(long, default_value = "")]
         overlay: String,
         /// Output PNG (single image).
-        #[arg(long, required_unless_present = "out_dir", conflicts_with_all = ["out_dir", "every"])]
+        #[arg(long, required_unless_present_any = ["out_dir", "gif"], conflicts_with_all = ["out_dir", "every", "gif"])]
         out: Option<PathBuf>,
-        /// Write a frame every K simulation frames (with --out-dir).
-        #[arg(long, requires = "out_dir")]
+        /// Write a frame every K simulation frames (with --out-dir or --gif).
+        #[arg(long)]
         every: Option<u32>,
         /// Directory for the frame sequence (frame_00000.png, …); must exist.
         #[arg(long)]
         out_dir: Option<PathBuf>,
+        /// An animated GIF of the run (every K-th frame with --every).
+        #[arg(long)]
+        gif: Option<PathBuf>,
     },
     /// What accuracy costs in time: every integrator × step size against a reference;
     /// writes accuracy.csv, accuracy.md and accuracy.png.
@@ -131,10 +140,10 @@ impl ImportArgs {
 /// What every simulating subcommand takes.
 #[derive(clap::Args)]
 struct RunArgs {
-    /// Scenario name (see `clothsim scenes`).
+    /// A built-in scene (see `clothsim scenes`) or a scene file (.toml).
     #[arg(long, default_value = "hanging")]
     scene: String,
-    /// Use this OBJ cloth instead of the scenario's default.
+    /// Use this OBJ cloth instead of the scene's own.
     #[arg(long)]
     obj: Option<PathBuf>,
     /// Integrator: explicit-euler, semi-implicit-euler, verlet, rk2, rk4, implicit-euler, xpbd.
@@ -155,10 +164,8 @@ struct RunArgs {
 
 impl RunArgs {
     fn simulation(&self) -> Result<Simulation> {
-        let mut scene = match &self.obj {
-            Some(path) => Scene::with_obj_options(&self.scene, path, &self.import.options()?)?,
-            None => Scene::builtin(&self.scene)?,
-        };
+        let mut scene =
+            Scene::open_with_obj(&self.scene, self.obj.as_deref(), &self.import.options()?)?;
         if let Some(k) = self.integrator {
             scene.params.integrator = k;
         }
@@ -212,13 +219,12 @@ fn run(cli: Cli) -> Result<()> {
             )
         }),
         Some(Command::Info { file, json, import }) => info(&file, json, &import.options()?),
-        Some(Command::Scenes) => {
-            for s in SCENARIOS {
-                println!("{:<16} {}", s.name, s.summary);
-            }
-            Ok(())
-        }
-        Some(Command::Simulate { run, json }) => simulate(&run, json),
+        Some(Command::Scenes { files }) => scenes(&files),
+        Some(Command::Simulate {
+            run,
+            json,
+            export_obj,
+        }) => simulate(&run, json, export_obj.as_deref()),
         Some(Command::Render {
             run,
             size,
@@ -226,13 +232,17 @@ fn run(cli: Cli) -> Result<()> {
             out,
             every,
             out_dir,
+            gif,
         }) => render(
             &run,
             &size,
             &overlay,
-            out.as_deref(),
-            every,
-            out_dir.as_deref(),
+            Output {
+                png: out.as_deref(),
+                every,
+                dir: out_dir.as_deref(),
+                gif: gif.as_deref(),
+            },
         ),
         Some(Command::Accuracy {
             scene,
@@ -298,9 +308,46 @@ fn info(file: &std::path::Path, json: bool, options: &mesh::ImportOptions) -> Re
     Ok(())
 }
 
-fn simulate(args: &RunArgs, json: bool) -> Result<()> {
+/// The effects of a scene file, in words.
+fn describe(file: &clothsim::scene::SceneFile) -> String {
+    let effects: Vec<&str> = file.effects().iter().map(|e| e.phase()).collect();
+    format!("{} [{}]", file.summary, effects.join(", "))
+}
+
+fn scenes(files: &[PathBuf]) -> Result<()> {
+    if files.is_empty() {
+        for s in clothsim::scene::scenarios() {
+            println!("{:<16} {}", s.name, describe(s));
+        }
+        return Ok(());
+    }
+    for path in files {
+        let loaded = clothsim::scene::SceneFile::load(path)?;
+        // Building it checks the cloth and the pins too.
+        let scene = Scene::from_loaded(&loaded)?;
+        println!(
+            "{}: {} — {} particles, {}",
+            path.display(),
+            loaded.file.name,
+            scene.model.particle_count(),
+            describe(&loaded.file)
+        );
+    }
+    Ok(())
+}
+
+fn simulate(args: &RunArgs, json: bool, export: Option<&std::path::Path>) -> Result<()> {
+    if let Some(path) = export {
+        check_directory(path)?;
+    }
     let mut sim = args.simulation()?;
     let summary = sim.run(args.seconds);
+    if let Some(path) = export {
+        clothsim::output::write_bytes(path, sim.export_obj().as_bytes())?;
+        if !json {
+            println!("wrote {}", path.display());
+        }
+    }
     if json {
         println!("{}", serde_json::to_string(&summary)?);
     } else {
@@ -332,6 +379,12 @@ fn simulate(args: &RunArgs, json: bool) -> Result<()> {
         for event in &summary.guard_events {
             println!("  stability guard: {event}");
         }
+        let phases: Vec<String> = summary
+            .phases
+            .iter()
+            .map(|(name, p)| format!("{name} {:.3} s ({} calls)", p.seconds, p.calls))
+            .collect();
+        println!("  phases: {}", phases.join(", "));
     }
     if let Some(e) = summary.error {
         bail!(e);
@@ -346,10 +399,7 @@ fn accuracy(
     out: &std::path::Path,
 ) -> Result<()> {
     config.validate()?;
-    let scene = match obj {
-        Some(path) => Scene::with_obj(scene, path)?,
-        None => Scene::builtin(scene)?,
-    };
+    let scene = Scene::open_with_obj(scene, obj, &mesh::ImportOptions::default())?;
     // Fail on an unusable output directory before a minute of work, not after it.
     std::fs::create_dir_all(out)
         .with_context(|| format!("{}: cannot create the output directory", out.display()))?;
@@ -402,27 +452,17 @@ fn parse_size(size: &str) -> Result<(u32, u32)> {
     }
 }
 
-fn render(
-    args: &RunArgs,
-    size: &str,
-    overlay: &str,
-    out: Option<&std::path::Path>,
+/// Where `render` writes.
+struct Output<'a> {
+    png: Option<&'a std::path::Path>,
     every: Option<u32>,
-    out_dir: Option<&std::path::Path>,
-) -> Result<()> {
-    use clothsim::render::{AdapterPreference, Offscreen, RenderOptions, save_png};
-    let (width, height) = parse_size(size)?;
-    let options = RenderOptions::default()
-        .with_overlays(overlay)
-        .map_err(anyhow::Error::msg)?;
-    if let Some(dir) = out_dir
-        && !dir.is_dir()
-    {
-        bail!("--out-dir {}: not an existing directory", dir.display());
-    }
-    // Fail before a long simulation, not after it.
-    if let Some(path) = out
-        && let Some(parent) = path.parent()
+    dir: Option<&'a std::path::Path>,
+    gif: Option<&'a std::path::Path>,
+}
+
+/// Fails before a long run, not after it, when a file's directory does not exist.
+fn check_directory(path: &std::path::Path) -> Result<()> {
+    if let Some(parent) = path.parent()
         && !parent.as_os_str().is_empty()
         && !parent.is_dir()
     {
@@ -432,47 +472,83 @@ fn render(
             parent.display()
         );
     }
+    Ok(())
+}
+
+fn render(args: &RunArgs, size: &str, overlay: &str, output: Output<'_>) -> Result<()> {
+    use clothsim::render::{AdapterPreference, GifWriter, Offscreen, RenderOptions, save_png};
+    let (width, height) = parse_size(size)?;
+    let options = RenderOptions::default()
+        .with_overlays(overlay)
+        .map_err(anyhow::Error::msg)?;
+    if let Some(dir) = output.dir
+        && !dir.is_dir()
+    {
+        bail!("--out-dir {}: not an existing directory", dir.display());
+    }
+    for path in [output.png, output.gif].into_iter().flatten() {
+        check_directory(path)?;
+    }
+    if output.png.is_none() && output.dir.is_none() && output.gif.is_none() {
+        bail!("give --out FILE.png, --out-dir DIR or --gif FILE.gif");
+    }
     let mut sim = args.simulation()?;
     let camera = view::default_camera(&sim, width as f32 / height as f32);
     let mut offscreen = Offscreen::new(width, height, AdapterPreference::Any)?;
     let frames = (args.seconds / sim.params().dt as f64).round() as u64;
-    match (out, out_dir) {
-        (Some(path), _) => {
-            for _ in 0..frames {
-                sim.step_frame()?;
-            }
+    if let Some(path) = output.png {
+        for _ in 0..frames {
+            sim.step_frame()?;
+        }
+        let image = offscreen.render(&view::frame(&sim), &camera, &options)?;
+        save_png(&image, path)?;
+        println!(
+            "wrote {} ({}x{}, t = {:.3} s)",
+            path.display(),
+            width,
+            height,
+            sim.state().time
+        );
+        return Ok(());
+    }
+    let every = output.every.unwrap_or(1).max(1) as u64;
+    let mut gif = match output.gif {
+        Some(path) => Some(GifWriter::create(
+            path,
+            every as f64 * sim.params().dt as f64,
+        )?),
+        None => None,
+    };
+    let bar = indicatif::ProgressBar::new(frames / every + 1);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let mut written = 0u64;
+    for f in 0..=frames {
+        if f > 0 {
+            sim.step_frame()?;
+        }
+        if f % every == 0 {
             let image = offscreen.render(&view::frame(&sim), &camera, &options)?;
-            save_png(&image, path)?;
-            println!(
-                "wrote {} ({}x{}, t = {:.3} s)",
-                path.display(),
-                width,
-                height,
-                sim.state().time
-            );
-        }
-        (None, Some(dir)) => {
-            let every = every.unwrap_or(1).max(1) as u64;
-            let bar = indicatif::ProgressBar::new(frames / every + 1);
-            bar.set_style(
-                indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames {msg}")
-                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-            );
-            let mut written = 0u64;
-            for f in 0..=frames {
-                if f > 0 {
-                    sim.step_frame()?;
-                }
-                if f % every == 0 {
-                    let image = offscreen.render(&view::frame(&sim), &camera, &options)?;
-                    save_png(&image, &dir.join(format!("frame_{written:05}.png")))?;
-                    written += 1;
-                    bar.inc(1);
-                }
+            if let Some(dir) = output.dir {
+                save_png(&image, &dir.join(format!("frame_{written:05}.png")))?;
             }
-            bar.finish_with_message(format!("written to {}", dir.display()));
+            if let Some(g) = gif.as_mut() {
+                g.add(&image)?;
+            }
+            written += 1;
+            bar.inc(1);
         }
-        (None, None) => bail!("give --out FILE.png or --out-dir DIR"),
+    }
+    bar.finish_and_clear();
+    if let Some(g) = gif {
+        g.finish()?;
+    }
+    for (what, place) in [("frames to", output.dir), ("a GIF to", output.gif)] {
+        if let Some(p) = place {
+            println!("wrote {written} {what} {}", p.display());
+        }
     }
     Ok(())
 }

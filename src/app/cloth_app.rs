@@ -3,16 +3,16 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use crate::mesh::{self, MeshBuild};
+use crate::mesh::MeshBuild;
 use crate::render::{OrbitCamera, RenderOptions};
-use crate::scene::{DEFAULT_CLOTH_NAME, DEFAULT_CLOTH_OBJ, Scene, Simulation};
+use crate::scene::{Scene, Simulation};
 use crate::sim::{Effect, GuardAction, PhaseTimings, SimParams};
 use crate::view;
 
 use super::accuracy::AccuracyWindow;
-use super::background::{ObjLoad, PngWriter, Written};
+use super::background::{Load, PngWriter};
 use super::transport::{STEP_BUDGET_SECONDS, Transport};
-use super::viewport::{Viewport, camera_input};
+use super::viewport::Viewport;
 
 /// How serious a status message is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,30 +41,36 @@ pub struct Stats {
 /// The eframe application.
 pub struct ClothApp {
     pub sim: Simulation,
-    /// The cloth in use as imported (unplaced), so a scenario switch can place it again.
-    cloth: MeshBuild,
-    cloth_name: String,
+    /// A cloth the user opened (unplaced, with its name): a scenario switch places it again.
+    /// `None`: each scene brings its own cloth.
+    pub(super) custom_cloth: Option<(MeshBuild, String)>,
     /// Width / height of the 3D view when last drawn, for framing the camera.
-    view_aspect: f32,
+    pub(super) view_aspect: f32,
     pub transport: Transport,
     pub camera: OrbitCamera,
     pub options: RenderOptions,
-    render_state: Option<egui_wgpu::RenderState>,
+    pub(super) render_state: Option<egui_wgpu::RenderState>,
     /// "name (backend, type)" of the adapter drawing the view, shown in the status bar.
-    adapter: Option<String>,
-    viewport: Option<Viewport>,
-    loading: Option<ObjLoad>,
-    writer: PngWriter,
+    pub(super) adapter: Option<String>,
+    pub(super) viewport: Option<Viewport>,
+    pub(super) loading: Option<Load>,
+    pub(super) writer: PngWriter,
     /// Where captures and recordings go.
     pub capture_dir: PathBuf,
-    capture_requested: bool,
-    /// Next frame number while recording.
-    recording: Option<(PathBuf, u64)>,
+    pub(super) capture_requested: bool,
+    /// Next frame number while recording a PNG sequence.
+    pub(super) recording: Option<(PathBuf, u64)>,
+    /// The GIF being recorded and when its last frame was drawn.
+    pub(super) gif: Option<(PathBuf, Option<Instant>)>,
+    /// A particle being dragged with the pointer: its index and the plane it moves in.
+    pub(super) grab: Option<super::pointer::Grab>,
     pub messages: Vec<Message>,
     pub stats: Stats,
-    last_update: Option<Instant>,
-    /// Text of the "open OBJ" path field.
+    pub(super) last_update: Option<Instant>,
+    /// Text of the "open" path field (an OBJ cloth or a `.toml` scene).
     pub open_path: String,
+    /// Text of the "save scene" path field.
+    pub save_path: String,
     /// The accuracy-versus-cost sweep of the current scene.
     pub accuracy: AccuracyWindow,
 }
@@ -73,15 +79,12 @@ impl ClothApp {
     /// Creates the app on the GUI's wgpu device (`None` shows no 3D view, e.g. without a GPU
     /// renderer), starting with `obj` if given.
     pub fn new(render_state: Option<egui_wgpu::RenderState>, obj: Option<&Path>) -> Self {
-        let cloth = default_cloth();
-        let scene = Scene::with_cloth("hanging", &cloth, DEFAULT_CLOTH_NAME)
-            .unwrap_or_else(|e| unreachable!("{e}"));
+        let scene = Scene::builtin("hanging").unwrap_or_else(|e| unreachable!("{e}"));
         let sim = Simulation::new(scene);
         let camera = view::default_camera(&sim, DEFAULT_ASPECT);
         let mut app = Self {
             sim,
-            cloth,
-            cloth_name: DEFAULT_CLOTH_NAME.to_string(),
+            custom_cloth: None,
             view_aspect: DEFAULT_ASPECT,
             transport: Transport::default(),
             camera,
@@ -96,10 +99,13 @@ impl ClothApp {
             capture_dir: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
             capture_requested: false,
             recording: None,
+            gif: None,
+            grab: None,
             messages: Vec::new(),
             stats: Stats::default(),
             last_update: None,
             open_path: String::new(),
+            save_path: "scene.toml".into(),
             accuracy: AccuracyWindow::default(),
         };
         if app.render_state.is_none() {
@@ -109,7 +115,7 @@ impl ClothApp {
             );
         }
         if let Some(path) = obj {
-            app.open_obj(path.to_path_buf());
+            app.open_path(path.to_path_buf());
         }
         app
     }
@@ -141,17 +147,21 @@ impl ClothApp {
     }
 
     pub fn cloth_name(&self) -> &str {
-        &self.cloth_name
+        self.sim.cloth_name()
     }
 
     pub fn is_loading(&self) -> bool {
         self.loading.is_some()
     }
 
-    /// Switches scenario, keeping the current cloth. Parameters and effects become the
-    /// scenario's; the camera frames the new scene.
+    /// Switches scenario. A cloth the user opened is kept; otherwise the scene brings its
+    /// own. Parameters and effects become the scenario's; the camera frames the new scene.
     pub fn set_scenario(&mut self, name: &str) {
-        match Scene::with_cloth(name, &self.cloth, &self.cloth_name) {
+        let scene = match &self.custom_cloth {
+            Some((cloth, cloth_name)) => Scene::with_cloth(name, cloth, cloth_name),
+            None => Scene::builtin(name),
+        };
+        match scene {
             Ok(scene) => {
                 self.sim = Simulation::new(scene);
                 self.reset_camera();
@@ -181,73 +191,9 @@ impl ClothApp {
         }
     }
 
-    /// Starts importing an OBJ in the background; the current cloth stays until it succeeds.
-    pub fn open_obj(&mut self, path: PathBuf) {
-        self.message(Level::Info, format!("loading {} …", path.display()));
-        self.loading = Some(ObjLoad::start(path));
-    }
-
-    /// Waits for a running import (tests, or when the caller must know the outcome).
-    pub fn finish_loading(&mut self) {
-        if let Some(load) = self.loading.take()
-            && let Some(result) = load.wait()
-        {
-            self.apply_loaded(&load.path, result);
-        }
-    }
-
-    fn poll_loading(&mut self) {
-        let Some(load) = &self.loading else { return };
-        let Some(result) = load.poll() else { return };
-        let path = load.path.clone();
-        self.loading = None;
-        self.apply_loaded(&path, result);
-    }
-
-    /// A new cloth keeps the scenario, its effects and the current parameters.
-    fn apply_loaded(&mut self, path: &Path, result: Result<MeshBuild, mesh::ObjError>) {
-        let build = match result {
-            Ok(b) => b,
-            Err(e) => {
-                self.message(Level::Error, format!("{e} — the current cloth is kept"));
-                return;
-            }
-        };
-        let name = path.display().to_string();
-        let scene = match Scene::with_cloth(self.sim.scenario(), &build, &name) {
-            Ok(scene) => scene,
-            Err(e) => return self.message(Level::Error, e.to_string()),
-        };
-        let mut sim = Simulation::new(scene);
-        // The current parameters were validated when they were set.
-        if let Err(e) = sim.set_params(self.sim.params().clone()) {
-            return self.message(Level::Error, e.to_string());
-        }
-        let _ = sim.set_effects(self.sim.effects().to_vec());
-        sim.set_pins_enabled(self.sim.pins_enabled());
-        let mut text = format!(
-            "loaded {name}: {} particles, {} triangles",
-            sim.model().particle_count(),
-            sim.model().triangles.len()
-        );
-        // Import notes (dropped faces and the like) stay visible with the result.
-        let level = if sim.warnings().is_empty() {
-            Level::Info
-        } else {
-            text += &format!(" ({})", sim.warnings().join("; "));
-            Level::Warning
-        };
-        self.message(level, text);
-        self.cloth = build;
-        self.cloth_name = name;
-        self.sim = sim;
-        self.reset_camera();
-    }
-
-    /// Back to the built-in cloth.
+    /// Back to each scene's own cloth.
     pub fn use_default_cloth(&mut self) {
-        self.cloth = default_cloth();
-        self.cloth_name = DEFAULT_CLOTH_NAME.to_string();
+        self.custom_cloth = None;
         let scenario = self.sim.scenario().to_string();
         self.set_scenario(&scenario);
     }
@@ -296,9 +242,9 @@ impl ClothApp {
 
     fn record_timings(&mut self, timings: PhaseTimings, frames: u32) {
         let new: Vec<(&'static str, f64)> = timings
-            .entries()
+            .phases()
             .iter()
-            .map(|(name, d)| (*name, d.as_secs_f64() * 1e3 / frames as f64))
+            .map(|p| (p.name, p.time.as_secs_f64() * 1e3 / frames as f64))
             .collect();
         // Exponential smoothing so the numbers are readable; phases that stopped running vanish.
         let old = std::mem::take(&mut self.stats.phase_ms);
@@ -309,70 +255,6 @@ impl ClothApp {
                 (name, 0.8 * prev + 0.2 * ms)
             })
             .collect();
-    }
-
-    /// Captures the next drawn frame to a PNG in [`ClothApp::capture_dir`].
-    pub fn request_capture(&mut self) {
-        self.capture_requested = true;
-    }
-
-    /// Starts or stops writing every drawn frame to a new numbered folder.
-    pub fn toggle_recording(&mut self) {
-        if let Some((dir, n)) = self.recording.take() {
-            self.message(
-                Level::Info,
-                format!("recorded {n} frames to {}", dir.display()),
-            );
-            return;
-        }
-        let dir = next_free(&self.capture_dir, "clothsim-recording", "");
-        match std::fs::create_dir_all(&dir) {
-            Ok(()) => {
-                self.message(Level::Info, format!("recording to {}", dir.display()));
-                self.recording = Some((dir, 0));
-            }
-            Err(e) => self.message(
-                Level::Error,
-                format!("{}: cannot create folder: {e}", dir.display()),
-            ),
-        }
-    }
-
-    pub fn is_recording(&self) -> bool {
-        self.recording.is_some()
-    }
-
-    /// Images queued for writing.
-    pub fn pending_writes(&self) -> usize {
-        self.writer.pending()
-    }
-
-    /// Blocks until queued PNG files are written, then reports them (tests, shutdown).
-    pub fn finish_writes(&mut self) {
-        let done = self.writer.wait_all();
-        self.report_writes(done);
-    }
-
-    /// Collects finished PNG writes into messages.
-    fn poll_writes(&mut self) {
-        let done = self.writer.finished();
-        self.report_writes(done);
-    }
-
-    fn report_writes(&mut self, done: Vec<Written>) {
-        for written in done {
-            match written.result {
-                Ok(()) if written.announce => {
-                    self.message(Level::Info, format!("saved {}", written.path.display()));
-                }
-                // Recorded frames are summarised when recording stops.
-                Ok(()) => {}
-                Err(e) => {
-                    self.recording = None;
-                    self.message(Level::Error, e.to_string());
-                }
-            }
-        }
     }
 
     /// Draws the 3D view into the available space and handles capture.
@@ -410,26 +292,8 @@ impl ClothApp {
             egui::Image::from_texture(egui::load::SizedTexture::new(texture, size))
                 .sense(egui::Sense::click_and_drag()),
         );
-        if camera_input(ui, &response, &mut self.camera) {
-            self.camera = view::default_camera(&self.sim, self.view_aspect);
-        }
-        let capture = std::mem::take(&mut self.capture_requested);
-        if capture || self.recording.is_some() {
-            match viewport.read(&rs) {
-                Ok(image) => {
-                    if capture {
-                        let path = next_free(&self.capture_dir, "clothsim-capture", ".png");
-                        self.writer.submit(image.clone(), path, true);
-                    }
-                    if let Some((dir, n)) = &mut self.recording {
-                        self.writer
-                            .submit(image, dir.join(format!("frame_{n:05}.png")), false);
-                        *n += 1;
-                    }
-                }
-                Err(e) => self.message(Level::Error, e.to_string()),
-            }
-        }
+        self.pointer_input(ui, &response);
+        self.capture_drawn(&rs);
     }
 
     /// One UI frame: input, simulation, panels, viewport.
@@ -451,7 +315,7 @@ impl ClothApp {
                 .collect()
         });
         if let Some(path) = dropped.into_iter().next() {
-            self.open_obj(path);
+            self.open_path(path);
         }
         self.poll_loading();
         self.poll_writes();
@@ -526,15 +390,8 @@ impl eframe::App for ClothApp {
 /// Width / height assumed for framing before the 3D view was first drawn.
 const DEFAULT_ASPECT: f32 = 1.4;
 
-/// The built-in cloth. It is compiled in and checked by the test suite
-/// (`the_default_asset_is_a_24x24_quad_grid`), so parsing it cannot fail at run time.
-fn default_cloth() -> MeshBuild {
-    mesh::obj_from_str(DEFAULT_CLOTH_OBJ, DEFAULT_CLOTH_NAME)
-        .unwrap_or_else(|e| unreachable!("built-in cloth asset is invalid: {e}"))
-}
-
 /// `dir/prefix-NNNN<suffix>` with the first number not yet taken.
-fn next_free(dir: &Path, prefix: &str, suffix: &str) -> PathBuf {
+pub(super) fn next_free(dir: &Path, prefix: &str, suffix: &str) -> PathBuf {
     (1..)
         .map(|n| dir.join(format!("{prefix}-{n:04}{suffix}")))
         .find(|p| !p.exists())

@@ -4,7 +4,7 @@ use egui::{RichText, Slider};
 
 use crate::mesh::SpringKind;
 use crate::render::SpringColoring;
-use crate::scene::SCENARIOS;
+use crate::scene::scenarios;
 use crate::sim::{Collider, Effect, IntegratorKind};
 
 use super::cloth_app::{ClothApp, Level};
@@ -154,14 +154,14 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut ClothApp) {
 fn scenario_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     ui.heading("Scenario");
     let current = app.sim.scenario().to_string();
-    for s in SCENARIOS {
+    for s in scenarios() {
         if ui
-            .selectable_label(current == s.name, s.name)
-            .on_hover_text(s.summary)
+            .selectable_label(current == s.name, &s.name)
+            .on_hover_text(&s.summary)
             .clicked()
             && current != s.name
         {
-            app.set_scenario(s.name);
+            app.set_scenario(&s.name);
         }
     }
     ui.add_space(4.0);
@@ -179,7 +179,7 @@ fn scenario_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     });
     ui.horizontal(|ui| {
         ui.label(RichText::new("or drop an OBJ on the window").weak());
-        if ui.small_button("Default cloth").clicked() {
+        if ui.small_button("Scene's cloth").clicked() {
             app.use_default_cloth();
         }
     });

@@ -45,6 +45,10 @@ pub struct ClothModel {
     pub springs: Springs,
     /// How many unique edges the triangulated mesh has (the first springs).
     pub mesh_edges: usize,
+    /// How many springs are bend springs (the last ones).
+    pub bend_springs: usize,
+    /// Interior edges as hinges `[x0, x1, a, b]` (see [`ClothMesh::hinges`]).
+    pub hinges: Vec<[u32; 4]>,
     /// Which springs meet at each particle.
     pub adjacency: Adjacency,
     /// Particle mass, kg (lumped from areal density by triangle area).
@@ -77,8 +81,10 @@ impl ClothModel {
             rest_positions: mesh.positions.clone(),
             uvs: mesh.uvs.clone(),
             triangles: mesh.triangles.clone(),
+            bend_springs: mesh.bend_pairs.len(),
             springs,
             mesh_edges: mesh.edges.len(),
+            hinges: mesh.hinges.clone(),
             mass: vec![0.0; n],
             inv_mass: vec![0.0; n],
             pins: Vec::new(),
@@ -103,6 +109,12 @@ impl ClothModel {
             uvs: vec![Vec2::ZERO; n],
             triangles: Vec::new(),
             mesh_edges: 0,
+            bend_springs: springs
+                .kind
+                .iter()
+                .filter(|k| **k == SpringKind::Bend)
+                .count(),
+            hinges: Vec::new(),
             springs,
             rest_positions,
             inv_mass: vec![0.0; n],

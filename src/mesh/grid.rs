@@ -10,6 +10,7 @@ use super::topology::{ClothMesh, build_mesh};
 
 /// The plane a generated grid lies in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum GridOrientation {
     /// Horizontal: x to the right, z towards the viewer (normal +y). For draping scenes.
     Horizontal,

@@ -64,6 +64,10 @@ pub struct ClothMesh {
     /// For each interior edge (exactly two triangles), its two opposite vertices; sorted,
     /// without repeats and without pairs that already are an edge or a diagonal.
     pub bend_pairs: Vec<[u32; 2]>,
+    /// Every interior edge as a hinge `[x0, x1, a, b]`: the edge x0→x1 as it runs in
+    /// triangle (x0, x1, a), and b, the vertex opposite in the other triangle. For dihedral
+    /// bending.
+    pub hinges: Vec<[u32; 4]>,
 }
 
 /// A built mesh plus what import had to drop or could not use.
@@ -192,6 +196,7 @@ pub fn build_mesh_with(
             edge_kinds: links.edge_kinds,
             cross_diagonals: links.cross_diagonals,
             bend_pairs: links.bend_pairs,
+            hinges: links.hinges,
         },
         warnings,
     })
@@ -253,21 +258,25 @@ struct Links {
     edge_kinds: Vec<SpringKind>,
     cross_diagonals: Vec<[u32; 2]>,
     bend_pairs: Vec<[u32; 2]>,
+    hinges: Vec<[u32; 4]>,
     non_manifold: usize,
 }
 
 /// Sorts the 3·T half-edges by vertex pair: each group is one unique edge; a group of two
 /// with distinct opposite vertices is an interior edge and proposes a bend pair.
 fn links(tri: &Triangulation) -> Links {
-    let mut half: Vec<(u32, u32, SpringKind, u32)> = Vec::with_capacity(tri.triangles.len() * 3);
+    // (low, high, kind, opposite, whether the triangle runs low → high)
+    let mut half: Vec<(u32, u32, SpringKind, u32, bool)> =
+        Vec::with_capacity(tri.triangles.len() * 3);
     for (t, sides) in tri.triangles.iter().zip(&tri.sides) {
         for s in 0..3 {
             let (a, b, opposite) = (t[s], t[(s + 1) % 3], t[(s + 2) % 3]);
-            half.push((a.min(b), a.max(b), sides[s], opposite));
+            half.push((a.min(b), a.max(b), sides[s], opposite, a < b));
         }
     }
     half.sort_unstable();
     let (mut edges, mut edge_kinds, mut bends) = (Vec::new(), Vec::new(), Vec::new());
+    let mut hinges = Vec::new();
     let mut non_manifold = 0usize;
     for group in half.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
         edges.push([group[0].0, group[0].1]);
@@ -277,6 +286,18 @@ fn links(tri: &Triangulation) -> Links {
             [_, _] if group[0].3 != group[1].3 => {
                 let (p, q) = (group[0].3, group[1].3);
                 bends.push([p.min(q), p.max(q)]);
+                // Orient the hinge by a triangle that runs along the edge low → high.
+                let (first, second) = if group[1].4 {
+                    (group[1], group[0])
+                } else {
+                    (group[0], group[1])
+                };
+                let (x0, x1) = if first.4 {
+                    (first.0, first.1)
+                } else {
+                    (first.1, first.0)
+                };
+                hinges.push([x0, x1, first.3, second.3]);
             }
             [_] | [_, _] => {}
             _ => non_manifold += 1,
@@ -294,6 +315,7 @@ fn links(tri: &Triangulation) -> Links {
         edge_kinds,
         cross_diagonals,
         bend_pairs: bends,
+        hinges,
         non_manifold,
     }
 }

@@ -122,6 +122,22 @@ impl OrbitCamera {
         camera
     }
 
+    /// The ray through pixel `(x, y)` (origin top-left) of a `width × height` image:
+    /// `(origin, unit direction)`.
+    pub fn ray(&self, x: f32, y: f32, width: f32, height: f32) -> (Vec3, Vec3) {
+        let inverse = self.view_projection(width / height.max(1.0)).inverse();
+        let ndc_x = 2.0 * x / width.max(1.0) - 1.0;
+        let ndc_y = 1.0 - 2.0 * y / height.max(1.0);
+        let near = inverse.project_point3(Vec3::new(ndc_x, ndc_y, 0.0));
+        let far = inverse.project_point3(Vec3::new(ndc_x, ndc_y, 1.0));
+        (near, (far - near).normalize_or(-Vec3::Z))
+    }
+
+    /// Unit vector from the eye towards the target.
+    pub fn forward(&self) -> Vec3 {
+        (self.target - self.eye()).normalize_or(-Vec3::Z)
+    }
+
     /// Projects a world point to pixel coordinates (origin top-left) in a `width × height`
     /// image; `None` behind the camera.
     pub fn project(&self, p: Vec3, width: u32, height: u32) -> Option<(f32, f32)> {

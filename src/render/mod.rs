@@ -8,6 +8,7 @@ mod device;
 mod error;
 mod frame;
 mod geometry;
+mod gif;
 mod offscreen;
 mod options;
 mod pipelines;
@@ -19,6 +20,7 @@ pub use capture::{RgbaImage, padded_bytes_per_row, read_target, save_png, strip_
 pub use device::{AdapterPreference, Gpu, describe_adapter};
 pub use error::RenderError;
 pub use frame::{Frame, Shape, SpringLines};
+pub use gif::GifWriter;
 pub use offscreen::Offscreen;
 pub use options::{RenderOptions, SpringColoring};
 pub use renderer::{CLEAR_COLOR, Renderer, kind_color, strain_color};

@@ -11,4 +11,21 @@ pub enum SceneError {
     /// A parameter set was refused; the simulation keeps the parameters it had.
     #[error("{0}; the previous parameters are kept")]
     Params(String),
+    /// A scene file could not be read.
+    #[error("{path}: cannot read the scene file: {detail}")]
+    Read {
+        path: std::path::PathBuf,
+        detail: String,
+    },
+    /// A scene file has a problem at a line and column.
+    #[error("{path}:{line}:{column}: {message}")]
+    File {
+        path: std::path::PathBuf,
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    /// The pins do not fit the cloth.
+    #[error("{0}")]
+    Pins(String),
 }

@@ -1,6 +1,7 @@
 //! Scenes: the scenario registry, scene construction, and the running simulation.
 
 mod error;
+mod file;
 mod framing;
 mod registry;
 #[allow(clippy::module_inception)]
@@ -9,7 +10,11 @@ mod simulation;
 mod summary;
 
 pub use error::SceneError;
-pub use registry::{PinRule, SCENARIOS, Scenario, ScenarioSetup, scenario};
+pub use file::{
+    BendingKind, ClothSpec, Corner, DEFAULT_DIHEDRAL_STIFFNESS, Edge, EffectSpec, GridShape,
+    LoadedSceneFile, MaterialSpec, OneOrTwo, PerKind, PinSpec, Region, SceneFile, SolverSpec,
+};
+pub use registry::{BUILTIN_SCENES, scenario, scenarios};
 pub use scene::{DEFAULT_CLOTH_NAME, DEFAULT_CLOTH_OBJ, Scene};
 pub use simulation::Simulation;
-pub use summary::RunSummary;
+pub use summary::{PhaseSummary, RunSummary};

@@ -1,16 +1,19 @@
 //! A scene: a placed cloth, its parameters and the effects that act on it — everything a
-//! [`super::Simulation`] starts from.
+//! [`super::Simulation`] starts from — built from a scene file.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Vec3};
 
 use crate::cloth::{ClothModel, ClothState};
-use crate::mesh::{self, ClothMesh, GridOrientation, MeshBuild, bounds, thinnest_axis};
+use crate::mesh::{
+    self, ClothMesh, GridOrientation, GridSpec, ImportOptions, MeshBuild, bounds, thinnest_axis,
+};
 use crate::sim::{Collider, Effect, SimParams};
 
 use super::error::SceneError;
-use super::registry::{PinRule, SCENARIOS, Scenario, ScenarioSetup, scenario};
+use super::file::{Corner, Edge, LoadedSceneFile, PinSpec, SceneFile};
+use super::registry::{BUILTIN_SCENES, scenario};
 
 /// The default cloth: a 1 m × 1 m square of 24 × 24 quads (see `assets/README.md`).
 pub const DEFAULT_CLOTH_OBJ: &str = include_str!("../../assets/cloth.obj");
@@ -21,36 +24,131 @@ pub const DEFAULT_CLOTH_NAME: &str = "assets/cloth.obj";
 /// then on the simulation owns these values.
 #[derive(Clone, Debug)]
 pub struct Scene {
-    /// Registry name of the scenario.
+    /// The file it was built from (with the cloth it actually has): what saving writes.
+    pub file: SceneFile,
+    /// Name of the scene.
     pub scenario: String,
-    /// Where the cloth came from (a file path or the built-in asset).
+    /// Where the cloth came from (a file path, or the grid it was generated as).
     pub cloth_name: String,
     pub model: ClothModel,
     pub initial: ClothState,
     pub params: SimParams,
     pub effects: Vec<Effect>,
-    /// The scenario's pins (applied while pins are enabled).
+    /// The scene's pins (applied while pins are enabled).
     pub pins: Vec<u32>,
     /// Notes from import (dropped faces and the like).
     pub warnings: Vec<String>,
 }
 
 impl Scene {
-    /// Builds a registered scenario with its default cloth.
+    /// A built-in scene.
     ///
     /// # Errors
     /// [`SceneError::UnknownScenario`].
     pub fn builtin(name: &str) -> Result<Scene, SceneError> {
-        let cloth = mesh::obj_from_str(DEFAULT_CLOTH_OBJ, DEFAULT_CLOTH_NAME)?;
-        Self::with_cloth(name, &cloth, DEFAULT_CLOTH_NAME)
+        Self::from_file(lookup(name)?.clone(), None)
     }
 
-    /// Builds a registered scenario with the cloth of an OBJ file.
+    /// A built-in scene or a scene file: `what` is a path when it ends in `.toml`.
+    ///
+    /// # Errors
+    /// [`SceneError::UnknownScenario`], or the file's errors.
+    pub fn open(what: &str) -> Result<Scene, SceneError> {
+        if what.ends_with(".toml") {
+            Self::from_loaded(&SceneFile::load(Path::new(what))?)
+        } else {
+            Self::builtin(what)
+        }
+    }
+
+    /// A built-in scene or a scene file (`what` ends in `.toml`), with its own cloth or, when
+    /// given, the cloth of an OBJ file imported with `options`.
+    ///
+    /// # Errors
+    /// [`SceneError::UnknownScenario`], the scene file's errors, or the OBJ's.
+    pub fn open_with_obj(
+        what: &str,
+        obj: Option<&Path>,
+        options: &ImportOptions,
+    ) -> Result<Scene, SceneError> {
+        let (file, base) = if what.ends_with(".toml") {
+            let loaded = SceneFile::load(Path::new(what))?;
+            let base = loaded.path.parent().map(Path::to_path_buf);
+            (loaded.file, base)
+        } else {
+            (lookup(what)?.clone(), None)
+        };
+        match obj {
+            Some(path) => {
+                let cloth = mesh::load_obj_with(path, options)?;
+                let mut file = file;
+                file.cloth.grid = None;
+                file.cloth.obj = Some(path.to_path_buf());
+                Self::with_mesh(file, &cloth, &path.display().to_string())
+            }
+            None => Self::from_file(file, base.as_deref()),
+        }
+    }
+
+    /// A scene file read from disk (an OBJ it names is found beside it).
+    ///
+    /// # Errors
+    /// The cloth's [`mesh::ObjError`], or [`SceneError::Pins`].
+    pub fn from_loaded(loaded: &LoadedSceneFile) -> Result<Scene, SceneError> {
+        Self::from_file(loaded.file.clone(), loaded.path.parent())
+    }
+
+    /// A scene from a parsed file; `base` is where relative paths start.
+    ///
+    /// # Errors
+    /// The cloth's [`mesh::ObjError`], or [`SceneError::Pins`].
+    pub fn from_file(file: SceneFile, base: Option<&Path>) -> Result<Scene, SceneError> {
+        let (cloth, name) = match (&file.cloth.obj, &file.cloth.grid) {
+            (Some(obj), _) => {
+                let path = base.map_or_else(|| obj.clone(), |b| b.join(obj));
+                let options = ImportOptions {
+                    weld_tolerance: file
+                        .cloth
+                        .weld_tolerance
+                        .unwrap_or(ImportOptions::default().weld_tolerance),
+                };
+                (
+                    mesh::load_obj_with(&path, &options)?,
+                    path.display().to_string(),
+                )
+            }
+            (None, Some(grid)) => {
+                let [qx, qy] = grid.quads.pair();
+                let [sx, sy] = grid.size.pair();
+                let spec = GridSpec {
+                    quads_x: qx,
+                    quads_y: qy,
+                    size_x: sx,
+                    size_y: sy,
+                    orientation: GridOrientation::Horizontal,
+                    center: Vec3::ZERO,
+                };
+                let mesh = spec.build()?;
+                let name = format!("{qx}×{qy}-quad grid, {sx}×{sy} m");
+                (
+                    MeshBuild {
+                        mesh,
+                        warnings: Vec::new(),
+                    },
+                    name,
+                )
+            }
+            (None, None) => unreachable!("SceneFile::check requires a cloth"),
+        };
+        Self::with_mesh(file, &cloth, &name)
+    }
+
+    /// A built-in scene with the cloth of an OBJ file.
     ///
     /// # Errors
     /// [`SceneError::UnknownScenario`], or the file's [`mesh::ObjError`].
     pub fn with_obj(name: &str, path: &Path) -> Result<Scene, SceneError> {
-        Self::with_obj_options(name, path, &mesh::ImportOptions::default())
+        Self::with_obj_options(name, path, &ImportOptions::default())
     }
 
     /// As [`Scene::with_obj`], importing with `options`.
@@ -60,50 +158,54 @@ impl Scene {
     pub fn with_obj_options(
         name: &str,
         path: &Path,
-        options: &mesh::ImportOptions,
+        options: &ImportOptions,
     ) -> Result<Scene, SceneError> {
         let cloth = mesh::load_obj_with(path, options)?;
         Self::with_cloth(name, &cloth, &path.display().to_string())
     }
 
-    /// Builds a registered scenario around an already imported cloth.
+    /// A built-in scene around an already imported cloth (`cloth_name`: its file).
     ///
     /// # Errors
-    /// [`SceneError::UnknownScenario`].
+    /// [`SceneError::UnknownScenario`], [`SceneError::Pins`].
     pub fn with_cloth(
         name: &str,
         cloth: &MeshBuild,
         cloth_name: &str,
     ) -> Result<Scene, SceneError> {
-        let entry = lookup(name)?;
-        Ok(Self::from_setup(entry, entry.setup(), cloth, cloth_name))
+        let mut file = lookup(name)?.clone();
+        file.cloth.grid = None;
+        file.cloth.obj = Some(PathBuf::from(cloth_name));
+        Self::with_mesh(file, cloth, cloth_name)
     }
 
-    /// Places `cloth` as `setup` says and builds model and initial state.
-    pub fn from_setup(
-        entry: &'static Scenario,
-        setup: ScenarioSetup,
+    /// Places `cloth` as `file` says, pins it, and builds model and initial state.
+    ///
+    /// # Errors
+    /// [`SceneError::Pins`] for a pin index the cloth does not have.
+    pub fn with_mesh(
+        file: SceneFile,
         cloth: &MeshBuild,
         cloth_name: &str,
-    ) -> Scene {
+    ) -> Result<Scene, SceneError> {
         let mut mesh = cloth.mesh.clone();
-        place(&mut mesh, setup.orientation, setup.center);
-        let pins = match setup.pins {
-            PinRule::None => Vec::new(),
-            PinRule::TopCorners => top_corners(&mesh.positions, setup.orientation),
-        };
-        let model = ClothModel::new(&mesh, setup.params.density, &pins);
+        let orientation = file.cloth.orientation;
+        place(&mut mesh, orientation, Vec3::from(file.cloth.center));
+        let pins = pins(&file.pins, &mesh.positions, orientation)?;
+        let params = file.params();
+        let model = ClothModel::new(&mesh, params.density, &pins);
         let initial = ClothState::at_rest(&model);
-        Scene {
-            scenario: entry.name.to_string(),
+        Ok(Scene {
+            scenario: file.name.clone(),
+            effects: file.effects(),
+            file,
             cloth_name: cloth_name.to_string(),
             model,
             initial,
-            params: setup.params,
-            effects: setup.effects,
+            params,
             pins,
             warnings: cloth.warnings.clone(),
-        }
+        })
     }
 
     /// The sphere collider, if the scene has one (to adjust before simulating).
@@ -115,12 +217,12 @@ impl Scene {
     }
 }
 
-fn lookup(name: &str) -> Result<&'static Scenario, SceneError> {
+fn lookup(name: &str) -> Result<&'static SceneFile, SceneError> {
     scenario(name).ok_or_else(|| SceneError::UnknownScenario {
         name: name.to_string(),
-        available: SCENARIOS
+        available: BUILTIN_SCENES
             .iter()
-            .map(|s| s.name)
+            .map(|(n, _)| *n)
             .collect::<Vec<_>>()
             .join(", "),
     })
@@ -152,27 +254,84 @@ fn place(mesh: &mut ClothMesh, orientation: GridOrientation, center: Vec3) {
     }
 }
 
-/// The two corners of the top edge: for a vertical cloth the particles nearest the top-left
-/// and top-right corners of its bounding box in the x–y plane; for a horizontal cloth those
-/// nearest the back-left and back-right corners in the x–z plane (ties go to the lower index).
-fn top_corners(pos: &[Vec3], orientation: GridOrientation) -> Vec<u32> {
-    let (lo, hi) = bounds(pos);
-    // Distance below the top edge: down from max y, or forward from min z.
-    let depth = |p: &Vec3| match orientation {
+/// How far below the top edge a point is, within the cloth's plane: down from the highest
+/// y of a vertical cloth, forward from the back (lowest z) of a horizontal one.
+fn depth(p: Vec3, lo: Vec3, hi: Vec3, orientation: GridOrientation) -> f32 {
+    match orientation {
         GridOrientation::Vertical => hi.y - p.y,
         GridOrientation::Horizontal => p.z - lo.z,
-    };
-    let nearest = |corner_x: f32| {
+    }
+}
+
+/// The particles the pin rules select, sorted and unique.
+fn pins(
+    spec: &PinSpec,
+    pos: &[Vec3],
+    orientation: GridOrientation,
+) -> Result<Vec<u32>, SceneError> {
+    let (lo, hi) = bounds(pos);
+    let size = (hi - lo).length().max(f32::MIN_POSITIVE);
+    let full_depth = depth(
+        match orientation {
+            GridOrientation::Vertical => lo,
+            GridOrientation::Horizontal => hi,
+        },
+        lo,
+        hi,
+        orientation,
+    );
+    let mut out = Vec::new();
+    for corner in &spec.corners {
+        let (x, bottom) = match corner {
+            Corner::TopLeft => (lo.x, false),
+            Corner::TopRight => (hi.x, false),
+            Corner::BottomLeft => (lo.x, true),
+            Corner::BottomRight => (hi.x, true),
+        };
+        // Nearest particle to the corner (ties to the lower index).
         let mut best = (f32::INFINITY, 0u32);
         for (i, p) in pos.iter().enumerate() {
-            let d = (p.x - corner_x).abs() + depth(p);
-            if d < best.0 {
-                best = (d, i as u32);
+            let d = depth(*p, lo, hi, orientation);
+            let along = if bottom { full_depth - d } else { d };
+            let score = (p.x - x).abs() + along;
+            if score < best.0 {
+                best = (score, i as u32);
             }
         }
-        best.1
-    };
-    let mut pins = vec![nearest(lo.x), nearest(hi.x)];
-    pins.dedup();
-    pins
+        out.push(best.1);
+    }
+    let eps = 1e-4 * size;
+    for edge in &spec.edges {
+        for (i, p) in pos.iter().enumerate() {
+            let d = depth(*p, lo, hi, orientation);
+            let on = match edge {
+                Edge::Top => d <= eps,
+                Edge::Bottom => d >= full_depth - eps,
+                Edge::Left => p.x <= lo.x + eps,
+                Edge::Right => p.x >= hi.x - eps,
+            };
+            if on {
+                out.push(i as u32);
+            }
+        }
+    }
+    if let Some(&bad) = spec.indices.iter().find(|&&i| i as usize >= pos.len()) {
+        return Err(SceneError::Pins(format!(
+            "pin index {bad} does not exist: the cloth has {} particles",
+            pos.len()
+        )));
+    }
+    out.extend_from_slice(&spec.indices);
+    if let Some(r) = spec.region {
+        let (min, max) = (Vec3::from(r.min), Vec3::from(r.max));
+        out.extend(
+            pos.iter()
+                .enumerate()
+                .filter(|(_, p)| p.cmpge(min).all() && p.cmple(max).all())
+                .map(|(i, _)| i as u32),
+        );
+    }
+    out.sort_unstable();
+    out.dedup();
+    Ok(out)
 }

@@ -10,16 +10,23 @@ use crate::sim::{
 };
 
 use super::error::SceneError;
+use super::file::SceneFile;
 use super::scene::Scene;
 
 /// Scene data, live state, parameters, effects and the backend that steps them.
 pub struct Simulation {
+    /// The file the scene was built from, for saving the current setup.
+    file: SceneFile,
     scenario: String,
     cloth_name: String,
     warnings: Vec<String>,
     /// The scenario's pins, applied while `pins_enabled`.
     scenario_pins: Vec<u32>,
     pins_enabled: bool,
+    /// Particles the user pinned or unpinned by hand (toggled on top of the scene's).
+    toggled_pins: Vec<u32>,
+    /// The particle being dragged, held where the pointer puts it.
+    grabbed: Option<u32>,
     model: ClothModel,
     initial: ClothState,
     state: ClothState,
@@ -46,11 +53,14 @@ impl Simulation {
             &scene.model,
         ));
         Self {
+            file: scene.file,
             scenario: scene.scenario,
             cloth_name: scene.cloth_name,
             warnings,
             scenario_pins: scene.pins,
             pins_enabled: true,
+            toggled_pins: Vec::new(),
+            grabbed: None,
             state: scene.initial.clone(),
             initial: scene.initial,
             model: scene.model,
@@ -114,6 +124,7 @@ impl Simulation {
     /// its initial state, and its current parameters and effects.
     pub fn to_scene(&self) -> Scene {
         Scene {
+            file: self.scene_file(),
             scenario: self.scenario.clone(),
             cloth_name: self.cloth_name.clone(),
             model: self.model.clone(),
@@ -123,6 +134,30 @@ impl Simulation {
             pins: self.scenario_pins.clone(),
             warnings: self.warnings.clone(),
         }
+    }
+
+    /// The current setup as a scene file: the scene's cloth and placement with the
+    /// parameters, effects and pins in force now.
+    pub fn scene_file(&self) -> SceneFile {
+        let pins = (self.model.pins != self.scenario_pins).then_some(self.model.pins.as_slice());
+        self.file.with_setup(&self.params, &self.effects, pins)
+    }
+
+    /// The cloth as it is now, as OBJ text: current positions, the triangles, the UVs.
+    /// Importing it gives back the same particles and triangles.
+    pub fn export_obj(&self) -> String {
+        let soup = crate::mesh::PolygonSoup {
+            positions: self.state.pos.clone(),
+            uvs: Some(self.model.uvs.clone()),
+            face_indices: self.model.triangles.iter().flatten().copied().collect(),
+            face_arities: vec![3; self.model.triangles.len()],
+        };
+        crate::mesh::write_obj(&soup)
+    }
+
+    /// The last self-collision pass's work, when the scene has self-collision.
+    pub fn self_collision_work(&self) -> Option<crate::sim::SelfWork> {
+        self.backend.self_collision_work()
     }
 
     /// Total mechanical energy (kinetic plus the potential of the conservative forces),
@@ -173,13 +208,77 @@ impl Simulation {
     /// Switches the scenario's pins on or off. Newly pinned particles stop where they are.
     pub fn set_pins_enabled(&mut self, enabled: bool) {
         self.pins_enabled = enabled;
-        let pins = if enabled {
+        self.refresh_pins();
+    }
+
+    /// Pins particle `p` if it is free, frees it if it is pinned (on top of the scene's pins).
+    pub fn toggle_pin(&mut self, p: u32) {
+        if p as usize >= self.model.particle_count() {
+            return;
+        }
+        match self.toggled_pins.iter().position(|&q| q == p) {
+            Some(i) => {
+                self.toggled_pins.remove(i);
+            }
+            None => self.toggled_pins.push(p),
+        }
+        self.refresh_pins();
+    }
+
+    /// Holds particle `p` at `target` (metres), moved there from where it was over one
+    /// frame; it stays held until [`Simulation::release`]. Works under every integrator: a
+    /// held particle is pinned, and its velocity is what the pointer gives it.
+    pub fn grab(&mut self, p: u32, target: glam::Vec3) {
+        if p as usize >= self.model.particle_count() || !target.is_finite() {
+            return;
+        }
+        if self.grabbed != Some(p) {
+            self.grabbed = Some(p);
+            self.refresh_pins();
+        }
+        let dt = self.params.dt;
+        let i = p as usize;
+        self.state.vel[i] = (target - self.state.pos[i]) / dt;
+        self.state.pos[i] = target;
+        self.backend.invalidate();
+    }
+
+    /// Lets go of the held particle; it flies on with the pointer's last velocity.
+    pub fn release(&mut self) {
+        if self.grabbed.take().is_some() {
+            self.refresh_pins();
+        }
+    }
+
+    /// The particle being held, if any.
+    pub fn grabbed(&self) -> Option<u32> {
+        self.grabbed
+    }
+
+    /// Pins in force: the scene's (when enabled), toggled by hand, and the held particle.
+    fn refresh_pins(&mut self) {
+        let mut pins = if self.pins_enabled {
             self.scenario_pins.clone()
         } else {
             Vec::new()
         };
+        for &p in &self.toggled_pins {
+            match pins.iter().position(|&q| q == p) {
+                Some(i) => {
+                    pins.remove(i);
+                }
+                None => pins.push(p),
+            }
+        }
+        let held: Vec<u32> = self.grabbed.into_iter().collect();
+        pins.extend(held.iter().copied());
+        let newly_pinned: Vec<u32> = pins
+            .iter()
+            .copied()
+            .filter(|p| !self.model.pins.contains(p) && !held.contains(p))
+            .collect();
         self.model.set_pins(&pins);
-        for &p in &self.model.pins {
+        for p in newly_pinned {
             self.state.vel[p as usize] = glam::Vec3::ZERO;
         }
         self.backend.invalidate();

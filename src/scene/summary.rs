@@ -1,5 +1,6 @@
 //! Headless runs and their summary, as `clothsim simulate --json` prints it.
 
+use std::collections::BTreeMap;
 use std::time::Instant;
 
 use crate::mesh::SpringKind;
@@ -44,14 +45,25 @@ pub struct RunSummary {
     pub integrator_in_effect: String,
     /// Everything the stability guard did, in order.
     pub guard_events: Vec<GuardEvent>,
+    /// Wall time and calls of every phase that ran during the run (only those).
+    pub phases: BTreeMap<String, PhaseSummary>,
     /// Set when the run stopped early because it diverged.
     pub error: Option<String>,
+}
+
+/// One phase of a run.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct PhaseSummary {
+    pub calls: u64,
+    pub seconds: f64,
 }
 
 impl Simulation {
     /// Runs headless for `seconds` of simulated time (whole frames) and summarises.
     pub fn run(&mut self, seconds: f64) -> RunSummary {
         let frames = (seconds / self.params().dt as f64).round().max(0.0) as u64;
+        // Timings gathered before the run are not the run's.
+        self.take_timings();
         let start = Instant::now();
         let mut refined = 0;
         let mut error = None;
@@ -69,6 +81,18 @@ impl Simulation {
             }
         }
         let mut summary = self.summary(start.elapsed().as_secs_f64());
+        summary.phases = self
+            .take_timings()
+            .phases()
+            .iter()
+            .map(|p| {
+                let s = PhaseSummary {
+                    calls: p.calls,
+                    seconds: p.time.as_secs_f64(),
+                };
+                (p.name.to_string(), s)
+            })
+            .collect();
         summary.refined_frames = refined;
         summary.guard_events = events;
         summary.error = error;
@@ -104,6 +128,7 @@ impl Simulation {
             refined_frames: 0,
             integrator_in_effect: self.integrator_in_effect().name().to_string(),
             guard_events: Vec::new(),
+            phases: BTreeMap::new(),
             error: None,
         }
     }

@@ -61,4 +61,7 @@ pub trait StepBackend: Send {
 
     /// The integrator in effect (the guard's fallback may have replaced the requested one).
     fn integrator(&self) -> IntegratorKind;
+
+    /// The work of the last self-collision pass, when the scene has self-collision.
+    fn self_collision_work(&self) -> Option<super::self_collision::SelfWork>;
 }

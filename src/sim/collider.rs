@@ -26,6 +26,14 @@ pub enum Collider {
 }
 
 impl Collider {
+    /// The name of its phase in timings.
+    pub fn phase(&self) -> &'static str {
+        match self {
+            Collider::Sphere { .. } => "sphere",
+            Collider::Plane { .. } => "plane",
+        }
+    }
+
     /// Signed distance from `p` to the surface (metres, negative inside), the outward unit
     /// normal there, and the surface velocity there (m/s).
     pub fn surface(&self, p: Vec3) -> (f32, Vec3, Vec3) {

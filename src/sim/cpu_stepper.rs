@@ -8,7 +8,7 @@ use crate::cloth::{ClothModel, ClothState};
 
 use super::backend::StepBackend;
 use super::collider::{Collider, colliders_of};
-use super::effect::Effect;
+use super::effect::{Effect, wind_of};
 use super::forces::ForceSet;
 use super::guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check};
 use super::guard_state::GuardState;
@@ -16,6 +16,7 @@ use super::integrator::{
     Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport,
 };
 use super::params::{SimParams, SolverConfig};
+use super::self_collision::{SelfCollision, SelfContacts};
 use super::stats::StepStats;
 use super::timings::PhaseTimings;
 
@@ -42,6 +43,10 @@ pub struct CpuStepper {
     frame_start: ClothState,
     /// Positions at the start of the current substep: the paths colliders sweep.
     substep_start: Vec<glam::Vec3>,
+    self_collision: Option<SelfCollision>,
+    self_contacts: SelfContacts,
+    /// Fastest the wind gets, m/s (for the guard's speed limit).
+    wind: f32,
 }
 
 impl CpuStepper {
@@ -64,6 +69,9 @@ impl CpuStepper {
             meter: StepMeter::default(),
             frame_start: ClothState::default(),
             substep_start: Vec::new(),
+            self_collision: None,
+            self_contacts: SelfContacts::default(),
+            wind: 0.0,
         };
         stepper.configure(model, params, effects);
         stepper
@@ -86,9 +94,14 @@ impl CpuStepper {
             self.integrator.step(&mut ctx, state, h)
         };
         let total = start.elapsed();
-        let m = self.meter;
-        if m.force_evals > 0 || m.forces > Duration::ZERO {
-            self.timings.add("forces", m.forces);
+        let m = &self.meter;
+        for &(name, took, calls) in &m.terms.entries {
+            if calls > 0 {
+                self.timings.add_calls(name, took, calls as u64);
+            }
+        }
+        if m.derivatives > Duration::ZERO {
+            self.timings.add("jacobian", m.derivatives);
         }
         if m.solve > Duration::ZERO {
             self.timings.add("solve", m.solve);
@@ -240,6 +253,11 @@ impl StepBackend for CpuStepper {
     fn configure(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]) {
         self.forces.configure(model, params, effects);
         self.colliders = colliders_of(effects);
+        self.self_collision = effects.iter().find_map(|e| match e {
+            Effect::SelfCollision(s) => Some(*s),
+            _ => None,
+        });
+        self.wind = wind_of(effects).map_or(0.0, |w| w.peak_speed());
         if self.integrator.kind() != params.integrator {
             self.integrator = params.integrator.build();
         }
@@ -273,19 +291,27 @@ impl StepBackend for CpuStepper {
         state: &mut ClothState,
     ) -> Result<StepReport, StepError> {
         let h = self.substep_length();
-        if !self.colliders.is_empty() {
+        let contacts_exist = !self.colliders.is_empty() || self.self_collision.is_some();
+        if contacts_exist {
             self.substep_start.clone_from(&state.pos);
         }
+        self.forces.set_time(state.time);
         let report = self.integrate(model, state, h)?;
         self.stats.record(&report);
-        if !self.colliders.is_empty() {
-            let (colliders, offset, start) = (&self.colliders, self.offset, &self.substep_start);
-            let contacts = self.timings.time("collide", || {
-                colliders
-                    .iter()
-                    .map(|c| c.resolve(model, start, state, offset))
-                    .sum::<usize>()
-            });
+        if contacts_exist {
+            let mut contacts = 0;
+            let start = &self.substep_start;
+            for c in &self.colliders {
+                contacts += self
+                    .timings
+                    .time(c.phase(), || c.resolve(model, start, state, self.offset));
+            }
+            if let Some(params) = &self.self_collision {
+                let solver = &mut self.self_contacts;
+                contacts += self.timings.time("self-collision", || {
+                    solver.resolve(params, model, start, state)
+                });
+            }
             if contacts > 0 {
                 // Contacts changed positions and velocities after the integrator's step.
                 self.integrator.invalidate();
@@ -319,7 +345,7 @@ impl StepBackend for CpuStepper {
             return Ok(FrameOutcome::Stepped);
         }
         if self.guard.limits.is_none() {
-            let wind = 0.0;
+            let wind = self.wind;
             self.guard.limits = Some(GuardLimits::derive(
                 &self.guard.policy,
                 model,
@@ -364,5 +390,9 @@ impl StepBackend for CpuStepper {
 
     fn integrator(&self) -> IntegratorKind {
         self.integrator.kind()
+    }
+
+    fn self_collision_work(&self) -> Option<super::self_collision::SelfWork> {
+        self.self_collision.map(|_| self.self_contacts.work)
     }
 }

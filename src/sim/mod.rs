@@ -12,6 +12,7 @@ mod guard;
 mod guard_state;
 pub mod integrator;
 mod params;
+mod self_collision;
 mod stats;
 mod timings;
 
@@ -20,12 +21,13 @@ pub use cg::{CgOutcome, ConjugateGradient};
 pub use collider::{Collider, colliders_of, min_collider_distance, small_sphere_warnings};
 pub use constraints::DistanceConstraints;
 pub use cpu_stepper::CpuStepper;
-pub use effect::Effect;
-pub use forces::{Force, ForceSet, JacobianMode, SystemMatrix};
+pub use effect::{BendingModel, Effect, wind_of};
+pub use forces::{Force, ForceSet, JacobianMode, SystemMatrix, Wind};
 pub use guard::{
     Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, GuardPolicy, Trouble, check,
 };
 pub use integrator::{Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport};
 pub use params::{SimParams, SolverConfig};
+pub use self_collision::{SelfCollision, SelfContacts, SelfWork};
 pub use stats::StepStats;
-pub use timings::PhaseTimings;
+pub use timings::{Phase, PhaseTimings};

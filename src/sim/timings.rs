@@ -1,20 +1,40 @@
-//! Per-phase wall-clock timings of the stepper. Only phases that ran appear.
+//! Per-phase wall-clock timings and call counts of the stepper. Only phases that ran appear.
 
 use std::time::{Duration, Instant};
 
-/// Accumulated time per named phase, in first-run order.
+/// One phase's totals.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Phase {
+    pub name: &'static str,
+    pub time: Duration,
+    pub calls: u64,
+}
+
+/// Accumulated time and calls per named phase, in first-run order.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PhaseTimings {
-    entries: Vec<(&'static str, Duration)>,
+    entries: Vec<Phase>,
 }
 
 impl PhaseTimings {
-    /// Adds `elapsed` to `phase`.
-    pub fn add(&mut self, phase: &'static str, elapsed: Duration) {
-        match self.entries.iter_mut().find(|(name, _)| *name == phase) {
-            Some((_, total)) => *total += elapsed,
-            None => self.entries.push((phase, elapsed)),
+    /// Adds `calls` runs taking `elapsed` in all to `phase`.
+    pub fn add_calls(&mut self, phase: &'static str, elapsed: Duration, calls: u64) {
+        match self.entries.iter_mut().find(|p| p.name == phase) {
+            Some(p) => {
+                p.time += elapsed;
+                p.calls += calls;
+            }
+            None => self.entries.push(Phase {
+                name: phase,
+                time: elapsed,
+                calls,
+            }),
         }
+    }
+
+    /// Adds one run of `elapsed` to `phase`.
+    pub fn add(&mut self, phase: &'static str, elapsed: Duration) {
+        self.add_calls(phase, elapsed, 1);
     }
 
     /// Runs `f`, charging its time to `phase`.
@@ -26,8 +46,20 @@ impl PhaseTimings {
     }
 
     /// The phases and their totals.
-    pub fn entries(&self) -> &[(&'static str, Duration)] {
+    pub fn phases(&self) -> &[Phase] {
         &self.entries
+    }
+
+    /// The phase called `name`, if it ran.
+    pub fn get(&self, name: &str) -> Option<&Phase> {
+        self.entries.iter().find(|p| p.name == name)
+    }
+
+    /// Adds another set of timings to this one.
+    pub fn merge(&mut self, other: &PhaseTimings) {
+        for p in &other.entries {
+            self.add_calls(p.name, p.time, p.calls);
+        }
     }
 
     /// Returns the totals so far and starts again from zero.

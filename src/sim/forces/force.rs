@@ -5,38 +5,64 @@ use glam::Vec3;
 use crate::cloth::ClothModel;
 
 use super::air_damping::AirDamping;
+use super::dihedral::DihedralBending;
 use super::gravity::Gravity;
 use super::jacobian::{JacobianMode, SystemMatrix};
 use super::springs::SpringForce;
+use super::wind::Wind;
 
-/// A force term. Each yields forces in newtons and, for implicit methods, its derivatives.
+/// A force term. Each yields forces in newtons; the springs and air damping also give
+/// their derivatives for implicit methods, which treat the others explicitly.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Force {
     Gravity(Gravity),
     Springs(SpringForce),
     AirDamping(AirDamping),
+    Bending(DihedralBending),
+    Wind(Wind),
 }
 
 impl Force {
-    /// Adds this term's forces at `(pos, vel)` to `f`, newtons.
-    pub fn add_forces(&self, model: &ClothModel, pos: &[Vec3], vel: &[Vec3], f: &mut [Vec3]) {
+    /// The term's phase name in timings.
+    pub fn phase(&self) -> &'static str {
+        match self {
+            Force::Gravity(_) => "gravity",
+            Force::Springs(_) => "springs",
+            Force::AirDamping(_) => "air-damping",
+            Force::Bending(_) => "bending",
+            Force::Wind(_) => "wind",
+        }
+    }
+
+    /// Adds this term's forces at `(pos, vel)` and time `t` to `f`, newtons.
+    pub fn add_forces(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        t: f64,
+        f: &mut [Vec3],
+    ) {
         match self {
             Force::Gravity(g) => g.add_forces(&model.mass, f),
             Force::Springs(s) => s.add_forces(&model.springs, pos, vel, f),
             Force::AirDamping(d) => d.add_forces(&model.mass, vel, f),
+            Force::Bending(b) => b.add_forces(model, pos, f),
+            Force::Wind(w) => w.add_forces(model, pos, vel, t, f),
         }
     }
 
-    /// Potential energy at `pos`, joules; zero for dissipative terms.
+    /// Potential energy at `pos`, joules; zero for dissipative and driving terms.
     pub fn potential_energy(&self, model: &ClothModel, pos: &[Vec3]) -> f64 {
         match self {
             Force::Gravity(g) => g.potential_energy(&model.mass, pos),
             Force::Springs(s) => s.potential_energy(&model.springs, pos),
-            Force::AirDamping(_) => 0.0,
+            Force::Bending(b) => b.potential_energy(model, pos),
+            Force::AirDamping(_) | Force::Wind(_) => 0.0,
         }
     }
 
-    /// Adds `(∂f/∂x)·u` to `out` (N/m × m).
+    /// Adds `(∂f/∂x)·u` to `out` (N/m × m) for the terms that give derivatives.
     pub fn add_df_dx(
         &self,
         model: &ClothModel,
@@ -51,7 +77,7 @@ impl Force {
         }
     }
 
-    /// Adds `(∂f/∂v)·u` to `out` (N·s/m × m/s).
+    /// Adds `(∂f/∂v)·u` to `out` (N·s/m × m/s) for the terms that give derivatives.
     pub fn add_df_dv(
         &self,
         model: &ClothModel,
@@ -61,9 +87,9 @@ impl Force {
         out: &mut [Vec3],
     ) {
         match self {
-            Force::Gravity(_) => {}
             Force::Springs(s) => s.add_df_dv(&model.springs, pos, vel, u, out),
             Force::AirDamping(d) => d.add_df_dv(&model.mass, u, out),
+            Force::Gravity(_) | Force::Bending(_) | Force::Wind(_) => {}
         }
     }
 
@@ -76,9 +102,9 @@ impl Force {
         sys: &mut SystemMatrix,
     ) {
         match self {
-            Force::Gravity(_) => {}
             Force::Springs(s) => s.add_to_system(&model.springs, pos, vel, sys),
             Force::AirDamping(d) => d.add_to_system(&model.mass, sys),
+            Force::Gravity(_) | Force::Bending(_) | Force::Wind(_) => {}
         }
     }
 }

@@ -5,9 +5,10 @@ use glam::Vec3;
 use crate::cloth::ClothModel;
 
 use super::super::constraints::DistanceConstraints;
-use super::super::effect::Effect;
+use super::super::effect::{BendingModel, Effect};
 use super::super::params::SimParams;
 use super::air_damping::AirDamping;
+use super::dihedral::DihedralBending;
 use super::force::Force;
 use super::gravity::Gravity;
 use super::jacobian::{JacobianMode, SystemMatrix};
@@ -17,6 +18,31 @@ use super::springs::SpringForce;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ForceSet {
     terms: Vec<Force>,
+    /// Simulated time the forces are evaluated at (the wind's gusts move with it), seconds.
+    time: f64,
+}
+
+/// Wall time and evaluations per term, in term order, filled by [`ForceSet::forces_timed`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TermTimes {
+    pub entries: Vec<(&'static str, std::time::Duration, u32)>,
+}
+
+impl TermTimes {
+    pub fn clear(&mut self) {
+        self.entries.clear();
+    }
+
+    fn add(&mut self, slot: usize, name: &'static str, took: std::time::Duration) {
+        if self.entries.len() <= slot {
+            self.entries
+                .resize(slot + 1, (name, std::time::Duration::ZERO, 0));
+        }
+        let entry = &mut self.entries[slot];
+        entry.0 = name;
+        entry.1 += took;
+        entry.2 += 1;
+    }
 }
 
 impl ForceSet {
@@ -29,17 +55,33 @@ impl ForceSet {
 
     /// A set of exactly these terms (tests, tools).
     pub fn from_terms(terms: Vec<Force>) -> Self {
-        Self { terms }
+        Self { terms, time: 0.0 }
+    }
+
+    /// Sets the simulated time forces are evaluated at, seconds.
+    pub fn set_time(&mut self, time: f64) {
+        self.time = time;
     }
 
     /// Rebuilds the term list for `effects` and `params`, keeping the per-spring expansion
     /// when the spring strengths did not change.
     pub fn configure(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]) {
-        let old_springs = self.terms.iter().find_map(|t| match t {
-            Force::Springs(s) => Some(s.clone()),
+        let old = std::mem::take(&mut self.terms);
+        let kept_springs = old.iter().find_map(|t| match t {
+            Force::Springs(s) => Some(s),
             _ => None,
         });
-        self.terms.clear();
+        let kept_bending = old.iter().find_map(|t| match t {
+            Force::Bending(b) => Some(b),
+            _ => None,
+        });
+        // Bend springs act only when the scene bends by springs.
+        let bend_springs = effects.contains(&Effect::Bending(BendingModel::Springs));
+        let active = if bend_springs {
+            model.springs.len()
+        } else {
+            model.springs.len() - model.bend_springs
+        };
         for effect in effects {
             let term = match effect {
                 Effect::Gravity => Force::Gravity(Gravity { g: params.gravity }),
@@ -47,13 +89,23 @@ impl ForceSet {
                     rate: params.air_damping,
                 }),
                 Effect::Springs => {
-                    let mut s = old_springs.clone().unwrap_or_else(|| {
-                        SpringForce::new(&model.springs, params.stiffness, params.damping)
+                    let mut s = kept_springs.cloned().unwrap_or_else(|| {
+                        SpringForce::first(&model.springs, active, params.stiffness, params.damping)
                     });
-                    s.set_strengths(&model.springs, params.stiffness, params.damping);
+                    s.set_strengths(&model.springs, active, params.stiffness, params.damping);
                     Force::Springs(s)
                 }
-                Effect::Collider(_) => continue,
+                Effect::Bending(BendingModel::Dihedral { stiffness }) => {
+                    let mut b = kept_bending
+                        .cloned()
+                        .unwrap_or_else(|| DihedralBending::new(model, *stiffness));
+                    b.set_stiffness(*stiffness);
+                    Force::Bending(b)
+                }
+                Effect::Wind(w) => Force::Wind(*w),
+                Effect::Bending(BendingModel::Springs)
+                | Effect::SelfCollision(_)
+                | Effect::Collider(_) => continue,
             };
             self.terms.push(term);
         }
@@ -91,7 +143,26 @@ impl ForceSet {
         f.clear();
         f.resize(pos.len(), Vec3::ZERO);
         for term in self.terms.iter().filter(|t| keep(t)) {
-            term.add_forces(model, pos, vel, f);
+            term.add_forces(model, pos, vel, self.time, f);
+        }
+    }
+
+    /// As [`ForceSet::forces_where`], charging each term's wall time to `times`.
+    pub fn forces_timed(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        keep: impl Fn(&Force) -> bool,
+        f: &mut Vec<Vec3>,
+        times: &mut TermTimes,
+    ) {
+        f.clear();
+        f.resize(pos.len(), Vec3::ZERO);
+        for (slot, term) in self.terms.iter().enumerate().filter(|(_, t)| keep(t)) {
+            let start = std::time::Instant::now();
+            term.add_forces(model, pos, vel, self.time, f);
+            times.add(slot, term.phase(), start.elapsed());
         }
     }
 

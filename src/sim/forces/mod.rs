@@ -2,18 +2,22 @@
 //! together and is the one place forces become accelerations.
 
 mod air_damping;
+mod dihedral;
 mod force;
 mod force_set;
 mod gravity;
 mod jacobian;
 mod springs;
+mod wind;
 
 pub use air_damping::AirDamping;
+pub use dihedral::{DihedralBending, hinge_angle};
 pub use force::Force;
-pub use force_set::{ForceSet, to_accelerations};
+pub use force_set::{ForceSet, TermTimes, to_accelerations};
 pub use gravity::Gravity;
 pub use jacobian::{JacobianMode, SystemMatrix};
 pub use springs::{SpringBlocks, SpringForce};
+pub use wind::Wind;
 
 #[cfg(test)]
 mod derivative_tests;

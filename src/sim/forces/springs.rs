@@ -12,11 +12,14 @@ use crate::cloth::Springs;
 use super::jacobian::{JacobianMode, SystemMatrix};
 use crate::sim::constraints::DistanceConstraints;
 
-/// Springs with per-kind stiffness (N/m) and damping (N·s/m), expanded per spring.
+/// Springs with per-kind stiffness (N/m) and damping (N·s/m), expanded per spring. Only the
+/// first `active` springs act: the bend springs (the last ones) are left out when the scene
+/// bends by dihedral angles, or not at all.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SpringForce {
     stiffness: [f32; 3],
     damping: [f32; 3],
+    active: usize,
     /// Stiffness of each spring, N/m.
     k: Vec<f32>,
     /// Damping of each spring, N·s/m.
@@ -38,11 +41,17 @@ fn outer(u: Vec3, v: Vec3) -> Mat3 {
 }
 
 impl SpringForce {
-    /// Per-kind strengths expanded over `springs`.
+    /// Per-kind strengths expanded over all of `springs`.
     pub fn new(springs: &Springs, stiffness: [f32; 3], damping: [f32; 3]) -> Self {
+        Self::first(springs, springs.len(), stiffness, damping)
+    }
+
+    /// Per-kind strengths expanded over the first `active` of `springs`.
+    pub fn first(springs: &Springs, active: usize, stiffness: [f32; 3], damping: [f32; 3]) -> Self {
         let mut s = Self {
             stiffness,
             damping,
+            active: active.min(springs.len()),
             k: Vec::new(),
             c: Vec::new(),
         };
@@ -50,31 +59,37 @@ impl SpringForce {
         s
     }
 
-    /// Changes the strengths; re-expands only when they or the spring count changed.
-    pub fn set_strengths(&mut self, springs: &Springs, stiffness: [f32; 3], damping: [f32; 3]) {
-        if (self.stiffness, self.damping, self.k.len()) != (stiffness, damping, springs.len()) {
+    /// Changes the strengths and the active count; re-expands only when they changed.
+    pub fn set_strengths(
+        &mut self,
+        springs: &Springs,
+        active: usize,
+        stiffness: [f32; 3],
+        damping: [f32; 3],
+    ) {
+        let active = active.min(springs.len());
+        if (self.stiffness, self.damping, self.active) != (stiffness, damping, active) {
             self.stiffness = stiffness;
             self.damping = damping;
+            self.active = active;
             self.expand(springs);
         }
     }
 
+    /// How many springs act.
+    pub fn active(&self) -> usize {
+        self.active
+    }
+
     fn expand(&mut self, springs: &Springs) {
-        self.k = springs
-            .kind
-            .iter()
-            .map(|k| self.stiffness[k.index()])
-            .collect();
-        self.c = springs
-            .kind
-            .iter()
-            .map(|k| self.damping[k.index()])
-            .collect();
+        let kinds = &springs.kind[..self.active];
+        self.k = kinds.iter().map(|k| self.stiffness[k.index()]).collect();
+        self.c = kinds.iter().map(|k| self.damping[k.index()]).collect();
     }
 
     /// Adds every spring's force (N) to `f`.
     pub fn add_forces(&self, springs: &Springs, pos: &[Vec3], vel: &[Vec3], f: &mut [Vec3]) {
-        for e in 0..springs.len() {
+        for e in 0..self.active {
             let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
             let d = pos[b] - pos[a];
             let len = d.length();
@@ -90,7 +105,7 @@ impl SpringForce {
 
     /// `Σ ½k(|d| − l₀)²`, joules.
     pub fn potential_energy(&self, springs: &Springs, pos: &[Vec3]) -> f64 {
-        (0..springs.len())
+        (0..self.active)
             .map(|e| {
                 let d = pos[springs.b[e] as usize].distance(pos[springs.a[e] as usize]);
                 let stretch = (d - springs.rest[e]) as f64;
@@ -150,7 +165,7 @@ impl SpringForce {
         mode: JacobianMode,
         out: &mut [Vec3],
     ) {
-        for e in 0..springs.len() {
+        for e in 0..self.active {
             let block = self.blocks(springs, pos, vel, e, mode).dx;
             apply_pair(springs, e, block, u, out);
         }
@@ -165,7 +180,7 @@ impl SpringForce {
         u: &[Vec3],
         out: &mut [Vec3],
     ) {
-        for e in 0..springs.len() {
+        for e in 0..self.active {
             let block = self.blocks(springs, pos, vel, e, JacobianMode::Definite).dv;
             apply_pair(springs, e, block, u, out);
         }
@@ -179,7 +194,7 @@ impl SpringForce {
         vel: &[Vec3],
         sys: &mut SystemMatrix,
     ) {
-        for e in 0..springs.len() {
+        for e in 0..self.active {
             let b = self.blocks(springs, pos, vel, e, JacobianMode::Definite);
             sys.add_spring(springs, e, b.dx, b.dv, vel);
         }
@@ -189,7 +204,7 @@ impl SpringForce {
     /// and compliance `1/k` (m/N). Springs of zero stiffness are no constraint and are left out.
     pub fn constraints(&self, springs: &Springs) -> DistanceConstraints {
         let mut out = DistanceConstraints::default();
-        for e in (0..springs.len()).filter(|&e| self.k[e] > 0.0) {
+        for e in (0..self.active).filter(|&e| self.k[e] > 0.0) {
             out.a.push(springs.a[e]);
             out.b.push(springs.b[e]);
             out.rest.push(springs.rest[e]);

@@ -7,17 +7,21 @@ use glam::Vec3;
 
 use crate::cloth::ClothModel;
 
-use super::super::forces::{Force, ForceSet};
+use super::super::forces::{Force, ForceSet, TermTimes};
 use super::super::params::SolverConfig;
 use super::step::StepReport;
 
 /// Work done inside one step, filled by [`StepContext`] and read by the stepper, which
 /// charges it to the phases.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct StepMeter {
     pub force_evals: u32,
     /// Wall time spent evaluating forces and their derivatives.
     pub forces: Duration,
+    /// Of which: each force term's time and evaluations.
+    pub terms: TermTimes,
+    /// Of which: assembling derivatives.
+    pub derivatives: Duration,
     /// Wall time spent in linear solves / constraint projection.
     pub solve: Duration,
     pub solver_iterations: u32,
@@ -41,8 +45,11 @@ impl<'a> StepContext<'a> {
         config: &'a SolverConfig,
         meter: &'a mut StepMeter,
     ) -> Self {
+        let mut terms = std::mem::take(&mut meter.terms);
+        terms.clear();
         *meter = StepMeter {
             converged: true,
+            terms,
             ..StepMeter::default()
         };
         Self {
@@ -53,17 +60,10 @@ impl<'a> StepContext<'a> {
         }
     }
 
-    fn timed<R>(&mut self, f: impl FnOnce(&ClothModel, &ForceSet) -> R) -> R {
-        let start = Instant::now();
-        let out = f(self.model, self.forces);
-        self.meter.forces += start.elapsed();
-        self.meter.force_evals += 1;
-        out
-    }
-
     /// Accelerations at `(pos, vel)` into `acc` (pinned particles get zero).
     pub fn accelerations(&mut self, pos: &[Vec3], vel: &[Vec3], acc: &mut Vec<Vec3>) {
-        self.timed(|model, forces| forces.accelerations(model, pos, vel, acc));
+        self.forces_where(pos, vel, |_| true, acc);
+        super::super::forces::to_accelerations(&self.model.inv_mass, acc);
     }
 
     /// Forces (N) at `(pos, vel)` of the terms `keep` selects, into `f`.
@@ -74,7 +74,12 @@ impl<'a> StepContext<'a> {
         keep: impl Fn(&Force) -> bool,
         f: &mut Vec<Vec3>,
     ) {
-        self.timed(|model, forces| forces.forces_where(model, pos, vel, keep, f));
+        let start = Instant::now();
+        let meter = &mut *self.meter;
+        self.forces
+            .forces_timed(self.model, pos, vel, keep, f, &mut meter.terms);
+        meter.forces += start.elapsed();
+        meter.force_evals += 1;
     }
 
     /// Runs a linear solve or projection `f`, charging its time to the solve phase and
@@ -94,7 +99,9 @@ impl<'a> StepContext<'a> {
     pub fn derivative_work<R>(&mut self, f: impl FnOnce(&ClothModel, &ForceSet) -> R) -> R {
         let start = Instant::now();
         let out = f(self.model, self.forces);
-        self.meter.forces += start.elapsed();
+        let took = start.elapsed();
+        self.meter.forces += took;
+        self.meter.derivatives += took;
         out
     }
 

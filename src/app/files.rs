@@ -1,0 +1,118 @@
+//! Opening cloths and scene files, saving the current setup as a scene file, exporting the
+//! cloth as OBJ. A bad file never replaces what the app has.
+
+use std::path::{Path, PathBuf};
+
+use crate::scene::{Scene, Simulation};
+
+use super::background::{Load, Loaded};
+use super::cloth_app::{ClothApp, Level, next_free};
+
+impl ClothApp {
+    /// Starts loading `path` in the background: a `.toml` scene file replaces the scene, an
+    /// OBJ replaces the cloth. What the app has stays until the load succeeds.
+    pub fn open_path(&mut self, path: PathBuf) {
+        self.message(Level::Info, format!("loading {} …", path.display()));
+        self.loading = Some(Load::start(path));
+    }
+
+    /// As [`ClothApp::open_path`] (kept for callers that open cloths).
+    pub fn open_obj(&mut self, path: PathBuf) {
+        self.open_path(path);
+    }
+
+    /// Waits for a running load (tests, or when the caller must know the outcome).
+    pub fn finish_loading(&mut self) {
+        if let Some(load) = self.loading.take()
+            && let Some(result) = load.wait()
+        {
+            self.apply_loaded(&load.path, result);
+        }
+    }
+
+    pub(super) fn poll_loading(&mut self) {
+        let Some(load) = &self.loading else { return };
+        let Some(result) = load.poll() else { return };
+        let path = load.path.clone();
+        self.loading = None;
+        self.apply_loaded(&path, result);
+    }
+
+    fn apply_loaded(&mut self, path: &Path, result: Result<Loaded, String>) {
+        match result {
+            Err(e) => {
+                let kept = if path.extension().is_some_and(|e| e == "toml") {
+                    "the current scene is kept"
+                } else {
+                    "the current cloth is kept"
+                };
+                self.message(Level::Error, format!("{e} — {kept}"));
+            }
+            Ok(Loaded::Scene(scene)) => {
+                let text = format!(
+                    "opened scene `{}` from {}: {} particles",
+                    scene.scenario,
+                    path.display(),
+                    scene.model.particle_count()
+                );
+                // A scene file brings its own cloth.
+                self.custom_cloth = None;
+                self.sim = Simulation::new(*scene);
+                self.message(Level::Info, text);
+                self.reset_camera();
+            }
+            Ok(Loaded::Cloth(build)) => self.use_cloth(path, *build),
+        }
+    }
+
+    /// A new cloth keeps the scenario, its effects and the current parameters.
+    fn use_cloth(&mut self, path: &Path, build: crate::mesh::MeshBuild) {
+        let name = path.display().to_string();
+        let scene = match Scene::with_cloth(self.sim.scenario(), &build, &name) {
+            Ok(scene) => scene,
+            Err(e) => return self.message(Level::Error, e.to_string()),
+        };
+        let mut sim = Simulation::new(scene);
+        // The current parameters were validated when they were set.
+        if let Err(e) = sim.set_params(self.sim.params().clone()) {
+            return self.message(Level::Error, e.to_string());
+        }
+        let _ = sim.set_effects(self.sim.effects().to_vec());
+        sim.set_pins_enabled(self.sim.pins_enabled());
+        let mut text = format!(
+            "loaded {name}: {} particles, {} triangles",
+            sim.model().particle_count(),
+            sim.model().triangles.len()
+        );
+        // Import notes (dropped faces and the like) stay visible with the result.
+        let level = if sim.warnings().is_empty() {
+            Level::Info
+        } else {
+            text += &format!(" ({})", sim.warnings().join("; "));
+            Level::Warning
+        };
+        self.message(level, text);
+        self.custom_cloth = Some((build, name));
+        self.sim = sim;
+        self.reset_camera();
+    }
+
+    /// Writes the current setup (cloth, placement, parameters, effects, pins) as a scene
+    /// file; a failure is reported and nothing is left half-written.
+    pub fn save_scene(&mut self, path: &Path) {
+        let text = self.sim.scene_file().to_toml();
+        match crate::output::write_bytes(path, text.as_bytes()) {
+            Ok(()) => self.message(Level::Info, format!("saved scene to {}", path.display())),
+            Err(e) => self.message(Level::Error, e.to_string()),
+        }
+    }
+
+    /// Writes the cloth as it is now as `clothsim-export-NNNN.obj` in the capture folder.
+    pub fn export_obj(&mut self) {
+        let path = next_free(&self.capture_dir, "clothsim-export", ".obj");
+        match crate::output::write_bytes(&path, self.sim.export_obj().as_bytes()) {
+            Ok(()) => self.message(Level::Info, format!("exported {}", path.display())),
+            Err(e) => self.message(Level::Error, e.to_string()),
+        }
+    }
+}

@@ -1,0 +1,571 @@
+//! Scene files: TOML describing the cloth, its pins, the solver, the material and the
+//! effects. The built-in scenarios are such files too (`assets/scenes/`). Unknown keys are
+//! errors; every error names the file, the line and column, and the key.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::mesh::GridOrientation;
+use crate::sim::{
+    BendingModel, Collider, Effect, GuardPolicy, IntegratorKind, SelfCollision, SimParams,
+    SolverConfig, Wind,
+};
+
+use super::error::SceneError;
+
+/// A scene file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    pub name: String,
+    #[serde(default)]
+    pub summary: String,
+    pub cloth: ClothSpec,
+    #[serde(default)]
+    pub pins: PinSpec,
+    #[serde(default)]
+    pub solver: SolverSpec,
+    #[serde(default)]
+    pub material: MaterialSpec,
+    #[serde(default)]
+    pub effects: Vec<EffectSpec>,
+}
+
+/// The cloth: an OBJ file or a generated grid, and where it goes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClothSpec {
+    /// An OBJ file, relative to the scene file (or absolute).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub obj: Option<PathBuf>,
+    /// A rectangular grid of quads.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grid: Option<GridShape>,
+    /// The plane the cloth is turned into (its thinnest axis becomes the plane's normal).
+    #[serde(default = "horizontal")]
+    pub orientation: GridOrientation,
+    /// Where the centre of its bounding box goes, metres.
+    pub center: [f32; 3],
+    /// Welding tolerance for an OBJ, a fraction of its size (default 1e-6).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weld_tolerance: Option<f32>,
+}
+
+fn horizontal() -> GridOrientation {
+    GridOrientation::Horizontal
+}
+
+/// A grid: `quads` per side (or `[across, down]`), `size` metres per side (or `[w, h]`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridShape {
+    pub quads: OneOrTwo<u32>,
+    pub size: OneOrTwo<f32>,
+}
+
+/// One number for both directions, or two.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum OneOrTwo<T> {
+    One(T),
+    Two([T; 2]),
+}
+
+impl<T: Copy> OneOrTwo<T> {
+    pub fn pair(&self) -> [T; 2] {
+        match *self {
+            OneOrTwo::One(x) => [x, x],
+            OneOrTwo::Two(p) => p,
+        }
+    }
+}
+
+/// A corner of the cloth, as seen in its plane (for a horizontal cloth "top" is the back).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Corner {
+    TopLeft,
+    TopRight,
+    BottomLeft,
+    BottomRight,
+}
+
+/// An edge of the cloth, likewise.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Edge {
+    Top,
+    Bottom,
+    Left,
+    Right,
+}
+
+/// Which particles are pinned: the union of every rule given.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PinSpec {
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub corners: Vec<Corner>,
+    /// Every particle along these edges.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub edges: Vec<Edge>,
+    /// Particle indices.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub indices: Vec<u32>,
+    /// Every particle inside this box (placed coordinates, metres).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub region: Option<Region>,
+}
+
+/// An axis-aligned box, metres.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Region {
+    pub min: [f32; 3],
+    pub max: [f32; 3],
+}
+
+/// The solver: integrator, steps, and how it solves.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SolverSpec {
+    pub integrator: IntegratorKind,
+    /// Frame time step, seconds.
+    pub dt: f32,
+    pub substeps: u32,
+    /// Collision thickness against colliders, metres.
+    pub collision_offset: f32,
+    pub tolerance: f32,
+    pub max_iterations: u32,
+    pub newton_iterations: u32,
+    pub newton_tolerance: f32,
+    pub xpbd_iterations: u32,
+    pub guard: GuardPolicy,
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        let p = SimParams::default();
+        Self {
+            integrator: p.integrator,
+            dt: p.dt,
+            substeps: p.substeps,
+            collision_offset: p.collision_offset,
+            tolerance: p.solver.tolerance,
+            max_iterations: p.solver.max_iterations,
+            newton_iterations: p.solver.newton_iterations,
+            newton_tolerance: p.solver.newton_tolerance,
+            xpbd_iterations: p.solver.xpbd_iterations,
+            guard: p.guard,
+        }
+    }
+}
+
+/// A value per spring kind.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PerKind {
+    pub structural: f32,
+    pub shear: f32,
+    pub bend: f32,
+}
+
+impl From<[f32; 3]> for PerKind {
+    fn from(v: [f32; 3]) -> Self {
+        Self {
+            structural: v[0],
+            shear: v[1],
+            bend: v[2],
+        }
+    }
+}
+
+impl From<PerKind> for [f32; 3] {
+    fn from(v: PerKind) -> Self {
+        [v.structural, v.shear, v.bend]
+    }
+}
+
+/// The cloth's material.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Areal density, kg/m².
+    pub density: f32,
+    /// Spring stiffness per kind, N/m (`bend` acts with `bending` by springs).
+    pub stiffness: PerKind,
+    /// Spring damping per kind, N·s/m.
+    pub damping: PerKind,
+}
+
+impl Default for MaterialSpec {
+    fn default() -> Self {
+        let p = SimParams::default();
+        Self {
+            density: p.density,
+            stiffness: p.stiffness.into(),
+            damping: p.damping.into(),
+        }
+    }
+}
+
+/// How a scene bends.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BendingKind {
+    Springs,
+    Dihedral,
+}
+
+/// One effect and its parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum EffectSpec {
+    Gravity {
+        /// m/s².
+        #[serde(default = "standard_gravity")]
+        acceleration: [f32; 3],
+    },
+    AirDamping {
+        /// 1/s.
+        rate: f32,
+    },
+    Bending {
+        model: BendingKind,
+        /// N·m for dihedral bending; for springs the material's `stiffness.bend` applies.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        stiffness: Option<f32>,
+    },
+    Wind(Wind),
+    Sphere {
+        center: [f32; 3],
+        radius: f32,
+        /// rad/s about each axis.
+        #[serde(default)]
+        spin: [f32; 3],
+        #[serde(default = "default_friction")]
+        friction: f32,
+    },
+    Plane {
+        #[serde(default)]
+        point: [f32; 3],
+        #[serde(default = "up")]
+        normal: [f32; 3],
+        #[serde(default = "default_friction")]
+        friction: f32,
+    },
+    SelfCollision(SelfCollision),
+}
+
+fn standard_gravity() -> [f32; 3] {
+    [0.0, -9.81, 0.0]
+}
+
+fn up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+fn default_friction() -> f32 {
+    0.5
+}
+
+/// Default dihedral bending stiffness, N·m.
+pub const DEFAULT_DIHEDRAL_STIFFNESS: f32 = 2e-3;
+
+/// A scene file read from disk: the parsed file and where it was (for relative paths).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadedSceneFile {
+    pub file: SceneFile,
+    pub path: PathBuf,
+}
+
+/// Line and column (1-based) of byte `offset` in `text`.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+    (line, column)
+}
+
+/// The line of `key = …` inside the `index`-th `[[effects]]` table, or anywhere.
+fn locate_key(text: &str, index: Option<usize>, key: &str) -> (usize, usize) {
+    let mut offset = 0;
+    if let Some(i) = index
+        && let Some((at, _)) = text.match_indices("[[effects]]").nth(i)
+    {
+        offset = at;
+    }
+    let found = text[offset..]
+        .match_indices(key)
+        .map(|(at, _)| at + offset)
+        .find(|&at| text[at + key.len()..].trim_start().starts_with('='));
+    line_column(text, found.unwrap_or(offset))
+}
+
+impl SceneFile {
+    /// Parses scene-file text; `path` names it in errors.
+    ///
+    /// # Errors
+    /// [`SceneError::File`] with the line, column and key of the first problem: TOML
+    /// syntax, an unknown key, a wrong type, or a value out of range.
+    pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
+        let file: SceneFile = toml::from_str(text).map_err(|e| {
+            let (line, column) = e.span().map_or((1, 1), |s| line_column(text, s.start));
+            SceneError::File {
+                path: path.to_path_buf(),
+                line,
+                column,
+                message: e.message().trim().replace('\n', " "),
+            }
+        })?;
+        file.check().map_err(|(index, key, message)| {
+            let (line, column) = locate_key(text, index, &key);
+            SceneError::File {
+                path: path.to_path_buf(),
+                line,
+                column,
+                message: format!("`{key}`: {message}"),
+            }
+        })?;
+        Ok(file)
+    }
+
+    /// Reads and parses a scene file.
+    ///
+    /// # Errors
+    /// [`SceneError::Read`] or [`SceneError::File`].
+    pub fn load(path: &Path) -> Result<LoadedSceneFile, SceneError> {
+        let meta = std::fs::metadata(path).map_err(|e| SceneError::Read {
+            path: path.to_path_buf(),
+            detail: e.to_string(),
+        })?;
+        // Scene files are small; refuse anything else before reading it.
+        if !meta.is_file() || meta.len() > 1 << 20 {
+            return Err(SceneError::Read {
+                path: path.to_path_buf(),
+                detail: "not a regular file of at most 1 MiB".into(),
+            });
+        }
+        let text = std::fs::read_to_string(path).map_err(|e| SceneError::Read {
+            path: path.to_path_buf(),
+            detail: e.to_string(),
+        })?;
+        Ok(LoadedSceneFile {
+            file: Self::parse(&text, path)?,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// The file as TOML text.
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).unwrap_or_else(|e| format!("# cannot write scene: {e}\n"))
+    }
+
+    /// Values the types cannot rule out: `(effect index, key, why)` of the first bad one.
+    fn check(&self) -> Result<(), (Option<usize>, String, String)> {
+        let bad = |index, key: &str, why: &str| Err((index, key.to_string(), why.to_string()));
+        match (&self.cloth.obj, &self.cloth.grid) {
+            (Some(_), Some(_)) | (None, None) => {
+                return bad(None, "cloth", "give exactly one of `obj` or `grid`");
+            }
+            (None, Some(g)) => {
+                let [qx, qy] = g.quads.pair();
+                let [sx, sy] = g.size.pair();
+                if qx == 0 || qy == 0 || qx > 2048 || qy > 2048 {
+                    return bad(None, "quads", "must be in 1..=2048");
+                }
+                if !(sx.is_finite() && sy.is_finite() && sx > 0.0 && sy > 0.0) {
+                    return bad(None, "size", "must be positive metres");
+                }
+            }
+            (Some(_), None) => {}
+        }
+        if !self.cloth.center.iter().all(|c| c.is_finite()) {
+            return bad(None, "center", "must be finite metres");
+        }
+        for (i, e) in self.effects.iter().enumerate() {
+            let at = Some(i);
+            match e {
+                EffectSpec::Sphere { radius, .. } if !(radius.is_finite() && *radius > 0.0) => {
+                    return bad(at, "radius", "must be positive metres");
+                }
+                EffectSpec::Plane { normal, .. } if Vec3::from(*normal).length() < 1e-6 => {
+                    return bad(at, "normal", "must not be zero");
+                }
+                EffectSpec::Bending {
+                    model: BendingKind::Dihedral,
+                    stiffness: Some(k),
+                } if !(k.is_finite() && *k >= 0.0) => {
+                    return bad(at, "stiffness", "must be ≥ 0 N·m");
+                }
+                EffectSpec::SelfCollision(s) if !(s.thickness.is_finite() && s.thickness > 0.0) => {
+                    return bad(at, "thickness", "must be positive metres");
+                }
+                EffectSpec::Wind(w) if !(w.velocity.is_finite() && w.gust_period > 0.0) => {
+                    return bad(
+                        at,
+                        "velocity",
+                        "wind needs a finite velocity and a positive gust_period",
+                    );
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// The simulation parameters the file gives.
+    pub fn params(&self) -> SimParams {
+        let s = &self.solver;
+        let defaults = SimParams::default();
+        let mut p = SimParams {
+            dt: s.dt,
+            substeps: s.substeps,
+            integrator: s.integrator,
+            stiffness: self.material.stiffness.into(),
+            damping: self.material.damping.into(),
+            density: self.material.density,
+            collision_offset: s.collision_offset,
+            guard: s.guard.clone(),
+            solver: SolverConfig {
+                tolerance: s.tolerance,
+                max_iterations: s.max_iterations,
+                newton_iterations: s.newton_iterations,
+                newton_tolerance: s.newton_tolerance,
+                xpbd_iterations: s.xpbd_iterations,
+            },
+            // Without the effect the strength is unused; keep the defaults for the sliders.
+            gravity: defaults.gravity,
+            air_damping: defaults.air_damping,
+        };
+        for e in &self.effects {
+            match e {
+                EffectSpec::Gravity { acceleration } => p.gravity = Vec3::from(*acceleration),
+                EffectSpec::AirDamping { rate } => p.air_damping = *rate,
+                _ => {}
+            }
+        }
+        p
+    }
+
+    /// The effects the file lists, with the cloth's springs first.
+    pub fn effects(&self) -> Vec<Effect> {
+        let mut out = vec![Effect::Springs];
+        for e in &self.effects {
+            out.push(match e {
+                EffectSpec::Gravity { .. } => Effect::Gravity,
+                EffectSpec::AirDamping { .. } => Effect::AirDamping,
+                EffectSpec::Bending { model, stiffness } => Effect::Bending(match model {
+                    BendingKind::Springs => BendingModel::Springs,
+                    BendingKind::Dihedral => BendingModel::Dihedral {
+                        stiffness: stiffness.unwrap_or(DEFAULT_DIHEDRAL_STIFFNESS),
+                    },
+                }),
+                EffectSpec::Wind(w) => Effect::Wind(*w),
+                EffectSpec::Sphere {
+                    center,
+                    radius,
+                    spin,
+                    friction,
+                } => Effect::Collider(Collider::Sphere {
+                    center: Vec3::from(*center),
+                    radius: *radius,
+                    spin: Vec3::from(*spin),
+                    friction: *friction,
+                }),
+                EffectSpec::Plane {
+                    point,
+                    normal,
+                    friction,
+                } => Effect::Collider(Collider::Plane {
+                    point: Vec3::from(*point),
+                    normal: Vec3::from(*normal).normalize(),
+                    friction: *friction,
+                }),
+                EffectSpec::SelfCollision(s) => Effect::SelfCollision(*s),
+            });
+        }
+        out
+    }
+
+    /// This file with its solver, material, effects and pins replaced by those of a running
+    /// simulation (what "save the current setup" writes).
+    pub fn with_setup(
+        &self,
+        params: &SimParams,
+        effects: &[Effect],
+        pins: Option<&[u32]>,
+    ) -> SceneFile {
+        let mut file = self.clone();
+        file.solver = SolverSpec {
+            integrator: params.integrator,
+            dt: params.dt,
+            substeps: params.substeps,
+            collision_offset: params.collision_offset,
+            tolerance: params.solver.tolerance,
+            max_iterations: params.solver.max_iterations,
+            newton_iterations: params.solver.newton_iterations,
+            newton_tolerance: params.solver.newton_tolerance,
+            xpbd_iterations: params.solver.xpbd_iterations,
+            guard: params.guard.clone(),
+        };
+        file.material = MaterialSpec {
+            density: params.density,
+            stiffness: params.stiffness.into(),
+            damping: params.damping.into(),
+        };
+        file.effects = effects
+            .iter()
+            .filter_map(|e| {
+                Some(match e {
+                    Effect::Springs => return None,
+                    Effect::Gravity => EffectSpec::Gravity {
+                        acceleration: params.gravity.to_array(),
+                    },
+                    Effect::AirDamping => EffectSpec::AirDamping {
+                        rate: params.air_damping,
+                    },
+                    Effect::Bending(BendingModel::Springs) => EffectSpec::Bending {
+                        model: BendingKind::Springs,
+                        stiffness: None,
+                    },
+                    Effect::Bending(BendingModel::Dihedral { stiffness }) => EffectSpec::Bending {
+                        model: BendingKind::Dihedral,
+                        stiffness: Some(*stiffness),
+                    },
+                    Effect::Wind(w) => EffectSpec::Wind(*w),
+                    Effect::SelfCollision(s) => EffectSpec::SelfCollision(*s),
+                    Effect::Collider(Collider::Sphere {
+                        center,
+                        radius,
+                        spin,
+                        friction,
+                    }) => EffectSpec::Sphere {
+                        center: center.to_array(),
+                        radius: *radius,
+                        spin: spin.to_array(),
+                        friction: *friction,
+                    },
+                    Effect::Collider(Collider::Plane {
+                        point,
+                        normal,
+                        friction,
+                    }) => EffectSpec::Plane {
+                        point: point.to_array(),
+                        normal: normal.to_array(),
+                        friction: *friction,
+                    },
+                })
+            })
+            .collect();
+        if let Some(pins) = pins {
+            file.pins = PinSpec {
+                indices: pins.to_vec(),
+                ..PinSpec::default()
+            };
+        }
+        file
+    }
+}

@@ -1,0 +1,248 @@
+//! Self-collision: particle against triangle, so cloth folds onto itself without passing
+//! through itself. Candidates come from a spatial hash (triangles binned by their box grown
+//! by the thickness, sorted by cell), so the work grows with the particle count, not its
+//! square.
+
+use glam::Vec3;
+
+use crate::cloth::{ClothModel, ClothState};
+
+/// The cloth's thickness against itself and its friction.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SelfCollision {
+    /// Particles are kept this far from every triangle they are not a corner of, metres
+    /// (keep it below the particle spacing).
+    pub thickness: f32,
+    /// Coulomb friction between layers (dimensionless).
+    pub friction: f32,
+}
+
+impl Default for SelfCollision {
+    fn default() -> Self {
+        Self {
+            thickness: 0.01,
+            friction: 0.3,
+        }
+    }
+}
+
+/// Work done by the last resolve: for cost checks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SelfWork {
+    /// Particle–triangle pairs examined.
+    pub candidates: u64,
+    /// Pairs that were closer than the thickness.
+    pub contacts: u64,
+}
+
+/// Reusable buffers of the spatial hash.
+#[derive(Clone, Debug, Default)]
+pub struct SelfContacts {
+    /// (cell key, triangle), sorted by key.
+    bins: Vec<(u64, u32)>,
+    pub work: SelfWork,
+}
+
+fn cell_key(c: [i32; 3]) -> u64 {
+    // Three coordinates wrapped into 21 bits each: distinct cells rarely share a key, and a
+    // shared key only adds candidates.
+    let w = |x: i32| (x as u64) & 0x1F_FFFF;
+    w(c[0]) | (w(c[1]) << 21) | (w(c[2]) << 42)
+}
+
+fn cell_of(p: Vec3, size: f32) -> [i32; 3] {
+    (p / size).floor().as_ivec3().to_array()
+}
+
+/// The point of triangle (a, b, c) closest to `p`, with its barycentric weights.
+fn closest_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, [f32; 3]) {
+    // Ericson, Real-Time Collision Detection, 5.1.5: regions by barycentric signs.
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (a, [1.0, 0.0, 0.0]);
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return (b, [0.0, 1.0, 0.0]);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (a + v * ab, [1.0 - v, v, 0.0]);
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return (c, [0.0, 0.0, 1.0]);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (a + w * ac, [1.0 - w, 0.0, w]);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + w * (c - b), [0.0, 1.0 - w, w]);
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    (a + ab * v + ac * w, [1.0 - v - w, v, w])
+}
+
+impl SelfContacts {
+    /// Keeps every particle at least `params.thickness` from every triangle it is not a
+    /// corner of, on the side it was on at the start of the substep (`start`): a particle
+    /// over a triangle is pushed out along the triangle's normal, one beside it away from
+    /// its closest point; particle and triangle share the correction by inverse mass.
+    /// Approaching relative velocity is removed and friction applied. Returns the contacts.
+    pub fn resolve(
+        &mut self,
+        params: &SelfCollision,
+        model: &ClothModel,
+        start: &[Vec3],
+        state: &mut ClothState,
+    ) -> usize {
+        let thickness = params.thickness;
+        if thickness <= 0.0 || model.triangles.is_empty() {
+            return 0;
+        }
+        let cell = self.bin(model, &state.pos, thickness);
+        let mut work = SelfWork::default();
+        for p in 0..state.pos.len() {
+            if model.inv_mass[p] == 0.0 {
+                continue;
+            }
+            let key = cell_key(cell_of(state.pos[p], cell));
+            let first = self.bins.partition_point(|&(k, _)| k < key);
+            for slot in first..self.bins.len() {
+                let (k, t) = self.bins[slot];
+                if k != key {
+                    break;
+                }
+                let tri = model.triangles[t as usize];
+                if tri.contains(&(p as u32)) {
+                    continue;
+                }
+                work.candidates += 1;
+                if push_apart(params, model, start, state, p, tri) {
+                    work.contacts += 1;
+                }
+            }
+        }
+        self.work = work;
+        work.contacts as usize
+    }
+
+    /// Bins every triangle into the cells its box, grown by the thickness, touches; returns
+    /// the cell size (twice the longest rest edge or the thickness, whichever is larger).
+    fn bin(&mut self, model: &ClothModel, pos: &[Vec3], thickness: f32) -> f32 {
+        let longest = model.springs.rest[..model.mesh_edges.min(model.springs.len())]
+            .iter()
+            .fold(0.0f32, |m, &r| m.max(r));
+        let cell = (2.0 * longest).max(2.0 * thickness).max(1e-6);
+        self.bins.clear();
+        for (t, tri) in model.triangles.iter().enumerate() {
+            let [a, b, c] = tri.map(|i| pos[i as usize]);
+            let lo = cell_of(a.min(b).min(c) - Vec3::splat(thickness), cell);
+            let hi = cell_of(a.max(b).max(c) + Vec3::splat(thickness), cell);
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for z in lo[2]..=hi[2] {
+                        self.bins.push((cell_key([x, y, z]), t as u32));
+                    }
+                }
+            }
+        }
+        self.bins.sort_unstable();
+        cell
+    }
+}
+
+/// Resolves particle `p` against triangle `tri` if closer than the thickness; returns
+/// whether it was.
+fn push_apart(
+    params: &SelfCollision,
+    model: &ClothModel,
+    start: &[Vec3],
+    state: &mut ClothState,
+    p: usize,
+    tri: [u32; 3],
+) -> bool {
+    let [ia, ib, ic] = tri.map(|i| i as usize);
+    let (a, b, c) = (state.pos[ia], state.pos[ib], state.pos[ic]);
+    let x = state.pos[p];
+    let (closest, bary) = closest_on_triangle(x, a, b, c);
+    let gap = x - closest;
+    let dist = gap.length();
+    if dist >= params.thickness {
+        return false;
+    }
+    let normal = (b - a).cross(c - a).normalize_or_zero();
+    if normal == Vec3::ZERO {
+        return false;
+    }
+    let over = bary.iter().all(|&w| w > 0.0);
+    let direction = if over {
+        // Over the triangle: out along its normal, to the side the particle started on.
+        let before = (b - a).cross(c - a);
+        let was = (start[p] - start[ia]).dot((start[ib] - start[ia]).cross(start[ic] - start[ia]));
+        let side = if was != 0.0 {
+            was.signum()
+        } else {
+            gap.dot(before).signum()
+        };
+        normal * if side == 0.0 { 1.0 } else { side }
+    } else if dist > 1e-9 {
+        gap / dist
+    } else {
+        normal
+    };
+    let depth = params.thickness - gap.dot(direction);
+    if depth <= 0.0 {
+        return false;
+    }
+    let w = &model.inv_mass;
+    let corners = [ia, ib, ic];
+    let weight = w[p]
+        + corners
+            .iter()
+            .zip(bary)
+            .map(|(&i, b)| b * b * w[i])
+            .sum::<f32>();
+    if weight <= 0.0 {
+        return false;
+    }
+    let lambda = depth / weight;
+    state.pos[p] += (w[p] * lambda) * direction;
+    for (&i, b) in corners.iter().zip(bary) {
+        state.pos[i] -= (b * w[i] * lambda) * direction;
+    }
+    // Velocities: no approach along the direction; friction on the sliding part.
+    let surface: Vec3 = corners
+        .iter()
+        .zip(bary)
+        .map(|(&i, b)| b * state.vel[i])
+        .sum();
+    let relative = state.vel[p] - surface;
+    let approach = relative.dot(direction);
+    if approach < 0.0 {
+        let sliding = relative - approach * direction;
+        let speed = sliding.length();
+        let friction = if speed > 0.0 {
+            (params.friction * -approach / speed).min(1.0)
+        } else {
+            0.0
+        };
+        let change = -approach * direction - friction * sliding;
+        let impulse = change / weight;
+        state.vel[p] += w[p] * impulse;
+        for (&i, b) in corners.iter().zip(bary) {
+            state.vel[i] -= b * w[i] * impulse;
+        }
+    }
+    true
+}
