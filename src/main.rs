@@ -77,10 +77,10 @@ enum Command {
     /// What accuracy costs in time: every integrator × step size against a reference;
     /// writes accuracy.csv, accuracy.md and accuracy.png.
     Accuracy {
-        /// Scenario name (see `clothsim scenes`).
+        /// A built-in scene (see `clothsim scenes`) or a scene file (.toml).
         #[arg(long, default_value = "hanging")]
         scene: String,
-        /// Use this OBJ cloth instead of the scenario's default.
+        /// Use this OBJ cloth instead of the scene's own.
         #[arg(long)]
         obj: Option<PathBuf>,
         /// Comma-separated integrators (default: all seven).

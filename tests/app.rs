@@ -11,8 +11,13 @@ use clothsim::app::ClothApp;
 use clothsim::mesh::{GridOrientation, GridSpec};
 
 fn harness() -> Harness<'static, ClothApp> {
+    harness_sized(1280.0, 800.0)
+}
+
+/// A window of this size (a tall one shows the whole side panel without scrolling).
+fn harness_sized(width: f32, height: f32) -> Harness<'static, ClothApp> {
     let mut harness = Harness::builder()
-        .with_size([1280.0, 800.0])
+        .with_size([width, height])
         .wgpu()
         .build_eframe(|cc| {
             let mut app = ClothApp::new(cc.wgpu_render_state.clone(), None);
@@ -355,4 +360,278 @@ fn the_guard_acting_is_shown_to_the_user() {
     );
     assert!(app.sim.substeps() > 12);
     harness.get_by_label_contains("stability guard");
+}
+
+/// Drops a file that already exists and waits for it to load.
+fn drop_path(harness: &mut Harness<'static, ClothApp>, path: &Path) {
+    harness
+        .input_mut()
+        .dropped_files
+        .push(Arc::new(Dropped(path.to_path_buf())));
+    harness.run_steps(1);
+    harness.state_mut().finish_loading();
+    harness.run_steps(2);
+}
+
+#[test]
+fn dropping_a_scene_file_opens_that_scene_and_a_bad_one_keeps_the_current() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = dir.path().join("breeze.toml");
+    std::fs::write(
+        &good,
+        "name = \"breeze\"\n[cloth]\ngrid = { quads = 8, size = 0.5 }\norientation = \"vertical\"\n\
+         [pins]\nedges = [\"top\"]\n[[effects]]\ntype = \"gravity\"\n[[effects]]\ntype = \"wind\"\n",
+    )
+    .unwrap();
+    let mut harness = harness();
+    drop_path(&mut harness, &good);
+    let sim = &harness.state().sim;
+    assert_eq!(sim.scenario(), "breeze");
+    assert_eq!(sim.model().particle_count(), 81);
+    assert_eq!(sim.model().pins.len(), 9);
+    // The panel shows exactly this scene's effects.
+    harness.get_by_label("Wind");
+    assert!(harness.query_by_label("Air damping").is_none());
+
+    let bad = dir.path().join("broken.toml");
+    std::fs::write(
+        &bad,
+        "name = \"b\"\n[cloth]\ngrid = { quads = 8, size = 0.5 }\nwobble = 1\n",
+    )
+    .unwrap();
+    drop_path(&mut harness, &bad);
+    assert_eq!(
+        harness.state().sim.scenario(),
+        "breeze",
+        "the current scene stays"
+    );
+    let error = harness.state().last_error().unwrap().to_string();
+    assert!(
+        error.contains("broken.toml:4:1") && error.contains("`wobble`"),
+        "{error}"
+    );
+    harness.get_by_label_contains("broken.toml:4:1");
+}
+
+#[test]
+fn the_effects_panel_shows_the_scenes_effects_and_adds_and_removes_them() {
+    let mut harness = harness_sized(1280.0, 1600.0);
+    // Hanging: gravity, air damping, bending; no wind, no colliders, no self-collision.
+    for present in ["Gravity", "Air damping", "Bending"] {
+        harness.get_by_label(present);
+    }
+    for absent in ["Wind", "Sphere", "Ground plane", "Self-collision"] {
+        assert!(harness.query_by_label(absent).is_none(), "{absent} shown");
+    }
+    // Add wind through the menu.
+    harness.get_by_label("Add effect").click();
+    harness.run_steps(2);
+    harness.get_by_label("Wind").click();
+    harness.run_steps(2);
+    assert!(
+        harness
+            .state()
+            .sim
+            .effects()
+            .iter()
+            .any(|e| matches!(e, clothsim::sim::Effect::Wind(_)))
+    );
+    harness.get_by_label("Wind");
+    // Its phase shows in the status bar once it has run.
+    harness.get_by_label("Step").click();
+    harness.run_steps(2);
+    harness.get_by_label_contains(" wind ");
+    // Remove gravity: the first "Remove" belongs to the first removable effect, gravity.
+    let before = harness.state().sim.effects().len();
+    let removes = harness.query_all_by_label("Remove").count();
+    assert_eq!(
+        removes,
+        before - 1,
+        "every effect but the springs can be removed"
+    );
+    harness.query_all_by_label("Remove").next().unwrap().click();
+    harness.run_steps(2);
+    let effects = harness.state().sim.effects().to_vec();
+    assert_eq!(effects.len(), before - 1);
+    assert!(!effects.contains(&clothsim::sim::Effect::Gravity));
+    assert!(harness.query_by_label("Gravity").is_none());
+}
+
+#[test]
+fn save_scene_writes_a_file_that_reopens_as_the_same_setup() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("saved.toml");
+    let mut harness = harness();
+    harness.get_by_label("flag").click();
+    harness.run_steps(2);
+    harness.state_mut().save_path = path.to_string_lossy().into_owned();
+    harness.get_by_label("Save scene").click();
+    harness.run_steps(2);
+    assert!(path.is_file(), "{:?}", harness.state().messages);
+    let effects = harness.state().sim.effects().to_vec();
+    harness.get_by_label("hanging").click();
+    harness.run_steps(2);
+    drop_path(&mut harness, &path);
+    assert_eq!(harness.state().sim.scenario(), "flag");
+    assert_eq!(harness.state().sim.effects(), &effects[..]);
+    // An unwritable path is an error and writes nothing.
+    harness.state_mut().save_path = "/no/such/dir/s.toml".into();
+    harness.get_by_label("Save scene").click();
+    harness.run_steps(2);
+    assert!(
+        harness
+            .state()
+            .last_error()
+            .unwrap()
+            .contains("/no/such/dir")
+    );
+}
+
+#[test]
+fn export_obj_writes_the_cloth_as_it_is_now() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut harness = harness();
+    harness.state_mut().capture_dir = dir.path().to_path_buf();
+    for _ in 0..3 {
+        harness.get_by_label("Step").click();
+        harness.run_steps(1);
+    }
+    harness.get_by_label("Export OBJ").click();
+    harness.run_steps(2);
+    let path = dir.path().join("clothsim-export-0001.obj");
+    let back = clothsim::mesh::load_obj(&path).expect("a valid OBJ");
+    assert_eq!(back.mesh.positions, harness.state().sim.state().pos);
+}
+
+#[test]
+fn record_gif_writes_an_animated_gif_of_the_view() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut harness = harness();
+    harness.state_mut().capture_dir = dir.path().to_path_buf();
+    harness.state_mut().transport.playing = true;
+    harness.get_by_label("Record GIF").click();
+    harness.run_steps(5);
+    assert!(
+        harness.state().is_recording_gif(),
+        "{:?}",
+        harness.state().messages
+    );
+    harness.get_by_label("Stop GIF").click();
+    harness.run_steps(1);
+    harness.state_mut().finish_writes();
+    harness.run_steps(1);
+    let path = dir.path().join("clothsim-recording-0001.gif");
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::RGBA);
+    let mut decoder = options
+        .read_info(std::fs::File::open(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())))
+        .unwrap();
+    assert!(decoder.width() > 400, "the view's size");
+    let mut frames = 0;
+    while decoder.read_next_frame().unwrap().is_some() {
+        frames += 1;
+    }
+    assert!(frames >= 3, "{frames} frames");
+    harness.get_by_label_contains("saved");
+}
+
+/// A point in the view over the cloth, and the particle it picks.
+fn point_on_cloth(harness: &Harness<'static, ClothApp>) -> (egui::Pos2, u32) {
+    let app = harness.state();
+    let rect = app.view_rect().expect("the view was drawn");
+    let centre = rect.center();
+    // Search outwards from the centre of the view.
+    for r in 0..40 {
+        for k in 0..16 {
+            let angle = k as f32 * std::f32::consts::TAU / 16.0;
+            let at = centre + egui::vec2(angle.cos(), angle.sin()) * (r as f32 * 8.0);
+            if let Some((p, _)) = app.particle_at(rect, at)
+                && !app.sim.model().pins.contains(&p)
+            {
+                return (at, p);
+            }
+        }
+    }
+    panic!("no cloth in the view");
+}
+
+#[test]
+fn dragging_the_cloth_pulls_a_particle_and_ctrl_click_pins_it_under_every_integrator() {
+    use clothsim::sim::IntegratorKind;
+    let mut harness = harness();
+    for kind in IntegratorKind::ALL {
+        let mut params = harness.state().sim.params().clone();
+        params.integrator = kind;
+        params.substeps = match kind {
+            IntegratorKind::ExplicitEuler => 2400,
+            IntegratorKind::Rk2 => 150,
+            IntegratorKind::ImplicitEuler => 4,
+            IntegratorKind::Xpbd => 10,
+            _ => 48,
+        };
+        harness.state_mut().reset();
+        harness.state_mut().apply_params(params);
+        harness.state_mut().transport.playing = true;
+        harness.run_steps(2);
+        let (at, _) = point_on_cloth(&harness);
+        // Press on the cloth and drag 60 points to the right over a few frames.
+        harness.hover_at(at);
+        harness.run_steps(1);
+        let start = harness.state().sim.state().pos.clone();
+        harness.drag_at(at);
+        harness.run_steps(1);
+        for k in 1..=6 {
+            harness.hover_at(at + egui::vec2(10.0 * k as f32, 0.0));
+            harness.run_steps(1);
+        }
+        // The particle picked where the drag began (the cloth moves meanwhile).
+        let p = harness
+            .state()
+            .sim
+            .grabbed()
+            .unwrap_or_else(|| panic!("{kind:?}: nothing held"));
+        let moved = harness.state().sim.state().pos[p as usize] - start[p as usize];
+        // The camera looks at the cloth from the front-right: screen-right has +x in it.
+        assert!(
+            moved.length() > 0.05 && moved.x > 0.0,
+            "{kind:?}: moved {moved}"
+        );
+        harness.drop_at(at + egui::vec2(60.0, 0.0));
+        harness.run_steps(2);
+        assert_eq!(harness.state().sim.grabbed(), None, "{kind:?}: let go");
+        assert_eq!(harness.state().sim.integrator_in_effect(), kind);
+
+        // Ctrl-click pins the particle under the pointer; again frees it.
+        harness.state_mut().transport.pause();
+        harness.run_steps(1);
+        let (at, p) = point_on_cloth(&harness);
+        let ctrl_click = |harness: &mut Harness<'static, ClothApp>| {
+            harness.hover_at(at);
+            harness.run_steps(1);
+            harness.event(egui::Event::ModifiersChanged(egui::Modifiers::COMMAND));
+            harness.drag_at(at);
+            harness.run_steps(1);
+            harness.event(egui::Event::PointerButton {
+                pos: at,
+                button: egui::PointerButton::Primary,
+                pressed: false,
+                modifiers: egui::Modifiers::COMMAND,
+            });
+            harness.run_steps(1);
+            harness.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+            harness.run_steps(1);
+        };
+        ctrl_click(&mut harness);
+        assert!(
+            harness.state().sim.model().pins.contains(&p),
+            "{kind:?}: pinned"
+        );
+        harness.get_by_label(&format!("pinned particle {p}"));
+        ctrl_click(&mut harness);
+        assert!(
+            !harness.state().sim.model().pins.contains(&p),
+            "{kind:?}: freed {:?}",
+            harness.state().messages
+        );
+    }
 }

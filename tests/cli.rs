@@ -366,3 +366,173 @@ fn simulate_json_records_what_the_guard_did() {
     let calm = json(&clothsim(&["simulate", "--seconds", "0.2", "--json"]));
     assert_eq!(calm["guard_events"].as_array().unwrap().len(), 0);
 }
+
+#[test]
+fn simulate_json_lists_only_the_phases_that_ran() {
+    let phases = |scene: &str| {
+        let v = json(&clothsim(&[
+            "simulate",
+            "--scene",
+            scene,
+            "--seconds",
+            "0.05",
+            "--json",
+        ]));
+        let phases = v["phases"]
+            .as_object()
+            .expect("phases is an object")
+            .clone();
+        for (name, p) in &phases {
+            assert!(p["calls"].as_u64().unwrap() > 0, "{name}: {p}");
+            assert!(p["seconds"].as_f64().unwrap() >= 0.0, "{name}: {p}");
+        }
+        phases.keys().cloned().collect::<Vec<String>>()
+    };
+    let hanging = phases("hanging");
+    for absent in ["sphere", "plane", "self-collision", "wind"] {
+        assert!(
+            !hanging.contains(&absent.to_string()),
+            "{absent}: {hanging:?}"
+        );
+    }
+    assert!(hanging.contains(&"bending".to_string()), "{hanging:?}");
+    let drop = phases("sphere-drop");
+    assert!(drop.contains(&"sphere".to_string()) && drop.contains(&"plane".to_string()));
+    assert!(phases("flag").contains(&"wind".to_string()));
+    assert!(phases("self-fold").contains(&"self-collision".to_string()));
+}
+
+#[test]
+fn scene_files_run_from_the_cli_and_bad_ones_name_file_line_and_key() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy("assets/cloth.obj", dir.path().join("c.obj")).unwrap();
+    let path = dir.path().join("mine.toml");
+    std::fs::write(
+        &path,
+        "name = \"mine\"\n[cloth]\nobj = \"c.obj\"\ncenter = [0.0, 1.0, 0.0]\n\
+         [pins]\ncorners = [\"top-left\"]\n\
+         [[effects]]\ntype = \"gravity\"\n[[effects]]\ntype = \"wind\"\n",
+    )
+    .unwrap();
+    let file = path.to_str().unwrap();
+    // `scenes FILE` checks it and says what it holds, run from another directory.
+    let out = clothsim(&["scenes", file]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("mine") && text.contains("wind"), "{text}");
+    let v = json(&clothsim(&[
+        "simulate",
+        "--scene",
+        file,
+        "--seconds",
+        "0.05",
+        "--json",
+    ]));
+    assert_eq!(v["scene"], "mine");
+    assert_eq!(v["particles"], 625);
+    assert!(v["phases"].get("wind").is_some(), "{v}");
+
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "name = \"b\"\n[cloth]\nobj = \"c.obj\"\nspin = 3\n").unwrap();
+    for args in [
+        vec!["scenes", bad.to_str().unwrap()],
+        vec!["simulate", "--scene", bad.to_str().unwrap()],
+    ] {
+        let out = clothsim(&args);
+        assert!(!out.status.success());
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+        assert!(
+            stderr.contains("bad.toml:4:1:") && stderr.contains("`spin`"),
+            "{stderr}"
+        );
+    }
+}
+
+#[test]
+fn simulate_exports_the_final_cloth_as_obj() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("final.obj");
+    let v = json(&clothsim(&[
+        "simulate",
+        "--scene",
+        "sphere-drop",
+        "--seconds",
+        "1.5",
+        "--json",
+        "--export-obj",
+        path.to_str().unwrap(),
+    ]));
+    let info = json(&clothsim(&["info", path.to_str().unwrap(), "--json"]));
+    assert_eq!(info["particles"], v["particles"]);
+    assert_eq!(info["triangles"], 1152);
+    // Not the rest shape: the cloth fell.
+    let text = std::fs::read_to_string(&path).unwrap();
+    let heights: Vec<f32> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| l.split_whitespace().nth(1).unwrap().parse().unwrap())
+        .collect();
+    let spread = heights.iter().fold(f32::MIN, |a, &b| a.max(b))
+        - heights.iter().fold(f32::MAX, |a, &b| a.min(b));
+    assert!(
+        spread > 0.01,
+        "the exported cloth is draped, not flat: {spread}"
+    );
+    // An unwritable path fails before the run, in one line.
+    let out = clothsim(&[
+        "simulate",
+        "--seconds",
+        "0.1",
+        "--export-obj",
+        "/no/such/dir/x.obj",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such/dir"));
+}
+
+#[test]
+fn render_gif_writes_an_animation() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("run.gif");
+    let out = clothsim(&[
+        "render",
+        "--scene",
+        "flag",
+        "--seconds",
+        "0.25",
+        "--size",
+        "96x64",
+        "--every",
+        "5",
+        "--gif",
+        path.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::RGBA);
+    let mut decoder = options
+        .read_info(std::fs::File::open(&path).unwrap())
+        .unwrap();
+    assert_eq!((decoder.width(), decoder.height()), (96, 64));
+    let mut frames = Vec::new();
+    while let Some(frame) = decoder.read_next_frame().unwrap() {
+        // Five simulation frames at 60 per second each: 1/12 s, 8 hundredths rounded.
+        assert_eq!(frame.delay, 8);
+        frames.push(frame.buffer.to_vec());
+    }
+    // 15 frames, every 5th counting frame 0: 0, 5, 10, 15.
+    assert_eq!(frames.len(), 4);
+    assert_ne!(frames[0], frames[3], "the flag moved");
+    let out = clothsim(&["render", "--seconds", "0", "--gif", "/no/such/dir/x.gif"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such/dir"));
+}

@@ -46,6 +46,8 @@ pub struct ClothApp {
     pub(super) custom_cloth: Option<(MeshBuild, String)>,
     /// Width / height of the 3D view when last drawn, for framing the camera.
     pub(super) view_aspect: f32,
+    /// Where the 3D view was last drawn, in points.
+    pub(super) view_rect: Option<egui::Rect>,
     pub transport: Transport,
     pub camera: OrbitCamera,
     pub options: RenderOptions,
@@ -86,6 +88,7 @@ impl ClothApp {
             sim,
             custom_cloth: None,
             view_aspect: DEFAULT_ASPECT,
+            view_rect: None,
             transport: Transport::default(),
             camera,
             options: RenderOptions::default(),
@@ -148,6 +151,17 @@ impl ClothApp {
 
     pub fn cloth_name(&self) -> &str {
         self.sim.cloth_name()
+    }
+
+    /// Where the 3D view was last drawn, in points (`None` before the first frame or
+    /// without a renderer).
+    pub fn view_rect(&self) -> Option<egui::Rect> {
+        self.view_rect
+    }
+
+    /// Whether the user opened a cloth that replaces each scene's own.
+    pub fn has_custom_cloth(&self) -> bool {
+        self.custom_cloth.is_some()
     }
 
     pub fn is_loading(&self) -> bool {
@@ -292,6 +306,7 @@ impl ClothApp {
             egui::Image::from_texture(egui::load::SizedTexture::new(texture, size))
                 .sense(egui::Sense::click_and_drag()),
         );
+        self.view_rect = Some(response.rect);
         self.pointer_input(ui, &response);
         self.capture_drawn(&rs);
     }

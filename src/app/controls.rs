@@ -5,7 +5,7 @@ use egui::{RichText, Slider};
 use crate::mesh::SpringKind;
 use crate::render::SpringColoring;
 use crate::scene::scenarios;
-use crate::sim::{Collider, Effect, IntegratorKind};
+use crate::sim::IntegratorKind;
 
 use super::cloth_app::{ClothApp, Level};
 
@@ -56,8 +56,24 @@ pub fn transport_bar(ui: &mut egui::Ui, app: &mut ClothApp) {
         } else {
             "Record"
         };
-        if ui.button(record).clicked() {
+        if ui
+            .button(record)
+            .on_hover_text("every drawn frame as a numbered PNG")
+            .clicked()
+        {
             app.toggle_recording();
+        }
+        let gif = if app.is_recording_gif() {
+            "Stop GIF"
+        } else {
+            "Record GIF"
+        };
+        if ui
+            .button(gif)
+            .on_hover_text("what the view shows, as an animated GIF")
+            .clicked()
+        {
+            app.toggle_gif();
         }
         if app.transport.behind {
             ui.separator();
@@ -113,19 +129,23 @@ pub fn status_bar(ui: &mut egui::Ui, app: &mut ClothApp) {
             ui.label("loading…");
         }
     });
-    if let Some(m) = app.messages.last().cloned() {
-        let color = match m.level {
-            Level::Info => ui.visuals().text_color(),
-            Level::Warning => egui::Color32::from_rgb(230, 160, 40),
-            Level::Error => egui::Color32::from_rgb(240, 80, 70),
-        };
-        ui.horizontal(|ui| {
+    // The message row is always there, so the 3D view does not jump when one appears.
+    ui.horizontal(|ui| match app.messages.last().cloned() {
+        Some(m) => {
+            let color = match m.level {
+                Level::Info => ui.visuals().text_color(),
+                Level::Warning => egui::Color32::from_rgb(230, 160, 40),
+                Level::Error => egui::Color32::from_rgb(240, 80, 70),
+            };
             ui.label(RichText::new(&m.text).color(color));
             if ui.small_button("Dismiss").clicked() {
                 app.messages.clear();
             }
-        });
-    }
+        }
+        None => {
+            ui.add_enabled(false, egui::Button::new("Dismiss").small());
+        }
+    });
 }
 
 pub fn drop_hint(ui: &mut egui::Ui) {
@@ -135,7 +155,7 @@ pub fn drop_hint(ui: &mut egui::Ui) {
     ui.painter().text(
         rect.center(),
         egui::Align2::CENTER_CENTER,
-        "Drop an OBJ to use it as the cloth",
+        "Drop an OBJ (the cloth) or a .toml (a whole scene)",
         egui::FontId::proportional(24.0),
         egui::Color32::WHITE,
     );
@@ -146,7 +166,7 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut ClothApp) {
         scenario_section(ui, app);
         solver_section(ui, app);
         material_section(ui, app);
-        collider_section(ui, app);
+        super::effects::effects_section(ui, app);
         render_section(ui, app);
     });
 }
@@ -169,20 +189,43 @@ fn scenario_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     ui.horizontal(|ui| {
         ui.add(
             egui::TextEdit::singleline(&mut app.open_path)
-                .hint_text("path/to/cloth.obj")
+                .hint_text("cloth.obj or scene.toml")
                 .desired_width(170.0),
         );
         if ui.button("Open").clicked() && !app.open_path.trim().is_empty() {
             let path = std::path::PathBuf::from(app.open_path.trim());
-            app.open_obj(path);
+            app.open_path(path);
         }
     });
     ui.horizontal(|ui| {
-        ui.label(RichText::new("or drop an OBJ on the window").weak());
-        if ui.small_button("Scene's cloth").clicked() {
+        ui.label(RichText::new("or drop one on the window").weak());
+        if app.has_custom_cloth() && ui.small_button("Scene's cloth").clicked() {
             app.use_default_cloth();
         }
     });
+    ui.horizontal(|ui| {
+        ui.add(
+            egui::TextEdit::singleline(&mut app.save_path)
+                .hint_text("scene.toml")
+                .desired_width(170.0),
+        );
+        if ui
+            .button("Save scene")
+            .on_hover_text("the cloth, pins, solver, material and effects as they are now")
+            .clicked()
+            && !app.save_path.trim().is_empty()
+        {
+            let path = std::path::PathBuf::from(app.save_path.trim());
+            app.save_scene(&path);
+        }
+    });
+    if ui
+        .button("Export OBJ")
+        .on_hover_text("the cloth's current shape, into the capture folder")
+        .clicked()
+    {
+        app.export_obj();
+    }
     let mut pins = app.sim.pins_enabled();
     if !app.sim.scenario_pins().is_empty() && ui.checkbox(&mut pins, "Pins").changed() {
         app.sim.set_pins_enabled(pins);
@@ -242,7 +285,8 @@ fn material_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     ui.heading("Material");
     let mut params = app.sim.params().clone();
     let mut changed = false;
-    for kind in SpringKind::ALL {
+    // Bend springs are set under Effects → Bending, where they exist.
+    for kind in [SpringKind::Structural, SpringKind::Shear] {
         let k = kind.index();
         let stiffness = Slider::new(&mut params.stiffness[k], 0.0..=5000.0)
             .logarithmic(true)
@@ -260,71 +304,17 @@ fn material_section(ui: &mut egui::Ui, app: &mut ClothApp) {
         .suffix(" kg/m²")
         .text("density");
     changed |= ui.add(density).changed();
-    let gravity = Slider::new(&mut params.gravity.y, -30.0..=0.0)
-        .suffix(" m/s²")
-        .text("gravity");
-    changed |= ui.add(gravity).changed();
-    let air = Slider::new(&mut params.air_damping, 0.0..=5.0)
-        .suffix(" 1/s")
-        .text("air damping");
-    changed |= ui.add(air).changed();
+    let offset = Slider::new(&mut params.collision_offset, 0.0..=0.05)
+        .suffix(" m")
+        .text("collision thickness");
+    changed |= ui
+        .add(offset)
+        .on_hover_text("how far particles stay from collider surfaces")
+        .changed();
     if changed {
         app.apply_params(params);
     }
     ui.separator();
-}
-
-fn collider_section(ui: &mut egui::Ui, app: &mut ClothApp) {
-    let mut changed = false;
-    let mut effects = app.sim.effects().to_vec();
-    let colliders = effects.iter_mut().filter_map(|e| match e {
-        Effect::Collider(c) => Some(c),
-        _ => None,
-    });
-    let mut any = false;
-    for collider in colliders {
-        if !any {
-            ui.heading("Colliders");
-            any = true;
-        }
-        match collider {
-            Collider::Sphere {
-                radius,
-                spin,
-                friction,
-                ..
-            } => {
-                ui.label("Sphere");
-                let mut rate = spin.length();
-                let axis = spin.try_normalize().unwrap_or(glam::Vec3::Y);
-                changed |= ui
-                    .add(Slider::new(radius, 0.05..=2.0).text("radius m"))
-                    .changed();
-                if ui
-                    .add(Slider::new(&mut rate, -10.0..=10.0).text("spin rad/s"))
-                    .changed()
-                {
-                    *spin = axis * rate;
-                    changed = true;
-                }
-                changed |= ui
-                    .add(Slider::new(friction, 0.0..=2.0).text("friction μ"))
-                    .changed();
-            }
-            Collider::Plane { friction, .. } => {
-                ui.label("Ground");
-                changed |= ui
-                    .add(Slider::new(friction, 0.0..=2.0).text("friction μ"))
-                    .changed();
-            }
-        }
-    }
-    if changed {
-        app.apply_effects(effects);
-    }
-    if any {
-        ui.separator();
-    }
 }
 
 fn render_section(ui: &mut egui::Ui, app: &mut ClothApp) {

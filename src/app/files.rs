@@ -16,11 +16,6 @@ impl ClothApp {
         self.loading = Some(Load::start(path));
     }
 
-    /// As [`ClothApp::open_path`] (kept for callers that open cloths).
-    pub fn open_obj(&mut self, path: PathBuf) {
-        self.open_path(path);
-    }
-
     /// Waits for a running load (tests, or when the caller must know the outcome).
     pub fn finish_loading(&mut self) {
         if let Some(load) = self.loading.take()

@@ -5,6 +5,7 @@ mod accuracy;
 mod background;
 mod cloth_app;
 mod controls;
+mod effects;
 mod files;
 mod pointer;
 mod record;

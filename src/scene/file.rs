@@ -46,7 +46,8 @@ pub struct ClothSpec {
     /// The plane the cloth is turned into (its thinnest axis becomes the plane's normal).
     #[serde(default = "horizontal")]
     pub orientation: GridOrientation,
-    /// Where the centre of its bounding box goes, metres.
+    /// Where the centre of its bounding box goes, metres (default: the origin).
+    #[serde(default)]
     pub center: [f32; 3],
     /// Welding tolerance for an OBJ, a fraction of its size (default 1e-6).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -297,11 +298,23 @@ fn locate_key(text: &str, index: Option<usize>, key: &str) -> (usize, usize) {
     {
         offset = at;
     }
-    let found = text[offset..]
+    line_column(text, find_key(text, offset, key).unwrap_or(offset))
+}
+
+/// Byte offset of the first `key = …` at or after `offset`.
+fn find_key(text: &str, offset: usize, key: &str) -> Option<usize> {
+    let offset = offset.min(text.len());
+    text[offset..]
         .match_indices(key)
         .map(|(at, _)| at + offset)
-        .find(|&at| text[at + key.len()..].trim_start().starts_with('='));
-    line_column(text, found.unwrap_or(offset))
+        .find(|&at| {
+            // A whole key: not the tail of a longer one, and followed by `=`.
+            let whole = text[..at]
+                .chars()
+                .next_back()
+                .is_none_or(|c| !(c.is_alphanumeric() || c == '_' || c == '-'));
+            whole && text[at + key.len()..].trim_start().starts_with('=')
+        })
 }
 
 impl SceneFile {
@@ -312,7 +325,14 @@ impl SceneFile {
     /// syntax, an unknown key, a wrong type, or a value out of range.
     pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
         let file: SceneFile = toml::from_str(text).map_err(|e| {
-            let (line, column) = e.span().map_or((1, 1), |s| line_column(text, s.start));
+            let start = e.span().map_or(0, |s| s.start);
+            // An unknown key inside a table is reported at the table; point at the key.
+            let unknown = e
+                .message()
+                .strip_prefix("unknown field `")
+                .and_then(|rest| rest.split('`').next())
+                .and_then(|key| find_key(text, start, key));
+            let (line, column) = line_column(text, unknown.unwrap_or(start));
             SceneError::File {
                 path: path.to_path_buf(),
                 line,
@@ -322,11 +342,17 @@ impl SceneFile {
         })?;
         file.check().map_err(|(index, key, message)| {
             let (line, column) = locate_key(text, index, &key);
+            // A message that already names its key (`dt` = …) is shown as it is.
+            let message = if message.starts_with('`') {
+                message
+            } else {
+                format!("`{key}`: {message}")
+            };
             SceneError::File {
                 path: path.to_path_buf(),
                 line,
                 column,
-                message: format!("`{key}`: {message}"),
+                message,
             }
         })?;
         Ok(file)
@@ -412,6 +438,29 @@ impl SceneFile {
                 }
                 _ => {}
             }
+        }
+        // Solver and material values, checked as the simulation will check them.
+        if let Err(message) = self.params().validate() {
+            let name = message.split('`').nth(1).unwrap_or("solver").to_string();
+            let in_effect = |pick: fn(&EffectSpec) -> bool| self.effects.iter().position(pick);
+            let (index, key) = match name.as_str() {
+                "air_damping" => (
+                    in_effect(|e| matches!(e, EffectSpec::AirDamping { .. })),
+                    "rate".to_string(),
+                ),
+                "gravity" => (
+                    in_effect(|e| matches!(e, EffectSpec::Gravity { .. })),
+                    "acceleration".to_string(),
+                ),
+                // `solver.tolerance` is `tolerance` in [solver], `guard.x` is `x` in [solver.guard].
+                other => (None, other.rsplit('.').next().unwrap_or(other).to_string()),
+            };
+            // Named as the file names it.
+            let detail = message
+                .strip_prefix("parameter ")
+                .unwrap_or(&message)
+                .replacen(&format!("`{name}`"), &format!("`{key}`"), 1);
+            return Err((index, key, detail));
         }
         Ok(())
     }

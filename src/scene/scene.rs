@@ -324,12 +324,19 @@ fn pins(
     out.extend_from_slice(&spec.indices);
     if let Some(r) = spec.region {
         let (min, max) = (Vec3::from(r.min), Vec3::from(r.max));
+        let before = out.len();
         out.extend(
             pos.iter()
                 .enumerate()
                 .filter(|(_, p)| p.cmpge(min).all() && p.cmple(max).all())
                 .map(|(i, _)| i as u32),
         );
+        // An empty region is a mistake (a typo in a bound), not a wish for no pins.
+        if out.len() == before {
+            return Err(SceneError::Pins(format!(
+                "the pin region from {min} to {max} holds no particle: the cloth spans {lo} to {hi}"
+            )));
+        }
     }
     out.sort_unstable();
     out.dedup();

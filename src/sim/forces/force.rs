@@ -16,7 +16,10 @@ use super::wind::Wind;
 #[derive(Clone, Debug, PartialEq)]
 pub enum Force {
     Gravity(Gravity),
+    /// The structural and shear springs.
     Springs(SpringForce),
+    /// The bend springs (a scene that bends by springs).
+    BendSprings(SpringForce),
     AirDamping(AirDamping),
     Bending(DihedralBending),
     Wind(Wind),
@@ -29,7 +32,7 @@ impl Force {
             Force::Gravity(_) => "gravity",
             Force::Springs(_) => "springs",
             Force::AirDamping(_) => "air-damping",
-            Force::Bending(_) => "bending",
+            Force::Bending(_) | Force::BendSprings(_) => "bending",
             Force::Wind(_) => "wind",
         }
     }
@@ -45,7 +48,7 @@ impl Force {
     ) {
         match self {
             Force::Gravity(g) => g.add_forces(&model.mass, f),
-            Force::Springs(s) => s.add_forces(&model.springs, pos, vel, f),
+            Force::Springs(s) | Force::BendSprings(s) => s.add_forces(&model.springs, pos, vel, f),
             Force::AirDamping(d) => d.add_forces(&model.mass, vel, f),
             Force::Bending(b) => b.add_forces(model, pos, f),
             Force::Wind(w) => w.add_forces(model, pos, vel, t, f),
@@ -56,7 +59,7 @@ impl Force {
     pub fn potential_energy(&self, model: &ClothModel, pos: &[Vec3]) -> f64 {
         match self {
             Force::Gravity(g) => g.potential_energy(&model.mass, pos),
-            Force::Springs(s) => s.potential_energy(&model.springs, pos),
+            Force::Springs(s) | Force::BendSprings(s) => s.potential_energy(&model.springs, pos),
             Force::Bending(b) => b.potential_energy(model, pos),
             Force::AirDamping(_) | Force::Wind(_) => 0.0,
         }
@@ -72,7 +75,7 @@ impl Force {
         mode: JacobianMode,
         out: &mut [Vec3],
     ) {
-        if let Force::Springs(s) = self {
+        if let Force::Springs(s) | Force::BendSprings(s) = self {
             s.add_df_dx(&model.springs, pos, vel, u, mode, out);
         }
     }
@@ -87,7 +90,9 @@ impl Force {
         out: &mut [Vec3],
     ) {
         match self {
-            Force::Springs(s) => s.add_df_dv(&model.springs, pos, vel, u, out),
+            Force::Springs(s) | Force::BendSprings(s) => {
+                s.add_df_dv(&model.springs, pos, vel, u, out)
+            }
             Force::AirDamping(d) => d.add_df_dv(&model.mass, u, out),
             Force::Gravity(_) | Force::Bending(_) | Force::Wind(_) => {}
         }
@@ -102,7 +107,9 @@ impl Force {
         sys: &mut SystemMatrix,
     ) {
         match self {
-            Force::Springs(s) => s.add_to_system(&model.springs, pos, vel, sys),
+            Force::Springs(s) | Force::BendSprings(s) => {
+                s.add_to_system(&model.springs, pos, vel, sys)
+            }
             Force::AirDamping(d) => d.add_to_system(&model.mass, sys),
             Force::Gravity(_) | Force::Bending(_) | Force::Wind(_) => {}
         }

@@ -71,16 +71,24 @@ impl ForceSet {
             Force::Springs(s) => Some(s),
             _ => None,
         });
+        let kept_bend_springs = old.iter().find_map(|t| match t {
+            Force::BendSprings(s) => Some(s),
+            _ => None,
+        });
         let kept_bending = old.iter().find_map(|t| match t {
             Force::Bending(b) => Some(b),
             _ => None,
         });
-        // Bend springs act only when the scene bends by springs.
-        let bend_springs = effects.contains(&Effect::Bending(BendingModel::Springs));
-        let active = if bend_springs {
-            model.springs.len()
-        } else {
-            model.springs.len() - model.bend_springs
+        // The bend springs are the last ones.
+        let bend_start = model.springs.len() - model.bend_springs;
+        let (stiffness, damping) = (params.stiffness, params.damping);
+        let springs = |kept: Option<&SpringForce>, range: std::ops::Range<usize>| {
+            let mut s = kept
+                .filter(|s| s.range() == range)
+                .cloned()
+                .unwrap_or_else(|| SpringForce::over(&model.springs, range, stiffness, damping));
+            s.set_strengths(&model.springs, stiffness, damping);
+            s
         };
         for effect in effects {
             let term = match effect {
@@ -88,12 +96,9 @@ impl ForceSet {
                 Effect::AirDamping => Force::AirDamping(AirDamping {
                     rate: params.air_damping,
                 }),
-                Effect::Springs => {
-                    let mut s = kept_springs.cloned().unwrap_or_else(|| {
-                        SpringForce::first(&model.springs, active, params.stiffness, params.damping)
-                    });
-                    s.set_strengths(&model.springs, active, params.stiffness, params.damping);
-                    Force::Springs(s)
+                Effect::Springs => Force::Springs(springs(kept_springs, 0..bend_start)),
+                Effect::Bending(BendingModel::Springs) => {
+                    Force::BendSprings(springs(kept_bend_springs, bend_start..model.springs.len()))
                 }
                 Effect::Bending(BendingModel::Dihedral { stiffness }) => {
                     let mut b = kept_bending
@@ -103,9 +108,7 @@ impl ForceSet {
                     Force::Bending(b)
                 }
                 Effect::Wind(w) => Force::Wind(*w),
-                Effect::Bending(BendingModel::Springs)
-                | Effect::SelfCollision(_)
-                | Effect::Collider(_) => continue,
+                Effect::SelfCollision(_) | Effect::Collider(_) => continue,
             };
             self.terms.push(term);
         }
@@ -115,19 +118,21 @@ impl ForceSet {
         &self.terms
     }
 
-    /// The spring term, if the scene has springs.
-    pub fn springs(&self) -> Option<&SpringForce> {
-        self.terms.iter().find_map(|t| match t {
-            Force::Springs(s) => Some(s),
+    /// The spring terms (structural and shear, and bend springs when present).
+    pub fn springs(&self) -> impl Iterator<Item = &SpringForce> {
+        self.terms.iter().filter_map(|t| match t {
+            Force::Springs(s) | Force::BendSprings(s) => Some(s),
             _ => None,
         })
     }
 
     /// The springs as distance constraints (empty without springs).
     pub fn constraints(&self, model: &ClothModel) -> DistanceConstraints {
-        self.springs()
-            .map(|s| s.constraints(&model.springs))
-            .unwrap_or_default()
+        let mut out = DistanceConstraints::default();
+        for s in self.springs() {
+            s.add_constraints(&model.springs, &mut out);
+        }
+        out
     }
 
     /// Writes the total force at `(pos, vel)` into `f` (resized), newtons. Terms selected

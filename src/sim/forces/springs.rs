@@ -5,6 +5,8 @@
 //! `K_x = ∂f_a/∂x_b` and `K_v = ∂f_a/∂v_b` (then `∂f_a/∂x_a = −K_x`, `∂f_b/∂x_b = −K_x`,
 //! `∂f_b/∂x_a = K_x`), and as matrix-free actions on a vector.
 
+use std::ops::Range;
+
 use glam::{Mat3, Vec3};
 
 use crate::cloth::Springs;
@@ -12,17 +14,17 @@ use crate::cloth::Springs;
 use super::jacobian::{JacobianMode, SystemMatrix};
 use crate::sim::constraints::DistanceConstraints;
 
-/// Springs with per-kind stiffness (N/m) and damping (N·s/m), expanded per spring. Only the
-/// first `active` springs act: the bend springs (the last ones) are left out when the scene
-/// bends by dihedral angles, or not at all.
+/// Springs with per-kind stiffness (N/m) and damping (N·s/m), expanded per spring, over a
+/// range of the model's springs: the structural and shear springs are one term, the bend
+/// springs (the last ones) another, present only when the scene bends by springs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SpringForce {
     stiffness: [f32; 3],
     damping: [f32; 3],
-    active: usize,
-    /// Stiffness of each spring, N/m.
+    range: Range<usize>,
+    /// Stiffness of each spring in the range, N/m.
     k: Vec<f32>,
-    /// Damping of each spring, N·s/m.
+    /// Damping of each spring in the range, N·s/m.
     c: Vec<f32>,
 }
 
@@ -43,15 +45,21 @@ fn outer(u: Vec3, v: Vec3) -> Mat3 {
 impl SpringForce {
     /// Per-kind strengths expanded over all of `springs`.
     pub fn new(springs: &Springs, stiffness: [f32; 3], damping: [f32; 3]) -> Self {
-        Self::first(springs, springs.len(), stiffness, damping)
+        Self::over(springs, 0..springs.len(), stiffness, damping)
     }
 
-    /// Per-kind strengths expanded over the first `active` of `springs`.
-    pub fn first(springs: &Springs, active: usize, stiffness: [f32; 3], damping: [f32; 3]) -> Self {
+    /// Per-kind strengths expanded over `range` of `springs` (clamped to the springs there are).
+    pub fn over(
+        springs: &Springs,
+        range: Range<usize>,
+        stiffness: [f32; 3],
+        damping: [f32; 3],
+    ) -> Self {
+        let end = range.end.min(springs.len());
         let mut s = Self {
             stiffness,
             damping,
-            active: active.min(springs.len()),
+            range: range.start.min(end)..end,
             k: Vec::new(),
             c: Vec::new(),
         };
@@ -59,37 +67,37 @@ impl SpringForce {
         s
     }
 
-    /// Changes the strengths and the active count; re-expands only when they changed.
-    pub fn set_strengths(
-        &mut self,
-        springs: &Springs,
-        active: usize,
-        stiffness: [f32; 3],
-        damping: [f32; 3],
-    ) {
-        let active = active.min(springs.len());
-        if (self.stiffness, self.damping, self.active) != (stiffness, damping, active) {
+    /// Changes the strengths; re-expands only when they changed.
+    pub fn set_strengths(&mut self, springs: &Springs, stiffness: [f32; 3], damping: [f32; 3]) {
+        if (self.stiffness, self.damping) != (stiffness, damping) {
             self.stiffness = stiffness;
             self.damping = damping;
-            self.active = active;
             self.expand(springs);
         }
     }
 
-    /// How many springs act.
-    pub fn active(&self) -> usize {
-        self.active
+    /// The springs this term covers.
+    pub fn range(&self) -> Range<usize> {
+        self.range.clone()
     }
 
     fn expand(&mut self, springs: &Springs) {
-        let kinds = &springs.kind[..self.active];
+        let kinds = &springs.kind[self.range.clone()];
         self.k = kinds.iter().map(|k| self.stiffness[k.index()]).collect();
         self.c = kinds.iter().map(|k| self.damping[k.index()]).collect();
     }
 
+    /// Each spring's index with its stiffness and damping.
+    fn each(&self) -> impl Iterator<Item = (usize, f32, f32)> + '_ {
+        self.range
+            .clone()
+            .zip(self.k.iter().zip(&self.c))
+            .map(|(e, (&k, &c))| (e, k, c))
+    }
+
     /// Adds every spring's force (N) to `f`.
     pub fn add_forces(&self, springs: &Springs, pos: &[Vec3], vel: &[Vec3], f: &mut [Vec3]) {
-        for e in 0..self.active {
+        for (e, k, c) in self.each() {
             let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
             let d = pos[b] - pos[a];
             let len = d.length();
@@ -97,7 +105,7 @@ impl SpringForce {
                 continue; // coincident ends: no defined direction
             }
             let n = d / len;
-            let s = self.k[e] * (len - springs.rest[e]) + self.c[e] * (vel[b] - vel[a]).dot(n);
+            let s = k * (len - springs.rest[e]) + c * (vel[b] - vel[a]).dot(n);
             f[a] += s * n;
             f[b] -= s * n;
         }
@@ -105,16 +113,16 @@ impl SpringForce {
 
     /// `Σ ½k(|d| − l₀)²`, joules.
     pub fn potential_energy(&self, springs: &Springs, pos: &[Vec3]) -> f64 {
-        (0..self.active)
-            .map(|e| {
+        self.each()
+            .map(|(e, k, _)| {
                 let d = pos[springs.b[e] as usize].distance(pos[springs.a[e] as usize]);
                 let stretch = (d - springs.rest[e]) as f64;
-                0.5 * self.k[e] as f64 * stretch * stretch
+                0.5 * k as f64 * stretch * stretch
             })
             .sum()
     }
 
-    /// The derivative blocks of spring `e`.
+    /// The derivative blocks of spring `e` (an index into the model's springs, in range).
     ///
     /// [`JacobianMode::Exact`] is the true derivative. [`JacobianMode::Definite`] is the
     /// usual implicit-solver form: the transverse stiffness `k(1 − l₀/|d|)` of a compressed
@@ -141,7 +149,7 @@ impl SpringForce {
         let n = d / len;
         let nn = outer(n, n);
         let transverse = Mat3::IDENTITY - nn;
-        let (k, c) = (self.k[e], self.c[e]);
+        let (k, c) = (self.k[e - self.range.start], self.c[e - self.range.start]);
         let stretch = 1.0 - springs.rest[e] / len;
         let dx = match mode {
             JacobianMode::Exact => {
@@ -165,7 +173,7 @@ impl SpringForce {
         mode: JacobianMode,
         out: &mut [Vec3],
     ) {
-        for e in 0..self.active {
+        for e in self.range.clone() {
             let block = self.blocks(springs, pos, vel, e, mode).dx;
             apply_pair(springs, e, block, u, out);
         }
@@ -180,7 +188,7 @@ impl SpringForce {
         u: &[Vec3],
         out: &mut [Vec3],
     ) {
-        for e in 0..self.active {
+        for e in self.range.clone() {
             let block = self.blocks(springs, pos, vel, e, JacobianMode::Definite).dv;
             apply_pair(springs, e, block, u, out);
         }
@@ -194,7 +202,7 @@ impl SpringForce {
         vel: &[Vec3],
         sys: &mut SystemMatrix,
     ) {
-        for e in 0..self.active {
+        for e in self.range.clone() {
             let b = self.blocks(springs, pos, vel, e, JacobianMode::Definite);
             sys.add_spring(springs, e, b.dx, b.dv, vel);
         }
@@ -204,14 +212,19 @@ impl SpringForce {
     /// and compliance `1/k` (m/N). Springs of zero stiffness are no constraint and are left out.
     pub fn constraints(&self, springs: &Springs) -> DistanceConstraints {
         let mut out = DistanceConstraints::default();
-        for e in (0..self.active).filter(|&e| self.k[e] > 0.0) {
+        self.add_constraints(springs, &mut out);
+        out
+    }
+
+    /// Appends these springs as distance constraints to `out`.
+    pub fn add_constraints(&self, springs: &Springs, out: &mut DistanceConstraints) {
+        for (e, k, c) in self.each().filter(|&(_, k, _)| k > 0.0) {
             out.a.push(springs.a[e]);
             out.b.push(springs.b[e]);
             out.rest.push(springs.rest[e]);
-            out.compliance.push(1.0 / self.k[e]);
-            out.damping.push(self.c[e]);
+            out.compliance.push(1.0 / k);
+            out.damping.push(c);
         }
-        out
     }
 }
 

@@ -82,7 +82,7 @@ impl Integrator for Xpbd {
             self.constraints = ctx.forces.constraints(model);
             self.built = true;
         }
-        let not_springs = |t: &Force| !matches!(t, Force::Springs(_));
+        let not_springs = |t: &Force| !matches!(t, Force::Springs(_) | Force::BendSprings(_));
         ctx.forces_where(&state.pos, &state.vel, not_springs, &mut self.force);
         let w = &model.inv_mass;
         self.predicted.clear();

@@ -1,0 +1,133 @@
+//! Grabbing and pinning particles while the simulation runs, under every integrator.
+
+use std::path::Path;
+
+use clothsim::scene::{Scene, SceneFile, Simulation};
+use clothsim::sim::IntegratorKind;
+use glam::Vec3;
+
+/// A 10×10-quad cloth held by its top corners, run for a moment with `kind` at substeps it
+/// is stable with.
+fn hanging(kind: IntegratorKind) -> Simulation {
+    let text = "name = \"small\"\n\
+        [cloth]\ngrid = { quads = 10, size = 1.0 }\norientation = \"vertical\"\ncenter = [0.0, 1.5, 0.0]\n\
+        [pins]\ncorners = [\"top-left\", \"top-right\"]\n\
+        [material]\ndensity = 0.2\n\
+        stiffness = { structural = 400.0, shear = 150.0, bend = 20.0 }\n\
+        damping = { structural = 0.02, shear = 0.01, bend = 0.002 }\n\
+        [[effects]]\ntype = \"gravity\"\n\
+        [[effects]]\ntype = \"air-damping\"\nrate = 0.5\n\
+        [[effects]]\ntype = \"bending\"\nmodel = \"springs\"\n";
+    let mut scene = Scene::from_file(
+        SceneFile::parse(text, Path::new("small.toml")).unwrap(),
+        None,
+    )
+    .unwrap();
+    scene.params.integrator = kind;
+    // Well inside each method's stable range for this cloth (see the accuracy report).
+    scene.params.substeps = match kind {
+        IntegratorKind::ExplicitEuler => 1500,
+        IntegratorKind::Rk2 => 120,
+        IntegratorKind::ImplicitEuler => 4,
+        IntegratorKind::Xpbd => 10,
+        _ => 40,
+    };
+    let mut sim = Simulation::new(scene);
+    sim.run(0.2);
+    sim
+}
+
+/// The free particle farthest from the pins, and one of its spring neighbours.
+fn bottom_middle(sim: &Simulation) -> (u32, u32) {
+    let pos = &sim.state().pos;
+    let p = (0..pos.len())
+        .filter(|&i| i % 11 == 5)
+        .min_by(|&a, &b| pos[a].y.total_cmp(&pos[b].y))
+        .unwrap() as u32;
+    let springs = &sim.model().springs;
+    let q = (0..springs.len())
+        .find_map(|e| (springs.a[e] == p).then_some(springs.b[e]))
+        .unwrap();
+    (p, q)
+}
+
+#[test]
+fn a_grabbed_particle_follows_the_pointer_and_pulls_the_cloth_under_every_integrator() {
+    for kind in IntegratorKind::ALL {
+        let mut sim = hanging(kind);
+        let (p, q) = bottom_middle(&sim);
+        let (start, neighbour) = (sim.state().pos[p as usize], sim.state().pos[q as usize]);
+        let pull = Vec3::new(0.0, 0.0, 0.3);
+        for k in 1..=30 {
+            let target = start + pull * (k as f32 / 30.0);
+            sim.grab(p, target);
+            sim.step_frame().unwrap_or_else(|e| panic!("{kind:?}: {e}"));
+            assert_eq!(
+                sim.state().pos[p as usize],
+                target,
+                "{kind:?}: held where the pointer is"
+            );
+            assert_eq!(sim.grabbed(), Some(p));
+        }
+        assert_eq!(
+            sim.integrator_in_effect(),
+            kind,
+            "{kind:?} ran without falling back"
+        );
+        let moved = sim.state().pos[q as usize] - neighbour;
+        assert!(
+            moved.z > 0.15,
+            "{kind:?}: the neighbour followed by only {moved}"
+        );
+        // Let go: the particle is free again and swings back.
+        let held = sim.state().pos[p as usize];
+        sim.release();
+        assert_eq!(sim.grabbed(), None);
+        assert!(
+            !sim.model().pins.contains(&p),
+            "{kind:?}: released particles are not pins"
+        );
+        sim.run(0.25);
+        let back = held.z - sim.state().pos[p as usize].z;
+        assert!(back > 0.02, "{kind:?}: swung back by {back} m");
+    }
+}
+
+#[test]
+fn clicking_pins_a_particle_where_it_is_and_clicking_again_frees_it() {
+    for kind in IntegratorKind::ALL {
+        let mut sim = hanging(kind);
+        let (p, _) = bottom_middle(&sim);
+        // Give it some motion first, so pinning must stop it.
+        sim.modify_state(|s| s.vel[p as usize] = Vec3::new(0.0, 0.0, 1.0));
+        sim.toggle_pin(p);
+        assert!(sim.model().pins.contains(&p));
+        let at = sim.state().pos[p as usize];
+        sim.run(0.25);
+        assert_eq!(
+            sim.state().pos[p as usize],
+            at,
+            "{kind:?}: a pinned particle stays put"
+        );
+        // The rest of the cloth still moves around it.
+        assert!(sim.state().kinetic_energy(sim.model()) > 0.0);
+        sim.toggle_pin(p);
+        assert!(!sim.model().pins.contains(&p));
+        sim.run(0.25);
+        let moved = sim.state().pos[p as usize].distance(at);
+        assert!(moved > 1e-3, "{kind:?}: freed, it moves ({moved} m)");
+        // The scene's own pins are toggled the same way.
+        let corner = sim.scenario_pins()[0];
+        sim.toggle_pin(corner);
+        assert!(
+            !sim.model().pins.contains(&corner),
+            "{kind:?}: a scene pin released"
+        );
+        let corner_at = sim.state().pos[corner as usize];
+        sim.run(0.25);
+        assert!(
+            sim.state().pos[corner as usize].y < corner_at.y - 0.01,
+            "{kind:?}: it drops"
+        );
+    }
+}
