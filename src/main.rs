@@ -545,9 +545,9 @@ fn render(args: &RunArgs, size: &str, overlay: &str, output: Output<'_>) -> Resu
     if let Some(g) = gif {
         g.finish()?;
     }
-    for (what, place) in [("frames to", output.dir), ("a GIF to", output.gif)] {
+    for (what, place) in [("", output.dir), (" as a GIF", output.gif)] {
         if let Some(p) = place {
-            println!("wrote {written} {what} {}", p.display());
+            println!("wrote {written} frames{what} to {}", p.display());
         }
     }
     Ok(())

@@ -421,3 +421,18 @@ fn the_default_asset_is_a_24x24_quad_grid() {
     assert_eq!(m.triangles.len(), 1152);
     assert_eq!(m.edge_count(SpringKind::Shear), 576);
 }
+
+#[test]
+fn an_empty_polyline_is_an_error_not_a_panic() {
+    // Found by the fuzzer (`fuzz/`): an `l` element with no points made triangulation
+    // subtract one from zero.
+    for text in [
+        "\u{1} \nl",
+        "v 0 0 0\nl",
+        "v 0 0 0\nv 1 0 0\nl 1 2\n",
+        "v 0 0 0\np 1\n",
+    ] {
+        let err = clothsim::mesh::obj_from_str(text, "odd.obj").expect_err(text);
+        assert!(err.to_string().contains("odd.obj"), "{err}");
+    }
+}

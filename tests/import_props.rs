@@ -44,6 +44,9 @@ fn line() -> impl Strategy<Value = String> {
         1 => prop::collection::vec(number(), 0..4).prop_map(|n| format!("vt {}", n.join(" "))),
         1 => prop::collection::vec(number(), 0..4).prop_map(|n| format!("vn {}", n.join(" "))),
         5 => prop::collection::vec(corner(), 0..7).prop_map(|c| format!("f {}", c.join(" "))),
+        // Points and polylines (an empty `l` once crashed triangulation; the fuzzer found it).
+        1 => (prop_oneof![Just("l"), Just("p")], prop::collection::vec(corner(), 0..4))
+            .prop_map(|(e, c)| std::iter::once(e.to_string()).chain(c).collect::<Vec<_>>().join(" ")),
         1 => Just("mtllib /no/such.mtl".to_string()),
         1 => Just("usemtl red".to_string()),
         1 => "[og] [a-z]{0,5}",

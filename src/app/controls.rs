@@ -172,7 +172,7 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut ClothApp) {
 }
 
 fn scenario_section(ui: &mut egui::Ui, app: &mut ClothApp) {
-    ui.heading("Scenario");
+    ui.heading("Scene");
     let current = app.sim.scenario().to_string();
     for s in scenarios() {
         if ui

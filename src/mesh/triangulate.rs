@@ -35,10 +35,13 @@ pub fn triangulate(
     let mut seen: HashSet<[u32; 3]> = HashSet::with_capacity(corners.len());
     let mut start = 0usize;
     for &arity in arities {
-        let face = &corners[start..start + arity as usize];
+        let Some(face) = corners.get(start..start + arity as usize) else {
+            break; // arities that overrun the corners (never from a valid parse)
+        };
         start += arity as usize;
         let mut kept = 0;
-        for k in 1..face.len() - 1 {
+        // A "face" of fewer than three corners (a point or a polyline) has no triangle.
+        for k in 1..face.len().saturating_sub(1) {
             let t = [face[0], face[k], face[k + 1]];
             if is_degenerate(positions, t, min_area) {
                 out.degenerate += 1;
