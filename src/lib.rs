@@ -22,6 +22,7 @@
 //! ```
 
 pub mod app;
+pub mod bench;
 pub mod cloth;
 pub mod mesh;
 pub mod output;

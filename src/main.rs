@@ -99,6 +99,26 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Speed on the `hanging-bench` scene: µs per substep and the sag after 2 s for each
+    /// size × integrator × thread count (the scene the peer frameworks run too).
+    Bench {
+        /// Comma-separated particles per side.
+        #[arg(long, value_delimiter = ',', default_value = "32,64,128,256")]
+        sizes: Vec<u32>,
+        /// Comma-separated integrators.
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "semi-implicit-euler,implicit-euler,xpbd"
+        )]
+        integrators: Vec<IntegratorKind>,
+        /// Comma-separated thread counts.
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
+        /// Print one JSON object per row.
+        #[arg(long)]
+        json: bool,
+    },
     /// Write a rectangular grid cloth as an OBJ file (quads: diagonals become shear springs).
     Grid {
         /// Quads along each side.
@@ -272,6 +292,12 @@ fn run(cli: Cli) -> Result<()> {
             triangles,
             out,
         }) => grid(quads, size, triangles, &out),
+        Some(Command::Bench {
+            sizes,
+            integrators,
+            threads,
+            json,
+        }) => bench(&sizes, &integrators, &threads, json),
     }
 }
 
@@ -548,6 +574,77 @@ fn render(args: &RunArgs, size: &str, overlay: &str, output: Output<'_>) -> Resu
     for (what, place) in [("", output.dir), (" as a GIF", output.gif)] {
         if let Some(p) = place {
             println!("wrote {written} frames{what} to {}", p.display());
+        }
+    }
+    Ok(())
+}
+
+fn bench(
+    sizes: &[u32],
+    integrators: &[IntegratorKind],
+    threads: &[usize],
+    json: bool,
+) -> Result<()> {
+    if let Some(&n) = sizes.iter().find(|&&n| !(3..=2048).contains(&n)) {
+        bail!("--sizes: {n} particles per side is outside 3..=2048");
+    }
+    if let Some(&t) = threads.iter().find(|&&t| !(1..=256).contains(&t)) {
+        bail!("--threads: {t} is outside 1..=256");
+    }
+    if !json {
+        println!(
+            "{:>5} {:<20} {:>7} {:>9} {:>12} {:>12} {:>10} {:>10}  sag",
+            "N",
+            "integrator",
+            "threads",
+            "substeps",
+            "µs/substep",
+            "substeps/s",
+            "sag m",
+            "reference",
+        );
+    }
+    for &t in threads {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .with_context(|| format!("cannot start {t} threads"))?;
+        for &n in sizes {
+            for &k in integrators {
+                let row = pool.install(|| clothsim::bench::bench_one(n, k))?;
+                if json {
+                    println!("{}", serde_json::to_string(&row)?);
+                } else {
+                    let verdict = match (row.finite, row.sag_ok, row.sag_error) {
+                        (false, _, _) => "diverged".to_string(),
+                        (true, Some(ok), Some(e)) => {
+                            format!(
+                                "{:.2} % off{}",
+                                100.0 * e,
+                                if ok {
+                                    ""
+                                } else {
+                                    " (too far: the speed does not count)"
+                                }
+                            )
+                        }
+                        _ => "no reference".to_string(),
+                    };
+                    println!(
+                        "{:>5} {:<20} {:>7} {:>9} {:>12.1} {:>12.0} {:>10.5} {:>10}  {}",
+                        row.n,
+                        row.integrator,
+                        row.threads,
+                        row.substeps_per_frame,
+                        row.us_per_substep,
+                        row.substeps_per_second,
+                        row.sag_m,
+                        row.reference_sag_m
+                            .map_or("—".into(), |r| format!("{r:.5}")),
+                        verdict
+                    );
+                }
+            }
         }
     }
     Ok(())

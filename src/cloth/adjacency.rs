@@ -18,8 +18,14 @@ impl Adjacency {
     /// Builds the adjacency of `springs` over `particles` particles; each particle's list
     /// is in spring order, so gathers are deterministic.
     pub fn new(particles: usize, springs: &Springs) -> Self {
+        Self::from_pairs(particles, &springs.a, &springs.b)
+    }
+
+    /// The adjacency of the springs `a[e]`–`b[e]` (numbered from 0 in this list) over
+    /// `particles` particles (every index must be below it).
+    pub fn from_pairs(particles: usize, a: &[u32], b: &[u32]) -> Self {
         let mut count = vec![0u32; particles + 1];
-        for (&a, &b) in springs.a.iter().zip(&springs.b) {
+        for (&a, &b) in a.iter().zip(b) {
             count[a as usize + 1] += 1;
             count[b as usize + 1] += 1;
         }
@@ -30,7 +36,7 @@ impl Adjacency {
         let total = offsets[particles] as usize;
         let mut next = count;
         let (mut spring, mut other, mut sign) = (vec![0; total], vec![0; total], vec![0.0; total]);
-        for (e, (&a, &b)) in springs.a.iter().zip(&springs.b).enumerate() {
+        for (e, (&a, &b)) in a.iter().zip(b).enumerate() {
             for (p, q, s) in [(a, b, 1.0), (b, a, -1.0)] {
                 let slot = next[p as usize] as usize;
                 next[p as usize] += 1;

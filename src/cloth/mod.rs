@@ -5,5 +5,5 @@ mod model;
 mod state;
 
 pub use adjacency::Adjacency;
-pub use model::{ClothModel, MASS_FLOOR, Springs};
+pub use model::{ClothModel, MASS_FLOOR, MassDistribution, Springs};
 pub use state::ClothState;

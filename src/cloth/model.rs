@@ -32,6 +32,18 @@ impl Springs {
     }
 }
 
+/// How a cloth's mass is shared among its particles.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MassDistribution {
+    /// Each triangle gives a third of its mass to each corner (with a floor; see
+    /// [`ClothModel::set_density`]).
+    #[default]
+    Lumped,
+    /// Every particle weighs the same: the cloth's mass over the particle count.
+    Uniform,
+}
+
 /// Smallest particle mass, as a fraction of the mean particle mass.
 pub const MASS_FLOOR: f32 = 0.1;
 
@@ -59,6 +71,8 @@ pub struct ClothModel {
     pub pins: Vec<u32>,
     /// Areal density the masses came from, kg/m².
     pub density: f32,
+    /// How the mass is shared among the particles.
+    pub masses: MassDistribution,
 }
 
 impl ClothModel {
@@ -89,6 +103,7 @@ impl ClothModel {
             inv_mass: vec![0.0; n],
             pins: Vec::new(),
             density,
+            masses: MassDistribution::Lumped,
         };
         model.set_density(density);
         model.set_pins(pins);
@@ -121,6 +136,7 @@ impl ClothModel {
             mass,
             pins: Vec::new(),
             density: 0.0,
+            masses: MassDistribution::Lumped,
         };
         model.set_pins(pins);
         model
@@ -147,7 +163,10 @@ impl ClothModel {
             }
         }
         let total: f32 = self.mass.iter().sum();
-        if total > 0.0 {
+        if self.masses == MassDistribution::Uniform {
+            let each = total / self.mass.len().max(1) as f32;
+            self.mass.iter_mut().for_each(|m| *m = each);
+        } else if total > 0.0 {
             let floor = MASS_FLOOR * total / self.mass.len() as f32;
             self.mass.iter_mut().for_each(|m| *m = m.max(floor));
             let scale = total / self.mass.iter().sum::<f32>();
@@ -155,6 +174,12 @@ impl ClothModel {
         }
         let pins = std::mem::take(&mut self.pins);
         self.set_pins(&pins);
+    }
+
+    /// Shares the mass as `masses` says (recomputed from the current density).
+    pub fn set_mass_distribution(&mut self, masses: MassDistribution) {
+        self.masses = masses;
+        self.set_density(self.density);
     }
 
     /// Replaces the pin set; pinned particles get inverse mass 0, the rest 1/mass.

@@ -18,6 +18,18 @@ pub enum GridOrientation {
     Vertical,
 }
 
+/// Which particle pairs of a grid get bend springs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GridBends {
+    /// The two vertices opposite each interior edge (as for any imported mesh).
+    #[default]
+    AcrossEdges,
+    /// Every particle to the one two steps along its row and its column (Provot's flexion
+    /// springs, the 12-neighbour stencil's `(2,0)` and `(0,2)`).
+    SkipOne,
+}
+
 /// A grid of `quads_x × quads_y` quads, `size_x × size_y` metres, centred on `center`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GridSpec {
@@ -98,5 +110,44 @@ impl GridSpec {
     /// [`ObjError::Empty`] when a size is zero or not finite.
     pub fn build(&self) -> Result<ClothMesh, ObjError> {
         Ok(build_mesh(&self.polygons(), Path::new("<grid>"))?.mesh)
+    }
+
+    /// The grid's topology with bend springs chosen by `bends`.
+    ///
+    /// # Errors
+    /// As [`GridSpec::build`].
+    pub fn build_with(&self, bends: GridBends) -> Result<ClothMesh, ObjError> {
+        let soup = self.polygons();
+        let mut mesh = build_mesh(&soup, Path::new("<grid>"))?.mesh;
+        if bends == GridBends::SkipOne {
+            // Welding numbers particles by first use in the faces, not row by row: find
+            // each grid vertex's particle by its (exactly kept) position.
+            let key = |p: Vec3| p.to_array().map(f32::to_bits);
+            let particle: std::collections::HashMap<[u32; 3], u32> = mesh
+                .positions
+                .iter()
+                .enumerate()
+                .map(|(i, &p)| (key(p), i as u32))
+                .collect();
+            let id = |k: u32| particle.get(&key(soup.positions[k as usize])).copied();
+            let (nx, ny) = (self.quads_x.max(1), self.quads_y.max(1));
+            let row = nx + 1;
+            let mut pairs = Vec::new();
+            for j in 0..=ny {
+                for i in 0..=nx {
+                    let k = j * row + i;
+                    let right = (i + 2 <= nx).then_some(k + 2);
+                    let down = (j + 2 <= ny).then_some(k + 2 * row);
+                    for other in [right, down].into_iter().flatten() {
+                        if let (Some(a), Some(b)) = (id(k), id(other)) {
+                            pairs.push([a.min(b), a.max(b)]);
+                        }
+                    }
+                }
+            }
+            pairs.sort_unstable();
+            mesh.bend_pairs = pairs;
+        }
+        Ok(mesh)
     }
 }

@@ -18,7 +18,7 @@ mod weld;
 
 pub use bounds::{bbox_diagonal, bounds, thinnest_axis};
 pub use error::ObjError;
-pub use grid::{GridOrientation, GridSpec};
+pub use grid::{GridBends, GridOrientation, GridSpec};
 pub use import::{load_obj, load_obj_with, obj_from_str, obj_from_str_with};
 pub use limits::{MAX_COORDINATE, MAX_FILE_BYTES, MAX_TRIANGLES, MAX_VERTICES};
 pub use normals::vertex_normals;

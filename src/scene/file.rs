@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use crate::mesh::GridOrientation;
+use crate::cloth::MassDistribution;
+use crate::mesh::{GridBends, GridOrientation};
 use crate::sim::{
     BendingModel, Collider, Effect, GuardPolicy, IntegratorKind, SelfCollision, SimParams,
     SolverConfig, Wind,
@@ -64,6 +65,13 @@ fn horizontal() -> GridOrientation {
 pub struct GridShape {
     pub quads: OneOrTwo<u32>,
     pub size: OneOrTwo<f32>,
+    /// Which pairs get bend springs (default: across each interior edge).
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub bend: GridBends,
+}
+
+fn is_default<T: Default + PartialEq>(value: &T) -> bool {
+    *value == T::default()
 }
 
 /// One number for both directions, or two.
@@ -199,6 +207,9 @@ pub struct MaterialSpec {
     pub stiffness: PerKind,
     /// Spring damping per kind, N·s/m.
     pub damping: PerKind,
+    /// How the mass is shared: `lumped` by triangle area (default) or `uniform`.
+    #[serde(skip_serializing_if = "is_default")]
+    pub masses: MassDistribution,
 }
 
 impl Default for MaterialSpec {
@@ -208,6 +219,7 @@ impl Default for MaterialSpec {
             density: p.density,
             stiffness: p.stiffness.into(),
             damping: p.damping.into(),
+            masses: MassDistribution::Lumped,
         }
     }
 }
@@ -564,6 +576,7 @@ impl SceneFile {
             density: params.density,
             stiffness: params.stiffness.into(),
             damping: params.damping.into(),
+            masses: self.material.masses,
         };
         file.effects = effects
             .iter()

@@ -22,6 +22,10 @@ pub static BUILTIN_SCENES: &[(&str, &str)] = &[
         "self-fold",
         include_str!("../../assets/scenes/self-fold.toml"),
     ),
+    (
+        "hanging-bench",
+        include_str!("../../assets/scenes/hanging-bench.toml"),
+    ),
 ];
 
 /// The built-in scenes, parsed once. They are part of the program and checked by the test

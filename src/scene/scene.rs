@@ -128,7 +128,7 @@ impl Scene {
                     orientation: GridOrientation::Horizontal,
                     center: Vec3::ZERO,
                 };
-                let mesh = spec.build()?;
+                let mesh = spec.build_with(grid.bend)?;
                 let name = format!("{qx}×{qy}-quad grid, {sx}×{sy} m");
                 (
                     MeshBuild {
@@ -193,7 +193,10 @@ impl Scene {
         place(&mut mesh, orientation, Vec3::from(file.cloth.center));
         let pins = pins(&file.pins, &mesh.positions, orientation)?;
         let params = file.params();
-        let model = ClothModel::new(&mesh, params.density, &pins);
+        let mut model = ClothModel::new(&mesh, params.density, &pins);
+        if file.material.masses != model.masses {
+            model.set_mass_distribution(file.material.masses);
+        }
         let initial = ClothState::at_rest(&model);
         Ok(Scene {
             scenario: file.name.clone(),

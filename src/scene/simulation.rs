@@ -329,6 +329,12 @@ impl Simulation {
         self.backend.substep(&self.model, &mut self.state)
     }
 
+    /// Makes [`Simulation::state`] current when the backend steps a copy of its own (the
+    /// GPU backend between read-backs); a no-op on the CPU.
+    pub fn sync_state(&mut self) {
+        self.backend.sync(&mut self.state);
+    }
+
     /// Wall time per phase since the last call.
     pub fn take_timings(&mut self) -> PhaseTimings {
         self.backend.take_timings()

@@ -64,4 +64,8 @@ pub trait StepBackend: Send {
 
     /// The work of the last self-collision pass, when the scene has self-collision.
     fn self_collision_work(&self) -> Option<super::self_collision::SelfWork>;
+
+    /// Brings `state` up to date with a copy the backend keeps elsewhere (a GPU buffer).
+    /// Backends that step `state` in place have nothing to do.
+    fn sync(&mut self, _state: &mut ClothState) {}
 }

@@ -7,6 +7,7 @@ mod force;
 mod force_set;
 mod gravity;
 mod jacobian;
+mod spring_runs;
 mod springs;
 mod wind;
 

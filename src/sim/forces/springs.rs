@@ -11,6 +11,8 @@ use glam::{Mat3, Vec3};
 
 use crate::cloth::Springs;
 
+use super::spring_runs::SpringRuns;
+
 use super::jacobian::{JacobianMode, SystemMatrix};
 use crate::sim::constraints::DistanceConstraints;
 
@@ -26,6 +28,8 @@ pub struct SpringForce {
     k: Vec<f32>,
     /// Damping of each spring in the range, N·s/m.
     c: Vec<f32>,
+    /// The same springs regrouped for fast force evaluation.
+    runs: SpringRuns,
 }
 
 /// The derivative blocks of one spring.
@@ -56,12 +60,14 @@ impl SpringForce {
         damping: [f32; 3],
     ) -> Self {
         let end = range.end.min(springs.len());
+        let range = range.start.min(end)..end;
         let mut s = Self {
             stiffness,
             damping,
-            range: range.start.min(end)..end,
+            range,
             k: Vec::new(),
             c: Vec::new(),
+            runs: SpringRuns::default(),
         };
         s.expand(springs);
         s
@@ -85,6 +91,17 @@ impl SpringForce {
         let kinds = &springs.kind[self.range.clone()];
         self.k = kinds.iter().map(|k| self.stiffness[k.index()]).collect();
         self.c = kinds.iter().map(|k| self.damping[k.index()]).collect();
+        let r = self.range.clone();
+        let (a, b) = (&springs.a[r.clone()], &springs.b[r.clone()]);
+        let particles = a.iter().chain(b).map(|&p| p as usize + 1).max();
+        self.runs = SpringRuns::new(
+            particles.unwrap_or(0),
+            a,
+            b,
+            &springs.rest[r],
+            &self.k,
+            &self.c,
+        );
     }
 
     /// Each spring's index with its stiffness and damping.
@@ -95,20 +112,10 @@ impl SpringForce {
             .map(|(e, (&k, &c))| (e, k, c))
     }
 
-    /// Adds every spring's force (N) to `f`.
-    pub fn add_forces(&self, springs: &Springs, pos: &[Vec3], vel: &[Vec3], f: &mut [Vec3]) {
-        for (e, k, c) in self.each() {
-            let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
-            let d = pos[b] - pos[a];
-            let len = d.length();
-            if len <= 1e-9 {
-                continue; // coincident ends: no defined direction
-            }
-            let n = d / len;
-            let s = k * (len - springs.rest[e]) + c * (vel[b] - vel[a]).dot(n);
-            f[a] += s * n;
-            f[b] -= s * n;
-        }
+    /// Adds every spring's force (N) to `f`, in parallel for large cloths, with the same
+    /// result on any number of threads (see [`SpringRuns`]).
+    pub fn add_forces(&self, pos: &[Vec3], vel: &[Vec3], f: &mut [Vec3]) {
+        self.runs.add_forces(pos, vel, f);
     }
 
     /// `Σ ½k(|d| − l₀)²`, joules.

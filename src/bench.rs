@@ -1,0 +1,170 @@
+//! The speed benchmark behind `clothsim bench`: the `hanging-bench` scene (the one the peer
+//! frameworks in `../shared/peers` run too) at N × N particles, timed per substep, with the
+//! sag that says whether the speed bought the right answer.
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::scene::{OneOrTwo, Scene, SceneError, Simulation, scenario};
+use crate::sim::IntegratorKind;
+
+/// The bench scene's name.
+pub const BENCH_SCENE: &str = "hanging-bench";
+
+/// Simulated seconds of every bench run (the sag is read at its end).
+pub const BENCH_SECONDS: f64 = 2.0;
+
+/// Sag after 2 s of the reference solution (semi-implicit Euler at `dt = 1/(60 N)`, from
+/// `../shared/peers/scene.py`), metres, by N.
+pub const REFERENCE_SAG: [(u32, f64); 4] =
+    [(32, 0.01055), (64, 0.01247), (128, 0.0135), (256, 0.01478)];
+
+/// How close the sag must be for a speed to count: 1 %, 5 % for implicit Euler and XPBD
+/// (which trade accuracy for their large steps).
+pub fn sag_tolerance(integrator: IntegratorKind) -> f64 {
+    match integrator {
+        IntegratorKind::ImplicitEuler | IntegratorKind::Xpbd => 0.05,
+        _ => 0.01,
+    }
+}
+
+/// Substeps per 1/60 s frame the bench gives each integrator: N (so `dt = 1/(60 N)`, the
+/// scene's definition), five large steps for implicit Euler.
+pub fn bench_substeps(integrator: IntegratorKind, n: u32) -> u32 {
+    match integrator {
+        IntegratorKind::ImplicitEuler => 5,
+        _ => n,
+    }
+}
+
+/// One row of the bench table.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BenchRow {
+    /// Particles per side.
+    pub n: u32,
+    pub integrator: String,
+    pub backend: String,
+    pub threads: usize,
+    pub substeps_per_frame: u32,
+    pub us_per_substep: f64,
+    pub substeps_per_second: f64,
+    /// Downward displacement of the mean of the 4 central particles after 2 s, metres.
+    pub sag_m: f64,
+    /// The reference sag for this N, if known.
+    pub reference_sag_m: Option<f64>,
+    /// |sag − reference| / reference.
+    pub sag_error: Option<f64>,
+    /// Whether the sag is within the integrator's tolerance of the reference.
+    pub sag_ok: Option<bool>,
+    pub finite: bool,
+    /// From building the scene to the end of the first substep, milliseconds.
+    pub startup_ms: f64,
+}
+
+/// The bench scene at `n × n` particles for `integrator`: the built-in file with its grid
+/// and substeps changed.
+///
+/// # Errors
+/// [`SceneError`] if `n < 3`.
+pub fn bench_scene(n: u32, integrator: IntegratorKind) -> Result<Scene, SceneError> {
+    if n < 3 {
+        return Err(SceneError::Pins(format!(
+            "the bench cloth needs at least 3 × 3 particles, got {n}"
+        )));
+    }
+    let mut file = scenario(BENCH_SCENE)
+        .ok_or_else(|| SceneError::UnknownScenario {
+            name: BENCH_SCENE.into(),
+            available: String::new(),
+        })?
+        .clone();
+    if let Some(grid) = file.cloth.grid.as_mut() {
+        grid.quads = OneOrTwo::One(n - 1);
+    }
+    file.solver.integrator = integrator;
+    file.solver.substeps = bench_substeps(integrator, n);
+    // Timed as it stands: nothing rolls back or refines behind the figures.
+    file.solver.guard.enabled = false;
+    Scene::from_file(file, None)
+}
+
+/// The 4 particles nearest the middle of the cloth's rest shape.
+fn central(sim: &Simulation) -> Vec<usize> {
+    let rest = &sim.model().rest_positions;
+    let (lo, hi) = crate::mesh::bounds(rest);
+    let mid = 0.5 * (lo + hi);
+    let mut order: Vec<usize> = (0..rest.len()).collect();
+    order.sort_by(|&a, &b| rest[a].distance(mid).total_cmp(&rest[b].distance(mid)));
+    order.truncate(4);
+    order
+}
+
+/// Runs the bench scene at `n` with `integrator` for [`BENCH_SECONDS`] on the current
+/// rayon pool and times it.
+///
+/// # Errors
+/// [`SceneError`] for a bad `n`.
+pub fn bench_one(n: u32, integrator: IntegratorKind) -> Result<BenchRow, SceneError> {
+    bench_with(n, integrator, |scene| Ok(Simulation::new(scene)), "cpu")
+}
+
+/// As [`bench_one`], with the simulation built by `make` (another backend), named `backend`.
+///
+/// # Errors
+/// [`SceneError`] for a bad `n`, or what `make` returns.
+pub fn bench_with(
+    n: u32,
+    integrator: IntegratorKind,
+    make: impl FnOnce(Scene) -> Result<Simulation, SceneError>,
+    backend: &str,
+) -> Result<BenchRow, SceneError> {
+    let start = Instant::now();
+    let mut sim = make(bench_scene(n, integrator)?)?;
+    let mut finite = sim.substep().is_ok();
+    let startup_ms = start.elapsed().as_secs_f64() * 1e3;
+    let centre = central(&sim);
+    let y0: f64 = centre
+        .iter()
+        .map(|&p| sim.initial().pos[p].y as f64)
+        .sum::<f64>()
+        / 4.0;
+    let substeps = sim.params().substeps;
+    let frames = (BENCH_SECONDS * 60.0).round() as u64;
+    // The first substep is done; run the rest of the first frame, then whole frames.
+    let total = frames * substeps as u64;
+    let timer = Instant::now();
+    for _ in 1..total {
+        if !finite {
+            break;
+        }
+        finite = sim.substep().is_ok();
+    }
+    let wall = timer.elapsed().as_secs_f64();
+    sim.sync_state();
+    finite &= sim.state().is_finite();
+    let y: f64 = centre
+        .iter()
+        .map(|&p| sim.state().pos[p].y as f64)
+        .sum::<f64>()
+        / 4.0;
+    let sag = y0 - y;
+    let reference = REFERENCE_SAG.iter().find(|(m, _)| *m == n).map(|(_, s)| *s);
+    let error = reference.map(|r| (sag - r).abs() / r);
+    let us = wall * 1e6 / (total - 1).max(1) as f64;
+    Ok(BenchRow {
+        n,
+        integrator: integrator.name().to_string(),
+        backend: backend.to_string(),
+        threads: rayon::current_num_threads(),
+        substeps_per_frame: substeps,
+        us_per_substep: us,
+        substeps_per_second: 1e6 / us,
+        sag_m: sag,
+        reference_sag_m: reference,
+        sag_error: error,
+        sag_ok: error.map(|e| finite && e <= sag_tolerance(integrator)),
+        finite,
+        startup_ms,
+    })
+}

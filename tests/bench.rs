@@ -1,0 +1,136 @@
+//! The `hanging-bench` scene is the scene the peer frameworks run (`../shared/peers`): same
+//! particles, springs, masses and pins, and the same sag after 2 s.
+
+use std::process::Command;
+
+use clothsim::bench::{REFERENCE_SAG, bench_one, bench_scene};
+use clothsim::mesh::SpringKind;
+use clothsim::sim::IntegratorKind;
+
+#[test]
+fn bench_scene_has_the_peers_particles_springs_masses_and_pins() {
+    let n = 32usize;
+    let scene = bench_scene(n as u32, IntegratorKind::SemiImplicitEuler).expect("builds");
+    let model = &scene.model;
+    assert_eq!(model.particle_count(), n * n);
+    // The 12-neighbour stencil: (1,0),(0,1) structural, (1,±1) shear, (2,0),(0,2) bend.
+    let s = &model.springs;
+    assert_eq!(s.count(SpringKind::Structural), 2 * n * (n - 1));
+    assert_eq!(s.count(SpringKind::Shear), 2 * (n - 1) * (n - 1));
+    assert_eq!(s.count(SpringKind::Bend), 2 * n * (n - 2));
+    assert_eq!(s.len(), 5826);
+    let h = 1.0 / (n - 1) as f32;
+    for e in 0..s.len() {
+        let (a, b) = (
+            model.rest_positions[s.a[e] as usize],
+            model.rest_positions[s.b[e] as usize],
+        );
+        let d = (b - a).abs();
+        let want = match s.kind[e] {
+            SpringKind::Structural => h,
+            SpringKind::Shear => h * 2f32.sqrt(),
+            // Bend springs skip one particle along a grid line.
+            SpringKind::Bend => 2.0 * h,
+        };
+        assert!(
+            (s.rest[e] - want).abs() < 1e-5,
+            "spring {e} rest {}",
+            s.rest[e]
+        );
+        if s.kind[e] == SpringKind::Bend {
+            assert!(d.x < 1e-5 || d.y < 1e-5, "bend spring {e} is along an axis");
+        }
+    }
+    // Total mass 1 kg shared equally; the top corners pinned, nothing else.
+    for &m in &model.mass {
+        assert!((m * (n * n) as f32 - 1.0).abs() < 1e-5, "mass {m}");
+    }
+    let top = model
+        .rest_positions
+        .iter()
+        .map(|p| p.y)
+        .fold(f32::MIN, f32::max);
+    let pinned: Vec<_> = model
+        .pins
+        .iter()
+        .map(|&p| model.rest_positions[p as usize])
+        .collect();
+    assert_eq!(pinned.len(), 2);
+    for p in pinned {
+        assert!(
+            (p.y - top).abs() < 1e-6 && (p.x.abs() - 0.5).abs() < 1e-6,
+            "{p}"
+        );
+    }
+}
+
+#[test]
+fn bench_sag_matches_the_reference_at_n32() {
+    let row = bench_one(32, IntegratorKind::SemiImplicitEuler).expect("runs");
+    let reference = REFERENCE_SAG[0].1;
+    assert!(row.finite);
+    assert!(
+        (row.sag_m - reference).abs() < 0.01 * reference,
+        "sag {} vs {reference}",
+        row.sag_m
+    );
+    assert_eq!(row.sag_ok, Some(true));
+    assert_eq!(row.substeps_per_frame, 32);
+}
+
+#[test]
+fn bench_cli_prints_one_json_row_per_size_and_thread_count() {
+    let out = Command::new(env!("CARGO_BIN_EXE_clothsim"))
+        .args([
+            "bench",
+            "--sizes",
+            "8,12",
+            "--integrators",
+            "semi-implicit-euler",
+            "--threads",
+            "1,2",
+            "--json",
+        ])
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("one JSON object per line"))
+        .collect();
+    assert_eq!(rows.len(), 4);
+    for row in &rows {
+        for key in [
+            "n",
+            "integrator",
+            "threads",
+            "us_per_substep",
+            "sag_m",
+            "finite",
+        ] {
+            assert!(row.get(key).is_some(), "{key} missing in {row}");
+        }
+        assert_eq!(row["finite"], true);
+        assert!(
+            row["sag_m"].as_f64().expect("number") > 0.0,
+            "the cloth sags"
+        );
+    }
+    let threads: Vec<_> = rows.iter().map(|r| r["threads"].as_u64()).collect();
+    assert_eq!(threads, [Some(1), Some(1), Some(2), Some(2)]);
+    // The same cloth gives the same sag on 1 and 2 threads.
+    assert_eq!(rows[0]["sag_m"], rows[2]["sag_m"]);
+    // A bad size is one clear line, not a panic.
+    let bad = Command::new(env!("CARGO_BIN_EXE_clothsim"))
+        .args(["bench", "--sizes", "2"])
+        .output()
+        .expect("runs");
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(err.contains("--sizes") && err.contains("3..=2048"), "{err}");
+}
