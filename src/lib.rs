@@ -24,6 +24,7 @@
 pub mod app;
 pub mod bench;
 pub mod cloth;
+pub mod gpu;
 pub mod mesh;
 pub mod output;
 pub mod render;

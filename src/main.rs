@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 
+use clothsim::gpu::{Backend, gpu_simulation};
 use clothsim::mesh::{self, GridOrientation, GridSpec, SpringKind};
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::IntegratorKind;
@@ -118,6 +119,9 @@ enum Command {
         /// Print one JSON object per row.
         #[arg(long)]
         json: bool,
+        /// cpu, or gpu (semi-implicit Euler on wgpu compute; --threads does not apply).
+        #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+        backend: Backend,
     },
     /// Write a rectangular grid cloth as an OBJ file (quads: diagonals become shear springs).
     Grid {
@@ -178,6 +182,10 @@ struct RunArgs {
     /// Substeps per frame.
     #[arg(long)]
     substeps: Option<u32>,
+    /// What steps the cloth: cpu (every integrator and effect) or gpu (wgpu compute:
+    /// semi-implicit Euler, springs, gravity, air damping, pins, spheres, planes).
+    #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+    backend: Backend,
     #[command(flatten)]
     import: ImportArgs,
 }
@@ -205,7 +213,14 @@ impl RunArgs {
         for w in &scene.warnings {
             eprintln!("warning: {}: {w}", scene.cloth_name);
         }
-        Ok(Simulation::new(scene))
+        match self.backend {
+            Backend::Cpu => Ok(Simulation::new(scene)),
+            Backend::Gpu => {
+                let (sim, adapter) = gpu_simulation(scene, true)?;
+                eprintln!("note: stepping on the GPU: {adapter}");
+                Ok(sim)
+            }
+        }
     }
 }
 
@@ -297,7 +312,8 @@ fn run(cli: Cli) -> Result<()> {
             integrators,
             threads,
             json,
-        }) => bench(&sizes, &integrators, &threads, json),
+            backend,
+        }) => bench(&sizes, &integrators, &threads, json, backend),
     }
 }
 
@@ -584,6 +600,7 @@ fn bench(
     integrators: &[IntegratorKind],
     threads: &[usize],
     json: bool,
+    backend: Backend,
 ) -> Result<()> {
     if let Some(&n) = sizes.iter().find(|&&n| !(3..=2048).contains(&n)) {
         bail!("--sizes: {n} particles per side is outside 3..=2048");
@@ -604,6 +621,22 @@ fn bench(
             "reference",
         );
     }
+    if backend == Backend::Gpu
+        && let Some(k) = integrators
+            .iter()
+            .find(|&&k| k != IntegratorKind::SemiImplicitEuler)
+    {
+        bail!(
+            "--backend gpu runs semi-implicit Euler only, not {}",
+            k.name()
+        );
+    }
+    // The GPU rows do not depend on the CPU threads: once.
+    let threads = if backend == Backend::Gpu {
+        &threads[..threads.len().min(1)]
+    } else {
+        threads
+    };
     for &t in threads {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(t)
@@ -611,7 +644,20 @@ fn bench(
             .with_context(|| format!("cannot start {t} threads"))?;
         for &n in sizes {
             for &k in integrators {
-                let row = pool.install(|| clothsim::bench::bench_one(n, k))?;
+                let row = pool.install(|| match backend {
+                    Backend::Cpu => Ok(clothsim::bench::bench_one(n, k)?),
+                    Backend::Gpu => clothsim::bench::bench_with(
+                        n,
+                        k,
+                        |scene| {
+                            gpu_simulation(scene, false)
+                                .map(|(sim, _)| sim)
+                                .map_err(|e| clothsim::scene::SceneError::Backend(format!("{e:#}")))
+                        },
+                        "gpu",
+                    )
+                    .map_err(anyhow::Error::from),
+                })?;
                 if json {
                     println!("{}", serde_json::to_string(&row)?);
                 } else {

@@ -69,10 +69,15 @@ impl Gpu {
     }
 
     fn open(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu, RenderError> {
+        // Large cloths on the GPU backend need storage buffers as large as the adapter has.
+        let available = adapter.limits();
+        let mut limits = wgpu::Limits::downlevel_defaults().using_resolution(available.clone());
+        limits.max_storage_buffer_binding_size = available.max_storage_buffer_binding_size;
+        limits.max_buffer_size = available.max_buffer_size;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("clothsim device"),
             required_features: wgpu::Features::empty(),
-            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            required_limits: limits,
             ..Default::default()
         }))
         .map_err(|e| RenderError::Device(e.to_string()))?;

@@ -28,4 +28,7 @@ pub enum SceneError {
     /// The pins do not fit the cloth.
     #[error("{0}")]
     Pins(String),
+    /// The step backend cannot run the scene (or could not start).
+    #[error("{0}")]
+    Backend(String),
 }

@@ -104,8 +104,8 @@ impl SpringForce {
         );
     }
 
-    /// Each spring's index with its stiffness and damping.
-    fn each(&self) -> impl Iterator<Item = (usize, f32, f32)> + '_ {
+    /// Each spring's index (into the model's springs) with its stiffness and damping.
+    pub fn each(&self) -> impl Iterator<Item = (usize, f32, f32)> + '_ {
         self.range
             .clone()
             .zip(self.k.iter().zip(&self.c))

@@ -30,6 +30,9 @@ pub enum StepError {
     /// The solve produced NaN or infinity.
     #[error("the linear solve produced non-finite values after {iterations} iterations")]
     NonFinite { iterations: u32 },
+    /// The backend cannot run what the scene asks for (the GPU backend and wind, say).
+    #[error("{0}")]
+    Unsupported(String),
 }
 
 /// Advances a cloth state by one substep of `h` seconds.

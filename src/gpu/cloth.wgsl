@@ -1,0 +1,155 @@
+// One semi-implicit Euler substep of the mass-spring cloth, one invocation per particle:
+// gather the particle's spring forces (no atomics: each particle sums its own springs),
+// add gravity and air damping, step the velocity then the position, then resolve the
+// sphere and plane colliders against the path of the substep, with friction.
+// Reads `src`, writes `dst`; the host swaps them every substep (ping-pong).
+
+struct Particle {
+    // xyz: position (m); w: inverse mass (1/kg), 0 for a pinned particle.
+    x: vec4<f32>,
+    // xyz: velocity (m/s).
+    v: vec4<f32>,
+}
+
+struct Neighbour {
+    other: u32,
+    rest: f32,
+    k: f32,
+    c: f32,
+}
+
+struct Collider {
+    // x: kind (0 none, 1 sphere, 2 plane); y: radius; z: friction.
+    info: vec4<f32>,
+    // Sphere: centre; plane: a point on it.
+    a: vec4<f32>,
+    // Sphere: angular velocity (rad/s); plane: unit normal.
+    b: vec4<f32>,
+}
+
+struct Params {
+    // xyz: gravity (m/s²); w: substep length h (s).
+    gravity: vec4<f32>,
+    // x: air damping rate (1/s); y: collision offset (m).
+    drag: vec4<f32>,
+    // x: particle count; y: collider count.
+    counts: vec4<u32>,
+    colliders: array<Collider, 4>,
+}
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> src: array<Particle>;
+@group(0) @binding(2) var<storage, read_write> dst: array<Particle>;
+@group(0) @binding(3) var<storage, read> offsets: array<u32>;
+@group(0) @binding(4) var<storage, read> neighbours: array<Neighbour>;
+
+// The first point where the segment a→b (relative to the centre) enters the sphere of
+// radius r, if it starts outside and crosses in during the segment.
+fn first_entry(a: vec3<f32>, b: vec3<f32>, r: f32) -> vec4<f32> {
+    let d = b - a;
+    let aa = dot(a, a);
+    let dd = dot(d, d);
+    if (aa < r * r || dd == 0.0) {
+        return vec4<f32>(0.0);
+    }
+    let half_b = dot(a, d);
+    let disc = half_b * half_b - dd * (aa - r * r);
+    if (half_b >= 0.0 || disc < 0.0) {
+        return vec4<f32>(0.0);
+    }
+    let t = (-half_b - sqrt(disc)) / dd;
+    if (t < 0.0 || t > 1.0) {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(a + t * d, 1.0);
+}
+
+fn unit_or_up(p: vec3<f32>) -> vec3<f32> {
+    let len = length(p);
+    if (len > 1e-9) {
+        return p / len;
+    }
+    return vec3<f32>(0.0, 1.0, 0.0);
+}
+
+@compute @workgroup_size(64)
+fn substep(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i >= params.counts.x) {
+        return;
+    }
+    let me = src[i];
+    let w = me.x.w;
+    if (w == 0.0) {
+        dst[i] = me;
+        return;
+    }
+    let x = me.x.xyz;
+    let v = me.v.xyz;
+    var f = vec3<f32>(0.0);
+    for (var s = offsets[i]; s < offsets[i + 1u]; s = s + 1u) {
+        let nb = neighbours[s];
+        let o = src[nb.other];
+        let d = o.x.xyz - x;
+        let len = length(d);
+        if (len > 1e-9) {
+            let n = d / len;
+            f = f + (nb.k * (len - nb.rest) + nb.c * dot(o.v.xyz - v, n)) * n;
+        }
+    }
+    let h = params.gravity.w;
+    let a = f * w + params.gravity.xyz - params.drag.x * v;
+    var nv = v + a * h;
+    var nx = x + nv * h;
+    let offset = params.drag.y;
+    for (var c = 0u; c < params.counts.y; c = c + 1u) {
+        let col = params.colliders[c];
+        let mu = col.info.z;
+        var caught = false;
+        var n = vec3<f32>(0.0, 1.0, 0.0);
+        var v_surface = vec3<f32>(0.0);
+        if (col.info.x == 1.0) {
+            let centre = col.a.xyz;
+            let radius = col.info.y;
+            let reach = radius + offset;
+            let entry = first_entry(x - centre, nx - centre, reach);
+            let to = nx - centre;
+            if (entry.w == 1.0 || dot(to, to) < reach * reach) {
+                var moved = to;
+                if (entry.w == 1.0) {
+                    let hit = entry.xyz;
+                    let hn = unit_or_up(hit);
+                    let rest = to - hit;
+                    moved = hit + rest - min(dot(rest, hn), 0.0) * hn;
+                }
+                let len = length(moved);
+                n = unit_or_up(moved);
+                nx = centre + n * max(reach, len);
+                v_surface = cross(col.b.xyz, n * radius);
+                caught = true;
+            }
+        } else if (col.info.x == 2.0) {
+            let normal = col.b.xyz;
+            let depth = offset - dot(nx - col.a.xyz, normal);
+            if (depth > 0.0) {
+                nx = nx + depth * normal;
+                n = normal;
+                caught = true;
+            }
+        }
+        if (caught) {
+            let v_rel = nv - v_surface;
+            let vn = dot(v_rel, n);
+            if (vn < 0.0) {
+                let v_t = v_rel - vn * n;
+                let t_speed = length(v_t);
+                var keep = 0.0;
+                if (t_speed > 0.0) {
+                    keep = max(1.0 - mu * (-vn) / t_speed, 0.0);
+                }
+                nv = v_surface + keep * v_t;
+            }
+        }
+    }
+    dst[i] = Particle(vec4<f32>(nx, w), vec4<f32>(nv, 0.0));
+}

@@ -1,0 +1,583 @@
+//! Positions and velocities live in two storage buffers that swap roles every substep
+//! (ping-pong); each particle gathers its own springs over a CSR adjacency, so there are
+//! no atomics and the result does not depend on the order the GPU runs the particles in.
+//! `vec3` arrays would get a 16-byte stride in WGSL, so every vector is stored as a `vec4`
+//! (the position's fourth component carries the inverse mass, 0 for a pin).
+
+use std::time::Instant;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+use crate::cloth::{ClothModel, ClothState};
+use crate::sim::{
+    BendingModel, Collider, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent, IntegratorKind,
+    PhaseTimings, SimParams, StepBackend, StepError, StepReport, StepStats, colliders_of,
+};
+
+/// Particles per workgroup (the shader's `@workgroup_size`).
+const WORKGROUP: u32 = 64;
+/// Colliders the shader has room for.
+const MAX_COLLIDERS: usize = 4;
+
+/// Why the GPU backend cannot run a scene.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum GpuError {
+    #[error("the GPU backend {0}")]
+    Unsupported(String),
+    #[error("the GPU backend could not read its state back: {0}")]
+    Readback(String),
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct Particle {
+    x: [f32; 4],
+    v: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct Neighbour {
+    other: u32,
+    rest: f32,
+    k: f32,
+    c: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GpuCollider {
+    info: [f32; 4],
+    a: [f32; 4],
+    b: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct Params {
+    gravity: [f32; 4],
+    drag: [f32; 4],
+    counts: [u32; 4],
+    colliders: [GpuCollider; MAX_COLLIDERS],
+}
+
+/// What of `params` and `effects` the GPU backend cannot run, if anything: it runs
+/// semi-implicit Euler with gravity, springs (and bend springs), air damping, pins and up
+/// to four sphere and plane colliders.
+pub fn gpu_support(params: &SimParams, effects: &[Effect]) -> Result<(), GpuError> {
+    if params.integrator != IntegratorKind::SemiImplicitEuler {
+        return Err(GpuError::Unsupported(format!(
+            "runs semi-implicit Euler only, not {}",
+            params.integrator.label()
+        )));
+    }
+    for e in effects {
+        let missing = match e {
+            Effect::Wind(_) => Some("wind"),
+            Effect::SelfCollision(_) => Some("self-collision"),
+            Effect::Bending(BendingModel::Dihedral { .. }) => Some("dihedral bending"),
+            _ => None,
+        };
+        if let Some(what) = missing {
+            return Err(GpuError::Unsupported(format!(
+                "has no {what}; run this scene on the CPU backend"
+            )));
+        }
+    }
+    if colliders_of(effects).len() > MAX_COLLIDERS {
+        return Err(GpuError::Unsupported(format!(
+            "takes at most {MAX_COLLIDERS} colliders"
+        )));
+    }
+    Ok(())
+}
+
+/// Steps a cloth with semi-implicit Euler on a wgpu device (see the module documentation).
+pub struct GpuStepper {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    uniform: wgpu::Buffer,
+    /// The two particle buffers; `current` holds the latest state.
+    particles: [wgpu::Buffer; 2],
+    offsets: wgpu::Buffer,
+    neighbours: wgpu::Buffer,
+    /// `groups[i]` reads `particles[i]` and writes the other.
+    groups: [wgpu::BindGroup; 2],
+    readback: wgpu::Buffer,
+    current: usize,
+    count: u32,
+    params: Params,
+    dt: f32,
+    substeps: u32,
+    /// The GPU copy must be replaced by the caller's state before the next step.
+    upload: bool,
+    /// Copy the state back into the caller's after every frame (else only on `sync`).
+    read_every_frame: bool,
+    /// Why the current configuration cannot run, if it cannot.
+    unsupported: Option<String>,
+    timings: PhaseTimings,
+    stats: StepStats,
+}
+
+impl GpuStepper {
+    /// A stepper on `device` for `model` with `params` and `effects`. With
+    /// `read_every_frame`, [`StepBackend::frame`] leaves the new state in the caller's
+    /// [`ClothState`]; without, only [`StepBackend::sync`] does (benchmarks).
+    ///
+    /// # Errors
+    /// [`GpuError::Unsupported`] for an integrator or effect the shader does not have.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        model: &ClothModel,
+        params: &SimParams,
+        effects: &[Effect],
+        read_every_frame: bool,
+    ) -> Result<Self, GpuError> {
+        gpu_support(params, effects)?;
+        let count = model.particle_count() as u32;
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("cloth substep"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("cloth.wgsl").into()),
+        });
+        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cloth substep"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                storage(1, true),
+                storage(2, false),
+                storage(3, true),
+                storage(4, true),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("cloth substep"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("cloth substep"),
+            layout: Some(&pipeline_layout),
+            module: &shader,
+            entry_point: Some("substep"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let bytes = (count.max(1) as u64) * std::mem::size_of::<Particle>() as u64;
+        let particle_buffer = |label| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            })
+        };
+        let particles = [
+            particle_buffer("particles A"),
+            particle_buffer("particles B"),
+        ];
+        let small = |label, size: u64, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size.max(16),
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let uniform = small(
+            "cloth params",
+            std::mem::size_of::<Params>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        let storage_dst = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        let offsets = small("spring offsets", (count as u64 + 1) * 4, storage_dst);
+        let springs: u64 = model.springs.len() as u64 * 2;
+        let neighbours = small(
+            "spring neighbours",
+            springs * std::mem::size_of::<Neighbour>() as u64,
+            storage_dst,
+        );
+        let readback = small(
+            "particles readback",
+            bytes,
+            wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        );
+        let group = |from: usize| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("cloth substep"),
+                layout: &layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: uniform.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: particles[from].as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: particles[1 - from].as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: offsets.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: neighbours.as_entire_binding(),
+                    },
+                ],
+            })
+        };
+        let groups = [group(0), group(1)];
+        let mut stepper = Self {
+            device: device.clone(),
+            queue: queue.clone(),
+            pipeline,
+            layout,
+            uniform,
+            particles,
+            offsets,
+            neighbours,
+            groups,
+            readback,
+            current: 0,
+            count,
+            params: Params::zeroed(),
+            dt: params.dt,
+            substeps: params.substeps.max(1),
+            upload: true,
+            read_every_frame,
+            unsupported: None,
+            timings: PhaseTimings::default(),
+            stats: StepStats::default(),
+        };
+        stepper.configure(model, params, effects);
+        Ok(stepper)
+    }
+
+    /// The buffer holding the latest positions (`vec4` per particle, xyz in metres), for a
+    /// renderer on the same device.
+    pub fn position_buffer(&self) -> &wgpu::Buffer {
+        &self.particles[self.current]
+    }
+
+    /// The bind group layout of the substep shader (for tools that inspect it).
+    pub fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    /// Sends the springs of `forces` as each particle's neighbour list.
+    fn upload_springs(&self, model: &ClothModel, forces: &ForceSet) {
+        let n = self.count as usize;
+        let mut lists: Vec<Vec<Neighbour>> = vec![Vec::new(); n];
+        let s = &model.springs;
+        for term in forces.springs() {
+            for (e, k, c) in term.each() {
+                let (a, b, rest) = (s.a[e] as usize, s.b[e] as usize, s.rest[e]);
+                if a == b || a >= n || b >= n {
+                    continue;
+                }
+                lists[a].push(Neighbour {
+                    other: b as u32,
+                    rest,
+                    k,
+                    c,
+                });
+                lists[b].push(Neighbour {
+                    other: a as u32,
+                    rest,
+                    k,
+                    c,
+                });
+            }
+        }
+        let mut offsets = Vec::with_capacity(n + 1);
+        let mut flat = Vec::new();
+        offsets.push(0u32);
+        for list in &lists {
+            flat.extend_from_slice(list);
+            offsets.push(flat.len() as u32);
+        }
+        self.queue
+            .write_buffer(&self.offsets, 0, bytemuck::cast_slice(&offsets));
+        if !flat.is_empty() {
+            self.queue
+                .write_buffer(&self.neighbours, 0, bytemuck::cast_slice(&flat));
+        }
+    }
+
+    fn upload_state(&mut self, model: &ClothModel, state: &ClothState) {
+        let data: Vec<Particle> = (state.pos.iter().zip(&state.vel))
+            .zip(&model.inv_mass)
+            .map(|((x, v), &w)| Particle {
+                x: [x.x, x.y, x.z, w],
+                v: [v.x, v.y, v.z, 0.0],
+            })
+            .collect();
+        if !data.is_empty() {
+            self.queue.write_buffer(
+                &self.particles[self.current],
+                0,
+                bytemuck::cast_slice(&data),
+            );
+        }
+        self.upload = false;
+    }
+
+    /// Encodes and submits `substeps` substeps.
+    fn run(
+        &mut self,
+        model: &ClothModel,
+        state: &ClothState,
+        substeps: u32,
+    ) -> Result<(), StepError> {
+        if let Some(why) = &self.unsupported {
+            return Err(StepError::Unsupported(why.clone()));
+        }
+        if self.upload {
+            self.upload_state(model, state);
+        }
+        let h = self.dt / self.substeps as f32;
+        self.params.gravity[3] = h;
+        self.queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("cloth substeps"),
+            });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("cloth substeps"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            for _ in 0..substeps {
+                pass.set_bind_group(0, &self.groups[self.current], &[]);
+                pass.dispatch_workgroups(self.count.div_ceil(WORKGROUP), 1, 1);
+                self.current = 1 - self.current;
+            }
+        }
+        self.queue.submit([encoder.finish()]);
+        for _ in 0..substeps {
+            self.stats.record(&StepReport {
+                force_evals: 1,
+                solver_iterations: 0,
+                residual: None,
+                converged: true,
+            });
+        }
+        Ok(())
+    }
+
+    /// Copies the latest state back into `state` (waits for the GPU).
+    fn read_back(&mut self, state: &mut ClothState) -> Result<(), GpuError> {
+        let bytes = self.count as u64 * std::mem::size_of::<Particle>() as u64;
+        if bytes == 0 {
+            return Ok(());
+        }
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("particles readback"),
+            });
+        encoder.copy_buffer_to_buffer(&self.particles[self.current], 0, &self.readback, 0, bytes);
+        self.queue.submit([encoder.finish()]);
+        let slice = self.readback.slice(..bytes);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        rx.recv()
+            .map_err(|e| GpuError::Readback(e.to_string()))?
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        {
+            let view = slice
+                .get_mapped_range()
+                .map_err(|e| GpuError::Readback(e.to_string()))?;
+            let data: &[Particle] = bytemuck::cast_slice(&view);
+            for ((p, x), v) in data.iter().zip(&mut state.pos).zip(&mut state.vel) {
+                *x = Vec3::new(p.x[0], p.x[1], p.x[2]);
+                *v = Vec3::new(p.v[0], p.v[1], p.v[2]);
+            }
+        }
+        self.readback.unmap();
+        Ok(())
+    }
+
+    fn timed_run(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+        substeps: u32,
+    ) -> Result<(), StepError> {
+        let start = Instant::now();
+        self.run(model, state, substeps)?;
+        if self.read_every_frame {
+            self.read_back(state)
+                .map_err(|e| StepError::Unsupported(e.to_string()))?;
+        }
+        self.timings.add("gpu", start.elapsed());
+        Ok(())
+    }
+}
+
+impl StepBackend for GpuStepper {
+    fn name(&self) -> &'static str {
+        "gpu"
+    }
+
+    fn configure(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]) {
+        self.unsupported = gpu_support(params, effects).err().map(|e| e.to_string());
+        let forces = ForceSet::new(model, params, effects);
+        self.upload_springs(model, &forces);
+        let has = |want: fn(&Effect) -> bool| effects.iter().any(want);
+        let g = if has(|e| matches!(e, Effect::Gravity)) {
+            params.gravity
+        } else {
+            Vec3::ZERO
+        };
+        let drag = if has(|e| matches!(e, Effect::AirDamping)) {
+            params.air_damping
+        } else {
+            0.0
+        };
+        let mut out = [GpuCollider::zeroed(); MAX_COLLIDERS];
+        let colliders = colliders_of(effects);
+        for (slot, c) in out.iter_mut().zip(&colliders) {
+            *slot = match *c {
+                Collider::Sphere {
+                    center,
+                    radius,
+                    spin,
+                    friction,
+                } => GpuCollider {
+                    info: [1.0, radius, friction, 0.0],
+                    a: center.extend(0.0).to_array(),
+                    b: spin.extend(0.0).to_array(),
+                },
+                Collider::Plane {
+                    point,
+                    normal,
+                    friction,
+                } => GpuCollider {
+                    info: [2.0, 0.0, friction, 0.0],
+                    a: point.extend(0.0).to_array(),
+                    b: normal.extend(0.0).to_array(),
+                },
+            };
+        }
+        self.params = Params {
+            gravity: [g.x, g.y, g.z, 0.0],
+            drag: [drag, params.collision_offset, 0.0, 0.0],
+            counts: [self.count, colliders.len().min(MAX_COLLIDERS) as u32, 0, 0],
+            colliders: out,
+        };
+        self.dt = params.dt;
+        self.substeps = params.substeps.max(1);
+        // Masses or pins may have changed with the parameters: send the state again.
+        self.upload = true;
+    }
+
+    fn invalidate(&mut self) {
+        self.upload = true;
+    }
+
+    /// One frame of substeps in one submission. The GPU path has no rollback guard (that
+    /// would need a read-back per frame to check); a diverged state shows as non-finite.
+    fn frame(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+    ) -> Result<FrameOutcome, Diverged> {
+        let end = state.time + self.dt as f64;
+        self.timed_run(model, state, self.substeps)
+            .map_err(|e| Diverged {
+                time: state.time,
+                reason: e.to_string(),
+                substeps: self.substeps,
+                fallback: String::new(),
+            })?;
+        state.time = end;
+        Ok(FrameOutcome::Stepped)
+    }
+
+    fn substep(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+    ) -> Result<StepReport, StepError> {
+        self.timed_run(model, state, 1)?;
+        state.time += self.substep_length() as f64;
+        Ok(StepReport {
+            force_evals: 1,
+            solver_iterations: 0,
+            residual: None,
+            converged: true,
+        })
+    }
+
+    fn substeps(&self) -> u32 {
+        self.substeps
+    }
+
+    fn substep_length(&self) -> f32 {
+        self.dt / self.substeps as f32
+    }
+
+    fn take_timings(&mut self) -> PhaseTimings {
+        self.timings.take()
+    }
+
+    fn take_stats(&mut self) -> StepStats {
+        std::mem::take(&mut self.stats)
+    }
+
+    fn take_guard_events(&mut self) -> Vec<GuardEvent> {
+        Vec::new()
+    }
+
+    fn integrator(&self) -> IntegratorKind {
+        IntegratorKind::SemiImplicitEuler
+    }
+
+    fn self_collision_work(&self) -> Option<crate::sim::SelfWork> {
+        None
+    }
+
+    fn sync(&mut self, state: &mut ClothState) {
+        if !self.read_every_frame && !self.upload {
+            // A failed read-back leaves the last state; the next frame reports the trouble.
+            let _ = self.read_back(state);
+        }
+    }
+}
