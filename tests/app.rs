@@ -18,7 +18,9 @@ fn harness() -> Harness<'static, ClothApp> {
 fn harness_sized(width: f32, height: f32) -> Harness<'static, ClothApp> {
     let mut harness = Harness::builder()
         .with_size([width, height])
-        .wgpu()
+        .wgpu_setup(clothsim::app::with_compute_limits(
+            egui_kittest::wgpu::default_wgpu_setup(),
+        ))
         .build_eframe(|cc| {
             let mut app = ClothApp::new(cc.wgpu_render_state.clone(), None);
             // Deterministic: nothing advances unless a test asks.
@@ -634,4 +636,55 @@ fn dragging_the_cloth_pulls_a_particle_and_ctrl_click_pins_it_under_every_integr
             harness.state().messages
         );
     }
+}
+
+#[test]
+fn the_gpu_button_moves_the_cloth_to_the_gpu_and_back_keeping_its_state() {
+    let mut harness = harness();
+    harness.get_by_label("Step").click();
+    harness.run_steps(3);
+    let before = harness.state().sim.state().clone();
+    harness.get_by_label("GPU").click();
+    harness.run_steps(2);
+    assert_eq!(
+        harness.state().sim.backend_name(),
+        "gpu",
+        "{:?}",
+        harness.state().last_error()
+    );
+    // The GPU continues from the CPU's state and steps the same cloth as the CPU would.
+    let mut cpu = clothsim::scene::Simulation::new(harness.state().sim.to_scene());
+    cpu.modify_state(|s| *s = before.clone());
+    cpu.step_frame().expect("cpu frame");
+    harness.get_by_label("Step").click();
+    harness.run_steps(3);
+    let gpu = harness.state().sim.state().clone();
+    assert_eq!(harness.state().sim.frames(), 2);
+    assert_ne!(gpu.pos, before.pos, "the GPU stepped");
+    let worst = gpu
+        .pos
+        .iter()
+        .zip(&cpu.state().pos)
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f32::max);
+    assert!(
+        worst < 1e-5,
+        "GPU and CPU differ by {worst} m after one frame"
+    );
+    harness.get_by_label("CPU").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().sim.backend_name(), "cpu");
+    assert_eq!(
+        harness.state().sim.state().pos,
+        gpu.pos,
+        "the state came back"
+    );
+    // A scene the GPU cannot run stays on the CPU and says why.
+    harness.state_mut().set_scenario("flag");
+    harness.run_steps(1);
+    harness.get_by_label("GPU").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().sim.backend_name(), "cpu");
+    let err = harness.state().last_error().unwrap_or_default().to_string();
+    assert!(err.contains("staying on the CPU"), "{err}");
 }

@@ -185,6 +185,38 @@ impl ClothApp {
         }
     }
 
+    /// Moves the simulation to the CPU or the GPU (the view's device), keeping its state. A
+    /// scene the GPU cannot run is refused with the reason and stays on the CPU.
+    pub fn set_backend(&mut self, backend: crate::gpu::Backend) {
+        use crate::gpu::{Backend, GpuStepper};
+        match backend {
+            Backend::Cpu => {
+                self.sim.use_cpu();
+                self.message(Level::Info, "stepping on the CPU".into());
+            }
+            Backend::Gpu => {
+                let Some(rs) = &self.render_state else {
+                    self.message(
+                        Level::Error,
+                        "no wgpu device: the GPU backend is unavailable".into(),
+                    );
+                    return;
+                };
+                let (model, params, effects) =
+                    (self.sim.model(), self.sim.params(), self.sim.effects());
+                match GpuStepper::new(&rs.device, &rs.queue, model, params, effects, true) {
+                    Ok(stepper) => {
+                        self.sim.set_backend(Box::new(stepper));
+                        let text =
+                            format!("stepping on the GPU ({})", self.adapter().unwrap_or("wgpu"));
+                        self.message(Level::Info, text);
+                    }
+                    Err(e) => self.message(Level::Error, format!("{e}; staying on the CPU")),
+                }
+            }
+        }
+    }
+
     /// Frames the current scene with its default camera.
     pub fn reset_camera(&mut self) {
         self.camera = view::default_camera(&self.sim, self.view_aspect);

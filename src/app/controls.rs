@@ -235,6 +235,24 @@ fn scenario_section(ui: &mut egui::Ui, app: &mut ClothApp) {
 
 fn solver_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     ui.heading("Solver");
+    ui.horizontal(|ui| {
+        ui.label("Backend");
+        let on_gpu = app.sim.backend_name() == "gpu";
+        if ui.selectable_label(!on_gpu, "CPU").clicked() && on_gpu {
+            app.set_backend(crate::gpu::Backend::Cpu);
+        }
+        if ui
+            .selectable_label(on_gpu, "GPU")
+            .on_hover_text(
+                "wgpu compute: semi-implicit Euler, springs, gravity, air damping, pins, spheres \
+                 and planes",
+            )
+            .clicked()
+            && !on_gpu
+        {
+            app.set_backend(crate::gpu::Backend::Gpu);
+        }
+    });
     let mut params = app.sim.params().clone();
     let mut changed = false;
     for kind in IntegratorKind::ALL {

@@ -16,4 +16,4 @@ mod window;
 pub use accuracy::AccuracyWindow;
 pub use cloth_app::{ClothApp, Level, Message, Stats};
 pub use transport::Transport;
-pub use window::run;
+pub use window::{device_descriptor, run, with_compute_limits};

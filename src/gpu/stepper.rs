@@ -138,7 +138,24 @@ impl GpuStepper {
         read_every_frame: bool,
     ) -> Result<Self, GpuError> {
         gpu_support(params, effects)?;
+        let limits = device.limits();
+        let storage = limits.max_storage_buffers_per_shader_stage;
+        if storage < 4 {
+            return Err(GpuError::Unsupported(format!(
+                "needs 4 storage buffers in a compute shader; this device offers {storage}"
+            )));
+        }
         let count = model.particle_count() as u32;
+        let groups = limits.max_compute_workgroups_per_dimension as u64 * WORKGROUP as u64;
+        if limits.max_compute_workgroup_size_x < WORKGROUP
+            || limits.max_compute_invocations_per_workgroup < WORKGROUP
+            || (count as u64) > groups
+        {
+            return Err(GpuError::Unsupported(format!(
+                "needs compute workgroups of {WORKGROUP} for {count} particles, which this \
+                 device does not offer"
+            )));
+        }
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("cloth substep"),
             source: wgpu::ShaderSource::Wgsl(include_str!("cloth.wgsl").into()),

@@ -71,6 +71,21 @@ impl Simulation {
         }
     }
 
+    /// Moves the running simulation to another backend: the state, parameters and effects
+    /// stay; the new backend starts from the current state.
+    pub fn set_backend(&mut self, mut backend: Box<dyn StepBackend>) {
+        self.backend.sync(&mut self.state);
+        backend.configure(&self.model, &self.params, &self.effects);
+        backend.invalidate();
+        self.backend = backend;
+    }
+
+    /// Back on the CPU stepper (from the GPU, say), keeping the state.
+    pub fn use_cpu(&mut self) {
+        let cpu = CpuStepper::new(&self.model, &self.params, &self.effects);
+        self.set_backend(Box::new(cpu));
+    }
+
     pub fn scenario(&self) -> &str {
         &self.scenario
     }
