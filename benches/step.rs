@@ -19,7 +19,11 @@ fn grid(n: u32) -> MeshBuild {
 }
 
 fn frame(c: &mut Criterion) {
-    for scenario in scenarios() {
+    // The bench scene has its own matrix (benches/bench_scene.rs).
+    for scenario in scenarios()
+        .iter()
+        .filter(|s| s.name != clothsim::bench::BENCH_SCENE)
+    {
         let mut group = c.benchmark_group(format!("frame/{}", scenario.name));
         group.sample_size(10);
         for kind in IntegratorKind::ALL {

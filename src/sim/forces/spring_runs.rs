@@ -19,6 +19,10 @@ use rayon::prelude::*;
 
 /// Particles per block (a block is one parallel task).
 const BLOCK: usize = 1024;
+/// Blocks from which the blocks run in parallel. Below, handing blocks to other threads
+/// cost more than it saved on the 2-core machine this was measured on (N = 64 and 128 ran
+/// 10–20 % slower on 2 threads than on 1): from about 180 × 180 particles.
+const PARALLEL_BLOCKS: usize = 32;
 
 /// Springs `start..start + len` (in run order) join `a + j` to `a + off + j`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -167,7 +171,7 @@ impl SpringRuns {
         }
         // Per block: each spring's force, then the block's sums.
         let (p, v) = (&bufs.pos, &bufs.vel);
-        if self.blocks.len() > 1 {
+        if self.blocks.len() >= PARALLEL_BLOCKS {
             (self.blocks.par_iter().zip(bufs.blocks.par_iter_mut()))
                 .for_each(|(block, buf)| self.block_forces(block, p, v, buf));
         } else {
@@ -192,7 +196,7 @@ impl SpringRuns {
                 }
             }
         };
-        if self.blocks.len() > 1 {
+        if self.blocks.len() >= PARALLEL_BLOCKS {
             f[..n].par_chunks_mut(BLOCK).enumerate().for_each(gather);
         } else {
             f[..n].chunks_mut(BLOCK).enumerate().for_each(gather);
