@@ -48,7 +48,7 @@ impl Force {
     ) {
         match self {
             Force::Gravity(g) => g.add_forces(&model.mass, f),
-            Force::Springs(s) | Force::BendSprings(s) => s.add_forces(pos, vel, f),
+            Force::Springs(s) | Force::BendSprings(s) => s.add_forces(&model.springs, pos, vel, f),
             Force::AirDamping(d) => d.add_forces(&model.mass, vel, f),
             Force::Bending(b) => b.add_forces(model, pos, f),
             Force::Wind(w) => w.add_forces(model, pos, vel, t, f),

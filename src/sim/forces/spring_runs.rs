@@ -44,9 +44,13 @@ struct Block {
 }
 
 /// Springs regrouped for the fast path (see the module documentation).
-#[derive(Clone, Debug, PartialEq, Default)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SpringRuns {
     particles: usize,
+    /// For each place in run order, the index of its spring in the caller's arrays.
+    order: Vec<u32>,
+    /// Blocks from which the blocks run in parallel ([`PARALLEL_BLOCKS`]; tests lower it).
+    parallel_from: usize,
     rest: Vec<f32>,
     k: Vec<f32>,
     c: Vec<f32>,
@@ -134,16 +138,40 @@ impl SpringRuns {
                 hi: hi.min(particles).max(lo.min(particles)),
             });
         }
-        let pick = |v: &[f32]| order.iter().map(|&(_, _, e)| v[e]).collect::<Vec<f32>>();
-        Self {
+        let mut runs = Self {
             particles,
-            rest: pick(rest),
-            k: pick(k),
-            c: pick(c),
+            order: order.iter().map(|&(_, _, e)| e as u32).collect(),
+            parallel_from: PARALLEL_BLOCKS,
+            rest: Vec::new(),
+            k: Vec::new(),
+            c: Vec::new(),
             runs,
             blocks,
             scratch: Scratch::default(),
-        }
+        };
+        runs.rest = runs.pick(rest);
+        runs.set_strengths(k, c);
+        runs
+    }
+
+    /// New stiffness and damping per spring (indexed as given to [`SpringRuns::new`]): the
+    /// runs stay, only the values are put in run order again.
+    pub fn set_strengths(&mut self, k: &[f32], c: &[f32]) {
+        self.k = self.pick(k);
+        self.c = self.pick(c);
+    }
+
+    /// `v` (per spring, in the caller's order) in run order.
+    fn pick(&self, v: &[f32]) -> Vec<f32> {
+        self.order.iter().map(|&e| v[e as usize]).collect()
+    }
+
+    /// Runs the blocks in parallel from `blocks` blocks on (tests take the parallel path on
+    /// small cloths with 1).
+    #[cfg(test)]
+    fn parallel_from(mut self, blocks: usize) -> Self {
+        self.parallel_from = blocks;
+        self
     }
 
     /// How many runs the springs fell into (fewer is faster).
@@ -171,7 +199,8 @@ impl SpringRuns {
         }
         // Per block: each spring's force, then the block's sums.
         let (p, v) = (&bufs.pos, &bufs.vel);
-        if self.blocks.len() >= PARALLEL_BLOCKS {
+        let parallel = self.blocks.len() >= self.parallel_from;
+        if parallel {
             (self.blocks.par_iter().zip(bufs.blocks.par_iter_mut()))
                 .for_each(|(block, buf)| self.block_forces(block, p, v, buf));
         } else {
@@ -196,7 +225,7 @@ impl SpringRuns {
                 }
             }
         };
-        if self.blocks.len() >= PARALLEL_BLOCKS {
+        if parallel {
             f[..n].par_chunks_mut(BLOCK).enumerate().for_each(gather);
         } else {
             f[..n].chunks_mut(BLOCK).enumerate().for_each(gather);
@@ -443,16 +472,33 @@ mod tests {
                 want[p]
             );
         }
-        // The same again (buffers reused) and on one thread: identical bits.
+        // The same again (buffers reused), and with the blocks in parallel on one thread and
+        // on two: identical bits.
         let mut again = start.clone();
         runs.add_forces(&pos, &vel, &mut again);
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
-            .build()
-            .unwrap();
-        let mut single = start.clone();
-        pool.install(|| runs.add_forces(&pos, &vel, &mut single));
-        assert_eq!(got, again);
-        assert_eq!(got, single);
+        assert!(got == again, "a rerun changed the forces");
+        let parallel = runs.clone().parallel_from(1);
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut out = start.clone();
+            pool.install(|| parallel.add_forces(&pos, &vel, &mut out));
+            assert!(
+                got == out,
+                "parallel blocks on {threads} threads changed the forces"
+            );
+        }
+        // New strengths without rebuilding the runs: the same as runs built with them.
+        let stiffer: Vec<f32> = k.iter().map(|k| 2.0 * k).collect();
+        let mut changed = runs.clone();
+        changed.set_strengths(&stiffer, &c);
+        let rebuilt = SpringRuns::new(n, &a, &b, &rest, &stiffer, &c);
+        let (mut x, mut y) = (start.clone(), start.clone());
+        changed.add_forces(&pos, &vel, &mut x);
+        rebuilt.add_forces(&pos, &vel, &mut y);
+        assert!(x == y, "new strengths differ from runs built with them");
+        assert!(x != got, "the strengths changed nothing");
     }
 }

@@ -6,6 +6,7 @@
 //! `∂f_b/∂x_a = K_x`), and as matrix-free actions on a vector.
 
 use std::ops::Range;
+use std::sync::OnceLock;
 
 use glam::{Mat3, Vec3};
 
@@ -28,8 +29,20 @@ pub struct SpringForce {
     k: Vec<f32>,
     /// Damping of each spring in the range, N·s/m.
     c: Vec<f32>,
-    /// The same springs regrouped for fast force evaluation.
-    runs: SpringRuns,
+    /// The same springs regrouped for fast force evaluation, built on the first evaluation
+    /// (a term only asked for derivatives or constraints never needs them).
+    runs: LazyRuns,
+}
+
+/// Derived from the springs, so not part of the term's value: clones keep it, comparisons
+/// ignore it.
+#[derive(Clone, Debug, Default)]
+struct LazyRuns(OnceLock<SpringRuns>);
+
+impl PartialEq for LazyRuns {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 /// The derivative blocks of one spring.
@@ -67,7 +80,7 @@ impl SpringForce {
             range,
             k: Vec::new(),
             c: Vec::new(),
-            runs: SpringRuns::default(),
+            runs: LazyRuns::default(),
         };
         s.expand(springs);
         s
@@ -91,17 +104,26 @@ impl SpringForce {
         let kinds = &springs.kind[self.range.clone()];
         self.k = kinds.iter().map(|k| self.stiffness[k.index()]).collect();
         self.c = kinds.iter().map(|k| self.damping[k.index()]).collect();
-        let r = self.range.clone();
-        let (a, b) = (&springs.a[r.clone()], &springs.b[r.clone()]);
-        let particles = a.iter().chain(b).map(|&p| p as usize + 1).max();
-        self.runs = SpringRuns::new(
-            particles.unwrap_or(0),
-            a,
-            b,
-            &springs.rest[r],
-            &self.k,
-            &self.c,
-        );
+        if let Some(runs) = self.runs.0.get_mut() {
+            runs.set_strengths(&self.k, &self.c);
+        }
+    }
+
+    /// The runs of these springs, built the first time they are needed.
+    fn runs(&self, springs: &Springs) -> &SpringRuns {
+        self.runs.0.get_or_init(|| {
+            let r = self.range.clone();
+            let (a, b) = (&springs.a[r.clone()], &springs.b[r.clone()]);
+            let particles = a.iter().chain(b).map(|&p| p as usize + 1).max();
+            SpringRuns::new(
+                particles.unwrap_or(0),
+                a,
+                b,
+                &springs.rest[r],
+                &self.k,
+                &self.c,
+            )
+        })
     }
 
     /// Each spring's index (into the model's springs) with its stiffness and damping.
@@ -114,8 +136,8 @@ impl SpringForce {
 
     /// Adds every spring's force (N) to `f`, in parallel for large cloths, with the same
     /// result on any number of threads (see [`SpringRuns`]).
-    pub fn add_forces(&self, pos: &[Vec3], vel: &[Vec3], f: &mut [Vec3]) {
-        self.runs.add_forces(pos, vel, f);
+    pub fn add_forces(&self, springs: &Springs, pos: &[Vec3], vel: &[Vec3], f: &mut [Vec3]) {
+        self.runs(springs).add_forces(pos, vel, f);
     }
 
     /// `Σ ½k(|d| − l₀)²`, joules.
