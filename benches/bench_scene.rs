@@ -52,7 +52,7 @@ fn matrix(c: &mut Criterion) {
         group.bench_with_input(BenchmarkId::new("sie-frame", n), &n, |b, _| {
             b.iter(|| {
                 let _ = sim.step_frame();
-                sim.sync_state();
+                let _ = sim.sync_state();
             })
         });
     }

@@ -190,10 +190,10 @@ impl ClothApp {
     pub fn set_backend(&mut self, backend: crate::gpu::Backend) {
         use crate::gpu::{Backend, GpuStepper};
         match backend {
-            Backend::Cpu => {
-                self.sim.use_cpu();
-                self.message(Level::Info, "stepping on the CPU".into());
-            }
+            Backend::Cpu => match self.sim.use_cpu() {
+                Ok(()) => self.message(Level::Info, "stepping on the CPU".into()),
+                Err(e) => self.message(Level::Error, format!("{e}; staying on the GPU")),
+            },
             Backend::Gpu => {
                 let Some(rs) = &self.render_state else {
                     self.message(
@@ -206,7 +206,10 @@ impl ClothApp {
                     (self.sim.model(), self.sim.params(), self.sim.effects());
                 match GpuStepper::new(&rs.device, &rs.queue, model, params, effects, true) {
                     Ok(stepper) => {
-                        self.sim.set_backend(Box::new(stepper));
+                        if let Err(e) = self.sim.set_backend(Box::new(stepper)) {
+                            self.message(Level::Error, e.to_string());
+                            return;
+                        }
                         let text =
                             format!("stepping on the GPU ({})", self.adapter().unwrap_or("wgpu"));
                         self.message(Level::Info, text);

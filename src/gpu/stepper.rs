@@ -10,15 +10,23 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
 use crate::cloth::{ClothModel, ClothState};
+use crate::render::map_read;
 use crate::sim::{
-    BendingModel, Collider, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent, IntegratorKind,
-    PhaseTimings, SimParams, StepBackend, StepError, StepReport, StepStats, colliders_of,
+    BendingModel, Collider, Diverged, Effect, ForceSet, FrameOutcome, IntegratorKind, PhaseTimings,
+    SimParams, StepBackend, StepError, StepReport, StepStats, colliders_of,
 };
 
 /// Particles per workgroup (the shader's `@workgroup_size`).
 const WORKGROUP: u32 = 64;
 /// Colliders the shader has room for.
 const MAX_COLLIDERS: usize = 4;
+/// What one GPU substep is: one force evaluation, no solve.
+const SUBSTEP: StepReport = StepReport {
+    force_evals: 1,
+    solver_iterations: 0,
+    residual: None,
+    converged: true,
+};
 
 /// Why the GPU backend cannot run a scene.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -98,7 +106,6 @@ pub struct GpuStepper {
     device: wgpu::Device,
     queue: wgpu::Queue,
     pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
     /// The two particle buffers; `current` holds the latest state.
     particles: [wgpu::Buffer; 2],
@@ -276,7 +283,6 @@ impl GpuStepper {
             device: device.clone(),
             queue: queue.clone(),
             pipeline,
-            layout,
             uniform,
             particles,
             offsets,
@@ -304,41 +310,32 @@ impl GpuStepper {
         &self.particles[self.current]
     }
 
-    /// The bind group layout of the substep shader (for tools that inspect it).
-    pub fn layout(&self) -> &wgpu::BindGroupLayout {
-        &self.layout
-    }
-
-    /// Sends the springs of `forces` as each particle's neighbour list.
+    /// Sends each particle's springs (the model's adjacency, with the strengths of the
+    /// spring terms in `forces`; springs no term covers are left out).
     fn upload_springs(&self, model: &ClothModel, forces: &ForceSet) {
-        let n = self.count as usize;
-        let mut lists: Vec<Vec<Neighbour>> = vec![Vec::new(); n];
         let s = &model.springs;
+        let mut strength: Vec<Option<(f32, f32)>> = vec![None; s.len()];
         for term in forces.springs() {
             for (e, k, c) in term.each() {
-                let (a, b, rest) = (s.a[e] as usize, s.b[e] as usize, s.rest[e]);
-                if a == b || a >= n || b >= n {
-                    continue;
-                }
-                lists[a].push(Neighbour {
-                    other: b as u32,
-                    rest,
-                    k,
-                    c,
-                });
-                lists[b].push(Neighbour {
-                    other: a as u32,
-                    rest,
-                    k,
-                    c,
-                });
+                strength[e] = Some((k, c));
             }
         }
-        let mut offsets = Vec::with_capacity(n + 1);
-        let mut flat = Vec::new();
+        let adj = &model.adjacency;
+        let mut offsets = Vec::with_capacity(self.count as usize + 1);
+        let mut flat = Vec::with_capacity(adj.spring.len());
         offsets.push(0u32);
-        for list in &lists {
-            flat.extend_from_slice(list);
+        for p in 0..self.count as usize {
+            for slot in adj.range(p) {
+                let (e, other) = (adj.spring[slot] as usize, adj.other[slot]);
+                if let Some((k, c)) = strength[e].filter(|_| other as usize != p) {
+                    flat.push(Neighbour {
+                        other,
+                        rest: s.rest[e],
+                        k,
+                        c,
+                    });
+                }
+            }
             offsets.push(flat.len() as u32);
         }
         self.queue
@@ -380,10 +377,6 @@ impl GpuStepper {
         if self.upload {
             self.upload_state(model, state);
         }
-        let h = self.dt / self.substeps as f32;
-        self.params.gravity[3] = h;
-        self.queue
-            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -403,12 +396,7 @@ impl GpuStepper {
         }
         self.queue.submit([encoder.finish()]);
         for _ in 0..substeps {
-            self.stats.record(&StepReport {
-                force_evals: 1,
-                solver_iterations: 0,
-                residual: None,
-                converged: true,
-            });
+            self.stats.record(&SUBSTEP);
         }
         Ok(())
     }
@@ -427,16 +415,7 @@ impl GpuStepper {
         encoder.copy_buffer_to_buffer(&self.particles[self.current], 0, &self.readback, 0, bytes);
         self.queue.submit([encoder.finish()]);
         let slice = self.readback.slice(..bytes);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        rx.recv()
-            .map_err(|e| GpuError::Readback(e.to_string()))?
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        map_read(&self.device, &slice).map_err(|e| GpuError::Readback(e.to_string()))?;
         {
             let view = slice
                 .get_mapped_range()
@@ -461,7 +440,7 @@ impl GpuStepper {
         self.run(model, state, substeps)?;
         if self.read_every_frame {
             self.read_back(state)
-                .map_err(|e| StepError::Unsupported(e.to_string()))?;
+                .map_err(|e| StepError::Device(e.to_string()))?;
         }
         self.timings.add("gpu", start.elapsed());
         Ok(())
@@ -521,6 +500,9 @@ impl StepBackend for GpuStepper {
         };
         self.dt = params.dt;
         self.substeps = params.substeps.max(1);
+        self.params.gravity[3] = self.substep_length();
+        self.queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
         // Masses or pins may have changed with the parameters: send the state again.
         self.upload = true;
     }
@@ -555,12 +537,7 @@ impl StepBackend for GpuStepper {
     ) -> Result<StepReport, StepError> {
         self.timed_run(model, state, 1)?;
         state.time += self.substep_length() as f64;
-        Ok(StepReport {
-            force_evals: 1,
-            solver_iterations: 0,
-            residual: None,
-            converged: true,
-        })
+        Ok(SUBSTEP)
     }
 
     fn substeps(&self) -> u32 {
@@ -579,22 +556,16 @@ impl StepBackend for GpuStepper {
         std::mem::take(&mut self.stats)
     }
 
-    fn take_guard_events(&mut self) -> Vec<GuardEvent> {
-        Vec::new()
-    }
-
     fn integrator(&self) -> IntegratorKind {
         IntegratorKind::SemiImplicitEuler
     }
 
-    fn self_collision_work(&self) -> Option<crate::sim::SelfWork> {
-        None
-    }
-
-    fn sync(&mut self, state: &mut ClothState) {
-        if !self.read_every_frame && !self.upload {
-            // A failed read-back leaves the last state; the next frame reports the trouble.
-            let _ = self.read_back(state);
+    fn sync(&mut self, state: &mut ClothState) -> Result<(), StepError> {
+        // After `invalidate` the caller's state is the newer one.
+        if self.read_every_frame || self.upload {
+            return Ok(());
         }
+        self.read_back(state)
+            .map_err(|e| StepError::Device(e.to_string()))
     }
 }

@@ -28,6 +28,24 @@ pub fn padded_bytes_per_row(width: u32) -> u32 {
     (width * 4).div_ceil(align) * align
 }
 
+/// Maps `slice` of a `MAP_READ` buffer for reading and waits until it is (after the
+/// commands that fill it were submitted).
+///
+/// # Errors
+/// [`RenderError::Readback`] when the device fails or the mapping is refused.
+pub fn map_read(device: &wgpu::Device, slice: &wgpu::BufferSlice<'_>) -> Result<(), RenderError> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| RenderError::Readback(e.to_string()))?;
+    rx.recv()
+        .map_err(|e| RenderError::Readback(e.to_string()))?
+        .map_err(|e| RenderError::Readback(e.to_string()))
+}
+
 /// Copies the target's resolved colour texture to memory (blocks until the GPU is done).
 ///
 /// # Errors
@@ -66,16 +84,7 @@ pub fn read_target(
     );
     queue.submit([encoder.finish()]);
     let slice = buffer.slice(..);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
-    rx.recv()
-        .map_err(|e| RenderError::Readback(e.to_string()))?
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
+    map_read(device, &slice)?;
     let pixels = {
         let view = slice
             .get_mapped_range()

@@ -16,7 +16,9 @@ mod renderer;
 mod target;
 
 pub use camera::OrbitCamera;
-pub use capture::{RgbaImage, padded_bytes_per_row, read_target, save_png, strip_row_padding};
+pub use capture::{
+    RgbaImage, map_read, padded_bytes_per_row, read_target, save_png, strip_row_padding,
+};
 pub use device::{AdapterPreference, Gpu, describe_adapter};
 pub use error::RenderError;
 pub use frame::{Frame, Shape, SpringLines};

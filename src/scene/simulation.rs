@@ -73,17 +73,24 @@ impl Simulation {
 
     /// Moves the running simulation to another backend: the state, parameters and effects
     /// stay; the new backend starts from the current state.
-    pub fn set_backend(&mut self, mut backend: Box<dyn StepBackend>) {
-        self.backend.sync(&mut self.state);
+    ///
+    /// # Errors
+    /// The old backend's state could not be read back; it stays in use.
+    pub fn set_backend(&mut self, mut backend: Box<dyn StepBackend>) -> Result<(), StepError> {
+        self.backend.sync(&mut self.state)?;
         backend.configure(&self.model, &self.params, &self.effects);
         backend.invalidate();
         self.backend = backend;
+        Ok(())
     }
 
     /// Back on the CPU stepper (from the GPU, say), keeping the state.
-    pub fn use_cpu(&mut self) {
+    ///
+    /// # Errors
+    /// As [`Simulation::set_backend`].
+    pub fn use_cpu(&mut self) -> Result<(), StepError> {
         let cpu = CpuStepper::new(&self.model, &self.params, &self.effects);
-        self.set_backend(Box::new(cpu));
+        self.set_backend(Box::new(cpu))
     }
 
     pub fn scenario(&self) -> &str {
@@ -346,8 +353,11 @@ impl Simulation {
 
     /// Makes [`Simulation::state`] current when the backend steps a copy of its own (the
     /// GPU backend between read-backs); a no-op on the CPU.
-    pub fn sync_state(&mut self) {
-        self.backend.sync(&mut self.state);
+    ///
+    /// # Errors
+    /// [`StepError::Device`] when the copy could not be read; the state is then unchanged.
+    pub fn sync_state(&mut self) -> Result<(), StepError> {
+        self.backend.sync(&mut self.state)
     }
 
     /// Wall time per phase since the last call.

@@ -56,16 +56,25 @@ pub trait StepBackend: Send {
     /// Work counters since the last call; resets them.
     fn take_stats(&mut self) -> StepStats;
 
-    /// What the stability guard did since the last call.
-    fn take_guard_events(&mut self) -> Vec<GuardEvent>;
+    /// What the stability guard did since the last call (nothing, for a backend without one).
+    fn take_guard_events(&mut self) -> Vec<GuardEvent> {
+        Vec::new()
+    }
 
     /// The integrator in effect (the guard's fallback may have replaced the requested one).
     fn integrator(&self) -> IntegratorKind;
 
     /// The work of the last self-collision pass, when the scene has self-collision.
-    fn self_collision_work(&self) -> Option<super::self_collision::SelfWork>;
+    fn self_collision_work(&self) -> Option<super::self_collision::SelfWork> {
+        None
+    }
 
     /// Brings `state` up to date with a copy the backend keeps elsewhere (a GPU buffer).
     /// Backends that step `state` in place have nothing to do.
-    fn sync(&mut self, _state: &mut ClothState) {}
+    ///
+    /// # Errors
+    /// [`StepError::Device`] when the copy could not be read; `state` is then unchanged.
+    fn sync(&mut self, _state: &mut ClothState) -> Result<(), StepError> {
+        Ok(())
+    }
 }

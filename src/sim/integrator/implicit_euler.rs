@@ -41,7 +41,7 @@ impl ImplicitEuler {
                 Err(StepError::Breakdown { iterations } | StepError::NonFinite { iterations }) => {
                     (*iterations, None, false)
                 }
-                Err(StepError::Unsupported(_)) => (0, None, false),
+                Err(StepError::Unsupported(_) | StepError::Device(_)) => (0, None, false),
             };
             (out, iterations, residual, converged)
         });

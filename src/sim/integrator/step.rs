@@ -33,6 +33,9 @@ pub enum StepError {
     /// The backend cannot run what the scene asks for (the GPU backend and wind, say).
     #[error("{0}")]
     Unsupported(String),
+    /// The device stepping the cloth failed (a GPU read-back, say).
+    #[error("the device failed: {0}")]
+    Device(String),
 }
 
 /// Advances a cloth state by one substep of `h` seconds.
