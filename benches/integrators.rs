@@ -11,13 +11,10 @@ use clothsim::sim::IntegratorKind;
 
 /// A square grid with `n × n` particles.
 fn grid(n: u32) -> MeshBuild {
-    let mesh = GridSpec::square(n - 1, 1.0, GridOrientation::Horizontal, glam::Vec3::ZERO)
+    GridSpec::square(n - 1, 1.0, GridOrientation::Horizontal, glam::Vec3::ZERO)
         .build()
-        .expect("valid grid");
-    MeshBuild {
-        mesh,
-        warnings: Vec::new(),
-    }
+        .expect("valid grid")
+        .into()
 }
 
 /// Steps taken from one start before it is restored (untimed): long enough to keep the

@@ -12,15 +12,8 @@ fn render(c: &mut Criterion) {
     let mesh = GridSpec::square(99, 1.0, GridOrientation::Horizontal, glam::Vec3::ZERO)
         .build()
         .expect("valid grid");
-    let scene = Scene::with_cloth(
-        "sphere-drop",
-        &MeshBuild {
-            mesh,
-            warnings: Vec::new(),
-        },
-        "grid 100x100",
-    )
-    .expect("registered");
+    let scene = Scene::with_cloth("sphere-drop", &MeshBuild::from(mesh), "grid 100x100")
+        .expect("registered");
     let mut sim = Simulation::new(scene);
     sim.run(1.0);
     let mut off = Offscreen::new(1280, 720, AdapterPreference::Software).expect("software adapter");

@@ -12,15 +12,7 @@ fn small_hanging() -> Scene {
     let mesh = GridSpec::square(8, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
         .build()
         .unwrap();
-    Scene::with_cloth(
-        "hanging",
-        &MeshBuild {
-            mesh,
-            warnings: Vec::new(),
-        },
-        "grid",
-    )
-    .unwrap()
+    Scene::with_cloth("hanging", &MeshBuild::from(mesh), "grid").unwrap()
 }
 
 /// Three steps (1/60 s over 12, 24, 48 substeps), every integrator, 0.2 s.

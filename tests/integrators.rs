@@ -150,10 +150,7 @@ fn undamped_hanging(quads: u32) -> Scene {
     let mesh = GridSpec::square(quads, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
         .build()
         .unwrap();
-    let cloth = MeshBuild {
-        mesh,
-        warnings: Vec::new(),
-    };
+    let cloth = MeshBuild::from(mesh);
     let mut scene = Scene::with_cloth("hanging", &cloth, "grid").unwrap();
     scene.params.air_damping = 0.0;
     scene.params.damping = [0.0; 3];

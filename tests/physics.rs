@@ -233,10 +233,7 @@ fn coarse_cloth() -> clothsim::mesh::MeshBuild {
     )
     .build()
     .unwrap();
-    clothsim::mesh::MeshBuild {
-        mesh,
-        warnings: Vec::new(),
-    }
+    clothsim::mesh::MeshBuild::from(mesh)
 }
 
 #[test]

@@ -18,12 +18,7 @@ impl Adjacency {
     /// Builds the adjacency of `springs` over `particles` particles; each particle's list
     /// is in spring order, so gathers are deterministic.
     pub fn new(particles: usize, springs: &Springs) -> Self {
-        Self::from_pairs(particles, &springs.a, &springs.b)
-    }
-
-    /// The adjacency of the springs `a[e]`–`b[e]` (numbered from 0 in this list) over
-    /// `particles` particles (every index must be below it).
-    pub fn from_pairs(particles: usize, a: &[u32], b: &[u32]) -> Self {
+        let (a, b) = (&springs.a, &springs.b);
         let mut count = vec![0u32; particles + 1];
         for (&a, &b) in a.iter().zip(b) {
             count[a as usize + 1] += 1;

@@ -78,6 +78,16 @@ pub struct MeshBuild {
     pub warnings: Vec<String>,
 }
 
+/// A mesh built in code (a grid): nothing to warn about.
+impl From<ClothMesh> for MeshBuild {
+    fn from(mesh: ClothMesh) -> Self {
+        Self {
+            mesh,
+            warnings: Vec::new(),
+        }
+    }
+}
+
 impl ClothMesh {
     /// Number of mesh edges of the given kind.
     pub fn edge_count(&self, kind: SpringKind) -> usize {

@@ -130,13 +130,7 @@ impl Scene {
                 };
                 let mesh = spec.build_with(grid.bend)?;
                 let name = format!("{qx}×{qy}-quad grid, {sx}×{sy} m");
-                (
-                    MeshBuild {
-                        mesh,
-                        warnings: Vec::new(),
-                    },
-                    name,
-                )
+                (MeshBuild::from(mesh), name)
             }
             (None, None) => unreachable!("SceneFile::check requires a cloth"),
         };
