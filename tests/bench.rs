@@ -134,3 +134,37 @@ fn bench_cli_prints_one_json_row_per_size_and_thread_count() {
     let err = String::from_utf8_lossy(&bad.stderr);
     assert!(err.contains("--sizes") && err.contains("3..=2048"), "{err}");
 }
+
+#[test]
+fn bench_cli_refuses_bad_thread_counts_and_gpu_integrators_in_one_line() {
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_clothsim"))
+            .args(args)
+            .output()
+            .expect("runs");
+        assert!(!out.status.success(), "{args:?} succeeded");
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        err
+    };
+    let err = run(&["bench", "--sizes", "8", "--threads", "0"]);
+    assert!(
+        err.contains("--threads") && err.contains("1..=256"),
+        "{err}"
+    );
+    let err = run(&[
+        "bench",
+        "--sizes",
+        "8",
+        "--backend",
+        "gpu",
+        "--integrators",
+        "rk4",
+    ]);
+    assert!(
+        err.contains("semi-implicit Euler only") && err.contains("rk4"),
+        "{err}"
+    );
+    let err = run(&["bench", "--sizes", "8", "--backend", "tpu"]);
+    assert!(err.contains("--backend"), "{err}");
+}

@@ -17,6 +17,21 @@ fn max_strain(sim: &Simulation) -> f32 {
         .fold(0.0, f32::max)
 }
 
+/// The structural springs stretch by less than `bound` (a fraction of their rest length).
+fn assert_stretch_below(sim: &Simulation, bound: f32) {
+    let strain = max_strain(sim);
+    assert!(strain < bound, "stretched {:.1} %", 100.0 * strain);
+}
+
+/// The run finished: finite, and no error left standing.
+fn assert_finished(summary: &clothsim::scene::RunSummary) {
+    assert!(
+        summary.finite && summary.error.is_none(),
+        "{:?}",
+        summary.error
+    );
+}
+
 /// Whether the segment `a → b` passes closer than `r` to `c`.
 fn segment_enters_sphere(a: Vec3, b: Vec3, c: Vec3, r: f32) -> bool {
     let d = b - a;
@@ -84,7 +99,7 @@ fn stiff_cloth_at_100x_stiffness_with_implicit_euler_stays_calm() {
     let mut sim = Simulation::new(scene);
     let start = sim.energy();
     let summary = sim.run(3.0);
-    assert!(summary.finite && summary.error.is_none(), "{summary:?}");
+    assert_finished(&summary);
     assert!(
         summary.guard_events.is_empty(),
         "{:?}",
@@ -92,11 +107,7 @@ fn stiff_cloth_at_100x_stiffness_with_implicit_euler_stays_calm() {
     );
     assert_passive(start, sim.energy(), "stiff cloth");
     // 40 000 N/m springs hardly stretch under a 0.2 kg cloth.
-    assert!(
-        max_strain(&sim) < 0.01,
-        "stretched {:.2} %",
-        100.0 * max_strain(&sim)
-    );
+    assert_stretch_below(&sim, 0.01);
 }
 
 /// Story: symplectic Euler needs about 30 substeps per frame on the default cloth. At 12
@@ -108,21 +119,13 @@ fn an_explicit_integrator_beyond_its_limit_is_caught_and_the_run_finishes() {
     let mut sim = Simulation::new(scene);
     let start = sim.energy();
     let summary = sim.run(3.0);
-    assert!(
-        summary.finite && summary.error.is_none(),
-        "{:?}",
-        summary.error
-    );
+    assert_finished(&summary);
     let first = summary.guard_events.first().expect("the guard acted");
     assert_eq!(first.substeps_before, 12);
     assert!(first.substeps_after >= 24);
     assert!(first.reason.is_some());
     assert_passive(start, sim.energy(), "after rescue");
-    assert!(
-        max_strain(&sim) < 0.2,
-        "stretched {:.0} %",
-        100.0 * max_strain(&sim)
-    );
+    assert_stretch_below(&sim, 0.2);
 }
 
 #[test]
@@ -229,11 +232,7 @@ fn tiny_and_near_degenerate_triangles_stay_stable_at_the_default_step() {
     let mut sim = Simulation::new(Scene::with_cloth("hanging", &cloth, "tiny.obj").unwrap());
     let start = sim.energy();
     let summary = sim.run(2.0);
-    assert!(
-        summary.finite && summary.error.is_none(),
-        "{:?}",
-        summary.error
-    );
+    assert_finished(&summary);
     // The tiny vertices' masses are floored, so their stiff modes are as slow as the
     // cloth's: no refinement or fallback is needed.
     assert!(
@@ -277,17 +276,9 @@ fn extreme_mass_ratios_between_neighbours_are_carried_through() {
     let mut sim = Simulation::new(scene);
     let start = sim.energy();
     let summary = sim.run(2.0);
-    assert!(
-        summary.finite && summary.error.is_none(),
-        "{:?}",
-        summary.error
-    );
+    assert_finished(&summary);
     assert_passive(start, sim.energy(), "mass ratios");
-    assert!(
-        max_strain(&sim) < 0.3,
-        "stretched {:.0} %",
-        100.0 * max_strain(&sim)
-    );
+    assert_stretch_below(&sim, 0.3);
     // The light particles' modes are 100 times faster than the default cloth's: explicit
     // steps cannot follow them, and the guard says what it did about it.
     assert!(
@@ -410,7 +401,7 @@ fn strong_gusting_wind_flaps_the_flag_hard_without_blowing_up() {
     let (mut strain, mut speed, mut flapping) = (0.0f32, 0.0f32, 0.0f32);
     for _ in 0..10 {
         let summary = sim.run(0.5);
-        assert!(summary.finite && summary.error.is_none(), "{summary:?}");
+        assert_finished(&summary);
         assert!(
             summary.guard_events.is_empty(),
             "{:?}",
