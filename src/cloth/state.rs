@@ -5,7 +5,7 @@ use glam::Vec3;
 use super::model::ClothModel;
 
 /// Positions and velocities at a simulated time. Reset is a copy of the initial state.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Debug, Default, PartialEq)]
 pub struct ClothState {
     /// Metres.
     pub pos: Vec<Vec3>,
@@ -13,6 +13,24 @@ pub struct ClothState {
     pub vel: Vec<Vec3>,
     /// Simulated time, seconds.
     pub time: f64,
+}
+
+/// `clone_from` reuses the buffers (the stepper copies states every frame: frame start,
+/// rollback points); a derived `Clone` would allocate new ones each time.
+impl Clone for ClothState {
+    fn clone(&self) -> Self {
+        Self {
+            pos: self.pos.clone(),
+            vel: self.vel.clone(),
+            time: self.time,
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.pos.clone_from(&source.pos);
+        self.vel.clone_from(&source.vel);
+        self.time = source.time;
+    }
 }
 
 impl ClothState {
@@ -52,5 +70,32 @@ impl ClothState {
             .zip(&model.mass)
             .map(|((p, v), &m)| (m as f64) * ((*p - origin).cross(*v).dot(axis)) as f64)
             .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clone_from_copies_into_the_existing_buffers() {
+        let source = ClothState {
+            pos: vec![Vec3::X, Vec3::Y],
+            vel: vec![Vec3::Z, Vec3::ONE],
+            time: 2.5,
+        };
+        let mut copy = ClothState {
+            pos: Vec::with_capacity(8),
+            vel: Vec::with_capacity(8),
+            time: 0.0,
+        };
+        let (p, v) = (copy.pos.as_ptr(), copy.vel.as_ptr());
+        copy.clone_from(&source);
+        assert_eq!(copy, source);
+        assert_eq!(
+            (copy.pos.as_ptr(), copy.vel.as_ptr()),
+            (p, v),
+            "no new buffers"
+        );
     }
 }

@@ -15,6 +15,9 @@ pub struct GuardState {
     pub checkpoint: Option<ClothState>,
     /// The next checkpoint, and how many healthy frames it has aged.
     pub candidate: Option<(ClothState, u32)>,
+    /// A retired checkpoint's buffers, reused for the next candidate (no allocation per
+    /// checkpoint in a long run).
+    spare: Option<ClothState>,
     /// Healthy frames since the substeps last changed.
     pub good_frames: u32,
     /// Healthy frames needed before stepping down (doubles after a step down that failed).
@@ -32,6 +35,7 @@ impl GuardState {
             limits: None,
             checkpoint: None,
             candidate: None,
+            spare: None,
             good_frames: 0,
             stepped_down: false,
             events: Vec::new(),
@@ -52,14 +56,21 @@ impl GuardState {
         match &mut self.candidate {
             Some((_, age)) if *age + 1 >= age_needed => {
                 let (state, _) = self.candidate.take().unwrap_or_default();
-                self.checkpoint = Some(state);
+                self.spare = self.checkpoint.replace(state);
             }
             Some((_, age)) => *age += 1,
-            None => self.candidate = Some((start.clone(), 0)),
+            None => self.candidate = Some((self.copy_of(start), 0)),
         }
         if self.checkpoint.is_none() {
-            self.checkpoint = Some(start.clone());
+            self.checkpoint = Some(self.copy_of(start));
         }
+    }
+
+    /// `state` copied into the spare buffers when there are some.
+    fn copy_of(&mut self, state: &ClothState) -> ClothState {
+        let mut copy = self.spare.take().unwrap_or_default();
+        copy.clone_from(state);
+        copy
     }
 
     /// A frame failed: if it came soon after a step down, wait longer before the next one.
