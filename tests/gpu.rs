@@ -5,6 +5,14 @@ use clothsim::gpu::{Backend, gpu_simulation, gpu_support};
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::IntegratorKind;
 
+/// The largest distance between the same particle in `a` and `b`, metres.
+fn farthest(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0, f32::max)
+}
+
 /// Runs `scene` for `seconds` on both backends; the largest distance between the same
 /// particle's positions, and the largest distance any particle moved (for scale).
 fn compare(scene: Scene, frames: usize) -> (f32, f32, Simulation) {
@@ -18,20 +26,8 @@ fn compare(scene: Scene, frames: usize) -> (f32, f32, Simulation) {
     }
     gpu.sync_state().expect("read back");
     assert!((cpu.state().time - gpu.state().time).abs() < 1e-9);
-    let worst = cpu
-        .state()
-        .pos
-        .iter()
-        .zip(&gpu.state().pos)
-        .map(|(a, b)| a.distance(*b))
-        .fold(0.0, f32::max);
-    let moved = cpu
-        .state()
-        .pos
-        .iter()
-        .zip(&start)
-        .map(|(a, b)| a.distance(*b))
-        .fold(0.0, f32::max);
+    let worst = farthest(&cpu.state().pos, &gpu.state().pos);
+    let moved = farthest(&cpu.state().pos, &start);
     (worst, moved, gpu)
 }
 
@@ -117,13 +113,7 @@ fn a_parameter_change_mid_run_reaches_the_gpu() {
         }
     }
     assert_eq!(gpu.substeps(), 24);
-    let worst = cpu
-        .state()
-        .pos
-        .iter()
-        .zip(&gpu.state().pos)
-        .map(|(a, b)| a.distance(*b))
-        .fold(0.0, f32::max);
+    let worst = farthest(&cpu.state().pos, &gpu.state().pos);
     let drift = cpu
         .state()
         .pos
