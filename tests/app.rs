@@ -46,6 +46,14 @@ impl egui::DroppedFile for Dropped {
 
 /// Writes `text` as the file `name`, drops it on the window, waits for the background
 /// import, and lets the UI catch up.
+/// Runs `frames` UI frames, then waits for the stepping thread to finish what it was asked
+/// and shows the result.
+fn run_settled(harness: &mut Harness<'static, ClothApp>, frames: usize) {
+    harness.run_steps(frames);
+    harness.state_mut().settle();
+    harness.run_steps(1);
+}
+
 fn drop_obj(harness: &mut Harness<'static, ClothApp>, name: &str, text: &str) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join(name);
@@ -73,11 +81,11 @@ fn drop_obj(harness: &mut Harness<'static, ClothApp>, name: &str, text: &str) {
 #[test]
 fn switching_scenario_rebuilds_the_cloth() {
     let mut harness = harness();
-    assert_eq!(harness.state().sim.scenario(), "hanging");
-    assert!(harness.state().sim.colliders().is_empty());
+    assert_eq!(harness.state().sim().scenario(), "hanging");
+    assert!(harness.state().sim().colliders().is_empty());
     harness.get_by_label("sphere-drop").click();
     harness.run_steps(2);
-    let sim = &harness.state().sim;
+    let sim = harness.state().sim();
     assert_eq!(sim.scenario(), "sphere-drop");
     assert_eq!(sim.colliders().len(), 2, "sphere and ground");
     assert!(sim.model().pins.is_empty(), "sphere-drop pins nothing");
@@ -89,24 +97,24 @@ fn dropping_a_valid_obj_changes_the_particle_count() {
     let mut harness = harness();
     harness.get_by_label("rotating-sphere").click();
     harness.run_steps(1);
-    assert_eq!(harness.state().sim.model().particle_count(), 625);
+    assert_eq!(harness.state().sim().model().particle_count(), 625);
     let grid = GridSpec::square(8, 0.6, GridOrientation::Horizontal, glam::Vec3::ZERO);
     drop_obj(&mut harness, "small.obj", &grid.to_obj());
     let app = harness.state();
-    assert_eq!(app.sim.model().particle_count(), 81);
+    assert_eq!(app.sim().model().particle_count(), 81);
     assert_eq!(
-        app.sim.scenario(),
+        app.sim().scenario(),
         "rotating-sphere",
         "the new cloth keeps the scenario"
     );
-    assert_eq!(app.sim.colliders().len(), 2, "and its effects");
+    assert_eq!(app.sim().colliders().len(), 2, "and its effects");
     assert!(app.cloth_name().ends_with("small.obj"));
 }
 
 #[test]
 fn dropping_a_malformed_obj_shows_an_error_and_keeps_the_cloth() {
     let mut harness = harness();
-    let before = harness.state().sim.model().particle_count();
+    let before = harness.state().sim().model().particle_count();
     drop_obj(
         &mut harness,
         "broken.obj",
@@ -121,7 +129,7 @@ fn dropping_a_malformed_obj_shows_an_error_and_keeps_the_cloth() {
         error.contains("broken.obj") && error.contains(":4:"),
         "{error}"
     );
-    assert_eq!(harness.state().sim.model().particle_count(), before);
+    assert_eq!(harness.state().sim().model().particle_count(), before);
     // The user sees it.
     harness.get_by_label_contains("broken.obj:4:");
 }
@@ -129,20 +137,20 @@ fn dropping_a_malformed_obj_shows_an_error_and_keeps_the_cloth() {
 #[test]
 fn pause_and_step_advances_exactly_one_frame() {
     let mut harness = harness();
-    let dt = harness.state().sim.params().dt as f64;
-    assert_eq!(harness.state().sim.frames(), 0);
+    let dt = harness.state().sim().params().dt as f64;
+    assert_eq!(harness.state().sim().frames(), 0);
     harness.get_by_label("Step").click();
-    harness.run_steps(3);
-    assert_eq!(harness.state().sim.frames(), 1);
-    assert!((harness.state().sim.state().time - dt).abs() < 1e-9);
+    run_settled(&mut harness, 3);
+    assert_eq!(harness.state().sim().frames(), 1);
+    assert!((harness.state().sim().state().time - dt).abs() < 1e-9);
     assert!(!harness.state().transport.playing);
     harness.get_by_label("Step").click();
-    harness.run_steps(3);
-    assert_eq!(harness.state().sim.frames(), 2);
+    run_settled(&mut harness, 3);
+    assert_eq!(harness.state().sim().frames(), 2);
     harness.get_by_label("Reset").click();
-    harness.run_steps(1);
-    assert_eq!(harness.state().sim.frames(), 0);
-    assert_eq!(harness.state().sim.state().time, 0.0);
+    run_settled(&mut harness, 1);
+    assert_eq!(harness.state().sim().frames(), 0);
+    assert_eq!(harness.state().sim().state().time, 0.0);
 }
 
 #[test]
@@ -184,7 +192,7 @@ fn import_warnings_stay_visible_after_a_drop() {
         "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nv 2 0 0\nv 2 0 1\nf 1 4 3 2\nf 2 3 6 5\nf 2 3 6 5\n";
     let mut harness = harness();
     drop_obj(&mut harness, "twice.obj", obj);
-    assert_eq!(harness.state().sim.model().particle_count(), 6);
+    assert_eq!(harness.state().sim().model().particle_count(), 6);
     harness.get_by_label_contains("duplicate triangle");
 }
 
@@ -230,10 +238,10 @@ fn record_writes_a_numbered_frame_sequence() {
 fn the_accuracy_window_sweeps_in_the_background_and_applies_its_choice() {
     let mut harness = harness();
     // Start from parameters that are not among the sweep's choices.
-    let mut params = harness.state().sim.params().clone();
+    let mut params = harness.state().sim().params().clone();
     params.integrator = clothsim::sim::IntegratorKind::Verlet;
     params.substeps = 24;
-    harness.state_mut().sim.set_params(params).unwrap();
+    harness.state_mut().apply_params(params);
     harness.get_by_label("Accuracy").click();
     harness.run_steps(2);
     assert!(harness.state().accuracy.open);
@@ -256,11 +264,11 @@ fn the_accuracy_window_sweeps_in_the_background_and_applies_its_choice() {
         harness.state().accuracy.is_running(),
         "the sweep runs in the background"
     );
-    let frames = harness.state().sim.frames();
+    let frames = harness.state().sim().frames();
     harness.state_mut().transport.playing = true;
     harness.run_steps(3);
     assert!(
-        harness.state().sim.frames() > frames || harness.state().accuracy.is_running(),
+        harness.state().sim().frames() > frames || harness.state().accuracy.is_running(),
         "the viewport keeps stepping while the sweep runs"
     );
     harness.state_mut().accuracy.wait();
@@ -285,7 +293,7 @@ fn the_accuracy_window_sweeps_in_the_background_and_applies_its_choice() {
     assert_eq!(&choice, cheapest);
     harness.get_by_label("Apply").click();
     harness.run_steps(2);
-    let params = harness.state().sim.params();
+    let params = harness.state().sim().params();
     assert_eq!(params.integrator, choice.integrator);
     assert_eq!(params.substeps, choice.substeps_per_frame.round() as u32);
     assert_ne!(
@@ -299,12 +307,12 @@ fn the_accuracy_window_sweeps_in_the_background_and_applies_its_choice() {
 #[test]
 fn a_bad_parameter_is_refused_and_the_simulation_keeps_its_own() {
     let mut harness = harness();
-    let before = harness.state().sim.params().clone();
+    let before = harness.state().sim().params().clone();
     let mut bad = before.clone();
     bad.dt = f32::NAN;
     harness.state_mut().apply_params(bad);
     harness.run_steps(1);
-    assert_eq!(harness.state().sim.params(), &before);
+    assert_eq!(harness.state().sim().params(), &before);
     let error = harness
         .state()
         .last_error()
@@ -318,7 +326,7 @@ fn a_bad_parameter_is_refused_and_the_simulation_keeps_its_own() {
 fn a_failed_capture_is_reported_and_loses_nothing() {
     let mut harness = harness();
     harness.state_mut().capture_dir = std::path::PathBuf::from("/no/such/folder");
-    let particles = harness.state().sim.model().particle_count();
+    let particles = harness.state().sim().model().particle_count();
     harness.get_by_label("Capture PNG").click();
     harness.run_steps(2);
     harness.state_mut().finish_writes();
@@ -332,7 +340,7 @@ fn a_failed_capture_is_reported_and_loses_nothing() {
         error.contains("/no/such/folder") && error.contains("does not exist"),
         "{error}"
     );
-    assert_eq!(harness.state().sim.model().particle_count(), particles);
+    assert_eq!(harness.state().sim().model().particle_count(), particles);
     // The app goes on: a capture to a good folder works.
     let dir = tempfile::tempdir().unwrap();
     harness.state_mut().capture_dir = dir.path().to_path_buf();
@@ -345,12 +353,12 @@ fn a_failed_capture_is_reported_and_loses_nothing() {
 #[test]
 fn the_guard_acting_is_shown_to_the_user() {
     let mut harness = harness();
-    let mut params = harness.state().sim.params().clone();
+    let mut params = harness.state().sim().params().clone();
     params.substeps = 12;
     harness.state_mut().apply_params(params);
     for _ in 0..3 {
         harness.get_by_label("Step").click();
-        harness.run_steps(2);
+        run_settled(&mut harness, 2);
     }
     let app = harness.state();
     assert!(
@@ -360,7 +368,7 @@ fn the_guard_acting_is_shown_to_the_user() {
         "{:?}",
         app.messages
     );
-    assert!(app.sim.substeps() > 12);
+    assert!(app.in_effect().substeps > 12);
     harness.get_by_label_contains("stability guard");
 }
 
@@ -387,7 +395,7 @@ fn dropping_a_scene_file_opens_that_scene_and_a_bad_one_keeps_the_current() {
     .unwrap();
     let mut harness = harness();
     drop_path(&mut harness, &good);
-    let sim = &harness.state().sim;
+    let sim = harness.state().sim();
     assert_eq!(sim.scenario(), "breeze");
     assert_eq!(sim.model().particle_count(), 81);
     assert_eq!(sim.model().pins.len(), 9);
@@ -403,7 +411,7 @@ fn dropping_a_scene_file_opens_that_scene_and_a_bad_one_keeps_the_current() {
     .unwrap();
     drop_path(&mut harness, &bad);
     assert_eq!(
-        harness.state().sim.scenario(),
+        harness.state().sim().scenario(),
         "breeze",
         "the current scene stays"
     );
@@ -433,7 +441,7 @@ fn the_effects_panel_shows_the_scenes_effects_and_adds_and_removes_them() {
     assert!(
         harness
             .state()
-            .sim
+            .sim()
             .effects()
             .iter()
             .any(|e| matches!(e, clothsim::sim::Effect::Wind(_)))
@@ -444,7 +452,7 @@ fn the_effects_panel_shows_the_scenes_effects_and_adds_and_removes_them() {
     harness.run_steps(2);
     harness.get_by_label_contains(" wind ");
     // Remove gravity: the first "Remove" belongs to the first removable effect, gravity.
-    let before = harness.state().sim.effects().len();
+    let before = harness.state().sim().effects().len();
     let removes = harness.query_all_by_label("Remove").count();
     assert_eq!(
         removes,
@@ -453,7 +461,7 @@ fn the_effects_panel_shows_the_scenes_effects_and_adds_and_removes_them() {
     );
     harness.query_all_by_label("Remove").next().unwrap().click();
     harness.run_steps(2);
-    let effects = harness.state().sim.effects().to_vec();
+    let effects = harness.state().sim().effects().to_vec();
     assert_eq!(effects.len(), before - 1);
     assert!(!effects.contains(&clothsim::sim::Effect::Gravity));
     assert!(harness.query_by_label("Gravity").is_none());
@@ -470,12 +478,12 @@ fn save_scene_writes_a_file_that_reopens_as_the_same_setup() {
     harness.get_by_label("Save scene").click();
     harness.run_steps(2);
     assert!(path.is_file(), "{:?}", harness.state().messages);
-    let effects = harness.state().sim.effects().to_vec();
+    let effects = harness.state().sim().effects().to_vec();
     harness.get_by_label("hanging").click();
     harness.run_steps(2);
     drop_path(&mut harness, &path);
-    assert_eq!(harness.state().sim.scenario(), "flag");
-    assert_eq!(harness.state().sim.effects(), &effects[..]);
+    assert_eq!(harness.state().sim().scenario(), "flag");
+    assert_eq!(harness.state().sim().effects(), &effects[..]);
     // An unwritable path is an error and writes nothing.
     harness.state_mut().save_path = "/no/such/dir/s.toml".into();
     harness.get_by_label("Save scene").click();
@@ -502,7 +510,7 @@ fn export_obj_writes_the_cloth_as_it_is_now() {
     harness.run_steps(2);
     let path = dir.path().join("clothsim-export-0001.obj");
     let back = clothsim::mesh::load_obj(&path).expect("a valid OBJ");
-    assert_eq!(back.mesh.positions, harness.state().sim.state().pos);
+    assert_eq!(back.mesh.positions, harness.state().sim().state().pos);
 }
 
 #[test]
@@ -548,7 +556,7 @@ fn point_on_cloth(harness: &Harness<'static, ClothApp>) -> (egui::Pos2, u32) {
             let angle = k as f32 * std::f32::consts::TAU / 16.0;
             let at = centre + egui::vec2(angle.cos(), angle.sin()) * (r as f32 * 8.0);
             if let Some((p, _)) = app.particle_at(rect, at)
-                && !app.sim.model().pins.contains(&p)
+                && !app.sim().model().pins.contains(&p)
             {
                 return (at, p);
             }
@@ -562,7 +570,7 @@ fn dragging_the_cloth_pulls_a_particle_and_ctrl_click_pins_it_under_every_integr
     use clothsim::sim::IntegratorKind;
     let mut harness = harness();
     for kind in IntegratorKind::ALL {
-        let mut params = harness.state().sim.params().clone();
+        let mut params = harness.state().sim().params().clone();
         params.integrator = kind;
         params.substeps = match kind {
             IntegratorKind::ExplicitEuler => 2400,
@@ -574,38 +582,39 @@ fn dragging_the_cloth_pulls_a_particle_and_ctrl_click_pins_it_under_every_integr
         harness.state_mut().reset();
         harness.state_mut().apply_params(params);
         harness.state_mut().transport.playing = true;
-        harness.run_steps(2);
+        run_settled(&mut harness, 2);
         let (at, _) = point_on_cloth(&harness);
         // Press on the cloth and drag 60 points to the right over a few frames.
         harness.hover_at(at);
         harness.run_steps(1);
-        let start = harness.state().sim.state().pos.clone();
+        let start = harness.state().sim().state().pos.clone();
         harness.drag_at(at);
         harness.run_steps(1);
         for k in 1..=6 {
             harness.hover_at(at + egui::vec2(10.0 * k as f32, 0.0));
             harness.run_steps(1);
         }
+        harness.state_mut().settle();
         // The particle picked where the drag began (the cloth moves meanwhile).
         let p = harness
             .state()
-            .sim
+            .sim()
             .grabbed()
             .unwrap_or_else(|| panic!("{kind:?}: nothing held"));
-        let moved = harness.state().sim.state().pos[p as usize] - start[p as usize];
+        let moved = harness.state().sim().state().pos[p as usize] - start[p as usize];
         // The camera looks at the cloth from the front-right: screen-right has +x in it.
         assert!(
             moved.length() > 0.05 && moved.x > 0.0,
             "{kind:?}: moved {moved}"
         );
         harness.drop_at(at + egui::vec2(60.0, 0.0));
-        harness.run_steps(2);
-        assert_eq!(harness.state().sim.grabbed(), None, "{kind:?}: let go");
-        assert_eq!(harness.state().sim.integrator_in_effect(), kind);
+        run_settled(&mut harness, 2);
+        assert_eq!(harness.state().sim().grabbed(), None, "{kind:?}: let go");
+        assert_eq!(harness.state().in_effect().integrator, kind);
 
         // Ctrl-click pins the particle under the pointer; again frees it.
-        harness.state_mut().transport.pause();
-        harness.run_steps(1);
+        harness.state_mut().set_playing(false);
+        run_settled(&mut harness, 1);
         let (at, p) = point_on_cloth(&harness);
         let ctrl_click = |harness: &mut Harness<'static, ClothApp>| {
             harness.hover_at(at);
@@ -625,13 +634,13 @@ fn dragging_the_cloth_pulls_a_particle_and_ctrl_click_pins_it_under_every_integr
         };
         ctrl_click(&mut harness);
         assert!(
-            harness.state().sim.model().pins.contains(&p),
+            harness.state().sim().model().pins.contains(&p),
             "{kind:?}: pinned"
         );
         harness.get_by_label(&format!("pinned particle {p}"));
         ctrl_click(&mut harness);
         assert!(
-            !harness.state().sim.model().pins.contains(&p),
+            !harness.state().sim().model().pins.contains(&p),
             "{kind:?}: freed {:?}",
             harness.state().messages
         );
@@ -642,24 +651,24 @@ fn dragging_the_cloth_pulls_a_particle_and_ctrl_click_pins_it_under_every_integr
 fn the_gpu_button_moves_the_cloth_to_the_gpu_and_back_keeping_its_state() {
     let mut harness = harness();
     harness.get_by_label("Step").click();
-    harness.run_steps(3);
-    let before = harness.state().sim.state().clone();
+    run_settled(&mut harness, 3);
+    let before = harness.state().sim().state().clone();
     harness.get_by_label("GPU").click();
-    harness.run_steps(2);
+    run_settled(&mut harness, 2);
     assert_eq!(
-        harness.state().sim.backend_name(),
+        harness.state().in_effect().backend,
         "gpu",
         "{:?}",
         harness.state().last_error()
     );
     // The GPU continues from the CPU's state and steps the same cloth as the CPU would.
-    let mut cpu = clothsim::scene::Simulation::new(harness.state().sim.to_scene());
+    let mut cpu = clothsim::scene::Simulation::new(harness.state().sim().to_scene());
     cpu.modify_state(|s| *s = before.clone());
     cpu.step_frame().expect("cpu frame");
     harness.get_by_label("Step").click();
-    harness.run_steps(3);
-    let gpu = harness.state().sim.state().clone();
-    assert_eq!(harness.state().sim.frames(), 2);
+    run_settled(&mut harness, 3);
+    let gpu = harness.state().sim().state().clone();
+    assert_eq!(harness.state().sim().frames(), 2);
     assert_ne!(gpu.pos, before.pos, "the GPU stepped");
     let worst = gpu
         .pos
@@ -672,10 +681,10 @@ fn the_gpu_button_moves_the_cloth_to_the_gpu_and_back_keeping_its_state() {
         "GPU and CPU differ by {worst} m after one frame"
     );
     harness.get_by_label("CPU").click();
-    harness.run_steps(2);
-    assert_eq!(harness.state().sim.backend_name(), "cpu");
+    run_settled(&mut harness, 2);
+    assert_eq!(harness.state().in_effect().backend, "cpu");
     assert_eq!(
-        harness.state().sim.state().pos,
+        harness.state().sim().state().pos,
         gpu.pos,
         "the state came back"
     );
@@ -683,8 +692,24 @@ fn the_gpu_button_moves_the_cloth_to_the_gpu_and_back_keeping_its_state() {
     harness.state_mut().set_scenario("flag");
     harness.run_steps(1);
     harness.get_by_label("GPU").click();
-    harness.run_steps(2);
-    assert_eq!(harness.state().sim.backend_name(), "cpu");
+    run_settled(&mut harness, 2);
+    assert_eq!(harness.state().in_effect().backend, "cpu");
     let err = harness.state().last_error().unwrap_or_default().to_string();
     assert!(err.contains("staying on the CPU"), "{err}");
+}
+
+#[test]
+fn the_antialiasing_setting_redraws_the_view_with_that_many_samples() {
+    // Tall enough that the View section is on screen.
+    let mut harness = harness_sized(1280.0, 2000.0);
+    let most = harness.state().samples_in_use();
+    assert_eq!(harness.state().view_samples(), Some(most));
+    assert!(most > 1, "the software adapter offers MSAA");
+    harness.get_by_label("off").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().view_samples(), Some(1));
+    // Asking for more than the adapter has gives the most it has.
+    harness.state_mut().samples = 16;
+    harness.run_steps(2);
+    assert_eq!(harness.state().view_samples(), Some(most));
 }

@@ -11,7 +11,8 @@ use crate::view;
 
 use super::accuracy::AccuracyWindow;
 use super::background::{Load, PngWriter};
-use super::transport::{STEP_BUDGET_SECONDS, Transport};
+use super::stepping::{InEffect, SimThread, Taken};
+use super::transport::Transport;
 use super::viewport::Viewport;
 
 /// How serious a status message is.
@@ -38,9 +39,20 @@ pub struct Stats {
     pub phase_ms: Vec<(&'static str, f64)>,
 }
 
+/// How long "slower than real time" stays shown after the simulation last fell behind.
+const BEHIND_SHOWN: Duration = Duration::from_secs(1);
+
 /// The eframe application.
 pub struct ClothApp {
-    pub sim: Simulation,
+    /// The UI's replica of the simulation: what is shown and edited. The copy that steps
+    /// lives on its own thread (see [`super::stepping`]); change both through the app's
+    /// methods, never this one alone.
+    pub(super) sim: Simulation,
+    pub(super) stepping: SimThread,
+    /// What the stepping copy has in effect (backend, substeps, integrator).
+    in_effect: InEffect,
+    /// When the simulation last ran slower than real time.
+    last_behind: Option<Instant>,
     /// A cloth the user opened (unplaced, with its name): a scenario switch places it again.
     /// `None`: each scene brings its own cloth.
     pub(super) custom_cloth: Option<(MeshBuild, String)>,
@@ -51,6 +63,11 @@ pub struct ClothApp {
     pub transport: Transport,
     pub camera: OrbitCamera,
     pub options: RenderOptions,
+    /// Antialiasing: MSAA samples per pixel of the 3D view (the quality setting; 1 is the
+    /// fastest on a software adapter).
+    pub samples: u32,
+    /// The MSAA counts the adapter supports, ascending.
+    pub(super) sample_choices: Vec<u32>,
     pub(super) render_state: Option<egui_wgpu::RenderState>,
     /// "name (backend, type)" of the adapter drawing the view, shown in the status bar.
     pub(super) adapter: Option<String>,
@@ -84,7 +101,11 @@ impl ClothApp {
         let scene = Scene::builtin("hanging").unwrap_or_else(|e| unreachable!("{e}"));
         let sim = Simulation::new(scene);
         let camera = view::default_camera(&sim, DEFAULT_ASPECT);
+        let stepping = SimThread::start(sim.fork());
         let mut app = Self {
+            in_effect: stepping.in_effect(),
+            stepping,
+            last_behind: None,
             sim,
             custom_cloth: None,
             view_aspect: DEFAULT_ASPECT,
@@ -92,6 +113,11 @@ impl ClothApp {
             transport: Transport::default(),
             camera,
             options: RenderOptions::default(),
+            samples: DEFAULT_SAMPLES,
+            sample_choices: render_state.as_ref().map_or_else(
+                || vec![1],
+                |rs| crate::render::supported_sample_counts(&rs.adapter),
+            ),
             adapter: render_state
                 .as_ref()
                 .map(|rs| crate::render::describe_adapter(&rs.adapter)),
@@ -153,6 +179,65 @@ impl ClothApp {
         self.sim.cloth_name()
     }
 
+    /// The simulation as the UI shows it: its scene, parameters and effects, and the
+    /// latest state the stepping thread finished.
+    pub fn sim(&self) -> &Simulation {
+        &self.sim
+    }
+
+    /// What the stepping simulation has in effect: its backend, and the substeps and
+    /// integrator the stability guard left in force.
+    pub fn in_effect(&self) -> InEffect {
+        self.in_effect
+    }
+
+    /// Applies `change` to the UI's replica now and to the stepping copy after everything
+    /// sent before it (the same change on the same data: the two stay equal).
+    pub(super) fn edit(&mut self, change: impl Fn(&mut Simulation) + Send + 'static) {
+        change(&mut self.sim);
+        let sent = self.stepping.edit(Box::new(move |s| {
+            change(s);
+            None
+        }));
+        self.report_sent(sent);
+    }
+
+    /// Makes `sim` the simulation, shown and stepped from its state (a new scene or cloth).
+    pub(super) fn replace_sim(&mut self, sim: Simulation) {
+        let copy = sim.fork();
+        self.sim = sim;
+        let sent = self.stepping.edit_state(Box::new(move |s| {
+            *s = copy;
+            None
+        }));
+        self.report_sent(sent);
+    }
+
+    fn report_sent(&mut self, sent: Result<(), String>) {
+        if let Err(e) = sent {
+            self.transport.pause();
+            self.message(Level::Error, e);
+        }
+    }
+
+    /// Plays or pauses; pausing drops the frames already due.
+    pub fn set_playing(&mut self, playing: bool) {
+        if playing {
+            self.transport.playing = true;
+        } else {
+            self.transport.pause();
+            let sent = self.stepping.hold();
+            self.report_sent(sent);
+        }
+    }
+
+    /// Waits until the stepping thread has done everything asked of it and shows the
+    /// result (tests; anything that must see a step's outcome at once).
+    pub fn settle(&mut self) {
+        self.stepping.settle();
+        self.poll_stepping();
+    }
+
     /// Where the 3D view was last drawn, in points (`None` before the first frame or
     /// without a renderer).
     pub fn view_rect(&self) -> Option<egui::Rect> {
@@ -177,7 +262,7 @@ impl ClothApp {
         };
         match scene {
             Ok(scene) => {
-                self.sim = Simulation::new(scene);
+                self.replace_sim(Simulation::new(scene));
                 self.reset_camera();
                 self.recording = None;
             }
@@ -190,10 +275,13 @@ impl ClothApp {
     pub fn set_backend(&mut self, backend: crate::gpu::Backend) {
         use crate::gpu::{Backend, GpuStepper};
         match backend {
-            Backend::Cpu => match self.sim.use_cpu() {
-                Ok(()) => self.message(Level::Info, "stepping on the CPU".into()),
-                Err(e) => self.message(Level::Error, format!("{e}; staying on the GPU")),
-            },
+            Backend::Cpu => {
+                let sent = self.stepping.edit(Box::new(|s| {
+                    (s.use_cpu().err()).map(|e| format!("{e}; staying on the GPU"))
+                }));
+                self.report_sent(sent);
+                self.message(Level::Info, "stepping on the CPU".into());
+            }
             Backend::Gpu => {
                 let Some(rs) = &self.render_state else {
                     self.message(
@@ -206,10 +294,13 @@ impl ClothApp {
                     (self.sim.model(), self.sim.params(), self.sim.effects());
                 match GpuStepper::new(&rs.device, &rs.queue, model, params, effects, true) {
                     Ok(stepper) => {
-                        if let Err(e) = self.sim.set_backend(Box::new(stepper)) {
-                            self.message(Level::Error, e.to_string());
-                            return;
-                        }
+                        // The stepping copy moves to the GPU; the replica never steps.
+                        let sent = self.stepping.edit(Box::new(move |s| {
+                            s.set_backend(Box::new(stepper))
+                                .err()
+                                .map(|e| e.to_string())
+                        }));
+                        self.report_sent(sent);
                         let text =
                             format!("stepping on the GPU ({})", self.adapter().unwrap_or("wgpu"));
                         self.message(Level::Info, text);
@@ -228,16 +319,32 @@ impl ClothApp {
     /// Applies edited parameters to the running simulation; a bad value is reported and
     /// the previous parameters stay.
     pub fn apply_params(&mut self, params: SimParams) {
-        if let Err(e) = self.sim.set_params(params) {
-            self.message(Level::Error, e.to_string());
+        match self.sim.set_params(params.clone()) {
+            Ok(()) => {
+                let sent = self.stepping.edit(Box::new(move |s| {
+                    s.set_params(params).err().map(|e| e.to_string())
+                }));
+                self.report_sent(sent);
+            }
+            Err(e) => self.message(Level::Error, e.to_string()),
         }
     }
 
     /// Applies an edited effect list (collider settings) to the running simulation.
     pub fn apply_effects(&mut self, effects: Vec<Effect>) {
-        for warning in self.sim.set_effects(effects) {
+        for warning in self.sim.set_effects(effects.clone()) {
             self.message(Level::Warning, warning);
         }
+        let sent = self.stepping.edit(Box::new(move |s| {
+            s.set_effects(effects);
+            None
+        }));
+        self.report_sent(sent);
+    }
+
+    /// Turns the scene's pins on or off.
+    pub fn set_pins_enabled(&mut self, enabled: bool) {
+        self.edit(move |s| s.set_pins_enabled(enabled));
     }
 
     /// Back to each scene's own cloth.
@@ -249,44 +356,63 @@ impl ClothApp {
 
     pub fn reset(&mut self) {
         self.sim.reset();
+        let sent = self.stepping.edit_state(Box::new(|s| {
+            s.reset();
+            None
+        }));
+        self.report_sent(sent);
     }
 
     /// Pauses and advances exactly one simulation frame.
     pub fn step_once(&mut self) {
-        self.transport.pause();
-        self.advance(1);
+        self.set_playing(false);
+        let sent = self.stepping.advance(1);
+        self.report_sent(sent);
     }
 
-    /// Steps up to `frames` frames within the wall-clock budget; returns how many ran.
-    fn advance(&mut self, frames: u32) -> u32 {
-        let start = Instant::now();
-        let mut done = 0;
-        while done < frames {
-            let outcome = self.sim.step_frame();
-            for event in self.sim.take_guard_events() {
-                let level = match event.action {
-                    GuardAction::Recovered => Level::Info,
-                    GuardAction::Refined | GuardAction::FellBack { .. } => Level::Warning,
-                    // The error below says it.
-                    GuardAction::GaveUp => continue,
-                };
-                self.message(level, format!("stability guard: {event}"));
-            }
-            if let Err(e) = outcome {
-                self.transport.pause();
-                self.message(Level::Error, format!("{e} Paused."));
-                break;
-            }
-            done += 1;
-            if start.elapsed().as_secs_f64() > STEP_BUDGET_SECONDS {
-                break;
-            }
+    /// Shows what the stepping thread finished: its latest state, the guard's events, a
+    /// frame that failed (which pauses), and the timings.
+    fn poll_stepping(&mut self) {
+        let sim = &mut self.sim;
+        let Taken {
+            stepped,
+            timings,
+            guard_events,
+            failed,
+            notes,
+            behind,
+            in_effect,
+        } = self
+            .stepping
+            .take(|state, frames| sim.adopt_state(state, frames));
+        self.in_effect = in_effect;
+        for event in guard_events {
+            let level = match event.action {
+                GuardAction::Recovered => Level::Info,
+                GuardAction::Refined | GuardAction::FellBack { .. } => Level::Warning,
+                // The failure below says it.
+                GuardAction::GaveUp => continue,
+            };
+            self.message(level, format!("stability guard: {event}"));
         }
-        if done > 0 {
-            let timings = self.sim.take_timings();
-            self.record_timings(timings, done);
+        for note in notes {
+            self.message(Level::Error, note);
         }
-        done
+        if let Some(failed) = failed {
+            self.set_playing(false);
+            self.message(Level::Error, failed);
+        }
+        if stepped > 0 {
+            self.record_timings(timings, stepped);
+        }
+        let now = Instant::now();
+        if behind && self.transport.playing {
+            self.last_behind = Some(now);
+        }
+        self.transport.behind = self.transport.playing
+            && self
+                .last_behind
+                .is_some_and(|t| now.duration_since(t) < BEHIND_SHOWN);
     }
 
     fn record_timings(&mut self, timings: PhaseTimings, frames: u32) {
@@ -306,6 +432,18 @@ impl ClothApp {
             .collect();
     }
 
+    /// The MSAA count in use: the one asked for, or the largest supported below it.
+    pub fn samples_in_use(&self) -> u32 {
+        let fits = self.sample_choices.iter().filter(|&&n| n <= self.samples);
+        fits.max().copied().unwrap_or(1)
+    }
+
+    /// MSAA samples of the 3D view as last drawn (`None` before the first draw or without a
+    /// renderer).
+    pub fn view_samples(&self) -> Option<u32> {
+        self.viewport.as_ref().map(Viewport::samples)
+    }
+
     /// Draws the 3D view into the available space and handles capture.
     fn viewport_ui(&mut self, ui: &mut egui::Ui) {
         let Some(rs) = self.render_state.clone() else {
@@ -318,8 +456,13 @@ impl ClothApp {
             ((size.x * ppp).round() as u32).max(1),
             ((size.y * ppp).round() as u32).max(1),
         );
+        // A new quality setting takes a new target (and pipelines for it).
+        let samples = self.samples_in_use();
+        if let Some(v) = self.viewport.take_if(|v| v.samples() != samples) {
+            v.free(&rs);
+        }
         if self.viewport.is_none() {
-            match Viewport::new(&rs, w, h) {
+            match Viewport::new(&rs, w, h, samples) {
                 Ok(v) => self.viewport = Some(v),
                 Err(e) => {
                     ui.label(format!("3D view unavailable: {e}"));
@@ -370,9 +513,12 @@ impl ClothApp {
         self.poll_loading();
         self.poll_writes();
 
+        self.poll_stepping();
         let due = self.transport.credit(wall_dt, self.sim.params().dt as f64);
-        let done = if due > 0 { self.advance(due) } else { 0 };
-        self.transport.stepped(due, done);
+        if due > 0 {
+            let sent = self.stepping.advance(due);
+            self.report_sent(sent);
+        }
 
         egui::Panel::top("transport").show(ui, |ui| super::controls::transport_bar(ui, self));
         egui::Panel::bottom("status").show(ui, |ui| super::controls::status_bar(ui, self));
@@ -436,6 +582,9 @@ impl eframe::App for ClothApp {
         self.shutdown();
     }
 }
+
+/// MSAA samples asked for at start: smooth edges at a cost a software adapter can carry.
+const DEFAULT_SAMPLES: u32 = 4;
 
 /// Width / height assumed for framing before the 3D view was first drawn.
 const DEFAULT_ASPECT: f32 = 1.4;

@@ -17,11 +17,7 @@ pub fn transport_bar(ui: &mut egui::Ui, app: &mut ClothApp) {
             "Play"
         };
         if ui.button(label).on_hover_text("Space").clicked() {
-            if app.transport.playing {
-                app.transport.pause();
-            } else {
-                app.transport.playing = true;
-            }
+            app.set_playing(!app.transport.playing);
         }
         if ui
             .button("Step")
@@ -84,11 +80,7 @@ pub fn transport_bar(ui: &mut egui::Ui, app: &mut ClothApp) {
         }
     });
     if ui.input(|i| i.key_pressed(egui::Key::Space)) && !ui.ctx().egui_wants_keyboard_input() {
-        if app.transport.playing {
-            app.transport.pause();
-        } else {
-            app.transport.playing = true;
-        }
+        app.set_playing(!app.transport.playing);
     }
 }
 
@@ -228,7 +220,7 @@ fn scenario_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     }
     let mut pins = app.sim.pins_enabled();
     if !app.sim.scenario_pins().is_empty() && ui.checkbox(&mut pins, "Pins").changed() {
-        app.sim.set_pins_enabled(pins);
+        app.set_pins_enabled(pins);
     }
     ui.separator();
 }
@@ -237,7 +229,7 @@ fn solver_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     ui.heading("Solver");
     ui.horizontal(|ui| {
         ui.label("Backend");
-        let on_gpu = app.sim.backend_name() == "gpu";
+        let on_gpu = app.in_effect().backend == "gpu";
         if ui.selectable_label(!on_gpu, "CPU").clicked() && on_gpu {
             app.set_backend(crate::gpu::Backend::Cpu);
         }
@@ -279,7 +271,7 @@ fn solver_section(ui: &mut egui::Ui, app: &mut ClothApp) {
                 .add(egui::DragValue::new(&mut params.substeps).range(1..=2000))
                 .labelled_by(label.id)
                 .changed();
-            let effective = app.sim.substeps();
+            let effective = app.in_effect().substeps;
             if effective != params.substeps {
                 ui.label(
                     RichText::new(format!("in effect: {effective}"))
@@ -290,7 +282,7 @@ fn solver_section(ui: &mut egui::Ui, app: &mut ClothApp) {
         });
         ui.end_row();
         ui.label("Substep");
-        ui.label(format!("{:.3} ms", 1e3 * app.sim.substep_length()));
+        ui.label(format!("{:.3} ms", 1e3 * app.in_effect().substep_length));
         ui.end_row();
     });
     if changed {
@@ -359,6 +351,21 @@ fn render_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     });
     ui.checkbox(&mut o.particles, "Particles");
     ui.checkbox(&mut o.colliders, "Colliders");
+    ui.horizontal(|ui| {
+        ui.label("Antialiasing")
+            .on_hover_text("MSAA samples per pixel: fewer draw faster on a software adapter");
+        let in_use = app.samples_in_use();
+        for &n in &app.sample_choices.clone() {
+            let label = if n == 1 {
+                "off".to_string()
+            } else {
+                format!("{n}×")
+            };
+            if ui.selectable_label(in_use == n, label).clicked() {
+                app.samples = n;
+            }
+        }
+    });
     if ui
         .button("Reset view")
         .on_hover_text("or double-click the view")

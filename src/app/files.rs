@@ -52,7 +52,7 @@ impl ClothApp {
                 );
                 // A scene file brings its own cloth.
                 self.custom_cloth = None;
-                self.sim = Simulation::new(*scene);
+                self.replace_sim(Simulation::new(*scene));
                 self.message(Level::Info, text);
                 self.reset_camera();
             }
@@ -88,7 +88,7 @@ impl ClothApp {
         };
         self.message(level, text);
         self.custom_cloth = Some((build, name));
-        self.sim = sim;
+        self.replace_sim(sim);
         self.reset_camera();
     }
 

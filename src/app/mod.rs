@@ -9,11 +9,13 @@ mod effects;
 mod files;
 mod pointer;
 mod record;
+mod stepping;
 mod transport;
 mod viewport;
 mod window;
 
 pub use accuracy::AccuracyWindow;
 pub use cloth_app::{ClothApp, Level, Message, Stats};
+pub use stepping::InEffect;
 pub use transport::Transport;
 pub use window::{device_descriptor, run, with_compute_limits};

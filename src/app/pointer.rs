@@ -42,7 +42,7 @@ impl ClothApp {
             if let Some(at) = response.interact_pointer_pos()
                 && let Some((p, _)) = self.particle_at(rect, at)
             {
-                self.sim.toggle_pin(p);
+                self.edit(move |s| s.toggle_pin(p));
                 let state = if self.sim.model().pins.contains(&p) {
                     "pinned"
                 } else {
@@ -70,13 +70,14 @@ impl ClothApp {
                     let across = direction.dot(grab.plane_normal);
                     if across.abs() > 1e-6 {
                         let t = (grab.plane_point - origin).dot(grab.plane_normal) / across;
-                        self.sim.grab(grab.particle, origin + t * direction);
+                        let (p, target) = (grab.particle, origin + t * direction);
+                        self.edit(move |s| s.grab(p, target));
                     }
                 }
             }
             Some(_) => {
                 self.grab = None;
-                self.sim.release();
+                self.edit(|s| s.release());
             }
             None => {
                 if camera_input(ui, response, &mut self.camera) {

@@ -1,9 +1,6 @@
 //! Play / pause / step and the fixed-step accumulator that turns wall-clock time into whole
 //! simulation frames, so frame-rate hiccups never change the physics.
 
-/// Wall-clock time per UI frame the simulation may use before it is declared behind
-/// (keeps the UI responsive when the simulation cannot keep up).
-pub const STEP_BUDGET_SECONDS: f64 = 0.030;
 /// Longest wall-clock gap credited at once (after a stall the simulation does not race).
 const MAX_CREDIT_SECONDS: f64 = 0.25;
 
@@ -13,8 +10,8 @@ pub struct Transport {
     /// Simulated seconds per wall-clock second.
     pub speed: f32,
     accumulator: f64,
-    /// True when the last update could not step all due frames: the simulation is running
-    /// slower than `speed` × real time.
+    /// True while the simulation runs slower than `speed` × real time (the stepping thread
+    /// owed frames when more became due, or dropped a backlog).
     pub behind: bool,
 }
 
@@ -41,15 +38,6 @@ impl Transport {
         let due = (self.accumulator / frame_dt).floor();
         self.accumulator -= due * frame_dt;
         due as u32
-    }
-
-    /// Reports how many of the due frames were actually stepped; when fewer, the backlog is
-    /// dropped (the simulation runs slower than real time rather than freezing the UI).
-    pub fn stepped(&mut self, due: u32, done: u32) {
-        self.behind = done < due;
-        if self.behind {
-            self.accumulator = 0.0;
-        }
     }
 
     /// Pausing also clears the slow-down warning.
@@ -90,14 +78,5 @@ mod tests {
             25,
             "a 10 s stall credits at most 0.25 s"
         );
-    }
-
-    #[test]
-    fn falling_behind_drops_the_backlog() {
-        let mut t = Transport::default();
-        let due = t.credit(0.2, 0.01);
-        t.stepped(due, 3);
-        assert!(t.behind);
-        assert_eq!(t.credit(0.0, 0.01), 0);
     }
 }

@@ -5,7 +5,6 @@ use egui_wgpu::RenderState;
 
 use crate::render::{
     Frame, OrbitCamera, RenderError, RenderOptions, RenderTarget, Renderer, RgbaImage, read_target,
-    supported_sample_count,
 };
 
 /// Radians of orbit per point dragged.
@@ -20,12 +19,17 @@ pub struct Viewport {
 }
 
 impl Viewport {
-    /// Creates the renderer and a first target on the GUI's device.
+    /// Creates the renderer and a first target with `samples` MSAA samples (one the adapter
+    /// supports) on the GUI's device.
     ///
     /// # Errors
     /// [`RenderError::BadSize`] for an impossible size.
-    pub fn new(rs: &RenderState, width: u32, height: u32) -> Result<Self, RenderError> {
-        let samples = supported_sample_count(&rs.adapter);
+    pub fn new(
+        rs: &RenderState,
+        width: u32,
+        height: u32,
+        samples: u32,
+    ) -> Result<Self, RenderError> {
         let target = RenderTarget::new(&rs.device, width.max(1), height.max(1), samples)?;
         let renderer = Renderer::new(&rs.device, samples);
         let texture = rs.renderer.write().register_native_texture(
@@ -67,6 +71,11 @@ impl Viewport {
         self.renderer
             .render(&rs.device, &rs.queue, &self.target, camera, frame, options);
         Ok(())
+    }
+
+    /// MSAA samples per pixel.
+    pub fn samples(&self) -> u32 {
+        self.target.sample_count()
     }
 
     pub fn texture(&self) -> egui::TextureId {

@@ -26,4 +26,6 @@ pub use gif::GifWriter;
 pub use offscreen::Offscreen;
 pub use options::{RenderOptions, SpringColoring};
 pub use renderer::{CLEAR_COLOR, Renderer, kind_color, strain_color};
-pub use target::{COLOR_FORMAT, DEPTH_FORMAT, RenderTarget, supported_sample_count};
+pub use target::{
+    COLOR_FORMAT, DEPTH_FORMAT, RenderTarget, supported_sample_count, supported_sample_counts,
+};

@@ -22,12 +22,20 @@ pub struct RenderTarget {
 
 /// The largest MSAA count ≤ 4 that both target formats support on this adapter.
 pub fn supported_sample_count(adapter: &wgpu::Adapter) -> u32 {
+    supported_sample_counts(adapter)
+        .last()
+        .copied()
+        .unwrap_or(1)
+}
+
+/// The MSAA counts (1, 2, 4) that both target formats support on this adapter, ascending.
+pub fn supported_sample_counts(adapter: &wgpu::Adapter) -> Vec<u32> {
     let color = adapter.get_texture_format_features(COLOR_FORMAT).flags;
     let depth = adapter.get_texture_format_features(DEPTH_FORMAT).flags;
-    [4, 2]
+    [1, 2, 4]
         .into_iter()
-        .find(|&n| color.sample_count_supported(n) && depth.sample_count_supported(n))
-        .unwrap_or(1)
+        .filter(|&n| n == 1 || color.sample_count_supported(n) && depth.sample_count_supported(n))
+        .collect()
 }
 
 impl RenderTarget {

@@ -84,6 +84,39 @@ impl Simulation {
         Ok(())
     }
 
+    /// An independent copy on a fresh CPU stepper: the same scene, model, state, frame
+    /// count, parameters, effects and pins. What only a backend knows (substeps the guard
+    /// raised, a multi-step integrator's history, timings) starts anew.
+    pub fn fork(&self) -> Simulation {
+        let mut backend = Box::new(CpuStepper::new(&self.model, &self.params, &self.effects));
+        backend.configure(&self.model, &self.params, &self.effects);
+        Simulation {
+            file: self.file.clone(),
+            scenario: self.scenario.clone(),
+            cloth_name: self.cloth_name.clone(),
+            warnings: self.warnings.clone(),
+            scenario_pins: self.scenario_pins.clone(),
+            pins_enabled: self.pins_enabled,
+            toggled_pins: self.toggled_pins.clone(),
+            grabbed: self.grabbed,
+            model: self.model.clone(),
+            initial: self.initial.clone(),
+            state: self.state.clone(),
+            params: self.params.clone(),
+            effects: self.effects.clone(),
+            backend,
+            frames: self.frames,
+        }
+    }
+
+    /// Takes over a state stepped elsewhere (a copy of this simulation on another thread)
+    /// with the frames it had advanced.
+    pub fn adopt_state(&mut self, state: &ClothState, frames: u64) {
+        self.state.clone_from(state);
+        self.frames = frames;
+        self.backend.invalidate();
+    }
+
     /// Back on the CPU stepper (from the GPU, say), keeping the state.
     ///
     /// # Errors

@@ -1,0 +1,486 @@
+//! The simulation's own thread. The UI keeps a replica of the simulation for everything it
+//! shows and edits (parameters, effects, pins, the latest finished state); the stepping
+//! thread owns the copy that steps. Every edit is applied to both, in the order it was made;
+//! the thread steps the frames the UI's clock says are due and publishes each finished
+//! state, which the UI adopts on its next frame. So the UI never waits for a frame to be
+//! computed: a slider or an orbit stays smooth however long a frame takes.
+
+use std::sync::mpsc::{self, Receiver, Sender, TryRecvError};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use crate::cloth::ClothState;
+use crate::scene::Simulation;
+use crate::sim::{GuardEvent, IntegratorKind, PhaseTimings};
+
+/// Frames the stepping thread may owe at most; beyond, the backlog is dropped and the run
+/// is reported as slower than real time (a quarter of a second at 60 frames per second).
+const MAX_BACKLOG: u32 = 15;
+
+/// A change to the simulation; `Some(text)` is an error to show.
+pub(super) type Edit = Box<dyn FnOnce(&mut Simulation) -> Option<String> + Send>;
+
+enum Job {
+    Edit(Edit),
+    /// Frames that became due.
+    Advance(u32),
+    /// Forget the frames owed (paused).
+    Hold,
+    Quit,
+}
+
+/// What the stepping thread's copy has in effect now.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InEffect {
+    /// "cpu" or "gpu".
+    pub backend: &'static str,
+    /// Substeps per frame: the requested count, or more if the guard raised it.
+    pub substeps: u32,
+    /// The substep, seconds.
+    pub substep_length: f32,
+    /// The requested integrator, or the guard's fallback.
+    pub integrator: IntegratorKind,
+}
+
+impl InEffect {
+    fn of(sim: &Simulation) -> Self {
+        Self {
+            backend: sim.backend_name(),
+            substeps: sim.substeps(),
+            substep_length: sim.substep_length(),
+            integrator: sim.integrator_in_effect(),
+        }
+    }
+}
+
+/// What the stepping thread reports; the UI takes it once per frame.
+pub(super) struct Report {
+    /// Jobs done, in the order sent.
+    pub done: u64,
+    /// No frames owed: the thread waits for the next job.
+    pub idle: bool,
+    /// The latest finished state, the frames at it, and the jobs done when it was
+    /// published; `fresh` until the UI took it.
+    pub state: ClothState,
+    pub frames: u64,
+    pub state_done: u64,
+    pub fresh: bool,
+    /// Frames stepped, their timings and guard events since the UI last took them.
+    pub stepped: u32,
+    pub timings: PhaseTimings,
+    pub guard_events: Vec<GuardEvent>,
+    /// A frame that could not be stepped (the thread stopped stepping until asked again).
+    pub failed: Option<String>,
+    /// Errors from edits (a backend that could not be changed).
+    pub notes: Vec<String>,
+    /// Since the UI last looked, frames became due while more than one was still owed, or
+    /// a backlog was dropped: the simulation runs slower than real time.
+    pub behind: bool,
+    pub in_effect: InEffect,
+}
+
+struct Shared {
+    report: Mutex<Report>,
+    changed: Condvar,
+}
+
+impl Shared {
+    fn lock(&self) -> MutexGuard<'_, Report> {
+        self.report.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// The stepping thread and the UI's end of it.
+pub(super) struct SimThread {
+    jobs: Sender<Job>,
+    shared: Arc<Shared>,
+    handle: Option<JoinHandle<()>>,
+    /// Jobs sent so far.
+    sent: u64,
+    /// The job count from which published states include the last edit that replaced the
+    /// state outright (a reset, a new scene): earlier ones are not shown.
+    barrier: u64,
+}
+
+impl SimThread {
+    /// Starts a thread stepping `sim` (the UI keeps its own replica).
+    pub fn start(sim: Simulation) -> Self {
+        let shared = Arc::new(Shared {
+            report: Mutex::new(Report {
+                done: 0,
+                idle: true,
+                state: sim.state().clone(),
+                frames: sim.frames(),
+                state_done: 0,
+                fresh: false,
+                stepped: 0,
+                timings: PhaseTimings::default(),
+                guard_events: Vec::new(),
+                failed: None,
+                notes: Vec::new(),
+                behind: false,
+                in_effect: InEffect::of(&sim),
+            }),
+            changed: Condvar::new(),
+        });
+        let (jobs, rx) = mpsc::channel();
+        let worker = Arc::clone(&shared);
+        let handle = std::thread::Builder::new()
+            .name("clothsim-step".into())
+            .spawn(move || run(sim, &rx, &worker))
+            .ok();
+        Self {
+            jobs,
+            shared,
+            handle,
+            sent: 0,
+            barrier: 0,
+        }
+    }
+
+    fn send(&mut self, job: Job) -> Result<(), String> {
+        self.jobs
+            .send(job)
+            .map_err(|_| "the simulation thread stopped; reset or switch scene".to_string())?;
+        self.sent += 1;
+        Ok(())
+    }
+
+    /// Applies `edit` on the stepping thread after everything sent before it.
+    pub fn edit(&mut self, edit: Edit) -> Result<(), String> {
+        self.send(Job::Edit(edit))
+    }
+
+    /// Like [`SimThread::edit`] for an edit that replaces the state outright: states
+    /// finished before it are no longer shown.
+    pub fn edit_state(&mut self, edit: Edit) -> Result<(), String> {
+        self.send(Job::Edit(edit))?;
+        self.barrier = self.sent;
+        Ok(())
+    }
+
+    /// `frames` more frames are due.
+    pub fn advance(&mut self, frames: u32) -> Result<(), String> {
+        self.send(Job::Advance(frames))
+    }
+
+    /// Drops the frames owed.
+    pub fn hold(&mut self) -> Result<(), String> {
+        self.send(Job::Hold)
+    }
+
+    /// The report, with the latest state only if it includes every state-replacing edit.
+    /// Takes what the UI consumes (stepped frames, timings, events, errors).
+    pub fn take(&mut self, mut adopt: impl FnMut(&ClothState, u64)) -> Taken {
+        let mut r = self.shared.lock();
+        if r.fresh && r.state_done >= self.barrier {
+            adopt(&r.state, r.frames);
+            r.fresh = false;
+        }
+        Taken {
+            stepped: std::mem::take(&mut r.stepped),
+            timings: r.timings.take(),
+            guard_events: std::mem::take(&mut r.guard_events),
+            failed: r.failed.take(),
+            notes: std::mem::take(&mut r.notes),
+            behind: std::mem::take(&mut r.behind),
+            in_effect: r.in_effect,
+        }
+    }
+
+    /// What the stepping copy has in effect, as last published.
+    pub fn in_effect(&self) -> InEffect {
+        self.shared.lock().in_effect
+    }
+
+    /// Waits until the thread has done every job sent and owes no frames (tests, and
+    /// anything that must see the result of a step), or it stopped.
+    pub fn settle(&self) {
+        let mut r = self.shared.lock();
+        while !(r.done >= self.sent && r.idle) {
+            if self.handle.as_ref().is_none_or(|h| h.is_finished()) {
+                return;
+            }
+            r = match self
+                .shared
+                .changed
+                .wait_timeout(r, Duration::from_millis(50))
+            {
+                Ok((r, _)) => r,
+                Err(e) => e.into_inner().0,
+            };
+        }
+    }
+}
+
+impl Drop for SimThread {
+    fn drop(&mut self) {
+        let _ = self.jobs.send(Job::Quit);
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+/// What [`SimThread::take`] hands the UI.
+pub(super) struct Taken {
+    pub stepped: u32,
+    pub timings: PhaseTimings,
+    pub guard_events: Vec<GuardEvent>,
+    pub failed: Option<String>,
+    pub notes: Vec<String>,
+    pub behind: bool,
+    pub in_effect: InEffect,
+}
+
+/// The stepping thread: applies jobs in order, steps one owed frame at a time (taking new
+/// jobs between frames) and publishes after each.
+fn run(mut sim: Simulation, jobs: &Receiver<Job>, shared: &Shared) {
+    let (mut owed, mut done) = (0u32, 0u64);
+    loop {
+        let job = if owed == 0 {
+            match jobs.recv() {
+                Ok(job) => Some(job),
+                Err(_) => return,
+            }
+        } else {
+            match jobs.try_recv() {
+                Ok(job) => Some(job),
+                Err(TryRecvError::Empty) => None,
+                Err(TryRecvError::Disconnected) => return,
+            }
+        };
+        let mut published = Published::default();
+        match job {
+            Some(Job::Quit) => return,
+            Some(Job::Edit(edit)) => {
+                done += 1;
+                published.note = edit(&mut sim);
+                published.state = true;
+            }
+            Some(Job::Advance(n)) => {
+                done += 1;
+                let want = owed.saturating_add(n);
+                published.behind = owed > 1 || want > MAX_BACKLOG;
+                owed = want.min(MAX_BACKLOG);
+            }
+            Some(Job::Hold) => {
+                done += 1;
+                owed = 0;
+            }
+            None => {
+                owed -= 1;
+                let outcome = sim.step_frame();
+                published.stepped = true;
+                published.state = true;
+                if let Err(e) = outcome {
+                    owed = 0;
+                    published.failed = Some(format!("{e} Paused."));
+                }
+            }
+        }
+        published.write(&mut sim, shared, done, owed);
+    }
+}
+
+/// What one pass of the stepping loop has to publish.
+#[derive(Default)]
+struct Published {
+    state: bool,
+    stepped: bool,
+    behind: bool,
+    failed: Option<String>,
+    note: Option<String>,
+}
+
+impl Published {
+    fn write(self, sim: &mut Simulation, shared: &Shared, done: u64, owed: u32) {
+        let (timings, events) = if self.stepped {
+            (sim.take_timings(), sim.take_guard_events())
+        } else {
+            (PhaseTimings::default(), Vec::new())
+        };
+        {
+            let mut r = shared.lock();
+            r.done = done;
+            r.idle = owed == 0;
+            if self.state {
+                r.state.clone_from(sim.state());
+                r.frames = sim.frames();
+                r.state_done = done;
+                r.fresh = true;
+            }
+            if self.stepped {
+                r.stepped += 1;
+                r.timings.merge(&timings);
+                r.guard_events.extend(events);
+            }
+            if let Some(f) = self.failed {
+                r.failed = Some(f);
+            }
+            r.notes.extend(self.note);
+            r.behind |= self.behind;
+            r.in_effect = InEffect::of(sim);
+        }
+        shared.changed.notify_all();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    fn hanging() -> Simulation {
+        Simulation::new(Scene::builtin("hanging").unwrap())
+    }
+
+    /// The replica's view of the thread after it settled: the adopted state and frames.
+    fn settled(thread: &mut SimThread, replica: &mut Simulation) -> Taken {
+        thread.settle();
+        thread.take(|state, frames| replica.adopt_state(state, frames))
+    }
+
+    #[test]
+    fn frames_stepped_on_the_thread_are_the_frames_a_direct_run_steps() {
+        let mut direct = hanging();
+        let mut replica = hanging();
+        let mut thread = SimThread::start(replica.fork());
+        // An edit takes effect at the next frame boundary after it arrives: here, after the
+        // third frame.
+        thread.advance(3).unwrap();
+        thread.settle();
+        thread
+            .edit(Box::new(|s| {
+                let mut p = s.params().clone();
+                p.air_damping = 2.0;
+                s.set_params(p).err().map(|e| e.to_string())
+            }))
+            .unwrap();
+        thread.advance(2).unwrap();
+        let taken = settled(&mut thread, &mut replica);
+        for _ in 0..3 {
+            direct.step_frame().unwrap();
+        }
+        let mut p = direct.params().clone();
+        p.air_damping = 2.0;
+        direct.set_params(p).unwrap();
+        for _ in 0..2 {
+            direct.step_frame().unwrap();
+        }
+        assert_eq!(replica.frames(), 5);
+        assert_eq!(taken.stepped, 5);
+        let same =
+            replica.state().pos == direct.state().pos && replica.state().vel == direct.state().vel;
+        assert!(same, "the thread's frames differ from a direct run's");
+        assert!(taken.timings.get("springs").is_some_and(|p| p.calls > 0));
+        assert!(!taken.behind);
+    }
+
+    #[test]
+    fn a_state_from_before_a_reset_is_never_shown() {
+        let mut replica = hanging();
+        let mut thread = SimThread::start(replica.fork());
+        // The thread is held inside an edit while it has a stepped state published.
+        thread.advance(2).unwrap();
+        thread.settle();
+        let (go, wait) = mpsc::channel::<()>();
+        thread
+            .edit(Box::new(move |_| {
+                let _ = wait.recv();
+                None
+            }))
+            .unwrap();
+        replica.reset();
+        thread
+            .edit_state(Box::new(|s| {
+                s.reset();
+                None
+            }))
+            .unwrap();
+        // The published state has 2 frames but predates the reset: not adopted.
+        let mut adopted = false;
+        let _ = thread.take(|_, _| adopted = true);
+        assert!(!adopted, "a stale state was shown");
+        assert_eq!(replica.frames(), 0);
+        go.send(()).unwrap();
+        settled(&mut thread, &mut replica);
+        assert_eq!(replica.frames(), 0);
+        assert_eq!(replica.state().pos, replica.initial().pos);
+    }
+
+    /// Story: the UI must never wait for the simulation. With the thread stuck in a long
+    /// frame (here: held inside an edit), the UI still takes reports at once and its edits
+    /// queue; they are applied, in order, when the thread is free.
+    #[test]
+    fn the_ui_never_waits_for_a_busy_simulation() {
+        let mut replica = hanging();
+        let mut thread = SimThread::start(replica.fork());
+        let (go, wait) = mpsc::channel::<()>();
+        thread
+            .edit(Box::new(move |_| {
+                let _ = wait.recv();
+                None
+            }))
+            .unwrap();
+        thread.advance(4).unwrap();
+        for substeps in [50, 60, 70] {
+            let taken = thread.take(|_, _| {});
+            assert_eq!(taken.stepped, 0, "nothing finished while busy");
+            thread
+                .edit(Box::new(move |s| {
+                    let mut p = s.params().clone();
+                    p.substeps = substeps;
+                    s.set_params(p).err().map(|e| e.to_string())
+                }))
+                .unwrap();
+        }
+        go.send(()).unwrap();
+        let taken = settled(&mut thread, &mut replica);
+        assert_eq!(taken.in_effect.substeps, 70, "the last edit is in effect");
+        assert_eq!(taken.stepped, 4);
+    }
+
+    #[test]
+    fn a_backlog_beyond_a_quarter_second_is_dropped_and_reported() {
+        let mut replica = hanging();
+        let mut thread = SimThread::start(replica.fork());
+        thread.advance(100).unwrap();
+        let taken = settled(&mut thread, &mut replica);
+        assert_eq!(taken.stepped, MAX_BACKLOG);
+        assert_eq!(replica.frames(), MAX_BACKLOG as u64);
+        assert!(taken.behind, "slower than real time is said");
+        // Holding drops what is owed.
+        let (go, wait) = mpsc::channel::<()>();
+        thread
+            .edit(Box::new(move |_| {
+                let _ = wait.recv();
+                None
+            }))
+            .unwrap();
+        thread.advance(5).unwrap();
+        thread.hold().unwrap();
+        go.send(()).unwrap();
+        let taken = settled(&mut thread, &mut replica);
+        assert_eq!(taken.stepped, 0);
+        assert!(!taken.behind);
+    }
+
+    #[test]
+    fn a_frame_that_cannot_be_saved_stops_the_stepping_and_says_why() {
+        let mut scene = Scene::builtin("hanging").unwrap();
+        scene.params.integrator = IntegratorKind::ExplicitEuler;
+        scene.params.substeps = 1;
+        scene.params.guard.max_refinements = 0;
+        scene.params.guard.fallback = None;
+        let mut replica = Simulation::new(scene);
+        let mut thread = SimThread::start(replica.fork());
+        thread.advance(10).unwrap();
+        let taken = settled(&mut thread, &mut replica);
+        let failed = taken.failed.expect("the failure is reported");
+        assert!(failed.ends_with("Paused."), "{failed}");
+        assert!(taken.stepped < 10, "it stopped at the failing frame");
+        assert!(replica.state().is_finite(), "the last good state is shown");
+    }
+}
