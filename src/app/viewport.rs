@@ -32,10 +32,12 @@ impl Viewport {
     ) -> Result<Self, RenderError> {
         let target = RenderTarget::new(&rs.device, width.max(1), height.max(1), samples)?;
         let renderer = Renderer::new(&rs.device, samples);
+        // The view is drawn at its own size, one texel per pixel: nearest sampling shows the
+        // same image as linear and costs less on a software adapter.
         let texture = rs.renderer.write().register_native_texture(
             &rs.device,
             target.view(),
-            wgpu::FilterMode::Linear,
+            wgpu::FilterMode::Nearest,
         );
         Ok(Self {
             renderer,
@@ -64,7 +66,7 @@ impl Viewport {
             rs.renderer.write().update_egui_texture_from_wgpu_texture(
                 &rs.device,
                 self.target.view(),
-                wgpu::FilterMode::Linear,
+                wgpu::FilterMode::Nearest,
                 self.texture,
             );
         }
