@@ -123,7 +123,7 @@ impl GridSpec {
             // Welding numbers particles by first use in the faces, not row by row: find
             // each grid vertex's particle by its (exactly kept) position.
             let key = |p: Vec3| p.to_array().map(f32::to_bits);
-            let particle: std::collections::HashMap<[u32; 3], u32> = mesh
+            let particle: rustc_hash::FxHashMap<[u32; 3], u32> = mesh
                 .positions
                 .iter()
                 .enumerate()

@@ -1,7 +1,7 @@
 //! Fan triangulation of welded polygons: which triangle sides are polygon sides, which are
 //! diagonals, and the second diagonal of every quad.
 
-use std::collections::HashSet;
+use rustc_hash::FxHashSet;
 
 use glam::Vec3;
 
@@ -32,7 +32,8 @@ pub fn triangulate(
     min_area: f32,
 ) -> Triangulation {
     let mut out = Triangulation::default();
-    let mut seen: HashSet<[u32; 3]> = HashSet::with_capacity(corners.len());
+    let mut seen: FxHashSet<[u32; 3]> =
+        FxHashSet::with_capacity_and_hasher(corners.len(), Default::default());
     let mut start = 0usize;
     for &arity in arities {
         let Some(face) = corners.get(start..start + arity as usize) else {

@@ -1,9 +1,8 @@
 //! Welding: corners at the same position — within a tolerance relative to the cloth's size
 //! — become one particle.
 
-use std::collections::HashMap;
-
 use glam::{Vec2, Vec3};
+use rustc_hash::FxHashMap;
 
 use super::bounds::bbox_diagonal;
 use super::polygons::PolygonSoup;
@@ -19,8 +18,12 @@ pub struct Welded {
 }
 
 /// Welds the corners of `soup`: a corner joins the earliest particle within `relative` ×
-/// the soup's bounding-box diagonal (a spatial hash of cells that size finds candidates in
-/// the 27 cells around it); 0 welds only bit-equal positions (−0 and +0 count as equal).
+/// the soup's bounding-box diagonal; 0 welds only bit-equal positions (−0 and +0 count as
+/// equal).
+///
+/// Candidates come from a spatial hash of cubes twice the tolerance across: a particle
+/// within the tolerance of a corner lies in the corner's cube or in the neighbour on the
+/// nearer side along each axis, so 8 cubes are searched.
 pub fn weld(soup: &PolygonSoup, relative: f32) -> Welded {
     let tolerance = relative * bbox_diagonal(&soup.positions);
     let mut out = Welded {
@@ -28,27 +31,34 @@ pub fn weld(soup: &PolygonSoup, relative: f32) -> Welded {
         uvs: Vec::new(),
         corners: Vec::with_capacity(soup.face_indices.len()),
     };
-    let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::with_capacity(soup.positions.len());
-    let cell_of = |p: Vec3| -> [i64; 3] {
-        if tolerance > 0.0 {
-            (p / tolerance).floor().as_i64vec3().to_array()
-        } else {
-            let bits = |x: f32| if x == 0.0 { 0 } else { x.to_bits() as i64 };
-            [bits(p.x), bits(p.y), bits(p.z)]
-        }
-    };
+    let mut cells: FxHashMap<[i64; 3], Vec<u32>> =
+        FxHashMap::with_capacity_and_hasher(soup.positions.len(), Default::default());
+    let cell = 2.0 * tolerance;
     for &i in &soup.face_indices {
         let p = soup.positions[i as usize];
-        let home = cell_of(p);
-        let found = if tolerance > 0.0 {
-            neighbours(home)
+        let (home, found) = if tolerance > 0.0 {
+            let scaled = p / cell;
+            let home = scaled.floor();
+            // −1 or +1 per axis: towards the nearer face of the cube.
+            let side = (scaled - home).cmplt(Vec3::splat(0.5));
+            let toward = Vec3::select(side, Vec3::NEG_ONE, Vec3::ONE);
+            let home = home.as_i64vec3().to_array();
+            let step = toward.as_i64vec3().to_array();
+            let found = (0..8)
+                .map(|corner| {
+                    let pick = |axis: usize| home[axis] + step[axis] * ((corner >> axis) & 1);
+                    [pick(0), pick(1), pick(2)]
+                })
                 .filter_map(|c| cells.get(&c))
                 .flatten()
                 .copied()
                 .filter(|&id| out.positions[id as usize].distance(p) <= tolerance)
-                .min()
+                .min();
+            (home, found)
         } else {
-            cells.get(&home).and_then(|ids| ids.first().copied())
+            let bits = |x: f32| if x == 0.0 { 0 } else { x.to_bits() as i64 };
+            let home = [bits(p.x), bits(p.y), bits(p.z)];
+            (home, cells.get(&home).and_then(|ids| ids.first().copied()))
         };
         let id = found.unwrap_or_else(|| {
             let id = out.positions.len() as u32;
@@ -63,9 +73,61 @@ pub fn weld(soup: &PolygonSoup, relative: f32) -> Welded {
     out
 }
 
-/// The 27 cells around (and including) `c`.
-fn neighbours(c: [i64; 3]) -> impl Iterator<Item = [i64; 3]> {
-    (-1..=1).flat_map(move |dx| {
-        (-1..=1).flat_map(move |dy| (-1..=1).map(move |dz| [c[0] + dx, c[1] + dy, c[2] + dz]))
-    })
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rule itself, corner by corner against every particle so far.
+    fn brute_force(positions: &[Vec3], corners: &[u32], tolerance: f32) -> (Vec<Vec3>, Vec<u32>) {
+        let (mut particles, mut out) = (Vec::<Vec3>::new(), Vec::new());
+        for &i in corners {
+            let p = positions[i as usize];
+            let id = particles
+                .iter()
+                .position(|q| q.distance(p) <= tolerance)
+                .unwrap_or_else(|| {
+                    particles.push(p);
+                    particles.len() - 1
+                });
+            out.push(id as u32);
+        }
+        (particles, out)
+    }
+
+    #[test]
+    fn the_hash_finds_exactly_the_earliest_particle_within_the_tolerance() {
+        // Clusters of points scattered over about three tolerances, so pairs fall on both
+        // sides of cube faces, just inside and just outside the tolerance.
+        let mut seed = 99u64;
+        let mut rnd = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut positions = Vec::new();
+        for _ in 0..60 {
+            let centre = Vec3::new(rnd(), rnd(), rnd());
+            for _ in 0..20 {
+                positions.push(centre + 3e-3 * (Vec3::new(rnd(), rnd(), rnd()) - 0.5));
+            }
+        }
+        positions.push(Vec3::ZERO);
+        positions.push(Vec3::ONE); // bounding box diagonal √3
+        let corners: Vec<u32> = (0..positions.len() as u32).collect();
+        let soup = PolygonSoup {
+            positions: positions.clone(),
+            uvs: None,
+            face_indices: corners.clone(),
+            face_arities: vec![],
+        };
+        let relative = 1e-3;
+        let tolerance = relative * bbox_diagonal(&positions);
+        let welded = weld(&soup, relative);
+        let (particles, ids) = brute_force(&positions, &corners, tolerance);
+        assert!(particles.len() < positions.len() / 2, "the clusters weld");
+        assert!(particles.len() > 60, "but not into one per cluster");
+        assert_eq!(welded.corners, ids);
+        assert_eq!(welded.positions, particles);
+    }
 }
