@@ -24,6 +24,12 @@ const BLOCK: usize = 1024;
 /// 10–20 % slower on 2 threads than on 1): from about 180 × 180 particles.
 const PARALLEL_BLOCKS: usize = 32;
 
+/// Longest gap in a run filled with springs of no strength (rest length, stiffness and
+/// damping 0: their force is exactly zero) rather than starting a new run.
+const MAX_GAP: u32 = 8;
+/// The run-order index of such a filler.
+const GHOST: u32 = u32::MAX;
+
 /// Springs `start..start + len` (in run order) join `a + j` to `a + off + j`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Run {
@@ -47,7 +53,8 @@ struct Block {
 #[derive(Clone, Debug, PartialEq)]
 pub struct SpringRuns {
     particles: usize,
-    /// For each place in run order, the index of its spring in the caller's arrays.
+    /// For each place in run order, the index of its spring in the caller's arrays
+    /// ([`GHOST`] for a filler).
     order: Vec<u32>,
     /// Blocks from which the blocks run in parallel ([`PARALLEL_BLOCKS`]; tests lower it).
     parallel_from: usize,
@@ -109,38 +116,52 @@ impl SpringRuns {
         let blocks_n = particles.div_ceil(BLOCK).max(1);
         let mut runs: Vec<Run> = Vec::new();
         let mut blocks = Vec::with_capacity(blocks_n);
+        // Run order: each place's spring, or GHOST for a gap filled to join two runs.
+        let mut placed: Vec<u32> = Vec::with_capacity(order.len() + order.len() / 8);
         let mut next = 0;
         for block in 0..blocks_n {
-            let (first_run, first_spring) = (runs.len(), next);
+            let (first_run, first_spring) = (runs.len(), placed.len());
             let mut hi = (block + 1) * BLOCK;
-            while let Some(&(off, lo, _)) = order.get(next) {
+            while let Some(&(off, lo, e)) = order.get(next) {
                 if lo as usize / BLOCK != block {
                     break;
                 }
                 let in_block = runs.len() > first_run;
                 match runs.last_mut() {
-                    Some(r) if in_block && r.off == off && r.a + r.len == lo => r.len += 1,
+                    // A short gap in a run (a grid row's end) is filled with springs of no
+                    // strength, so the row's run and the next one are one vector loop.
+                    Some(r)
+                        if in_block
+                            && r.off == off
+                            && lo >= r.a + r.len
+                            && lo - (r.a + r.len) <= MAX_GAP =>
+                    {
+                        let gap = lo - (r.a + r.len);
+                        placed.extend(std::iter::repeat_n(GHOST, gap as usize));
+                        r.len += gap + 1;
+                    }
                     _ => runs.push(Run {
                         a: lo,
                         off,
-                        start: next as u32,
+                        start: placed.len() as u32,
                         len: 1,
                     }),
                 }
+                placed.push(e as u32);
                 hi = hi.max((lo + off) as usize + 1);
                 next += 1;
             }
             let lo = block * BLOCK;
             blocks.push(Block {
                 runs: first_run..runs.len(),
-                springs: first_spring..next,
+                springs: first_spring..placed.len(),
                 lo: lo.min(particles),
                 hi: hi.min(particles).max(lo.min(particles)),
             });
         }
         let mut runs = Self {
             particles,
-            order: order.iter().map(|&(_, _, e)| e as u32).collect(),
+            order: placed,
             parallel_from: PARALLEL_BLOCKS,
             rest: Vec::new(),
             k: Vec::new(),
@@ -161,9 +182,11 @@ impl SpringRuns {
         self.c = self.pick(c);
     }
 
-    /// `v` (per spring, in the caller's order) in run order.
+    /// `v` (per spring, in the caller's order) in run order; 0 for gap fillers.
     fn pick(&self, v: &[f32]) -> Vec<f32> {
-        self.order.iter().map(|&e| v[e as usize]).collect()
+        (self.order.iter())
+            .map(|&e| if e == GHOST { 0.0 } else { v[e as usize] })
+            .collect()
     }
 
     /// Runs the blocks in parallel from `blocks` blocks on (tests take the parallel path on
@@ -500,5 +523,45 @@ mod tests {
         rebuilt.add_forces(&pos, &vel, &mut y);
         assert!(x == y, "new strengths differ from runs built with them");
         assert!(x != got, "the strengths changed nothing");
+    }
+
+    /// A plain grid's stencil: the ends of its rows are filled, so each offset is one run
+    /// per block, not one per row; the fillers add nothing.
+    #[test]
+    fn row_ends_are_filled_so_each_offset_is_one_run_per_block() {
+        let (w, h) = (50usize, 60usize);
+        let n = w * h;
+        let offsets = [(1, 0), (0, 1), (1, 1), (2, 0)];
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for p in 0..n {
+            for (di, dj) in offsets {
+                let (i, j) = (p % w + di, p / w + dj);
+                if i < w && j < h {
+                    a.push(p as u32);
+                    b.push((j * w + i) as u32);
+                }
+            }
+        }
+        let pos: Vec<Vec3> = (0..n)
+            .map(|p| Vec3::new((p % w) as f32, (p / w) as f32, (p % 7) as f32) * 0.01)
+            .collect();
+        let vel: Vec<Vec3> = (0..n).map(|p| Vec3::splat((p % 5) as f32 - 2.0)).collect();
+        let rest = vec![0.008; a.len()];
+        let (k, c) = (vec![300.0; a.len()], vec![0.02; a.len()]);
+        let runs = SpringRuns::new(n, &a, &b, &rest, &k, &c);
+        assert!(
+            runs.run_count() <= offsets.len() * runs.blocks.len(),
+            "{} runs for {} offsets in {} blocks",
+            runs.run_count(),
+            offsets.len(),
+            runs.blocks.len()
+        );
+        let want = reference(&a, &b, &rest, &k, &c, &pos, &vel);
+        let mut got = vec![Vec3::ZERO; n];
+        runs.add_forces(&pos, &vel, &mut got);
+        let scale = want.iter().map(|f| f.length()).fold(0.0, f32::max);
+        for p in 0..n {
+            assert!((got[p] - want[p]).length() <= 1e-5 * scale, "particle {p}");
+        }
     }
 }
