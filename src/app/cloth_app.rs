@@ -11,7 +11,7 @@ use crate::view;
 
 use super::accuracy::AccuracyWindow;
 use super::background::{Load, PngWriter};
-use super::stepping::{InEffect, SimThread, Taken};
+use super::stepping::{InEffect, News, SimThread};
 use super::transport::Transport;
 use super::viewport::Viewport;
 
@@ -374,17 +374,17 @@ impl ClothApp {
     /// frame that failed (which pauses), and the timings.
     fn poll_stepping(&mut self) {
         let sim = &mut self.sim;
-        let Taken {
+        let (news, in_effect) = self
+            .stepping
+            .take(|state, frames| sim.adopt_state(state, frames));
+        let News {
             stepped,
             timings,
             guard_events,
             failed,
             notes,
             behind,
-            in_effect,
-        } = self
-            .stepping
-            .take(|state, frames| sim.adopt_state(state, frames));
+        } = news;
         self.in_effect = in_effect;
         for event in guard_events {
             let level = match event.action {

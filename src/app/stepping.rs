@@ -66,7 +66,15 @@ pub(super) struct Report {
     pub frames: u64,
     pub state_done: u64,
     pub fresh: bool,
-    /// Frames stepped, their timings and guard events since the UI last took them.
+    /// What happened since the UI last took it.
+    pub news: News,
+    pub in_effect: InEffect,
+}
+
+/// What happened on the stepping thread since the UI last looked.
+#[derive(Default)]
+pub(super) struct News {
+    /// Frames stepped, their timings and guard events.
     pub stepped: u32,
     pub timings: PhaseTimings,
     pub guard_events: Vec<GuardEvent>,
@@ -74,10 +82,9 @@ pub(super) struct Report {
     pub failed: Option<String>,
     /// Errors from edits (a backend that could not be changed).
     pub notes: Vec<String>,
-    /// Since the UI last looked, frames became due while more than one was still owed, or
-    /// a backlog was dropped: the simulation runs slower than real time.
+    /// Frames became due while more than one was still owed, or a backlog was dropped:
+    /// the simulation runs slower than real time.
     pub behind: bool,
-    pub in_effect: InEffect,
 }
 
 struct Shared {
@@ -114,12 +121,7 @@ impl SimThread {
                 frames: sim.frames(),
                 state_done: 0,
                 fresh: false,
-                stepped: 0,
-                timings: PhaseTimings::default(),
-                guard_events: Vec::new(),
-                failed: None,
-                notes: Vec::new(),
-                behind: false,
+                news: News::default(),
                 in_effect: InEffect::of(&sim),
             }),
             changed: Condvar::new(),
@@ -170,23 +172,15 @@ impl SimThread {
         self.send(Job::Hold)
     }
 
-    /// The report, with the latest state only if it includes every state-replacing edit.
-    /// Takes what the UI consumes (stepped frames, timings, events, errors).
-    pub fn take(&mut self, mut adopt: impl FnMut(&ClothState, u64)) -> Taken {
+    /// What happened since the last call, and what is in effect; shows the latest state
+    /// (through `adopt`) only if it includes every state-replacing edit.
+    pub fn take(&mut self, mut adopt: impl FnMut(&ClothState, u64)) -> (News, InEffect) {
         let mut r = self.shared.lock();
         if r.fresh && r.state_done >= self.barrier {
             adopt(&r.state, r.frames);
             r.fresh = false;
         }
-        Taken {
-            stepped: std::mem::take(&mut r.stepped),
-            timings: r.timings.take(),
-            guard_events: std::mem::take(&mut r.guard_events),
-            failed: r.failed.take(),
-            notes: std::mem::take(&mut r.notes),
-            behind: std::mem::take(&mut r.behind),
-            in_effect: r.in_effect,
-        }
+        (std::mem::take(&mut r.news), r.in_effect)
     }
 
     /// What the stepping copy has in effect, as last published.
@@ -221,17 +215,6 @@ impl Drop for SimThread {
             let _ = h.join();
         }
     }
-}
-
-/// What [`SimThread::take`] hands the UI.
-pub(super) struct Taken {
-    pub stepped: u32,
-    pub timings: PhaseTimings,
-    pub guard_events: Vec<GuardEvent>,
-    pub failed: Option<String>,
-    pub notes: Vec<String>,
-    pub behind: bool,
-    pub in_effect: InEffect,
 }
 
 /// The stepping thread: applies jobs in order, steps one owed frame at a time (taking new
@@ -311,16 +294,17 @@ impl Published {
                 r.state_done = done;
                 r.fresh = true;
             }
+            let news = &mut r.news;
             if self.stepped {
-                r.stepped += 1;
-                r.timings.merge(&timings);
-                r.guard_events.extend(events);
+                news.stepped += 1;
+                news.timings.merge(&timings);
+                news.guard_events.extend(events);
             }
             if let Some(f) = self.failed {
-                r.failed = Some(f);
+                news.failed = Some(f);
             }
-            r.notes.extend(self.note);
-            r.behind |= self.behind;
+            news.notes.extend(self.note);
+            news.behind |= self.behind;
             r.in_effect = InEffect::of(sim);
         }
         shared.changed.notify_all();
@@ -337,7 +321,7 @@ mod tests {
     }
 
     /// The replica's view of the thread after it settled: the adopted state and frames.
-    fn settled(thread: &mut SimThread, replica: &mut Simulation) -> Taken {
+    fn settled(thread: &mut SimThread, replica: &mut Simulation) -> (News, InEffect) {
         thread.settle();
         thread.take(|state, frames| replica.adopt_state(state, frames))
     }
@@ -359,7 +343,7 @@ mod tests {
             }))
             .unwrap();
         thread.advance(2).unwrap();
-        let taken = settled(&mut thread, &mut replica);
+        let (taken, _) = settled(&mut thread, &mut replica);
         for _ in 0..3 {
             direct.step_frame().unwrap();
         }
@@ -426,7 +410,7 @@ mod tests {
             .unwrap();
         thread.advance(4).unwrap();
         for substeps in [50, 60, 70] {
-            let taken = thread.take(|_, _| {});
+            let (taken, _) = thread.take(|_, _| {});
             assert_eq!(taken.stepped, 0, "nothing finished while busy");
             thread
                 .edit(Box::new(move |s| {
@@ -437,8 +421,8 @@ mod tests {
                 .unwrap();
         }
         go.send(()).unwrap();
-        let taken = settled(&mut thread, &mut replica);
-        assert_eq!(taken.in_effect.substeps, 70, "the last edit is in effect");
+        let (taken, in_effect) = settled(&mut thread, &mut replica);
+        assert_eq!(in_effect.substeps, 70, "the last edit is in effect");
         assert_eq!(taken.stepped, 4);
     }
 
@@ -447,7 +431,7 @@ mod tests {
         let mut replica = hanging();
         let mut thread = SimThread::start(replica.fork());
         thread.advance(100).unwrap();
-        let taken = settled(&mut thread, &mut replica);
+        let (taken, _) = settled(&mut thread, &mut replica);
         assert_eq!(taken.stepped, MAX_BACKLOG);
         assert_eq!(replica.frames(), MAX_BACKLOG as u64);
         assert!(taken.behind, "slower than real time is said");
@@ -462,7 +446,7 @@ mod tests {
         thread.advance(5).unwrap();
         thread.hold().unwrap();
         go.send(()).unwrap();
-        let taken = settled(&mut thread, &mut replica);
+        let (taken, _) = settled(&mut thread, &mut replica);
         assert_eq!(taken.stepped, 0);
         assert!(!taken.behind);
     }
@@ -477,7 +461,7 @@ mod tests {
         let mut replica = Simulation::new(scene);
         let mut thread = SimThread::start(replica.fork());
         thread.advance(10).unwrap();
-        let taken = settled(&mut thread, &mut replica);
+        let (taken, _) = settled(&mut thread, &mut replica);
         let failed = taken.failed.expect("the failure is reported");
         assert!(failed.ends_with("Paused."), "{failed}");
         assert!(taken.stepped < 10, "it stopped at the failing frame");

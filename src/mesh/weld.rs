@@ -98,13 +98,7 @@ mod tests {
     fn the_hash_finds_exactly_the_earliest_particle_within_the_tolerance() {
         // Clusters of points scattered over about three tolerances, so pairs fall on both
         // sides of cube faces, just inside and just outside the tolerance.
-        let mut seed = 99u64;
-        let mut rnd = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rnd = crate::test_rng::uniform(99);
         let mut positions = Vec::new();
         for _ in 0..60 {
             let centre = Vec3::new(rnd(), rnd(), rnd());

@@ -429,13 +429,7 @@ mod tests {
     fn runs_give_the_springs_forces_on_any_layout() {
         let (w, h) = (70usize, 40usize);
         let n = w * h;
-        let mut seed = 12345u64;
-        let mut rnd = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 33) as f32 / (1u64 << 31) as f32
-        };
+        let mut rnd = crate::test_rng::uniform(12345);
         let pos: Vec<Vec3> = (0..n)
             .map(|p| {
                 Vec3::new((p % w) as f32 * 0.01, (p / w) as f32 * -0.01, 0.0)
