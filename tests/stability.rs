@@ -32,6 +32,15 @@ fn assert_finished(summary: &clothsim::scene::RunSummary) {
     );
 }
 
+/// The stability guard never had to act.
+fn assert_guard_quiet(summary: &clothsim::scene::RunSummary) {
+    assert!(
+        summary.guard_events.is_empty(),
+        "{:?}",
+        summary.guard_events
+    );
+}
+
 /// Whether the segment `a → b` passes closer than `r` to `c`.
 fn segment_enters_sphere(a: Vec3, b: Vec3, c: Vec3, r: f32) -> bool {
     let d = b - a;
@@ -100,11 +109,7 @@ fn stiff_cloth_at_100x_stiffness_with_implicit_euler_stays_calm() {
     let start = sim.energy();
     let summary = sim.run(3.0);
     assert_finished(&summary);
-    assert!(
-        summary.guard_events.is_empty(),
-        "{:?}",
-        summary.guard_events
-    );
+    assert_guard_quiet(&summary);
     assert_passive(start, sim.energy(), "stiff cloth");
     // 40 000 N/m springs hardly stretch under a 0.2 kg cloth.
     assert_stretch_below(&sim, 0.01);
@@ -235,11 +240,7 @@ fn tiny_and_near_degenerate_triangles_stay_stable_at_the_default_step() {
     assert_finished(&summary);
     // The tiny vertices' masses are floored, so their stiff modes are as slow as the
     // cloth's: no refinement or fallback is needed.
-    assert!(
-        summary.guard_events.is_empty(),
-        "{:?}",
-        summary.guard_events
-    );
+    assert_guard_quiet(&summary);
     assert_passive(start, sim.energy(), "tiny triangles");
     // The cloth's own springs stretch a few percent; the 0.1 mm ones flap by tens of µm
     // (measured 29 µm): both far from a blow-up.
@@ -402,11 +403,7 @@ fn strong_gusting_wind_flaps_the_flag_hard_without_blowing_up() {
     for _ in 0..10 {
         let summary = sim.run(0.5);
         assert_finished(&summary);
-        assert!(
-            summary.guard_events.is_empty(),
-            "{:?}",
-            summary.guard_events
-        );
+        assert_guard_quiet(&summary);
         strain = strain.max(max_strain(&sim));
         speed = speed.max(summary.max_speed);
         flapping = flapping.max(sim.state().kinetic_energy(sim.model()) as f32);
@@ -495,11 +492,7 @@ fn a_256_by_256_curtain_pushed_in_the_middle_stays_stable_for_10_seconds_and_set
     for _ in 0..10 {
         let summary = sim.run(1.0);
         assert_finished(&summary);
-        assert!(
-            summary.guard_events.is_empty(),
-            "{:?}",
-            summary.guard_events
-        );
+        assert_guard_quiet(&summary);
         peak = peak.max(sim.energy());
         strain = strain.max(max_strain(&sim));
     }

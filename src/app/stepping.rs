@@ -320,6 +320,19 @@ mod tests {
         Simulation::new(Scene::builtin("hanging").unwrap())
     }
 
+    /// Holds the thread inside an edit (a frame that takes long) until the returned sender
+    /// sends.
+    fn keep_busy(thread: &mut SimThread) -> mpsc::Sender<()> {
+        let (go, wait) = mpsc::channel::<()>();
+        thread
+            .edit(Box::new(move |_| {
+                let _ = wait.recv();
+                None
+            }))
+            .unwrap();
+        go
+    }
+
     /// The replica's view of the thread after it settled: the adopted state and frames.
     fn settled(thread: &mut SimThread, replica: &mut Simulation) -> (News, InEffect) {
         thread.settle();
@@ -369,13 +382,7 @@ mod tests {
         // The thread is held inside an edit while it has a stepped state published.
         thread.advance(2).unwrap();
         thread.settle();
-        let (go, wait) = mpsc::channel::<()>();
-        thread
-            .edit(Box::new(move |_| {
-                let _ = wait.recv();
-                None
-            }))
-            .unwrap();
+        let go = keep_busy(&mut thread);
         replica.reset();
         thread
             .edit_state(Box::new(|s| {
@@ -401,13 +408,7 @@ mod tests {
     fn the_ui_never_waits_for_a_busy_simulation() {
         let mut replica = hanging();
         let mut thread = SimThread::start(replica.fork());
-        let (go, wait) = mpsc::channel::<()>();
-        thread
-            .edit(Box::new(move |_| {
-                let _ = wait.recv();
-                None
-            }))
-            .unwrap();
+        let go = keep_busy(&mut thread);
         thread.advance(4).unwrap();
         for substeps in [50, 60, 70] {
             let (taken, _) = thread.take(|_, _| {});
@@ -436,13 +437,7 @@ mod tests {
         assert_eq!(replica.frames(), MAX_BACKLOG as u64);
         assert!(taken.behind, "slower than real time is said");
         // Holding drops what is owed.
-        let (go, wait) = mpsc::channel::<()>();
-        thread
-            .edit(Box::new(move |_| {
-                let _ = wait.recv();
-                None
-            }))
-            .unwrap();
+        let go = keep_busy(&mut thread);
         thread.advance(5).unwrap();
         thread.hold().unwrap();
         go.send(()).unwrap();
