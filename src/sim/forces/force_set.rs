@@ -145,11 +145,7 @@ impl ForceSet {
         keep: impl Fn(&Force) -> bool,
         f: &mut Vec<Vec3>,
     ) {
-        f.clear();
-        f.resize(pos.len(), Vec3::ZERO);
-        for term in self.terms.iter().filter(|t| keep(t)) {
-            term.add_forces(model, pos, vel, self.time, f);
-        }
+        self.sum_forces(model, pos, vel, keep, f, None);
     }
 
     /// As [`ForceSet::forces_where`], charging each term's wall time to `times`.
@@ -162,12 +158,29 @@ impl ForceSet {
         f: &mut Vec<Vec3>,
         times: &mut TermTimes,
     ) {
+        self.sum_forces(model, pos, vel, keep, f, Some(times));
+    }
+
+    fn sum_forces(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        keep: impl Fn(&Force) -> bool,
+        f: &mut Vec<Vec3>,
+        mut times: Option<&mut TermTimes>,
+    ) {
         f.clear();
         f.resize(pos.len(), Vec3::ZERO);
         for (slot, term) in self.terms.iter().enumerate().filter(|(_, t)| keep(t)) {
-            let start = std::time::Instant::now();
-            term.add_forces(model, pos, vel, self.time, f);
-            times.add(slot, term.phase(), start.elapsed());
+            match times.as_deref_mut() {
+                Some(times) => {
+                    let start = std::time::Instant::now();
+                    term.add_forces(model, pos, vel, self.time, f);
+                    times.add(slot, term.phase(), start.elapsed());
+                }
+                None => term.add_forces(model, pos, vel, self.time, f),
+            }
         }
     }
 
