@@ -193,13 +193,34 @@ impl ClothApp {
 
     /// Applies `change` to the UI's replica now and to the stepping copy after everything
     /// sent before it (the same change on the same data: the two stay equal).
-    pub(super) fn edit(&mut self, change: impl Fn(&mut Simulation) + Send + 'static) {
-        change(&mut self.sim);
-        let sent = self.stepping.edit(Box::new(move |s| {
+    /// Returns what the change returned on the replica.
+    pub(super) fn edit<R>(&mut self, change: impl Fn(&mut Simulation) -> R + Send + 'static) -> R {
+        self.send_edit(change, false)
+    }
+
+    /// As [`ClothApp::edit`], for a change that replaces the state outright (a reset): no
+    /// state stepped before it is shown afterwards.
+    fn edit_state<R>(&mut self, change: impl Fn(&mut Simulation) -> R + Send + 'static) -> R {
+        self.send_edit(change, true)
+    }
+
+    fn send_edit<R>(
+        &mut self,
+        change: impl Fn(&mut Simulation) -> R + Send + 'static,
+        replaces_state: bool,
+    ) -> R {
+        let out = change(&mut self.sim);
+        let job: super::stepping::Edit = Box::new(move |s| {
             change(s);
             None
-        }));
+        });
+        let sent = if replaces_state {
+            self.stepping.edit_state(job)
+        } else {
+            self.stepping.edit(job)
+        };
         self.report_sent(sent);
+        out
     }
 
     /// Makes `sim` the simulation, shown and stepped from its state (a new scene or cloth).
@@ -319,27 +340,16 @@ impl ClothApp {
     /// Applies edited parameters to the running simulation; a bad value is reported and
     /// the previous parameters stay.
     pub fn apply_params(&mut self, params: SimParams) {
-        match self.sim.set_params(params.clone()) {
-            Ok(()) => {
-                let sent = self.stepping.edit(Box::new(move |s| {
-                    s.set_params(params).err().map(|e| e.to_string())
-                }));
-                self.report_sent(sent);
-            }
-            Err(e) => self.message(Level::Error, e.to_string()),
+        if let Err(e) = self.edit(move |s| s.set_params(params.clone())) {
+            self.message(Level::Error, e.to_string());
         }
     }
 
     /// Applies an edited effect list (collider settings) to the running simulation.
     pub fn apply_effects(&mut self, effects: Vec<Effect>) {
-        for warning in self.sim.set_effects(effects.clone()) {
+        for warning in self.edit(move |s| s.set_effects(effects.clone())) {
             self.message(Level::Warning, warning);
         }
-        let sent = self.stepping.edit(Box::new(move |s| {
-            s.set_effects(effects);
-            None
-        }));
-        self.report_sent(sent);
     }
 
     /// Turns the scene's pins on or off.
@@ -355,12 +365,7 @@ impl ClothApp {
     }
 
     pub fn reset(&mut self) {
-        self.sim.reset();
-        let sent = self.stepping.edit_state(Box::new(|s| {
-            s.reset();
-            None
-        }));
-        self.report_sent(sent);
+        self.edit_state(Simulation::reset);
     }
 
     /// Pauses and advances exactly one simulation frame.
