@@ -5,7 +5,7 @@ use egui::{RichText, Slider};
 use crate::mesh::SpringKind;
 use crate::render::SpringColoring;
 use crate::scene::scenarios;
-use crate::sim::IntegratorKind;
+use crate::sim::{IntegratorKind, SimParams};
 
 use super::cloth_app::{ClothApp, Level};
 
@@ -291,23 +291,34 @@ fn solver_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     ui.separator();
 }
 
+/// Stiffness and damping sliders of one spring kind, labelled `{prefix}stiffness` and
+/// `{prefix}damping`; whether either changed.
+pub(super) fn spring_sliders(
+    ui: &mut egui::Ui,
+    params: &mut SimParams,
+    kind: SpringKind,
+    prefix: &str,
+) -> bool {
+    let k = kind.index();
+    let stiffness = Slider::new(&mut params.stiffness[k], 0.0..=5000.0)
+        .logarithmic(true)
+        .suffix(" N/m")
+        .text(format!("{prefix}stiffness"));
+    let changed = ui.add(stiffness).changed();
+    let damping = Slider::new(&mut params.damping[k], 0.0..=2.0)
+        .logarithmic(true)
+        .suffix(" N·s/m")
+        .text(format!("{prefix}damping"));
+    changed | ui.add(damping).changed()
+}
+
 fn material_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     ui.heading("Material");
     let mut params = app.sim.params().clone();
     let mut changed = false;
     // Bend springs are set under Effects → Bending, where they exist.
     for kind in [SpringKind::Structural, SpringKind::Shear] {
-        let k = kind.index();
-        let stiffness = Slider::new(&mut params.stiffness[k], 0.0..=5000.0)
-            .logarithmic(true)
-            .suffix(" N/m")
-            .text(format!("{} stiffness", kind.name()));
-        changed |= ui.add(stiffness).changed();
-        let damping = Slider::new(&mut params.damping[k], 0.0..=2.0)
-            .logarithmic(true)
-            .suffix(" N·s/m")
-            .text(format!("{} damping", kind.name()));
-        changed |= ui.add(damping).changed();
+        changed |= spring_sliders(ui, &mut params, kind, &format!("{} ", kind.name()));
     }
     let density = Slider::new(&mut params.density, 0.01..=5.0)
         .logarithmic(true)

@@ -198,23 +198,7 @@ fn effect_controls(ui: &mut egui::Ui, effect: &mut Effect, params: &mut SimParam
             }
             match model {
                 BendingModel::Springs => {
-                    let k = SpringKind::Bend.index();
-                    p |= ui
-                        .add(
-                            Slider::new(&mut params.stiffness[k], 0.0..=5000.0)
-                                .logarithmic(true)
-                                .suffix(" N/m")
-                                .text("stiffness"),
-                        )
-                        .changed();
-                    p |= ui
-                        .add(
-                            Slider::new(&mut params.damping[k], 0.0..=2.0)
-                                .logarithmic(true)
-                                .suffix(" N·s/m")
-                                .text("damping"),
-                        )
-                        .changed();
+                    p |= super::controls::spring_sliders(ui, params, SpringKind::Bend, "");
                 }
                 BendingModel::Dihedral { stiffness } => {
                     e |= ui
