@@ -54,6 +54,15 @@ fn run_settled(harness: &mut Harness<'static, ClothApp>, frames: usize) {
     harness.run_steps(1);
 }
 
+/// The app's last error message; there must be one.
+fn last_error(harness: &Harness<'static, ClothApp>) -> String {
+    harness
+        .state()
+        .last_error()
+        .expect("an error message")
+        .to_string()
+}
+
 fn drop_obj(harness: &mut Harness<'static, ClothApp>, name: &str, text: &str) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join(name);
@@ -120,11 +129,7 @@ fn dropping_a_malformed_obj_shows_an_error_and_keeps_the_cloth() {
         "broken.obj",
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
     );
-    let error = harness
-        .state()
-        .last_error()
-        .expect("an error message")
-        .to_string();
+    let error = last_error(&harness);
     assert!(
         error.contains("broken.obj") && error.contains(":4:"),
         "{error}"
@@ -313,11 +318,7 @@ fn a_bad_parameter_is_refused_and_the_simulation_keeps_its_own() {
     harness.state_mut().apply_params(bad);
     harness.run_steps(1);
     assert_eq!(harness.state().sim().params(), &before);
-    let error = harness
-        .state()
-        .last_error()
-        .expect("an error message")
-        .to_string();
+    let error = last_error(&harness);
     assert!(error.contains("`dt`") && error.contains("kept"), "{error}");
     harness.get_by_label_contains("`dt`");
 }
@@ -331,11 +332,7 @@ fn a_failed_capture_is_reported_and_loses_nothing() {
     harness.run_steps(2);
     harness.state_mut().finish_writes();
     harness.run_steps(1);
-    let error = harness
-        .state()
-        .last_error()
-        .expect("an error message")
-        .to_string();
+    let error = last_error(&harness);
     assert!(
         error.contains("/no/such/folder") && error.contains("does not exist"),
         "{error}"
@@ -415,7 +412,7 @@ fn dropping_a_scene_file_opens_that_scene_and_a_bad_one_keeps_the_current() {
         "breeze",
         "the current scene stays"
     );
-    let error = harness.state().last_error().unwrap().to_string();
+    let error = last_error(&harness);
     assert!(
         error.contains("broken.toml:4:1") && error.contains("`wobble`"),
         "{error}"
@@ -488,13 +485,7 @@ fn save_scene_writes_a_file_that_reopens_as_the_same_setup() {
     harness.state_mut().save_path = "/no/such/dir/s.toml".into();
     harness.get_by_label("Save scene").click();
     harness.run_steps(2);
-    assert!(
-        harness
-            .state()
-            .last_error()
-            .unwrap()
-            .contains("/no/such/dir")
-    );
+    assert!(last_error(&harness).contains("/no/such/dir"));
 }
 
 #[test]
