@@ -40,13 +40,19 @@ pub struct Simulation {
 impl Simulation {
     /// Starts the scene from its initial state on the CPU backend.
     pub fn new(scene: Scene) -> Self {
+        // A new CPU stepper is configured for the scene already.
         let backend = Box::new(CpuStepper::new(&scene.model, &scene.params, &scene.effects));
-        Self::with_backend(scene, backend)
+        Self::assemble(scene, backend)
     }
 
     /// Starts the scene on the given backend (configured here with the scene's parameters).
     pub fn with_backend(scene: Scene, mut backend: Box<dyn StepBackend>) -> Self {
         backend.configure(&scene.model, &scene.params, &scene.effects);
+        Self::assemble(scene, backend)
+    }
+
+    /// The simulation of `scene` on `backend`, configured for it.
+    fn assemble(scene: Scene, backend: Box<dyn StepBackend>) -> Self {
         let mut warnings = scene.warnings;
         warnings.extend(small_sphere_warnings(
             &colliders_of(&scene.effects),
@@ -88,8 +94,7 @@ impl Simulation {
     /// count, parameters, effects and pins. What only a backend knows (substeps the guard
     /// raised, a multi-step integrator's history, timings) starts anew.
     pub fn fork(&self) -> Simulation {
-        let mut backend = Box::new(CpuStepper::new(&self.model, &self.params, &self.effects));
-        backend.configure(&self.model, &self.params, &self.effects);
+        let backend = Box::new(CpuStepper::new(&self.model, &self.params, &self.effects));
         Simulation {
             file: self.file.clone(),
             scenario: self.scenario.clone(),
