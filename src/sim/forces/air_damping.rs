@@ -3,6 +3,7 @@
 
 use glam::Vec3;
 
+use super::components::Components;
 use super::jacobian::SystemMatrix;
 
 /// Air damping rate, 1/s.
@@ -16,6 +17,16 @@ impl AirDamping {
     pub fn add_forces(&self, mass: &[f32], vel: &[Vec3], f: &mut [Vec3]) {
         for ((f, v), &m) in f.iter_mut().zip(vel).zip(mass) {
             *f -= (self.rate * m) * *v;
+        }
+    }
+
+    /// As [`AirDamping::add_forces`] with velocities and forces stored one array per
+    /// component.
+    pub fn add_forces_components(&self, mass: &[f32], vel: &Components, f: &mut Components) {
+        for (f, v) in f.iter_mut().zip(vel) {
+            for ((f, v), &m) in f.iter_mut().zip(v).zip(mass) {
+                *f -= (self.rate * m) * *v;
+            }
         }
     }
 

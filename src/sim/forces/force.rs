@@ -5,6 +5,7 @@ use glam::Vec3;
 use crate::cloth::ClothModel;
 
 use super::air_damping::AirDamping;
+use super::components::Components;
 use super::dihedral::DihedralBending;
 use super::gravity::Gravity;
 use super::jacobian::{JacobianMode, SystemMatrix};
@@ -53,6 +54,36 @@ impl Force {
             Force::Bending(b) => b.add_forces(model, pos, f),
             Force::Wind(w) => w.add_forces(model, pos, vel, t, f),
         }
+    }
+
+    /// Whether [`Force::add_forces_components`] evaluates this term: gravity, the springs
+    /// and air damping do; dihedral bending and wind need the vectors whole.
+    pub fn takes_components(&self) -> bool {
+        matches!(
+            self,
+            Force::Gravity(_) | Force::Springs(_) | Force::BendSprings(_) | Force::AirDamping(_)
+        )
+    }
+
+    /// As [`Force::add_forces`] with positions, velocities and forces stored one array per
+    /// component (the same bits); a term that does not [take
+    /// components](Force::takes_components) adds nothing and returns false.
+    pub fn add_forces_components(
+        &self,
+        model: &ClothModel,
+        pos: &Components,
+        vel: &Components,
+        f: &mut Components,
+    ) -> bool {
+        match self {
+            Force::Gravity(g) => g.add_forces_components(&model.mass, f),
+            Force::Springs(s) | Force::BendSprings(s) => {
+                s.add_forces_components(&model.springs, pos, vel, f)
+            }
+            Force::AirDamping(d) => d.add_forces_components(&model.mass, vel, f),
+            Force::Bending(_) | Force::Wind(_) => return false,
+        }
+        true
     }
 
     /// Potential energy at `pos`, joules; zero for dissipative and driving terms.

@@ -8,6 +8,7 @@ use super::super::constraints::DistanceConstraints;
 use super::super::effect::{BendingModel, Effect};
 use super::super::params::SimParams;
 use super::air_damping::AirDamping;
+use super::components::{Components, zeroed};
 use super::dihedral::DihedralBending;
 use super::force::Force;
 use super::gravity::Gravity;
@@ -168,20 +169,60 @@ impl ForceSet {
         vel: &[Vec3],
         keep: impl Fn(&Force) -> bool,
         f: &mut Vec<Vec3>,
-        mut times: Option<&mut TermTimes>,
+        times: Option<&mut TermTimes>,
     ) {
         f.clear();
         f.resize(pos.len(), Vec3::ZERO);
+        self.each_term(keep, times, |term| {
+            term.add_forces(model, pos, vel, self.time, f);
+        });
+    }
+
+    /// Calls `eval` on each term `keep` selects, in order, charging its wall time to `times`.
+    fn each_term(
+        &self,
+        keep: impl Fn(&Force) -> bool,
+        mut times: Option<&mut TermTimes>,
+        mut eval: impl FnMut(&Force),
+    ) {
         for (slot, term) in self.terms.iter().enumerate().filter(|(_, t)| keep(t)) {
             match times.as_deref_mut() {
                 Some(times) => {
                     let start = std::time::Instant::now();
-                    term.add_forces(model, pos, vel, self.time, f);
+                    eval(term);
                     times.add(slot, term.phase(), start.elapsed());
                 }
-                None => term.add_forces(model, pos, vel, self.time, f),
+                None => eval(term),
             }
         }
+    }
+
+    /// Whether every term [takes components](Force::takes_components), so that
+    /// [`ForceSet::forces_components_timed`] gives the whole force.
+    pub fn takes_components(&self) -> bool {
+        self.terms.iter().all(Force::takes_components)
+    }
+
+    /// As [`ForceSet::forces_timed`] (all terms) with positions, velocities and forces
+    /// stored one array per component: `f` is set to `pos`'s length and the terms add in
+    /// the same order, so the forces are the same bits. Returns false, with `f` only
+    /// partly summed, when a term does not [take components](ForceSet::takes_components).
+    pub fn forces_components_timed(
+        &self,
+        model: &ClothModel,
+        pos: &Components,
+        vel: &Components,
+        f: &mut Components,
+        times: &mut TermTimes,
+    ) -> bool {
+        zeroed(f, pos[0].len());
+        let mut whole = true;
+        self.each_term(
+            |_| true,
+            Some(times),
+            |term| whole &= term.add_forces_components(model, pos, vel, f),
+        );
+        whole
     }
 
     /// Writes the total force at `(pos, vel)` into `f`, newtons.

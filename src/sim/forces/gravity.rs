@@ -2,6 +2,8 @@
 
 use glam::Vec3;
 
+use super::components::Components;
+
 /// Uniform gravitational acceleration, m/s².
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Gravity {
@@ -13,6 +15,15 @@ impl Gravity {
     pub fn add_forces(&self, mass: &[f32], f: &mut [Vec3]) {
         for (f, &m) in f.iter_mut().zip(mass) {
             *f += m * self.g;
+        }
+    }
+
+    /// As [`Gravity::add_forces`] on forces stored one array per component.
+    pub fn add_forces_components(&self, mass: &[f32], f: &mut Components) {
+        for (f, g) in f.iter_mut().zip(self.g.to_array()) {
+            for (f, &m) in f.iter_mut().zip(mass) {
+                *f += m * g;
+            }
         }
     }
 

@@ -2,6 +2,7 @@
 //! together and is the one place forces become accelerations.
 
 mod air_damping;
+mod components;
 mod dihedral;
 mod force;
 mod force_set;
@@ -12,6 +13,7 @@ mod springs;
 mod wind;
 
 pub use air_damping::AirDamping;
+pub use components::{Components, split, zeroed};
 pub use dihedral::{DihedralBending, hinge_angle};
 pub use force::Force;
 pub use force_set::{ForceSet, TermTimes, to_accelerations};

@@ -17,6 +17,8 @@ use std::sync::Mutex;
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::components::{Components, split};
+
 /// Particles per block (a block is one parallel task).
 const BLOCK: usize = 1024;
 /// Blocks from which the blocks run in parallel. Below, handing blocks to other threads
@@ -29,6 +31,9 @@ const PARALLEL_BLOCKS: usize = 32;
 const MAX_GAP: u32 = 8;
 /// The run-order index of such a filler.
 const GHOST: u32 = u32::MAX;
+
+/// The same particles' chunk of each component's array.
+type ChunkOf3<'a> = (&'a mut [f32], (&'a mut [f32], &'a mut [f32]));
 
 /// Springs `start..start + len` (in run order) join `a + j` to `a + off + j`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -74,16 +79,19 @@ struct Scratch(Mutex<Buffers>);
 #[derive(Debug, Default)]
 struct Buffers {
     /// Positions and velocities, one array per component.
-    pos: [Vec<f32>; 3],
-    vel: [Vec<f32>; 3],
-    /// Per block: its springs' forces on their first ends and its sums over `lo..hi`.
+    pos: Components,
+    vel: Components,
+    /// Per block: its springs' forces summed over `lo..hi`.
     blocks: Vec<BlockBuffers>,
 }
 
 #[derive(Debug, Default)]
 struct BlockBuffers {
-    force: [Vec<f32>; 3],
-    sums: [Vec<f32>; 3],
+    /// The sums (built as the forces on first ends, less `second`).
+    sums: Components,
+    /// The forces on second ends (subtracted), summed apart so that one vector loop adds at
+    /// both ends of a run, however near its offset.
+    second: Components,
 }
 
 impl Clone for Scratch {
@@ -213,45 +221,104 @@ impl SpringRuns {
         let bufs = &mut *buffers;
         split(pos, &mut bufs.pos, n);
         split(vel, &mut bufs.vel, n);
-        bufs.blocks.resize_with(self.blocks.len(), Default::default);
-        for (buf, block) in bufs.blocks.iter_mut().zip(&self.blocks) {
-            for (force, sums) in buf.force.iter_mut().zip(&mut buf.sums) {
-                force.resize(block.springs.len(), 0.0);
-                sums.resize(block.hi - block.lo, 0.0);
-            }
-        }
-        // Per block: each spring's force, then the block's sums.
-        let (p, v) = (&bufs.pos, &bufs.vel);
-        let parallel = self.blocks.len() >= self.parallel_from;
-        if parallel {
-            (self.blocks.par_iter().zip(bufs.blocks.par_iter_mut()))
-                .for_each(|(block, buf)| self.block_forces(block, p, v, buf));
-        } else {
-            for (block, buf) in self.blocks.iter().zip(bufs.blocks.iter_mut()) {
-                self.block_forces(block, p, v, buf);
-            }
-        }
-        // Every particle adds the sums that cover it, in block order.
-        let (blocks, buffers) = (&self.blocks, &bufs.blocks);
+        self.block_sums(&bufs.pos, &bufs.vel, &mut bufs.blocks);
+        let blocks = &bufs.blocks;
         let gather = |(q, out): (usize, &mut [Vec3])| {
-            let (lo, hi) = (q * BLOCK, q * BLOCK + out.len());
-            for (b, buf) in blocks.iter().zip(buffers).take(q + 1) {
-                let s = &buf.sums;
-                let (from, to) = (lo.max(b.lo), hi.min(b.hi));
-                if from >= to {
-                    continue;
-                }
-                let range = from - b.lo..to - b.lo;
-                let (sx, sy, sz) = (&s[0][range.clone()], &s[1][range.clone()], &s[2][range]);
-                for (j, o) in out[from - lo..to - lo].iter_mut().enumerate() {
+            self.cover(blocks, q, out.len(), |at, [sx, sy, sz]| {
+                for (j, o) in out[at..at + sx.len()].iter_mut().enumerate() {
                     *o += Vec3::new(sx[j], sy[j], sz[j]);
                 }
-            }
+            });
         };
-        if parallel {
+        if self.parallel() {
             f[..n].par_chunks_mut(BLOCK).enumerate().for_each(gather);
         } else {
             f[..n].chunks_mut(BLOCK).enumerate().for_each(gather);
+        }
+    }
+
+    /// As [`SpringRuns::add_forces`] with positions, velocities and forces stored one array
+    /// per component (no copies made): the same operations in the same order, so the same
+    /// bits.
+    pub fn add_forces_components(&self, pos: &Components, vel: &Components, f: &mut Components) {
+        let n = (pos.iter().chain(vel).map(Vec::len))
+            .chain(f.iter().map(Vec::len))
+            .fold(self.particles, usize::min);
+        if self.runs.is_empty() || n < self.particles {
+            return;
+        }
+        let mut buffers = self.scratch.0.lock().unwrap_or_else(|e| e.into_inner());
+        let blocks = &mut buffers.blocks;
+        self.block_sums(pos, vel, blocks);
+        let blocks = &*blocks;
+        let gather = |(q, (fx, (fy, fz))): (usize, ChunkOf3<'_>)| {
+            self.cover(blocks, q, fx.len(), |at, sums| {
+                for (out, s) in [&mut *fx, &mut *fy, &mut *fz].into_iter().zip(sums) {
+                    for (o, &x) in out[at..at + s.len()].iter_mut().zip(s) {
+                        *o += x;
+                    }
+                }
+            });
+        };
+        let [fx, fy, fz] = f;
+        let (fx, fy, fz) = (&mut fx[..n], &mut fy[..n], &mut fz[..n]);
+        if self.parallel() {
+            let chunks = fx
+                .par_chunks_mut(BLOCK)
+                .zip(fy.par_chunks_mut(BLOCK).zip(fz.par_chunks_mut(BLOCK)));
+            chunks.enumerate().for_each(gather);
+        } else {
+            let chunks = fx
+                .chunks_mut(BLOCK)
+                .zip(fy.chunks_mut(BLOCK).zip(fz.chunks_mut(BLOCK)));
+            chunks.enumerate().for_each(gather);
+        }
+    }
+
+    /// Whether the blocks are many enough to run in parallel.
+    fn parallel(&self) -> bool {
+        self.blocks.len() >= self.parallel_from
+    }
+
+    /// Every block's spring forces and sums (see [`SpringRuns::block_forces`]).
+    fn block_sums(&self, p: &Components, v: &Components, bufs: &mut Vec<BlockBuffers>) {
+        bufs.resize_with(self.blocks.len(), Default::default);
+        for (buf, block) in bufs.iter_mut().zip(&self.blocks) {
+            for sums in buf.sums.iter_mut().chain(&mut buf.second) {
+                sums.resize(block.hi - block.lo, 0.0);
+            }
+        }
+        if self.parallel() {
+            (self.blocks.par_iter().zip(bufs.par_iter_mut()))
+                .for_each(|(block, buf)| self.block_forces(block, p, v, buf));
+        } else {
+            for (block, buf) in self.blocks.iter().zip(bufs.iter_mut()) {
+                self.block_forces(block, p, v, buf);
+            }
+        }
+    }
+
+    /// Calls `add(at, sums)` for each block's sums over the particles of output chunk `q`
+    /// (`len` particles from `q·BLOCK`), in block order; `at` is where in the chunk they
+    /// start.
+    fn cover(
+        &self,
+        buffers: &[BlockBuffers],
+        q: usize,
+        len: usize,
+        mut add: impl FnMut(usize, [&[f32]; 3]),
+    ) {
+        let (lo, hi) = (q * BLOCK, q * BLOCK + len);
+        for (b, buf) in self.blocks.iter().zip(buffers).take(q + 1) {
+            let (from, to) = (lo.max(b.lo), hi.min(b.hi));
+            if from < to {
+                let range = from - b.lo..to - b.lo;
+                let s = &buf.sums;
+                add(
+                    from - lo,
+                    [&s[0][range.clone()], &s[1][range.clone()], &s[2][range]],
+                );
+            }
         }
     }
 
@@ -259,13 +326,7 @@ impl SpringRuns {
     ///
     /// Compiled twice, plainly and for AVX2 (picked at run time): the same IEEE operations
     /// in the same order either way (no fused multiply-add), so the results are identical.
-    fn block_forces(
-        &self,
-        block: &Block,
-        p: &[Vec<f32>; 3],
-        v: &[Vec<f32>; 3],
-        buf: &mut BlockBuffers,
-    ) {
+    fn block_forces(&self, block: &Block, p: &Components, v: &Components, buf: &mut BlockBuffers) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2 (checked just above).
@@ -280,8 +341,8 @@ impl SpringRuns {
     fn block_forces_avx2(
         &self,
         block: &Block,
-        p: &[Vec<f32>; 3],
-        v: &[Vec<f32>; 3],
+        p: &Components,
+        v: &Components,
         buf: &mut BlockBuffers,
     ) {
         self.block_forces_body(block, p, v, buf);
@@ -291,21 +352,24 @@ impl SpringRuns {
     fn block_forces_body(
         &self,
         block: &Block,
-        p: &[Vec<f32>; 3],
-        v: &[Vec<f32>; 3],
+        p: &Components,
+        v: &Components,
         buf: &mut BlockBuffers,
     ) {
-        let [fx, fy, fz] = &mut buf.force;
-        let sums = &mut buf.sums;
-        for s in sums.iter_mut() {
+        let (sums, second) = (&mut buf.sums, &mut buf.second);
+        for s in sums.iter_mut().chain(second.iter_mut()) {
             s.fill(0.0);
         }
-        let base = block.springs.start;
         for run in &self.runs[block.runs.clone()] {
             let (a, off, len) = (run.a as usize, run.off as usize, run.len as usize);
-            let local = run.start as usize - base..run.start as usize - base + len;
-            let global = run.start as usize..run.start as usize + len;
+            let springs = run.start as usize..run.start as usize + len;
             let ends = [a..a + len, a + off..a + off + len];
+            let (at_a, at_b) = (
+                a - block.lo..a - block.lo + len,
+                a + off - block.lo..a + off - block.lo + len,
+            );
+            let [s0, s1, s2] = &mut *sums;
+            let [t0, t1, t2] = &mut *second;
             kernel(
                 [
                     &p[0][ends[0].clone()],
@@ -328,42 +392,26 @@ impl SpringRuns {
                     &v[2][ends[1].clone()],
                 ],
                 [
-                    &self.rest[global.clone()],
-                    &self.k[global.clone()],
-                    &self.c[global],
+                    &self.rest[springs.clone()],
+                    &self.k[springs.clone()],
+                    &self.c[springs],
                 ],
-                [
-                    &mut fx[local.clone()],
-                    &mut fy[local.clone()],
-                    &mut fz[local.clone()],
-                ],
+                [&mut s0[at_a.clone()], &mut s1[at_a.clone()], &mut s2[at_a]],
+                [&mut t0[at_b.clone()], &mut t1[at_b.clone()], &mut t2[at_b]],
             );
-            let (at_a, at_b) = (a - block.lo, a + off - block.lo);
-            for (s, f) in
-                sums.iter_mut()
-                    .zip([&fx[local.clone()], &fy[local.clone()], &fz[local.clone()]])
-            {
-                for (o, &x) in s[at_a..at_a + len].iter_mut().zip(f) {
-                    *o += x;
-                }
-                for (o, &x) in s[at_b..at_b + len].iter_mut().zip(f) {
-                    *o -= x;
-                }
+        }
+        for (s, t) in sums.iter_mut().zip(second.iter()) {
+            for (s, &t) in s.iter_mut().zip(t) {
+                *s -= t;
             }
         }
     }
 }
 
-/// Copies the first `n` vectors of `src` into one array per component.
-fn split(src: &[Vec3], out: &mut [Vec<f32>; 3], n: usize) {
-    for (c, comp) in out.iter_mut().enumerate() {
-        comp.clear();
-        comp.extend(src[..n].iter().map(|v| v[c]));
-    }
-}
-
 /// The force on each spring's first end, for springs whose ends' positions and velocities
-/// are given per component: `[k(|d| − l₀) + c(v_b − v_a)·d̂] d̂`, zero for coincident ends.
+/// are given per component: `[k(|d| − l₀) + c(v_b − v_a)·d̂] d̂`, zero for coincident ends;
+/// added to `first` (at the first ends) and to `second` (at the second ends, where it is
+/// subtracted later).
 #[inline(always)]
 fn kernel(
     xa: [&[f32]; 3],
@@ -371,11 +419,14 @@ fn kernel(
     va: [&[f32]; 3],
     vb: [&[f32]; 3],
     params: [&[f32]; 3],
-    out: [&mut [f32]; 3],
+    first: [&mut [f32]; 3],
+    second: [&mut [f32]; 3],
 ) {
-    let n = out[0].len();
-    let [ox, oy, oz] = out;
+    let n = first[0].len();
+    let [ox, oy, oz] = first;
     let (ox, oy, oz) = (&mut ox[..n], &mut oy[..n], &mut oz[..n]);
+    let [tx, ty, tz] = second;
+    let (tx, ty, tz) = (&mut tx[..n], &mut ty[..n], &mut tz[..n]);
     let (xax, xay, xaz) = (&xa[0][..n], &xa[1][..n], &xa[2][..n]);
     let (xbx, xby, xbz) = (&xb[0][..n], &xb[1][..n], &xb[2][..n]);
     let (vax, vay, vaz) = (&va[0][..n], &va[1][..n], &va[2][..n]);
@@ -388,9 +439,13 @@ fn kernel(
         let (nx, ny, nz) = (dx * inv, dy * inv, dz * inv);
         let rel = (vbx[j] - vax[j]) * nx + (vby[j] - vay[j]) * ny + (vbz[j] - vaz[j]) * nz;
         let s = k[j] * (len - rest[j]) + c[j] * rel;
-        ox[j] = s * nx;
-        oy[j] = s * ny;
-        oz[j] = s * nz;
+        let (fx, fy, fz) = (s * nx, s * ny, s * nz);
+        ox[j] += fx;
+        oy[j] += fy;
+        oz[j] += fz;
+        tx[j] += fx;
+        ty[j] += fy;
+        tz[j] += fz;
     }
 }
 
@@ -421,6 +476,19 @@ mod tests {
             }
         }
         f
+    }
+
+    /// `start` plus the forces, computed on component arrays.
+    fn on_components(runs: &SpringRuns, pos: &[Vec3], vel: &[Vec3], start: &[Vec3]) -> Vec<Vec3> {
+        let n = pos.len();
+        let (mut p, mut v, mut f) = <(Components, Components, Components)>::default();
+        split(pos, &mut p, n);
+        split(vel, &mut v, n);
+        split(start, &mut f, n);
+        runs.add_forces_components(&p, &v, &mut f);
+        (0..n)
+            .map(|i| Vec3::new(f[0][i], f[1][i], f[2][i]))
+            .collect()
     }
 
     /// A scrambled cloth: a grid's stencil springs (long runs) plus random ones (runs of
@@ -506,7 +574,11 @@ mod tests {
                 got == out,
                 "parallel blocks on {threads} threads changed the forces"
             );
+            let out = pool.install(|| on_components(&parallel, &pos, &vel, &start));
+            assert!(got == out, "on components, {threads} threads");
         }
+        // On component arrays: the same bits.
+        assert!(got == on_components(&runs, &pos, &vel, &start));
         // New strengths without rebuilding the runs: the same as runs built with them.
         let stiffer: Vec<f32> = k.iter().map(|k| 2.0 * k).collect();
         let mut changed = runs.clone();

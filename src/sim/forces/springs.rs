@@ -12,6 +12,7 @@ use glam::{Mat3, Vec3};
 
 use crate::cloth::Springs;
 
+use super::components::Components;
 use super::spring_runs::SpringRuns;
 
 use super::jacobian::{JacobianMode, SystemMatrix};
@@ -138,6 +139,18 @@ impl SpringForce {
     /// result on any number of threads (see [`SpringRuns`]).
     pub fn add_forces(&self, springs: &Springs, pos: &[Vec3], vel: &[Vec3], f: &mut [Vec3]) {
         self.runs(springs).add_forces(pos, vel, f);
+    }
+
+    /// As [`SpringForce::add_forces`] with positions, velocities and forces stored one array
+    /// per component: the same bits.
+    pub fn add_forces_components(
+        &self,
+        springs: &Springs,
+        pos: &Components,
+        vel: &Components,
+        f: &mut Components,
+    ) {
+        self.runs(springs).add_forces_components(pos, vel, f);
     }
 
     /// `Σ ½k(|d| − l₀)²`, joules.

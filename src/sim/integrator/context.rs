@@ -7,7 +7,7 @@ use glam::Vec3;
 
 use crate::cloth::ClothModel;
 
-use super::super::forces::{Force, ForceSet, TermTimes};
+use super::super::forces::{Components, Force, ForceSet, TermTimes};
 use super::super::params::SolverConfig;
 use super::step::StepReport;
 
@@ -80,6 +80,27 @@ impl<'a> StepContext<'a> {
             .forces_timed(self.model, pos, vel, keep, f, &mut meter.terms);
         meter.forces += start.elapsed();
         meter.force_evals += 1;
+    }
+
+    /// Forces (N) of all terms on positions and velocities stored one array per component,
+    /// into `f` (the same bits as [`StepContext::forces_where`] with every term); false, with
+    /// nothing counted, when the scene has a term that needs the vectors whole.
+    pub fn forces_components(
+        &mut self,
+        pos: &Components,
+        vel: &Components,
+        f: &mut Components,
+    ) -> bool {
+        if !self.forces.takes_components() {
+            return false;
+        }
+        let start = Instant::now();
+        let meter = &mut *self.meter;
+        let whole =
+            (self.forces).forces_components_timed(self.model, pos, vel, f, &mut meter.terms);
+        meter.forces += start.elapsed();
+        meter.force_evals += 1;
+        whole
     }
 
     /// Runs a linear solve or projection `f`, charging its time to the solve phase and
