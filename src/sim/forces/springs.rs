@@ -136,7 +136,7 @@ impl SpringForce {
     }
 
     /// Adds every spring's force (N) to `f`, in parallel for large cloths, with the same
-    /// result on any number of threads (see [`SpringRuns`]).
+    /// result on any number of threads.
     pub fn add_forces(&self, springs: &Springs, pos: &[Vec3], vel: &[Vec3], f: &mut [Vec3]) {
         self.runs(springs).add_forces(pos, vel, f);
     }

@@ -12,7 +12,8 @@ use crate::cloth::ClothState;
 /// Each substep: the forces that are not springs (gravity, air damping, …) move the
 /// particles explicitly to a prediction; then every spring, seen as a distance constraint
 /// with compliance `α = 1/k`, is projected in `xpbd_iterations` Gauss–Seidel sweeps with its
-/// Lagrange multiplier (XPBD), and its dashpot `c` as constraint damping `γ = α·c/h`;
+/// Lagrange multiplier (XPBD), visited colour by colour
+/// ([`DistanceConstraints::coloured`]), and its dashpot `c` as constraint damping `γ = α·c/h`;
 /// finally `v = (x' − x)/h`. With many small substeps and one sweep this is the "small steps"
 /// method: stable at any stiffness, and as `α → 0` it approaches inextensible springs.
 ///
@@ -79,7 +80,7 @@ impl Integrator for Xpbd {
         let model = ctx.model;
         if !self.built {
             // The compliances come from the current stiffness: rebuilt when forces change.
-            self.constraints = ctx.forces.constraints(model);
+            self.constraints = ctx.forces.constraints(model).coloured();
             self.built = true;
         }
         let not_springs = |t: &Force| !matches!(t, Force::Springs(_) | Force::BendSprings(_));
