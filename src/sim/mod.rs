@@ -14,6 +14,7 @@ pub mod integrator;
 mod params;
 mod self_collision;
 mod stats;
+pub mod team;
 mod timings;
 
 pub use backend::StepBackend;

@@ -7,24 +7,25 @@
 //! mesh gives short runs and still works, just with less to vectorise.
 //!
 //! Parallel without races and deterministic: the particles are cut into a number of blocks
-//! that depends on the cloth's size only (never on the thread count). Each block's runs write
+//! that depends on the cloth's size only (never on the thread count), shared out between
+//! the members of a [`Team`]. Each block's runs write
 //! into the block's own buffer, which spans the block plus the reach of its longest offset;
 //! then every particle adds the buffers that cover it, in block order. So 1, 2 or 64 threads
 //! give bit-identical forces.
 
 use std::sync::Mutex;
 
-use glam::Vec3;
-use rayon::prelude::*;
-
+use super::super::team::{Disjoint, Team, share};
 use super::components::{Components, split};
+use glam::Vec3;
 
 /// Particles per block (a block is one parallel task).
 const BLOCK: usize = 1024;
-/// Blocks from which the blocks run in parallel. Below, handing blocks to other threads
-/// cost more than it saved on the 2-core machine this was measured on (N = 64 and 128 ran
-/// 10–20 % slower on 2 threads than on 1): from about 180 × 180 particles.
-const PARALLEL_BLOCKS: usize = 32;
+/// Blocks from which the blocks run in parallel (on the [`Team`]), from about 90 × 90
+/// particles. On the 2-core machine this was measured on, N = 64 (4 blocks) ran slower on
+/// two threads than on one (its data moves between the cores' caches every substep) and
+/// N = 128 (16 blocks) faster.
+const PARALLEL_BLOCKS: usize = 8;
 
 /// Longest gap in a run filled with springs of no strength (rest length, stiffness and
 /// damping 0: their force is exactly zero) rather than starting a new run.
@@ -32,8 +33,14 @@ const MAX_GAP: u32 = 8;
 /// The run-order index of such a filler.
 const GHOST: u32 = u32::MAX;
 
-/// The same particles' chunk of each component's array.
-type ChunkOf3<'a> = (&'a mut [f32], (&'a mut [f32], &'a mut [f32]));
+/// One team member's share of the force chunks.
+struct Chunks<'a, 'b, T> {
+    /// Chunk numbers (chunk `q` holds particles `q·BLOCK..`).
+    indices: std::ops::Range<usize>,
+    /// The particles they hold.
+    particles: std::ops::Range<usize>,
+    forces: &'a Disjoint<'b, T>,
+}
 
 /// Springs `start..start + len` (in run order) join `a + j` to `a + off + j`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -223,18 +230,21 @@ impl SpringRuns {
         split(vel, &mut bufs.vel, n);
         self.block_sums(&bufs.pos, &bufs.vel, &mut bufs.blocks);
         let blocks = &bufs.blocks;
-        let gather = |(q, out): (usize, &mut [Vec3])| {
-            self.cover(blocks, q, out.len(), |at, [sx, sy, sz]| {
-                for (j, o) in out[at..at + sx.len()].iter_mut().enumerate() {
-                    *o += Vec3::new(sx[j], sy[j], sz[j]);
+        self.each_chunk(
+            n,
+            |chunks| {
+                // SAFETY: each member's chunks are its own (see `each_chunk`).
+                let f = unsafe { chunks.forces.part(chunks.particles.clone()) };
+                for (q, out) in chunks.indices.zip(f.chunks_mut(BLOCK)) {
+                    self.cover(blocks, q, out.len(), |at, [sx, sy, sz]| {
+                        for (j, o) in out[at..at + sx.len()].iter_mut().enumerate() {
+                            *o += Vec3::new(sx[j], sy[j], sz[j]);
+                        }
+                    });
                 }
-            });
-        };
-        if self.parallel() {
-            f[..n].par_chunks_mut(BLOCK).enumerate().for_each(gather);
-        } else {
-            f[..n].chunks_mut(BLOCK).enumerate().for_each(gather);
-        }
+            },
+            &mut f[..n],
+        );
     }
 
     /// As [`SpringRuns::add_forces`] with positions, velocities and forces stored one array
@@ -251,27 +261,62 @@ impl SpringRuns {
         let blocks = &mut buffers.blocks;
         self.block_sums(pos, vel, blocks);
         let blocks = &*blocks;
-        let gather = |(q, (fx, (fy, fz))): (usize, ChunkOf3<'_>)| {
-            self.cover(blocks, q, fx.len(), |at, sums| {
-                for (out, s) in [&mut *fx, &mut *fy, &mut *fz].into_iter().zip(sums) {
-                    for (o, &x) in out[at..at + s.len()].iter_mut().zip(s) {
-                        *o += x;
-                    }
+        let [fx, fy, fz] = f;
+        let (fy, fz) = (Disjoint::new(&mut fy[..n]), Disjoint::new(&mut fz[..n]));
+        self.each_chunk(
+            n,
+            |chunks| {
+                let range = chunks.particles.clone();
+                // SAFETY: each member's chunks are its own (see `each_chunk`).
+                let out = unsafe {
+                    [
+                        chunks.forces.part(range.clone()),
+                        fy.part(range.clone()),
+                        fz.part(range),
+                    ]
+                };
+                let [ox, oy, oz] = out;
+                let chunked = ox
+                    .chunks_mut(BLOCK)
+                    .zip(oy.chunks_mut(BLOCK).zip(oz.chunks_mut(BLOCK)));
+                for (q, (ox, (oy, oz))) in chunks.indices.zip(chunked) {
+                    self.cover(blocks, q, ox.len(), |at, sums| {
+                        for (out, s) in [&mut *ox, &mut *oy, &mut *oz].into_iter().zip(sums) {
+                            for (o, &x) in out[at..at + s.len()].iter_mut().zip(s) {
+                                *o += x;
+                            }
+                        }
+                    });
                 }
+            },
+            &mut fx[..n],
+        );
+    }
+
+    /// Calls `gather` for each team member's share of the `BLOCK`-particle chunks of
+    /// `forces` (the first `n` particles' forces), in parallel when the blocks are many
+    /// enough; every chunk's sum is the same whoever takes it.
+    fn each_chunk<T: Send>(
+        &self,
+        n: usize,
+        gather: impl Fn(Chunks<'_, '_, T>) + Sync,
+        forces: &mut [T],
+    ) {
+        let chunks = n.div_ceil(BLOCK);
+        let forces = Disjoint::new(forces);
+        let take = |members: usize, i: usize| {
+            let indices = share(chunks, members, i);
+            gather(Chunks {
+                particles: indices.start * BLOCK..(indices.end * BLOCK).min(n),
+                indices,
+                forces: &forces,
             });
         };
-        let [fx, fy, fz] = f;
-        let (fx, fy, fz) = (&mut fx[..n], &mut fy[..n], &mut fz[..n]);
-        if self.parallel() {
-            let chunks = fx
-                .par_chunks_mut(BLOCK)
-                .zip(fy.par_chunks_mut(BLOCK).zip(fz.par_chunks_mut(BLOCK)));
-            chunks.enumerate().for_each(gather);
+        let team = Team::current();
+        if self.parallel() && team.members() > 1 {
+            team.run(&|i| take(team.members(), i));
         } else {
-            let chunks = fx
-                .chunks_mut(BLOCK)
-                .zip(fy.chunks_mut(BLOCK).zip(fz.chunks_mut(BLOCK)));
-            chunks.enumerate().for_each(gather);
+            take(1, 0);
         }
     }
 
@@ -288,9 +333,17 @@ impl SpringRuns {
                 sums.resize(block.hi - block.lo, 0.0);
             }
         }
-        if self.parallel() {
-            (self.blocks.par_iter().zip(bufs.par_iter_mut()))
-                .for_each(|(block, buf)| self.block_forces(block, p, v, buf));
+        let team = Team::current();
+        if self.parallel() && team.members() > 1 {
+            let bufs = Disjoint::new(&mut bufs[..]);
+            team.run(&|i| {
+                let mine = share(self.blocks.len(), team.members(), i);
+                // SAFETY: the members' shares of the blocks are disjoint.
+                let buffers = unsafe { bufs.part(mine.clone()) };
+                for (block, buf) in self.blocks[mine].iter().zip(buffers) {
+                    self.block_forces(block, p, v, buf);
+                }
+            });
         } else {
             for (block, buf) in self.blocks.iter().zip(bufs.iter_mut()) {
                 self.block_forces(block, p, v, buf);
@@ -562,8 +615,9 @@ mod tests {
         let mut again = start.clone();
         runs.add_forces(&pos, &vel, &mut again);
         assert!(got == again, "a rerun changed the forces");
-        let parallel = runs.clone().parallel_from(1);
         for threads in [1, 2] {
+            // A fresh copy: no sums left over from another run can hide a block not done.
+            let parallel = runs.clone().parallel_from(1);
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
@@ -574,7 +628,8 @@ mod tests {
                 got == out,
                 "parallel blocks on {threads} threads changed the forces"
             );
-            let out = pool.install(|| on_components(&parallel, &pos, &vel, &start));
+            let fresh = runs.clone().parallel_from(1);
+            let out = pool.install(|| on_components(&fresh, &pos, &vel, &start));
             assert!(got == out, "on components, {threads} threads");
         }
         // On component arrays: the same bits.

@@ -1,0 +1,347 @@
+//! A small team of threads that stays awake between the many tiny parallel sections of a
+//! simulation step.
+//!
+//! A substep of a 64 × 64 cloth is tens of microseconds of work, split a few times between
+//! threads. On the 2-core virtual machine this was measured on, rayon's fork–join gained
+//! nothing there: its idle workers yield and fall asleep between sections, and waking one
+//! costs about as much as the work. A team's helpers instead spin for a while after each
+//! section (a fraction of a millisecond, so a running simulation keeps them awake and an
+//! idle one lets them sleep), and a section is handed over by bumping a counter.
+//!
+//! Work is split by a member's index only, never by who finishes first, so callers that
+//! give each member a fixed share get the same result on any number of threads.
+
+use std::any::Any;
+use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
+use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicUsize, Ordering};
+use std::sync::{Arc, Condvar, Mutex, OnceLock, TryLockError};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// How long a helper spins for the next section before it sleeps.
+const SPIN: Duration = Duration::from_micros(300);
+/// Most members a team has.
+const MAX_MEMBERS: usize = 16;
+
+/// A section: called once per member with the member's index.
+type Section<'a> = dyn Fn(usize) + Sync + 'a;
+
+/// What the caller and the helpers share.
+struct Shared {
+    /// Bumped to hand a new section over.
+    epoch: AtomicUsize,
+    /// The current section (a `*const &Section`, valid until every helper is done).
+    section: AtomicPtr<()>,
+    /// Helpers done with the current section.
+    done: AtomicUsize,
+    /// Helpers asleep (or about to be), so the caller knows it must wake them.
+    asleep: AtomicUsize,
+    stop: AtomicBool,
+    /// A helper's panic, passed on to the caller.
+    panic: Mutex<Option<Box<dyn Any + Send>>>,
+    bed: Mutex<()>,
+    wake: Condvar,
+}
+
+/// A team of `members` threads: the caller and `members − 1` helpers.
+pub struct Team {
+    shared: Arc<Shared>,
+    helpers: Vec<JoinHandle<()>>,
+    /// Taken by the caller of a section: a second caller at the same time runs alone.
+    busy: Mutex<()>,
+}
+
+impl Team {
+    /// A team of `members` (at least 1, at most 16) threads.
+    pub fn new(members: usize) -> Self {
+        let members = members.clamp(1, MAX_MEMBERS);
+        let shared = Arc::new(Shared {
+            epoch: AtomicUsize::new(0),
+            section: AtomicPtr::new(std::ptr::null_mut()),
+            done: AtomicUsize::new(0),
+            asleep: AtomicUsize::new(0),
+            stop: AtomicBool::new(false),
+            panic: Mutex::new(None),
+            bed: Mutex::new(()),
+            wake: Condvar::new(),
+        });
+        let helpers = (1..members)
+            .filter_map(|index| {
+                let shared = Arc::clone(&shared);
+                std::thread::Builder::new()
+                    .name(format!("clothsim-team-{index}"))
+                    .spawn(move || helper(&shared, index))
+                    .ok()
+            })
+            .collect();
+        Self {
+            shared,
+            helpers,
+            busy: Mutex::new(()),
+        }
+    }
+
+    /// The shared team for `members` threads (made the first time it is asked for).
+    pub fn shared(members: usize) -> &'static Team {
+        static TEAMS: [OnceLock<Team>; MAX_MEMBERS] = [const { OnceLock::new() }; MAX_MEMBERS];
+        let members = members.clamp(1, MAX_MEMBERS);
+        TEAMS[members - 1].get_or_init(|| Team::new(members))
+    }
+
+    /// The team for the current rayon pool's thread count (so `--threads` and
+    /// `ThreadPool::install` choose it too).
+    pub fn current() -> &'static Team {
+        Self::shared(rayon::current_num_threads())
+    }
+
+    /// How many threads work on a section.
+    pub fn members(&self) -> usize {
+        self.helpers.len() + 1
+    }
+
+    /// Runs `section(i)` for every member `i` at the same time, the caller taking `i = 0`,
+    /// and returns when all are done. If another section of this team is running (another
+    /// thread's), the caller runs every member's share itself, in order. A panic in any
+    /// share is passed on after all are done.
+    pub fn run(&self, section: &Section<'_>) {
+        let _busy = match self.busy.try_lock() {
+            Ok(guard) => guard,
+            // A share panicked last time; the team itself is fine.
+            Err(TryLockError::Poisoned(poisoned)) => poisoned.into_inner(),
+            Err(TryLockError::WouldBlock) => {
+                (0..self.members()).for_each(section);
+                return;
+            }
+        };
+        if self.helpers.is_empty() {
+            section(0);
+            return;
+        }
+        let shared = &*self.shared;
+        // The helpers read the section through this pointer until they are done; the wait
+        // below (also on unwinding) keeps it alive until then.
+        let pointer: *const &Section<'_> = &section;
+        shared.section.store(pointer as *mut (), Ordering::SeqCst);
+        shared.done.store(0, Ordering::SeqCst);
+        shared.epoch.fetch_add(1, Ordering::SeqCst);
+        if shared.asleep.load(Ordering::SeqCst) > 0 {
+            let _bed = shared.bed.lock().unwrap_or_else(|e| e.into_inner());
+            shared.wake.notify_all();
+        }
+        let waiting = WaitForHelpers {
+            shared,
+            helpers: self.helpers.len(),
+        };
+        section(0);
+        drop(waiting);
+        let panic = shared
+            .panic
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take();
+        if let Some(payload) = panic {
+            resume_unwind(payload);
+        }
+    }
+}
+
+impl Drop for Team {
+    fn drop(&mut self) {
+        self.shared.stop.store(true, Ordering::SeqCst);
+        {
+            let _bed = self.shared.bed.lock().unwrap_or_else(|e| e.into_inner());
+            self.shared.wake.notify_all();
+        }
+        for helper in self.helpers.drain(..) {
+            let _ = helper.join();
+        }
+    }
+}
+
+/// Waits (when dropped, so also while unwinding) until every helper is done.
+struct WaitForHelpers<'a> {
+    shared: &'a Shared,
+    helpers: usize,
+}
+
+impl Drop for WaitForHelpers<'_> {
+    fn drop(&mut self) {
+        let mut spins = 0u32;
+        while self.shared.done.load(Ordering::SeqCst) < self.helpers {
+            spins = spins.saturating_add(1);
+            if spins < 1 << 16 {
+                std::hint::spin_loop();
+            } else {
+                std::thread::yield_now();
+            }
+        }
+    }
+}
+
+/// A helper's life: wait for a section, run its share, say so; sleep when idle long.
+fn helper(shared: &Shared, index: usize) {
+    // The epoch the team was made with (not read here: a section may already be waiting).
+    let mut seen = 0;
+    loop {
+        let idle = Instant::now();
+        let mut spins = 0u32;
+        while shared.epoch.load(Ordering::SeqCst) == seen {
+            if shared.stop.load(Ordering::SeqCst) {
+                return;
+            }
+            spins = spins.wrapping_add(1);
+            if !spins.is_multiple_of(64) || idle.elapsed() < SPIN {
+                std::hint::spin_loop();
+                continue;
+            }
+            // Asleep until woken (the caller sees `asleep` after bumping the epoch, or this
+            // sees the new epoch under the lock); the timeout is only a safety net.
+            shared.asleep.fetch_add(1, Ordering::SeqCst);
+            let bed = shared.bed.lock().unwrap_or_else(|e| e.into_inner());
+            if shared.epoch.load(Ordering::SeqCst) == seen && !shared.stop.load(Ordering::SeqCst) {
+                let _ = shared.wake.wait_timeout(bed, Duration::from_millis(50));
+            }
+            shared.asleep.fetch_sub(1, Ordering::SeqCst);
+        }
+        seen = shared.epoch.load(Ordering::SeqCst);
+        let pointer = shared.section.load(Ordering::SeqCst) as *const &Section<'_>;
+        // SAFETY: the caller stored a pointer to a live `&Section` before bumping the
+        // epoch and waits for `done` before letting it go.
+        let section = unsafe { &*pointer };
+        if let Err(payload) = catch_unwind(AssertUnwindSafe(|| section(index))) {
+            *shared.panic.lock().unwrap_or_else(|e| e.into_inner()) = Some(payload);
+        }
+        shared.done.fetch_add(1, Ordering::SeqCst);
+    }
+}
+
+/// A slice that members take disjoint parts of, each its own.
+pub struct Disjoint<'a, T> {
+    start: *mut T,
+    len: usize,
+    _slice: std::marker::PhantomData<&'a mut [T]>,
+}
+
+// SAFETY: members only reach the elements through `part`, whose contract keeps their
+// parts disjoint; `T: Send` lets each part be used on another thread.
+unsafe impl<T: Send> Sync for Disjoint<'_, T> {}
+
+impl<'a, T> Disjoint<'a, T> {
+    pub fn new(slice: &'a mut [T]) -> Self {
+        Self {
+            start: slice.as_mut_ptr(),
+            len: slice.len(),
+            _slice: std::marker::PhantomData,
+        }
+    }
+
+    /// Elements `range` (clamped to the slice).
+    ///
+    /// # Safety
+    /// No two parts in use at the same time may overlap.
+    #[allow(clippy::mut_from_ref)]
+    pub unsafe fn part(&self, range: std::ops::Range<usize>) -> &mut [T] {
+        let end = range.end.min(self.len);
+        let start = range.start.min(end);
+        // SAFETY: in bounds (clamped); disjoint from other parts by the caller's contract.
+        unsafe { std::slice::from_raw_parts_mut(self.start.add(start), end - start) }
+    }
+
+    /// Element `i`.
+    ///
+    /// # Safety
+    /// As [`Disjoint::part`]: no other member uses element `i` at the same time; `i` is in
+    /// bounds.
+    #[allow(clippy::mut_from_ref)]
+    pub unsafe fn at(&self, i: usize) -> &mut T {
+        debug_assert!(i < self.len);
+        // SAFETY: by the caller's contract.
+        unsafe { &mut *self.start.add(i) }
+    }
+}
+
+/// `0..len` cut into `parts` nearly equal ranges; the `i`-th.
+pub fn share(len: usize, parts: usize, i: usize) -> std::ops::Range<usize> {
+    let parts = parts.max(1);
+    (len * i / parts)..(len * (i + 1) / parts)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::AtomicU64;
+
+    #[test]
+    fn every_member_runs_its_share_once_per_section_and_the_caller_waits_for_all() {
+        for members in [1, 2, 3] {
+            let team = Team::new(members);
+            assert_eq!(team.members(), members);
+            let sums: Vec<AtomicU64> = (0..members).map(|_| AtomicU64::new(0)).collect();
+            for round in 0..2000u64 {
+                team.run(&|i| {
+                    // Work long enough that an early return would be caught.
+                    let mut x = round;
+                    for _ in 0..200 {
+                        x = std::hint::black_box(x.wrapping_mul(6364136223846793005) + 1);
+                    }
+                    let _ = x;
+                    sums[i].fetch_add(round + 1, Ordering::SeqCst);
+                });
+                let want = (round + 1) * (round + 2) / 2;
+                for (i, s) in sums.iter().enumerate() {
+                    assert_eq!(s.load(Ordering::SeqCst), want, "member {i}, round {round}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn helpers_that_fell_asleep_wake_for_the_next_section() {
+        let team = Team::new(2);
+        let hits = AtomicUsize::new(0);
+        for _ in 0..3 {
+            std::thread::sleep(SPIN * 4);
+            team.run(&|_| {
+                hits.fetch_add(1, Ordering::SeqCst);
+            });
+        }
+        assert_eq!(hits.load(Ordering::SeqCst), 6);
+    }
+
+    #[test]
+    fn a_panic_in_a_helper_reaches_the_caller_and_the_team_goes_on() {
+        let team = Team::new(2);
+        let caught = catch_unwind(AssertUnwindSafe(|| {
+            team.run(&|i| assert!(i != 1, "member 1 fails"));
+        }));
+        assert!(caught.is_err());
+        let hits = AtomicUsize::new(0);
+        team.run(&|_| {
+            hits.fetch_add(1, Ordering::SeqCst);
+        });
+        assert_eq!(hits.load(Ordering::SeqCst), 2);
+    }
+
+    #[test]
+    fn a_second_caller_at_the_same_time_runs_every_share_itself() {
+        let team = Team::new(2);
+        let inner = AtomicUsize::new(0);
+        team.run(&|i| {
+            if i == 0 {
+                // The team is busy with this section: all of the nested one runs here.
+                team.run(&|_| {
+                    inner.fetch_add(1, Ordering::SeqCst);
+                });
+            }
+        });
+        assert_eq!(inner.load(Ordering::SeqCst), 2);
+    }
+
+    #[test]
+    fn shares_cover_the_range_in_order() {
+        for (len, parts) in [(10, 3), (0, 2), (7, 7), (5, 8)] {
+            let covered: Vec<usize> = (0..parts).flat_map(|i| share(len, parts, i)).collect();
+            assert_eq!(covered, (0..len).collect::<Vec<_>>());
+        }
+    }
+}
