@@ -5,7 +5,7 @@ use glam::{Mat3, Vec3};
 
 use crate::cloth::ClothModel;
 
-use super::forces::SystemMatrix;
+use super::forces::{SystemMatrix, SystemProduct};
 use super::integrator::StepError;
 
 /// How a solve ended.
@@ -26,6 +26,7 @@ pub struct ConjugateGradient {
     p: Vec<Vec3>,
     q: Vec<Vec3>,
     precond: Vec<Mat3>,
+    product: SystemProduct,
 }
 
 fn dot(a: &[Vec3], b: &[Vec3]) -> f64 {
@@ -84,7 +85,8 @@ impl ConjugateGradient {
         }
         // r = b − A·x for the starting guess.
         self.q.resize(n, Vec3::ZERO);
-        sys.apply(model, x, &mut self.q);
+        self.product.load(model, sys);
+        self.product.apply(sys, x, &mut self.q);
         self.r.clear();
         self.r.extend((0..n).map(|i| {
             if free(i) {
@@ -103,7 +105,7 @@ impl ConjugateGradient {
         let mut iterations = 0;
         while iterations < max_iterations && residual > target {
             iterations += 1;
-            sys.apply(model, &self.p, &mut self.q);
+            self.product.apply(sys, &self.p, &mut self.q);
             for (i, q) in self.q.iter_mut().enumerate() {
                 if !free(i) {
                     *q = Vec3::ZERO;

@@ -3,7 +3,9 @@
 
 use glam::Vec3;
 
-use super::{AirDamping, Force, ForceSet, Gravity, JacobianMode, SpringForce, SystemMatrix};
+use super::{
+    AirDamping, Force, ForceSet, Gravity, JacobianMode, SpringForce, SystemMatrix, SystemProduct,
+};
 use crate::cloth::ClothModel;
 use crate::mesh::{GridOrientation, GridSpec};
 
@@ -295,6 +297,20 @@ fn the_system_matrix_is_mass_minus_h_dfdv_minus_h2_dfdx() {
         .collect();
     let err = difference(&au, &expected) / norm(&expected);
     assert!(err < 1e-5, "relative difference {err}");
+    // So is the run-ordered copy the linear solver multiplies with, also after the
+    // matrix changes.
+    let mut product = SystemProduct::default();
+    let mut sys = sys;
+    for round in 0..2 {
+        sys.apply(&model, &u, &mut au);
+        product.load(&model, &sys);
+        let mut fast = vec![Vec3::ZERO; u.len()];
+        product.apply(&sys, &u, &mut fast);
+        let err = difference(&fast, &au) / norm(&au);
+        assert!(err < 1e-6, "round {round}: relative difference {err}");
+        sys.spring.iter_mut().for_each(|s| *s *= 3.0);
+    }
+    sys.apply(&model, &u, &mut au);
     // The dense form is the same operator.
     let dense = sys.dense(&model.springs);
     for (i, row) in dense.iter().enumerate() {

@@ -5,6 +5,9 @@ use glam::{Mat3, Vec3};
 
 use crate::cloth::{ClothModel, Springs};
 
+use super::components::{Components, split, zeroed};
+use super::spring_runs::SpringRuns;
+
 /// Which derivative a force term reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum JacobianMode {
@@ -100,5 +103,52 @@ impl SystemMatrix {
             put(b, a, s, -1.0);
         }
         m
+    }
+}
+
+/// [`SystemMatrix::apply`] for repeated products with one matrix (a linear solve's): the
+/// springs' blocks copied once into the order of the springs' runs, one array per entry, so
+/// each product is the vector loops and threads of the spring forces rather than a 3×3
+/// product per neighbour. The runs are kept while the model's springs stay the same.
+#[derive(Clone, Debug, Default)]
+pub struct SystemProduct {
+    /// The springs the runs were made for.
+    ends: (Vec<u32>, Vec<u32>),
+    runs: Option<SpringRuns>,
+    blocks: [Vec<f32>; 9],
+    u: Components,
+    sums: Components,
+}
+
+impl SystemProduct {
+    /// Takes `sys`'s spring blocks (call again when the matrix changes).
+    pub fn load(&mut self, model: &ClothModel, sys: &SystemMatrix) {
+        let springs = &model.springs;
+        if self.runs.is_none() || self.ends.0 != springs.a || self.ends.1 != springs.b {
+            self.ends = (springs.a.clone(), springs.b.clone());
+            let none = vec![0.0; springs.len()];
+            let particles = model.particle_count();
+            self.runs = Some(SpringRuns::new(
+                particles, &springs.a, &springs.b, &none, &none, &none,
+            ));
+        }
+        if let Some(runs) = &self.runs {
+            runs.blocks_in_order(&sys.spring, &mut self.blocks);
+        }
+    }
+
+    /// `out = A·u` with the matrix last [loaded](SystemProduct::load) (`sys` gives its
+    /// diagonal blocks): the same as [`SystemMatrix::apply`] up to rounding.
+    pub fn apply(&mut self, sys: &SystemMatrix, u: &[Vec3], out: &mut [Vec3]) {
+        let n = u.len().min(out.len()).min(sys.diag.len());
+        split(u, &mut self.u, n);
+        zeroed(&mut self.sums, n);
+        if let Some(runs) = &self.runs {
+            runs.add_block_products(&self.blocks, &self.u, &mut self.sums);
+        }
+        let [sx, sy, sz] = &self.sums;
+        for (p, o) in out[..n].iter_mut().enumerate() {
+            *o = sys.diag[p] * u[p] - Vec3::new(sx[p], sy[p], sz[p]);
+        }
     }
 }

@@ -17,7 +17,9 @@ use std::sync::Mutex;
 
 use super::super::team::{Disjoint, Team, share};
 use super::components::{Components, split};
-use glam::Vec3;
+use std::ops::Range;
+
+use glam::{Mat3, Vec3};
 
 /// Particles per block (a block is one parallel task).
 const BLOCK: usize = 1024;
@@ -228,7 +230,10 @@ impl SpringRuns {
         let bufs = &mut *buffers;
         split(pos, &mut bufs.pos, n);
         split(vel, &mut bufs.vel, n);
-        self.block_sums(&bufs.pos, &bufs.vel, &mut bufs.blocks);
+        let (p, v) = (&bufs.pos, &bufs.vel);
+        self.block_sums(&mut bufs.blocks, |block, buf| {
+            self.block_pass(block, buf, &ForcePass { runs: self, p, v })
+        });
         let blocks = &bufs.blocks;
         self.each_chunk(
             n,
@@ -259,8 +264,17 @@ impl SpringRuns {
         }
         let mut buffers = self.scratch.0.lock().unwrap_or_else(|e| e.into_inner());
         let blocks = &mut buffers.blocks;
-        self.block_sums(pos, vel, blocks);
-        let blocks = &*blocks;
+        let pass = ForcePass {
+            runs: self,
+            p: pos,
+            v: vel,
+        };
+        self.block_sums(blocks, |block, buf| self.block_pass(block, buf, &pass));
+        self.gather_components(blocks, f, n);
+    }
+
+    /// Adds every block's sums to `f` (the first `n` particles).
+    fn gather_components(&self, blocks: &[BlockBuffers], f: &mut Components, n: usize) {
         let [fx, fy, fz] = f;
         let (fy, fz) = (Disjoint::new(&mut fy[..n]), Disjoint::new(&mut fz[..n]));
         self.each_chunk(
@@ -325,8 +339,13 @@ impl SpringRuns {
         self.blocks.len() >= self.parallel_from
     }
 
-    /// Every block's spring forces and sums (see [`SpringRuns::block_forces`]).
-    fn block_sums(&self, p: &Components, v: &Components, bufs: &mut Vec<BlockBuffers>) {
+    /// Every block's sums by `pass` (which fills one block's buffers), the blocks shared out
+    /// between the team's members when they are many enough.
+    fn block_sums(
+        &self,
+        bufs: &mut Vec<BlockBuffers>,
+        pass: impl Fn(&Block, &mut BlockBuffers) + Sync,
+    ) {
         bufs.resize_with(self.blocks.len(), Default::default);
         for (buf, block) in bufs.iter_mut().zip(&self.blocks) {
             for sums in buf.sums.iter_mut().chain(&mut buf.second) {
@@ -341,12 +360,12 @@ impl SpringRuns {
                 // SAFETY: the members' shares of the blocks are disjoint.
                 let buffers = unsafe { bufs.part(mine.clone()) };
                 for (block, buf) in self.blocks[mine].iter().zip(buffers) {
-                    self.block_forces(block, p, v, buf);
+                    pass(block, buf);
                 }
             });
         } else {
             for (block, buf) in self.blocks.iter().zip(bufs.iter_mut()) {
-                self.block_forces(block, p, v, buf);
+                pass(block, buf);
             }
         }
     }
@@ -375,47 +394,37 @@ impl SpringRuns {
         }
     }
 
-    /// One block's spring forces and their sums over the block's particles.
+    /// One block's sums by `pass`, run by run (see [`SpringRuns::each_run`]).
     ///
     /// Compiled twice, plainly and for AVX2 (picked at run time): the same IEEE operations
     /// in the same order either way (no fused multiply-add), so the results are identical.
-    fn block_forces(&self, block: &Block, p: &Components, v: &Components, buf: &mut BlockBuffers) {
+    fn block_pass(&self, block: &Block, buf: &mut BlockBuffers, pass: &impl RunPass) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2 (checked just above).
-            unsafe { self.block_forces_avx2(block, p, v, buf) };
+            unsafe { self.block_pass_avx2(block, buf, pass) };
             return;
         }
-        self.block_forces_body(block, p, v, buf);
+        self.each_run(block, buf, pass);
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn block_forces_avx2(
-        &self,
-        block: &Block,
-        p: &Components,
-        v: &Components,
-        buf: &mut BlockBuffers,
-    ) {
-        self.block_forces_body(block, p, v, buf);
+    fn block_pass_avx2(&self, block: &Block, buf: &mut BlockBuffers, pass: &impl RunPass) {
+        self.each_run(block, buf, pass);
     }
 
+    /// Fills one block's sums: [`RunPass::run`] for each of its runs, then
+    /// `sums = first ∓ second` ([`RunPass::COMBINE`]).
     #[inline(always)]
-    fn block_forces_body(
-        &self,
-        block: &Block,
-        p: &Components,
-        v: &Components,
-        buf: &mut BlockBuffers,
-    ) {
+    fn each_run(&self, block: &Block, buf: &mut BlockBuffers, pass: &impl RunPass) {
         let (sums, second) = (&mut buf.sums, &mut buf.second);
         for s in sums.iter_mut().chain(second.iter_mut()) {
             s.fill(0.0);
         }
-        for run in &self.runs[block.runs.clone()] {
-            let (a, off, len) = (run.a as usize, run.off as usize, run.len as usize);
-            let springs = run.start as usize..run.start as usize + len;
+        for r in &self.runs[block.runs.clone()] {
+            let (a, off, len) = (r.a as usize, r.off as usize, r.len as usize);
+            let springs = r.start as usize..r.start as usize + len;
             let ends = [a..a + len, a + off..a + off + len];
             let (at_a, at_b) = (
                 a - block.lo..a - block.lo + len,
@@ -423,42 +432,154 @@ impl SpringRuns {
             );
             let [s0, s1, s2] = &mut *sums;
             let [t0, t1, t2] = &mut *second;
-            kernel(
-                [
-                    &p[0][ends[0].clone()],
-                    &p[1][ends[0].clone()],
-                    &p[2][ends[0].clone()],
-                ],
-                [
-                    &p[0][ends[1].clone()],
-                    &p[1][ends[1].clone()],
-                    &p[2][ends[1].clone()],
-                ],
-                [
-                    &v[0][ends[0].clone()],
-                    &v[1][ends[0].clone()],
-                    &v[2][ends[0].clone()],
-                ],
-                [
-                    &v[0][ends[1].clone()],
-                    &v[1][ends[1].clone()],
-                    &v[2][ends[1].clone()],
-                ],
-                [
-                    &self.rest[springs.clone()],
-                    &self.k[springs.clone()],
-                    &self.c[springs],
-                ],
+            pass.run(
+                ends,
+                springs,
                 [&mut s0[at_a.clone()], &mut s1[at_a.clone()], &mut s2[at_a]],
                 [&mut t0[at_b.clone()], &mut t1[at_b.clone()], &mut t2[at_b]],
             );
         }
         for (s, t) in sums.iter_mut().zip(second.iter()) {
-            for (s, &t) in s.iter_mut().zip(t) {
-                *s -= t;
+            match pass.combine() {
+                Combine::Subtract => s.iter_mut().zip(t).for_each(|(s, &t)| *s -= t),
+                Combine::Add => s.iter_mut().zip(t).for_each(|(s, &t)| *s += t),
             }
         }
     }
+
+    /// Each spring's 3×3 block (indexed as given to [`SpringRuns::new`]) in run order, one
+    /// array per entry (column-major), zero for gap fillers: what
+    /// [`SpringRuns::add_block_products`] reads.
+    pub fn blocks_in_order(&self, blocks: &[Mat3], out: &mut [Vec<f32>; 9]) {
+        for (k, entry) in out.iter_mut().enumerate() {
+            entry.clear();
+            entry.extend(self.order.iter().map(|&e| {
+                if e == GHOST {
+                    0.0
+                } else {
+                    blocks[e as usize].col(k / 3)[k % 3]
+                }
+            }));
+        }
+    }
+
+    /// Adds `Σ_e S_e·u_other` to `out` at both ends of every spring `e`, with `S_e` the
+    /// spring's block as put in order by [`SpringRuns::blocks_in_order`]: the off-diagonal
+    /// part of a matrix-vector product with the implicit system (whose off-diagonal blocks
+    /// are `−S_e`). In parallel as the forces are, with the same result on any number of
+    /// threads.
+    pub fn add_block_products(&self, s: &[Vec<f32>; 9], u: &Components, out: &mut Components) {
+        let n = (u.iter().chain(out.iter()).map(Vec::len)).fold(self.particles, usize::min);
+        if self.runs.is_empty() || n < self.particles || s[0].len() != self.order.len() {
+            return;
+        }
+        let mut buffers = self.scratch.0.lock().unwrap_or_else(|e| e.into_inner());
+        let blocks = &mut buffers.blocks;
+        let pass = ProductPass { s, u };
+        self.block_sums(blocks, |block, buf| self.block_pass(block, buf, &pass));
+        self.gather_components(blocks, out, n);
+    }
+}
+
+/// What a block pass does with each run: `run` gets the run's two ranges of ends, its
+/// springs (run order) and its slices of the block's sums at its first and second ends.
+trait RunPass: Sync {
+    /// How the sums at second ends join those at first ends.
+    fn combine(&self) -> Combine;
+    fn run(
+        &self,
+        ends: [Range<usize>; 2],
+        springs: Range<usize>,
+        first: [&mut [f32]; 3],
+        second: [&mut [f32]; 3],
+    );
+}
+
+/// The spring forces (see [`kernel`]).
+struct ForcePass<'a> {
+    runs: &'a SpringRuns,
+    p: &'a Components,
+    v: &'a Components,
+}
+
+impl RunPass for ForcePass<'_> {
+    fn combine(&self) -> Combine {
+        Combine::Subtract
+    }
+
+    #[inline(always)]
+    fn run(
+        &self,
+        [ea, eb]: [Range<usize>; 2],
+        springs: Range<usize>,
+        first: [&mut [f32]; 3],
+        second: [&mut [f32]; 3],
+    ) {
+        let (p, v, r) = (self.p, self.v, self.runs);
+        kernel(
+            [&p[0][ea.clone()], &p[1][ea.clone()], &p[2][ea.clone()]],
+            [&p[0][eb.clone()], &p[1][eb.clone()], &p[2][eb.clone()]],
+            [&v[0][ea.clone()], &v[1][ea.clone()], &v[2][ea]],
+            [&v[0][eb.clone()], &v[1][eb.clone()], &v[2][eb]],
+            [
+                &r.rest[springs.clone()],
+                &r.k[springs.clone()],
+                &r.c[springs],
+            ],
+            first,
+            second,
+        );
+    }
+}
+
+/// Block products `S_e·u_other` at both ends (see [`SpringRuns::add_block_products`]).
+struct ProductPass<'a> {
+    s: &'a [Vec<f32>; 9],
+    u: &'a Components,
+}
+
+impl RunPass for ProductPass<'_> {
+    fn combine(&self) -> Combine {
+        Combine::Add
+    }
+
+    #[inline(always)]
+    fn run(
+        &self,
+        [ea, eb]: [Range<usize>; 2],
+        springs: Range<usize>,
+        first: [&mut [f32]; 3],
+        second: [&mut [f32]; 3],
+    ) {
+        let (s, u) = (self.s, self.u);
+        let n = springs.len();
+        let m: [&[f32]; 9] = std::array::from_fn(|k| &s[k][springs.clone()][..n]);
+        let [ax, ay, az] = [&u[0][ea.clone()], &u[1][ea.clone()], &u[2][ea]];
+        let [bx, by, bz] = [&u[0][eb.clone()], &u[1][eb.clone()], &u[2][eb]];
+        let (ax, ay, az, bx, by, bz) = (&ax[..n], &ay[..n], &az[..n], &bx[..n], &by[..n], &bz[..n]);
+        let [f0, f1, f2] = first;
+        let [t0, t1, t2] = second;
+        let (f0, f1, f2) = (&mut f0[..n], &mut f1[..n], &mut f2[..n]);
+        let (t0, t1, t2) = (&mut t0[..n], &mut t1[..n], &mut t2[..n]);
+        for j in 0..n {
+            // Column-major: row r of S·w is S[r]·w.x + S[3 + r]·w.y + S[6 + r]·w.z.
+            f0[j] += m[0][j] * bx[j] + m[3][j] * by[j] + m[6][j] * bz[j];
+            f1[j] += m[1][j] * bx[j] + m[4][j] * by[j] + m[7][j] * bz[j];
+            f2[j] += m[2][j] * bx[j] + m[5][j] * by[j] + m[8][j] * bz[j];
+            t0[j] += m[0][j] * ax[j] + m[3][j] * ay[j] + m[6][j] * az[j];
+            t1[j] += m[1][j] * ax[j] + m[4][j] * ay[j] + m[7][j] * az[j];
+            t2[j] += m[2][j] * ax[j] + m[5][j] * ay[j] + m[8][j] * az[j];
+        }
+    }
+}
+
+/// How a block's sums at second ends join those at first ends.
+#[derive(Clone, Copy)]
+enum Combine {
+    /// Forces: equal and opposite at the two ends.
+    Subtract,
+    /// Block products: each end gets its own.
+    Add,
 }
 
 /// The force on each spring's first end, for springs whose ends' positions and velocities
@@ -644,6 +765,70 @@ mod tests {
         rebuilt.add_forces(&pos, &vel, &mut y);
         assert!(x == y, "new strengths differ from runs built with them");
         assert!(x != got, "the strengths changed nothing");
+    }
+
+    /// Block products against the plain per-spring sum, on one thread and on two.
+    #[test]
+    fn block_products_are_each_springs_block_times_the_other_end() {
+        let (w, h) = (60usize, 50usize);
+        let n = w * h;
+        let mut rnd = crate::test_rng::uniform(99);
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for p in 0..n {
+            for (di, dj) in [(1, 0), (0, 1), (1, 1), (0, 2)] {
+                let (i, j) = (p % w + di, p / w + dj);
+                if i < w && j < h {
+                    // Ends in either order.
+                    let q = (j * w + i) as u32;
+                    let (x, y) = if rnd() < 0.5 {
+                        (p as u32, q)
+                    } else {
+                        (q, p as u32)
+                    };
+                    a.push(x);
+                    b.push(y);
+                }
+            }
+        }
+        let blocks: Vec<Mat3> = (0..a.len())
+            .map(|_| Mat3::from_cols_array(&std::array::from_fn(|_| rnd() - 0.5)))
+            .collect();
+        let u: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
+        let mut want = vec![Vec3::ZERO; n];
+        for e in 0..a.len() {
+            let (i, j) = (a[e] as usize, b[e] as usize);
+            want[i] += blocks[e] * u[j];
+            want[j] += blocks[e] * u[i];
+        }
+        let zero = vec![0.0; a.len()];
+        let runs = SpringRuns::new(n, &a, &b, &zero, &zero, &zero);
+        let mut s: [Vec<f32>; 9] = Default::default();
+        runs.blocks_in_order(&blocks, &mut s);
+        let mut uc = Components::default();
+        split(&u, &mut uc, n);
+        let product = |runs: &SpringRuns| {
+            let mut out = Components::default();
+            crate::sim::forces::zeroed(&mut out, n);
+            runs.add_block_products(&s, &uc, &mut out);
+            out
+        };
+        let got = product(&runs);
+        let scale = want.iter().map(|v| v.length()).fold(0.0, f32::max);
+        for p in 0..n {
+            let g = Vec3::new(got[0][p], got[1][p], got[2][p]);
+            assert!((g - want[p]).length() <= 1e-5 * scale, "particle {p}");
+        }
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let parallel = runs.clone().parallel_from(1);
+            assert!(
+                pool.install(|| product(&parallel)) == got,
+                "{threads} threads"
+            );
+        }
     }
 
     /// A plain grid's stencil: the ends of its rows are filled, so each offset is one run
