@@ -1,11 +1,11 @@
 //! Preconditioned conjugate gradients on the implicit system, with pinned particles
 //! filtered out of the solve (their unknowns stay zero) and a block-Jacobi preconditioner.
 
-use glam::{Mat3, Vec3};
+use glam::Vec3;
 
 use crate::cloth::ClothModel;
 
-use super::forces::{SystemMatrix, SystemProduct};
+use super::forces::{Components, SystemMatrix, SystemProduct, split, zeroed};
 use super::integrator::StepError;
 
 /// How a solve ended.
@@ -18,19 +18,43 @@ pub struct CgOutcome {
     pub converged: bool,
 }
 
-/// Scratch vectors of a solve, kept between steps (no allocation once sized).
+/// Scratch vectors of a solve, kept between steps (no allocation once sized). The vectors
+/// are stored one array per component, so every update is a vector loop.
 #[derive(Clone, Debug, Default)]
 pub struct ConjugateGradient {
-    r: Vec<Vec3>,
-    z: Vec<Vec3>,
-    p: Vec<Vec3>,
-    q: Vec<Vec3>,
-    precond: Vec<Mat3>,
+    x: Components,
+    r: Components,
+    z: Components,
+    p: Components,
+    q: Components,
+    /// The preconditioner's 3×3 blocks, one array per entry (column-major).
+    precond: [Vec<f32>; 9],
+    free: Vec<bool>,
     product: SystemProduct,
 }
 
-fn dot(a: &[Vec3], b: &[Vec3]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x.dot(*y) as f64).sum()
+/// `Σ a_i·b_i`, each particle's dot product in f32 summed in f64.
+fn dot(a: &Components, b: &Components) -> f64 {
+    let [ax, ay, az] = a;
+    let [bx, by, bz] = b;
+    let n = ax.len().min(bx.len());
+    let (ay, az, by, bz) = (&ay[..n], &az[..n], &by[..n], &bz[..n]);
+    (0..n)
+        .map(|i| (ax[i] * bx[i] + ay[i] * by[i] + az[i] * bz[i]) as f64)
+        .sum()
+}
+
+/// `out = M·u` with `M` given per particle as nine arrays (column-major).
+fn blocks_times(m: &[Vec<f32>; 9], u: &Components, out: &mut Components) {
+    let n = u[0].len();
+    for (r, out) in out.iter_mut().enumerate() {
+        let (c0, c1, c2) = (&m[r][..n], &m[3 + r][..n], &m[6 + r][..n]);
+        let (ux, uy, uz) = (&u[0][..n], &u[1][..n], &u[2][..n]);
+        let out = &mut out[..n];
+        for i in 0..n {
+            out[i] = c0[i] * ux[i] + c1[i] * uy[i] + c2[i] * uz[i];
+        }
+    }
 }
 
 impl ConjugateGradient {
@@ -52,26 +76,20 @@ impl ConjugateGradient {
         max_iterations: u32,
     ) -> Result<CgOutcome, StepError> {
         let n = b.len();
-        let free = |i: usize| model.inv_mass[i] > 0.0;
+        self.free.clear();
+        self.free.extend((0..n).map(|i| model.inv_mass[i] > 0.0));
+        let free = &self.free;
         if x.len() != n {
             x.clear();
             x.resize(n, Vec3::ZERO);
         }
         for (i, xi) in x.iter_mut().enumerate() {
-            if !free(i) || !xi.is_finite() {
+            if !free[i] || !xi.is_finite() {
                 *xi = Vec3::ZERO;
             }
         }
-        self.precond.clear();
-        self.precond.extend((0..n).map(|i| {
-            if free(i) {
-                sys.diag[i].inverse()
-            } else {
-                Mat3::ZERO
-            }
-        }));
         let b_norm = (0..n)
-            .filter(|&i| free(i))
+            .filter(|&i| free[i])
             .map(|i| b[i].length_squared() as f64)
             .sum::<f64>()
             .sqrt();
@@ -83,21 +101,30 @@ impl ConjugateGradient {
                 converged: true,
             });
         }
-        // r = b − A·x for the starting guess.
-        self.q.resize(n, Vec3::ZERO);
-        self.product.load(model, sys);
-        self.product.apply(sys, x, &mut self.q);
-        self.r.clear();
-        self.r.extend((0..n).map(|i| {
-            if free(i) {
-                b[i] - self.q[i]
-            } else {
-                Vec3::ZERO
+        for entry in &mut self.precond {
+            entry.clear();
+            entry.resize(n, 0.0);
+        }
+        for (i, d) in sys.diag.iter().take(n).enumerate() {
+            if free[i] {
+                for (k, v) in d.inverse().to_cols_array().into_iter().enumerate() {
+                    self.precond[k][i] = v;
+                }
             }
-        }));
-        self.z.clear();
-        self.z
-            .extend(self.precond.iter().zip(&self.r).map(|(m, r)| *m * *r));
+        }
+        for v in [&mut self.r, &mut self.z, &mut self.p, &mut self.q] {
+            zeroed(v, n);
+        }
+        split(x, &mut self.x, n);
+        // r = b − A·x for the starting guess.
+        self.product.load(model, sys);
+        self.product.apply_components(&self.x, &mut self.q);
+        for (c, r) in self.r.iter_mut().enumerate() {
+            for (i, r) in r.iter_mut().enumerate() {
+                *r = if free[i] { b[i][c] - self.q[c][i] } else { 0.0 };
+            }
+        }
+        blocks_times(&self.precond, &self.r, &mut self.z);
         self.p.clone_from(&self.z);
         let mut rz = dot(&self.r, &self.z);
         let target = tolerance as f64 * b_norm;
@@ -105,10 +132,10 @@ impl ConjugateGradient {
         let mut iterations = 0;
         while iterations < max_iterations && residual > target {
             iterations += 1;
-            self.product.apply(sys, &self.p, &mut self.q);
-            for (i, q) in self.q.iter_mut().enumerate() {
-                if !free(i) {
-                    *q = Vec3::ZERO;
+            self.product.apply_components(&self.p, &mut self.q);
+            for q in &mut self.q {
+                for (q, &free) in q.iter_mut().zip(free) {
+                    *q = if free { *q } else { 0.0 };
                 }
             }
             let curvature = dot(&self.p, &self.q);
@@ -119,21 +146,24 @@ impl ConjugateGradient {
                 return Err(StepError::Breakdown { iterations });
             }
             let alpha = (rz / curvature) as f32;
-            for (x, p) in x.iter_mut().zip(&self.p) {
-                *x += alpha * *p;
+            for (x, p) in self.x.iter_mut().zip(&self.p) {
+                x.iter_mut().zip(p).for_each(|(x, &p)| *x += alpha * p);
             }
-            let residuals = self.r.iter_mut().zip(self.z.iter_mut());
-            for (((r, z), q), m) in residuals.zip(&self.q).zip(&self.precond) {
-                *r -= alpha * *q;
-                *z = *m * *r;
+            for (r, q) in self.r.iter_mut().zip(&self.q) {
+                r.iter_mut().zip(q).for_each(|(r, &q)| *r -= alpha * q);
             }
+            blocks_times(&self.precond, &self.r, &mut self.z);
             residual = dot(&self.r, &self.r).sqrt();
             let rz_next = dot(&self.r, &self.z);
             let beta = (rz_next / rz) as f32;
             rz = rz_next;
             for (p, z) in self.p.iter_mut().zip(&self.z) {
-                *p = *z + beta * *p;
+                p.iter_mut().zip(z).for_each(|(p, &z)| *p = z + beta * *p);
             }
+        }
+        let [x0, x1, x2] = &self.x;
+        for (i, xi) in x.iter_mut().enumerate() {
+            *xi = Vec3::new(x0[i], x1[i], x2[i]);
         }
         if !residual.is_finite() {
             return Err(StepError::NonFinite { iterations });

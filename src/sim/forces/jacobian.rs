@@ -116,6 +116,8 @@ pub struct SystemProduct {
     ends: (Vec<u32>, Vec<u32>),
     runs: Option<SpringRuns>,
     blocks: [Vec<f32>; 9],
+    /// The particles' diagonal blocks, one array per entry (column-major).
+    diag: [Vec<f32>; 9],
     u: Components,
     sums: Components,
 }
@@ -135,20 +137,48 @@ impl SystemProduct {
         if let Some(runs) = &self.runs {
             runs.blocks_in_order(&sys.spring, &mut self.blocks);
         }
+        for (k, entry) in self.diag.iter_mut().enumerate() {
+            entry.clear();
+            entry.extend(sys.diag.iter().map(|d| d.col(k / 3)[k % 3]));
+        }
     }
 
     /// `out = A·u` with the matrix last [loaded](SystemProduct::load) (`sys` gives its
     /// diagonal blocks): the same as [`SystemMatrix::apply`] up to rounding.
-    pub fn apply(&mut self, sys: &SystemMatrix, u: &[Vec3], out: &mut [Vec3]) {
-        let n = u.len().min(out.len()).min(sys.diag.len());
+    pub fn apply(&mut self, u: &[Vec3], out: &mut [Vec3]) {
+        let n = u.len().min(out.len());
         split(u, &mut self.u, n);
-        zeroed(&mut self.sums, n);
-        if let Some(runs) = &self.runs {
-            runs.add_block_products(&self.blocks, &self.u, &mut self.sums);
-        }
-        let [sx, sy, sz] = &self.sums;
+        let mut sums = std::mem::take(&mut self.sums);
+        zeroed(&mut sums, n);
+        self.apply_components(&self.u, &mut sums);
+        let [sx, sy, sz] = &sums;
         for (p, o) in out[..n].iter_mut().enumerate() {
-            *o = sys.diag[p] * u[p] - Vec3::new(sx[p], sy[p], sz[p]);
+            *o = Vec3::new(sx[p], sy[p], sz[p]);
+        }
+        self.sums = sums;
+    }
+
+    /// As [`SystemProduct::apply`] with `u` and `out` stored one array per component (`out`
+    /// as long as `u`).
+    pub fn apply_components(&self, u: &Components, out: &mut Components) {
+        let n = u[0].len().min(self.diag[0].len());
+        for o in out.iter_mut() {
+            o[..n].fill(0.0);
+        }
+        if let Some(runs) = &self.runs {
+            runs.add_block_products(&self.blocks, u, out);
+        }
+        for (r, out) in out.iter_mut().enumerate() {
+            let (c0, c1, c2) = (
+                &self.diag[r][..n],
+                &self.diag[3 + r][..n],
+                &self.diag[6 + r][..n],
+            );
+            let (ux, uy, uz) = (&u[0][..n], &u[1][..n], &u[2][..n]);
+            let out = &mut out[..n];
+            for i in 0..n {
+                out[i] = c0[i] * ux[i] + c1[i] * uy[i] + c2[i] * uz[i] - out[i];
+            }
         }
     }
 }
