@@ -31,10 +31,20 @@ pub fn weld(soup: &PolygonSoup, relative: f32) -> Welded {
         uvs: Vec::new(),
         corners: Vec::with_capacity(soup.face_indices.len()),
     };
-    let mut cells: FxHashMap<[i64; 3], Vec<u32>> =
+    // Each cube's particles as a chain: the newest in `cells`, each one's elder in `elder`
+    // (no list allocated per cube).
+    let mut cells: FxHashMap<[i64; 3], u32> =
         FxHashMap::with_capacity_and_hasher(soup.positions.len(), Default::default());
+    let mut elder: Vec<u32> = Vec::new();
     let cell = 2.0 * tolerance;
+    // A position seen before gets the same particle: particles made since have larger
+    // numbers, so the earliest within reach is still the one it found.
+    let mut seen = vec![NONE; soup.positions.len()];
     for &i in &soup.face_indices {
+        if let Some(&id) = seen.get(i as usize).filter(|&&id| id != NONE) {
+            out.corners.push(id);
+            continue;
+        }
         let p = soup.positions[i as usize];
         let (home, found) = if tolerance > 0.0 {
             let scaled = p / cell;
@@ -45,32 +55,45 @@ pub fn weld(soup: &PolygonSoup, relative: f32) -> Welded {
             let home = home.as_i64vec3().to_array();
             let step = toward.as_i64vec3().to_array();
             let found = (0..8)
-                .map(|corner| {
+                .flat_map(|corner| {
                     let pick = |axis: usize| home[axis] + step[axis] * ((corner >> axis) & 1);
-                    [pick(0), pick(1), pick(2)]
+                    chain(&cells, &elder, [pick(0), pick(1), pick(2)])
                 })
-                .filter_map(|c| cells.get(&c))
-                .flatten()
-                .copied()
                 .filter(|&id| out.positions[id as usize].distance(p) <= tolerance)
                 .min();
             (home, found)
         } else {
             let bits = |x: f32| if x == 0.0 { 0 } else { x.to_bits() as i64 };
             let home = [bits(p.x), bits(p.y), bits(p.z)];
-            (home, cells.get(&home).and_then(|ids| ids.first().copied()))
+            // Positions equal to the bit: a cube never holds two particles.
+            (home, cells.get(&home).copied())
         };
         let id = found.unwrap_or_else(|| {
             let id = out.positions.len() as u32;
             out.positions.push(p);
             out.uvs
                 .push(soup.uvs.as_ref().map_or(Vec2::ZERO, |uv| uv[i as usize]));
-            cells.entry(home).or_default().push(id);
+            elder.push(cells.insert(home, id).unwrap_or(NONE));
             id
         });
+        seen[i as usize] = id;
         out.corners.push(id);
     }
     out
+}
+
+/// The end of a cube's chain.
+const NONE: u32 = u32::MAX;
+
+/// The particles in `cube`, newest first.
+fn chain<'a>(
+    cells: &'a FxHashMap<[i64; 3], u32>,
+    elder: &'a [u32],
+    cube: [i64; 3],
+) -> impl Iterator<Item = u32> + 'a {
+    std::iter::successors(cells.get(&cube).copied(), move |&id| {
+        Some(elder[id as usize]).filter(|&e| e != NONE)
+    })
 }
 
 #[cfg(test)]
@@ -108,7 +131,9 @@ mod tests {
         }
         positions.push(Vec3::ZERO);
         positions.push(Vec3::ONE); // bounding box diagonal √3
-        let corners: Vec<u32> = (0..positions.len() as u32).collect();
+        // Every position once, then again in another order (shared corners, as a mesh has).
+        let n = positions.len() as u32;
+        let corners: Vec<u32> = (0..n).chain((0..n).rev().step_by(3)).collect();
         let soup = PolygonSoup {
             positions: positions.clone(),
             uvs: None,
