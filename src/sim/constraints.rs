@@ -28,7 +28,7 @@ impl DistanceConstraints {
     /// processor works on several at once (and the colours are what a parallel sweep
     /// needs). Greedy: each constraint, in the given order, takes the first colour neither
     /// of its particles has yet; at most 64, the last one taking what is left over.
-    pub fn coloured(&self) -> Self {
+    pub fn coloured(&self) -> Coloured {
         let particles = self.a.iter().chain(&self.b).map(|&p| p as usize + 1).max();
         let mut used = vec![0u64; particles.unwrap_or(0)];
         let colour: Vec<u32> = (self.a.iter().zip(&self.b))
@@ -44,14 +44,35 @@ impl DistanceConstraints {
         let mut order: Vec<usize> = (0..self.len()).collect();
         order.sort_by_key(|&k| colour[k]);
         let pick = |v: &[f32]| order.iter().map(|&k| v[k]).collect();
-        Self {
-            a: order.iter().map(|&k| self.a[k]).collect(),
-            b: order.iter().map(|&k| self.b[k]).collect(),
-            rest: pick(&self.rest),
-            compliance: pick(&self.compliance),
-            damping: pick(&self.damping),
+        let sorted: Vec<u32> = order.iter().map(|&k| colour[k]).collect();
+        let colours = sorted
+            .chunk_by(|x, y| x == y)
+            .scan(0, |end, run| {
+                let start = *end;
+                *end += run.len();
+                Some((start..*end, run[0] < COLOURS - 1))
+            })
+            .collect();
+        Coloured {
+            constraints: Self {
+                a: order.iter().map(|&k| self.a[k]).collect(),
+                b: order.iter().map(|&k| self.b[k]).collect(),
+                rest: pick(&self.rest),
+                compliance: pick(&self.compliance),
+                damping: pick(&self.damping),
+            },
+            colours,
         }
     }
+}
+
+/// Constraints in colour order, with where each colour lies.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Coloured {
+    pub constraints: DistanceConstraints,
+    /// Each colour's constraints, in order, and whether no two of them share a particle
+    /// (false only for the last colour, should a mesh need more than 64).
+    pub colours: Vec<(std::ops::Range<usize>, bool)>,
 }
 
 /// Most colours [`DistanceConstraints::coloured`] uses (a grid's 12-neighbour stencil needs
@@ -104,7 +125,20 @@ mod tests {
             c.compliance.push(2.0);
             c.damping.push(1.0);
         }
-        let coloured = c.coloured();
+        let Coloured {
+            constraints: coloured,
+            colours,
+        } = c.coloured();
+        // The colours tile the constraints, and within each no particle repeats.
+        assert_eq!(colours.len(), independent_runs(&coloured));
+        assert_eq!(colours.last().map(|c| c.0.end), Some(c.len()));
+        for (range, independent) in &colours {
+            assert!(*independent);
+            let mut seen = std::collections::HashSet::new();
+            for k in range.clone() {
+                assert!(seen.insert(coloured.a[k]) && seen.insert(coloured.b[k]));
+            }
+        }
         // The 10-neighbour stencil's degree is 10: the greedy colouring stays near it.
         assert!(independent_runs(&c) > 1000);
         let runs = independent_runs(&coloured);

@@ -4,6 +4,7 @@ use glam::Vec3;
 
 use super::super::constraints::DistanceConstraints;
 use super::super::forces::Force;
+use super::super::team::{Disjoint, Team, share};
 use super::context::StepContext;
 use super::kind::IntegratorKind;
 use super::step::{Integrator, StepError, StepReport};
@@ -24,6 +25,8 @@ use crate::cloth::ClothState;
 #[derive(Default)]
 pub struct Xpbd {
     constraints: DistanceConstraints,
+    /// Each colour's constraints and whether they share no particle.
+    colours: Vec<(std::ops::Range<usize>, bool)>,
     built: bool,
     force: Vec<Vec3>,
     predicted: Vec<Vec3>,
@@ -32,37 +35,82 @@ pub struct Xpbd {
 }
 
 impl Xpbd {
-    /// One Gauss–Seidel sweep over every constraint.
+    /// One Gauss–Seidel sweep over every constraint, colour by colour; a colour with enough
+    /// constraints is shared out between the threads of the [`Team`] (its constraints
+    /// share no particle, so the order within it changes nothing: the same bits on any
+    /// number of threads).
     fn sweep(&mut self, inv_mass: &[f32], h: f32) {
         let c = &self.constraints;
-        let p = &mut self.predicted;
-        let dx = &mut self.displacement;
-        for k in 0..c.len() {
-            let (a, b) = (c.a[k] as usize, c.b[k] as usize);
-            let (wa, wb) = (inv_mass[a], inv_mass[b]);
-            if wa + wb == 0.0 {
-                continue;
+        let team = Team::current();
+        let (p, dx) = (
+            Disjoint::new(&mut self.predicted),
+            Disjoint::new(&mut self.displacement),
+        );
+        let lambda = Disjoint::new(&mut self.lambda);
+        let project = |k: usize| {
+            // SAFETY: constraint k's particles and multiplier are touched by no other
+            // constraint of its colour, and colours run one after another.
+            unsafe { project(c, k, inv_mass, h, &p, &dx, &lambda) };
+        };
+        for (range, independent) in &self.colours {
+            if *independent && team.members() > 1 && range.len() >= PARALLEL_COLOUR {
+                team.run(&|i| {
+                    share(range.len(), team.members(), i).for_each(|k| project(range.start + k))
+                });
+            } else {
+                range.clone().for_each(project);
             }
-            let d = p[b] - p[a];
-            let len = d.length();
-            if len <= 1e-9 {
-                continue;
-            }
-            let n = d / len;
-            let alpha = c.compliance[k] / (h * h);
-            let gamma = c.compliance[k] * c.damping[k] / h;
-            // ∇C · (p − x): how fast the constraint is changing this step.
-            let rate = n.dot(dx[b] - dx[a]);
-            let constraint = len - c.rest[k];
-            let dl = (-constraint - alpha * self.lambda[k] - gamma * rate)
-                / ((1.0 + gamma) * (wa + wb) + alpha);
-            self.lambda[k] += dl;
-            let (da, db) = ((wa * dl) * n, (wb * dl) * n);
-            p[a] -= da;
-            p[b] += db;
-            dx[a] -= da;
-            dx[b] += db;
         }
+    }
+}
+
+/// Colours from this many constraints are shared out between threads.
+const PARALLEL_COLOUR: usize = 1024;
+
+/// Projects constraint `k` (XPBD with constraint damping), moving its particles' predicted
+/// positions and displacements and its multiplier.
+///
+/// # Safety
+/// No other thread may use constraint `k`'s particles or multiplier meanwhile.
+#[inline(always)]
+unsafe fn project(
+    c: &DistanceConstraints,
+    k: usize,
+    inv_mass: &[f32],
+    h: f32,
+    p: &Disjoint<'_, Vec3>,
+    dx: &Disjoint<'_, Vec3>,
+    lambda: &Disjoint<'_, f32>,
+) {
+    let (a, b) = (c.a[k] as usize, c.b[k] as usize);
+    let (wa, wb) = (inv_mass[a], inv_mass[b]);
+    if wa + wb == 0.0 {
+        return;
+    }
+    // SAFETY: the caller's contract (a ≠ b: the constraint view has no self-springs with a
+    // force, and a self-constraint would have zero length and return below).
+    let (pa, pb, dxa, dxb, lambda) =
+        unsafe { (*p.at(a), *p.at(b), *dx.at(a), *dx.at(b), lambda.at(k)) };
+    let d = pb - pa;
+    let len = d.length();
+    if len <= 1e-9 {
+        return;
+    }
+    let n = d / len;
+    let alpha = c.compliance[k] / (h * h);
+    let gamma = c.compliance[k] * c.damping[k] / h;
+    // ∇C · (p − x): how fast the constraint is changing this step.
+    let rate = n.dot(dxb - dxa);
+    let constraint = len - c.rest[k];
+    let dl = (-constraint - alpha * *lambda - gamma * rate) / ((1.0 + gamma) * (wa + wb) + alpha);
+    *lambda += dl;
+    let (da, db) = ((wa * dl) * n, (wb * dl) * n);
+    // SAFETY: as above.
+    unsafe {
+        *p.at(a) = pa - da;
+        *p.at(b) = pb + db;
+        *dx.at(a) = dxa - da;
+        *dx.at(b) = dxb + db;
     }
 }
 
@@ -80,7 +128,8 @@ impl Integrator for Xpbd {
         let model = ctx.model;
         if !self.built {
             // The compliances come from the current stiffness: rebuilt when forces change.
-            self.constraints = ctx.forces.constraints(model).coloured();
+            let coloured = ctx.forces.constraints(model).coloured();
+            (self.constraints, self.colours) = (coloured.constraints, coloured.colours);
             self.built = true;
         }
         let not_springs = |t: &Force| !matches!(t, Force::Springs(_) | Force::BendSprings(_));
