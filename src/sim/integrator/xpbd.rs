@@ -41,6 +41,12 @@ impl Xpbd {
     /// number of threads).
     fn sweep(&mut self, inv_mass: &[f32], h: f32) {
         let c = &self.constraints;
+        // `project` indexes `inv_mass` first (checked), so these make its other accesses in
+        // bounds.
+        assert!(
+            self.predicted.len() >= inv_mass.len() && self.displacement.len() >= inv_mass.len()
+        );
+        assert!(self.lambda.len() >= c.len());
         let team = Team::current();
         let (p, dx) = (
             Disjoint::new(&mut self.predicted),
@@ -71,7 +77,8 @@ const PARALLEL_COLOUR: usize = 1024;
 /// positions and displacements and its multiplier.
 ///
 /// # Safety
-/// No other thread may use constraint `k`'s particles or multiplier meanwhile.
+/// No other thread may use constraint `k`'s particles or multiplier meanwhile; `p` and `dx`
+/// are at least as long as `inv_mass`, and `lambda` as `c`.
 #[inline(always)]
 unsafe fn project(
     c: &DistanceConstraints,
@@ -87,8 +94,9 @@ unsafe fn project(
     if wa + wb == 0.0 {
         return;
     }
-    // SAFETY: the caller's contract (a ≠ b: the constraint view has no self-springs with a
-    // force, and a self-constraint would have zero length and return below).
+    // SAFETY: in bounds (`inv_mass[a]`, `inv_mass[b]` and `c.a[k]` were checked, and the
+    // caller's contract sizes the rest); no other thread uses them (the caller's contract).
+    // Each `at` is read at once, so even a self-constraint (a = b) holds no two borrows.
     let (pa, pb, dxa, dxb, lambda) =
         unsafe { (*p.at(a), *p.at(b), *dx.at(a), *dx.at(b), lambda.at(k)) };
     let d = pb - pa;
