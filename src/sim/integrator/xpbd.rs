@@ -55,7 +55,8 @@ impl Xpbd {
         let lambda = Disjoint::new(&mut self.lambda);
         let project = |k: usize| {
             // SAFETY: constraint k's particles and multiplier are touched by no other
-            // constraint of its colour, and colours run one after another.
+            // constraint of its colour, and colours run one after another; the arrays'
+            // lengths were checked above.
             unsafe { project(c, k, inv_mass, h, &p, &dx, &lambda) };
         };
         for (range, independent) in &self.colours {
