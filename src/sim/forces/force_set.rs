@@ -8,7 +8,7 @@ use super::super::constraints::DistanceConstraints;
 use super::super::effect::{BendingModel, Effect};
 use super::super::params::SimParams;
 use super::air_damping::AirDamping;
-use super::components::{Components, zeroed};
+use super::components::{Components, Scratch, split, zeroed};
 use super::dihedral::DihedralBending;
 use super::force::Force;
 use super::gravity::Gravity;
@@ -21,6 +21,9 @@ pub struct ForceSet {
     terms: Vec<Force>,
     /// Simulated time the forces are evaluated at (the wind's gusts move with it), seconds.
     time: f64,
+    /// Positions, velocities and forces one array per component, for
+    /// [`ForceSet::accelerations_components`].
+    scratch: Scratch<[Components; 3]>,
 }
 
 /// Wall time and evaluations per term, in term order, filled by [`ForceSet::forces_timed`].
@@ -56,7 +59,10 @@ impl ForceSet {
 
     /// A set of exactly these terms (tests, tools).
     pub fn from_terms(terms: Vec<Force>) -> Self {
-        Self { terms, time: 0.0 }
+        Self {
+            terms,
+            ..Self::default()
+        }
     }
 
     /// Sets the simulated time forces are evaluated at, seconds.
@@ -223,6 +229,34 @@ impl ForceSet {
             |term| whole &= term.add_forces_components(model, pos, vel, f),
         );
         whole
+    }
+
+    /// Accelerations at `(pos, vel)` into `acc` (resized) summed on component arrays, the
+    /// same bits as [`ForceSet::accelerations`]; false, with nothing done, when a term needs
+    /// the vectors whole.
+    pub fn accelerations_components(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        acc: &mut Vec<Vec3>,
+        times: &mut TermTimes,
+    ) -> bool {
+        if !self.takes_components() {
+            return false;
+        }
+        let mut scratch = self.scratch.lock();
+        let [p, v, f] = &mut *scratch;
+        let n = pos.len().min(vel.len()).min(model.inv_mass.len());
+        split(pos, p, n);
+        split(vel, v, n);
+        if !self.forces_components_timed(model, p, v, f, times) {
+            return false;
+        }
+        let [fx, fy, fz] = &*f;
+        acc.clear();
+        acc.extend((0..n).map(|i| Vec3::new(fx[i], fy[i], fz[i]) * model.inv_mass[i]));
+        true
     }
 
     /// Writes the total force at `(pos, vel)` into `f`, newtons.

@@ -13,10 +13,8 @@
 //! then every particle adds the buffers that cover it, in block order. So 1, 2 or 64 threads
 //! give bit-identical forces.
 
-use std::sync::Mutex;
-
 use super::super::team::{Disjoint, Team, share};
-use super::components::{Components, split};
+use super::components::{Components, Scratch, split};
 use std::ops::Range;
 
 use glam::{Mat3, Vec3};
@@ -77,13 +75,8 @@ pub struct SpringRuns {
     c: Vec<f32>,
     runs: Vec<Run>,
     blocks: Vec<Block>,
-    scratch: Scratch,
+    scratch: Scratch<Buffers>,
 }
-
-/// Buffers reused between evaluations (not part of the value: clones start empty and
-/// comparisons ignore them).
-#[derive(Debug, Default)]
-struct Scratch(Mutex<Buffers>);
 
 #[derive(Debug, Default)]
 struct Buffers {
@@ -101,18 +94,6 @@ struct BlockBuffers {
     /// The forces on second ends (subtracted), summed apart so that one vector loop adds at
     /// both ends of a run, however near its offset.
     second: Components,
-}
-
-impl Clone for Scratch {
-    fn clone(&self) -> Self {
-        Self::default()
-    }
-}
-
-impl PartialEq for Scratch {
-    fn eq(&self, _: &Self) -> bool {
-        true
-    }
 }
 
 impl SpringRuns {
@@ -226,7 +207,7 @@ impl SpringRuns {
         if self.runs.is_empty() || n < self.particles {
             return;
         }
-        let mut buffers = self.scratch.0.lock().unwrap_or_else(|e| e.into_inner());
+        let mut buffers = self.scratch.lock();
         let bufs = &mut *buffers;
         split(pos, &mut bufs.pos, n);
         split(vel, &mut bufs.vel, n);
@@ -262,7 +243,7 @@ impl SpringRuns {
         if self.runs.is_empty() || n < self.particles {
             return;
         }
-        let mut buffers = self.scratch.0.lock().unwrap_or_else(|e| e.into_inner());
+        let mut buffers = self.scratch.lock();
         let blocks = &mut buffers.blocks;
         let pass = ForcePass {
             runs: self,
@@ -473,7 +454,7 @@ impl SpringRuns {
         if self.runs.is_empty() || n < self.particles || s[0].len() != self.order.len() {
             return;
         }
-        let mut buffers = self.scratch.0.lock().unwrap_or_else(|e| e.into_inner());
+        let mut buffers = self.scratch.lock();
         let blocks = &mut buffers.blocks;
         let pass = ProductPass { s, u };
         self.block_sums(blocks, |block, buf| self.block_pass(block, buf, &pass));
