@@ -5,7 +5,7 @@ use glam::{Mat3, Vec3};
 
 use crate::cloth::{ClothModel, Springs};
 
-use super::components::{Components, split, zeroed};
+use super::components::Components;
 use super::spring_runs::SpringRuns;
 
 /// Which derivative a force term reports.
@@ -118,8 +118,6 @@ pub struct SystemProduct {
     blocks: [Vec<f32>; 9],
     /// The particles' diagonal blocks, one array per entry (column-major).
     diag: [Vec<f32>; 9],
-    u: Components,
-    sums: Components,
 }
 
 impl SystemProduct {
@@ -143,23 +141,9 @@ impl SystemProduct {
         }
     }
 
-    /// `out = A·u` with the matrix last [loaded](SystemProduct::load) (`sys` gives its
-    /// diagonal blocks): the same as [`SystemMatrix::apply`] up to rounding.
-    pub fn apply(&mut self, u: &[Vec3], out: &mut [Vec3]) {
-        let n = u.len().min(out.len());
-        split(u, &mut self.u, n);
-        let mut sums = std::mem::take(&mut self.sums);
-        zeroed(&mut sums, n);
-        self.apply_components(&self.u, &mut sums);
-        let [sx, sy, sz] = &sums;
-        for (p, o) in out[..n].iter_mut().enumerate() {
-            *o = Vec3::new(sx[p], sy[p], sz[p]);
-        }
-        self.sums = sums;
-    }
-
-    /// As [`SystemProduct::apply`] with `u` and `out` stored one array per component (`out`
-    /// as long as `u`).
+    /// `out = A·u` with the matrix last [loaded](SystemProduct::load), `u` and `out` stored
+    /// one array per component (`out` as long as `u`): the same as [`SystemMatrix::apply`] up
+    /// to rounding.
     pub fn apply_components(&self, u: &Components, out: &mut Components) {
         let n = u[0].len().min(self.diag[0].len());
         for o in out.iter_mut() {
