@@ -1,11 +1,13 @@
 //! Preconditioned conjugate gradients on the implicit system, with pinned particles
 //! filtered out of the solve (their unknowns stay zero) and a block-Jacobi preconditioner.
 
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 
 use crate::cloth::ClothModel;
 
-use super::forces::{Components, SystemMatrix, SystemProduct, split, zeroed};
+use super::forces::{
+    Blocks, Components, SystemMatrix, SystemProduct, blocks_times, split, split_blocks, zeroed,
+};
 use super::integrator::StepError;
 
 /// How a solve ended.
@@ -28,7 +30,7 @@ pub struct ConjugateGradient {
     p: Components,
     q: Components,
     /// The preconditioner's 3×3 blocks, one array per entry (column-major).
-    precond: [Vec<f32>; 9],
+    precond: Blocks,
     free: Vec<bool>,
     product: SystemProduct,
 }
@@ -42,19 +44,6 @@ fn dot(a: &Components, b: &Components) -> f64 {
     (0..n)
         .map(|i| (ax[i] * bx[i] + ay[i] * by[i] + az[i] * bz[i]) as f64)
         .sum()
-}
-
-/// `out = M·u` with `M` given per particle as nine arrays (column-major).
-fn blocks_times(m: &[Vec<f32>; 9], u: &Components, out: &mut Components) {
-    let n = u[0].len();
-    for (r, out) in out.iter_mut().enumerate() {
-        let (c0, c1, c2) = (&m[r][..n], &m[3 + r][..n], &m[6 + r][..n]);
-        let (ux, uy, uz) = (&u[0][..n], &u[1][..n], &u[2][..n]);
-        let out = &mut out[..n];
-        for i in 0..n {
-            out[i] = c0[i] * ux[i] + c1[i] * uy[i] + c2[i] * uz[i];
-        }
-    }
 }
 
 impl ConjugateGradient {
@@ -101,17 +90,8 @@ impl ConjugateGradient {
                 converged: true,
             });
         }
-        for entry in &mut self.precond {
-            entry.clear();
-            entry.resize(n, 0.0);
-        }
-        for (i, d) in sys.diag.iter().take(n).enumerate() {
-            if free[i] {
-                for (k, v) in d.inverse().to_cols_array().into_iter().enumerate() {
-                    self.precond[k][i] = v;
-                }
-            }
-        }
+        let inverse = |(d, &free): (&Mat3, &bool)| if free { d.inverse() } else { Mat3::ZERO };
+        split_blocks(sys.diag.iter().zip(free).map(inverse), &mut self.precond);
         for v in [&mut self.r, &mut self.z, &mut self.p, &mut self.q] {
             zeroed(v, n);
         }
@@ -124,7 +104,7 @@ impl ConjugateGradient {
                 *r = if free[i] { b[i][c] - self.q[c][i] } else { 0.0 };
             }
         }
-        blocks_times(&self.precond, &self.r, &mut self.z);
+        blocks_times(&self.precond, &self.r, &mut self.z, |z, _| z);
         self.p.clone_from(&self.z);
         let mut rz = dot(&self.r, &self.z);
         let target = tolerance as f64 * b_norm;
@@ -152,7 +132,7 @@ impl ConjugateGradient {
             for (r, q) in self.r.iter_mut().zip(&self.q) {
                 r.iter_mut().zip(q).for_each(|(r, &q)| *r -= alpha * q);
             }
-            blocks_times(&self.precond, &self.r, &mut self.z);
+            blocks_times(&self.precond, &self.r, &mut self.z, |z, _| z);
             residual = dot(&self.r, &self.r).sqrt();
             let rz_next = dot(&self.r, &self.z);
             let beta = (rz_next / rz) as f32;

@@ -3,7 +3,7 @@
 
 use std::sync::{Mutex, MutexGuard};
 
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 
 /// x, y and z of a list of vectors, one array each (all the same length).
 pub type Components = [Vec<f32>; 3];
@@ -21,6 +21,41 @@ pub fn zeroed(out: &mut Components, n: usize) {
     for comp in out {
         comp.clear();
         comp.resize(n, 0.0);
+    }
+}
+
+/// 3×3 blocks (one per particle or per spring) stored one array per entry, column-major:
+/// entry `3c + r` is row `r` of column `c`.
+pub type Blocks = [Vec<f32>; 9];
+
+/// Sets `out` to `blocks`, one array per entry.
+pub fn split_blocks(blocks: impl Iterator<Item = Mat3>, out: &mut Blocks) {
+    for entry in out.iter_mut() {
+        entry.clear();
+    }
+    for m in blocks {
+        for (entry, v) in out.iter_mut().zip(m.to_cols_array()) {
+            entry.push(v);
+        }
+    }
+}
+
+/// `out_i = combine(M_i·u_i, out_i)` for every particle `i` (`M` one block per particle).
+#[inline(always)]
+pub fn blocks_times(
+    m: &Blocks,
+    u: &Components,
+    out: &mut Components,
+    combine: impl Fn(f32, f32) -> f32,
+) {
+    let n = u[0].len().min(m[0].len());
+    let (ux, uy, uz) = (&u[0][..n], &u[1][..n], &u[2][..n]);
+    for (r, out) in out.iter_mut().enumerate() {
+        let (c0, c1, c2) = (&m[r][..n], &m[3 + r][..n], &m[6 + r][..n]);
+        let out = &mut out[..n];
+        for i in 0..n {
+            out[i] = combine(c0[i] * ux[i] + c1[i] * uy[i] + c2[i] * uz[i], out[i]);
+        }
     }
 }
 

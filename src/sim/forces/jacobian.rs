@@ -5,7 +5,7 @@ use glam::{Mat3, Vec3};
 
 use crate::cloth::{ClothModel, Springs};
 
-use super::components::Components;
+use super::components::{Blocks, Components, blocks_times, split_blocks};
 use super::spring_runs::SpringRuns;
 
 /// Which derivative a force term reports.
@@ -115,9 +115,9 @@ pub struct SystemProduct {
     /// The springs the runs were made for.
     ends: (Vec<u32>, Vec<u32>),
     runs: Option<SpringRuns>,
-    blocks: [Vec<f32>; 9],
+    blocks: Blocks,
     /// The particles' diagonal blocks, one array per entry (column-major).
-    diag: [Vec<f32>; 9],
+    diag: Blocks,
 }
 
 impl SystemProduct {
@@ -135,10 +135,7 @@ impl SystemProduct {
         if let Some(runs) = &self.runs {
             runs.blocks_in_order(&sys.spring, &mut self.blocks);
         }
-        for (k, entry) in self.diag.iter_mut().enumerate() {
-            entry.clear();
-            entry.extend(sys.diag.iter().map(|d| d.col(k / 3)[k % 3]));
-        }
+        split_blocks(sys.diag.iter().copied(), &mut self.diag);
     }
 
     /// `out = A·u` with the matrix last [loaded](SystemProduct::load), `u` and `out` stored
@@ -152,17 +149,6 @@ impl SystemProduct {
         if let Some(runs) = &self.runs {
             runs.add_block_products(&self.blocks, u, out);
         }
-        for (r, out) in out.iter_mut().enumerate() {
-            let (c0, c1, c2) = (
-                &self.diag[r][..n],
-                &self.diag[3 + r][..n],
-                &self.diag[6 + r][..n],
-            );
-            let (ux, uy, uz) = (&u[0][..n], &u[1][..n], &u[2][..n]);
-            let out = &mut out[..n];
-            for i in 0..n {
-                out[i] = c0[i] * ux[i] + c1[i] * uy[i] + c2[i] * uz[i] - out[i];
-            }
-        }
+        blocks_times(&self.diag, u, out, |diagonal, sums| diagonal - sums);
     }
 }

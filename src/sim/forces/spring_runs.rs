@@ -14,7 +14,7 @@
 //! give bit-identical forces.
 
 use super::super::team::{Disjoint, Team, share};
-use super::components::{Components, Scratch, split};
+use super::components::{Blocks, Components, Scratch, split, split_blocks};
 use std::ops::Range;
 
 use glam::{Mat3, Vec3};
@@ -431,17 +431,15 @@ impl SpringRuns {
     /// Each spring's 3×3 block (indexed as given to [`SpringRuns::new`]) in run order, one
     /// array per entry (column-major), zero for gap fillers: what
     /// [`SpringRuns::add_block_products`] reads.
-    pub fn blocks_in_order(&self, blocks: &[Mat3], out: &mut [Vec<f32>; 9]) {
-        for (k, entry) in out.iter_mut().enumerate() {
-            entry.clear();
-            entry.extend(self.order.iter().map(|&e| {
-                if e == GHOST {
-                    0.0
-                } else {
-                    blocks[e as usize].col(k / 3)[k % 3]
-                }
-            }));
-        }
+    pub fn blocks_in_order(&self, blocks: &[Mat3], out: &mut Blocks) {
+        let block = |&e: &u32| {
+            if e == GHOST {
+                Mat3::ZERO
+            } else {
+                blocks[e as usize]
+            }
+        };
+        split_blocks(self.order.iter().map(block), out);
     }
 
     /// Adds `Σ_e S_e·u_other` to `out` at both ends of every spring `e`, with `S_e` the
@@ -449,7 +447,7 @@ impl SpringRuns {
     /// part of a matrix-vector product with the implicit system (whose off-diagonal blocks
     /// are `−S_e`). In parallel as the forces are, with the same result on any number of
     /// threads.
-    pub fn add_block_products(&self, s: &[Vec<f32>; 9], u: &Components, out: &mut Components) {
+    pub fn add_block_products(&self, s: &Blocks, u: &Components, out: &mut Components) {
         let n = (u.iter().chain(out.iter()).map(Vec::len)).fold(self.particles, usize::min);
         if self.runs.is_empty() || n < self.particles || s[0].len() != self.order.len() {
             return;
@@ -515,7 +513,7 @@ impl RunPass for ForcePass<'_> {
 
 /// Block products `S_e·u_other` at both ends (see [`SpringRuns::add_block_products`]).
 struct ProductPass<'a> {
-    s: &'a [Vec<f32>; 9],
+    s: &'a Blocks,
     u: &'a Components,
 }
 
@@ -783,7 +781,7 @@ mod tests {
         }
         let zero = vec![0.0; a.len()];
         let runs = SpringRuns::new(n, &a, &b, &zero, &zero, &zero);
-        let mut s: [Vec<f32>; 9] = Default::default();
+        let mut s: Blocks = Default::default();
         runs.blocks_in_order(&blocks, &mut s);
         let mut uc = Components::default();
         split(&u, &mut uc, n);
