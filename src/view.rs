@@ -14,6 +14,7 @@ pub fn frame(sim: &Simulation) -> Frame<'_> {
     let springs = &model.springs;
     Frame {
         positions: &sim.state().pos,
+        device_positions: None,
         uvs: &model.uvs,
         triangles: &model.triangles,
         springs: SpringLines {

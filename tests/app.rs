@@ -671,9 +671,14 @@ fn the_gpu_button_moves_the_cloth_to_the_gpu_and_back_keeping_its_state() {
         worst < 1e-5,
         "GPU and CPU differ by {worst} m after one frame"
     );
+    assert!(
+        harness.state().drawn_from_gpu(),
+        "the view draws the GPU's buffer"
+    );
     harness.get_by_label("CPU").click();
     run_settled(&mut harness, 2);
     assert_eq!(harness.state().in_effect().backend, "cpu");
+    assert!(!harness.state().drawn_from_gpu());
     assert_eq!(
         harness.state().sim().state().pos,
         gpu.pos,

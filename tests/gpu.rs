@@ -94,11 +94,19 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
 
 /// A parameter change on a running GPU simulation reaches the shader: new spring
 /// strengths, substeps and gravity, applied mid-run on both backends, keep them together.
+/// Also when the GPU's state is not read back every frame (as the app runs it): the change
+/// must start from the GPU's latest frame, not from the stale copy on the CPU.
 #[test]
 fn a_parameter_change_mid_run_reaches_the_gpu() {
+    for read_every_frame in [true, false] {
+        parameter_change_mid_run(read_every_frame);
+    }
+}
+
+fn parameter_change_mid_run(read_every_frame: bool) {
     let scene = clothsim::bench::bench_scene(16, IntegratorKind::SemiImplicitEuler).expect("scene");
     let mut cpu = Simulation::new(scene.clone());
-    let (mut gpu, _) = gpu_simulation(scene, true).expect("gpu");
+    let (mut gpu, _) = gpu_simulation(scene, read_every_frame).expect("gpu");
     for sim in [&mut cpu, &mut gpu] {
         for _ in 0..10 {
             sim.step_frame().expect("frame");
@@ -113,6 +121,8 @@ fn a_parameter_change_mid_run_reaches_the_gpu() {
         }
     }
     assert_eq!(gpu.substeps(), 24);
+    assert_eq!(gpu.state_behind(), !read_every_frame);
+    gpu.sync_state().expect("read back");
     let worst = farthest(&cpu.state().pos, &gpu.state().pos);
     let drift = cpu
         .state()
@@ -123,6 +133,73 @@ fn a_parameter_change_mid_run_reaches_the_gpu() {
     assert!(drift > 1e-3, "the sideways gravity acted ({drift} m)");
     assert!(
         worst < 1e-5,
-        "GPU and CPU differ by {worst} m after the change"
+        "GPU and CPU differ by {worst} m after the change (read every frame: {read_every_frame})"
+    );
+}
+
+/// The view draws the GPU backend's cloth from the stepper's display buffer: after half a
+/// second stepped with nothing read back, the picture drawn from the buffer is the picture
+/// of the state read back afterwards, and not that of the stale copy on the CPU.
+#[test]
+fn the_gpu_cloth_is_drawn_from_its_buffer_without_a_read_back() {
+    use clothsim::gpu::GpuStepper;
+    use clothsim::render::{AdapterPreference, DevicePositions, Offscreen, RenderOptions};
+    use clothsim::view;
+
+    let mut off = Offscreen::new(160, 120, AdapterPreference::Software).expect("offscreen");
+    let scene = Scene::builtin("sphere-drop").expect("scene");
+    let mut stepper = GpuStepper::new(
+        &off.gpu.device,
+        &off.gpu.queue,
+        &scene.model,
+        &scene.params,
+        &scene.effects,
+        false,
+    )
+    .expect("stepper");
+    let display = stepper.display_buffer();
+    let mut sim = Simulation::with_backend(scene, Box::new(stepper));
+    let camera = view::default_camera(&sim, off.aspect());
+    let options = RenderOptions::default();
+    let on_device = DevicePositions {
+        buffer: &display,
+        stride: GpuStepper::DISPLAY_STRIDE,
+    };
+    // Before any step the buffer holds the uploaded start.
+    sim.sync_state().expect("upload");
+    let start = off
+        .render(&view::frame(&sim), &camera, &options)
+        .expect("image");
+    let mut frame = view::frame(&sim);
+    frame.device_positions = Some(on_device);
+    let first = off.render(&frame, &camera, &options).expect("image");
+    assert_eq!(start.as_raw(), first.as_raw(), "the buffer holds the start");
+
+    for _ in 0..30 {
+        sim.step_frame().expect("frame");
+    }
+    assert!(sim.state_behind(), "nothing was read back while stepping");
+    let mut frame = view::frame(&sim);
+    frame.device_positions = Some(on_device);
+    let drawn = off.render(&frame, &camera, &options).expect("image");
+    assert!(sim.state_behind(), "drawing read nothing back");
+    let stale = off
+        .render(&view::frame(&sim), &camera, &options)
+        .expect("image");
+    sim.sync_state().expect("read back");
+    let latest = off
+        .render(&view::frame(&sim), &camera, &options)
+        .expect("image");
+    let differing =
+        |a: &[u8], b: &[u8]| a.iter().zip(b).filter(|(x, y)| x.abs_diff(**y) > 1).count();
+    assert_eq!(
+        differing(drawn.as_raw(), latest.as_raw()),
+        0,
+        "drawn from the buffer = drawn from the state read back"
+    );
+    let moved = differing(stale.as_raw(), latest.as_raw());
+    assert!(
+        moved > 1000,
+        "the cloth fell in the picture ({moved} bytes)"
     );
 }

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use crate::mesh::MeshBuild;
-use crate::render::{OrbitCamera, RenderOptions};
+use crate::render::{DevicePositions, OrbitCamera, RenderOptions};
 use crate::scene::{Scene, Simulation};
 use crate::sim::{Effect, GuardAction, PhaseTimings, SimParams};
 use crate::view;
@@ -72,6 +72,11 @@ pub struct ClothApp {
     /// "name (backend, type)" of the adapter drawing the view, shown in the status bar.
     pub(super) adapter: Option<String>,
     pub(super) viewport: Option<Viewport>,
+    /// The GPU backend's display buffer (on the view's device), drawn from while the
+    /// stepping copy runs on the GPU: the view then reads nothing back.
+    gpu_display: Option<wgpu::Buffer>,
+    /// The view was last drawn from `gpu_display`.
+    drawn_from_gpu: bool,
     pub(super) loading: Option<Load>,
     pub(super) writer: PngWriter,
     /// Where captures and recordings go.
@@ -123,6 +128,8 @@ impl ClothApp {
                 .map(|rs| crate::render::describe_adapter(&rs.adapter)),
             render_state,
             viewport: None,
+            gpu_display: None,
+            drawn_from_gpu: false,
             loading: None,
             writer: PngWriter::default(),
             capture_dir: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
@@ -227,6 +234,8 @@ impl ClothApp {
     pub(super) fn replace_sim(&mut self, sim: Simulation) {
         let copy = sim.fork();
         self.sim = sim;
+        // The new copy steps on the CPU.
+        self.gpu_display = None;
         let sent = self.stepping.edit_state(Box::new(move |s| {
             *s = copy;
             None
@@ -297,6 +306,7 @@ impl ClothApp {
         use crate::gpu::{Backend, GpuStepper};
         match backend {
             Backend::Cpu => {
+                self.gpu_display = None;
                 let sent = self.stepping.edit(Box::new(|s| {
                     (s.use_cpu().err()).map(|e| format!("{e}; staying on the GPU"))
                 }));
@@ -313,8 +323,10 @@ impl ClothApp {
                 };
                 let (model, params, effects) =
                     (self.sim.model(), self.sim.params(), self.sim.effects());
-                match GpuStepper::new(&rs.device, &rs.queue, model, params, effects, true) {
-                    Ok(stepper) => {
+                // Not read back every frame: the view draws from the stepper's display buffer.
+                match GpuStepper::new(&rs.device, &rs.queue, model, params, effects, false) {
+                    Ok(mut stepper) => {
+                        self.gpu_display = Some(stepper.display_buffer());
                         // The stepping copy moves to the GPU; the replica never steps.
                         let sent = self.stepping.edit(Box::new(move |s| {
                             s.set_backend(Box::new(stepper))
@@ -443,6 +455,12 @@ impl ClothApp {
         fits.max().copied().unwrap_or(1)
     }
 
+    /// Whether the 3D view was last drawn straight from the GPU backend's buffer (the
+    /// stepping copy runs on the GPU; nothing was read back to draw it).
+    pub fn drawn_from_gpu(&self) -> bool {
+        self.drawn_from_gpu
+    }
+
     /// MSAA samples of the 3D view as last drawn (`None` before the first draw or without a
     /// renderer).
     pub fn view_samples(&self) -> Option<u32> {
@@ -479,7 +497,14 @@ impl ClothApp {
             return;
         };
         self.view_aspect = w as f32 / h as f32;
-        let frame = view::frame(&self.sim);
+        let mut frame = view::frame(&self.sim);
+        if self.in_effect.backend == "gpu" {
+            frame.device_positions = self.gpu_display.as_ref().map(|buffer| DevicePositions {
+                buffer,
+                stride: crate::gpu::GpuStepper::DISPLAY_STRIDE,
+            });
+        }
+        self.drawn_from_gpu = frame.device_positions.is_some();
         if let Err(e) = viewport.draw(&rs, w, h, &frame, &self.camera, &self.options) {
             ui.label(format!("3D view: {e}"));
             return;

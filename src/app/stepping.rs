@@ -4,11 +4,15 @@
 //! the thread steps the frames the UI's clock says are due and publishes each finished
 //! state, which the UI adopts on its next frame. So the UI never waits for a frame to be
 //! computed: a slider or an orbit stays smooth however long a frame takes.
+//!
+//! A backend that steps a copy of its own (the GPU backend, which the view draws from
+//! directly) is read back only now and then: every [`SYNC_EVERY`] while running, and once
+//! the stepping stops, for what the UI computes from the state (picking, kinetic energy).
 
-use std::sync::mpsc::{self, Receiver, Sender, TryRecvError};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender, TryRecvError};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use crate::cloth::ClothState;
 use crate::scene::Simulation;
@@ -17,6 +21,11 @@ use crate::sim::{GuardEvent, IntegratorKind, PhaseTimings};
 /// Frames the stepping thread may owe at most; beyond, the backlog is dropped and the run
 /// is reported as slower than real time (a quarter of a second at 60 frames per second).
 const MAX_BACKLOG: u32 = 15;
+
+/// While a backend's own copy runs ahead of the state, the state is read back this often.
+const SYNC_EVERY: Duration = Duration::from_millis(250);
+/// ... and once no job came for this long after a frame (the run paused or stepped once).
+const SYNC_WHEN_STILL: Duration = Duration::from_millis(30);
 
 /// A change to the simulation; `Some(text)` is an error to show.
 pub(super) type Edit = Box<dyn FnOnce(&mut Simulation) -> Option<String> + Send>;
@@ -58,7 +67,7 @@ impl InEffect {
 pub(super) struct Report {
     /// Jobs done, in the order sent.
     pub done: u64,
-    /// No frames owed: the thread waits for the next job.
+    /// No frames owed and the state is current: the thread waits for the next job.
     pub idle: bool,
     /// The latest finished state, the frames at it, and the jobs done when it was
     /// published; `fresh` until the UI took it.
@@ -221,11 +230,23 @@ impl Drop for SimThread {
 /// jobs between frames) and publishes after each.
 fn run(mut sim: Simulation, jobs: &Receiver<Job>, shared: &Shared) {
     let (mut owed, mut done) = (0u32, 0u64);
+    let mut synced = Instant::now();
     loop {
         let job = if owed == 0 {
-            match jobs.recv() {
+            let next = if sim.state_behind() {
+                jobs.recv_timeout(SYNC_WHEN_STILL)
+            } else {
+                jobs.recv().map_err(|_| RecvTimeoutError::Disconnected)
+            };
+            match next {
                 Ok(job) => Some(job),
-                Err(_) => return,
+                Err(RecvTimeoutError::Timeout) => {
+                    let mut published = Published::default();
+                    sync(&mut sim, &mut synced, &mut published);
+                    published.write(&mut sim, shared, done, owed);
+                    continue;
+                }
+                Err(RecvTimeoutError::Disconnected) => return,
             }
         } else {
             match jobs.try_recv() {
@@ -240,7 +261,8 @@ fn run(mut sim: Simulation, jobs: &Receiver<Job>, shared: &Shared) {
             Some(Job::Edit(edit)) => {
                 done += 1;
                 published.note = edit(&mut sim);
-                published.state = true;
+                // A backend with its own copy takes the edited state now (what it draws).
+                sync(&mut sim, &mut synced, &mut published);
             }
             Some(Job::Advance(n)) => {
                 done += 1;
@@ -258,13 +280,27 @@ fn run(mut sim: Simulation, jobs: &Receiver<Job>, shared: &Shared) {
                 published.stepped = true;
                 published.state = true;
                 if let Err(e) = outcome {
-                    owed = 0;
                     published.failed = Some(format!("{e} Paused."));
+                } else if synced.elapsed() >= SYNC_EVERY {
+                    sync(&mut sim, &mut synced, &mut published);
                 }
             }
         }
+        if published.failed.is_some() {
+            owed = 0;
+        }
         published.write(&mut sim, shared, done, owed);
     }
+}
+
+/// Brings the state up to date with the backend's own copy (or the copy with the state),
+/// to be published.
+fn sync(sim: &mut Simulation, synced: &mut Instant, published: &mut Published) {
+    if let Err(e) = sim.sync_state() {
+        published.failed = Some(format!("{e} Paused."));
+    }
+    *synced = Instant::now();
+    published.state = true;
 }
 
 /// What one pass of the stepping loop has to publish.
@@ -287,7 +323,7 @@ impl Published {
         {
             let mut r = shared.lock();
             r.done = done;
-            r.idle = owed == 0;
+            r.idle = owed == 0 && !sim.state_behind();
             if self.state {
                 r.state.clone_from(sim.state());
                 r.frames = sim.frames();

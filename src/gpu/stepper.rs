@@ -114,6 +114,9 @@ pub struct GpuStepper {
     /// `groups[i]` reads `particles[i]` and writes the other.
     groups: [wgpu::BindGroup; 2],
     readback: wgpu::Buffer,
+    /// A copy of the state at the end of the last frame, for a renderer on the same device;
+    /// made on the first [`GpuStepper::display_buffer`], then kept current.
+    display: Option<wgpu::Buffer>,
     current: usize,
     count: u32,
     params: Params,
@@ -121,10 +124,15 @@ pub struct GpuStepper {
     substeps: u32,
     /// The GPU copy must be replaced by the caller's state before the next step.
     upload: bool,
+    /// The GPU copy stepped since the caller's state was last brought up to date.
+    behind: bool,
     /// Copy the state back into the caller's after every frame (else only on `sync`).
     read_every_frame: bool,
     /// Why the current configuration cannot run, if it cannot.
     unsupported: Option<String>,
+    /// Why the state could not be read back, if it could not: every later frame fails with
+    /// it (the GPU copy and the caller's state can no longer be brought together).
+    lost: Option<String>,
     timings: PhaseTimings,
     stats: StepStats,
 }
@@ -289,14 +297,17 @@ impl GpuStepper {
             neighbours,
             groups,
             readback,
+            display: None,
             current: 0,
             count,
             params: Params::zeroed(),
             dt: params.dt,
             substeps: params.substeps.max(1),
             upload: true,
+            behind: false,
             read_every_frame,
             unsupported: None,
+            lost: None,
             timings: PhaseTimings::default(),
             stats: StepStats::default(),
         };
@@ -304,10 +315,34 @@ impl GpuStepper {
         Ok(stepper)
     }
 
-    /// The buffer holding the latest positions (`vec4` per particle, xyz in metres), for a
-    /// renderer on the same device.
-    pub fn position_buffer(&self) -> &wgpu::Buffer {
-        &self.particles[self.current]
+    /// Stride of [`GpuStepper::display_buffer`], in `vec4`s per particle.
+    pub const DISPLAY_STRIDE: u32 = 2;
+
+    /// A buffer that holds the state at the end of the latest frame (or upload), for a
+    /// renderer on the same device to draw from without reading anything back: per particle
+    /// a `vec4` whose xyz is the position in metres, then one with the velocity
+    /// ([`GpuStepper::DISPLAY_STRIDE`]). Every frame's submission ends with the copy into it,
+    /// so work submitted to the queue later sees a whole frame. Made on the first call (a
+    /// stepper nobody draws, the benchmark's, copies nothing).
+    pub fn display_buffer(&mut self) -> wgpu::Buffer {
+        if let Some(display) = &self.display {
+            return display.clone();
+        }
+        let display = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("particles display"),
+            size: self.particles[0].size(),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("particles display"),
+            });
+        encoder.copy_buffer_to_buffer(&self.particles[self.current], 0, &display, 0, None);
+        self.queue.submit([encoder.finish()]);
+        self.display = Some(display.clone());
+        display
     }
 
     /// Sends each particle's springs (the model's adjacency, with the strengths of the
@@ -355,13 +390,13 @@ impl GpuStepper {
             })
             .collect();
         if !data.is_empty() {
-            self.queue.write_buffer(
-                &self.particles[self.current],
-                0,
-                bytemuck::cast_slice(&data),
-            );
+            for buffer in std::iter::once(&self.particles[self.current]).chain(&self.display) {
+                self.queue
+                    .write_buffer(buffer, 0, bytemuck::cast_slice(&data));
+            }
         }
         self.upload = false;
+        self.behind = false;
     }
 
     /// Encodes and submits `substeps` substeps.
@@ -373,6 +408,9 @@ impl GpuStepper {
     ) -> Result<(), StepError> {
         if let Some(why) = &self.unsupported {
             return Err(StepError::Unsupported(why.clone()));
+        }
+        if let Some(why) = &self.lost {
+            return Err(StepError::Device(why.clone()));
         }
         if self.upload {
             self.upload_state(model, state);
@@ -394,7 +432,11 @@ impl GpuStepper {
                 self.current = 1 - self.current;
             }
         }
+        if let Some(display) = &self.display {
+            encoder.copy_buffer_to_buffer(&self.particles[self.current], 0, display, 0, None);
+        }
         self.queue.submit([encoder.finish()]);
+        self.behind = true;
         for _ in 0..substeps {
             self.stats.record(&SUBSTEP);
         }
@@ -427,6 +469,7 @@ impl GpuStepper {
             }
         }
         self.readback.unmap();
+        self.behind = false;
         Ok(())
     }
 
@@ -560,12 +603,24 @@ impl StepBackend for GpuStepper {
         IntegratorKind::SemiImplicitEuler
     }
 
-    fn sync(&mut self, state: &mut ClothState) -> Result<(), StepError> {
-        // After `invalidate` the caller's state is the newer one.
-        if self.read_every_frame || self.upload {
+    fn sync(&mut self, model: &ClothModel, state: &mut ClothState) -> Result<(), StepError> {
+        if self.upload {
+            // After `invalidate` or `configure` the caller's state is the newer one.
+            self.upload_state(model, state);
             return Ok(());
         }
-        self.read_back(state)
-            .map_err(|e| StepError::Device(e.to_string()))
+        if !self.behind {
+            return Ok(());
+        }
+        self.read_back(state).map_err(|e| {
+            let why = e.to_string();
+            self.lost = Some(why.clone());
+            StepError::Device(why)
+        })
+    }
+
+    fn state_behind(&self) -> bool {
+        // After a failed read-back there is nothing more to read.
+        self.behind && self.lost.is_none()
     }
 }

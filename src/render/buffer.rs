@@ -17,7 +17,8 @@ impl GrowBuffer {
         usage: wgpu::BufferUsages,
         capacity: u64,
     ) -> Self {
-        let usage = usage | wgpu::BufferUsages::COPY_DST;
+        // COPY_SRC: what the device wrote can be read back (tests).
+        let usage = usage | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: capacity.max(256),
@@ -48,6 +49,27 @@ impl GrowBuffer {
         }
         self.len = needed;
         grew
+    }
+
+    /// Makes room for `bytes` that the device will write (a compute pass), reallocating (to
+    /// twice the need) only when they do not fit. Returns whether the buffer was reallocated.
+    pub fn reserve(&mut self, device: &wgpu::Device, bytes: u64) -> bool {
+        let grew = bytes > self.buffer.size();
+        if grew {
+            self.buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(self.label),
+                size: bytes * 2,
+                usage: self.usage,
+                mapped_at_creation: false,
+            });
+        }
+        self.len = bytes;
+        grew
+    }
+
+    /// The whole buffer, to bind.
+    pub fn buffer(&self) -> &wgpu::Buffer {
+        &self.buffer
     }
 
     /// The written bytes.

@@ -28,11 +28,22 @@ pub enum Shape {
     Plane { point: Vec3, normal: Vec3 },
 }
 
+/// Particle positions that live on the device the renderer draws with (the GPU backend's
+/// state): particle i's position, metres, is the xyz of the `vec4` at index `i · stride`.
+#[derive(Clone, Copy, Debug)]
+pub struct DevicePositions<'a> {
+    pub buffer: &'a wgpu::Buffer,
+    pub stride: u32,
+}
+
 /// One frame: the cloth, its springs and pins, and the solids around it.
 #[derive(Clone, Debug, Default)]
 pub struct Frame<'a> {
-    /// Particle positions, metres.
+    /// Particle positions, metres (not read when `device_positions` is given).
     pub positions: &'a [Vec3],
+    /// The positions on the renderer's device, when they live there: the renderer draws
+    /// from them without reading them back. There is one per texture coordinate.
+    pub device_positions: Option<DevicePositions<'a>>,
     /// One texture coordinate per particle.
     pub uvs: &'a [Vec2],
     pub triangles: &'a [[u32; 3]],

@@ -5,6 +5,7 @@ mod buffer;
 mod camera;
 mod capture;
 mod device;
+mod display;
 mod error;
 mod frame;
 mod geometry;
@@ -21,7 +22,7 @@ pub use capture::{
 };
 pub use device::{AdapterPreference, Gpu, describe_adapter};
 pub use error::RenderError;
-pub use frame::{Frame, Shape, SpringLines};
+pub use frame::{DevicePositions, Frame, Shape, SpringLines};
 pub use gif::GifWriter;
 pub use offscreen::Offscreen;
 pub use options::{RenderOptions, SpringColoring};

@@ -9,6 +9,7 @@ use crate::mesh::{SpringKind, vertex_normals};
 
 use super::buffer::GrowBuffer;
 use super::camera::OrbitCamera;
+use super::display::{DisplayPass, LineSpec, Outputs, PARTICLE_COLOR, PINNED_COLOR};
 use super::frame::{Frame, Shape};
 use super::geometry::{
     ClothVertex, ColorVertex, SolidVertex, ground_quad, triangle_edges, uv_sphere,
@@ -89,6 +90,11 @@ pub struct Renderer {
     cloth_indices: GrowBuffer,
     /// The triangles last uploaded; indices are re-uploaded only when they change.
     uploaded_triangles: Vec<[u32; 3]>,
+    /// Counts the changes of `uploaded_triangles`.
+    topology_generation: u64,
+    /// Fills the vertex buffers on the device for frames whose positions live there; made
+    /// for the first such frame.
+    display: Option<DisplayPass>,
     /// Unique edges of those triangles, for the wireframe.
     wire_edges: Vec<[u32; 2]>,
     lines: GrowBuffer,
@@ -102,6 +108,7 @@ pub struct Renderer {
     /// `(slot, is_sphere)` of the colliders to draw, in order.
     solid_draws: Vec<(usize, bool)>,
     normals: Vec<Vec3>,
+    line_specs: Vec<LineSpec>,
     cloth_scratch: Vec<ClothVertex>,
     line_scratch: Vec<ColorVertex>,
     point_scratch: Vec<ColorVertex>,
@@ -125,7 +132,12 @@ impl Renderer {
                 resource: globals.as_entire_binding(),
             }],
         });
-        let vertex = wgpu::BufferUsages::VERTEX;
+        // Vertex buffers a display pass may fill on the device, where it can run.
+        let vertex = if device.limits().max_storage_buffers_per_shader_stage >= 4 {
+            wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::STORAGE
+        } else {
+            wgpu::BufferUsages::VERTEX
+        };
         Self {
             sample_count,
             globals,
@@ -138,6 +150,8 @@ impl Renderer {
                 1 << 16,
             ),
             uploaded_triangles: Vec::new(),
+            topology_generation: 0,
+            display: None,
             wire_edges: Vec::new(),
             lines: GrowBuffer::new(device, "clothsim lines", vertex, 1 << 16),
             line_vertices: 0,
@@ -149,6 +163,7 @@ impl Renderer {
             solid_draws: Vec::new(),
             pipelines,
             normals: Vec::new(),
+            line_specs: Vec::new(),
             cloth_scratch: Vec::new(),
             line_scratch: Vec::new(),
             point_scratch: Vec::new(),
@@ -159,7 +174,9 @@ impl Renderer {
         self.sample_count
     }
 
-    /// Uploads the frame and draws it into `target`, submitting one command buffer.
+    /// Uploads the frame and draws it into `target`, submitting one command buffer. A frame
+    /// whose positions live on the device is drawn from them there (nothing is read back);
+    /// if their buffer is too small for the frame's particles, from `positions`.
     pub fn render(
         &mut self,
         device: &wgpu::Device,
@@ -175,21 +192,54 @@ impl Renderer {
         }
         let (width, height) = target.size();
         self.upload_globals(queue, camera, width, height, options);
-        // Normals and vertices are only worth computing when the surface is drawn.
         self.update_topology(device, queue, frame);
-        if options.mesh {
-            self.upload_cloth(device, queue, frame);
+        self.line_specs(frame, options);
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("clothsim frame"),
+        });
+        // A buffer too small for the frame's particles (a stale one) is not read.
+        let vec4 = 16;
+        let on_device = frame.device_positions.filter(|d| {
+            d.buffer.size() >= frame.uvs.len() as u64 * u64::from(d.stride.max(1)) * vec4
+        });
+        match on_device {
+            Some(source) => {
+                let display = self.display.get_or_insert_with(|| DisplayPass::new(device));
+                let outputs = Outputs {
+                    cloth: options.mesh.then_some(&mut self.cloth_vertices),
+                    lines: &mut self.lines,
+                    points: options.particles.then_some(&mut self.points),
+                };
+                display.encode(
+                    device,
+                    queue,
+                    &mut encoder,
+                    source,
+                    frame,
+                    self.topology_generation,
+                    &self.line_specs,
+                    outputs,
+                );
+                self.line_vertices = 2 * self.line_specs.len() as u32;
+                self.point_count = if options.particles {
+                    frame.uvs.len() as u32
+                } else {
+                    0
+                };
+            }
+            None => {
+                // Normals and vertices are only worth computing when the surface is drawn.
+                if options.mesh {
+                    self.upload_cloth(device, queue, frame);
+                }
+                self.upload_lines(device, queue, frame);
+                self.upload_points(device, queue, frame, options);
+            }
         }
-        self.upload_lines(device, queue, frame, options);
-        self.upload_points(device, queue, frame, options);
         self.solid_draws.clear();
         if options.colliders {
             self.upload_solids(device, queue, frame);
         }
-
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("clothsim frame"),
-        });
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("clothsim frame"),
@@ -263,6 +313,7 @@ impl Renderer {
     fn update_topology(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, frame: &Frame<'_>) {
         if self.uploaded_triangles != frame.triangles {
             self.uploaded_triangles = frame.triangles.to_vec();
+            self.topology_generation += 1;
             self.wire_edges = triangle_edges(frame.triangles);
             self.cloth_indices
                 .write(device, queue, bytemuck::cast_slice(frame.triangles));
@@ -288,46 +339,52 @@ impl Renderer {
             .write(device, queue, bytemuck::cast_slice(&self.cloth_scratch));
     }
 
-    fn upload_lines(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        frame: &Frame<'_>,
-        options: &RenderOptions,
-    ) {
-        let s = &frame.springs;
-        let pos = frame.positions;
-        let lines = &mut self.line_scratch;
-        lines.clear();
-        let mut push = |a: u32, b: u32, color: [f32; 4]| {
-            lines.push(ColorVertex {
-                position: pos[a as usize].to_array(),
-                color,
-            });
-            lines.push(ColorVertex {
-                position: pos[b as usize].to_array(),
-                color,
-            });
+    /// The lines the options ask for (wireframe, then springs), into `line_specs`.
+    fn line_specs(&mut self, frame: &Frame<'_>, options: &RenderOptions) {
+        let specs = &mut self.line_specs;
+        specs.clear();
+        let line = |a, b, rest, by_strain, color| LineSpec {
+            a,
+            b,
+            rest,
+            by_strain: u32::from(by_strain),
+            color,
         };
         if options.wireframe {
-            for &[a, b] in &self.wire_edges {
-                push(a, b, [0.02, 0.02, 0.03, 0.85]);
-            }
+            let wire = [0.02, 0.02, 0.03, 0.85];
+            specs.extend(
+                self.wire_edges
+                    .iter()
+                    .map(|&[a, b]| line(a, b, 0.0, false, wire)),
+            );
         }
         if options.springs {
+            let s = &frame.springs;
+            let by_strain = options.spring_coloring == SpringColoring::ByStrain;
             for i in 0..s.a.len() {
                 let kind = s.kind[i];
-                if !options.spring_kinds[kind.index()] {
-                    continue;
+                if options.spring_kinds[kind.index()] {
+                    specs.push(line(s.a[i], s.b[i], s.rest[i], by_strain, kind_color(kind)));
                 }
-                let color = match options.spring_coloring {
-                    SpringColoring::ByKind => kind_color(kind),
-                    SpringColoring::ByStrain => {
-                        let len = pos[s.a[i] as usize].distance(pos[s.b[i] as usize]);
-                        strain_color((len - s.rest[i]) / s.rest[i].max(1e-9))
-                    }
-                };
-                push(s.a[i], s.b[i], color);
+            }
+        }
+    }
+
+    fn upload_lines(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, frame: &Frame<'_>) {
+        let pos = frame.positions;
+        self.line_scratch.clear();
+        for l in &self.line_specs {
+            let (a, b) = (pos[l.a as usize], pos[l.b as usize]);
+            let color = if l.by_strain == 0 {
+                l.color
+            } else {
+                strain_color((a.distance(b) - l.rest) / l.rest.max(1e-9))
+            };
+            for position in [a, b] {
+                self.line_scratch.push(ColorVertex {
+                    position: position.to_array(),
+                    color,
+                });
             }
         }
         self.line_vertices = self.line_scratch.len() as u32;
@@ -347,11 +404,11 @@ impl Renderer {
             self.point_scratch
                 .extend(frame.positions.iter().map(|p| ColorVertex {
                     position: p.to_array(),
-                    color: [1.0, 0.85, 0.15, 1.0],
+                    color: PARTICLE_COLOR,
                 }));
             for &p in frame.pinned {
                 if let Some(v) = self.point_scratch.get_mut(p as usize) {
-                    v.color = [1.0, 0.05, 0.05, 1.0];
+                    v.color = PINNED_COLOR;
                 }
             }
         }
@@ -431,4 +488,155 @@ pub fn strain_color(strain: f32) -> [f32; 4] {
         grey.lerp(Vec3::new(0.05, 0.3, 1.0), -t)
     };
     c.extend(1.0).into()
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec2;
+
+    use super::*;
+    use crate::mesh::{GridOrientation, GridSpec};
+    use crate::render::{
+        AdapterPreference, DevicePositions, Gpu, RgbaImage, SpringLines, map_read, read_target,
+    };
+
+    /// The first `floats` floats of `buffer`, read back.
+    fn read_floats(gpu: &Gpu, buffer: &GrowBuffer, floats: usize) -> Vec<f32> {
+        let bytes = (floats * 4) as u64;
+        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("test readback"),
+            size: bytes.max(4),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(buffer.buffer(), 0, &staging, 0, bytes);
+        gpu.queue.submit([encoder.finish()]);
+        let slice = staging.slice(..);
+        map_read(&gpu.device, &slice).expect("mapped");
+        bytemuck::cast_slice(&slice.get_mapped_range().expect("range")).to_vec()
+    }
+
+    /// The cloth, line and point vertices a renderer drew last, and the picture.
+    struct Drawn {
+        cloth: Vec<f32>,
+        lines: Vec<f32>,
+        points: Vec<f32>,
+        image: RgbaImage,
+    }
+
+    fn draw(gpu: &Gpu, renderer: &mut Renderer, frame: &Frame<'_>) -> Drawn {
+        let options = RenderOptions {
+            wireframe: true,
+            springs: true,
+            spring_coloring: SpringColoring::ByStrain,
+            spring_kinds: [true; 3],
+            particles: true,
+            ..RenderOptions::default()
+        };
+        let target = RenderTarget::new(&gpu.device, 96, 72, 1).expect("target");
+        let camera = OrbitCamera::framing(frame.positions, 96.0 / 72.0);
+        renderer.render(&gpu.device, &gpu.queue, &target, &camera, frame, &options);
+        let n = frame.positions.len();
+        Drawn {
+            cloth: read_floats(gpu, &renderer.cloth_vertices, 8 * n),
+            lines: read_floats(gpu, &renderer.lines, 7 * renderer.line_vertices as usize),
+            points: read_floats(gpu, &renderer.points, 7 * n),
+            image: read_target(&gpu.device, &gpu.queue, &target).expect("image"),
+        }
+    }
+
+    fn assert_close(what: &str, cpu: &[f32], device: &[f32], tolerance: f32) {
+        assert_eq!(cpu.len(), device.len(), "{what}: lengths");
+        let worst = (cpu.iter().zip(device))
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        assert!(worst <= tolerance, "{what}: differ by up to {worst}");
+    }
+
+    /// A crumpled cloth drawn from positions on the device (every overlay on, springs
+    /// coloured by strain) gets the vertices and the picture the CPU path makes from the
+    /// same positions; and after its triangles change, still does.
+    #[test]
+    fn drawing_from_device_positions_matches_drawing_from_the_cpu() {
+        let gpu = Gpu::headless(AdapterPreference::Software).expect("software adapter");
+        let mesh = GridSpec::square(8, 1.0, GridOrientation::Vertical, Vec3::ZERO)
+            .build()
+            .expect("grid");
+        let rest = mesh.positions.clone();
+        // Crumpled out of plane and stretched or squeezed up to ±20 %: varied normals, and
+        // strains past both ends of the colour scale.
+        let positions: Vec<Vec3> = (rest.iter().enumerate())
+            .map(|(i, p)| {
+                let f = i as f32;
+                Vec3::new(
+                    p.x * (1.0 + 0.2 * (0.7 * f).sin()),
+                    p.y,
+                    0.15 * (1.3 * f).sin() * p.x.cos(),
+                )
+            })
+            .collect();
+        let (mut a, mut b, mut lengths, mut kinds) = (vec![], vec![], vec![], vec![]);
+        let pairs = (mesh.edges.iter().zip(&mesh.edge_kinds))
+            .map(|(e, &k)| (*e, k))
+            .chain(mesh.bend_pairs.iter().map(|&e| (e, SpringKind::Bend)));
+        for ([i, j], kind) in pairs {
+            a.push(i);
+            b.push(j);
+            lengths.push(rest[i as usize].distance(rest[j as usize]));
+            kinds.push(kind);
+        }
+        // On the device: position, then a velocity the renderer must skip (stride 2).
+        let words: Vec<[f32; 4]> = positions
+            .iter()
+            .flat_map(|p| [p.extend(1.0).to_array(), [99.0; 4]])
+            .collect();
+        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("test positions"),
+            size: (words.len() * 16) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        gpu.queue
+            .write_buffer(&buffer, 0, bytemuck::cast_slice(&words));
+        let uvs: Vec<Vec2> = mesh.uvs.clone();
+        let pinned = [0u32, 8];
+        let mut frame = Frame {
+            positions: &positions,
+            device_positions: None,
+            uvs: &uvs,
+            triangles: &mesh.triangles,
+            springs: SpringLines {
+                a: &a,
+                b: &b,
+                rest: &lengths,
+                kind: &kinds,
+            },
+            pinned: &pinned,
+            shapes: Vec::new(),
+        };
+        let on_device = Some(DevicePositions {
+            buffer: &buffer,
+            stride: 2,
+        });
+        let (mut cpu, mut device) = (Renderer::new(&gpu.device, 1), Renderer::new(&gpu.device, 1));
+        let half = &mesh.triangles[..mesh.triangles.len() / 2];
+        for triangles in [&mesh.triangles[..], half] {
+            frame.triangles = triangles;
+            frame.device_positions = None;
+            let want = draw(&gpu, &mut cpu, &frame);
+            frame.device_positions = on_device;
+            let got = draw(&gpu, &mut device, &frame);
+            assert_close("cloth vertices", &want.cloth, &got.cloth, 1e-6);
+            assert_close("line vertices", &want.lines, &got.lines, 1e-6);
+            assert_close("particle vertices", &want.points, &got.points, 0.0);
+            let differing = (want.image.as_raw().iter().zip(got.image.as_raw()))
+                .filter(|(x, y)| x.abs_diff(**y) > 1)
+                .count();
+            assert!(
+                differing <= 8,
+                "{differing} image bytes differ by more than 1"
+            );
+        }
+    }
 }

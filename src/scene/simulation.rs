@@ -83,7 +83,7 @@ impl Simulation {
     /// # Errors
     /// The old backend's state could not be read back; it stays in use.
     pub fn set_backend(&mut self, mut backend: Box<dyn StepBackend>) -> Result<(), StepError> {
-        self.backend.sync(&mut self.state)?;
+        self.backend.sync(&self.model, &mut self.state)?;
         backend.configure(&self.model, &self.params, &self.effects);
         backend.invalidate();
         self.backend = backend;
@@ -236,6 +236,7 @@ impl Simulation {
     /// [`SceneError::Params`] naming the bad value; nothing changes then.
     pub fn set_params(&mut self, params: SimParams) -> Result<(), SceneError> {
         params.validate().map_err(SceneError::Params)?;
+        self.before_edit();
         if params.density != self.params.density {
             self.model.set_density(params.density);
             self.backend.invalidate();
@@ -249,6 +250,7 @@ impl Simulation {
     /// Replaces the effect list (switches forces on or off, moves or retunes colliders).
     /// Returns warnings about it (a sphere smaller than the particle spacing).
     pub fn set_effects(&mut self, effects: Vec<Effect>) -> Vec<String> {
+        self.before_edit();
         self.effects = effects;
         let warnings = small_sphere_warnings(&self.colliders(), &self.model);
         self.backend
@@ -292,6 +294,7 @@ impl Simulation {
         if p as usize >= self.model.particle_count() || !target.is_finite() {
             return;
         }
+        self.before_edit();
         if self.grabbed != Some(p) {
             self.grabbed = Some(p);
             self.refresh_pins();
@@ -317,6 +320,7 @@ impl Simulation {
 
     /// Pins in force: the scene's (when enabled), toggled by hand, and the held particle.
     fn refresh_pins(&mut self) {
+        self.before_edit();
         let mut pins = if self.pins_enabled {
             self.scenario_pins.clone()
         } else {
@@ -346,6 +350,7 @@ impl Simulation {
 
     /// Changes the live state (a drag, a throw); the backend is told.
     pub fn modify_state(&mut self, change: impl FnOnce(&mut ClothState)) {
+        self.before_edit();
         change(&mut self.state);
         self.backend.invalidate();
     }
@@ -395,7 +400,22 @@ impl Simulation {
     /// # Errors
     /// [`StepError::Device`] when the copy could not be read; the state is then unchanged.
     pub fn sync_state(&mut self) -> Result<(), StepError> {
-        self.backend.sync(&mut self.state)
+        self.backend.sync(&self.model, &mut self.state)
+    }
+
+    /// Whether the backend stepped past [`Simulation::state`] (the GPU backend between
+    /// read-backs): [`Simulation::sync_state`] would bring it up to date.
+    pub fn state_behind(&self) -> bool {
+        self.backend.state_behind()
+    }
+
+    /// Before an edit that reads or replaces part of the state or the model: brings the state
+    /// up to date with the backend's copy, so the edit starts from the latest frame and
+    /// what the backend takes afterwards is the edited latest frame. A copy that cannot be
+    /// read leaves the state as it was; the backend remembers why and fails its next frame
+    /// with it, which is where the user hears of it.
+    fn before_edit(&mut self) {
+        let _ = self.backend.sync(&self.model, &mut self.state);
     }
 
     /// Wall time per phase since the last call.

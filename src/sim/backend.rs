@@ -69,12 +69,20 @@ pub trait StepBackend: Send {
         None
     }
 
-    /// Brings `state` up to date with a copy the backend keeps elsewhere (a GPU buffer).
-    /// Backends that step `state` in place have nothing to do.
+    /// Makes `state` and a copy the backend keeps elsewhere (a GPU buffer) agree: the copy
+    /// is read back when it stepped since they last agreed, or replaced by `state` when
+    /// that is the newer one (after [`StepBackend::invalidate`] or
+    /// [`StepBackend::configure`]). Backends that step `state` in place have nothing to do.
     ///
     /// # Errors
     /// [`StepError::Device`] when the copy could not be read; `state` is then unchanged.
-    fn sync(&mut self, _state: &mut ClothState) -> Result<(), StepError> {
+    fn sync(&mut self, _model: &ClothModel, _state: &mut ClothState) -> Result<(), StepError> {
         Ok(())
+    }
+
+    /// Whether the backend's own copy has stepped past `state` (a [`StepBackend::sync`]
+    /// would read it back).
+    fn state_behind(&self) -> bool {
+        false
     }
 }
