@@ -46,7 +46,7 @@ pub struct SimParams {
 #[serde(default)]
 pub struct SolverConfig {
     /// Conjugate gradients stop when the residual is this fraction of the right-hand
-    /// side's norm (default 1e-4).
+    /// side's norm (default 1e-3).
     pub tolerance: f32,
     /// Conjugate-gradient iteration cap per solve (default 200).
     pub max_iterations: u32,
@@ -63,7 +63,7 @@ pub struct SolverConfig {
 impl Default for SolverConfig {
     fn default() -> Self {
         Self {
-            tolerance: 1e-4,
+            tolerance: 1e-3,
             max_iterations: 200,
             newton_iterations: 1,
             newton_tolerance: 1e-3,
