@@ -243,7 +243,7 @@ impl ClothApp {
         self.report_sent(sent);
     }
 
-    fn report_sent(&mut self, sent: Result<(), String>) {
+    pub(super) fn report_sent(&mut self, sent: Result<(), String>) {
         if let Err(e) = sent {
             self.transport.pause();
             self.message(Level::Error, e);
@@ -389,7 +389,7 @@ impl ClothApp {
 
     /// Shows what the stepping thread finished: its latest state, the guard's events, a
     /// frame that failed (which pauses), and the timings.
-    fn poll_stepping(&mut self) {
+    pub(super) fn poll_stepping(&mut self) {
         let sim = &mut self.sim;
         let (news, in_effect) = self
             .stepping

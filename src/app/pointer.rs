@@ -35,9 +35,26 @@ impl ClothApp {
         Some((p, pos[p as usize]))
     }
 
+    /// Before picking: on the GPU backend the replica's state is read back only now and
+    /// then (the view draws from the GPU's buffer); bring it to the latest frame so the
+    /// pointer picks the cloth where it is drawn. One read-back per click or grab.
+    fn catch_up(&mut self) {
+        if self.in_effect().backend == "gpu" {
+            let sent = self.stepping.catch_up();
+            self.report_sent(sent);
+            self.poll_stepping();
+        }
+    }
+
     pub(super) fn pointer_input(&mut self, ui: &egui::Ui, response: &egui::Response) {
         let rect = response.rect;
         let ctrl = ui.input(|i| i.modifiers.command);
+        let shift = ui.input(|i| i.modifiers.shift);
+        let pressed = (response.drag_started_by(egui::PointerButton::Primary) && !shift)
+            || (response.clicked() && ctrl);
+        if pressed {
+            self.catch_up();
+        }
         if response.clicked() && ctrl {
             if let Some(at) = response.interact_pointer_pos()
                 && let Some((p, _)) = self.particle_at(rect, at)

@@ -192,6 +192,26 @@ impl SimThread {
         (std::mem::take(&mut r.news), r.in_effect)
     }
 
+    /// Has the thread bring its state up to date with its backend's own copy (after the
+    /// frame it is stepping, not the ones owed after it) and waits until it published it,
+    /// or stopped. For what must see the frame the view shows (picking on the GPU backend,
+    /// whose state is otherwise read back only now and then).
+    pub fn catch_up(&mut self) -> Result<(), String> {
+        // The thread syncs after every edit.
+        self.edit(Box::new(|_| None))?;
+        let mut r = self.shared.lock();
+        while r.done < self.sent {
+            if self.handle.as_ref().is_none_or(|h| h.is_finished()) {
+                break;
+            }
+            r = match (self.shared.changed).wait_timeout(r, Duration::from_millis(50)) {
+                Ok((r, _)) => r,
+                Err(e) => e.into_inner().0,
+            };
+        }
+        Ok(())
+    }
+
     /// What the stepping copy has in effect, as last published.
     pub fn in_effect(&self) -> InEffect {
         self.shared.lock().in_effect
@@ -497,5 +517,39 @@ mod tests {
         assert!(failed.ends_with("Paused."), "{failed}");
         assert!(taken.stepped < 10, "it stopped at the failing frame");
         assert!(replica.state().is_finite(), "the last good state is shown");
+    }
+
+    /// On a backend that steps its own copy (the GPU, not read back every frame),
+    /// `catch_up` publishes the state of the latest frame at once: the UI picks what the view
+    /// shows.
+    #[test]
+    fn catch_up_publishes_the_gpu_state_of_the_latest_frame() {
+        let scene = crate::bench::bench_scene(16, IntegratorKind::SemiImplicitEuler).unwrap();
+        let (gpu, _) = crate::gpu::gpu_simulation(scene.clone(), false).expect("GPU backend");
+        let (mut direct, mut replica) = (Simulation::new(scene.clone()), Simulation::new(scene));
+        let mut thread = SimThread::start(gpu);
+        thread.advance(3).unwrap();
+        // Once the third frame is published (its positions not read back yet, unless the
+        // thread's own timer came first), catch up.
+        for _ in 0..10_000 {
+            thread.take(|state, frames| replica.adopt_state(state, frames));
+            if replica.frames() == 3 {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        thread.catch_up().unwrap();
+        thread.take(|state, frames| replica.adopt_state(state, frames));
+        for _ in 0..3 {
+            direct.step_frame().unwrap();
+        }
+        assert_eq!(replica.frames(), 3);
+        let worst = (replica.state().pos.iter().zip(&direct.state().pos))
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0f32, f32::max);
+        assert!(
+            worst < 1e-5,
+            "the published state is {worst} m from the latest frame"
+        );
     }
 }
