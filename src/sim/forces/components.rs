@@ -28,15 +28,22 @@ pub fn zeroed(out: &mut Components, n: usize) {
 /// entry `3c + r` is row `r` of column `c`.
 pub type Blocks = [Vec<f32>; 9];
 
-/// Sets `out` to `blocks`, one array per entry.
-pub fn split_blocks(blocks: impl Iterator<Item = Mat3>, out: &mut Blocks) {
+/// Sets `out` to `blocks`, one array per entry (sized first, then written in place: nine
+/// pushes a block, each checking its vector's capacity, cost more than making the blocks).
+pub fn split_blocks(blocks: impl ExactSizeIterator<Item = Mat3>, out: &mut Blocks) {
+    let n = blocks.len();
     for entry in out.iter_mut() {
         entry.clear();
+        entry.resize(n, 0.0);
     }
-    for m in blocks {
-        for (entry, v) in out.iter_mut().zip(m.to_cols_array()) {
-            entry.push(v);
-        }
+    let [e0, e1, e2, e3, e4, e5, e6, e7, e8] = out;
+    let entries = [e0, e1, e2, e3, e4, e5, e6, e7, e8].map(|e| &mut e[..n]);
+    let [e0, e1, e2, e3, e4, e5, e6, e7, e8] = entries;
+    for (i, m) in blocks.enumerate().take(n) {
+        let v = m.to_cols_array();
+        (e0[i], e1[i], e2[i]) = (v[0], v[1], v[2]);
+        (e3[i], e4[i], e5[i]) = (v[3], v[4], v[5]);
+        (e6[i], e7[i], e8[i]) = (v[6], v[7], v[8]);
     }
 }
 
