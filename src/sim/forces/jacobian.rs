@@ -54,16 +54,14 @@ impl SystemMatrix {
         self.dfdx_v.resize(n, Vec3::ZERO);
     }
 
-    /// Adds spring `e`'s blocks (`K_x = ∂f_a/∂x_b`, `K_v = ∂f_a/∂v_b`) at velocities `vel`.
-    pub fn add_spring(&mut self, springs: &Springs, e: usize, dx: Mat3, dv: Mat3, vel: &[Vec3]) {
+    /// Adds spring `e`'s system block `S_e = h·K_v + h²·K_x` and `K_x·(v_b − v_a)`.
+    pub fn add_spring_block(&mut self, springs: &Springs, e: usize, s: Mat3, dfdx_w: Vec3) {
         let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
-        let s = self.h * dv + (self.h * self.h) * dx;
         self.spring[e] += s;
         self.diag[a] += s;
         self.diag[b] += s;
-        let t = dx * (vel[b] - vel[a]);
-        self.dfdx_v[a] += t;
-        self.dfdx_v[b] -= t;
+        self.dfdx_v[a] += dfdx_w;
+        self.dfdx_v[b] -= dfdx_w;
     }
 
     /// Adds a per-particle `∂f_p/∂v_p = d·I` (N·s/m).
