@@ -638,5 +638,22 @@ mod tests {
                 "{differing} image bytes differ by more than 1"
             );
         }
+        // A buffer too small for the frame's particles (a stale one) is not read: the frame
+        // is drawn from `positions`.
+        let stale = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("test stale positions"),
+            size: 64,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        frame.device_positions = None;
+        let want = draw(&gpu, &mut cpu, &frame);
+        frame.device_positions = Some(DevicePositions {
+            buffer: &stale,
+            stride: 2,
+        });
+        let got = draw(&gpu, &mut device, &frame);
+        assert_eq!(want.cloth, got.cloth, "drawn from the positions");
+        assert_eq!(want.image.as_raw(), got.image.as_raw());
     }
 }
