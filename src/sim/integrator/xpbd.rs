@@ -22,6 +22,13 @@ use crate::cloth::ClothState;
 /// them: recovering it as a difference of two nearly equal f32 positions would lose most of
 /// its digits at small steps (a 1 m/s particle moves 0.2 mm in a 0.2 ms step, a thousand
 /// rounding units of a coordinate near 1 m), and that noise grows as the step shrinks.
+/// A particle's predicted position and its displacement this step.
+#[derive(Clone, Copy, Debug)]
+struct Moved {
+    predicted: Vec3,
+    displacement: Vec3,
+}
+
 #[derive(Default)]
 pub struct Xpbd {
     constraints: DistanceConstraints,
@@ -29,8 +36,9 @@ pub struct Xpbd {
     colours: Vec<(std::ops::Range<usize>, bool)>,
     built: bool,
     force: Vec<Vec3>,
-    predicted: Vec<Vec3>,
-    displacement: Vec<Vec3>,
+    /// Per particle, its predicted position and its displacement side by side (a
+    /// projection touches both: one cache line rather than two).
+    moved: Vec<Moved>,
     lambda: Vec<f32>,
 }
 
@@ -43,21 +51,16 @@ impl Xpbd {
         let c = &self.constraints;
         // `project` indexes `inv_mass` first (checked), so these make its other accesses in
         // bounds.
-        assert!(
-            self.predicted.len() >= inv_mass.len() && self.displacement.len() >= inv_mass.len()
-        );
+        assert!(self.moved.len() >= inv_mass.len());
         assert!(self.lambda.len() >= c.len());
         let team = Team::current();
-        let (p, dx) = (
-            Disjoint::new(&mut self.predicted),
-            Disjoint::new(&mut self.displacement),
-        );
+        let moved = Disjoint::new(&mut self.moved);
         let lambda = Disjoint::new(&mut self.lambda);
         let project = |k: usize| {
             // SAFETY: constraint k's particles and multiplier are touched by no other
             // constraint of its colour, and colours run one after another; the arrays'
             // lengths were checked above.
-            unsafe { project(c, k, inv_mass, h, &p, &dx, &lambda) };
+            unsafe { project(c, k, inv_mass, h, &moved, &lambda) };
         };
         for (range, independent) in &self.colours {
             if *independent && team.members() > 1 && range.len() >= PARALLEL_COLOUR {
@@ -86,8 +89,7 @@ unsafe fn project(
     k: usize,
     inv_mass: &[f32],
     h: f32,
-    p: &Disjoint<'_, Vec3>,
-    dx: &Disjoint<'_, Vec3>,
+    moved: &Disjoint<'_, Moved>,
     lambda: &Disjoint<'_, f32>,
 ) {
     let (a, b) = (c.a[k] as usize, c.b[k] as usize);
@@ -98,8 +100,8 @@ unsafe fn project(
     // SAFETY: in bounds (`inv_mass[a]`, `inv_mass[b]` and `c.a[k]` were checked, and the
     // caller's contract sizes the rest); no other thread uses them (the caller's contract).
     // Each `at` is read at once, so even a self-constraint (a = b) holds no two borrows.
-    let (pa, pb, dxa, dxb, lambda) =
-        unsafe { (*p.at(a), *p.at(b), *dx.at(a), *dx.at(b), lambda.at(k)) };
+    let (ma, mb, lambda) = unsafe { (*moved.at(a), *moved.at(b), lambda.at(k)) };
+    let (pa, pb, dxa, dxb) = (ma.predicted, mb.predicted, ma.displacement, mb.displacement);
     let d = pb - pa;
     let len = d.length();
     if len <= 1e-9 {
@@ -116,10 +118,14 @@ unsafe fn project(
     let (da, db) = ((wa * dl) * n, (wb * dl) * n);
     // SAFETY: as above.
     unsafe {
-        *p.at(a) = pa - da;
-        *p.at(b) = pb + db;
-        *dx.at(a) = dxa - da;
-        *dx.at(b) = dxb + db;
+        *moved.at(a) = Moved {
+            predicted: pa - da,
+            displacement: dxa - da,
+        };
+        *moved.at(b) = Moved {
+            predicted: pb + db,
+            displacement: dxb + db,
+        };
     }
 }
 
@@ -144,15 +150,16 @@ impl Integrator for Xpbd {
         let not_springs = |t: &Force| !matches!(t, Force::Springs(_) | Force::BendSprings(_));
         ctx.forces_where(&state.pos, &state.vel, not_springs, &mut self.force);
         let w = &model.inv_mass;
-        self.predicted.clear();
-        self.displacement.clear();
+        self.moved.clear();
         let particles = state.pos.iter().zip(state.vel.iter_mut());
         for (((x, v), f), &w) in particles.zip(&self.force).zip(w) {
             if w != 0.0 {
                 *v += (*f * w) * h;
             }
-            self.displacement.push(*v * h);
-            self.predicted.push(*x + *v * h);
+            self.moved.push(Moved {
+                predicted: *x + *v * h,
+                displacement: *v * h,
+            });
         }
         self.lambda.clear();
         self.lambda.resize(self.constraints.len(), 0.0);
@@ -165,7 +172,8 @@ impl Integrator for Xpbd {
         });
         let inv_h = 1.0 / h;
         let particles = state.pos.iter_mut().zip(state.vel.iter_mut());
-        for (((x, v), d), &w) in particles.zip(&self.displacement).zip(w) {
+        let displacements = self.moved.iter().map(|m| &m.displacement);
+        for (((x, v), d), &w) in particles.zip(displacements).zip(w) {
             if w != 0.0 {
                 *v = *d * inv_h;
                 *x += *d;
