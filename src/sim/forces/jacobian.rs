@@ -6,7 +6,7 @@ use glam::{Mat3, Vec3};
 use crate::cloth::{ClothModel, Springs};
 
 use super::components::{Blocks, Components, blocks_times, split_blocks};
-use super::spring_runs::SpringRuns;
+use super::spring_runs::{Projectors, SpringRuns};
 
 /// Which derivative a force term reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -24,12 +24,35 @@ pub enum JacobianMode {
 /// A spring `e = (a, b)` with blocks `K_x`, `K_v` contributes `S_e = h·K_v + h²·K_x`: `+S_e`
 /// to the diagonal blocks of `a` and `b` and `−S_e` to the off-diagonal blocks `(a, b)`,
 /// `(b, a)`. Per-particle terms (air damping) add to the diagonal only.
+/// A spring's block in the system, `S = α·I + β·n nᵀ` (kg): the form every definite spring
+/// Jacobian takes (see [`super::SpringForce::add_to_system`]). Five numbers instead of
+/// nine, and half the arithmetic in a product.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SpringBlock {
+    pub alpha: f32,
+    pub beta: f32,
+    pub n: Vec3,
+}
+
+impl SpringBlock {
+    /// The block as a matrix.
+    pub fn matrix(&self) -> Mat3 {
+        let bn = self.beta * self.n;
+        self.alpha * Mat3::IDENTITY + Mat3::from_cols(bn * self.n.x, bn * self.n.y, bn * self.n.z)
+    }
+
+    /// `S·u`.
+    pub fn times(&self, u: Vec3) -> Vec3 {
+        self.alpha * u + (self.beta * self.n.dot(u)) * self.n
+    }
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct SystemMatrix {
     /// Step length, seconds.
     pub h: f32,
-    /// `S_e` per spring, kg.
-    pub spring: Vec<Mat3>,
+    /// `S_e` per spring.
+    pub spring: Vec<SpringBlock>,
     /// Diagonal block per particle, kg.
     pub diag: Vec<Mat3>,
     /// `(∂f/∂x)·v` at the state the matrix was built at, N/s.
@@ -42,7 +65,7 @@ impl SystemMatrix {
         let (n, e) = (model.particle_count(), model.springs.len());
         self.h = h;
         self.spring.clear();
-        self.spring.resize(e, Mat3::ZERO);
+        self.spring.resize(e, SpringBlock::default());
         self.diag.clear();
         self.diag.extend(
             model
@@ -54,12 +77,14 @@ impl SystemMatrix {
         self.dfdx_v.resize(n, Vec3::ZERO);
     }
 
-    /// Adds spring `e`'s system block `S_e = h·K_v + h²·K_x` and `K_x·(v_b − v_a)`.
-    pub fn add_spring_block(&mut self, springs: &Springs, e: usize, s: Mat3, dfdx_w: Vec3) {
+    /// Sets spring `e`'s system block `S_e = h·K_v + h²·K_x` (one force term per spring) and
+    /// adds `K_x·(v_b − v_a)`.
+    pub fn add_spring_block(&mut self, springs: &Springs, e: usize, s: SpringBlock, dfdx_w: Vec3) {
         let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
-        self.spring[e] += s;
-        self.diag[a] += s;
-        self.diag[b] += s;
+        self.spring[e] = s;
+        let m = s.matrix();
+        self.diag[a] += m;
+        self.diag[b] += m;
         self.dfdx_v[a] += dfdx_w;
         self.dfdx_v[b] -= dfdx_w;
     }
@@ -75,7 +100,7 @@ impl SystemMatrix {
         for (p, o) in out.iter_mut().enumerate() {
             let mut sum = self.diag[p] * u[p];
             for slot in adj.range(p) {
-                sum -= self.spring[adj.spring[slot] as usize] * u[adj.other[slot] as usize];
+                sum -= self.spring[adj.spring[slot] as usize].times(u[adj.other[slot] as usize]);
             }
             *o = sum;
         }
@@ -95,10 +120,10 @@ impl SystemMatrix {
         for (p, &d) in self.diag.iter().enumerate() {
             put(p, p, d, 1.0);
         }
-        for (e, &s) in self.spring.iter().enumerate() {
+        for (e, s) in self.spring.iter().enumerate() {
             let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
-            put(a, b, s, -1.0);
-            put(b, a, s, -1.0);
+            put(a, b, s.matrix(), -1.0);
+            put(b, a, s.matrix(), -1.0);
         }
         m
     }
@@ -113,7 +138,7 @@ pub struct SystemProduct {
     /// The springs the runs were made for.
     ends: (Vec<u32>, Vec<u32>),
     runs: Option<SpringRuns>,
-    blocks: Blocks,
+    blocks: Projectors,
     /// The particles' diagonal blocks, one array per entry (column-major).
     diag: Blocks,
 }
@@ -131,7 +156,11 @@ impl SystemProduct {
             ));
         }
         if let Some(runs) = &self.runs {
-            runs.blocks_in_order(&sys.spring, &mut self.blocks);
+            let spring = |e: usize| {
+                let s = sys.spring[e];
+                [s.alpha, s.beta, s.n.x, s.n.y, s.n.z]
+            };
+            runs.in_order(spring, &mut self.blocks);
         }
         split_blocks(sys.diag.iter().copied(), &mut self.diag);
     }

@@ -18,7 +18,7 @@ pub use dihedral::{DihedralBending, hinge_angle};
 pub use force::Force;
 pub use force_set::{ForceSet, TermTimes, to_accelerations};
 pub use gravity::Gravity;
-pub use jacobian::{JacobianMode, SystemMatrix, SystemProduct};
+pub use jacobian::{JacobianMode, SpringBlock, SystemMatrix, SystemProduct};
 pub use springs::{SpringBlocks, SpringForce};
 pub use wind::Wind;
 

@@ -14,10 +14,14 @@
 //! give bit-identical forces.
 
 use super::super::team::{Disjoint, Team, share};
-use super::components::{Blocks, Components, Scratch, split, split_blocks};
+use super::components::{Components, Scratch, split};
 use std::ops::Range;
 
-use glam::{Mat3, Vec3};
+use glam::Vec3;
+
+/// Springs' system blocks `α·I + β·n nᵀ` in run order: `[α, β, n.x, n.y, n.z]`, one array
+/// each ([`SpringRuns::add_block_products`]).
+pub type Projectors = [Vec<f32>; 5];
 
 /// Particles per block (a block is one parallel task).
 const BLOCK: usize = 1024;
@@ -428,26 +432,33 @@ impl SpringRuns {
         }
     }
 
-    /// Each spring's 3×3 block (indexed as given to [`SpringRuns::new`]) in run order, one
-    /// array per entry (column-major), zero for gap fillers: what
-    /// [`SpringRuns::add_block_products`] reads.
-    pub fn blocks_in_order(&self, blocks: &[Mat3], out: &mut Blocks) {
-        let block = |&e: &u32| {
-            if e == GHOST {
-                Mat3::ZERO
-            } else {
-                blocks[e as usize]
+    /// `K` numbers per spring (`value(e)` for spring `e` as given to [`SpringRuns::new`]) in
+    /// run order, one array each, zero for gap fillers.
+    pub fn in_order<const K: usize>(
+        &self,
+        value: impl Fn(usize) -> [f32; K],
+        out: &mut [Vec<f32>; K],
+    ) {
+        let n = self.order.len();
+        for entry in out.iter_mut() {
+            entry.clear();
+            entry.resize(n, 0.0);
+        }
+        for (i, &e) in self.order.iter().enumerate() {
+            if e != GHOST {
+                for (entry, v) in out.iter_mut().zip(value(e as usize)) {
+                    entry[i] = v;
+                }
             }
-        };
-        split_blocks(self.order.iter().map(block), out);
+        }
     }
 
-    /// Adds `Σ_e S_e·u_other` to `out` at both ends of every spring `e`, with `S_e` the
-    /// spring's block as put in order by [`SpringRuns::blocks_in_order`]: the off-diagonal
-    /// part of a matrix-vector product with the implicit system (whose off-diagonal blocks
-    /// are `−S_e`). In parallel as the forces are, with the same result on any number of
-    /// threads.
-    pub fn add_block_products(&self, s: &Blocks, u: &Components, out: &mut Components) {
+    /// Adds `Σ_e S_e·u_other` to `out` at both ends of every spring `e`, with
+    /// `S_e = α·I + β·n nᵀ` as put in run order by [`SpringRuns::in_order`]
+    /// (`[α, β, n.x, n.y, n.z]`): the off-diagonal part of a matrix-vector product with the
+    /// implicit system (whose off-diagonal blocks are `−S_e`). In parallel as the forces
+    /// are, with the same result on any number of threads.
+    pub fn add_block_products(&self, s: &Projectors, u: &Components, out: &mut Components) {
         let n = (u.iter().chain(out.iter()).map(Vec::len)).fold(self.particles, usize::min);
         if self.runs.is_empty() || n < self.particles || s[0].len() != self.order.len() {
             return;
@@ -513,7 +524,7 @@ impl RunPass for ForcePass<'_> {
 
 /// Block products `S_e·u_other` at both ends (see [`SpringRuns::add_block_products`]).
 struct ProductPass<'a> {
-    s: &'a Blocks,
+    s: &'a Projectors,
     u: &'a Components,
 }
 
@@ -532,7 +543,8 @@ impl RunPass for ProductPass<'_> {
     ) {
         let (s, u) = (self.s, self.u);
         let n = springs.len();
-        let m: [&[f32]; 9] = std::array::from_fn(|k| &s[k][springs.clone()][..n]);
+        let [al, be, nx, ny, nz]: [&[f32]; 5] =
+            std::array::from_fn(|k| &s[k][springs.clone()][..n]);
         let [ax, ay, az] = [&u[0][ea.clone()], &u[1][ea.clone()], &u[2][ea]];
         let [bx, by, bz] = [&u[0][eb.clone()], &u[1][eb.clone()], &u[2][eb]];
         let (ax, ay, az, bx, by, bz) = (&ax[..n], &ay[..n], &az[..n], &bx[..n], &by[..n], &bz[..n]);
@@ -541,13 +553,15 @@ impl RunPass for ProductPass<'_> {
         let (f0, f1, f2) = (&mut f0[..n], &mut f1[..n], &mut f2[..n]);
         let (t0, t1, t2) = (&mut t0[..n], &mut t1[..n], &mut t2[..n]);
         for j in 0..n {
-            // Column-major: row r of S·w is S[r]·w.x + S[3 + r]·w.y + S[6 + r]·w.z.
-            f0[j] += m[0][j] * bx[j] + m[3][j] * by[j] + m[6][j] * bz[j];
-            f1[j] += m[1][j] * bx[j] + m[4][j] * by[j] + m[7][j] * bz[j];
-            f2[j] += m[2][j] * bx[j] + m[5][j] * by[j] + m[8][j] * bz[j];
-            t0[j] += m[0][j] * ax[j] + m[3][j] * ay[j] + m[6][j] * az[j];
-            t1[j] += m[1][j] * ax[j] + m[4][j] * ay[j] + m[7][j] * az[j];
-            t2[j] += m[2][j] * ax[j] + m[5][j] * ay[j] + m[8][j] * az[j];
+            // S·w = α·w + β(n·w)·n.
+            let db = be[j] * (nx[j] * bx[j] + ny[j] * by[j] + nz[j] * bz[j]);
+            f0[j] += al[j] * bx[j] + db * nx[j];
+            f1[j] += al[j] * by[j] + db * ny[j];
+            f2[j] += al[j] * bz[j] + db * nz[j];
+            let da = be[j] * (nx[j] * ax[j] + ny[j] * ay[j] + nz[j] * az[j]);
+            t0[j] += al[j] * ax[j] + da * nx[j];
+            t1[j] += al[j] * ay[j] + da * ny[j];
+            t2[j] += al[j] * az[j] + da * nz[j];
         }
     }
 }
@@ -604,6 +618,7 @@ fn kernel(
 
 #[cfg(test)]
 mod tests {
+    use super::super::jacobian::SpringBlock;
     use super::*;
 
     /// The plain spring formula, spring by spring.
@@ -769,20 +784,29 @@ mod tests {
                 }
             }
         }
-        let blocks: Vec<Mat3> = (0..a.len())
-            .map(|_| Mat3::from_cols_array(&std::array::from_fn(|_| rnd() - 0.5)))
+        // Random α, β and (not unit) n: every number of a block weighs in.
+        let blocks: Vec<SpringBlock> = (0..a.len())
+            .map(|_| SpringBlock {
+                alpha: rnd() - 0.5,
+                beta: rnd() - 0.5,
+                n: Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5),
+            })
             .collect();
         let u: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
         let mut want = vec![Vec3::ZERO; n];
         for e in 0..a.len() {
             let (i, j) = (a[e] as usize, b[e] as usize);
-            want[i] += blocks[e] * u[j];
-            want[j] += blocks[e] * u[i];
+            want[i] += blocks[e].matrix() * u[j];
+            want[j] += blocks[e].matrix() * u[i];
         }
         let zero = vec![0.0; a.len()];
         let runs = SpringRuns::new(n, &a, &b, &zero, &zero, &zero);
-        let mut s: Blocks = Default::default();
-        runs.blocks_in_order(&blocks, &mut s);
+        let mut s: Projectors = Default::default();
+        let numbers = |e: usize| {
+            let s = blocks[e];
+            [s.alpha, s.beta, s.n.x, s.n.y, s.n.z]
+        };
+        runs.in_order(numbers, &mut s);
         let mut uc = Components::default();
         split(&u, &mut uc, n);
         let product = |runs: &SpringRuns| {

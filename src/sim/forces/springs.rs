@@ -15,7 +15,7 @@ use crate::cloth::Springs;
 use super::components::Components;
 use super::spring_runs::SpringRuns;
 
-use super::jacobian::{JacobianMode, SystemMatrix};
+use super::jacobian::{JacobianMode, SpringBlock, SystemMatrix};
 use crate::sim::constraints::DistanceConstraints;
 
 /// Springs with per-kind stiffness (N/m) and damping (N·s/m), expanded per spring, over a
@@ -263,12 +263,7 @@ impl SpringForce {
             let (alpha, beta) = (h * h * (k * s), h * c + h * h * (k * (1.0 - s)));
             let w = vel[b] - vel[a];
             let dfdx_w = (k * s) * w + (k * (1.0 - s) * n.dot(w)) * n;
-            sys.add_spring_block(
-                springs,
-                e,
-                alpha * Mat3::IDENTITY + outer(beta * n, n),
-                dfdx_w,
-            );
+            sys.add_spring_block(springs, e, SpringBlock { alpha, beta, n }, dfdx_w);
         }
     }
 
