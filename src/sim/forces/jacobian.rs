@@ -81,6 +81,11 @@ impl SystemMatrix {
     /// adds `K_x·(v_b − v_a)`.
     pub fn add_spring_block(&mut self, springs: &Springs, e: usize, s: SpringBlock, dfdx_w: Vec3) {
         let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
+        debug_assert_eq!(
+            self.spring[e],
+            SpringBlock::default(),
+            "spring {e} set twice"
+        );
         self.spring[e] = s;
         let m = s.matrix();
         self.diag[a] += m;
