@@ -504,6 +504,42 @@ fn export_obj_writes_the_cloth_as_it_is_now() {
     assert_eq!(back.mesh.positions, harness.state().sim().state().pos);
 }
 
+/// On the GPU backend the replica's state is read back only now and then; an export writes
+/// the frame just stepped, not an older one. (The export's own catch-up is checked by
+/// `catch_up_publishes_the_gpu_state_of_the_latest_frame`; here the thread's read-back when
+/// stepping stops often comes first, as a harness frame takes longer than its 30 ms.)
+#[test]
+fn export_obj_on_the_gpu_writes_the_latest_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut harness = harness();
+    harness.state_mut().capture_dir = dir.path().to_path_buf();
+    harness.state_mut().set_scenario("sphere-drop");
+    harness.run_steps(1);
+    harness.get_by_label("GPU").click();
+    run_settled(&mut harness, 2);
+    assert_eq!(harness.state().in_effect().backend, "gpu");
+    let before = harness.state().sim().state().pos.clone();
+    let frames = harness.state().sim().frames();
+    harness.state_mut().step_once();
+    // Once the frame is done (drawn from the GPU's buffer), export.
+    for _ in 0..1000 {
+        harness.run_steps(1);
+        if harness.state().sim().frames() > frames {
+            break;
+        }
+    }
+    harness.state_mut().export_obj();
+    let path = dir.path().join("clothsim-export-0001.obj");
+    let back = clothsim::mesh::load_obj(&path).expect("a valid OBJ");
+    run_settled(&mut harness, 1);
+    let latest = &harness.state().sim().state().pos;
+    assert_ne!(&before, latest, "the cloth moved");
+    assert_eq!(
+        &back.mesh.positions, latest,
+        "the export is the frame stepped"
+    );
+}
+
 #[test]
 fn record_gif_writes_an_animated_gif_of_the_view() {
     let dir = tempfile::tempdir().unwrap();

@@ -104,6 +104,7 @@ impl ClothApp {
 
     /// Writes the cloth as it is now as `clothsim-export-NNNN.obj` in the capture folder.
     pub fn export_obj(&mut self) {
+        self.catch_up();
         let path = next_free(&self.capture_dir, "clothsim-export", ".obj");
         match crate::output::write_bytes(&path, self.sim.export_obj().as_bytes()) {
             Ok(()) => self.message(Level::Info, format!("exported {}", path.display())),

@@ -35,10 +35,10 @@ impl ClothApp {
         Some((p, pos[p as usize]))
     }
 
-    /// Before picking: on the GPU backend the replica's state is read back only now and
-    /// then (the view draws from the GPU's buffer); bring it to the latest frame so the
-    /// pointer picks the cloth where it is drawn. One read-back per click or grab.
-    fn catch_up(&mut self) {
+    /// Before picking or exporting: on the GPU backend the replica's state is read back only
+    /// now and then (the view draws from the GPU's buffer); bring it to the latest frame so
+    /// the pointer picks, and an export writes, the cloth as it is drawn. One read-back.
+    pub(super) fn catch_up(&mut self) {
         if self.in_effect().backend == "gpu" {
             let sent = self.stepping.catch_up();
             self.report_sent(sent);
