@@ -18,12 +18,6 @@ pub enum JacobianMode {
     Definite,
 }
 
-/// `A = M − h·∂f/∂v − h²·∂f/∂x` for one step of length `h`, plus `∂f/∂x·v` for the
-/// right-hand side. With [`JacobianMode::Definite`] blocks it is symmetric positive definite.
-///
-/// A spring `e = (a, b)` with blocks `K_x`, `K_v` contributes `S_e = h·K_v + h²·K_x`: `+S_e`
-/// to the diagonal blocks of `a` and `b` and `−S_e` to the off-diagonal blocks `(a, b)`,
-/// `(b, a)`. Per-particle terms (air damping) add to the diagonal only.
 /// A spring's block in the system, `S = α·I + β·n nᵀ` (kg): the form every definite spring
 /// Jacobian takes (see [`super::SpringForce::add_to_system`]). Five numbers instead of
 /// nine, and half the arithmetic in a product.
@@ -47,6 +41,12 @@ impl SpringBlock {
     }
 }
 
+/// `A = M − h·∂f/∂v − h²·∂f/∂x` for one step of length `h`, plus `∂f/∂x·v` for the
+/// right-hand side. With [`JacobianMode::Definite`] blocks it is symmetric positive definite.
+///
+/// A spring `e = (a, b)` with blocks `K_x`, `K_v` contributes `S_e = h·K_v + h²·K_x`: `+S_e`
+/// to the diagonal blocks of `a` and `b` and `−S_e` to the off-diagonal blocks `(a, b)`,
+/// `(b, a)`. Per-particle terms (air damping) add to the diagonal only.
 #[derive(Clone, Debug, Default)]
 pub struct SystemMatrix {
     /// Step length, seconds.
@@ -134,10 +134,11 @@ impl SystemMatrix {
     }
 }
 
-/// [`SystemMatrix::apply`] for repeated products with one matrix (a linear solve's): the
-/// springs' blocks copied once into the order of the springs' runs, one array per entry, so
-/// each product is the vector loops and threads of the spring forces rather than a 3×3
-/// product per neighbour. The runs are kept while the model's springs stay the same.
+/// [`SystemMatrix::apply`] for repeated products with one matrix (a linear solve's): each
+/// spring's `α, β, n` copied once into the order of the springs' runs, one array per
+/// number, so each product is the vector loops and threads of the spring forces rather
+/// than a 3×3 product per neighbour. The runs are kept while the model's springs stay the
+/// same.
 #[derive(Clone, Debug, Default)]
 pub struct SystemProduct {
     /// The springs the runs were made for.
