@@ -2,13 +2,20 @@
 
 use glam::Vec3;
 
-use super::super::constraints::DistanceConstraints;
+use super::super::constraints::{Coloured, DistanceConstraints};
 use super::super::forces::Force;
 use super::super::team::{Disjoint, Team, share};
 use super::context::StepContext;
 use super::kind::IntegratorKind;
 use super::step::{Integrator, StepError, StepReport};
 use crate::cloth::ClothState;
+
+/// A particle's predicted position and its displacement this step.
+#[derive(Clone, Copy, Debug)]
+struct Moved {
+    predicted: Vec3,
+    displacement: Vec3,
+}
 
 /// Each substep: the forces that are not springs (gravity, air damping, …) move the
 /// particles explicitly to a prediction; then every spring, seen as a distance constraint
@@ -22,18 +29,10 @@ use crate::cloth::ClothState;
 /// them: recovering it as a difference of two nearly equal f32 positions would lose most of
 /// its digits at small steps (a 1 m/s particle moves 0.2 mm in a 0.2 ms step, a thousand
 /// rounding units of a coordinate near 1 m), and that noise grows as the step shrinks.
-/// A particle's predicted position and its displacement this step.
-#[derive(Clone, Copy, Debug)]
-struct Moved {
-    predicted: Vec3,
-    displacement: Vec3,
-}
-
 #[derive(Default)]
 pub struct Xpbd {
-    constraints: DistanceConstraints,
-    /// Each colour's constraints and whether they share no particle.
-    colours: Vec<(std::ops::Range<usize>, bool)>,
+    /// The springs as constraints, in colour order.
+    coloured: Coloured,
     built: bool,
     force: Vec<Vec3>,
     /// Per particle, its predicted position and its displacement side by side (a
@@ -48,7 +47,7 @@ impl Xpbd {
     /// share no particle, so the order within it changes nothing: the same bits on any
     /// number of threads).
     fn sweep(&mut self, inv_mass: &[f32], h: f32) {
-        let c = &self.constraints;
+        let c = &self.coloured.constraints;
         // `project` indexes `inv_mass` first (checked), so these make its other accesses in
         // bounds.
         assert!(self.moved.len() >= inv_mass.len());
@@ -62,7 +61,7 @@ impl Xpbd {
             // lengths were checked above.
             unsafe { project(c, k, inv_mass, h, &moved, &lambda) };
         };
-        for (range, independent) in &self.colours {
+        for (range, independent) in &self.coloured.colours {
             if *independent && team.members() > 1 && range.len() >= PARALLEL_COLOUR {
                 team.run(&|i| {
                     share(range.len(), team.members(), i).for_each(|k| project(range.start + k))
@@ -81,8 +80,8 @@ const PARALLEL_COLOUR: usize = 1024;
 /// positions and displacements and its multiplier.
 ///
 /// # Safety
-/// No other thread may use constraint `k`'s particles or multiplier meanwhile; `p` and `dx`
-/// are at least as long as `inv_mass`, and `lambda` as `c`.
+/// No other thread may use constraint `k`'s particles or multiplier meanwhile; `moved` is at
+/// least as long as `inv_mass`, and `lambda` as `c`.
 #[inline(always)]
 unsafe fn project(
     c: &DistanceConstraints,
@@ -143,8 +142,7 @@ impl Integrator for Xpbd {
         let model = ctx.model;
         if !self.built {
             // The compliances come from the current stiffness: rebuilt when forces change.
-            let coloured = ctx.forces.constraints(model).coloured();
-            (self.constraints, self.colours) = (coloured.constraints, coloured.colours);
+            self.coloured = ctx.forces.constraints(model).coloured();
             self.built = true;
         }
         let not_springs = |t: &Force| !matches!(t, Force::Springs(_) | Force::BendSprings(_));
@@ -162,7 +160,7 @@ impl Integrator for Xpbd {
             });
         }
         self.lambda.clear();
-        self.lambda.resize(self.constraints.len(), 0.0);
+        self.lambda.resize(self.coloured.constraints.len(), 0.0);
         let sweeps = ctx.config.xpbd_iterations;
         ctx.solve(|| {
             for _ in 0..sweeps {
