@@ -400,7 +400,7 @@ impl SpringRuns {
     }
 
     /// Fills one block's sums: [`RunPass::run`] for each of its runs, then
-    /// `sums = first ∓ second` ([`RunPass::COMBINE`]).
+    /// `sums = first ∓ second` ([`RunPass::combine`]).
     #[inline(always)]
     fn each_run(&self, block: &Block, buf: &mut BlockBuffers, pass: &impl RunPass) {
         let (sums, second) = (&mut buf.sums, &mut buf.second);
@@ -507,10 +507,10 @@ impl RunPass for ForcePass<'_> {
     ) {
         let (p, v, r) = (self.p, self.v, self.runs);
         kernel(
-            [&p[0][ea.clone()], &p[1][ea.clone()], &p[2][ea.clone()]],
-            [&p[0][eb.clone()], &p[1][eb.clone()], &p[2][eb.clone()]],
-            [&v[0][ea.clone()], &v[1][ea.clone()], &v[2][ea]],
-            [&v[0][eb.clone()], &v[1][eb.clone()], &v[2][eb]],
+            at(p, &ea),
+            at(p, &eb),
+            at(v, &ea),
+            at(v, &eb),
             [
                 &r.rest[springs.clone()],
                 &r.k[springs.clone()],
@@ -545,9 +545,8 @@ impl RunPass for ProductPass<'_> {
         let n = springs.len();
         let [al, be, nx, ny, nz]: [&[f32]; 5] =
             std::array::from_fn(|k| &s[k][springs.clone()][..n]);
-        let [ax, ay, az] = [&u[0][ea.clone()], &u[1][ea.clone()], &u[2][ea]];
-        let [bx, by, bz] = [&u[0][eb.clone()], &u[1][eb.clone()], &u[2][eb]];
-        let (ax, ay, az, bx, by, bz) = (&ax[..n], &ay[..n], &az[..n], &bx[..n], &by[..n], &bz[..n]);
+        let [ax, ay, az] = at(u, &(ea.start..ea.start + n));
+        let [bx, by, bz] = at(u, &(eb.start..eb.start + n));
         let [f0, f1, f2] = first;
         let [t0, t1, t2] = second;
         let (f0, f1, f2) = (&mut f0[..n], &mut f1[..n], &mut f2[..n]);
@@ -564,6 +563,16 @@ impl RunPass for ProductPass<'_> {
             t2[j] += al[j] * az[j] + da * nz[j];
         }
     }
+}
+
+/// The particles `range` of each component.
+#[inline(always)]
+fn at<'a>(c: &'a Components, range: &Range<usize>) -> [&'a [f32]; 3] {
+    [
+        &c[0][range.clone()],
+        &c[1][range.clone()],
+        &c[2][range.clone()],
+    ]
 }
 
 /// How a block's sums at second ends join those at first ends.
