@@ -59,8 +59,74 @@ impl Input {
     fn put(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, bytes: &[u8]) {
         if self.sent.as_deref() != Some(bytes) {
             self.buffer.write(device, queue, bytes);
-            self.sent = Some(bytes.to_vec());
+            let sent = self.sent.get_or_insert_with(Vec::new);
+            sent.clear();
+            sent.extend_from_slice(bytes);
         }
+    }
+}
+
+/// One entry point: its pipeline, and its bind group with the buffers it was made for
+/// (made again only when one of them changes: a grown output, another source).
+struct Stage {
+    pipeline: wgpu::ComputePipeline,
+    bound: Vec<wgpu::Buffer>,
+    group: Option<wgpu::BindGroup>,
+}
+
+impl Stage {
+    fn new(device: &wgpu::Device, module: &wgpu::ShaderModule, entry: &str) -> Self {
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("clothsim display"),
+            // The entry point's own layout: it binds only what it uses.
+            layout: None,
+            module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Self {
+            pipeline,
+            bound: Vec::new(),
+            group: None,
+        }
+    }
+
+    /// Binds `buffers` (binding, buffer) and dispatches one invocation per item, in
+    /// workgroups of [`WORKGROUP`] (wrapping into a second dimension past `max_groups`).
+    fn dispatch(
+        &mut self,
+        device: &wgpu::Device,
+        pass: &mut wgpu::ComputePass<'_>,
+        buffers: &[(u32, &wgpu::Buffer)],
+        items: usize,
+        max_groups: u32,
+    ) {
+        let same = self.bound.len() == buffers.len()
+            && (self.bound.iter().zip(buffers)).all(|(old, (_, new))| old == *new);
+        let group = match &self.group {
+            Some(group) if same => group,
+            _ => {
+                let entries: Vec<wgpu::BindGroupEntry<'_>> = (buffers.iter())
+                    .map(|&(binding, buffer)| wgpu::BindGroupEntry {
+                        binding,
+                        resource: buffer.as_entire_binding(),
+                    })
+                    .collect();
+                self.bound = buffers.iter().map(|&(_, b)| b.clone()).collect();
+                self.group
+                    .insert(device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("clothsim display"),
+                        layout: &self.pipeline.get_bind_group_layout(0),
+                        entries: &entries,
+                    }))
+            }
+        };
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, group, &[]);
+        let groups = (items as u32).div_ceil(WORKGROUP);
+        let x = groups.clamp(1, max_groups);
+        pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
     }
 }
 
@@ -72,9 +138,11 @@ pub(super) struct Outputs<'b> {
 }
 
 pub(super) struct DisplayPass {
-    cloth: wgpu::ComputePipeline,
-    line_ends: wgpu::ComputePipeline,
-    points: wgpu::ComputePipeline,
+    cloth: Stage,
+    line_ends: Stage,
+    points: Stage,
+    /// The device's `max_compute_workgroups_per_dimension`.
+    max_groups: u32,
     info: wgpu::Buffer,
     topology: Input,
     /// The `(particles, topology generation)` `topology` was built for.
@@ -91,21 +159,11 @@ impl DisplayPass {
             label: Some("clothsim display"),
             source: wgpu::ShaderSource::Wgsl(SOURCE.into()),
         });
-        let pipeline = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("clothsim display"),
-                // Each entry point's own layout: it binds only what it uses.
-                layout: None,
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
         Self {
-            cloth: pipeline("cloth"),
-            line_ends: pipeline("line_ends"),
-            points: pipeline("points"),
+            cloth: Stage::new(device, &module, "cloth"),
+            line_ends: Stage::new(device, &module, "line_ends"),
+            points: Stage::new(device, &module, "points"),
+            max_groups: device.limits().max_compute_workgroups_per_dimension,
             info: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("clothsim display info"),
                 size: std::mem::size_of::<Info>() as u64,
@@ -136,15 +194,11 @@ impl DisplayPass {
         out: Outputs<'_>,
     ) {
         let count = frame.uvs.len();
-        let topology = if self.topology_of != Some((count, generation)) {
+        if self.topology_of != Some((count, generation)) {
             self.topology_of = Some((count, generation));
-            Some(incident_triangles(count, frame.triangles))
-        } else {
-            None
-        };
-        if let Some(words) = &topology {
+            let words = incident_triangles(count, frame.triangles);
             self.topology
-                .put(device, queue, bytemuck::cast_slice(words));
+                .put(device, queue, bytemuck::cast_slice(&words));
         }
         let info = Info {
             count: count as u32,
@@ -161,38 +215,30 @@ impl DisplayPass {
             label: Some("clothsim display"),
             timestamp_writes: None,
         });
+        let (info, source) = ((0, &self.info), (1, source.buffer));
+        let max_groups = self.max_groups;
         if let Some(cloth) = out.cloth {
             self.uvs.put(device, queue, bytemuck::cast_slice(frame.uvs));
             cloth.reserve(device, count as u64 * 8 * float);
-            let inputs = [
-                self.topology.buffer.buffer(),
-                self.uvs.buffer.buffer(),
-                cloth.buffer(),
-            ];
-            self.dispatch(
-                device,
-                &mut pass,
-                &self.cloth,
+            let buffers = [
+                info,
                 source,
-                &[2, 3, 4],
-                &inputs,
-                count,
-            );
+                (2, self.topology.buffer.buffer()),
+                (3, self.uvs.buffer.buffer()),
+                (4, cloth.buffer()),
+            ];
+            (self.cloth).dispatch(device, &mut pass, &buffers, count, max_groups);
         }
         if !lines.is_empty() {
             self.lines.put(device, queue, bytemuck::cast_slice(lines));
             out.lines.reserve(device, lines.len() as u64 * 14 * float);
-            let inputs = [self.lines.buffer.buffer(), out.lines.buffer()];
-            let n = lines.len();
-            self.dispatch(
-                device,
-                &mut pass,
-                &self.line_ends,
+            let buffers = [
+                info,
                 source,
-                &[5, 6],
-                &inputs,
-                n,
-            );
+                (5, self.lines.buffer.buffer()),
+                (6, out.lines.buffer()),
+            ];
+            (self.line_ends).dispatch(device, &mut pass, &buffers, lines.len(), max_groups);
         }
         if let Some(points) = out.points {
             self.pinned_flags.clear();
@@ -205,55 +251,14 @@ impl DisplayPass {
             self.pinned
                 .put(device, queue, bytemuck::cast_slice(&self.pinned_flags));
             points.reserve(device, count as u64 * 7 * float);
-            let inputs = [self.pinned.buffer.buffer(), points.buffer()];
-            self.dispatch(
-                device,
-                &mut pass,
-                &self.points,
+            let buffers = [
+                info,
                 source,
-                &[7, 8],
-                &inputs,
-                count,
-            );
+                (7, self.pinned.buffer.buffer()),
+                (8, points.buffer()),
+            ];
+            (self.points).dispatch(device, &mut pass, &buffers, count, max_groups);
         }
-    }
-
-    /// Binds the info, `source` and `buffers` (at `bindings`) for `pipeline` and dispatches
-    /// one invocation per item (wrapping into a second dimension past the device's limit).
-    #[allow(clippy::too_many_arguments)]
-    fn dispatch(
-        &self,
-        device: &wgpu::Device,
-        pass: &mut wgpu::ComputePass<'_>,
-        pipeline: &wgpu::ComputePipeline,
-        source: DevicePositions<'_>,
-        bindings: &[u32],
-        buffers: &[&wgpu::Buffer],
-        items: usize,
-    ) {
-        fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            }
-        }
-        let mut entries = vec![entry(0, &self.info), entry(1, source.buffer)];
-        entries.extend(
-            bindings
-                .iter()
-                .zip(buffers)
-                .map(|(&b, &buffer)| entry(b, buffer)),
-        );
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("clothsim display"),
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &entries,
-        });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        let groups = (items as u32).div_ceil(WORKGROUP);
-        let x = groups.clamp(1, device.limits().max_compute_workgroups_per_dimension);
-        pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
     }
 }
 

@@ -556,7 +556,7 @@ mod tests {
 
     /// A crumpled cloth drawn from positions on the device (every overlay on, springs
     /// coloured by strain) gets the vertices and the picture the CPU path makes from the
-    /// same positions; and after its triangles change, still does.
+    /// same positions; and after its triangles change, and from another buffer, still does.
     #[test]
     fn drawing_from_device_positions_matches_drawing_from_the_cpu() {
         let gpu = Gpu::headless(AdapterPreference::Software).expect("software adapter");
@@ -587,18 +587,28 @@ mod tests {
             kinds.push(kind);
         }
         // On the device: position, then a velocity the renderer must skip (stride 2).
-        let words: Vec<[f32; 4]> = positions
+        let on_device = |positions: &[Vec3]| {
+            let words: Vec<[f32; 4]> = positions
+                .iter()
+                .flat_map(|p| [p.extend(1.0).to_array(), [99.0; 4]])
+                .collect();
+            let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("test positions"),
+                size: (words.len() * 16) as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            gpu.queue
+                .write_buffer(&buffer, 0, bytemuck::cast_slice(&words));
+            buffer
+        };
+        let buffer = on_device(&positions);
+        // The same cloth moved, in a buffer of its own (a new source must be bound).
+        let moved: Vec<Vec3> = positions
             .iter()
-            .flat_map(|p| [p.extend(1.0).to_array(), [99.0; 4]])
+            .map(|p| *p + Vec3::new(0.1, 0.2, 0.0))
             .collect();
-        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("test positions"),
-            size: (words.len() * 16) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        gpu.queue
-            .write_buffer(&buffer, 0, bytemuck::cast_slice(&words));
+        let moved_buffer = on_device(&moved);
         let uvs: Vec<Vec2> = mesh.uvs.clone();
         let pinned = [0u32, 8];
         let mut frame = Frame {
@@ -615,17 +625,19 @@ mod tests {
             pinned: &pinned,
             shapes: Vec::new(),
         };
-        let on_device = Some(DevicePositions {
-            buffer: &buffer,
-            stride: 2,
-        });
         let (mut cpu, mut device) = (Renderer::new(&gpu.device, 1), Renderer::new(&gpu.device, 1));
         let half = &mesh.triangles[..mesh.triangles.len() / 2];
-        for triangles in [&mesh.triangles[..], half] {
+        let cases = [
+            (&mesh.triangles[..], &positions, &buffer),
+            (half, &positions, &buffer),
+            (half, &moved, &moved_buffer),
+        ];
+        for (triangles, positions, buffer) in cases {
             frame.triangles = triangles;
+            frame.positions = positions;
             frame.device_positions = None;
             let want = draw(&gpu, &mut cpu, &frame);
-            frame.device_positions = on_device;
+            frame.device_positions = Some(DevicePositions { buffer, stride: 2 });
             let got = draw(&gpu, &mut device, &frame);
             assert_close("cloth vertices", &want.cloth, &got.cloth, 1e-6);
             assert_close("line vertices", &want.lines, &got.lines, 1e-6);
