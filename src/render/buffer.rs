@@ -52,10 +52,9 @@ impl GrowBuffer {
     }
 
     /// Makes room for `bytes` that the device will write (a compute pass), reallocating (to
-    /// twice the need) only when they do not fit. Returns whether the buffer was reallocated.
-    pub fn reserve(&mut self, device: &wgpu::Device, bytes: u64) -> bool {
-        let grew = bytes > self.buffer.size();
-        if grew {
+    /// twice the need) only when they do not fit.
+    pub fn reserve(&mut self, device: &wgpu::Device, bytes: u64) {
+        if bytes > self.buffer.size() {
             self.buffer = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(self.label),
                 size: bytes * 2,
@@ -64,7 +63,6 @@ impl GrowBuffer {
             });
         }
         self.len = bytes;
-        grew
     }
 
     /// The whole buffer, to bind.
