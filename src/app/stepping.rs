@@ -6,8 +6,9 @@
 //! computed: a slider or an orbit stays smooth however long a frame takes.
 //!
 //! A backend that steps a copy of its own (the GPU backend, which the view draws from
-//! directly) is read back only now and then: every [`SYNC_EVERY`] while running, and once
-//! the stepping stops, for what the UI computes from the state (picking, kinetic energy).
+//! directly) is read back only now and then: every [`SYNC_EVERY`] while running and once
+//! the stepping stops (for the kinetic energy shown), after every edit, and when the UI asks
+//! ([`SimThread::catch_up`]: picking, export).
 
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender, TryRecvError};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
@@ -199,16 +200,8 @@ impl SimThread {
     pub fn catch_up(&mut self) -> Result<(), String> {
         // The thread syncs after every edit.
         self.edit(Box::new(|_| None))?;
-        let mut r = self.shared.lock();
-        while r.done < self.sent {
-            if self.handle.as_ref().is_none_or(|h| h.is_finished()) {
-                break;
-            }
-            r = match (self.shared.changed).wait_timeout(r, Duration::from_millis(50)) {
-                Ok((r, _)) => r,
-                Err(e) => e.into_inner().0,
-            };
-        }
+        let sent = self.sent;
+        self.wait_until(|r| r.done >= sent);
         Ok(())
     }
 
@@ -220,16 +213,18 @@ impl SimThread {
     /// Waits until the thread has done every job sent and owes no frames (tests, and
     /// anything that must see the result of a step), or it stopped.
     pub fn settle(&self) {
+        let sent = self.sent;
+        self.wait_until(|r| r.done >= sent && r.idle);
+    }
+
+    /// Waits until the thread's report satisfies `ready`, or the thread stopped.
+    fn wait_until(&self, ready: impl Fn(&Report) -> bool) {
         let mut r = self.shared.lock();
-        while !(r.done >= self.sent && r.idle) {
+        while !ready(&r) {
             if self.handle.as_ref().is_none_or(|h| h.is_finished()) {
                 return;
             }
-            r = match self
-                .shared
-                .changed
-                .wait_timeout(r, Duration::from_millis(50))
-            {
+            r = match (self.shared.changed).wait_timeout(r, Duration::from_millis(50)) {
                 Ok((r, _)) => r,
                 Err(e) => e.into_inner().0,
             };
