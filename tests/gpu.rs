@@ -93,9 +93,10 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
 }
 
 /// A parameter change on a running GPU simulation reaches the shader: new spring
-/// strengths, substeps and gravity, applied mid-run on both backends, keep them together.
-/// Also when the GPU's state is not read back every frame (as the app runs it): the change
-/// must start from the GPU's latest frame, not from the stale copy on the CPU.
+/// strengths, substeps and gravity, then a pin and a push, applied mid-run on both backends,
+/// keep them together. Also when the GPU's state is not read back every frame (as the app
+/// runs it): each edit must start from the GPU's latest frame, not from the stale copy on
+/// the CPU.
 #[test]
 fn a_parameter_change_mid_run_reaches_the_gpu() {
     for read_every_frame in [true, false] {
@@ -117,6 +118,15 @@ fn parameter_change_mid_run(read_every_frame: bool) {
         params.gravity = glam::Vec3::new(2.0, -5.0, 1.0);
         sim.set_params(params).expect("valid");
         for _ in 0..20 {
+            sim.step_frame().expect("frame");
+        }
+        // Pin edits and a push, each after frames of its own.
+        sim.toggle_pin(8 * 16 + 8);
+        for _ in 0..5 {
+            sim.step_frame().expect("frame");
+        }
+        sim.modify_state(|s| s.vel[20] += glam::Vec3::new(0.0, 0.0, 0.5));
+        for _ in 0..5 {
             sim.step_frame().expect("frame");
         }
     }
