@@ -444,9 +444,9 @@ fn the_effects_panel_shows_the_scenes_effects_and_adds_and_removes_them() {
             .any(|e| matches!(e, clothsim::sim::Effect::Wind(_)))
     );
     harness.get_by_label("Wind");
-    // Its phase shows in the status bar once it has run.
+    // Its phase shows in the status bar once it has run (on the stepping thread: wait).
     harness.get_by_label("Step").click();
-    harness.run_steps(2);
+    run_settled(&mut harness, 2);
     harness.get_by_label_contains(" wind ");
     // Remove gravity: the first "Remove" belongs to the first removable effect, gravity.
     let before = harness.state().sim().effects().len();
@@ -744,4 +744,41 @@ fn the_antialiasing_setting_redraws_the_view_with_that_many_samples() {
     harness.state_mut().samples = 16;
     harness.run_steps(2);
     assert_eq!(harness.state().view_samples(), Some(most));
+}
+
+#[test]
+fn the_window_shows_the_view_exactly_as_captured() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut harness = harness();
+    harness.state_mut().capture_dir = dir.path().to_path_buf();
+    harness.get_by_label("Capture PNG").click();
+    harness.run_steps(2);
+    harness.state_mut().finish_writes();
+    let path = dir.path().join("clothsim-capture-0001.png");
+    let capture = image::open(&path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgba8();
+    // Away from the button, so that no tooltip points into the view.
+    harness.event(egui::Event::PointerGone);
+    harness.run_steps(2);
+    let window = harness.render().expect("the window renders");
+    let rect = harness.state().view_rect().expect("the view was drawn");
+    let ppp = harness.ctx.pixels_per_point();
+    let (left, top) = (
+        (rect.min.x * ppp).round() as u32,
+        (rect.min.y * ppp).round() as u32,
+    );
+    assert!(
+        left + capture.width() <= window.width() && top + capture.height() <= window.height(),
+        "a {:?} view at ({left}, {top}) in a {:?} window",
+        capture.dimensions(),
+        window.dimensions()
+    );
+    // Paused, the view is drawn again the same: the window holds the captured image texel
+    // for texel, in place and the right way up.
+    let differing = capture
+        .enumerate_pixels()
+        .filter(|&(x, y, p)| window.get_pixel(left + x, top + y) != p)
+        .count();
+    assert_eq!(differing, 0, "of {} pixels", capture.len() / 4);
 }

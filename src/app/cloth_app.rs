@@ -481,9 +481,7 @@ impl ClothApp {
         );
         // A new quality setting takes a new target (and pipelines for it).
         let samples = self.samples_in_use();
-        if let Some(v) = self.viewport.take_if(|v| v.samples() != samples) {
-            v.free(&rs);
-        }
+        self.viewport.take_if(|v| v.samples() != samples);
         if self.viewport.is_none() {
             match Viewport::new(&rs, w, h, samples) {
                 Ok(v) => self.viewport = Some(v),
@@ -509,11 +507,8 @@ impl ClothApp {
             ui.label(format!("3D view: {e}"));
             return;
         }
-        let texture = viewport.texture();
-        let response = ui.add(
-            egui::Image::from_texture(egui::load::SizedTexture::new(texture, size))
-                .sense(egui::Sense::click_and_drag()),
-        );
+        let (rect, response) = ui.allocate_exact_size(size, egui::Sense::click_and_drag());
+        viewport.paint(ui.painter(), rect);
         self.view_rect = Some(response.rect);
         self.pointer_input(ui, &response);
         self.capture_drawn(&rs);

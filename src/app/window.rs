@@ -54,6 +54,10 @@ pub fn run(obj: Option<PathBuf>) -> eframe::Result {
             .with_inner_size([1280.0, 800.0])
             .with_drag_and_drop(true),
         renderer: eframe::Renderer::Wgpu,
+        // egui's pass keeps one sample and no depth buffer: the 3D view's image is put into
+        // it by a pipeline made for exactly that (`viewport::ViewPaint`).
+        multisampling: 0,
+        depth_buffer: 0,
         wgpu_options,
         ..Default::default()
     };

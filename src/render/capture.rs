@@ -55,7 +55,19 @@ pub fn read_target(
     queue: &wgpu::Queue,
     target: &RenderTarget,
 ) -> Result<RgbaImage, RenderError> {
-    let (width, height) = target.size();
+    read_texture(device, queue, target.texture())
+}
+
+/// Reads a 2D texture of four bytes a texel (made with `COPY_SRC`) back to the CPU.
+///
+/// # Errors
+/// [`RenderError::Readback`] if mapping fails.
+pub fn read_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+) -> Result<RgbaImage, RenderError> {
+    let (width, height) = (texture.width(), texture.height());
     let padded = padded_bytes_per_row(width);
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("clothsim readback"),
@@ -67,7 +79,7 @@ pub fn read_target(
         label: Some("clothsim readback"),
     });
     encoder.copy_texture_to_buffer(
-        target.texture().as_image_copy(),
+        texture.as_image_copy(),
         wgpu::TexelCopyBufferInfo {
             buffer: &buffer,
             layout: wgpu::TexelCopyBufferLayout {

@@ -18,7 +18,8 @@ mod target;
 
 pub use camera::OrbitCamera;
 pub use capture::{
-    RgbaImage, map_read, padded_bytes_per_row, read_target, save_png, strip_row_padding,
+    RgbaImage, map_read, padded_bytes_per_row, read_target, read_texture, save_png,
+    strip_row_padding,
 };
 pub use device::{AdapterPreference, Gpu, describe_adapter};
 pub use error::RenderError;
