@@ -65,10 +65,9 @@ pub fn run(obj: Option<PathBuf>) -> eframe::Result {
         "clothsim",
         options,
         Box::new(move |cc| {
-            Ok(Box::new(super::ClothApp::new(
-                cc.wgpu_render_state.clone(),
-                obj.as_deref(),
-            )))
+            let mut app = super::ClothApp::new(cc.wgpu_render_state.clone(), obj.as_deref());
+            app.log_frame_times = std::env::var_os("CLOTHSIM_FRAME_TIMES").is_some();
+            Ok(Box::new(app))
         }),
     )
 }
