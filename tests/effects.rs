@@ -106,6 +106,49 @@ fn dihedral_forces_are_minus_the_energy_gradient() {
 }
 
 #[test]
+fn a_wing_collapsed_onto_its_hinge_gets_a_bounded_force_with_no_net_force_or_torque() {
+    // One quad: two triangles and one hinge, its diagonal; flat at rest.
+    let model = grid_model(1, 1.0);
+    assert_eq!(model.hinges.len(), 1);
+    let bending = DihedralBending::new(&model, 0.05);
+    let [x0, x1, a, b] = model.hinges[0].map(|i| i as usize);
+    let rest = &model.rest_positions;
+    let e = rest[x1] - rest[x0];
+    let normal = e.cross(rest[b] - rest[x0]).normalize();
+    // Wing `a` folded to 90° and pressed down towards the hinge's middle: its apex
+    // `height × |e|` above the hinge, so the angle stays 90° whatever the height.
+    let folded = |height: f32| {
+        let mut pos = rest.clone();
+        pos[a] = rest[x0] + 0.5 * e + height * e.length() * normal;
+        let f = forces_of(&bending, &model, &pos);
+        (pos, f)
+    };
+    let largest = |f: &[Vec3]| f.iter().map(|v| v.length()).fold(0.0f32, f32::max);
+    // At 2 % of the hinge the exact force applies; lower, it would grow as 1/height
+    // (20 000 times larger at 10⁻⁶). It stays at the 2 % level instead.
+    let (_, at_limit) = folded(0.02);
+    let (pos, f) = folded(1e-6);
+    let (limit, sliver) = (largest(&at_limit), largest(&f));
+    assert!(limit > 0.0);
+    assert!(
+        (0.5 * limit..=1.01 * limit).contains(&sliver),
+        "a sliver's force {sliver} N, at the limit {limit} N"
+    );
+    // Limited alike at all four points: still no net force and no torque.
+    let net: Vec3 = f.iter().sum();
+    let torque: Vec3 = pos
+        .iter()
+        .zip(&f)
+        .map(|(x, f)| (*x - rest[x0]).cross(*f))
+        .sum();
+    assert!(net.length() < 1e-5 * sliver, "net force {net}");
+    assert!(
+        torque.length() < 1e-5 * sliver * e.length(),
+        "torque {torque}"
+    );
+}
+
+#[test]
 fn a_flat_sheet_has_no_bending_force_however_it_is_placed() {
     let model = grid_model(4, 1.0);
     let bending = DihedralBending::new(&model, 1.0);

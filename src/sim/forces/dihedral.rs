@@ -42,6 +42,21 @@ pub fn hinge_angle(x0: Vec3, x1: Vec3, a: Vec3, b: Vec3) -> Option<(f32, [Vec3; 
     Some((theta, [g0, g1, ga, gb]))
 }
 
+/// Wings lower than this fraction of their hinge's length get a limited force.
+const MIN_WING: f32 = 0.02;
+
+/// The factor (≤ 1) a hinge's force is scaled by so that no wing's part of the gradient
+/// exceeds `1/(MIN_WING·|e|)`. A wing's part is `1/height`: as a wing collapses onto its
+/// hinge the angle loses its meaning and the exact force grows without bound (up to
+/// `|e|·10¹²` before [`hinge_angle`] calls the hinge degenerate). Scaling all four points'
+/// parts alike keeps the forces summing to zero and free of torque; the force is then no
+/// longer exactly the energy's gradient, for such slivers only.
+fn wing_limit(edge: Vec3, grad: &[Vec3; 4]) -> f32 {
+    let largest = grad[2].length().max(grad[3].length());
+    let cap = 1.0 / (MIN_WING * edge.length());
+    if largest > cap { cap / largest } else { 1.0 }
+}
+
 /// `theta − rest` wrapped into (−π, π]: a hinge folded through ±π stays continuous.
 fn angle_difference(theta: f32, rest: f32) -> f32 {
     let mut d = theta - rest;
@@ -101,14 +116,19 @@ impl DihedralBending {
             .sum()
     }
 
-    /// Adds `−∂E/∂x = −2k·w·(θ − θ₀)·∂θ/∂x` (N) to `f`.
+    /// Adds `−∂E/∂x = −2k·w·(θ − θ₀)·∂θ/∂x` (N) to `f`, limited for a wing nearly collapsed
+    /// onto its hinge (see [`wing_limit`]).
     pub fn add_forces(&self, model: &ClothModel, pos: &[Vec3], f: &mut [Vec3]) {
         for (h, (&rest, &w)) in model.hinges.iter().zip(self.rest.iter().zip(&self.weight)) {
             let [x0, x1, a, b] = h.map(|i| pos[i as usize]);
             let Some((theta, grad)) = hinge_angle(x0, x1, a, b) else {
                 continue;
             };
-            let scale = -2.0 * self.stiffness * w * angle_difference(theta, rest);
+            let scale = -2.0
+                * self.stiffness
+                * w
+                * angle_difference(theta, rest)
+                * wing_limit(x1 - x0, &grad);
             for (&i, g) in h.iter().zip(grad) {
                 f[i as usize] += scale * g;
             }
