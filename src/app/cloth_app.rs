@@ -500,7 +500,7 @@ impl ClothApp {
         };
         self.view_aspect = w as f32 / h as f32;
         let mut frame = view::frame(&self.sim);
-        if self.in_effect.backend == "gpu" {
+        if self.in_effect.on_gpu() {
             frame.device_positions = self.gpu_display.as_ref().map(|buffer| DevicePositions {
                 buffer,
                 stride: crate::gpu::GpuStepper::DISPLAY_STRIDE,

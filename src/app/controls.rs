@@ -229,7 +229,7 @@ fn solver_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     ui.heading("Solver");
     ui.horizontal(|ui| {
         ui.label("Backend");
-        let on_gpu = app.in_effect().backend == "gpu";
+        let on_gpu = app.in_effect().on_gpu();
         if ui.selectable_label(!on_gpu, "CPU").clicked() && on_gpu {
             app.set_backend(crate::gpu::Backend::Cpu);
         }

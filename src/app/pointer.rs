@@ -39,7 +39,7 @@ impl ClothApp {
     /// now and then (the view draws from the GPU's buffer); bring it to the latest frame so
     /// the pointer picks, and an export writes, the cloth as it is drawn. One read-back.
     pub(super) fn catch_up(&mut self) {
-        if self.in_effect().backend == "gpu" {
+        if self.in_effect().on_gpu() {
             let sent = self.stepping.catch_up();
             self.report_sent(sent);
             self.poll_stepping();

@@ -54,6 +54,12 @@ pub struct InEffect {
 }
 
 impl InEffect {
+    /// Whether the copy steps on the GPU (its state is then read back only now and then,
+    /// and the view draws from the GPU's buffer).
+    pub fn on_gpu(&self) -> bool {
+        self.backend == "gpu"
+    }
+
     fn of(sim: &Simulation) -> Self {
         Self {
             backend: sim.backend_name(),
