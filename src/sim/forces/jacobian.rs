@@ -35,6 +35,12 @@ impl SpringBlock {
         self.alpha * Mat3::IDENTITY + Mat3::from_cols(bn * self.n.x, bn * self.n.y, bn * self.n.z)
     }
 
+    /// `[α, β, n.x, n.y, n.z]`: the numbers [`SpringRuns::add_block_products`] reads per
+    /// spring.
+    pub fn numbers(&self) -> [f32; 5] {
+        [self.alpha, self.beta, self.n.x, self.n.y, self.n.z]
+    }
+
     /// `S·u`.
     pub fn times(&self, u: Vec3) -> Vec3 {
         self.alpha * u + (self.beta * self.n.dot(u)) * self.n
@@ -162,11 +168,7 @@ impl SystemProduct {
             ));
         }
         if let Some(runs) = &self.runs {
-            let spring = |e: usize| {
-                let s = sys.spring[e];
-                [s.alpha, s.beta, s.n.x, s.n.y, s.n.z]
-            };
-            runs.in_order(spring, &mut self.blocks);
+            runs.in_order(|e| sys.spring[e].numbers(), &mut self.blocks);
         }
         split_blocks(sys.diag.iter().copied(), &mut self.diag);
     }

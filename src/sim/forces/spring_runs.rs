@@ -19,8 +19,9 @@ use std::ops::Range;
 
 use glam::Vec3;
 
-/// Springs' system blocks `α·I + β·n nᵀ` in run order: `[α, β, n.x, n.y, n.z]`, one array
-/// each ([`SpringRuns::add_block_products`]).
+/// Springs' system blocks `α·I + β·n nᵀ` in run order: `[α, β, n.x, n.y, n.z]`
+/// ([`SpringBlock::numbers`](super::SpringBlock::numbers)), one array each
+/// ([`SpringRuns::add_block_products`]).
 pub type Projectors = [Vec<f32>; 5];
 
 /// Particles per block (a block is one parallel task).
@@ -811,11 +812,7 @@ mod tests {
         let zero = vec![0.0; a.len()];
         let runs = SpringRuns::new(n, &a, &b, &zero, &zero, &zero);
         let mut s: Projectors = Default::default();
-        let numbers = |e: usize| {
-            let s = blocks[e];
-            [s.alpha, s.beta, s.n.x, s.n.y, s.n.z]
-        };
-        runs.in_order(numbers, &mut s);
+        runs.in_order(|e| blocks[e].numbers(), &mut s);
         let mut uc = Components::default();
         split(&u, &mut uc, n);
         let product = |runs: &SpringRuns| {
