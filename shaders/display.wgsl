@@ -32,12 +32,11 @@ struct Line {
 // Eight floats per particle: position, normal, uv.
 @group(0) @binding(4) var<storage, read_write> cloth_out: array<f32>;
 @group(0) @binding(5) var<storage, read> lines: array<Line>;
-// Seven floats per line end: position, colour.
-@group(0) @binding(6) var<storage, read_write> line_out: array<f32>;
+// Seven floats per line end (`line_ends`) or per particle (`points`): position, colour.
+// The two entry points bind their own output buffers here.
+@group(0) @binding(6) var<storage, read_write> color_out: array<f32>;
 // One flag per particle: pinned (1) or not (0).
 @group(0) @binding(7) var<storage, read> pinned: array<u32>;
-// Seven floats per particle: position, colour.
-@group(0) @binding(8) var<storage, read_write> point_out: array<f32>;
 
 const WORKGROUP: u32 = 64u;
 
@@ -50,26 +49,15 @@ fn item(id: vec3<u32>, groups: vec3<u32>) -> u32 {
     return id.x + id.y * groups.x * WORKGROUP;
 }
 
-// A line end or a particle: seven floats, position then colour. (Two functions, not one
-// with a switch: each entry point may bind only the buffers it uses.)
-fn write_line_end(at: u32, p: vec3<f32>, c: vec4<f32>) {
-    line_out[at] = p.x;
-    line_out[at + 1u] = p.y;
-    line_out[at + 2u] = p.z;
-    line_out[at + 3u] = c.x;
-    line_out[at + 4u] = c.y;
-    line_out[at + 5u] = c.z;
-    line_out[at + 6u] = c.w;
-}
-
-fn write_point(at: u32, p: vec3<f32>, c: vec4<f32>) {
-    point_out[at] = p.x;
-    point_out[at + 1u] = p.y;
-    point_out[at + 2u] = p.z;
-    point_out[at + 3u] = c.x;
-    point_out[at + 4u] = c.y;
-    point_out[at + 5u] = c.z;
-    point_out[at + 6u] = c.w;
+// A line end or a particle: seven floats, position then colour.
+fn write_color_vertex(at: u32, p: vec3<f32>, c: vec4<f32>) {
+    color_out[at] = p.x;
+    color_out[at + 1u] = p.y;
+    color_out[at + 2u] = p.z;
+    color_out[at + 3u] = c.x;
+    color_out[at + 4u] = c.y;
+    color_out[at + 5u] = c.z;
+    color_out[at + 6u] = c.w;
 }
 
 // Area-weighted normals as `vertex_normals` (mesh/normals.rs) makes them on the CPU: each triangle's unnormalised
@@ -123,8 +111,8 @@ fn line_ends(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgrou
     if (line.by_strain != 0u) {
         color = strain_color((distance(a, b) - line.rest) / max(line.rest, 1.0e-9));
     }
-    write_line_end(14u * l, a, color);
-    write_line_end(14u * l + 7u, b, color);
+    write_color_vertex(14u * l, a, color);
+    write_color_vertex(14u * l + 7u, b, color);
 }
 
 @compute @workgroup_size(64)
@@ -134,5 +122,5 @@ fn points(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups)
         return;
     }
     let color = select(info.particle_color, info.pinned_color, pinned[i] != 0u);
-    write_point(7u * i, position(i), color);
+    write_color_vertex(7u * i, position(i), color);
 }

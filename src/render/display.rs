@@ -255,7 +255,7 @@ impl DisplayPass {
                 info,
                 source,
                 (7, self.pinned.buffer.buffer()),
-                (8, points.buffer()),
+                (6, points.buffer()),
             ];
             (self.points).dispatch(device, &mut pass, &buffers, count, max_groups);
         }
