@@ -88,10 +88,22 @@ impl CpuStepper {
         state: &mut ClothState,
         h: f32,
     ) -> Result<StepReport, StepError> {
+        self.integrate_with(model, state, |integrator, ctx, state| {
+            integrator.step(ctx, state, h)
+        })
+    }
+
+    /// Runs `steps` (the integrator's work) on `state` and charges its phases.
+    fn integrate_with<R>(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+        steps: impl FnOnce(&mut dyn Integrator, &mut StepContext<'_>, &mut ClothState) -> R,
+    ) -> R {
         let start = Instant::now();
         let result = {
             let mut ctx = StepContext::new(model, &self.forces, &self.solver, &mut self.meter);
-            self.integrator.step(&mut ctx, state, h)
+            steps(self.integrator.as_mut(), &mut ctx, state)
         };
         let total = start.elapsed();
         let m = &self.meter;
@@ -111,6 +123,31 @@ impl CpuStepper {
         result
     }
 
+    /// A frame's substeps: taken together where the integrator has a way to
+    /// ([`Integrator::steps`]) and nothing acts between them (no contacts), else one by one.
+    fn frame_substeps(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+    ) -> Result<(), StepError> {
+        let count = self.substeps;
+        if count > 1 && self.colliders.is_empty() && self.self_collision.is_none() {
+            let h = self.substep_length();
+            self.forces.set_time(state.time);
+            let together = self.integrate_with(model, state, |integrator, ctx, state| {
+                integrator.steps(ctx, state, h, count)
+            });
+            if let Some(report) = together {
+                self.stats.record_steps(&report?, count);
+                return Ok(());
+            }
+        }
+        for _ in 0..count {
+            self.substep(model, state)?;
+        }
+        Ok(())
+    }
+
     /// One frame at the substeps in effect, ending exactly at `end` (seconds); checked
     /// against the guard's limits.
     fn try_frame(
@@ -119,9 +156,7 @@ impl CpuStepper {
         state: &mut ClothState,
         end: f64,
     ) -> Result<(), Trouble> {
-        for _ in 0..self.substeps {
-            self.substep(model, state)?;
-        }
+        self.frame_substeps(model, state)?;
         // Whole frames end on the frame clock, however the substeps' lengths rounded.
         state.time = end;
         let limits = self.guard.limits.as_ref().ok_or(Trouble::NonFinite)?;
@@ -332,15 +367,13 @@ impl StepBackend for CpuStepper {
     ) -> Result<FrameOutcome, Diverged> {
         let end = state.time + self.dt as f64;
         if !self.guard.policy.enabled {
-            for _ in 0..self.substeps {
-                // With the guard off a failed solve is all there is to report.
-                self.substep(model, state).map_err(|e| Diverged {
-                    time: state.time,
-                    reason: e.to_string(),
-                    substeps: self.substeps,
-                    fallback: String::new(),
-                })?;
-            }
+            // With the guard off a failed solve is all there is to report.
+            self.frame_substeps(model, state).map_err(|e| Diverged {
+                time: state.time,
+                reason: e.to_string(),
+                substeps: self.substeps,
+                fallback: String::new(),
+            })?;
             state.time = end;
             return Ok(FrameOutcome::Stepped);
         }

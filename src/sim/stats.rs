@@ -28,6 +28,13 @@ impl StepStats {
         }
     }
 
+    /// Adds `count` steps taken together, `report` counting the work of all of them (an
+    /// unconverged solve among them counts once).
+    pub fn record_steps(&mut self, report: &StepReport, count: u32) {
+        self.record(report);
+        self.steps += count.saturating_sub(1) as u64;
+    }
+
     /// Force evaluations per step (0 without steps).
     pub fn force_evals_per_step(&self) -> f64 {
         self.force_evals as f64 / self.steps.max(1) as f64

@@ -16,6 +16,19 @@ pub fn split(src: &[Vec3], out: &mut Components, n: usize) {
     }
 }
 
+/// Writes the vectors of `src` (one array per component) into `out`, as many as both hold:
+/// the inverse of [`split`].
+pub fn join(src: &Components, out: &mut [Vec3]) {
+    let [x, y, z] = src;
+    for (i, o) in out
+        .iter_mut()
+        .enumerate()
+        .take(x.len().min(y.len()).min(z.len()))
+    {
+        *o = Vec3::new(x[i], y[i], z[i]);
+    }
+}
+
 /// Sets `out` to `n` zero vectors.
 pub fn zeroed(out: &mut Components, n: usize) {
     for comp in out {

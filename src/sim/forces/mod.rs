@@ -13,7 +13,7 @@ mod springs;
 mod wind;
 
 pub use air_damping::AirDamping;
-pub use components::{Blocks, Components, blocks_times, split, split_blocks, zeroed};
+pub use components::{Blocks, Components, blocks_times, join, split, split_blocks, zeroed};
 pub use dihedral::{DihedralBending, hinge_angle};
 pub use force::Force;
 pub use force_set::{ForceSet, TermTimes, to_accelerations};

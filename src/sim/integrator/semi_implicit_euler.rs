@@ -6,20 +6,24 @@ use super::context::StepContext;
 use super::kind::IntegratorKind;
 use super::step::{Integrator, StepError, StepReport};
 use crate::cloth::ClothState;
-use crate::sim::forces::{Components, split};
+use crate::sim::forces::{Components, join, split};
 
 /// `v ← v + a(x, v)·h`, then `x ← x + v·h` with the new velocity.
 ///
 /// When every force term takes its vectors one array per component (gravity, springs, air
-/// damping: the usual scene), the state is copied into such arrays once and the forces are
+/// damping: the usual scene), the state is copied into such arrays and the forces are
 /// summed there, in one vector loop per term and component; otherwise per vector. Both give
-/// the same bits.
+/// the same bits. A frame's substeps taken together ([`Integrator::steps`]) stay in those
+/// arrays from the first to the last, and the state is written once at the end.
 #[derive(Default)]
 pub struct SemiImplicitEuler {
     acc: Vec<Vec3>,
     pos: Components,
     vel: Components,
     force: Components,
+    /// The step's new positions and velocities (then swapped with `pos` and `vel`).
+    next_pos: Components,
+    next_vel: Components,
     /// Never takes the component path (tests compare the two).
     whole_vectors: bool,
 }
@@ -33,32 +37,42 @@ impl SemiImplicitEuler {
         }
     }
 
-    /// The step on component arrays; false (nothing changed) when a term cannot take them.
-    fn step_components(
-        &mut self,
-        ctx: &mut StepContext<'_>,
-        state: &mut ClothState,
-        h: f32,
-    ) -> bool {
-        if self.whole_vectors || !ctx.forces.takes_components() {
-            return false;
-        }
-        let n = state.pos.len();
-        split(&state.pos, &mut self.pos, n);
-        split(&state.vel, &mut self.vel, n);
+    /// Whether the forces can be summed on component arrays.
+    fn on_components(&self, ctx: &StepContext<'_>) -> bool {
+        !self.whole_vectors && ctx.forces.takes_components()
+    }
+
+    /// One step of the component arrays `self.pos`, `self.vel` (not of `state`, but for its
+    /// clock); false, with nothing changed, when a term could not take them.
+    fn advance(&mut self, ctx: &mut StepContext<'_>, state: &mut ClothState, h: f32) -> bool {
         if !ctx.forces_components(&self.pos, &self.vel, &mut self.force) {
             return false;
         }
-        let [fx, fy, fz] = &self.force;
-        let particles = state.pos.iter_mut().zip(state.vel.iter_mut());
-        for (p, ((x, v), &w)) in particles.zip(&ctx.model.inv_mass).enumerate() {
-            if w != 0.0 {
-                let a = Vec3::new(fx[p], fy[p], fz[p]) * w;
-                *v += a * h;
-                *x += *v * h;
-            }
+        let inv_mass = &ctx.model.inv_mass;
+        for c in 0..3 {
+            let (x, v) = (&mut self.next_pos[c], &mut self.next_vel[c]);
+            x.resize(self.pos[c].len(), 0.0);
+            v.resize(self.vel[c].len(), 0.0);
+            let now = [&self.pos[c][..], &self.vel[c][..], &self.force[c][..]];
+            update(now, inv_mass, h, [x, v]);
         }
+        std::mem::swap(&mut self.pos, &mut self.next_pos);
+        std::mem::swap(&mut self.vel, &mut self.next_vel);
+        state.time += h as f64;
         true
+    }
+
+    /// Copies the state into the component arrays.
+    fn load(&mut self, state: &ClothState) {
+        let n = state.pos.len();
+        split(&state.pos, &mut self.pos, n);
+        split(&state.vel, &mut self.vel, n);
+    }
+
+    /// Writes the component arrays back into the state.
+    fn store(&self, state: &mut ClothState) {
+        join(&self.pos, &mut state.pos);
+        join(&self.vel, &mut state.vel);
     }
 }
 
@@ -73,9 +87,12 @@ impl Integrator for SemiImplicitEuler {
         state: &mut ClothState,
         h: f32,
     ) -> Result<StepReport, StepError> {
-        if self.step_components(ctx, state, h) {
-            state.time += h as f64;
-            return Ok(ctx.report());
+        if self.on_components(ctx) {
+            self.load(state);
+            if self.advance(ctx, state, h) {
+                self.store(state);
+                return Ok(ctx.report());
+            }
         }
         ctx.accelerations(&state.pos, &state.vel, &mut self.acc);
         let particles = state.pos.iter_mut().zip(state.vel.iter_mut());
@@ -87,5 +104,74 @@ impl Integrator for SemiImplicitEuler {
         }
         state.time += h as f64;
         Ok(ctx.report())
+    }
+
+    /// On component arrays from the first step to the last (the forces here never depend
+    /// on time).
+    fn steps(
+        &mut self,
+        ctx: &mut StepContext<'_>,
+        state: &mut ClothState,
+        h: f32,
+        count: u32,
+    ) -> Option<Result<StepReport, StepError>> {
+        if !self.on_components(ctx) {
+            return None;
+        }
+        self.load(state);
+        for done in 0..count {
+            if !self.advance(ctx, state, h) {
+                if done == 0 {
+                    return None;
+                }
+                // A term could not take the arrays after all: the rest one at a time.
+                self.store(state);
+                for _ in done..count {
+                    if let Err(e) = self.step(ctx, state, h) {
+                        return Some(Err(e));
+                    }
+                }
+                return Some(Ok(ctx.report()));
+            }
+        }
+        self.store(state);
+        Some(Ok(ctx.report()))
+    }
+}
+
+/// One component of `v' = v + (f·w)·h`, then `x' = x + v'·h`, for the particles with
+/// `w ≠ 0` (the operations of the whole-vector path, in its order); the others keep `x` and
+/// `v`. Written to other arrays than it reads: in place, the compiler keeps the unmoved
+/// particles by masked stores, which are slow on some CPUs. Compiled plainly and for AVX2
+/// (picked at run time): the same IEEE operations either way, so the same bits.
+fn update([x, v, f]: [&[f32]; 3], w: &[f32], h: f32, out: [&mut [f32]; 2]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        unsafe { update_avx2([x, v, f], w, h, out) };
+        return;
+    }
+    update_in([x, v, f], w, h, out);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn update_avx2(now: [&[f32]; 3], w: &[f32], h: f32, out: [&mut [f32]; 2]) {
+    update_in(now, w, h, out);
+}
+
+#[inline(always)]
+fn update_in([x, v, f]: [&[f32]; 3], w: &[f32], h: f32, [x_out, v_out]: [&mut [f32]; 2]) {
+    let n = (x.len().min(v.len()).min(f.len()).min(w.len()))
+        .min(x_out.len())
+        .min(v_out.len());
+    let (x, v, f, w) = (&x[..n], &v[..n], &f[..n], &w[..n]);
+    let (x_out, v_out) = (&mut x_out[..n], &mut v_out[..n]);
+    for i in 0..n {
+        let moves = w[i] != 0.0;
+        let v_new = v[i] + f[i] * w[i] * h;
+        let x_new = x[i] + v_new * h;
+        v_out[i] = if moves { v_new } else { v[i] };
+        x_out[i] = if moves { x_new } else { x[i] };
     }
 }

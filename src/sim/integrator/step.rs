@@ -61,6 +61,22 @@ pub trait Integrator: Send {
         h: f32,
     ) -> Result<StepReport, StepError>;
 
+    /// `count` steps in a row, where this integrator has a faster way to take them than one
+    /// at a time; the stepper asks when nothing outside the integrator reads or changes the
+    /// state between them (a frame's substeps without contacts). The states are exactly
+    /// those of `count` calls to [`Integrator::step`]; the report counts all the steps'
+    /// work. `None`, with nothing changed, where there is no faster way (the default), or
+    /// where the forces depend on time (the stepper sets it before each step only).
+    fn steps(
+        &mut self,
+        _ctx: &mut StepContext<'_>,
+        _state: &mut ClothState,
+        _h: f32,
+        _count: u32,
+    ) -> Option<Result<StepReport, StepError>> {
+        None
+    }
+
     /// Forgets what was kept from earlier steps: the state changed outside the integrator
     /// (a contact, a rollback, a pin or density change, a drag).
     fn invalidate(&mut self) {}
