@@ -449,6 +449,35 @@ fn xpbd_on_two_threads_gives_the_same_bits_as_on_one() {
     assert!(one.pos == two.pos && one.vel == two.vel);
 }
 
+/// From about 90 × 90 particles semi-implicit Euler shares out its per-particle loops
+/// (forces of gravity and air, the update) as well as the springs between threads; each
+/// particle's work is its own, so two threads give the same bits as one, frame after frame.
+#[test]
+fn semi_implicit_euler_on_two_threads_gives_the_same_bits_as_on_one() {
+    let n = 96;
+    assert!(n * n >= clothsim::sim::team::PARALLEL_ELEMENTS);
+    let run = |threads: usize| {
+        let scene = clothsim::bench::bench_scene(n as u32, IntegratorKind::SemiImplicitEuler);
+        let mut sim = Simulation::new(scene.unwrap());
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            for _ in 0..3 {
+                sim.step_frame().unwrap();
+            }
+        });
+        sim.state().clone()
+    };
+    let (one, two) = (run(1), run(2));
+    let start = clothsim::bench::bench_scene(n as u32, IntegratorKind::SemiImplicitEuler);
+    let start = start.unwrap().initial;
+    let fell = one.pos.iter().zip(&start.pos).map(|(a, b)| b.y - a.y);
+    assert!(fell.fold(0.0, f32::max) > 1e-4, "the cloth hardly moved");
+    assert!(one.pos == two.pos && one.vel == two.vel);
+}
+
 /// The explicit integrators get their accelerations through `StepContext::accelerations`,
 /// which sums them on component arrays when every term allows it: along a moving cloth's
 /// trajectory they are the same bits as the general per-vector sum (`ForceSet::accelerations`),

@@ -3,6 +3,7 @@
 
 use glam::Vec3;
 
+use super::super::team::each_part;
 use super::components::Components;
 use super::jacobian::SystemMatrix;
 
@@ -23,11 +24,16 @@ impl AirDamping {
     /// As [`AirDamping::add_forces`] with velocities and forces stored one array per
     /// component.
     pub fn add_forces_components(&self, mass: &[f32], vel: &Components, f: &mut Components) {
-        for (f, v) in f.iter_mut().zip(vel) {
-            for ((f, v), &m) in f.iter_mut().zip(v).zip(mass) {
-                *f -= (self.rate * m) * *v;
+        let [f0, f1, f2] = f;
+        each_part([f0, f1, f2], |range, f| {
+            let mass = &mass[range.start..range.end.min(mass.len())];
+            for (f, v) in f.into_iter().zip(vel) {
+                let v = &v[range.start..range.end.min(v.len())];
+                for ((f, v), &m) in f.iter_mut().zip(v).zip(mass) {
+                    *f -= (self.rate * m) * *v;
+                }
             }
-        }
+        });
     }
 
     /// Adds `∂f_i/∂v_i = −c·m_i·I` (N·s/m), its only non-zero derivative, to the system.

@@ -2,6 +2,7 @@
 
 use glam::Vec3;
 
+use super::super::team::each_part;
 use super::components::Components;
 
 /// Uniform gravitational acceleration, m/s².
@@ -20,11 +21,16 @@ impl Gravity {
 
     /// As [`Gravity::add_forces`] on forces stored one array per component.
     pub fn add_forces_components(&self, mass: &[f32], f: &mut Components) {
-        for (f, g) in f.iter_mut().zip(self.g.to_array()) {
-            for (f, &m) in f.iter_mut().zip(mass) {
-                *f += m * g;
+        let g = self.g.to_array();
+        let [f0, f1, f2] = f;
+        each_part([f0, f1, f2], |range, f| {
+            let mass = &mass[range.start..range.end.min(mass.len())];
+            for (f, g) in f.into_iter().zip(g) {
+                for (f, &m) in f.iter_mut().zip(mass) {
+                    *f += m * g;
+                }
             }
-        }
+        });
     }
 
     /// `−Σ m·g·x`, joules.

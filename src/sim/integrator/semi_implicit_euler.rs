@@ -7,6 +7,7 @@ use super::kind::IntegratorKind;
 use super::step::{Integrator, StepError, StepReport};
 use crate::cloth::ClothState;
 use crate::sim::forces::{Components, join, split};
+use crate::sim::team::each_part;
 
 /// `v ← v + a(x, v)·h`, then `x ← x + v·h` with the new velocity.
 ///
@@ -49,13 +50,23 @@ impl SemiImplicitEuler {
             return false;
         }
         let inv_mass = &ctx.model.inv_mass;
-        for c in 0..3 {
-            let (x, v) = (&mut self.next_pos[c], &mut self.next_vel[c]);
-            x.resize(self.pos[c].len(), 0.0);
-            v.resize(self.vel[c].len(), 0.0);
-            let now = [&self.pos[c][..], &self.vel[c][..], &self.force[c][..]];
-            update(now, inv_mass, h, [x, v]);
+        let n = inv_mass.len();
+        for next in self.next_pos.iter_mut().chain(&mut self.next_vel) {
+            next.resize(n, 0.0);
         }
+        let [x0, x1, x2] = &mut self.next_pos;
+        let [v0, v1, v2] = &mut self.next_vel;
+        let (pos, vel, force) = (&self.pos, &self.vel, &self.force);
+        each_part(
+            [x0, x1, x2, v0, v1, v2],
+            |range, [x0, x1, x2, v0, v1, v2]| {
+                let w = &inv_mass[range.clone()];
+                for (c, out) in [[x0, v0], [x1, v1], [x2, v2]].into_iter().enumerate() {
+                    let now = [&pos[c], &vel[c], &force[c]].map(|a| &a[range.clone()]);
+                    update(now, w, h, out);
+                }
+            },
+        );
         std::mem::swap(&mut self.pos, &mut self.next_pos);
         std::mem::swap(&mut self.vel, &mut self.next_vel);
         state.time += h as f64;
