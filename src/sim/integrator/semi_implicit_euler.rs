@@ -50,7 +50,8 @@ impl SemiImplicitEuler {
             return false;
         }
         let inv_mass = &ctx.model.inv_mass;
-        let n = inv_mass.len();
+        // (A state and model of different sizes would step only the particles both have.)
+        let n = inv_mass.len().min(self.pos[0].len()).min(self.vel[0].len());
         for next in self.next_pos.iter_mut().chain(&mut self.next_vel) {
             next.resize(n, 0.0);
         }
