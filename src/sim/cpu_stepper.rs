@@ -81,6 +81,11 @@ impl CpuStepper {
         &self.colliders
     }
 
+    /// Whether anything acts on the state after each substep (colliders, self-collision).
+    fn contacts_exist(&self) -> bool {
+        !self.colliders.is_empty() || self.self_collision.is_some()
+    }
+
     /// Integrates one substep and charges its phases; the colliders are not applied.
     fn integrate(
         &mut self,
@@ -131,7 +136,7 @@ impl CpuStepper {
         state: &mut ClothState,
     ) -> Result<(), StepError> {
         let count = self.substeps;
-        if count > 1 && self.colliders.is_empty() && self.self_collision.is_none() {
+        if count > 1 && !self.contacts_exist() {
             let h = self.substep_length();
             self.forces.set_time(state.time);
             let together = self.integrate_with(model, state, |integrator, ctx, state| {
@@ -326,7 +331,7 @@ impl StepBackend for CpuStepper {
         state: &mut ClothState,
     ) -> Result<StepReport, StepError> {
         let h = self.substep_length();
-        let contacts_exist = !self.colliders.is_empty() || self.self_collision.is_some();
+        let contacts_exist = self.contacts_exist();
         if contacts_exist {
             self.substep_start.clone_from(&state.pos);
         }

@@ -44,11 +44,10 @@ impl SemiImplicitEuler {
     }
 
     /// One step of the component arrays `self.pos`, `self.vel` (not of `state`, but for its
-    /// clock); false, with nothing changed, when a term could not take them.
-    fn advance(&mut self, ctx: &mut StepContext<'_>, state: &mut ClothState, h: f32) -> bool {
-        if !ctx.forces_components(&self.pos, &self.vel, &mut self.force) {
-            return false;
-        }
+    /// clock). Only when [`SemiImplicitEuler::on_components`]: every term takes the arrays.
+    fn advance(&mut self, ctx: &mut StepContext<'_>, state: &mut ClothState, h: f32) {
+        let summed = ctx.forces_components(&self.pos, &self.vel, &mut self.force);
+        debug_assert!(summed, "a term refused component arrays it said it takes");
         let inv_mass = &ctx.model.inv_mass;
         // (A state and model of different sizes would step only the particles both have.)
         let n = inv_mass.len().min(self.pos[0].len()).min(self.vel[0].len());
@@ -71,7 +70,6 @@ impl SemiImplicitEuler {
         std::mem::swap(&mut self.pos, &mut self.next_pos);
         std::mem::swap(&mut self.vel, &mut self.next_vel);
         state.time += h as f64;
-        true
     }
 
     /// Copies the state into the component arrays.
@@ -101,10 +99,9 @@ impl Integrator for SemiImplicitEuler {
     ) -> Result<StepReport, StepError> {
         if self.on_components(ctx) {
             self.load(state);
-            if self.advance(ctx, state, h) {
-                self.store(state);
-                return Ok(ctx.report());
-            }
+            self.advance(ctx, state, h);
+            self.store(state);
+            return Ok(ctx.report());
         }
         ctx.accelerations(&state.pos, &state.vel, &mut self.acc);
         let particles = state.pos.iter_mut().zip(state.vel.iter_mut());
@@ -131,20 +128,8 @@ impl Integrator for SemiImplicitEuler {
             return None;
         }
         self.load(state);
-        for done in 0..count {
-            if !self.advance(ctx, state, h) {
-                if done == 0 {
-                    return None;
-                }
-                // A term could not take the arrays after all: the rest one at a time.
-                self.store(state);
-                for _ in done..count {
-                    if let Err(e) = self.step(ctx, state, h) {
-                        return Some(Err(e));
-                    }
-                }
-                return Some(Ok(ctx.report()));
-            }
+        for _ in 0..count {
+            self.advance(ctx, state, h);
         }
         self.store(state);
         Some(Ok(ctx.report()))
