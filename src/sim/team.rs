@@ -241,10 +241,9 @@ impl<'a, T> Disjoint<'a, T> {
     /// No two parts in use at the same time may overlap.
     #[allow(clippy::mut_from_ref)]
     pub unsafe fn part(&self, range: std::ops::Range<usize>) -> &mut [T] {
-        let end = range.end.min(self.len);
-        let start = range.start.min(end);
+        let range = clamped(range, self.len);
         // SAFETY: in bounds (clamped); disjoint from other parts by the caller's contract.
-        unsafe { std::slice::from_raw_parts_mut(self.start.add(start), end - start) }
+        unsafe { std::slice::from_raw_parts_mut(self.start.add(range.start), range.len()) }
     }
 
     /// Element `i`.
@@ -261,7 +260,7 @@ impl<'a, T> Disjoint<'a, T> {
 }
 
 /// Elements (particles) from which [`each_part`] shares its loop out between the team's
-/// members: about 90 × 90 particles, where the spring forces go parallel too. Below, on
+/// members: about 90 × 90 particles (the spring blocks go parallel from here too). Below, on
 /// the 2-core machine this was measured on, the data moving between the cores' caches cost
 /// more than the second core gained.
 pub const PARALLEL_ELEMENTS: usize = 8192;
@@ -291,6 +290,18 @@ pub fn each_part<const K: usize>(
         let mine = std::array::from_fn(|k| unsafe { arrays[k].part(range.clone()) });
         part(range, mine);
     });
+}
+
+/// `slice[range]`, cut short where `slice` ends: for arrays read beside those that
+/// [`each_part`] cuts, which may be shorter.
+pub fn within<T>(slice: &[T], range: std::ops::Range<usize>) -> &[T] {
+    &slice[clamped(range, slice.len())]
+}
+
+/// `range` cut short at `len` (empty where it starts past it).
+fn clamped(range: std::ops::Range<usize>, len: usize) -> std::ops::Range<usize> {
+    let end = range.end.min(len);
+    range.start.min(end)..end
 }
 
 /// `0..len` cut into `parts` nearly equal ranges; the `i`-th.
@@ -404,6 +415,14 @@ mod tests {
             assert!(parts.windows(2).all(|w| w[0].end == w[1].start));
             assert_eq!((parts[0].start, parts[members - 1].end), (0, len));
         }
+    }
+
+    #[test]
+    fn within_cuts_a_range_short_where_the_slice_ends() {
+        let s = [1, 2, 3, 4, 5];
+        assert_eq!(within(&s, 1..3), &[2, 3]);
+        assert_eq!(within(&s, 3..9), &[4, 5]);
+        assert!(within(&s, 7..9).is_empty());
     }
 
     #[test]

@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use super::super::team::each_part;
+use super::super::team::{each_part, within};
 use super::components::Components;
 use super::jacobian::SystemMatrix;
 
@@ -26,9 +26,9 @@ impl AirDamping {
     pub fn add_forces_components(&self, mass: &[f32], vel: &Components, f: &mut Components) {
         let [f0, f1, f2] = f;
         each_part([f0, f1, f2], |range, f| {
-            let mass = &mass[range.start..range.end.min(mass.len())];
+            let mass = within(mass, range.clone());
             for (f, v) in f.into_iter().zip(vel) {
-                let v = &v[range.start..range.end.min(v.len())];
+                let v = within(v, range.clone());
                 for ((f, v), &m) in f.iter_mut().zip(v).zip(mass) {
                     *f -= (self.rate * m) * *v;
                 }

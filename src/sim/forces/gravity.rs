@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 
-use super::super::team::each_part;
+use super::super::team::{each_part, within};
 use super::components::Components;
 
 /// Uniform gravitational acceleration, m/s².
@@ -24,7 +24,7 @@ impl Gravity {
         let g = self.g.to_array();
         let [f0, f1, f2] = f;
         each_part([f0, f1, f2], |range, f| {
-            let mass = &mass[range.start..range.end.min(mass.len())];
+            let mass = within(mass, range);
             for (f, g) in f.into_iter().zip(g) {
                 for (f, &m) in f.iter_mut().zip(mass) {
                     *f += m * g;

@@ -13,7 +13,7 @@
 //! then every particle adds the buffers that cover it, in block order. So 1, 2 or 64 threads
 //! give bit-identical forces.
 
-use super::super::team::{Disjoint, Team, share};
+use super::super::team::{Disjoint, PARALLEL_ELEMENTS, Team, share};
 use super::components::{Components, Scratch, split};
 use std::ops::Range;
 
@@ -26,11 +26,12 @@ pub type Projectors = [Vec<f32>; 5];
 
 /// Particles per block (a block is one parallel task).
 const BLOCK: usize = 1024;
-/// Blocks from which the blocks run in parallel (on the [`Team`]), from about 90 × 90
-/// particles. On the 2-core machine this was measured on, N = 64 (4 blocks) ran slower on
-/// two threads than on one (its data moves between the cores' caches every substep) and
-/// N = 128 (16 blocks) faster.
-const PARALLEL_BLOCKS: usize = 8;
+/// Blocks from which the blocks run in parallel (on the [`Team`]): as many as hold
+/// [`PARALLEL_ELEMENTS`] particles (8 blocks, about 90 × 90 particles), the point from which
+/// the per-particle loops go parallel too. On the 2-core machine this was measured on,
+/// N = 64 (4 blocks) ran slower on two threads than on one (its data moves between the
+/// cores' caches every substep) and N = 128 (16 blocks) faster.
+const PARALLEL_BLOCKS: usize = PARALLEL_ELEMENTS / BLOCK;
 
 /// Longest gap in a run filled with springs of no strength (rest length, stiffness and
 /// damping 0: their force is exactly zero) rather than starting a new run.
