@@ -330,7 +330,7 @@ fn state_bits(s: &ClothState) -> Vec<u32> {
 /// A frame's substeps taken together (semi-implicit Euler keeps its component arrays from
 /// the first substep to the last and writes the state once) end in exactly the state of
 /// the same substeps taken one at a time, a held particle (pinned, with the pointer's
-/// velocity) staying where it is held.
+/// velocity) staying where it is held, and the work counted is the same.
 #[test]
 fn a_frame_taken_whole_ends_where_its_substeps_one_by_one_do() {
     let held = 7;
@@ -353,6 +353,10 @@ fn a_frame_taken_whole_ends_where_its_substeps_one_by_one_do() {
         }
     }
     assert_eq!(whole.substeps(), substeps, "the guard stepped in");
+    // The work counted is the same too: every substep and its force evaluation.
+    let stats = whole.take_stats();
+    assert_eq!(stats, single.take_stats());
+    assert_eq!(stats.steps, 3 * substeps as u64);
     assert!(state_bits(whole.state()) == state_bits(single.state()));
     // (The substeps add up their f32 lengths; a frame ends on the frame clock.)
     assert!((whole.state().time - single.state().time).abs() < 1e-6);
