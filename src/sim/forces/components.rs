@@ -5,6 +5,8 @@ use std::sync::{Mutex, MutexGuard};
 
 use glam::{Mat3, Vec3};
 
+use super::super::team::each_part;
+
 /// x, y and z of a list of vectors, one array each (all the same length).
 pub type Components = [Vec<f32>; 3];
 
@@ -29,12 +31,15 @@ pub fn join(src: &Components, out: &mut [Vec3]) {
     }
 }
 
-/// Sets `out` to `n` zero vectors.
+/// Sets `out` to `n` zero vectors (filled by the team from [`each_part`]'s threshold on).
 pub fn zeroed(out: &mut Components, n: usize) {
-    for comp in out {
-        comp.clear();
+    for comp in out.iter_mut() {
         comp.resize(n, 0.0);
     }
+    let [x, y, z] = out;
+    each_part([x, y, z], |_, parts| {
+        parts.into_iter().for_each(|p| p.fill(0.0))
+    });
 }
 
 /// 3×3 blocks (one per particle or per spring) stored one array per entry, column-major:

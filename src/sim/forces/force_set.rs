@@ -7,9 +7,8 @@ use crate::cloth::ClothModel;
 use super::super::constraints::DistanceConstraints;
 use super::super::effect::{BendingModel, Effect};
 use super::super::params::SimParams;
-use super::super::team::each_part;
 use super::air_damping::AirDamping;
-use super::components::{Components, Scratch, split};
+use super::components::{Components, Scratch, split, zeroed};
 use super::dihedral::DihedralBending;
 use super::force::Force;
 use super::gravity::Gravity;
@@ -222,12 +221,7 @@ impl ForceSet {
         f: &mut Components,
         times: &mut TermTimes,
     ) -> bool {
-        let n = pos[0].len();
-        for f in f.iter_mut() {
-            f.resize(n, 0.0);
-        }
-        let [f0, f1, f2] = f;
-        each_part([f0, f1, f2], |_, f| f.into_iter().for_each(|f| f.fill(0.0)));
+        zeroed(f, pos[0].len());
         let mut whole = true;
         self.each_term(
             |_| true,
