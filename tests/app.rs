@@ -14,6 +14,29 @@ fn harness() -> Harness<'static, ClothApp> {
     harness_sized(1280.0, 800.0)
 }
 
+/// A harness whose captures, recordings and exports go to a fresh temporary folder (which
+/// lives as long as the first value).
+fn harness_in_tempdir() -> (tempfile::TempDir, Harness<'static, ClothApp>) {
+    let dir = tempfile::tempdir().unwrap();
+    let mut harness = harness();
+    harness.state_mut().capture_dir = dir.path().to_path_buf();
+    (dir, harness)
+}
+
+/// Clicks Capture PNG and lets the app queue the image.
+fn click_capture(harness: &mut Harness<'static, ClothApp>) {
+    harness.get_by_label("Capture PNG").click();
+    harness.run_steps(2);
+}
+
+/// The first capture written to `dir`.
+fn first_capture(dir: &std::path::Path) -> image::RgbaImage {
+    let path = dir.join("clothsim-capture-0001.png");
+    image::open(&path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgba8()
+}
+
 /// A window of this size (a tall one shows the whole side panel without scrolling).
 fn harness_sized(width: f32, height: f32) -> Harness<'static, ClothApp> {
     let mut harness = Harness::builder()
@@ -160,11 +183,8 @@ fn pause_and_step_advances_exactly_one_frame() {
 
 #[test]
 fn capture_button_writes_a_png_of_the_view() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut harness = harness();
-    harness.state_mut().capture_dir = dir.path().to_path_buf();
-    harness.get_by_label("Capture PNG").click();
-    harness.run_steps(2);
+    let (dir, mut harness) = harness_in_tempdir();
+    click_capture(&mut harness);
     assert_eq!(
         harness.state().pending_writes(),
         1,
@@ -172,10 +192,7 @@ fn capture_button_writes_a_png_of_the_view() {
     );
     harness.state_mut().finish_writes();
     harness.run_steps(1);
-    let path = dir.path().join("clothsim-capture-0001.png");
-    let image = image::open(&path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .to_rgba8();
+    let image = first_capture(dir.path());
     assert!(
         image.width() > 400 && image.height() > 300,
         "the viewport's size, got {:?}",
@@ -203,9 +220,7 @@ fn import_warnings_stay_visible_after_a_drop() {
 
 #[test]
 fn record_writes_a_numbered_frame_sequence() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut harness = harness();
-    harness.state_mut().capture_dir = dir.path().to_path_buf();
+    let (dir, mut harness) = harness_in_tempdir();
     harness.state_mut().transport.playing = true;
     harness.get_by_label("Record").click();
     harness.run_steps(4);
@@ -328,8 +343,7 @@ fn a_failed_capture_is_reported_and_loses_nothing() {
     let mut harness = harness();
     harness.state_mut().capture_dir = std::path::PathBuf::from("/no/such/folder");
     let particles = harness.state().sim().model().particle_count();
-    harness.get_by_label("Capture PNG").click();
-    harness.run_steps(2);
+    click_capture(&mut harness);
     harness.state_mut().finish_writes();
     harness.run_steps(1);
     let error = last_error(&harness);
@@ -341,8 +355,7 @@ fn a_failed_capture_is_reported_and_loses_nothing() {
     // The app goes on: a capture to a good folder works.
     let dir = tempfile::tempdir().unwrap();
     harness.state_mut().capture_dir = dir.path().to_path_buf();
-    harness.get_by_label("Capture PNG").click();
-    harness.run_steps(2);
+    click_capture(&mut harness);
     harness.state_mut().finish_writes();
     assert!(dir.path().join("clothsim-capture-0001.png").is_file());
 }
@@ -490,9 +503,7 @@ fn save_scene_writes_a_file_that_reopens_as_the_same_setup() {
 
 #[test]
 fn export_obj_writes_the_cloth_as_it_is_now() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut harness = harness();
-    harness.state_mut().capture_dir = dir.path().to_path_buf();
+    let (dir, mut harness) = harness_in_tempdir();
     for _ in 0..3 {
         harness.get_by_label("Step").click();
         harness.run_steps(1);
@@ -513,9 +524,7 @@ fn export_obj_writes_the_cloth_as_it_is_now() {
 /// stepping stops often comes first, as a harness frame takes longer than its 30 ms.)
 #[test]
 fn export_obj_on_the_gpu_writes_the_latest_frame() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut harness = harness();
-    harness.state_mut().capture_dir = dir.path().to_path_buf();
+    let (dir, mut harness) = harness_in_tempdir();
     harness.state_mut().set_scenario("sphere-drop");
     harness.run_steps(1);
     harness.get_by_label("GPU").click();
@@ -545,9 +554,7 @@ fn export_obj_on_the_gpu_writes_the_latest_frame() {
 
 #[test]
 fn record_gif_writes_an_animated_gif_of_the_view() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut harness = harness();
-    harness.state_mut().capture_dir = dir.path().to_path_buf();
+    let (dir, mut harness) = harness_in_tempdir();
     harness.state_mut().transport.playing = true;
     harness.get_by_label("Record GIF").click();
     harness.run_steps(5);
@@ -755,16 +762,10 @@ fn the_antialiasing_setting_redraws_the_view_with_that_many_samples() {
 
 #[test]
 fn the_window_shows_the_view_exactly_as_captured() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut harness = harness();
-    harness.state_mut().capture_dir = dir.path().to_path_buf();
-    harness.get_by_label("Capture PNG").click();
-    harness.run_steps(2);
+    let (dir, mut harness) = harness_in_tempdir();
+    click_capture(&mut harness);
     harness.state_mut().finish_writes();
-    let path = dir.path().join("clothsim-capture-0001.png");
-    let capture = image::open(&path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .to_rgba8();
+    let capture = first_capture(dir.path());
     // Away from the button, so that no tooltip points into the view.
     harness.event(egui::Event::PointerGone);
     harness.run_steps(2);
