@@ -105,13 +105,19 @@ fn dihedral_forces_are_minus_the_energy_gradient() {
     }
 }
 
-#[test]
-fn a_wing_collapsed_onto_its_hinge_gets_a_bounded_force_with_no_net_force_or_torque() {
-    // One quad: two triangles and one hinge, its diagonal; flat at rest.
+/// One quad of a 1 m grid: two triangles and one hinge, its diagonal, flat at rest; its
+/// dihedral bending of `stiffness`, and the hinge's points (edge ends, then wings).
+fn one_hinge(stiffness: f32) -> (ClothModel, DihedralBending, [usize; 4]) {
     let model = grid_model(1, 1.0);
     assert_eq!(model.hinges.len(), 1);
-    let bending = DihedralBending::new(&model, 0.05);
-    let [x0, x1, a, b] = model.hinges[0].map(|i| i as usize);
+    let bending = DihedralBending::new(&model, stiffness);
+    let hinge = model.hinges[0].map(|i| i as usize);
+    (model, bending, hinge)
+}
+
+#[test]
+fn a_wing_collapsed_onto_its_hinge_gets_a_bounded_force_with_no_net_force_or_torque() {
+    let (model, bending, [x0, x1, a, b]) = one_hinge(0.05);
     let rest = &model.rest_positions;
     let e = rest[x1] - rest[x0];
     let normal = e.cross(rest[b] - rest[x0]).normalize();
@@ -188,10 +194,7 @@ fn a_flat_sheet_has_no_bending_force_however_it_is_placed() {
 #[test]
 fn the_bending_force_points_back_towards_the_rest_angle() {
     // One hinge: two triangles sharing the edge x0–x1 along x; wing b folded up by 40°.
-    let model = grid_model(1, 1.0);
-    assert_eq!(model.hinges.len(), 1);
-    let bending = DihedralBending::new(&model, 0.1);
-    let [x0, x1, a, b] = model.hinges[0].map(|i| i as usize);
+    let (model, bending, [x0, x1, a, b]) = one_hinge(0.1);
     let mut pos = model.rest_positions.clone();
     let axis = (pos[x1] - pos[x0]).normalize();
     let fold = Quat::from_axis_angle(axis, 40f32.to_radians());
