@@ -235,6 +235,20 @@ impl<'a, T> Disjoint<'a, T> {
         }
     }
 
+    /// The first element, for kernels that gather through raw pointers (they must keep
+    /// [`Disjoint::part`]'s contract themselves).
+    pub fn as_ptr(&self) -> *mut T {
+        self.start
+    }
+
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
     /// Elements `range` (clamped to the slice).
     ///
     /// # Safety

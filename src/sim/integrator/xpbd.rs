@@ -1,5 +1,7 @@
 //! Extended position-based dynamics (XPBD) with small steps.
 
+use std::ops::Range;
+
 use glam::Vec3;
 
 use super::super::constraints::{Coloured, DistanceConstraints};
@@ -10,11 +12,15 @@ use super::kind::IntegratorKind;
 use super::step::{Integrator, StepError, StepReport};
 use crate::cloth::ClothState;
 
-/// A particle's predicted position and its displacement this step.
+/// A particle's predicted position and its displacement this step, and its inverse mass:
+/// eight f32 in this order (the AVX2 sweep loads and stores a particle as one 32-byte row).
 #[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
 struct Moved {
     predicted: Vec3,
     displacement: Vec3,
+    inv_mass: f32,
+    pad: f32,
 }
 
 /// Each substep: the forces that are not springs (gravity, air damping, …) move the
@@ -35,8 +41,8 @@ pub struct Xpbd {
     coloured: Coloured,
     built: bool,
     force: Vec<Vec3>,
-    /// Per particle, its predicted position and its displacement side by side (a
-    /// projection touches both: one cache line rather than two).
+    /// Per particle, its predicted position, its displacement and its inverse mass side by
+    /// side: a projection reads them all, from one 32-byte row.
     moved: Vec<Moved>,
     lambda: Vec<f32>,
 }
@@ -46,28 +52,27 @@ impl Xpbd {
     /// constraints is shared out between the threads of the [`Team`] (its constraints
     /// share no particle, so the order within it changes nothing: the same bits on any
     /// number of threads).
-    fn sweep(&mut self, inv_mass: &[f32], h: f32) {
+    fn sweep(&mut self, h: f32) {
         let c = &self.coloured.constraints;
-        // `project` indexes `inv_mass` first (checked), so these make its other accesses in
-        // bounds.
-        assert!(self.moved.len() >= inv_mass.len());
         assert!(self.lambda.len() >= c.len());
         let team = Team::current();
         let moved = Disjoint::new(&mut self.moved);
         let lambda = Disjoint::new(&mut self.lambda);
-        let project = |k: usize| {
-            // SAFETY: constraint k's particles and multiplier are touched by no other
-            // constraint of its colour, and colours run one after another; the arrays'
-            // lengths were checked above.
-            unsafe { project(c, k, inv_mass, h, &moved, &lambda) };
+        let project = |range: Range<usize>, independent: bool| {
+            // SAFETY: an independent colour's constraints share no particle or multiplier
+            // (a dependent one goes one constraint at a time), colours run one after
+            // another, and the members' ranges are disjoint; the arrays' lengths were
+            // checked above.
+            unsafe { project_range(c, range, independent, h, &moved, &lambda) };
         };
         for (range, independent) in &self.coloured.colours {
             if *independent && team.members() > 1 && range.len() >= PARALLEL_COLOUR {
                 team.run(&|i| {
-                    share(range.len(), team.members(), i).for_each(|k| project(range.start + k))
+                    let share = share(range.len(), team.members(), i);
+                    project(range.start + share.start..range.start + share.end, true);
                 });
             } else {
-                range.clone().for_each(project);
+                project(range.clone(), *independent);
             }
         }
     }
@@ -76,30 +81,288 @@ impl Xpbd {
 /// Colours from this many constraints are shared out between threads.
 const PARALLEL_COLOUR: usize = 1024;
 
+/// Projects constraints `range` in order; when `independent` (no two of them share a
+/// particle) and the CPU has AVX2, eight at a time, one per SIMD lane, with the same IEEE
+/// operations in the same order as [`project`] (no fused multiply-add): the same bits
+/// either way.
+///
+/// # Safety
+/// No other thread may use these constraints' particles or multipliers meanwhile; `lambda`
+/// is at least as long as `c`.
+unsafe fn project_range(
+    c: &DistanceConstraints,
+    range: Range<usize>,
+    independent: bool,
+    h: f32,
+    moved: &Disjoint<'_, Moved>,
+    lambda: &Disjoint<'_, f32>,
+) {
+    let mut rest = range;
+    #[cfg(target_arch = "x86_64")]
+    if independent && std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above); the rest is the caller's
+        // contract.
+        rest = unsafe { project_eights_avx2(c, rest, h, moved, lambda) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = independent;
+    for k in rest {
+        // SAFETY: the caller's contract.
+        unsafe { project(c, k, h, moved, lambda) };
+    }
+}
+
+/// Projects the whole groups of eight at the start of `range` (no two of whose constraints
+/// share a particle), each in one pass of AVX2 instructions: the particles' rows loaded
+/// and transposed into one register per quantity, the projection of [`project`] lane by
+/// lane, and the rows transposed back and stored (a lane that does not move stores what it
+/// loaded). Returns the constraints left over.
+///
+/// # Safety
+/// As [`project_range`], and the CPU supports AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn project_eights_avx2(
+    c: &DistanceConstraints,
+    range: Range<usize>,
+    h: f32,
+    moved: &Disjoint<'_, Moved>,
+    lambda: &Disjoint<'_, f32>,
+) -> Range<usize> {
+    use lanes::*;
+    use std::arch::x86_64::*;
+    let end = range.end.min(c.len()).min(lambda.len());
+    let (hh, hv) = (_mm256_set1_ps(h * h), _mm256_set1_ps(h));
+    let (zero, one, tiny) = (
+        _mm256_setzero_ps(),
+        _mm256_set1_ps(1.0),
+        _mm256_set1_ps(1e-9),
+    );
+    let sign = _mm256_set1_ps(-0.0);
+    let mut k = range.start;
+    while k + LANES <= end {
+        let group = k..k + LANES;
+        let (a, b) = (&c.a[group.clone()], &c.b[group.clone()]);
+        if a.iter().chain(b).any(|&p| p as usize >= moved.len()) {
+            // Out of range: left to `project`, whose indexing checks (and panics).
+            break;
+        }
+        // SAFETY: every particle is in bounds (checked just above), and this group's own
+        // (the caller's contract).
+        let rows = |ends: &[u32]| unsafe { load_rows(moved, ends) };
+        let [ax, ay, az, adx, ady, adz, wa, a_pad] = transpose(rows(a));
+        let [bx, by, bz, bdx, bdy, bdz, wb, b_pad] = transpose(rows(b));
+        let (pa, dxa, pb, dxb) = ([ax, ay, az], [adx, ady, adz], [bx, by, bz], [bdx, bdy, bdz]);
+        // SAFETY: `k + 8 ≤ end ≤ lambda.len()`; this thread alone uses these multipliers.
+        let lambda_k = unsafe { lambda.part(group.clone()) };
+        // SAFETY: each slice holds eight f32.
+        let (rest, compliance, damping, lam) = unsafe {
+            (
+                _mm256_loadu_ps(c.rest[group.clone()].as_ptr()),
+                _mm256_loadu_ps(c.compliance[group.clone()].as_ptr()),
+                _mm256_loadu_ps(c.damping[group.clone()].as_ptr()),
+                _mm256_loadu_ps(lambda_k.as_ptr()),
+            )
+        };
+        let d = sub(pb, pa);
+        let len = _mm256_sqrt_ps(dot(d, d));
+        let w = _mm256_add_ps(wa, wb);
+        // `project` returns when `wa + wb == 0` or `len <= 1e-9`: a lane moves otherwise.
+        let moves = _mm256_and_ps(
+            _mm256_cmp_ps::<_CMP_NEQ_UQ>(w, zero),
+            _mm256_cmp_ps::<_CMP_NLE_UQ>(len, tiny),
+        );
+        // A lane that does not move computes too (perhaps 0/0); the blends below drop it.
+        let n = div(d, len);
+        let alpha = _mm256_div_ps(compliance, hh);
+        let gamma = _mm256_div_ps(_mm256_mul_ps(compliance, damping), hv);
+        let rate = dot(n, sub(dxb, dxa));
+        let constraint = _mm256_sub_ps(len, rest);
+        let numerator = _mm256_sub_ps(
+            _mm256_sub_ps(_mm256_xor_ps(constraint, sign), _mm256_mul_ps(alpha, lam)),
+            _mm256_mul_ps(gamma, rate),
+        );
+        let denominator = _mm256_add_ps(_mm256_mul_ps(_mm256_add_ps(one, gamma), w), alpha);
+        let dl = _mm256_div_ps(numerator, denominator);
+        let keep = |old: V3, new: V3| [0, 1, 2].map(|i| _mm256_blendv_ps(old[i], new[i], moves));
+        let lam = _mm256_blendv_ps(lam, _mm256_add_ps(lam, dl), moves);
+        let (da, db) = (
+            scale(_mm256_mul_ps(wa, dl), n),
+            scale(_mm256_mul_ps(wb, dl), n),
+        );
+        let [ax, ay, az] = keep(pa, sub(pa, da));
+        let [adx, ady, adz] = keep(dxa, sub(dxa, da));
+        let [bx, by, bz] = keep(pb, add(pb, db));
+        let [bdx, bdy, bdz] = keep(dxb, add(dxb, db));
+        // SAFETY: as the loads above; every a is stored before any b, so a constraint of a
+        // particle with itself ends as `project` leaves it.
+        unsafe {
+            _mm256_storeu_ps(lambda_k.as_mut_ptr(), lam);
+            store_rows(moved, a, transpose([ax, ay, az, adx, ady, adz, wa, a_pad]));
+            store_rows(moved, b, transpose([bx, by, bz, bdx, bdy, bdz, wb, b_pad]));
+        }
+        k += LANES;
+    }
+    k..range.end
+}
+
+/// Eight 3-vectors in AVX2 registers, one per lane (`[x, y, z]`), and the few operations
+/// the XPBD sweep does on them, each the same IEEE operations as glam's `Vec3`.
+#[cfg(target_arch = "x86_64")]
+mod lanes {
+    use std::arch::x86_64::*;
+
+    use super::Moved;
+    use crate::sim::team::Disjoint;
+
+    pub const LANES: usize = 8;
+
+    pub type V3 = [__m256; 3];
+
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn sub(x: V3, y: V3) -> V3 {
+        [
+            _mm256_sub_ps(x[0], y[0]),
+            _mm256_sub_ps(x[1], y[1]),
+            _mm256_sub_ps(x[2], y[2]),
+        ]
+    }
+
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn add(x: V3, y: V3) -> V3 {
+        [
+            _mm256_add_ps(x[0], y[0]),
+            _mm256_add_ps(x[1], y[1]),
+            _mm256_add_ps(x[2], y[2]),
+        ]
+    }
+
+    /// `s · x`, lane by lane.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn scale(s: __m256, x: V3) -> V3 {
+        [
+            _mm256_mul_ps(s, x[0]),
+            _mm256_mul_ps(s, x[1]),
+            _mm256_mul_ps(s, x[2]),
+        ]
+    }
+
+    /// `x / s`, lane by lane.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn div(x: V3, s: __m256) -> V3 {
+        [
+            _mm256_div_ps(x[0], s),
+            _mm256_div_ps(x[1], s),
+            _mm256_div_ps(x[2], s),
+        ]
+    }
+
+    /// `(x₀y₀ + x₁y₁) + x₂y₂`, glam's order.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn dot(x: V3, y: V3) -> __m256 {
+        let xy = _mm256_add_ps(_mm256_mul_ps(x[0], y[0]), _mm256_mul_ps(x[1], y[1]));
+        _mm256_add_ps(xy, _mm256_mul_ps(x[2], y[2]))
+    }
+
+    /// The rows of `moved` at `ends`, one register each.
+    ///
+    /// # Safety
+    /// Every index is in bounds, and no other thread writes those rows meanwhile.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(super) unsafe fn load_rows(moved: &Disjoint<'_, Moved>, ends: &[u32]) -> [__m256; LANES] {
+        // SAFETY: `Moved` is eight f32, 32-byte aligned; the rest is the caller's contract.
+        core::array::from_fn(|l| unsafe {
+            _mm256_load_ps(moved.as_ptr().add(ends[l] as usize) as *const f32)
+        })
+    }
+
+    /// Stores `rows` into `moved` at `ends`, in order.
+    ///
+    /// # Safety
+    /// Every index is in bounds, and no other thread uses those rows meanwhile.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(super) unsafe fn store_rows(
+        moved: &Disjoint<'_, Moved>,
+        ends: &[u32],
+        rows: [__m256; LANES],
+    ) {
+        for (l, row) in rows.into_iter().enumerate() {
+            // SAFETY: as `load_rows`.
+            unsafe { _mm256_store_ps(moved.as_ptr().add(ends[l] as usize) as *mut f32, row) };
+        }
+    }
+
+    /// The 8 × 8 transpose: element `j` of row `i` becomes element `i` of row `j`.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn transpose(r: [__m256; LANES]) -> [__m256; LANES] {
+        let t = [
+            _mm256_unpacklo_ps(r[0], r[1]),
+            _mm256_unpackhi_ps(r[0], r[1]),
+            _mm256_unpacklo_ps(r[2], r[3]),
+            _mm256_unpackhi_ps(r[2], r[3]),
+            _mm256_unpacklo_ps(r[4], r[5]),
+            _mm256_unpackhi_ps(r[4], r[5]),
+            _mm256_unpacklo_ps(r[6], r[7]),
+            _mm256_unpackhi_ps(r[6], r[7]),
+        ];
+        let u = [
+            _mm256_shuffle_ps::<0x44>(t[0], t[2]),
+            _mm256_shuffle_ps::<0xEE>(t[0], t[2]),
+            _mm256_shuffle_ps::<0x44>(t[1], t[3]),
+            _mm256_shuffle_ps::<0xEE>(t[1], t[3]),
+            _mm256_shuffle_ps::<0x44>(t[4], t[6]),
+            _mm256_shuffle_ps::<0xEE>(t[4], t[6]),
+            _mm256_shuffle_ps::<0x44>(t[5], t[7]),
+            _mm256_shuffle_ps::<0xEE>(t[5], t[7]),
+        ];
+        [
+            _mm256_permute2f128_ps::<0x20>(u[0], u[4]),
+            _mm256_permute2f128_ps::<0x20>(u[1], u[5]),
+            _mm256_permute2f128_ps::<0x20>(u[2], u[6]),
+            _mm256_permute2f128_ps::<0x20>(u[3], u[7]),
+            _mm256_permute2f128_ps::<0x31>(u[0], u[4]),
+            _mm256_permute2f128_ps::<0x31>(u[1], u[5]),
+            _mm256_permute2f128_ps::<0x31>(u[2], u[6]),
+            _mm256_permute2f128_ps::<0x31>(u[3], u[7]),
+        ]
+    }
+}
+
 /// Projects constraint `k` (XPBD with constraint damping), moving its particles' predicted
 /// positions and displacements and its multiplier.
 ///
 /// # Safety
-/// No other thread may use constraint `k`'s particles or multiplier meanwhile; `moved` is at
-/// least as long as `inv_mass`, and `lambda` as `c`.
+/// No other thread may use constraint `k`'s particles or multiplier meanwhile; `lambda` is
+/// at least as long as `c`.
 #[inline(always)]
 unsafe fn project(
     c: &DistanceConstraints,
     k: usize,
-    inv_mass: &[f32],
     h: f32,
     moved: &Disjoint<'_, Moved>,
     lambda: &Disjoint<'_, f32>,
 ) {
     let (a, b) = (c.a[k] as usize, c.b[k] as usize);
-    let (wa, wb) = (inv_mass[a], inv_mass[b]);
+    assert!(
+        a < moved.len() && b < moved.len(),
+        "constraint {k} has no particle {a} or {b}"
+    );
+    // SAFETY: in bounds (`a`, `b` just now, `c.a[k]` checked, and `lambda` by the caller's
+    // contract); no other thread uses them (the caller's contract). Each `at` is read at
+    // once, so even a self-constraint (a = b) holds no two borrows.
+    let (ma, mb, lambda) = unsafe { (*moved.at(a), *moved.at(b), lambda.at(k)) };
+    let (wa, wb) = (ma.inv_mass, mb.inv_mass);
     if wa + wb == 0.0 {
         return;
     }
-    // SAFETY: in bounds (`inv_mass[a]`, `inv_mass[b]` and `c.a[k]` were checked, and the
-    // caller's contract sizes the rest); no other thread uses them (the caller's contract).
-    // Each `at` is read at once, so even a self-constraint (a = b) holds no two borrows.
-    let (ma, mb, lambda) = unsafe { (*moved.at(a), *moved.at(b), lambda.at(k)) };
     let (pa, pb, dxa, dxb) = (ma.predicted, mb.predicted, ma.displacement, mb.displacement);
     let d = pb - pa;
     let len = d.length();
@@ -120,10 +383,12 @@ unsafe fn project(
         *moved.at(a) = Moved {
             predicted: pa - da,
             displacement: dxa - da,
+            ..ma
         };
         *moved.at(b) = Moved {
             predicted: pb + db,
             displacement: dxb + db,
+            ..mb
         };
     }
 }
@@ -157,6 +422,8 @@ impl Integrator for Xpbd {
             self.moved.push(Moved {
                 predicted: *x + *v * h,
                 displacement: *v * h,
+                inv_mass: w,
+                pad: 0.0,
             });
         }
         self.lambda.clear();
@@ -164,7 +431,7 @@ impl Integrator for Xpbd {
         let sweeps = ctx.config.xpbd_iterations;
         ctx.solve(|| {
             for _ in 0..sweeps {
-                self.sweep(w, h);
+                self.sweep(h);
             }
             ((), sweeps, None, true)
         });
@@ -184,5 +451,98 @@ impl Integrator for Xpbd {
     /// The constraint view keeps nothing about the state; only new strengths make it stale.
     fn forces_changed(&mut self) {
         self.built = false;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 29 constraints on distinct particles (three groups of eight and five left over),
+    /// among them the cases a projection leaves alone or passes through: a particle tied
+    /// to itself, two fixed particles, one fixed particle, two particles at one point, and
+    /// a non-finite position.
+    fn one_colour() -> (DistanceConstraints, Vec<Moved>, Vec<f32>) {
+        let mut seed = 0x2545_f491_u32;
+        let mut random = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32
+        };
+        let count = 29;
+        let mut c = DistanceConstraints::default();
+        let mut moved = Vec::new();
+        for k in 0..count {
+            let (a, b) = (2 * k as u32, 2 * k as u32 + if k == 3 { 0 } else { 1 });
+            c.a.push(a);
+            c.b.push(b);
+            c.rest.push(0.05 + 0.1 * random());
+            c.compliance.push(1e-3 * (0.5 + random()));
+            c.damping.push(0.02 * random());
+            for _ in 0..2 {
+                let [x, y, z, dx, dy, dz] = [(); 6].map(|_| random() - 0.5);
+                let inv_mass = 0.5 + 2.0 * random();
+                moved.push(Moved {
+                    predicted: Vec3::new(x, y, z),
+                    displacement: 0.01 * Vec3::new(dx, dy, dz),
+                    inv_mass,
+                    pad: 0.0,
+                });
+            }
+        }
+        moved[10].inv_mass = 0.0;
+        moved[11].inv_mass = 0.0;
+        moved[18].inv_mass = 0.0;
+        moved[25].predicted = moved[24].predicted;
+        moved[35].predicted.y = f32::NAN;
+        let lambda = (0..count).map(|_| random() - 0.5).collect();
+        (c, moved, lambda)
+    }
+
+    #[test]
+    fn the_sweep_eight_at_a_time_gives_the_same_bits_as_one_at_a_time() {
+        let (c, start, lambda_start) = one_colour();
+        let h = 1.0 / 600.0;
+        let run = |eights: bool| {
+            let (mut moved, mut lambda) = (start.clone(), lambda_start.clone());
+            let (m, l) = (Disjoint::new(&mut moved), Disjoint::new(&mut lambda));
+            // SAFETY: one thread; the constraints share no particle; lengths match.
+            unsafe { project_range(&c, 0..c.len(), eights, h, &m, &l) };
+            // IEEE leaves a NaN's sign and payload to the hardware's operand order: any NaN
+            // counts as the same value here.
+            let bits = |v: Vec3| {
+                v.to_array()
+                    .map(|x| if x.is_nan() { u32::MAX } else { x.to_bits() })
+            };
+            let moved: Vec<_> = (moved.iter())
+                .map(|m| {
+                    (
+                        bits(m.predicted),
+                        bits(m.displacement),
+                        m.inv_mass.to_bits(),
+                    )
+                })
+                .collect();
+            let lambda: Vec<_> = lambda.iter().map(|&l| bits(Vec3::splat(l))[0]).collect();
+            (moved, lambda)
+        };
+        let (one_by_one, eights) = (run(false), run(true));
+        assert_eq!(one_by_one, eights);
+        // The projection did move particles, and left alone those it should.
+        let unchanged =
+            |p: usize| one_by_one.0[p].0 == start[p].predicted.to_array().map(f32::to_bits);
+        assert!(!unchanged(0) && !unchanged(1) && !unchanged(19));
+        assert!([6, 10, 11, 18, 24, 25].into_iter().all(unchanged));
+        assert_eq!(one_by_one.0[34].0, [u32::MAX; 3]);
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // The groups of eight went through the AVX2 kernel, the five left over not.
+            let (mut moved, mut lambda) = (start.clone(), lambda_start.clone());
+            let (m, l) = (Disjoint::new(&mut moved), Disjoint::new(&mut lambda));
+            // SAFETY: as above, and the CPU has AVX2.
+            let left = unsafe { project_eights_avx2(&c, 0..c.len(), h, &m, &l) };
+            assert_eq!(left, 24..29);
+        }
     }
 }
