@@ -443,8 +443,9 @@ fn same_bits_on_two_threads(n: u32, kind: IntegratorKind, advance: fn(&mut Simul
     assert!(one.pos == two.pos && one.vel == two.vel, "{kind}");
 }
 
-/// XPBD's colours are shared out between threads; constraints of one colour share no
-/// particle, so two threads give the same bits as one.
+/// XPBD sweeps the two halves of the cloth at the same time on two threads, then shares out
+/// the seam's large colours; what runs at the same time shares no particle, so two threads
+/// give the same bits as one.
 #[test]
 fn xpbd_on_two_threads_gives_the_same_bits_as_on_one() {
     same_bits_on_two_threads(48, IntegratorKind::Xpbd, |sim| {

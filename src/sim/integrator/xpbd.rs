@@ -4,7 +4,7 @@ use std::ops::Range;
 
 use glam::Vec3;
 
-use super::super::constraints::{Coloured, DistanceConstraints};
+use super::super::constraints::{DistanceConstraints, Halves};
 use super::super::forces::Force;
 use super::super::team::{Disjoint, Team, share};
 use super::context::StepContext;
@@ -26,8 +26,9 @@ struct Moved {
 /// Each substep: the forces that are not springs (gravity, air damping, …) move the
 /// particles explicitly to a prediction; then every spring, seen as a distance constraint
 /// with compliance `α = 1/k`, is projected in `xpbd_iterations` Gauss–Seidel sweeps with its
-/// Lagrange multiplier (XPBD), visited colour by colour
-/// ([`DistanceConstraints::coloured`]), and its dashpot `c` as constraint damping `γ = α·c/h`;
+/// Lagrange multiplier (XPBD), visited half by half and then across the seam, colour by
+/// colour ([`DistanceConstraints::halves`]), and its dashpot `c` as constraint damping
+/// `γ = α·c/h`;
 /// finally `v = (x' − x)/h`. With many small substeps and one sweep this is the "small steps"
 /// method: stable at any stiffness, and as `α → 0` it approaches inextensible springs.
 ///
@@ -37,35 +38,76 @@ struct Moved {
 /// rounding units of a coordinate near 1 m), and that noise grows as the step shrinks.
 #[derive(Default)]
 pub struct Xpbd {
-    /// The springs as constraints, in colour order.
-    coloured: Coloured,
+    /// The springs as constraints: two halves and their seam, each in colour order.
+    halves: Halves,
     built: bool,
     force: Vec<Vec3>,
     /// Per particle, its predicted position, its displacement and its inverse mass side by
     /// side: a projection reads them all, from one 32-byte row.
     moved: Vec<Moved>,
     lambda: Vec<f32>,
+    scaled: Scaled,
+}
+
+/// Each constraint's compliance and damping as the projection uses them at step `h`:
+/// `α̃ = α/h²` and `γ = α·c/h` (in constraint order; kept while `h` and the constraints
+/// stay).
+#[derive(Default)]
+struct Scaled {
+    h: Option<f32>,
+    alpha: Vec<f32>,
+    gamma: Vec<f32>,
+}
+
+impl Scaled {
+    fn update(&mut self, c: &DistanceConstraints, h: f32) {
+        if self.h == Some(h) && self.alpha.len() == c.len() {
+            return;
+        }
+        let compliance = c.compliance.iter().zip(&c.damping);
+        self.alpha = c.compliance.iter().map(|a| a / (h * h)).collect();
+        self.gamma = compliance.map(|(a, damping)| a * damping / h).collect();
+        self.h = Some(h);
+    }
 }
 
 impl Xpbd {
-    /// One Gauss–Seidel sweep over every constraint, colour by colour; a colour with enough
-    /// constraints is shared out between the threads of the [`Team`] (its constraints
-    /// share no particle, so the order within it changes nothing: the same bits on any
-    /// number of threads).
-    fn sweep(&mut self, h: f32) {
-        let c = &self.coloured.constraints;
-        assert!(self.lambda.len() >= c.len());
+    /// One Gauss–Seidel sweep over every constraint: the two halves, each colour by colour,
+    /// at the same time on two threads of the [`Team`] when they are large enough; then the
+    /// seam's colours, one after another, a large one shared out between the threads.
+    /// Constraints that run at the same time share no particle, so the order among them
+    /// changes nothing: the same bits on any number of threads.
+    fn sweep(&mut self) {
+        let Halves {
+            constraints: c,
+            halves,
+            seam,
+        } = &self.halves;
+        let s = &self.scaled;
+        assert!(self.lambda.len() >= c.len() && s.alpha.len() >= c.len());
+        assert!(s.gamma.len() >= c.len());
         let team = Team::current();
         let moved = Disjoint::new(&mut self.moved);
         let lambda = Disjoint::new(&mut self.lambda);
         let project = |range: Range<usize>, independent: bool| {
             // SAFETY: an independent colour's constraints share no particle or multiplier
-            // (a dependent one goes one constraint at a time), colours run one after
-            // another, and the members' ranges are disjoint; the arrays' lengths were
-            // checked above.
-            unsafe { project_range(c, range, independent, h, &moved, &lambda) };
+            // (a dependent one goes one constraint at a time); what runs at the same time is
+            // either the two halves (which share no particle) or the disjoint ranges of one
+            // seam colour; the arrays' lengths were checked above.
+            unsafe { project_range(c, s, range, independent, &moved, &lambda) };
         };
-        for (range, independent) in &self.coloured.colours {
+        let colours = |colours: &[(Range<usize>, bool)]| {
+            for (range, independent) in colours {
+                project(range.clone(), *independent);
+            }
+        };
+        let half_len = |h: &[(Range<usize>, bool)]| h.iter().map(|c| c.0.len()).sum::<usize>();
+        if team.members() > 1 && halves.iter().all(|h| half_len(h) >= PARALLEL_COLOUR) {
+            team.run(&|i| share(2, team.members(), i).for_each(|h| colours(&halves[h])));
+        } else {
+            halves.iter().for_each(|h| colours(h));
+        }
+        for (range, independent) in seam {
             if *independent && team.members() > 1 && range.len() >= PARALLEL_COLOUR {
                 team.run(&|i| {
                     let share = share(range.len(), team.members(), i);
@@ -78,7 +120,7 @@ impl Xpbd {
     }
 }
 
-/// Colours from this many constraints are shared out between threads.
+/// Halves, and seam colours, from this many constraints are shared out between threads.
 const PARALLEL_COLOUR: usize = 1024;
 
 /// Projects constraints `range` in order; when `independent` (no two of them share a
@@ -88,12 +130,12 @@ const PARALLEL_COLOUR: usize = 1024;
 ///
 /// # Safety
 /// No other thread may use these constraints' particles or multipliers meanwhile; `lambda`
-/// is at least as long as `c`.
+/// and `s`'s arrays are at least as long as `c`.
 unsafe fn project_range(
     c: &DistanceConstraints,
+    s: &Scaled,
     range: Range<usize>,
     independent: bool,
-    h: f32,
     moved: &Disjoint<'_, Moved>,
     lambda: &Disjoint<'_, f32>,
 ) {
@@ -102,20 +144,20 @@ unsafe fn project_range(
     if independent && std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked just above); the rest is the caller's
         // contract.
-        rest = unsafe { project_eights_avx2(c, rest, h, moved, lambda) };
+        rest = unsafe { project_eights_avx2(c, s, rest, moved, lambda) };
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = independent;
     for k in rest {
         // SAFETY: the caller's contract.
-        unsafe { project(c, k, h, moved, lambda) };
+        unsafe { project(c, s, k, moved, lambda) };
     }
 }
 
 /// Projects the whole groups of eight at the start of `range` (no two of whose constraints
 /// share a particle), each in one pass of AVX2 instructions: the particles' rows loaded
 /// and transposed into one register per quantity, the projection of [`project`] lane by
-/// lane, and the rows transposed back and stored (a lane that does not move stores what it
+/// lane, and the columns transposed back and stored (a lane that does not move stores what it
 /// loaded). Returns the constraints left over.
 ///
 /// # Safety
@@ -124,15 +166,16 @@ unsafe fn project_range(
 #[target_feature(enable = "avx2")]
 unsafe fn project_eights_avx2(
     c: &DistanceConstraints,
+    s: &Scaled,
     range: Range<usize>,
-    h: f32,
     moved: &Disjoint<'_, Moved>,
     lambda: &Disjoint<'_, f32>,
 ) -> Range<usize> {
     use lanes::*;
     use std::arch::x86_64::*;
-    let end = range.end.min(c.len()).min(lambda.len());
-    let (hh, hv) = (_mm256_set1_ps(h * h), _mm256_set1_ps(h));
+    let end = (range.end.min(c.len()).min(lambda.len()))
+        .min(s.alpha.len())
+        .min(s.gamma.len());
     let (zero, one, tiny) = (
         _mm256_setzero_ps(),
         _mm256_set1_ps(1.0),
@@ -149,18 +192,18 @@ unsafe fn project_eights_avx2(
         }
         // SAFETY: every particle is in bounds (checked just above), and this group's own
         // (the caller's contract).
-        let rows = |ends: &[u32]| unsafe { load_rows(moved, ends) };
-        let [ax, ay, az, adx, ady, adz, wa, a_pad] = transpose(rows(a));
-        let [bx, by, bz, bdx, bdy, bdz, wb, b_pad] = transpose(rows(b));
+        let columns = |ends: &[u32]| unsafe { load_columns(moved, ends) };
+        let [ax, ay, az, adx, ady, adz, wa, a_pad] = columns(a);
+        let [bx, by, bz, bdx, bdy, bdz, wb, b_pad] = columns(b);
         let (pa, dxa, pb, dxb) = ([ax, ay, az], [adx, ady, adz], [bx, by, bz], [bdx, bdy, bdz]);
         // SAFETY: `k + 8 ≤ end ≤ lambda.len()`; this thread alone uses these multipliers.
         let lambda_k = unsafe { lambda.part(group.clone()) };
         // SAFETY: each slice holds eight f32.
-        let (rest, compliance, damping, lam) = unsafe {
+        let (rest, alpha, gamma, lam) = unsafe {
             (
                 _mm256_loadu_ps(c.rest[group.clone()].as_ptr()),
-                _mm256_loadu_ps(c.compliance[group.clone()].as_ptr()),
-                _mm256_loadu_ps(c.damping[group.clone()].as_ptr()),
+                _mm256_loadu_ps(s.alpha[group.clone()].as_ptr()),
+                _mm256_loadu_ps(s.gamma[group.clone()].as_ptr()),
                 _mm256_loadu_ps(lambda_k.as_ptr()),
             )
         };
@@ -173,9 +216,7 @@ unsafe fn project_eights_avx2(
             _mm256_cmp_ps::<_CMP_NLE_UQ>(len, tiny),
         );
         // A lane that does not move computes too (perhaps 0/0); the blends below drop it.
-        let n = div(d, len);
-        let alpha = _mm256_div_ps(compliance, hh);
-        let gamma = _mm256_div_ps(_mm256_mul_ps(compliance, damping), hv);
+        let n = scale(_mm256_div_ps(one, len), d);
         let rate = dot(n, sub(dxb, dxa));
         let constraint = _mm256_sub_ps(len, rest);
         let numerator = _mm256_sub_ps(
@@ -198,8 +239,8 @@ unsafe fn project_eights_avx2(
         // particle with itself ends as `project` leaves it.
         unsafe {
             _mm256_storeu_ps(lambda_k.as_mut_ptr(), lam);
-            store_rows(moved, a, transpose([ax, ay, az, adx, ady, adz, wa, a_pad]));
-            store_rows(moved, b, transpose([bx, by, bz, bdx, bdy, bdz, wb, b_pad]));
+            store_columns(moved, a, [ax, ay, az, adx, ady, adz, wa, a_pad]);
+            store_columns(moved, b, [bx, by, bz, bdx, bdy, bdz, wb, b_pad]);
         }
         k += LANES;
     }
@@ -250,17 +291,6 @@ mod lanes {
         ]
     }
 
-    /// `x / s`, lane by lane.
-    #[target_feature(enable = "avx2")]
-    #[inline]
-    pub fn div(x: V3, s: __m256) -> V3 {
-        [
-            _mm256_div_ps(x[0], s),
-            _mm256_div_ps(x[1], s),
-            _mm256_div_ps(x[2], s),
-        ]
-    }
-
     /// `(x₀y₀ + x₁y₁) + x₂y₂`, glam's order.
     #[target_feature(enable = "avx2")]
     #[inline]
@@ -269,69 +299,80 @@ mod lanes {
         _mm256_add_ps(xy, _mm256_mul_ps(x[2], y[2]))
     }
 
-    /// The rows of `moved` at `ends`, one register each.
+    /// The rows of `moved` at `ends` as columns: register `j` holds element `j` of the
+    /// eight rows, one per lane. Each half row is loaded whole, row `i` beside row `i + 4`,
+    /// then transposed four by four within the halves of the registers.
     ///
     /// # Safety
     /// Every index is in bounds, and no other thread writes those rows meanwhile.
     #[target_feature(enable = "avx2")]
     #[inline]
-    pub(super) unsafe fn load_rows(moved: &Disjoint<'_, Moved>, ends: &[u32]) -> [__m256; LANES] {
-        // SAFETY: `Moved` is eight f32, 32-byte aligned; the rest is the caller's contract.
-        core::array::from_fn(|l| unsafe {
-            _mm256_load_ps(moved.as_ptr().add(ends[l] as usize) as *const f32)
-        })
+    pub(super) unsafe fn load_columns(moved: &Disjoint<'_, Moved>, ends: &[u32]) -> [__m256; 8] {
+        let base = moved.as_ptr() as *const f32;
+        let mut halves = [[_mm256_setzero_ps(); 4]; 2];
+        for (i, &end) in ends[..4].iter().enumerate() {
+            let (row, other) = (8 * end as usize, 8 * ends[i + 4] as usize);
+            for (h, half) in halves.iter_mut().enumerate() {
+                // SAFETY: `Moved` is eight f32, 32-byte aligned; the rest is the caller's
+                // contract.
+                half[i] = unsafe {
+                    let low = _mm256_castps128_ps256(_mm_load_ps(base.add(row + 4 * h)));
+                    _mm256_insertf128_ps::<1>(low, _mm_load_ps(base.add(other + 4 * h)))
+                };
+            }
+        }
+        let ([c0, c1, c2, c3], [c4, c5, c6, c7]) = (transpose4(halves[0]), transpose4(halves[1]));
+        [c0, c1, c2, c3, c4, c5, c6, c7]
     }
 
-    /// Stores `rows` into `moved` at `ends`, in order.
+    /// Stores columns as [`load_columns`] makes them back into the rows of `moved` at
+    /// `ends`, row by row in order.
     ///
     /// # Safety
     /// Every index is in bounds, and no other thread uses those rows meanwhile.
     #[target_feature(enable = "avx2")]
     #[inline]
-    pub(super) unsafe fn store_rows(
-        moved: &Disjoint<'_, Moved>,
-        ends: &[u32],
-        rows: [__m256; LANES],
-    ) {
-        for (l, row) in rows.into_iter().enumerate() {
-            // SAFETY: as `load_rows`.
-            unsafe { _mm256_store_ps(moved.as_ptr().add(ends[l] as usize) as *mut f32, row) };
+    pub(super) unsafe fn store_columns(moved: &Disjoint<'_, Moved>, ends: &[u32], c: [__m256; 8]) {
+        let base = moved.as_ptr() as *mut f32;
+        let low = transpose4([c[0], c[1], c[2], c[3]]);
+        let high = transpose4([c[4], c[5], c[6], c[7]]);
+        for (i, &end) in ends[..LANES].iter().enumerate() {
+            let (half, row) = (i % 4, 8 * end as usize);
+            // SAFETY: as `load_columns`.
+            unsafe {
+                let (l, h) = if i < 4 {
+                    (
+                        _mm256_castps256_ps128(low[half]),
+                        _mm256_castps256_ps128(high[half]),
+                    )
+                } else {
+                    (
+                        _mm256_extractf128_ps::<1>(low[half]),
+                        _mm256_extractf128_ps::<1>(high[half]),
+                    )
+                };
+                _mm_store_ps(base.add(row), l);
+                _mm_store_ps(base.add(row + 4), h);
+            }
         }
     }
 
-    /// The 8 × 8 transpose: element `j` of row `i` becomes element `i` of row `j`.
+    /// The 4 × 4 transpose within each 128-bit half: element `j` of register `i` becomes
+    /// element `i` of register `j`, for the low halves and for the high halves.
     #[target_feature(enable = "avx2")]
     #[inline]
-    pub fn transpose(r: [__m256; LANES]) -> [__m256; LANES] {
+    fn transpose4(r: [__m256; 4]) -> [__m256; 4] {
         let t = [
             _mm256_unpacklo_ps(r[0], r[1]),
             _mm256_unpackhi_ps(r[0], r[1]),
             _mm256_unpacklo_ps(r[2], r[3]),
             _mm256_unpackhi_ps(r[2], r[3]),
-            _mm256_unpacklo_ps(r[4], r[5]),
-            _mm256_unpackhi_ps(r[4], r[5]),
-            _mm256_unpacklo_ps(r[6], r[7]),
-            _mm256_unpackhi_ps(r[6], r[7]),
         ];
-        let u = [
+        [
             _mm256_shuffle_ps::<0x44>(t[0], t[2]),
             _mm256_shuffle_ps::<0xEE>(t[0], t[2]),
             _mm256_shuffle_ps::<0x44>(t[1], t[3]),
             _mm256_shuffle_ps::<0xEE>(t[1], t[3]),
-            _mm256_shuffle_ps::<0x44>(t[4], t[6]),
-            _mm256_shuffle_ps::<0xEE>(t[4], t[6]),
-            _mm256_shuffle_ps::<0x44>(t[5], t[7]),
-            _mm256_shuffle_ps::<0xEE>(t[5], t[7]),
-        ];
-        [
-            _mm256_permute2f128_ps::<0x20>(u[0], u[4]),
-            _mm256_permute2f128_ps::<0x20>(u[1], u[5]),
-            _mm256_permute2f128_ps::<0x20>(u[2], u[6]),
-            _mm256_permute2f128_ps::<0x20>(u[3], u[7]),
-            _mm256_permute2f128_ps::<0x31>(u[0], u[4]),
-            _mm256_permute2f128_ps::<0x31>(u[1], u[5]),
-            _mm256_permute2f128_ps::<0x31>(u[2], u[6]),
-            _mm256_permute2f128_ps::<0x31>(u[3], u[7]),
         ]
     }
 }
@@ -345,8 +386,8 @@ mod lanes {
 #[inline(always)]
 unsafe fn project(
     c: &DistanceConstraints,
+    s: &Scaled,
     k: usize,
-    h: f32,
     moved: &Disjoint<'_, Moved>,
     lambda: &Disjoint<'_, f32>,
 ) {
@@ -369,9 +410,8 @@ unsafe fn project(
     if len <= 1e-9 {
         return;
     }
-    let n = d / len;
-    let alpha = c.compliance[k] / (h * h);
-    let gamma = c.compliance[k] * c.damping[k] / h;
+    let n = (1.0 / len) * d;
+    let (alpha, gamma) = (s.alpha[k], s.gamma[k]);
     // ∇C · (p − x): how fast the constraint is changing this step.
     let rate = n.dot(dxb - dxa);
     let constraint = len - c.rest[k];
@@ -407,7 +447,8 @@ impl Integrator for Xpbd {
         let model = ctx.model;
         if !self.built {
             // The compliances come from the current stiffness: rebuilt when forces change.
-            self.coloured = ctx.forces.constraints(model).coloured();
+            self.halves = ctx.forces.constraints(model).halves(&state.pos);
+            self.scaled.h = None;
             self.built = true;
         }
         let not_springs = |t: &Force| !matches!(t, Force::Springs(_) | Force::BendSprings(_));
@@ -427,11 +468,12 @@ impl Integrator for Xpbd {
             });
         }
         self.lambda.clear();
-        self.lambda.resize(self.coloured.constraints.len(), 0.0);
+        self.lambda.resize(self.halves.constraints.len(), 0.0);
+        self.scaled.update(&self.halves.constraints, h);
         let sweeps = ctx.config.xpbd_iterations;
         ctx.solve(|| {
             for _ in 0..sweeps {
-                self.sweep(h);
+                self.sweep();
             }
             ((), sweeps, None, true)
         });
@@ -503,12 +545,13 @@ mod tests {
     #[test]
     fn the_sweep_eight_at_a_time_gives_the_same_bits_as_one_at_a_time() {
         let (c, start, lambda_start) = one_colour();
-        let h = 1.0 / 600.0;
+        let mut s = Scaled::default();
+        s.update(&c, 1.0 / 600.0);
         let run = |eights: bool| {
             let (mut moved, mut lambda) = (start.clone(), lambda_start.clone());
             let (m, l) = (Disjoint::new(&mut moved), Disjoint::new(&mut lambda));
             // SAFETY: one thread; the constraints share no particle; lengths match.
-            unsafe { project_range(&c, 0..c.len(), eights, h, &m, &l) };
+            unsafe { project_range(&c, &s, 0..c.len(), eights, &m, &l) };
             // IEEE leaves a NaN's sign and payload to the hardware's operand order: any NaN
             // counts as the same value here.
             let bits = |v: Vec3| {
@@ -541,7 +584,7 @@ mod tests {
             let (mut moved, mut lambda) = (start.clone(), lambda_start.clone());
             let (m, l) = (Disjoint::new(&mut moved), Disjoint::new(&mut lambda));
             // SAFETY: as above, and the CPU has AVX2.
-            let left = unsafe { project_eights_avx2(&c, 0..c.len(), h, &m, &l) };
+            let left = unsafe { project_eights_avx2(&c, &s, 0..c.len(), &m, &l) };
             assert_eq!(left, 24..29);
         }
     }
