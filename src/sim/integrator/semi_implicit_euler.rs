@@ -97,11 +97,8 @@ impl Integrator for SemiImplicitEuler {
         state: &mut ClothState,
         h: f32,
     ) -> Result<StepReport, StepError> {
-        if self.on_components(ctx) {
-            self.load(state);
-            self.advance(ctx, state, h);
-            self.store(state);
-            return Ok(ctx.report());
+        if let Some(report) = self.steps(ctx, state, h, 1) {
+            return report;
         }
         ctx.accelerations(&state.pos, &state.vel, &mut self.acc);
         let particles = state.pos.iter_mut().zip(state.vel.iter_mut());
