@@ -33,8 +33,7 @@ impl DistanceConstraints {
     /// needs). Greedy: each constraint, in the given order, takes the first colour neither
     /// of its particles has yet; at most 64, the last one taking what is left over.
     pub fn coloured(&self) -> Coloured {
-        let particles = self.a.iter().chain(&self.b).map(|&p| p as usize + 1).max();
-        let mut used = vec![0u64; particles.unwrap_or(0)];
+        let mut used = vec![0u64; self.particles()];
         let colour: Vec<u32> = (self.a.iter().zip(&self.b))
             .map(|(&a, &b)| {
                 let (a, b) = (a as usize, b as usize);
@@ -47,7 +46,6 @@ impl DistanceConstraints {
             .collect();
         let mut order: Vec<usize> = (0..self.len()).collect();
         order.sort_by_key(|&k| colour[k]);
-        let pick = |v: &[f32]| order.iter().map(|&k| v[k]).collect();
         let sorted: Vec<u32> = order.iter().map(|&k| colour[k]).collect();
         let colours = sorted
             .chunk_by(|x, y| x == y)
@@ -58,19 +56,17 @@ impl DistanceConstraints {
             })
             .collect();
         Coloured {
-            constraints: Self {
-                a: order.iter().map(|&k| self.a[k]).collect(),
-                b: order.iter().map(|&k| self.b[k]).collect(),
-                rest: pick(&self.rest),
-                compliance: pick(&self.compliance),
-                damping: pick(&self.damping),
-            },
+            constraints: self.subset(&order),
             colours,
         }
     }
-}
 
-impl DistanceConstraints {
+    /// One more than the largest particle a constraint names.
+    fn particles(&self) -> usize {
+        let last = self.a.iter().chain(&self.b).max();
+        last.map_or(0, |&p| p as usize + 1)
+    }
+
     /// Constraints `ks`, in that order.
     fn subset(&self, ks: &[usize]) -> Self {
         let pick = |v: &[f32]| ks.iter().map(|&k| v[k]).collect();
@@ -124,6 +120,7 @@ impl DistanceConstraints {
             constraints,
             halves: [half_0, half_1],
             seam,
+            particles: self.particles(),
         }
     }
 }
@@ -167,6 +164,8 @@ pub struct Halves {
     pub constraints: DistanceConstraints,
     pub halves: [Vec<(Range<usize>, bool)>; 2],
     pub seam: Vec<(Range<usize>, bool)>,
+    /// One more than the largest particle a constraint names.
+    pub particles: usize,
 }
 
 /// Constraints in colour order, with where each colour lies.

@@ -28,9 +28,9 @@ struct Moved {
 /// with compliance `α = 1/k`, is projected in `xpbd_iterations` Gauss–Seidel sweeps with its
 /// Lagrange multiplier (XPBD), visited half by half and then across the seam, colour by
 /// colour ([`DistanceConstraints::halves`]), and its dashpot `c` as constraint damping
-/// `γ = α·c/h`;
-/// finally `v = (x' − x)/h`. With many small substeps and one sweep this is the "small steps"
-/// method: stable at any stiffness, and as `α → 0` it approaches inextensible springs.
+/// `γ = α·c/h`; finally `v = (x' − x)/h`. With many small substeps and one sweep this is the
+/// "small steps" method: stable at any stiffness, and as `α → 0` it approaches inextensible
+/// springs.
 ///
 /// The step's displacement `x' − x` is kept beside the predicted positions and updated with
 /// them: recovering it as a difference of two nearly equal f32 positions would lose most of
@@ -64,9 +64,9 @@ impl Scaled {
         if self.h == Some(h) && self.alpha.len() == c.len() {
             return;
         }
-        let compliance = c.compliance.iter().zip(&c.damping);
         self.alpha = c.compliance.iter().map(|a| a / (h * h)).collect();
-        self.gamma = compliance.map(|(a, damping)| a * damping / h).collect();
+        let with_damping = c.compliance.iter().zip(&c.damping);
+        self.gamma = with_damping.map(|(a, damping)| a * damping / h).collect();
         self.h = Some(h);
     }
 }
@@ -82,10 +82,11 @@ impl Xpbd {
             constraints: c,
             halves,
             seam,
+            particles,
         } = &self.halves;
         let s = &self.scaled;
         assert!(self.lambda.len() >= c.len() && s.alpha.len() >= c.len());
-        assert!(s.gamma.len() >= c.len());
+        assert!(s.gamma.len() >= c.len() && *particles <= self.moved.len());
         let team = Team::current();
         let moved = Disjoint::new(&mut self.moved);
         let lambda = Disjoint::new(&mut self.lambda);
@@ -93,7 +94,8 @@ impl Xpbd {
             // SAFETY: an independent colour's constraints share no particle or multiplier
             // (a dependent one goes one constraint at a time); what runs at the same time is
             // either the two halves (which share no particle) or the disjoint ranges of one
-            // seam colour; the arrays' lengths were checked above.
+            // seam colour; the arrays' lengths, and every constraint's particles, were
+            // checked above.
             unsafe { project_range(c, s, range, independent, &moved, &lambda) };
         };
         let colours = |colours: &[(Range<usize>, bool)]| {
@@ -129,8 +131,8 @@ const PARALLEL_COLOUR: usize = 1024;
 /// either way.
 ///
 /// # Safety
-/// No other thread may use these constraints' particles or multipliers meanwhile; `lambda`
-/// and `s`'s arrays are at least as long as `c`.
+/// Every constraint's particles are in `moved`; no other thread may use these constraints'
+/// particles or multipliers meanwhile; `lambda` and `s`'s arrays are at least as long as `c`.
 unsafe fn project_range(
     c: &DistanceConstraints,
     s: &Scaled,
@@ -186,16 +188,10 @@ unsafe fn project_eights_avx2(
     while k + LANES <= end {
         let group = k..k + LANES;
         let (a, b) = (&c.a[group.clone()], &c.b[group.clone()]);
-        if a.iter().chain(b).any(|&p| p as usize >= moved.len()) {
-            // Out of range: left to `project`, whose indexing checks (and panics).
-            break;
-        }
-        // SAFETY: every particle is in bounds (checked just above), and this group's own
-        // (the caller's contract).
-        let columns = |ends: &[u32]| unsafe { load_columns(moved, ends) };
-        let [ax, ay, az, adx, ady, adz, wa, a_pad] = columns(a);
-        let [bx, by, bz, bdx, bdy, bdz, wb, b_pad] = columns(b);
-        let (pa, dxa, pb, dxb) = ([ax, ay, az], [adx, ady, adz], [bx, by, bz], [bdx, bdy, bdz]);
+        // SAFETY: every particle is in bounds, and this group's own (the caller's contract).
+        let (ca, cb) = unsafe { (load_columns(moved, a), load_columns(moved, b)) };
+        let (pa, dxa, wa) = (ca.predicted, ca.displacement, ca.inv_mass);
+        let (pb, dxb, wb) = (cb.predicted, cb.displacement, cb.inv_mass);
         // SAFETY: `k + 8 ≤ end ≤ lambda.len()`; this thread alone uses these multipliers.
         let lambda_k = unsafe { lambda.part(group.clone()) };
         // SAFETY: each slice holds eight f32.
@@ -231,16 +227,22 @@ unsafe fn project_eights_avx2(
             scale(_mm256_mul_ps(wa, dl), n),
             scale(_mm256_mul_ps(wb, dl), n),
         );
-        let [ax, ay, az] = keep(pa, sub(pa, da));
-        let [adx, ady, adz] = keep(dxa, sub(dxa, da));
-        let [bx, by, bz] = keep(pb, add(pb, db));
-        let [bdx, bdy, bdz] = keep(dxb, add(dxb, db));
+        let ca = Columns {
+            predicted: keep(pa, sub(pa, da)),
+            displacement: keep(dxa, sub(dxa, da)),
+            ..ca
+        };
+        let cb = Columns {
+            predicted: keep(pb, add(pb, db)),
+            displacement: keep(dxb, add(dxb, db)),
+            ..cb
+        };
         // SAFETY: as the loads above; every a is stored before any b, so a constraint of a
         // particle with itself ends as `project` leaves it.
         unsafe {
             _mm256_storeu_ps(lambda_k.as_mut_ptr(), lam);
-            store_columns(moved, a, [ax, ay, az, adx, ady, adz, wa, a_pad]);
-            store_columns(moved, b, [bx, by, bz, bdx, bdy, bdz, wb, b_pad]);
+            store_columns(moved, a, ca);
+            store_columns(moved, b, cb);
         }
         k += LANES;
     }
@@ -299,15 +301,24 @@ mod lanes {
         _mm256_add_ps(xy, _mm256_mul_ps(x[2], y[2]))
     }
 
-    /// The rows of `moved` at `ends` as columns: register `j` holds element `j` of the
-    /// eight rows, one per lane. Each half row is loaded whole, row `i` beside row `i + 4`,
-    /// then transposed four by four within the halves of the registers.
+    /// Eight particles' rows of `Moved` as columns: one register per quantity, one lane
+    /// per particle.
+    #[derive(Clone, Copy)]
+    pub struct Columns {
+        pub predicted: V3,
+        pub displacement: V3,
+        pub inv_mass: __m256,
+        pub pad: __m256,
+    }
+
+    /// The rows of `moved` at `ends` as columns. Each half row is loaded whole, row `i`
+    /// beside row `i + 4`, then transposed four by four within the halves of the registers.
     ///
     /// # Safety
     /// Every index is in bounds, and no other thread writes those rows meanwhile.
     #[target_feature(enable = "avx2")]
     #[inline]
-    pub(super) unsafe fn load_columns(moved: &Disjoint<'_, Moved>, ends: &[u32]) -> [__m256; 8] {
+    pub(super) unsafe fn load_columns(moved: &Disjoint<'_, Moved>, ends: &[u32]) -> Columns {
         let base = moved.as_ptr() as *const f32;
         let mut halves = [[_mm256_setzero_ps(); 4]; 2];
         for (i, &end) in ends[..4].iter().enumerate() {
@@ -321,8 +332,14 @@ mod lanes {
                 };
             }
         }
-        let ([c0, c1, c2, c3], [c4, c5, c6, c7]) = (transpose4(halves[0]), transpose4(halves[1]));
-        [c0, c1, c2, c3, c4, c5, c6, c7]
+        let ([x, y, z, dx], [dy, dz, inv_mass, pad]) =
+            (transpose4(halves[0]), transpose4(halves[1]));
+        Columns {
+            predicted: [x, y, z],
+            displacement: [dx, dy, dz],
+            inv_mass,
+            pad,
+        }
     }
 
     /// Stores columns as [`load_columns`] makes them back into the rows of `moved` at
@@ -332,10 +349,11 @@ mod lanes {
     /// Every index is in bounds, and no other thread uses those rows meanwhile.
     #[target_feature(enable = "avx2")]
     #[inline]
-    pub(super) unsafe fn store_columns(moved: &Disjoint<'_, Moved>, ends: &[u32], c: [__m256; 8]) {
+    pub(super) unsafe fn store_columns(moved: &Disjoint<'_, Moved>, ends: &[u32], c: Columns) {
         let base = moved.as_ptr() as *mut f32;
-        let low = transpose4([c[0], c[1], c[2], c[3]]);
-        let high = transpose4([c[4], c[5], c[6], c[7]]);
+        let ([x, y, z], [dx, dy, dz]) = (c.predicted, c.displacement);
+        let low = transpose4([x, y, z, dx]);
+        let high = transpose4([dy, dz, c.inv_mass, c.pad]);
         for (i, &end) in ends[..LANES].iter().enumerate() {
             let (half, row) = (i % 4, 8 * end as usize);
             // SAFETY: as `load_columns`.
@@ -381,8 +399,8 @@ mod lanes {
 /// positions and displacements and its multiplier.
 ///
 /// # Safety
-/// No other thread may use constraint `k`'s particles or multiplier meanwhile; `lambda` is
-/// at least as long as `c`.
+/// Constraint `k`'s particles are in `moved`, and no other thread uses them or its
+/// multiplier meanwhile; `lambda` is at least as long as `c`.
 #[inline(always)]
 unsafe fn project(
     c: &DistanceConstraints,
@@ -392,13 +410,9 @@ unsafe fn project(
     lambda: &Disjoint<'_, f32>,
 ) {
     let (a, b) = (c.a[k] as usize, c.b[k] as usize);
-    assert!(
-        a < moved.len() && b < moved.len(),
-        "constraint {k} has no particle {a} or {b}"
-    );
-    // SAFETY: in bounds (`a`, `b` just now, `c.a[k]` checked, and `lambda` by the caller's
-    // contract); no other thread uses them (the caller's contract). Each `at` is read at
-    // once, so even a self-constraint (a = b) holds no two borrows.
+    // SAFETY: in bounds (`c.a[k]` checked, the rest by the caller's contract); no other
+    // thread uses them (the caller's contract). Each `at` is read at once, so even a
+    // self-constraint (a = b) holds no two borrows.
     let (ma, mb, lambda) = unsafe { (*moved.at(a), *moved.at(b), lambda.at(k)) };
     let (wa, wb) = (ma.inv_mass, mb.inv_mass);
     if wa + wb == 0.0 {
