@@ -85,6 +85,7 @@ impl SystemMatrix {
 
     /// Sets spring `e`'s system block `S_e = h·K_v + h²·K_x` (one force term per spring) and
     /// adds `K_x·(v_b − v_a)`.
+    #[inline]
     pub fn add_spring_block(&mut self, springs: &Springs, e: usize, s: SpringBlock, dfdx_w: Vec3) {
         let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
         debug_assert_eq!(

@@ -257,9 +257,11 @@ impl SpringForce {
                 // No direction: both blocks are zero.
                 continue;
             }
-            let n = d / len;
+            // One division instead of four (three for `n`, one for `s`).
+            let inv = 1.0 / len;
+            let n = d * inv;
             let (k, c) = (self.k[e - self.range.start], self.c[e - self.range.start]);
-            let s = (1.0 - springs.rest[e] / len).max(0.0);
+            let s = (1.0 - springs.rest[e] * inv).max(0.0);
             let (alpha, beta) = (h * h * (k * s), h * c + h * h * (k * (1.0 - s)));
             let w = vel[b] - vel[a];
             let dfdx_w = (k * s) * w + (k * (1.0 - s) * n.dot(w)) * n;
