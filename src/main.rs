@@ -421,6 +421,12 @@ fn simulate(args: &RunArgs, json: bool, export: Option<&std::path::Path>) -> Res
         for event in &summary.guard_events {
             println!("  stability guard: {event}");
         }
+        if summary.solver_iterations_per_step > 0.0 {
+            println!(
+                "  linear solver: {:.1} conjugate-gradient iterations per step",
+                summary.solver_iterations_per_step
+            );
+        }
         let phases: Vec<String> = summary
             .phases
             .iter()

@@ -47,6 +47,9 @@ pub struct RunSummary {
     pub guard_events: Vec<GuardEvent>,
     /// Wall time and calls of every phase that ran during the run (only those).
     pub phases: BTreeMap<String, PhaseSummary>,
+    /// Linear-solver (conjugate-gradient) iterations per step during the run: 0 for
+    /// integrators without a linear solve.
+    pub solver_iterations_per_step: f64,
     /// Set when the run stopped early because it diverged.
     pub error: Option<String>,
 }
@@ -62,8 +65,9 @@ impl Simulation {
     /// Runs headless for `seconds` of simulated time (whole frames) and summarises.
     pub fn run(&mut self, seconds: f64) -> RunSummary {
         let frames = (seconds / self.params().dt as f64).round().max(0.0) as u64;
-        // Timings gathered before the run are not the run's.
+        // Timings and counts gathered before the run are not the run's.
         self.take_timings();
+        self.take_stats();
         let start = Instant::now();
         let mut refined = 0;
         let mut error = None;
@@ -93,6 +97,7 @@ impl Simulation {
                 (p.name.to_string(), s)
             })
             .collect();
+        summary.solver_iterations_per_step = self.take_stats().solver_iterations_per_step();
         summary.refined_frames = refined;
         summary.guard_events = events;
         summary.error = error;
@@ -129,6 +134,7 @@ impl Simulation {
             integrator_in_effect: self.integrator_in_effect().name().to_string(),
             guard_events: Vec::new(),
             phases: BTreeMap::new(),
+            solver_iterations_per_step: 0.0,
             error: None,
         }
     }
