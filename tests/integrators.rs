@@ -505,3 +505,76 @@ fn accelerations_on_component_arrays_match_the_general_path_bit_for_bit() {
         .map(|(x, y)| x.distance(*y));
     assert!(moved.fold(0.0, f32::max) > 0.005, "the cloth hardly moved");
 }
+
+/// Implicit Euler on the bench cloth (24 × 24, 5 substeps a frame) for `steps` steps from
+/// `start`: the end state and the conjugate-gradient iterations it took.
+fn implicit_run(
+    integrator: &mut clothsim::sim::integrator::ImplicitEuler,
+    start: &ClothState,
+    steps: usize,
+) -> (ClothState, u32) {
+    use clothsim::sim::Integrator;
+    let scene = clothsim::bench::bench_scene(24, IntegratorKind::ImplicitEuler).unwrap();
+    let forces = ForceSet::new(&scene.model, &scene.params, &scene.effects);
+    let (config, mut meter) = (SolverConfig::default(), StepMeter::default());
+    let (mut state, mut iterations) = (start.clone(), 0);
+    for _ in 0..steps {
+        let mut ctx = StepContext::new(&scene.model, &forces, &config, &mut meter);
+        integrator.step(&mut ctx, &mut state, 1.0 / 300.0).unwrap();
+        iterations += meter.solver_iterations;
+    }
+    (state, iterations)
+}
+
+/// Each implicit step's solve starts from the last two steps' Δv extrapolated: fewer
+/// iterations than from the last Δv alone, to the same tolerance, so the same cloth.
+#[test]
+fn implicit_euler_extrapolated_guess_saves_iterations_and_changes_nothing_else() {
+    use clothsim::sim::integrator::ImplicitEuler;
+    let scene = clothsim::bench::bench_scene(24, IntegratorKind::ImplicitEuler).unwrap();
+    let (extrapolated, fewer) = implicit_run(&mut ImplicitEuler::default(), &scene.initial, 300);
+    let (last, more) = implicit_run(&mut ImplicitEuler::last_step_guess(), &scene.initial, 300);
+    assert!(
+        (fewer as f64) < 0.95 * more as f64,
+        "{fewer} iterations extrapolated vs {more} from the last Δv"
+    );
+    let sag = |s: &ClothState| {
+        let moved = s
+            .pos
+            .iter()
+            .zip(&scene.initial.pos)
+            .map(|(a, b)| a.distance(*b));
+        moved.fold(0.0, f32::max)
+    };
+    let apart = extrapolated
+        .pos
+        .iter()
+        .zip(&last.pos)
+        .map(|(a, b)| a.distance(*b));
+    let apart = apart.fold(0.0, f32::max);
+    assert!(sag(&last) > 5e-3, "the cloth hardly moved: {}", sag(&last));
+    // (1.2e-7 m here: both solves stop within the tolerance of the same solution.)
+    assert!(apart < 1e-4 * sag(&last), "{apart} m apart");
+}
+
+/// After the state was changed outside (`invalidate`), the next solve starts from zero:
+/// the same bits as a fresh integrator, where a guess from the earlier steps would not be.
+#[test]
+fn implicit_euler_forgets_its_guess_when_the_state_changes_outside() {
+    use clothsim::sim::Integrator;
+    use clothsim::sim::integrator::ImplicitEuler;
+    let scene = clothsim::bench::bench_scene(24, IntegratorKind::ImplicitEuler).unwrap();
+    let mut used = ImplicitEuler::default();
+    let (mut moved, _) = implicit_run(&mut used, &scene.initial, 40);
+    for v in &mut moved.vel {
+        *v = -*v;
+    }
+    let (fresh, _) = implicit_run(&mut ImplicitEuler::default(), &moved, 1);
+    let mut stale = ImplicitEuler::default();
+    implicit_run(&mut stale, &scene.initial, 40);
+    let (guessed, _) = implicit_run(&mut stale, &moved, 1);
+    assert!(guessed.pos != fresh.pos, "the guess made no difference");
+    used.invalidate();
+    let (after, _) = implicit_run(&mut used, &moved, 1);
+    assert!(after.pos == fresh.pos && after.vel == fresh.vel);
+}
