@@ -513,6 +513,16 @@ fn implicit_run(
     start: &ClothState,
     steps: usize,
 ) -> (ClothState, u32) {
+    implicit_run_at(integrator, start, steps, 1.0 / 300.0)
+}
+
+/// As [`implicit_run`], with steps of `h` seconds.
+fn implicit_run_at(
+    integrator: &mut clothsim::sim::integrator::ImplicitEuler,
+    start: &ClothState,
+    steps: usize,
+    h: f32,
+) -> (ClothState, u32) {
     use clothsim::sim::Integrator;
     let scene = clothsim::bench::bench_scene(24, IntegratorKind::ImplicitEuler).unwrap();
     let forces = ForceSet::new(&scene.model, &scene.params, &scene.effects);
@@ -520,7 +530,7 @@ fn implicit_run(
     let (mut state, mut iterations) = (start.clone(), 0);
     for _ in 0..steps {
         let mut ctx = StepContext::new(&scene.model, &forces, &config, &mut meter);
-        integrator.step(&mut ctx, &mut state, 1.0 / 300.0).unwrap();
+        integrator.step(&mut ctx, &mut state, h).unwrap();
         iterations += meter.solver_iterations;
     }
     (state, iterations)
@@ -577,4 +587,13 @@ fn implicit_euler_forgets_its_guess_when_the_state_changes_outside() {
     used.invalidate();
     let (after, _) = implicit_run(&mut used, &moved, 1);
     assert!(after.pos == fresh.pos && after.vel == fresh.vel);
+    // Nor is a history of other step lengths a guess (Δv scales with the step): a step of
+    // half the length starts from zero too.
+    let half = 1.0 / 600.0;
+    let (fresh, _) = implicit_run_at(&mut ImplicitEuler::default(), &moved, 1, half);
+    let (after, _) = implicit_run_at(&mut stale, &moved, 1, half);
+    assert!(
+        after.pos == fresh.pos && after.vel == fresh.vel,
+        "half the step"
+    );
 }

@@ -25,9 +25,10 @@ pub struct ImplicitEuler {
     vel: Vec<Vec3>,
     pos: Vec<Vec3>,
     cg: ConjugateGradient,
-    /// Whether `dv` (and `previous_dv`, when as long) are the last steps' solutions, from
-    /// which this step's first guess is made ([`ImplicitEuler::guess`]).
-    warm: bool,
+    /// The step length at which `dv` (and `previous_dv`, when as long) are the last steps'
+    /// solutions, from which a step of that length makes its first guess
+    /// ([`ImplicitEuler::guess`]); `None` when there are none.
+    warm: Option<f32>,
     /// The Δv of the step before the last.
     previous_dv: Vec<Vec3>,
     /// Starts each solve from the last step's Δv alone (for comparisons).
@@ -45,11 +46,12 @@ impl ImplicitEuler {
 
     /// Turns `dv` into this step's first guess for the solve: the last two steps' Δv
     /// extrapolated linearly (`2·Δv₁ − Δv₂`), the last one alone after a single step,
-    /// and zero when the state changed outside since (no history). Only a starting
+    /// and zero when the state changed outside since or the step length `h` is not theirs
+    /// (no history: a guard that relaxes its substeps changes it). Only a starting
     /// point: the solve still runs to its tolerance, in fewer iterations (on the
     /// bench scene 27 instead of 29 a step).
-    fn guess(&mut self) {
-        if !self.warm {
+    fn guess(&mut self, h: f32) {
+        if self.warm != Some(h) {
             self.dv.clear();
             self.previous_dv.clear();
             return;
@@ -115,9 +117,9 @@ impl Integrator for ImplicitEuler {
             .map(|r| r.length_squared())
             .sum::<f32>()
             .sqrt();
-        self.guess();
+        self.guess(h);
         // Until this step succeeds, `dv` is no solution to start from.
-        self.warm = false;
+        self.warm = None;
         self.solve(ctx)?;
         self.vel.clear();
         self.vel
@@ -164,12 +166,12 @@ impl Integrator for ImplicitEuler {
             }
         }
         state.time += h as f64;
-        self.warm = true;
+        self.warm = Some(h);
         Ok(ctx.report())
     }
 
     /// The state changed outside: the last Δv is no longer a good guess.
     fn invalidate(&mut self) {
-        self.warm = false;
+        self.warm = None;
     }
 }
