@@ -485,7 +485,10 @@ impl ClothApp {
         );
         // A new quality setting takes a new target (and pipelines for it).
         let samples = self.samples_in_use();
-        self.viewport.take_if(|v| v.samples() != samples);
+        if let Some(old) = self.viewport.take_if(|v| v.samples() != samples) {
+            // (Its image would stay shown, and its target alive, until the new one replaces it.)
+            old.free(&rs);
+        }
         if self.viewport.is_none() {
             match Viewport::new(&rs, w, h, samples) {
                 Ok(v) => self.viewport = Some(v),
