@@ -52,8 +52,13 @@ pub struct BenchRow {
     pub backend: String,
     pub threads: usize,
     pub substeps_per_frame: u32,
+    /// Wall time of the whole run per substep: every pause a busy machine imposes counts.
     pub us_per_substep: f64,
     pub substeps_per_second: f64,
+    /// Per substep in the median frame and in the fastest frame (see [`frame_spread`]);
+    /// `None` where frames are only queued (the GPU), not finished, when the clock stops.
+    pub median_frame_us: Option<f64>,
+    pub best_frame_us: Option<f64>,
     /// Downward displacement of the mean of the 4 central particles after 2 s, metres.
     pub sag_m: f64,
     /// The reference sag for this N, if known.
@@ -148,11 +153,16 @@ pub fn bench_with(
             finite = sim.substep().is_ok();
         }
     }
+    let mut frame_us = Vec::with_capacity(frames as usize);
+    let mut frames_finished = !sim.state_behind();
     for _ in 1..frames {
         if !finite {
             break;
         }
+        let frame = Instant::now();
         finite = sim.step_frame().is_ok();
+        frame_us.push(frame.elapsed().as_secs_f64() * 1e6 / substeps.max(1) as f64);
+        frames_finished &= !sim.state_behind();
     }
     // Waits for a GPU to finish: its time counts. A state that cannot be read is no result.
     finite &= sim.sync_state().is_ok();
@@ -167,6 +177,7 @@ pub fn bench_with(
     let reference = REFERENCE_SAG.iter().find(|(m, _)| *m == n).map(|(_, s)| *s);
     let error = reference.map(|r| (sag - r).abs() / r);
     let us = wall * 1e6 / (total - 1).max(1) as f64;
+    let spread = frame_spread(&mut frame_us).filter(|_| frames_finished);
     Ok(BenchRow {
         n,
         integrator: integrator.name().to_string(),
@@ -175,6 +186,8 @@ pub fn bench_with(
         substeps_per_frame: substeps,
         us_per_substep: us,
         substeps_per_second: 1e6 / us,
+        median_frame_us: spread.map(|s| s.median),
+        best_frame_us: spread.map(|s| s.best),
         sag_m: sag,
         reference_sag_m: reference,
         sag_error: error,
@@ -182,4 +195,30 @@ pub fn bench_with(
         finite,
         startup_ms,
     })
+}
+
+/// The median and the least of some frames' times.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameSpread {
+    /// The middle time (the mean of the two middle ones for an even count).
+    pub median: f64,
+    pub best: f64,
+}
+
+/// The spread of per-frame times (sorted in place); `None` for no frames.
+///
+/// On a shared machine (a virtual machine whose cores other guests also use) the mean over
+/// a run counts every frame in which the simulation's threads were held off their cores;
+/// the median frame is what a run usually gets, and the best frame what the code costs when
+/// nothing else runs. The bench prints all three.
+pub fn frame_spread(times: &mut [f64]) -> Option<FrameSpread> {
+    times.sort_by(f64::total_cmp);
+    let n = times.len();
+    let best = *times.first()?;
+    let median = if n % 2 == 1 {
+        times[n / 2]
+    } else {
+        0.5 * (times[n / 2 - 1] + times[n / 2])
+    };
+    Some(FrameSpread { median, best })
 }

@@ -101,7 +101,8 @@ enum Command {
         out: PathBuf,
     },
     /// Speed on the `hanging-bench` scene: µs per substep and the sag after 2 s for each
-    /// size × integrator × thread count (the scene the peer frameworks run too).
+    /// size × integrator × thread count (the scene the peer frameworks run too). µs per
+    /// substep over the whole run, in its median frame and in its fastest frame.
     Bench {
         /// Comma-separated particles per side.
         #[arg(long, value_delimiter = ',', default_value = "32,64,128,256")]
@@ -616,12 +617,14 @@ fn bench(
     }
     if !json {
         println!(
-            "{:>5} {:<20} {:>7} {:>9} {:>12} {:>12} {:>10} {:>10}  sag",
+            "{:>5} {:<20} {:>7} {:>9} {:>12} {:>9} {:>9} {:>12} {:>10} {:>10}  sag",
             "N",
             "integrator",
             "threads",
             "substeps",
             "µs/substep",
+            "median fr",
+            "best fr",
             "substeps/s",
             "sag m",
             "reference",
@@ -682,13 +685,16 @@ fn bench(
                         }
                         _ => "no reference".to_string(),
                     };
+                    let frame = |us: Option<f64>| us.map_or("—".into(), |us| format!("{us:.1}"));
                     println!(
-                        "{:>5} {:<20} {:>7} {:>9} {:>12.1} {:>12.0} {:>10.5} {:>10}  {}",
+                        "{:>5} {:<20} {:>7} {:>9} {:>12.1} {:>9} {:>9} {:>12.0} {:>10.5} {:>10}  {}",
                         row.n,
                         row.integrator,
                         row.threads,
                         row.substeps_per_frame,
                         row.us_per_substep,
+                        frame(row.median_frame_us),
+                        frame(row.best_frame_us),
                         row.substeps_per_second,
                         row.sag_m,
                         row.reference_sag_m

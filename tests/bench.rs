@@ -3,7 +3,7 @@
 
 use std::process::Command;
 
-use clothsim::bench::{REFERENCE_SAG, bench_one, bench_scene};
+use clothsim::bench::{FrameSpread, REFERENCE_SAG, bench_one, bench_scene, frame_spread};
 use clothsim::mesh::SpringKind;
 use clothsim::sim::IntegratorKind;
 
@@ -76,6 +76,36 @@ fn bench_sag_matches_the_reference_at_n32() {
     );
     assert_eq!(row.sag_ok, Some(true));
     assert_eq!(row.substeps_per_frame, 32);
+    // The CPU finishes each frame before the clock stops: a median and a best frame.
+    let (median, best) = (
+        row.median_frame_us.expect("a median"),
+        row.best_frame_us.expect("a best"),
+    );
+    assert!(
+        0.0 < best && best <= median,
+        "best {best} µs, median {median} µs"
+    );
+}
+
+/// The frame spread is the median and the least, whatever the order the frames came in.
+#[test]
+fn frame_spread_is_the_median_and_the_fastest_frame() {
+    assert_eq!(
+        frame_spread(&mut [9.0, 3.0, 5.0]),
+        Some(FrameSpread {
+            median: 5.0,
+            best: 3.0
+        })
+    );
+    // An even count: the mean of the two middle frames.
+    assert_eq!(
+        frame_spread(&mut [8.0, 2.0, 40.0, 4.0]),
+        Some(FrameSpread {
+            median: 6.0,
+            best: 2.0
+        })
+    );
+    assert_eq!(frame_spread(&mut []), None);
 }
 
 /// Story: with one Gauss–Seidel sweep per substep XPBD's cloth is too soft (sag 12 % over
@@ -138,6 +168,8 @@ fn bench_cli_prints_one_json_row_per_size_and_thread_count() {
             "us_per_substep",
             "sag_m",
             "finite",
+            "median_frame_us",
+            "best_frame_us",
         ] {
             assert!(row.get(key).is_some(), "{key} missing in {row}");
         }
