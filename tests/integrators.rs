@@ -455,7 +455,7 @@ fn xpbd_on_two_threads_gives_the_same_bits_as_on_one() {
     });
 }
 
-/// From about 90 × 90 particles semi-implicit Euler shares out its per-particle loops
+/// From 64 × 64 particles semi-implicit Euler shares out its per-particle loops
 /// (forces of gravity and air, the update) as well as the springs between threads; each
 /// particle's work is its own, so two threads give the same bits as one, frame after frame.
 #[test]

@@ -27,10 +27,8 @@ pub type Projectors = [Vec<f32>; 5];
 /// Particles per block (a block is one parallel task).
 const BLOCK: usize = 1024;
 /// Blocks from which the blocks run in parallel (on the [`Team`]): as many as hold
-/// [`PARALLEL_ELEMENTS`] particles (8 blocks, about 90 × 90 particles), the point from which
-/// the per-particle loops go parallel too. On the 2-core machine this was measured on,
-/// N = 64 (4 blocks) ran slower on two threads than on one (its data moves between the
-/// cores' caches every substep) and N = 128 (16 blocks) faster.
+/// [`PARALLEL_ELEMENTS`] particles (4 blocks, 64 × 64 particles), the point from which the
+/// per-particle loops go parallel too.
 const PARALLEL_BLOCKS: usize = PARALLEL_ELEMENTS / BLOCK;
 
 /// Longest gap in a run filled with springs of no strength (rest length, stiffness and
