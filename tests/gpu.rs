@@ -213,3 +213,31 @@ fn the_gpu_cloth_is_drawn_from_its_buffer_without_a_read_back() {
         "the cloth fell in the picture ({moved} bytes)"
     );
 }
+
+/// The GPU's frames are only queued when the bench's clock stops after each: the row has
+/// the run's mean (the last frame waited for) but no median or best frame, and the same
+/// sag as the CPU row within the backends' agreement.
+#[test]
+fn gpu_bench_row_has_the_run_mean_but_no_frame_spread() {
+    let gpu = clothsim::bench::bench_with(
+        16,
+        IntegratorKind::SemiImplicitEuler,
+        |scene| {
+            gpu_simulation(scene, false)
+                .map(|(sim, _)| sim)
+                .map_err(|e| clothsim::scene::SceneError::Backend(format!("{e:#}")))
+        },
+        "gpu",
+    )
+    .expect("GPU bench on the software adapter");
+    let cpu = clothsim::bench::bench_one(16, IntegratorKind::SemiImplicitEuler).expect("cpu");
+    assert!(gpu.finite && gpu.us_per_substep > 0.0);
+    assert_eq!((gpu.median_frame_us, gpu.best_frame_us), (None, None));
+    assert!(cpu.median_frame_us.is_some() && cpu.best_frame_us.is_some());
+    assert!(
+        (gpu.sag_m - cpu.sag_m).abs() < 1e-5,
+        "{} vs {}",
+        gpu.sag_m,
+        cpu.sag_m
+    );
+}
