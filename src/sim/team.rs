@@ -141,9 +141,9 @@ impl Team {
             let _bed = shared.bed.lock().unwrap_or_else(|e| e.into_inner());
             shared.wake.notify_all();
         }
-        let waiting = WaitForHelpers {
+        let waiting = WaitForShares {
             shared,
-            helpers: self.helpers.len(),
+            others: self.helpers.len(),
         };
         section(0);
         // The shares no helper has come for yet (one held off its core, or asleep).
@@ -202,15 +202,16 @@ fn run_share(shared: &Shared, section: &Section<'_>, share: usize) {
 }
 
 /// Waits (when dropped, so also while unwinding) until every other share is done.
-struct WaitForHelpers<'a> {
+struct WaitForShares<'a> {
     shared: &'a Shared,
-    helpers: usize,
+    /// The shares other than the caller's (one per helper).
+    others: usize,
 }
 
-impl Drop for WaitForHelpers<'_> {
+impl Drop for WaitForShares<'_> {
     fn drop(&mut self) {
         let mut spins = 0u32;
-        while self.shared.done.load(Ordering::SeqCst) < self.helpers {
+        while self.shared.done.load(Ordering::SeqCst) < self.others {
             spins = spins.saturating_add(1);
             if spins < 1 << 16 {
                 std::hint::spin_loop();
