@@ -57,7 +57,10 @@ impl Force {
     }
 
     /// Whether [`Force::add_forces_components`] evaluates this term: gravity, the springs
-    /// and air damping do; dihedral bending and wind need the vectors whole.
+    /// and air damping do; dihedral bending and wind need the vectors whole. None of these
+    /// terms depends on time, and semi-implicit Euler relies on it when it takes a frame's
+    /// substeps together on component arrays (the clock is set once per batch): a term
+    /// that reads the time must not take components.
     pub fn takes_components(&self) -> bool {
         matches!(
             self,

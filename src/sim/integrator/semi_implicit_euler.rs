@@ -112,8 +112,8 @@ impl Integrator for SemiImplicitEuler {
         Ok(ctx.report())
     }
 
-    /// On component arrays from the first step to the last (the forces here never depend
-    /// on time).
+    /// On component arrays from the first step to the last (no term that takes them
+    /// depends on time: [`Force::takes_components`](crate::sim::forces::Force::takes_components)).
     fn steps(
         &mut self,
         ctx: &mut StepContext<'_>,
