@@ -376,14 +376,26 @@ fn xpbd_matches_spring_statics_and_approaches_the_inextensible_limit() {
 }
 
 /// Semi-implicit Euler sums the usual scene's forces on one array per component (a vector
-/// loop per term); the general path sums them per vector. Same operations in the same order:
-/// the same bits, step after step, with pins, air damping, bend springs and motion in all
-/// three directions.
+/// loop per term, fused with the update per range of particles); the general path sums them
+/// per vector. Same operations in the same order: the same bits, step after step, with pins,
+/// air damping, bend springs and motion in all three directions, on one thread below the
+/// parallel size and on two above it (the spring blocks and the ranges shared out).
 #[test]
 fn semi_implicit_euler_on_component_arrays_matches_the_general_path_bit_for_bit() {
+    const { assert!(64 * 64 >= clothsim::sim::team::PARALLEL_ELEMENTS) };
+    for (n, threads) in [(24, 1), (64, 2)] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| component_arrays_match_the_general_path(n));
+    }
+}
+
+fn component_arrays_match_the_general_path(n: u32) {
     use clothsim::sim::integrator::SemiImplicitEuler;
     use clothsim::sim::{Effect, Integrator};
-    let scene = clothsim::bench::bench_scene(24, IntegratorKind::SemiImplicitEuler).unwrap();
+    let scene = clothsim::bench::bench_scene(n, IntegratorKind::SemiImplicitEuler).unwrap();
     let model = &scene.model;
     for effects in [scene.effects.clone(), {
         let mut e = scene.effects.clone();
@@ -398,11 +410,13 @@ fn semi_implicit_euler_on_component_arrays_matches_the_general_path_bit_for_bit(
             *v = Vec3::new(0.3 * s, -0.2 * s * s, 0.5 * (p as f32 * 0.11).cos());
         }
         let (config, mut meter) = (SolverConfig::default(), StepMeter::default());
+        // The bench's substep for this size (stable).
+        let h = 1.0 / (60.0 * n as f32);
         let mut run = |mut integrator: SemiImplicitEuler| {
             let mut state = start.clone();
             for _ in 0..300 {
                 let mut ctx = StepContext::new(model, &forces, &config, &mut meter);
-                integrator.step(&mut ctx, &mut state, 1.0 / 1440.0).unwrap();
+                integrator.step(&mut ctx, &mut state, h).unwrap();
             }
             state
         };
@@ -414,7 +428,7 @@ fn semi_implicit_euler_on_component_arrays_matches_the_general_path_bit_for_bit(
         assert!(moved.fold(0.0, f32::max) > 0.01, "the cloth hardly moved");
         assert!(
             fast.pos == general.pos && fast.vel == general.vel,
-            "{effects:?}"
+            "{n} × {n}: {effects:?}"
         );
         assert_eq!(fast.time, general.time);
     }

@@ -26,14 +26,19 @@ impl AirDamping {
     pub fn add_forces_components(&self, mass: &[f32], vel: &Components, f: &mut Components) {
         let [f0, f1, f2] = f;
         each_part([f0, f1, f2], |range, f| {
-            let mass = within(mass, range.clone());
-            for (f, v) in f.into_iter().zip(vel) {
-                let v = within(v, range.clone());
-                for ((f, v), &m) in f.iter_mut().zip(v).zip(mass) {
-                    *f -= (self.rate * m) * *v;
-                }
-            }
+            let v = vel.each_ref().map(|v| within(v, range.clone()));
+            self.add_range(within(mass, range), v, f);
         });
+    }
+
+    /// As [`AirDamping::add_forces_components`] for one range of particles: `mass`, `vel`
+    /// and `f` are that range's.
+    pub fn add_range(&self, mass: &[f32], vel: [&[f32]; 3], f: [&mut [f32]; 3]) {
+        for (f, v) in f.into_iter().zip(vel) {
+            for ((f, v), &m) in f.iter_mut().zip(v).zip(mass) {
+                *f -= (self.rate * m) * *v;
+            }
+        }
     }
 
     /// Adds `∂f_i/∂v_i = −c·m_i·I` (N·s/m), its only non-zero derivative, to the system.

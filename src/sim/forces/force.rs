@@ -9,8 +9,19 @@ use super::components::Components;
 use super::dihedral::DihedralBending;
 use super::gravity::Gravity;
 use super::jacobian::{JacobianMode, SystemMatrix};
+use super::spring_runs::TwoPasses;
 use super::springs::SpringForce;
 use super::wind::Wind;
+
+/// How a term takes part in the fused path ([`Force::fused`]).
+pub enum Fused<'a> {
+    /// Each particle's force is its own: any range of particles at a time.
+    Pointwise,
+    /// Pairs of particles: every block's sums first, then per range of particles.
+    TwoPasses(TwoPasses<'a>),
+    /// Needs the vectors whole.
+    No,
+}
 
 /// A force term. Each yields forces in newtons; the springs and air damping also give
 /// their derivatives for implicit methods, which treat the others explicitly.
@@ -87,6 +98,30 @@ impl Force {
             Force::Bending(_) | Force::Wind(_) => return false,
         }
         true
+    }
+
+    /// How the fused path ([`ForceSet::fused_components`](super::ForceSet::fused_components))
+    /// evaluates this term: per particle over any range, in two passes (springs), or not at
+    /// all (the terms that do not [take components](Force::takes_components)).
+    pub fn fused<'a>(&'a self, model: &ClothModel) -> Fused<'a> {
+        match self {
+            Force::Gravity(_) | Force::AirDamping(_) => Fused::Pointwise,
+            Force::Springs(s) | Force::BendSprings(s) => {
+                Fused::TwoPasses(s.two_passes(&model.springs))
+            }
+            Force::Bending(_) | Force::Wind(_) => Fused::No,
+        }
+    }
+
+    /// Adds a pointwise term's forces on one range of particles (`mass`, `vel` and `f` are
+    /// that range's) to `f`, the same bits as [`Force::add_forces_components`] there; the
+    /// other terms add nothing.
+    pub fn add_pointwise(&self, mass: &[f32], vel: [&[f32]; 3], f: [&mut [f32]; 3]) {
+        match self {
+            Force::Gravity(g) => g.add_range(mass, f),
+            Force::AirDamping(d) => d.add_range(mass, vel, f),
+            _ => {}
+        }
     }
 
     /// Potential energy at `pos`, joules; zero for dissipative and driving terms.

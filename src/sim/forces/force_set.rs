@@ -1,5 +1,8 @@
 //! The forces a scene uses, evaluated together; accelerations are formed here and only here.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
 use glam::Vec3;
 
 use crate::cloth::ClothModel;
@@ -7,13 +10,20 @@ use crate::cloth::ClothModel;
 use super::super::constraints::DistanceConstraints;
 use super::super::effect::{BendingModel, Effect};
 use super::super::params::SimParams;
+use super::super::team::{Disjoint, PARALLEL_ELEMENTS, Team, share};
 use super::air_damping::AirDamping;
 use super::components::{Components, Scratch, split, zeroed};
 use super::dihedral::DihedralBending;
-use super::force::Force;
+use super::force::{Force, Fused};
 use super::gravity::Gravity;
 use super::jacobian::{JacobianMode, SystemMatrix};
+use super::spring_runs::{BlockPass, TwoPasses};
 use super::springs::SpringForce;
+
+/// Spring terms the fused path takes (a scene has two at most: springs and bend springs).
+const FUSED_PAIR_TERMS: usize = 2;
+/// Terms whose time the fused path records (a scene has six at most, one per effect).
+const MAX_TERMS: usize = 8;
 
 /// The scene's force terms, built from its effect list: an absent effect has no term.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -229,6 +239,106 @@ impl ForceSet {
             |term| whole &= term.add_forces_components(model, pos, vel, f),
         );
         whole
+    }
+
+    /// The forces on component arrays as [`ForceSet::forces_components_timed`] (the same
+    /// bits), fused with the caller's per-particle work `then(range, f)` (a step's update),
+    /// which gets each range's forces as soon as they are summed, while they are still in
+    /// the cache. Two team sections in all, where the term-by-term path takes one or two
+    /// per term: the blocks of every spring term, then per range of particles the zeroed
+    /// forces, each term in order, and `then`. A term's time is the calling thread's time on
+    /// its share; their sum is returned. `None`, with nothing done, when a term does not
+    /// [take components](Force::takes_components) or the arrays are shorter than the springs
+    /// reach.
+    pub fn fused_components(
+        &self,
+        model: &ClothModel,
+        pos: &Components,
+        vel: &Components,
+        f: &mut Components,
+        times: &mut TermTimes,
+        then: impl Fn(std::ops::Range<usize>, [&[f32]; 3]) + Sync,
+    ) -> Option<Duration> {
+        let n = (pos.iter().chain(vel).map(Vec::len)).fold(model.mass.len(), usize::min);
+        // The spring terms' passes, with their places in the term list.
+        let mut passes: [Option<(usize, TwoPasses<'_>)>; FUSED_PAIR_TERMS] =
+            std::array::from_fn(|_| None);
+        let mut pairs = 0;
+        for (slot, term) in self.terms.iter().enumerate() {
+            match term.fused(model) {
+                Fused::Pointwise => {}
+                Fused::TwoPasses(p) if pairs < FUSED_PAIR_TERMS && p.fits(n) => {
+                    passes[pairs] = Some((slot, p));
+                    pairs += 1;
+                }
+                Fused::TwoPasses(_) | Fused::No => return None,
+            }
+        }
+        for comp in f.iter_mut() {
+            comp.resize(n, 0.0);
+        }
+        let team = Team::current();
+        let members = if n >= PARALLEL_ELEMENTS {
+            team.members()
+        } else {
+            1
+        };
+        let run = |section: &(dyn Fn(usize) + Sync)| match members {
+            1 => section(0),
+            _ => team.run(section),
+        };
+        // The caller's time per term, nanoseconds.
+        let took: [AtomicU64; MAX_TERMS] = std::array::from_fn(|_| AtomicU64::new(0));
+        let timed = |i: usize, slot: usize, work: &mut dyn FnMut()| {
+            if i != 0 || slot >= MAX_TERMS {
+                return work();
+            }
+            let start = Instant::now();
+            work();
+            took[slot].fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        };
+        {
+            let fills: [Option<(usize, BlockPass<'_>)>; FUSED_PAIR_TERMS] =
+                (passes.each_mut()).map(|p| p.as_mut().map(|(slot, p)| (*slot, p.blocks())));
+            run(&|i| {
+                for (slot, fill) in fills.iter().flatten() {
+                    timed(i, *slot, &mut || fill.fill(i, members, pos, vel));
+                }
+            });
+        }
+        let [fx, fy, fz] = f;
+        let out = [&mut fx[..n], &mut fy[..n], &mut fz[..n]].map(Disjoint::new);
+        run(&|i| {
+            const LINE: usize = 16;
+            let lines = share(n.div_ceil(LINE), members, i);
+            let range = (lines.start * LINE).min(n)..(lines.end * LINE).min(n);
+            // SAFETY: the members' ranges are disjoint (shares of whole lines).
+            let [fx, fy, fz] = std::array::from_fn(|c| unsafe { out[c].part(range.clone()) });
+            for o in [&mut *fx, &mut *fy, &mut *fz] {
+                o.fill(0.0);
+            }
+            let mass = &model.mass[range.clone()];
+            let v = vel.each_ref().map(|v| &v[range.clone()]);
+            let mut pairs = passes.iter().flatten().peekable();
+            for (slot, term) in self.terms.iter().enumerate() {
+                let pair = pairs.next_if(|(at, _)| *at == slot);
+                timed(i, slot, &mut || {
+                    let f = [&mut *fx, &mut *fy, &mut *fz];
+                    match pair {
+                        Some((_, p)) => p.add_to(range.clone(), f),
+                        None => term.add_pointwise(mass, v, f),
+                    }
+                });
+            }
+            then(range, [&*fx, &*fy, &*fz]);
+        });
+        let mut total = Duration::ZERO;
+        for (slot, term) in self.terms.iter().enumerate().take(MAX_TERMS) {
+            let took = Duration::from_nanos(took[slot].load(Ordering::Relaxed));
+            times.add(slot, term.phase(), took);
+            total += took;
+        }
+        Some(total)
     }
 
     /// Accelerations at `(pos, vel)` into `acc` (resized) summed on component arrays, the

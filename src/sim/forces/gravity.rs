@@ -21,16 +21,20 @@ impl Gravity {
 
     /// As [`Gravity::add_forces`] on forces stored one array per component.
     pub fn add_forces_components(&self, mass: &[f32], f: &mut Components) {
-        let g = self.g.to_array();
         let [f0, f1, f2] = f;
         each_part([f0, f1, f2], |range, f| {
-            let mass = within(mass, range);
-            for (f, g) in f.into_iter().zip(g) {
-                for (f, &m) in f.iter_mut().zip(mass) {
-                    *f += m * g;
-                }
-            }
+            self.add_range(within(mass, range), f)
         });
+    }
+
+    /// As [`Gravity::add_forces_components`] for one range of particles: `mass` and `f` are
+    /// that range's.
+    pub fn add_range(&self, mass: &[f32], f: [&mut [f32]; 3]) {
+        for (f, g) in f.into_iter().zip(self.g.to_array()) {
+            for (f, &m) in f.iter_mut().zip(mass) {
+                *f += m * g;
+            }
+        }
     }
 
     /// `−Σ m·g·x`, joules.

@@ -331,12 +331,7 @@ impl SpringRuns {
         bufs: &mut Vec<BlockBuffers>,
         pass: impl Fn(&Block, &mut BlockBuffers) + Sync,
     ) {
-        bufs.resize_with(self.blocks.len(), Default::default);
-        for (buf, block) in bufs.iter_mut().zip(&self.blocks) {
-            for sums in buf.sums.iter_mut().chain(&mut buf.second) {
-                sums.resize(block.hi - block.lo, 0.0);
-            }
-        }
+        self.size_buffers(bufs);
         let team = Team::current();
         if self.parallel() && team.members() > 1 {
             let bufs = Disjoint::new(&mut bufs[..]);
@@ -355,6 +350,26 @@ impl SpringRuns {
         }
     }
 
+    /// One buffer per block, each as long as the block's reach.
+    fn size_buffers(&self, bufs: &mut Vec<BlockBuffers>) {
+        bufs.resize_with(self.blocks.len(), Default::default);
+        for (buf, block) in bufs.iter_mut().zip(&self.blocks) {
+            for sums in buf.sums.iter_mut().chain(&mut buf.second) {
+                sums.resize(block.hi - block.lo, 0.0);
+            }
+        }
+    }
+
+    /// The forces in two passes, for a caller that runs them in its own team sections
+    /// between other work (see [`ForceSet`](super::ForceSet)'s fused path): the buffers stay
+    /// locked until the result is dropped. The same operations as
+    /// [`SpringRuns::add_forces_components`], so the same bits.
+    pub fn two_passes(&self) -> TwoPasses<'_> {
+        let mut bufs = self.scratch.lock();
+        self.size_buffers(&mut bufs.blocks);
+        TwoPasses { runs: self, bufs }
+    }
+
     /// Calls `add(at, sums)` for each block's sums over the particles of output chunk `q`
     /// (`len` particles from `q·BLOCK`), in block order; `at` is where in the chunk they
     /// start.
@@ -363,10 +378,21 @@ impl SpringRuns {
         buffers: &[BlockBuffers],
         q: usize,
         len: usize,
+        add: impl FnMut(usize, [&[f32]; 3]),
+    ) {
+        self.cover_range(buffers, q * BLOCK..q * BLOCK + len, add);
+    }
+
+    /// Calls `add(at, sums)` for each block's sums over the particles `lo..hi`, in block
+    /// order; `at` is where from `lo` they start.
+    fn cover_range(
+        &self,
+        buffers: &[BlockBuffers],
+        std::ops::Range { start: lo, end: hi }: std::ops::Range<usize>,
         mut add: impl FnMut(usize, [&[f32]; 3]),
     ) {
-        let (lo, hi) = (q * BLOCK, q * BLOCK + len);
-        for (b, buf) in self.blocks.iter().zip(buffers).take(q + 1) {
+        let blocks = self.blocks.iter().zip(buffers);
+        for (b, buf) in blocks.take_while(|(b, _)| b.lo < hi) {
             let (from, to) = (lo.max(b.lo), hi.min(b.hi));
             if from < to {
                 let range = from - b.lo..to - b.lo;
@@ -468,6 +494,70 @@ impl SpringRuns {
         let pass = ProductPass { s, u };
         self.block_sums(blocks, |block, buf| self.block_pass(block, buf, &pass));
         self.gather_components(blocks, out, n);
+    }
+}
+
+/// The spring forces in two passes ([`SpringRuns::two_passes`]): first every block's sums
+/// ([`TwoPasses::blocks`], shared out by blocks), then, per range of particles, their sum
+/// ([`TwoPasses::add_to`]).
+pub struct TwoPasses<'a> {
+    runs: &'a SpringRuns,
+    bufs: std::sync::MutexGuard<'a, Buffers>,
+}
+
+/// The first pass of [`TwoPasses`], which team members share by blocks.
+pub struct BlockPass<'a> {
+    runs: &'a SpringRuns,
+    blocks: Disjoint<'a, BlockBuffers>,
+}
+
+impl TwoPasses<'_> {
+    /// Whether positions and velocities of `n` particles reach every spring's ends.
+    pub fn fits(&self, n: usize) -> bool {
+        n >= self.runs.particles
+    }
+
+    /// The first pass, for the members of a section to share.
+    pub fn blocks(&mut self) -> BlockPass<'_> {
+        BlockPass {
+            runs: self.runs,
+            blocks: Disjoint::new(&mut self.bufs.blocks[..]),
+        }
+    }
+
+    /// Adds the forces on particles `range` to `f` (that range of the forces): each block's
+    /// sums in block order, as [`SpringRuns::add_forces_components`] does. Particles past
+    /// the springs' last one get nothing.
+    pub fn add_to(&self, range: Range<usize>, f: [&mut [f32]; 3]) {
+        let [ox, oy, oz] = f;
+        let end = range.end.min(self.runs.particles);
+        (self.runs).cover_range(&self.bufs.blocks, range.start..end, |at, sums| {
+            for (out, s) in [&mut *ox, &mut *oy, &mut *oz].into_iter().zip(sums) {
+                for (o, &x) in out[at..at + s.len()].iter_mut().zip(s) {
+                    *o += x;
+                }
+            }
+        });
+    }
+}
+
+impl BlockPass<'_> {
+    /// Member `i` of `members`: fills its share of the blocks' sums from positions and
+    /// velocities `pos`, `vel` (all particles). Every member of a section must call this
+    /// with the same `members`, and none reads the sums before all are done.
+    pub fn fill(&self, i: usize, members: usize, pos: &Components, vel: &Components) {
+        let runs = self.runs;
+        let mine = share(runs.blocks.len(), members, i);
+        // SAFETY: the members' shares of the blocks are disjoint.
+        let buffers = unsafe { self.blocks.part(mine.clone()) };
+        let pass = ForcePass {
+            runs,
+            p: pos,
+            v: vel,
+        };
+        for (block, buf) in runs.blocks[mine].iter().zip(buffers) {
+            runs.block_pass(block, buf, &pass);
+        }
     }
 }
 

@@ -13,7 +13,7 @@ use glam::{Mat3, Vec3};
 use crate::cloth::Springs;
 
 use super::components::Components;
-use super::spring_runs::SpringRuns;
+use super::spring_runs::{SpringRuns, TwoPasses};
 
 use super::jacobian::{JacobianMode, SpringBlock, SystemMatrix};
 use crate::sim::constraints::DistanceConstraints;
@@ -151,6 +151,11 @@ impl SpringForce {
         f: &mut Components,
     ) {
         self.runs(springs).add_forces_components(pos, vel, f);
+    }
+
+    /// The forces in two passes (see [`SpringRuns::two_passes`]).
+    pub fn two_passes<'a>(&'a self, springs: &Springs) -> TwoPasses<'a> {
+        self.runs(springs).two_passes()
     }
 
     /// `Σ ½k(|d| − l₀)²`, joules.

@@ -110,6 +110,27 @@ impl<'a> StepContext<'a> {
         whole
     }
 
+    /// The forces as [`StepContext::forces_components`], fused with per-particle work
+    /// `then(range, f)` ([`ForceSet::fused_components`]); false, with nothing done or
+    /// counted, when the scene's terms do not allow it.
+    pub fn fused_forces(
+        &mut self,
+        pos: &Components,
+        vel: &Components,
+        f: &mut Components,
+        then: impl Fn(std::ops::Range<usize>, [&[f32]; 3]) + Sync,
+    ) -> bool {
+        let meter = &mut *self.meter;
+        let fused = self
+            .forces
+            .fused_components(self.model, pos, vel, f, &mut meter.terms, then);
+        if let Some(took) = fused {
+            meter.forces += took;
+            meter.force_evals += 1;
+        }
+        fused.is_some()
+    }
+
     /// Runs a linear solve or projection `f`, charging its time to the solve phase and
     /// recording its iterations and final relative residual.
     pub fn solve<R>(&mut self, f: impl FnOnce() -> (R, u32, Option<f32>, bool)) -> R {

@@ -7,7 +7,7 @@ use super::kind::IntegratorKind;
 use super::step::{Integrator, StepError, StepReport};
 use crate::cloth::ClothState;
 use crate::sim::forces::{Components, join, split};
-use crate::sim::team::each_part;
+use crate::sim::team::{Disjoint, each_part};
 
 /// `v ← v + a(x, v)·h`, then `x ← x + v·h` with the new velocity.
 ///
@@ -46,8 +46,6 @@ impl SemiImplicitEuler {
     /// One step of the component arrays `self.pos`, `self.vel` (not of `state`, but for its
     /// clock). Only when [`SemiImplicitEuler::on_components`]: every term takes the arrays.
     fn advance(&mut self, ctx: &mut StepContext<'_>, state: &mut ClothState, h: f32) {
-        let summed = ctx.forces_components(&self.pos, &self.vel, &mut self.force);
-        debug_assert!(summed, "a term refused component arrays it said it takes");
         let inv_mass = &ctx.model.inv_mass;
         // (A state and model of different sizes would step only the particles both have.)
         let n = inv_mass.len().min(self.pos[0].len()).min(self.vel[0].len());
@@ -56,17 +54,33 @@ impl SemiImplicitEuler {
         }
         let [x0, x1, x2] = &mut self.next_pos;
         let [v0, v1, v2] = &mut self.next_vel;
-        let (pos, vel, force) = (&self.pos, &self.vel, &self.force);
-        each_part(
-            [x0, x1, x2, v0, v1, v2],
-            |range, [x0, x1, x2, v0, v1, v2]| {
+        let next = [x0, x1, x2, v0, v1, v2].map(|a| Disjoint::new(&mut a[..n]));
+        let (pos, vel) = (&self.pos, &self.vel);
+        // Each range's update as soon as its forces are summed.
+        let fused = ctx.fused_forces(pos, vel, &mut self.force, |range, force| {
+            let w = &inv_mass[range.clone()];
+            // SAFETY: the ranges `fused_forces` hands out are disjoint.
+            let [x0, x1, x2, v0, v1, v2] =
+                next.each_ref().map(|a| unsafe { a.part(range.clone()) });
+            for (c, out) in [[x0, v0], [x1, v1], [x2, v2]].into_iter().enumerate() {
+                let now = [&pos[c][range.clone()], &vel[c][range.clone()], force[c]];
+                update(now, w, h, out);
+            }
+        });
+        if !fused {
+            let summed = ctx.forces_components(pos, vel, &mut self.force);
+            debug_assert!(summed, "a term refused component arrays it said it takes");
+            let force = &self.force;
+            // SAFETY: the whole arrays, the only parts in use.
+            let whole = next.each_ref().map(|a| unsafe { a.part(0..n) });
+            each_part(whole, |range, [x0, x1, x2, v0, v1, v2]| {
                 let w = &inv_mass[range.clone()];
                 for (c, out) in [[x0, v0], [x1, v1], [x2, v2]].into_iter().enumerate() {
                     let now = [&pos[c], &vel[c], &force[c]].map(|a| &a[range.clone()]);
                     update(now, w, h, out);
                 }
-            },
-        );
+            });
+        }
         std::mem::swap(&mut self.pos, &mut self.next_pos);
         std::mem::swap(&mut self.vel, &mut self.next_vel);
         state.time += h as f64;
