@@ -39,9 +39,7 @@ const GHOST: u32 = u32::MAX;
 
 /// One team member's share of the force chunks.
 struct Chunks<'a, 'b, T> {
-    /// Chunk numbers (chunk `q` holds particles `q·BLOCK..`).
-    indices: std::ops::Range<usize>,
-    /// The particles they hold.
+    /// The particles they hold (whole chunks of `BLOCK` but the last).
     particles: std::ops::Range<usize>,
     forces: &'a Disjoint<'b, T>,
 }
@@ -224,14 +222,12 @@ impl SpringRuns {
             n,
             |chunks| {
                 // SAFETY: each member's chunks are its own (see `each_chunk`).
-                let f = unsafe { chunks.forces.part(chunks.particles.clone()) };
-                for (q, out) in chunks.indices.zip(f.chunks_mut(BLOCK)) {
-                    self.cover(blocks, q, out.len(), |at, [sx, sy, sz]| {
-                        for (j, o) in out[at..at + sx.len()].iter_mut().enumerate() {
-                            *o += Vec3::new(sx[j], sy[j], sz[j]);
-                        }
-                    });
-                }
+                let out = unsafe { chunks.forces.part(chunks.particles.clone()) };
+                self.cover_range(blocks, chunks.particles, |at, [sx, sy, sz]| {
+                    for (j, o) in out[at..at + sx.len()].iter_mut().enumerate() {
+                        *o += Vec3::new(sx[j], sy[j], sz[j]);
+                    }
+                });
             },
             &mut f[..n],
         );
@@ -271,25 +267,26 @@ impl SpringRuns {
                     [
                         chunks.forces.part(range.clone()),
                         fy.part(range.clone()),
-                        fz.part(range),
+                        fz.part(range.clone()),
                     ]
                 };
-                let [ox, oy, oz] = out;
-                let chunked = ox
-                    .chunks_mut(BLOCK)
-                    .zip(oy.chunks_mut(BLOCK).zip(oz.chunks_mut(BLOCK)));
-                for (q, (ox, (oy, oz))) in chunks.indices.zip(chunked) {
-                    self.cover(blocks, q, ox.len(), |at, sums| {
-                        for (out, s) in [&mut *ox, &mut *oy, &mut *oz].into_iter().zip(sums) {
-                            for (o, &x) in out[at..at + s.len()].iter_mut().zip(s) {
-                                *o += x;
-                            }
-                        }
-                    });
-                }
+                self.add_sums(blocks, range, out);
             },
             &mut fx[..n],
         );
+    }
+
+    /// Adds the blocks' sums over particles `range` to `out` (that range of the forces),
+    /// each block's in block order.
+    fn add_sums(&self, blocks: &[BlockBuffers], range: Range<usize>, out: [&mut [f32]; 3]) {
+        let [ox, oy, oz] = out;
+        self.cover_range(blocks, range, |at, sums| {
+            for (out, s) in [&mut *ox, &mut *oy, &mut *oz].into_iter().zip(sums) {
+                for (o, &x) in out[at..at + s.len()].iter_mut().zip(s) {
+                    *o += x;
+                }
+            }
+        });
     }
 
     /// Calls `gather` for each team member's share of the `BLOCK`-particle chunks of
@@ -307,7 +304,6 @@ impl SpringRuns {
             let indices = share(chunks, members, i);
             gather(Chunks {
                 particles: indices.start * BLOCK..(indices.end * BLOCK).min(n),
-                indices,
                 forces: &forces,
             });
         };
@@ -335,18 +331,28 @@ impl SpringRuns {
         let team = Team::current();
         if self.parallel() && team.members() > 1 {
             let bufs = Disjoint::new(&mut bufs[..]);
-            team.run(&|i| {
-                let mine = share(self.blocks.len(), team.members(), i);
-                // SAFETY: the members' shares of the blocks are disjoint.
-                let buffers = unsafe { bufs.part(mine.clone()) };
-                for (block, buf) in self.blocks[mine].iter().zip(buffers) {
-                    pass(block, buf);
-                }
-            });
+            team.run(&|i| self.fill_share(&bufs, i, team.members(), &pass));
         } else {
             for (block, buf) in self.blocks.iter().zip(bufs.iter_mut()) {
                 pass(block, buf);
             }
+        }
+    }
+
+    /// Member `i` of `members`: `pass` over its share of the blocks (the members' shares
+    /// are disjoint, so each fills its own buffers).
+    fn fill_share(
+        &self,
+        bufs: &Disjoint<'_, BlockBuffers>,
+        i: usize,
+        members: usize,
+        pass: impl Fn(&Block, &mut BlockBuffers),
+    ) {
+        let mine = share(self.blocks.len(), members, i);
+        // SAFETY: the members' shares of the blocks are disjoint.
+        let buffers = unsafe { bufs.part(mine.clone()) };
+        for (block, buf) in self.blocks[mine].iter().zip(buffers) {
+            pass(block, buf);
         }
     }
 
@@ -368,19 +374,6 @@ impl SpringRuns {
         let mut bufs = self.scratch.lock();
         self.size_buffers(&mut bufs.blocks);
         TwoPasses { runs: self, bufs }
-    }
-
-    /// Calls `add(at, sums)` for each block's sums over the particles of output chunk `q`
-    /// (`len` particles from `q·BLOCK`), in block order; `at` is where in the chunk they
-    /// start.
-    fn cover(
-        &self,
-        buffers: &[BlockBuffers],
-        q: usize,
-        len: usize,
-        add: impl FnMut(usize, [&[f32]; 3]),
-    ) {
-        self.cover_range(buffers, q * BLOCK..q * BLOCK + len, add);
     }
 
     /// Calls `add(at, sums)` for each block's sums over the particles `lo..hi`, in block
@@ -529,15 +522,8 @@ impl TwoPasses<'_> {
     /// sums in block order, as [`SpringRuns::add_forces_components`] does. Particles past
     /// the springs' last one get nothing.
     pub fn add_to(&self, range: Range<usize>, f: [&mut [f32]; 3]) {
-        let [ox, oy, oz] = f;
         let end = range.end.min(self.runs.particles);
-        (self.runs).cover_range(&self.bufs.blocks, range.start..end, |at, sums| {
-            for (out, s) in [&mut *ox, &mut *oy, &mut *oz].into_iter().zip(sums) {
-                for (o, &x) in out[at..at + s.len()].iter_mut().zip(s) {
-                    *o += x;
-                }
-            }
-        });
+        (self.runs).add_sums(&self.bufs.blocks, range.start..end, f);
     }
 }
 
@@ -547,17 +533,14 @@ impl BlockPass<'_> {
     /// with the same `members`, and none reads the sums before all are done.
     pub fn fill(&self, i: usize, members: usize, pos: &Components, vel: &Components) {
         let runs = self.runs;
-        let mine = share(runs.blocks.len(), members, i);
-        // SAFETY: the members' shares of the blocks are disjoint.
-        let buffers = unsafe { self.blocks.part(mine.clone()) };
         let pass = ForcePass {
             runs,
             p: pos,
             v: vel,
         };
-        for (block, buf) in runs.blocks[mine].iter().zip(buffers) {
-            runs.block_pass(block, buf, &pass);
-        }
+        runs.fill_share(&self.blocks, i, members, |block, buf| {
+            runs.block_pass(block, buf, &pass)
+        });
     }
 }
 
