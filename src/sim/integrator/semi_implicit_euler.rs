@@ -7,7 +7,7 @@ use super::kind::IntegratorKind;
 use super::step::{Integrator, StepError, StepReport};
 use crate::cloth::ClothState;
 use crate::sim::forces::{Components, join, split};
-use crate::sim::team::{Disjoint, each_part};
+use crate::sim::team::Disjoint;
 
 /// `v ← v + a(x, v)·h`, then `x ← x + v·h` with the new velocity.
 ///
@@ -56,30 +56,24 @@ impl SemiImplicitEuler {
         let [v0, v1, v2] = &mut self.next_vel;
         let next = [x0, x1, x2, v0, v1, v2].map(|a| Disjoint::new(&mut a[..n]));
         let (pos, vel) = (&self.pos, &self.vel);
-        // Each range's update as soon as its forces are summed.
-        let fused = ctx.fused_forces(pos, vel, &mut self.force, |range, force| {
+        // One range's update, from that range's forces.
+        let step = |range: std::ops::Range<usize>, force: [&[f32]; 3]| {
             let w = &inv_mass[range.clone()];
-            // SAFETY: the ranges `fused_forces` hands out are disjoint.
+            // SAFETY: the ranges are disjoint (`fused_forces` hands out disjoint ones; the
+            // fallback below takes the one whole range).
             let [x0, x1, x2, v0, v1, v2] =
                 next.each_ref().map(|a| unsafe { a.part(range.clone()) });
             for (c, out) in [[x0, v0], [x1, v1], [x2, v2]].into_iter().enumerate() {
                 let now = [&pos[c][range.clone()], &vel[c][range.clone()], force[c]];
                 update(now, w, h, out);
             }
-        });
-        if !fused {
+        };
+        // Each range's update as soon as its forces are summed; term by term (in one range
+        // here) where the fused path does not apply.
+        if !ctx.fused_forces(pos, vel, &mut self.force, step) {
             let summed = ctx.forces_components(pos, vel, &mut self.force);
             debug_assert!(summed, "a term refused component arrays it said it takes");
-            let force = &self.force;
-            // SAFETY: the whole arrays, the only parts in use.
-            let whole = next.each_ref().map(|a| unsafe { a.part(0..n) });
-            each_part(whole, |range, [x0, x1, x2, v0, v1, v2]| {
-                let w = &inv_mass[range.clone()];
-                for (c, out) in [[x0, v0], [x1, v1], [x2, v2]].into_iter().enumerate() {
-                    let now = [&pos[c], &vel[c], &force[c]].map(|a| &a[range.clone()]);
-                    update(now, w, h, out);
-                }
-            });
+            step(0..n, self.force.each_ref().map(|f| &f[..n]));
         }
         std::mem::swap(&mut self.pos, &mut self.next_pos);
         std::mem::swap(&mut self.vel, &mut self.next_vel);
