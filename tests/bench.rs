@@ -201,6 +201,8 @@ fn bench_cli_refuses_bad_thread_counts_and_gpu_integrators_in_one_line() {
             .output()
             .expect("runs");
         assert!(!out.status.success(), "{args:?} succeeded");
+        // Refused before anything is printed: no table header left half-filled.
+        assert!(out.stdout.is_empty(), "{args:?} printed before failing");
         let err = String::from_utf8_lossy(&out.stderr).to_string();
         assert_eq!(err.trim().lines().count(), 1, "{err}");
         err

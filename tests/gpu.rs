@@ -241,3 +241,23 @@ fn gpu_bench_row_has_the_run_mean_but_no_frame_spread() {
         cpu.sag_m
     );
 }
+
+/// `bench --backend gpu` with no `--integrators` runs the one integrator the GPU has (not
+/// the CPU's default list, which it would refuse): one row, from the GPU.
+#[test]
+fn gpu_bench_cli_defaults_to_the_integrator_it_runs() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_clothsim"))
+        .args(["bench", "--backend", "gpu", "--sizes", "8", "--json"])
+        .output()
+        .expect("runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let rows: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("one JSON object per line"))
+        .collect();
+    assert_eq!(rows.len(), 1, "{rows:?}");
+    assert_eq!(rows[0]["integrator"], "semi-implicit-euler");
+    assert_eq!(rows[0]["backend"], "gpu");
+    assert_eq!(rows[0]["finite"], true);
+}
