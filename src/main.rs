@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 
-use clothsim::gpu::{Backend, gpu_simulation};
+use clothsim::gpu::{Backend, GPU_INTEGRATOR, gpu_simulation};
 use clothsim::mesh::{self, GridOrientation, GridSpec, SpringKind};
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::IntegratorKind;
@@ -318,7 +318,7 @@ fn run(cli: Cli) -> Result<()> {
                     IntegratorKind::ImplicitEuler,
                     IntegratorKind::Xpbd,
                 ],
-                Backend::Gpu => vec![IntegratorKind::SemiImplicitEuler],
+                Backend::Gpu => vec![GPU_INTEGRATOR],
             });
             bench(&sizes, &integrators, &threads, json, backend)
         }
@@ -625,7 +625,7 @@ fn bench(
     if backend == Backend::Gpu
         && let Some(k) = integrators
             .iter()
-            .find(|&&k| k != IntegratorKind::SemiImplicitEuler)
+            .find(|&&k| k != GPU_INTEGRATOR)
     {
         bail!(
             "--backend gpu runs semi-implicit Euler only, not {}",

@@ -4,7 +4,7 @@
 
 mod stepper;
 
-pub use stepper::{GpuError, GpuStepper, gpu_support};
+pub use stepper::{GPU_INTEGRATOR, GpuError, GpuStepper, gpu_support};
 
 use crate::render::{AdapterPreference, Gpu, describe_adapter};
 use crate::scene::{Scene, Simulation};

@@ -70,11 +70,14 @@ struct Params {
     colliders: [GpuCollider; MAX_COLLIDERS],
 }
 
+/// The one integrator the GPU backend runs.
+pub const GPU_INTEGRATOR: IntegratorKind = IntegratorKind::SemiImplicitEuler;
+
 /// What of `params` and `effects` the GPU backend cannot run, if anything: it runs
 /// semi-implicit Euler with gravity, springs (and bend springs), air damping, pins and up
 /// to four sphere and plane colliders.
 pub fn gpu_support(params: &SimParams, effects: &[Effect]) -> Result<(), GpuError> {
-    if params.integrator != IntegratorKind::SemiImplicitEuler {
+    if params.integrator != GPU_INTEGRATOR {
         return Err(GpuError::Unsupported(format!(
             "runs semi-implicit Euler only, not {}",
             params.integrator.label()
@@ -151,8 +154,9 @@ fn fits_buffers(limits: &wgpu::Limits, particles: u64, spring_ends: u64) -> Resu
     let mib = |bytes: u64| bytes as f64 / (1u64 << 20) as f64;
     match need.into_iter().find(|&(bytes, _)| bytes > most) {
         Some((bytes, what)) => Err(GpuError::Unsupported(format!(
-            "needs {:.1} MiB in one storage buffer for this cloth's {what} ({particles} \
-             particles, {spring_ends} spring ends); this device binds at most {:.1} MiB",
+            "needs {:.1} MiB ({bytes} bytes) in one storage buffer for this cloth's {what} \
+             ({particles} particles, {spring_ends} spring ends); this device binds at most \
+             {:.1} MiB ({most} bytes)",
             mib(bytes),
             mib(most)
         ))),
@@ -195,7 +199,8 @@ impl GpuStepper {
                  device does not offer"
             )));
         }
-        fits_buffers(&limits, count as u64, model.springs.len() as u64 * 2)?;
+        let spring_ends = model.springs.len() as u64 * 2;
+        fits_buffers(&limits, count as u64, spring_ends)?;
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("cloth substep"),
             source: wgpu::ShaderSource::Wgsl(include_str!("cloth.wgsl").into()),
@@ -272,10 +277,9 @@ impl GpuStepper {
         );
         let storage_dst = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
         let offsets = small("spring offsets", (count as u64 + 1) * 4, storage_dst);
-        let springs: u64 = model.springs.len() as u64 * 2;
         let neighbours = small(
             "spring neighbours",
-            springs * std::mem::size_of::<Neighbour>() as u64,
+            spring_ends * std::mem::size_of::<Neighbour>() as u64,
             storage_dst,
         );
         let readback = small(
@@ -625,7 +629,7 @@ impl StepBackend for GpuStepper {
     }
 
     fn integrator(&self) -> IntegratorKind {
-        IntegratorKind::SemiImplicitEuler
+        GPU_INTEGRATOR
     }
 
     fn sync(&mut self, model: &ClothModel, state: &mut ClothState) -> Result<(), StepError> {
