@@ -623,9 +623,7 @@ fn bench(
         bail!("--threads: {t} is outside 1..=256");
     }
     if backend == Backend::Gpu
-        && let Some(k) = integrators
-            .iter()
-            .find(|&&k| k != GPU_INTEGRATOR)
+        && let Some(k) = integrators.iter().find(|&&k| k != GPU_INTEGRATOR)
     {
         bail!(
             "--backend gpu runs semi-implicit Euler only, not {}",
@@ -660,8 +658,12 @@ fn bench(
             .with_context(|| format!("cannot start {t} threads"))?;
         for &n in sizes {
             for &k in integrators {
-                let row = pool.install(|| match backend {
-                    Backend::Cpu => Ok(clothsim::bench::bench_one(n, k)?),
+                let row = match backend {
+                    Backend::Cpu => pool.install(|| clothsim::bench::bench_one(n, k))?,
+                    // On this thread, not the pool's: a GL device (llvmpipe through EGL) is
+                    // current on the thread that made it, and a pool's thread still tearing
+                    // that down while the process exits corrupts the heap (a crash at exit
+                    // in a few runs in a hundred).
                     Backend::Gpu => clothsim::bench::bench_with(
                         n,
                         k,
@@ -671,9 +673,8 @@ fn bench(
                                 .map_err(|e| clothsim::scene::SceneError::Backend(format!("{e:#}")))
                         },
                         "gpu",
-                    )
-                    .map_err(anyhow::Error::from),
-                })?;
+                    )?,
+                };
                 if json {
                     println!("{}", serde_json::to_string(&row)?);
                 } else {
