@@ -2,6 +2,7 @@
 //! the same scene after the same simulated time.
 
 use clothsim::gpu::{Backend, gpu_simulation, gpu_support};
+use clothsim::render::{AdapterPreference, Gpu};
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::IntegratorKind;
 
@@ -260,4 +261,29 @@ fn gpu_bench_cli_defaults_to_the_integrator_it_runs() {
     assert_eq!(rows[0]["integrator"], "semi-implicit-euler");
     assert_eq!(rows[0]["backend"], "gpu");
     assert_eq!(rows[0]["finite"], true);
+}
+
+/// The 1 000 × 1 000 cloth through the same path as the CLI and the app: refused
+/// with its sizes where the device cannot bind its 12 million spring-end records of 16
+/// bytes in one buffer (llvmpipe's 128 MiB), built where it can.
+#[test]
+fn a_million_particle_cloth_is_refused_where_the_device_cannot_bind_its_springs() {
+    let scene =
+        clothsim::bench::bench_scene(1000, IntegratorKind::SemiImplicitEuler).expect("scene");
+    let bytes = scene.model.springs.len() as u64 * 2 * 16;
+    let gpu = Gpu::headless(AdapterPreference::Any).expect("an adapter");
+    let limits = gpu.device.limits();
+    let most = (limits.max_storage_buffer_binding_size).min(limits.max_buffer_size);
+    drop(gpu);
+    match gpu_simulation(scene, false) {
+        Err(e) => {
+            let text = format!("{e:#}");
+            assert!(bytes > most, "refused though it fits: {text}");
+            assert!(
+                text.contains("182.8 MiB") && text.contains("spring ends"),
+                "{text}"
+            );
+        }
+        Ok(_) => assert!(bytes <= most, "built though {bytes} bytes exceed {most}"),
+    }
 }
