@@ -732,6 +732,22 @@ mod tests {
         f
     }
 
+    /// The springs of a `w` × `h` grid's stencil `offsets` (columns, rows), from each
+    /// particle to its neighbour.
+    fn stencil(w: usize, h: usize, offsets: &[(usize, usize)]) -> (Vec<u32>, Vec<u32>) {
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for p in 0..w * h {
+            for &(di, dj) in offsets {
+                let (i, j) = (p % w + di, p / w + dj);
+                if i < w && j < h {
+                    a.push(p as u32);
+                    b.push((j * w + i) as u32);
+                }
+            }
+        }
+        (a, b)
+    }
+
     /// `start` plus the forces, computed on component arrays.
     fn on_components(runs: &SpringRuns, pos: &[Vec3], vel: &[Vec3], start: &[Vec3]) -> Vec<Vec3> {
         let n = pos.len();
@@ -761,16 +777,7 @@ mod tests {
         let vel: Vec<Vec3> = (0..n)
             .map(|_| Vec3::new(rnd(), rnd(), rnd()) - 0.5)
             .collect();
-        let (mut a, mut b) = (Vec::new(), Vec::new());
-        for p in 0..n {
-            for (di, dj) in [(1, 0), (0, 1), (1, 1), (2, 0)] {
-                let (i, j) = (p % w + di, p / w + dj);
-                if i < w && j < h {
-                    a.push(p as u32);
-                    b.push((j * w + i) as u32);
-                }
-            }
-        }
+        let (mut a, mut b) = stencil(w, h, &[(1, 0), (0, 1), (1, 1), (2, 0)]);
         for _ in 0..500 {
             a.push((rnd() * n as f32) as u32 % n as u32);
             b.push((rnd() * n as f32) as u32 % n as u32);
@@ -858,16 +865,7 @@ mod tests {
             .map(|p| Vec3::new((p % w) as f32, -((p / w) as f32), rnd()) * 0.02)
             .collect();
         let vel: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
-        let (mut a, mut b) = (Vec::new(), Vec::new());
-        for p in 0..n {
-            for (di, dj) in [(1, 0), (0, 1), (1, 1), (0, 2)] {
-                let (i, j) = (p % w + di, p / w + dj);
-                if i < w && j < h {
-                    a.push(p as u32);
-                    b.push((j * w + i) as u32);
-                }
-            }
-        }
+        let (a, b) = stencil(w, h, &[(1, 0), (0, 1), (1, 1), (0, 2)]);
         let rest: Vec<f32> = (0..a.len()).map(|_| 0.015 + 0.01 * rnd()).collect();
         let (k, c) = (vec![500.0; a.len()], vec![0.01; a.len()]);
         let runs = SpringRuns::new(n, &a, &b, &rest, &k, &c);
@@ -969,16 +967,7 @@ mod tests {
         let (w, h) = (50usize, 60usize);
         let n = w * h;
         let offsets = [(1, 0), (0, 1), (1, 1), (2, 0)];
-        let (mut a, mut b) = (Vec::new(), Vec::new());
-        for p in 0..n {
-            for (di, dj) in offsets {
-                let (i, j) = (p % w + di, p / w + dj);
-                if i < w && j < h {
-                    a.push(p as u32);
-                    b.push((j * w + i) as u32);
-                }
-            }
-        }
+        let (a, b) = stencil(w, h, &offsets);
         let pos: Vec<Vec3> = (0..n)
             .map(|p| Vec3::new((p % w) as f32, (p / w) as f32, (p % 7) as f32) * 0.01)
             .collect();
