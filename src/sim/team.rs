@@ -164,6 +164,38 @@ impl Team {
     }
 }
 
+impl Team {
+    /// Runs `work(member, piece)` once for every piece in `0..pieces`, shared between the
+    /// members: each first takes its own [`share`] of them, in order, then helps with the
+    /// pieces of the others that are still untaken. So a member that comes late (a helper the
+    /// machine held off its core for some microseconds) loses only the pieces the others
+    /// took meanwhile, not its whole share, while on time each member works on the same
+    /// data every section. For work whose result is the same whoever does a piece.
+    pub fn run_pieces(&self, pieces: usize, work: &(dyn Fn(usize, usize) + Sync)) {
+        let members = self.members();
+        // The next untaken piece of each member's share (on its own cache line, so that a
+        // member taking its own pieces does not move the others' counters between cores).
+        let next: [Padded; MAX_MEMBERS] =
+            std::array::from_fn(|i| Padded(AtomicUsize::new(share(pieces, members, i).start)));
+        self.run(&|i| {
+            for owner in (i..members).chain(0..i) {
+                let end = share(pieces, members, owner).end;
+                loop {
+                    let piece = next[owner].0.fetch_add(1, Ordering::Relaxed);
+                    if piece >= end {
+                        break;
+                    }
+                    work(i, piece);
+                }
+            }
+        });
+    }
+}
+
+/// A counter alone on its cache line (two lines: neighbouring lines are fetched together).
+#[repr(align(128))]
+struct Padded(AtomicUsize);
+
 impl Drop for Team {
     fn drop(&mut self) {
         self.shared.stop.store(true, Ordering::SeqCst);
@@ -436,6 +468,50 @@ mod tests {
             });
         }
         assert_eq!(hits.load(Ordering::SeqCst), 300);
+    }
+
+    /// Story: a helper is held up in its first piece; the caller, done with its own share,
+    /// takes the rest of the helper's pieces instead of waiting, and every piece runs once.
+    #[test]
+    fn run_pieces_runs_each_piece_once_and_the_caller_takes_a_slow_helpers_rest() {
+        let team = Team::new(2);
+        let caller = std::thread::current().id();
+        for round in 0..50 {
+            let ran: Vec<AtomicUsize> = (0..13).map(|_| AtomicUsize::new(0)).collect();
+            team.run_pieces(13, &|_, piece| {
+                ran[piece].fetch_add(1, Ordering::SeqCst);
+            });
+            assert!(ran.iter().all(|r| r.load(Ordering::SeqCst) == 1), "{round}");
+        }
+        let on_helper = Mutex::new(Vec::new());
+        let helper_began = AtomicBool::new(false);
+        let ran = AtomicUsize::new(0);
+        team.run_pieces(8, &|member, piece| {
+            if std::thread::current().id() == caller {
+                // The caller's first piece lasts until the helper is in its own first one.
+                let start = Instant::now();
+                while !helper_began.load(Ordering::SeqCst) && start.elapsed().as_secs() < 10 {
+                    std::hint::spin_loop();
+                }
+            } else {
+                on_helper.lock().unwrap().push((member, piece));
+                helper_began.store(true, Ordering::SeqCst);
+                std::thread::sleep(Duration::from_millis(200));
+            }
+            ran.fetch_add(1, Ordering::SeqCst);
+        });
+        assert_eq!(ran.load(Ordering::SeqCst), 8);
+        // The helper ran the first piece of its share (4..8); the caller took the others.
+        assert_eq!(on_helper.into_inner().unwrap(), [(1, 4)]);
+    }
+
+    #[test]
+    fn run_pieces_on_the_caller_alone_runs_them_in_order() {
+        let team = Team::new(3);
+        team.shared.helpers_stay_away.store(true, Ordering::SeqCst);
+        let order = Mutex::new(Vec::new());
+        team.run_pieces(10, &|_, piece| order.lock().unwrap().push(piece));
+        assert_eq!(order.into_inner().unwrap(), (0..10).collect::<Vec<_>>());
     }
 
     #[test]

@@ -22,6 +22,9 @@ use super::springs::SpringForce;
 
 /// Spring terms the fused path takes (a scene has two at most: springs and bend springs).
 const FUSED_PAIR_TERMS: usize = 2;
+/// Pieces of particles per team member in the fused path's second section: a member late
+/// for its share loses only the pieces the others took meanwhile ([`Team::run_pieces`]).
+const PIECES_PER_MEMBER: usize = 4;
 /// Terms whose time the fused path records (a scene has six at most, one per effect).
 const MAX_TERMS: usize = 8;
 
@@ -246,8 +249,9 @@ impl ForceSet {
     /// which gets each range's forces as soon as they are summed, while they are still in
     /// the cache. Two team sections in all, where the term-by-term path takes one or two
     /// per term: the blocks of every spring term, then per range of particles the zeroed
-    /// forces, each term in order, and `then`. A term's time is the calling thread's time on
-    /// its share; their sum is returned. `None`, with nothing done, when a term does not
+    /// forces, each term in order, and `then`. Both sections are cut into pieces that the
+    /// team's members take as they come ([`Team::run_pieces`]). A term's time is the calling
+    /// thread's time on the pieces it ran; their sum is returned. `None`, with nothing done, when a term does not
     /// [take components](Force::takes_components) or the arrays are shorter than the springs
     /// reach.
     pub fn fused_components(
@@ -283,9 +287,9 @@ impl ForceSet {
         } else {
             1
         };
-        let run = |section: &(dyn Fn(usize) + Sync)| match members {
-            1 => section(0),
-            _ => team.run(section),
+        let run = |pieces: usize, work: &(dyn Fn(usize, usize) + Sync)| match members {
+            1 => (0..pieces).for_each(|piece| work(0, piece)),
+            _ => team.run_pieces(pieces, work),
         };
         // The caller's time per term, nanoseconds.
         let took: [AtomicU64; MAX_TERMS] = std::array::from_fn(|_| AtomicU64::new(0));
@@ -300,19 +304,23 @@ impl ForceSet {
         {
             let fills: [Option<(usize, BlockPass<'_>)>; FUSED_PAIR_TERMS] =
                 (passes.each_mut()).map(|p| p.as_mut().map(|(slot, p)| (*slot, p.blocks())));
-            run(&|i| {
+            // A piece is one block of each spring term (its blocks cover the same particles).
+            let blocks = fills.iter().flatten().map(|(_, f)| f.len()).max();
+            run(blocks.unwrap_or(0), &|i, b| {
                 for (slot, fill) in fills.iter().flatten() {
-                    timed(i, *slot, &mut || fill.fill(i, members, pos, vel));
+                    timed(i, *slot, &mut || fill.fill(b, pos, vel));
                 }
             });
         }
         let [fx, fy, fz] = f;
         let out = [&mut fx[..n], &mut fy[..n], &mut fz[..n]].map(Disjoint::new);
-        run(&|i| {
-            const LINE: usize = 16;
-            let lines = share(n.div_ceil(LINE), members, i);
+        const LINE: usize = 16;
+        let lines = n.div_ceil(LINE);
+        let pieces = (members * PIECES_PER_MEMBER).min(lines);
+        run(pieces, &|i, piece| {
+            let lines = share(lines, pieces, piece);
             let range = (lines.start * LINE).min(n)..(lines.end * LINE).min(n);
-            // SAFETY: the members' ranges are disjoint (shares of whole lines).
+            // SAFETY: the pieces are disjoint (shares of whole lines), each run once.
             let [fx, fy, fz] = std::array::from_fn(|c| unsafe { out[c].part(range.clone()) });
             for o in [&mut *fx, &mut *fy, &mut *fz] {
                 o.fill(0.0);

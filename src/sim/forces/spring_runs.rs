@@ -531,19 +531,26 @@ impl TwoPasses<'_> {
 }
 
 impl BlockPass<'_> {
-    /// Member `i` of `members`: fills its share of the blocks' sums from positions and
-    /// velocities `pos`, `vel` (all particles). Every member of a section must call this
-    /// with the same `members`, and none reads the sums before all are done.
-    pub fn fill(&self, i: usize, members: usize, pos: &Components, vel: &Components) {
+    /// How many blocks there are to fill.
+    pub fn len(&self) -> usize {
+        self.runs.blocks.len()
+    }
+
+    /// Fills block `b`'s sums from positions and velocities `pos`, `vel` (all particles);
+    /// nothing for a block past the last. Each block must be filled by one member only, and
+    /// none may read the sums before all are filled.
+    pub fn fill(&self, b: usize, pos: &Components, vel: &Components) {
         let runs = self.runs;
+        let Some(block) = runs.blocks.get(b) else {
+            return;
+        };
         let pass = ForcePass {
             runs,
             p: pos,
             v: vel,
         };
-        runs.fill_share(&self.blocks, i, members, |block, buf| {
-            runs.block_pass(block, buf, &pass)
-        });
+        // SAFETY: block `b`'s buffer is filled by this member only (the contract above).
+        runs.block_pass(block, unsafe { self.blocks.at(b) }, &pass);
     }
 }
 
