@@ -251,9 +251,9 @@ impl ForceSet {
     /// per term: the blocks of every spring term, then per range of particles the zeroed
     /// forces, each term in order, and `then`. Both sections are cut into pieces that the
     /// team's members take as they come ([`Team::run_pieces`]). A term's time is the calling
-    /// thread's time on the pieces it ran; their sum is returned. `None`, with nothing done, when a term does not
-    /// [take components](Force::takes_components) or the arrays are shorter than the springs
-    /// reach.
+    /// thread's time on the pieces it ran; their sum is returned. `None`, with nothing done,
+    /// when a term does not [take components](Force::takes_components) or the arrays are
+    /// shorter than the springs reach.
     pub fn fused_components(
         &self,
         model: &ClothModel,
