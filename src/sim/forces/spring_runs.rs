@@ -13,7 +13,7 @@
 //! then every particle adds the buffers that cover it, in block order. So 1, 2 or 64 threads
 //! give bit-identical forces.
 
-use super::super::team::{Disjoint, PARALLEL_ELEMENTS, Team, share};
+use super::super::team::{Disjoint, PARALLEL_ELEMENTS, Team};
 use super::components::{Components, Scratch, split};
 use std::ops::Range;
 
@@ -37,7 +37,7 @@ const MAX_GAP: u32 = 8;
 /// The run-order index of such a filler.
 const GHOST: u32 = u32::MAX;
 
-/// One team member's share of the force chunks.
+/// Force chunks one call of a gather takes.
 struct Chunks<'a, 'b, T> {
     /// The particles they hold (whole chunks of `BLOCK` but the last).
     particles: std::ops::Range<usize>,
@@ -221,7 +221,7 @@ impl SpringRuns {
         self.each_chunk(
             n,
             |chunks| {
-                // SAFETY: each member's chunks are its own (see `each_chunk`).
+                // SAFETY: each chunk is taken by one call only (see `each_chunk`).
                 let out = unsafe { chunks.forces.part(chunks.particles.clone()) };
                 self.cover_range(blocks, chunks.particles, |at, [sx, sy, sz]| {
                     for (j, o) in out[at..at + sx.len()].iter_mut().enumerate() {
@@ -262,7 +262,7 @@ impl SpringRuns {
             n,
             |chunks| {
                 let range = chunks.particles.clone();
-                // SAFETY: each member's chunks are its own (see `each_chunk`).
+                // SAFETY: each chunk is taken by one call only (see `each_chunk`).
                 let out = unsafe {
                     [
                         chunks.forces.part(range.clone()),
@@ -289,9 +289,9 @@ impl SpringRuns {
         });
     }
 
-    /// Calls `gather` for each team member's share of the `BLOCK`-particle chunks of
-    /// `forces` (the first `n` particles' forces), in parallel when the blocks are many
-    /// enough; every chunk's sum is the same whoever takes it.
+    /// Calls `gather` for the `BLOCK`-particle chunks of `forces` (the first `n` particles'
+    /// forces): one chunk a piece of a team section ([`Team::run_pieces`]) when the blocks
+    /// are many enough, else all at once; every chunk's sum is the same whoever takes it.
     fn each_chunk<T: Send>(
         &self,
         n: usize,
@@ -300,8 +300,7 @@ impl SpringRuns {
     ) {
         let chunks = n.div_ceil(BLOCK);
         let forces = Disjoint::new(forces);
-        let take = |members: usize, i: usize| {
-            let indices = share(chunks, members, i);
+        let take = |indices: Range<usize>| {
             gather(Chunks {
                 particles: indices.start * BLOCK..(indices.end * BLOCK).min(n),
                 forces: &forces,
@@ -309,9 +308,9 @@ impl SpringRuns {
         };
         let team = Team::current();
         if self.parallel() && team.members() > 1 {
-            team.run(&|i| take(team.members(), i));
+            team.run_pieces(chunks, &|_, c| take(c..c + 1));
         } else {
-            take(1, 0);
+            take(0..chunks);
         }
     }
 
@@ -320,8 +319,8 @@ impl SpringRuns {
         self.blocks.len() >= self.parallel_from
     }
 
-    /// Every block's sums by `pass` (which fills one block's buffers), the blocks shared out
-    /// between the team's members when they are many enough.
+    /// Every block's sums by `pass` (which fills one block's buffers), one block a piece of a
+    /// team section ([`Team::run_pieces`]) when they are many enough.
     fn block_sums(
         &self,
         bufs: &mut Vec<BlockBuffers>,
@@ -331,28 +330,14 @@ impl SpringRuns {
         let team = Team::current();
         if self.parallel() && team.members() > 1 {
             let bufs = Disjoint::new(&mut bufs[..]);
-            team.run(&|i| self.fill_share(&bufs, i, team.members(), &pass));
+            team.run_pieces(self.blocks.len(), &|_, b| {
+                // SAFETY: each piece runs once, so each block's buffer has one member.
+                pass(&self.blocks[b], unsafe { bufs.at(b) })
+            });
         } else {
             for (block, buf) in self.blocks.iter().zip(bufs.iter_mut()) {
                 pass(block, buf);
             }
-        }
-    }
-
-    /// Member `i` of `members`: `pass` over its share of the blocks (the members' shares
-    /// are disjoint, so each fills its own buffers).
-    fn fill_share(
-        &self,
-        bufs: &Disjoint<'_, BlockBuffers>,
-        i: usize,
-        members: usize,
-        pass: impl Fn(&Block, &mut BlockBuffers),
-    ) {
-        let mine = share(self.blocks.len(), members, i);
-        // SAFETY: the members' shares of the blocks are disjoint.
-        let buffers = unsafe { bufs.part(mine.clone()) };
-        for (block, buf) in self.blocks[mine].iter().zip(buffers) {
-            pass(block, buf);
         }
     }
 
