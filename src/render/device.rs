@@ -22,26 +22,37 @@ pub enum AdapterPreference {
 impl Gpu {
     /// Creates a device without a display handle. The backend can be pinned with the
     /// `WGPU_BACKEND` environment variable; unpinned, [`AdapterPreference::Software`] tries
-    /// the GL backend (Mesa's llvmpipe) first, then every backend.
+    /// the GL backend first and takes it only if it is a software rasteriser (Mesa's
+    /// llvmpipe), then every backend. A GPU's own GL through EGL is passed over: NVIDIA's
+    /// lost the device on the first render target (seen on an H100).
     ///
     /// # Errors
     /// [`RenderError::NoAdapter`] with what was tried, or [`RenderError::Device`].
     pub fn headless(preference: AdapterPreference) -> Result<Gpu, RenderError> {
         let from_env = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
         let pinned = std::env::var_os("WGPU_BACKEND").is_some();
+        // (instance, whether only a software adapter will do)
         let mut attempts = Vec::new();
         if preference == AdapterPreference::Software && !pinned {
             // Golden images depend on the rasteriser: prefer Mesa's llvmpipe through GL.
             let mut gl = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
             gl.backends = wgpu::Backends::GL;
-            attempts.push(gl);
+            attempts.push((gl, true));
         }
-        attempts.push(from_env);
+        attempts.push((from_env, false));
         let mut failures = Vec::new();
-        for desc in attempts {
+        for (desc, software_only) in attempts {
             let backends = desc.backends;
             let instance = wgpu::Instance::new(desc);
             match Self::pick(&instance, preference) {
+                Ok(adapter)
+                    if software_only && adapter.get_info().device_type != wgpu::DeviceType::Cpu =>
+                {
+                    failures.push(format!(
+                        "{backends:?}: {} is not a software adapter",
+                        describe_adapter(&adapter)
+                    ));
+                }
                 Ok(adapter) => return Self::open(instance, adapter),
                 Err(e) => failures.push(format!("{backends:?}: {e}")),
             }
