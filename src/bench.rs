@@ -29,6 +29,14 @@ pub fn sag_tolerance(integrator: IntegratorKind) -> f64 {
     }
 }
 
+/// The integrators `clothsim bench` runs on the CPU unless told which: one explicit, one
+/// implicit, one constraint solver (the three targets).
+pub const BENCH_INTEGRATORS: [IntegratorKind; 3] = [
+    IntegratorKind::SemiImplicitEuler,
+    IntegratorKind::ImplicitEuler,
+    IntegratorKind::Xpbd,
+];
+
 /// Substeps per 1/60 s frame the bench gives each integrator: N (so `dt = 1/(60 N)`, the
 /// scene's definition), five large steps for implicit Euler.
 pub fn bench_substeps(integrator: IntegratorKind, n: u32) -> u32 {

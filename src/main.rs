@@ -313,11 +313,7 @@ fn run(cli: Cli) -> Result<()> {
             backend,
         }) => {
             let integrators = integrators.unwrap_or_else(|| match backend {
-                Backend::Cpu => vec![
-                    IntegratorKind::SemiImplicitEuler,
-                    IntegratorKind::ImplicitEuler,
-                    IntegratorKind::Xpbd,
-                ],
+                Backend::Cpu => clothsim::bench::BENCH_INTEGRATORS.to_vec(),
                 Backend::Gpu => vec![GPU_INTEGRATOR],
             });
             bench(&sizes, &integrators, &threads, json, backend)
