@@ -162,9 +162,7 @@ impl Team {
             resume_unwind(payload);
         }
     }
-}
 
-impl Team {
     /// Runs `work(member, piece)` once for every piece in `0..pieces`, shared between the
     /// members: each first takes its own [`share`] of them, in order, then helps with the
     /// pieces of the others that are still untaken. So a member that comes late (a helper the
