@@ -877,7 +877,11 @@ mod tests {
         for (block, (buf, twin)) in runs.blocks.iter().zip(buffers.iter_mut().zip(&mut plain)) {
             runs.block_pass(block, buf, &pass);
             runs.each_run(block, twin, &pass);
-            assert!(buf.sums == twin.sums, "block at {}", block.lo);
+            assert!(
+                buf.sums == twin.sums && buf.second == twin.second,
+                "block at {}",
+                block.lo
+            );
         }
         assert!(
             buffers[0].sums[0].iter().any(|&f| f != 0.0),
