@@ -248,8 +248,8 @@ impl ForceSet {
     /// bits), fused with the caller's per-particle work `then(range, f)` (a step's update),
     /// which gets each range's forces as soon as they are summed, while they are still in
     /// the cache. Two team sections in all, where the term-by-term path takes one or two
-    /// per term: the blocks of every spring term, then per range of particles the zeroed
-    /// forces, each term in order, and `then`. Both sections are cut into pieces that the
+    /// per term: the blocks of every spring term, then per range of particles each term in
+    /// order (the first overwriting the forces, or adding to zeros), and `then`. Both sections are cut into pieces that the
     /// team's members take as they come ([`Team::run_pieces`]). A term's time is the calling
     /// thread's time on the pieces it ran; their sum is returned. `None`, with nothing done,
     /// when a term does not [take components](Force::takes_components) or the arrays are
@@ -322,17 +322,22 @@ impl ForceSet {
             let range = (lines.start * LINE).min(n)..(lines.end * LINE).min(n);
             // SAFETY: the pieces are disjoint (shares of whole lines), each run once.
             let [fx, fy, fz] = std::array::from_fn(|c| unsafe { out[c].part(range.clone()) });
-            for o in [&mut *fx, &mut *fy, &mut *fz] {
-                o.fill(0.0);
-            }
             let mass = &model.mass[range.clone()];
             let v = vel.each_ref().map(|v| &v[range.clone()]);
             let mut pairs = passes.iter().flatten().peekable();
+            // The first term overwrites the forces when it is a spring term (the usual
+            // case); before any other, they are zeroed.
+            if !matches!(pairs.peek(), Some((0, _))) {
+                [&mut *fx, &mut *fy, &mut *fz]
+                    .into_iter()
+                    .for_each(|o| o.fill(0.0));
+            }
             for (slot, term) in self.terms.iter().enumerate() {
                 let pair = pairs.next_if(|(at, _)| *at == slot);
                 timed(i, slot, &mut || {
                     let f = [&mut *fx, &mut *fy, &mut *fz];
                     match pair {
+                        Some((_, p)) if slot == 0 => p.write_to(range.clone(), f),
                         Some((_, p)) => p.add_to(range.clone(), f),
                         None => term.add_pointwise(mass, v, f),
                     }

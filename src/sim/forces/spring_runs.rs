@@ -279,14 +279,43 @@ impl SpringRuns {
     /// Adds the blocks' sums over particles `range` to `out` (that range of the forces),
     /// each block's in block order.
     fn add_sums(&self, blocks: &[BlockBuffers], range: Range<usize>, out: [&mut [f32]; 3]) {
+        self.sum_blocks(blocks, range, out, false);
+    }
+
+    /// As [`SpringRuns::add_sums`], but `write`: the first sum to reach each particle of
+    /// `out` overwrites it (`0 + x`, the bits of adding to zero), and the particles past
+    /// `range` (to the end of `out`) are set to zero; so `out` needs no zeroing first.
+    fn sum_blocks(
+        &self,
+        blocks: &[BlockBuffers],
+        range: Range<usize>,
+        out: [&mut [f32]; 3],
+        write: bool,
+    ) {
         let [ox, oy, oz] = out;
+        let len = ox.len().min(oy.len()).min(oz.len());
+        // With `write`, the particles `..done` (from the range's start) have had a sum.
+        let mut done = if write { 0 } else { len };
         self.cover_range(blocks, range, |at, sums| {
+            let end = at + sums[0].len();
+            // Each block reaches from its first particle to at least the next block's: they
+            // leave no gap.
+            debug_assert!(done >= at, "a gap before {at}");
             for (out, s) in [&mut *ox, &mut *oy, &mut *oz].into_iter().zip(sums) {
-                for (o, &x) in out[at..at + s.len()].iter_mut().zip(s) {
+                let fresh = done.clamp(at, end);
+                let (added, written) = out[at..end].split_at_mut(fresh - at);
+                for (o, &x) in added.iter_mut().zip(s) {
                     *o += x;
                 }
+                for (o, &x) in written.iter_mut().zip(&s[fresh - at..]) {
+                    *o = 0.0 + x;
+                }
             }
+            done = done.max(end);
         });
+        for out in [ox, oy, oz] {
+            out[done.min(len)..len].fill(0.0);
+        }
     }
 
     /// Calls `gather` for the `BLOCK`-particle chunks of `forces` (the first `n` particles'
@@ -407,29 +436,28 @@ impl SpringRuns {
     }
 
     /// Fills one block's sums: [`RunPass::run`] for each of its runs, then
-    /// `sums = first ∓ second` ([`RunPass::combine`]).
+    /// `sums = first ∓ second` ([`RunPass::combine`]). The first run writes its slices of
+    /// the buffers rather than adding to them, so only the rest of them is zeroed first.
     #[inline(always)]
     fn each_run(&self, block: &Block, buf: &mut BlockBuffers, pass: &impl RunPass) {
         let (sums, second) = (&mut buf.sums, &mut buf.second);
-        for s in sums.iter_mut().chain(second.iter_mut()) {
-            s.fill(0.0);
+        let runs = &self.runs[block.runs.clone()];
+        let Some((first, rest)) = runs.split_first() else {
+            sums.iter_mut()
+                .chain(second.iter_mut())
+                .for_each(|s| s.fill(0.0));
+            return;
+        };
+        let [at_a, at_b] = Self::slices(block, first);
+        for (buffer, written) in [(&mut *sums, at_a), (&mut *second, at_b)] {
+            for s in buffer {
+                s[..written.start].fill(0.0);
+                s[written.end..].fill(0.0);
+            }
         }
-        for r in &self.runs[block.runs.clone()] {
-            let (a, off, len) = (r.a as usize, r.off as usize, r.len as usize);
-            let springs = r.start as usize..r.start as usize + len;
-            let ends = [a..a + len, a + off..a + off + len];
-            let (at_a, at_b) = (
-                a - block.lo..a - block.lo + len,
-                a + off - block.lo..a + off - block.lo + len,
-            );
-            let [s0, s1, s2] = &mut *sums;
-            let [t0, t1, t2] = &mut *second;
-            pass.run(
-                ends,
-                springs,
-                [&mut s0[at_a.clone()], &mut s1[at_a.clone()], &mut s2[at_a]],
-                [&mut t0[at_b.clone()], &mut t1[at_b.clone()], &mut t2[at_b]],
-            );
+        self.one_run::<true>(block, first, sums, second, pass);
+        for r in rest {
+            self.one_run::<false>(block, r, sums, second, pass);
         }
         for (s, t) in sums.iter_mut().zip(second.iter()) {
             match pass.combine() {
@@ -437,6 +465,38 @@ impl SpringRuns {
                 Combine::Add => s.iter_mut().zip(t).for_each(|(s, &t)| *s += t),
             }
         }
+    }
+
+    /// Where run `r` lands in its block's buffers: at its first ends and at its second.
+    #[inline(always)]
+    fn slices(block: &Block, r: &Run) -> [Range<usize>; 2] {
+        let (a, off, len) = (r.a as usize - block.lo, r.off as usize, r.len as usize);
+        [a..a + len, a + off..a + off + len]
+    }
+
+    /// Run `r` of `block` by `pass`, written into its slices of the buffers (`WRITE`) or
+    /// added to them.
+    #[inline(always)]
+    fn one_run<const WRITE: bool>(
+        &self,
+        block: &Block,
+        r: &Run,
+        sums: &mut Components,
+        second: &mut Components,
+        pass: &impl RunPass,
+    ) {
+        let (a, off, len) = (r.a as usize, r.off as usize, r.len as usize);
+        let springs = r.start as usize..r.start as usize + len;
+        let ends = [a..a + len, a + off..a + off + len];
+        let [at_a, at_b] = Self::slices(block, r);
+        let [s0, s1, s2] = sums;
+        let [t0, t1, t2] = second;
+        pass.run::<WRITE>(
+            ends,
+            springs,
+            [&mut s0[at_a.clone()], &mut s1[at_a.clone()], &mut s2[at_a]],
+            [&mut t0[at_b.clone()], &mut t1[at_b.clone()], &mut t2[at_b]],
+        );
     }
 
     /// `K` numbers per spring (`value(e)` for spring `e` as given to [`SpringRuns::new`]) in
@@ -513,6 +573,13 @@ impl TwoPasses<'_> {
         let end = range.end.min(self.runs.particles);
         (self.runs).add_sums(&self.bufs.blocks, range.start..end, f);
     }
+
+    /// As [`TwoPasses::add_to`], but overwrites `f` (which needs no zeroing first): the
+    /// same bits as adding to zeros. Particles past the springs' last one get zero.
+    pub fn write_to(&self, range: Range<usize>, f: [&mut [f32]; 3]) {
+        let end = range.end.min(self.runs.particles).max(range.start);
+        (self.runs).sum_blocks(&self.bufs.blocks, range.start..end, f, true);
+    }
 }
 
 impl BlockPass<'_> {
@@ -540,11 +607,12 @@ impl BlockPass<'_> {
 }
 
 /// What a block pass does with each run: `run` gets the run's two ranges of ends, its
-/// springs (run order) and its slices of the block's sums at its first and second ends.
+/// springs (run order) and its slices of the block's sums at its first and second ends,
+/// which it overwrites (`WRITE`: `0 + x`, the bits of adding to zero) or adds to.
 trait RunPass: Sync {
     /// How the sums at second ends join those at first ends.
     fn combine(&self) -> Combine;
-    fn run(
+    fn run<const WRITE: bool>(
         &self,
         ends: [Range<usize>; 2],
         springs: Range<usize>,
@@ -566,7 +634,7 @@ impl RunPass for ForcePass<'_> {
     }
 
     #[inline(always)]
-    fn run(
+    fn run<const WRITE: bool>(
         &self,
         [ea, eb]: [Range<usize>; 2],
         springs: Range<usize>,
@@ -574,7 +642,7 @@ impl RunPass for ForcePass<'_> {
         second: [&mut [f32]; 3],
     ) {
         let (p, v, r) = (self.p, self.v, self.runs);
-        kernel(
+        kernel::<WRITE>(
             at(p, &ea),
             at(p, &eb),
             at(v, &ea),
@@ -602,7 +670,7 @@ impl RunPass for ProductPass<'_> {
     }
 
     #[inline(always)]
-    fn run(
+    fn run<const WRITE: bool>(
         &self,
         [ea, eb]: [Range<usize>; 2],
         springs: Range<usize>,
@@ -619,16 +687,17 @@ impl RunPass for ProductPass<'_> {
         let [t0, t1, t2] = second;
         let (f0, f1, f2) = (&mut f0[..n], &mut f1[..n], &mut f2[..n]);
         let (t0, t1, t2) = (&mut t0[..n], &mut t1[..n], &mut t2[..n]);
+        let was = |o: f32| if WRITE { 0.0 } else { o };
         for j in 0..n {
             // S·w = α·w + β(n·w)·n.
             let db = be[j] * (nx[j] * bx[j] + ny[j] * by[j] + nz[j] * bz[j]);
-            f0[j] += al[j] * bx[j] + db * nx[j];
-            f1[j] += al[j] * by[j] + db * ny[j];
-            f2[j] += al[j] * bz[j] + db * nz[j];
+            f0[j] = was(f0[j]) + (al[j] * bx[j] + db * nx[j]);
+            f1[j] = was(f1[j]) + (al[j] * by[j] + db * ny[j]);
+            f2[j] = was(f2[j]) + (al[j] * bz[j] + db * nz[j]);
             let da = be[j] * (nx[j] * ax[j] + ny[j] * ay[j] + nz[j] * az[j]);
-            t0[j] += al[j] * ax[j] + da * nx[j];
-            t1[j] += al[j] * ay[j] + da * ny[j];
-            t2[j] += al[j] * az[j] + da * nz[j];
+            t0[j] = was(t0[j]) + (al[j] * ax[j] + da * nx[j]);
+            t1[j] = was(t1[j]) + (al[j] * ay[j] + da * ny[j]);
+            t2[j] = was(t2[j]) + (al[j] * az[j] + da * nz[j]);
         }
     }
 }
@@ -657,8 +726,10 @@ enum Combine {
 /// added to `first` (at the first ends) and to `second` (at the second ends, where it is
 /// subtracted later). Computed as `g·d` with `g = [k(|d| − l₀) + c((v_b − v_a)·d)/|d|]/|d|`,
 /// with fused multiply-adds: 27 operations a spring where `n = d/|d|` first took 36.
+/// `WRITE`: overwrites `first` and `second` instead (with `g·d + 0`, the same bits as
+/// adding to zeroed sums).
 #[inline(always)]
-fn kernel(
+fn kernel<const WRITE: bool>(
     xa: [&[f32]; 3],
     xb: [&[f32]; 3],
     va: [&[f32]; 3],
@@ -685,12 +756,13 @@ fn kernel(
         let along = uz.mul_add(dz, uy.mul_add(dy, ux * dx));
         let s = c[j].mul_add(along * inv, k[j] * (len - rest[j]));
         let g = s * inv;
-        ox[j] = g.mul_add(dx, ox[j]);
-        oy[j] = g.mul_add(dy, oy[j]);
-        oz[j] = g.mul_add(dz, oz[j]);
-        tx[j] = g.mul_add(dx, tx[j]);
-        ty[j] = g.mul_add(dy, ty[j]);
-        tz[j] = g.mul_add(dz, tz[j]);
+        let was = |o: f32| if WRITE { 0.0 } else { o };
+        ox[j] = g.mul_add(dx, was(ox[j]));
+        oy[j] = g.mul_add(dy, was(oy[j]));
+        oz[j] = g.mul_add(dz, was(oz[j]));
+        tx[j] = g.mul_add(dx, was(tx[j]));
+        ty[j] = g.mul_add(dy, was(ty[j]));
+        tz[j] = g.mul_add(dz, was(tz[j]));
     }
 }
 
@@ -834,6 +906,19 @@ mod tests {
         }
         // On component arrays: the same bits.
         assert!(got == on_components(&runs, &pos, &vel, &start));
+        // Buffers reused at another state: the forces there, as from runs never used (each
+        // block's first run overwrites its slices, the rest of its buffers is zeroed).
+        let moved: Vec<Vec3> = (pos.iter().enumerate())
+            .map(|(p, x)| *x * 1.02 + Vec3::new(0.0, 0.0, 0.001 * (p % 3) as f32))
+            .collect();
+        let (mut reused, mut fresh) = (start.clone(), start.clone());
+        runs.add_forces(&moved, &vel, &mut reused);
+        SpringRuns::new(n, &a, &b, &rest, &k, &c).add_forces(&moved, &vel, &mut fresh);
+        assert!(
+            reused == fresh,
+            "sums of the last state stayed in the buffers"
+        );
+        assert!(reused != got, "the moved state gave the same forces");
         // New strengths without rebuilding the runs: the same as runs built with them.
         let stiffer: Vec<f32> = k.iter().map(|k| 2.0 * k).collect();
         let mut changed = runs.clone();
@@ -887,6 +972,49 @@ mod tests {
             buffers[0].sums[0].iter().any(|&f| f != 0.0),
             "no forces at all"
         );
+    }
+
+    /// [`TwoPasses::write_to`] overwrites what was there with the bits
+    /// [`TwoPasses::add_to`] adds to zeros: over ranges that start and end inside blocks,
+    /// span several, and reach past the last particle (which get zero).
+    #[test]
+    fn written_sums_are_the_added_ones_whatever_was_there() {
+        let (w, h) = (70usize, 40usize);
+        let n = w * h;
+        let mut rnd = crate::test_rng::uniform(31);
+        let pos: Vec<Vec3> = (0..n)
+            .map(|p| Vec3::new((p % w) as f32, -((p / w) as f32), rnd()) * 0.01)
+            .collect();
+        let vel: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
+        let (a, b) = stencil(w, h, &[(1, 0), (0, 1), (1, 1), (2, 0)]);
+        let rest: Vec<f32> = (0..a.len()).map(|_| 0.008 + 0.01 * rnd()).collect();
+        let (k, c) = (vec![400.0; a.len()], vec![0.02; a.len()]);
+        let runs = SpringRuns::new(n, &a, &b, &rest, &k, &c);
+        assert!(runs.blocks.len() >= 3, "the test spans several blocks");
+        let (mut p, mut v) = (Components::default(), Components::default());
+        split(&pos, &mut p, n);
+        split(&vel, &mut v, n);
+        let mut two = runs.two_passes();
+        let blocks = two.blocks();
+        (0..blocks.len()).for_each(|b| blocks.fill(b, &p, &v));
+        let past = n + 40;
+        let ranges = [
+            0..past,
+            5..1000,
+            1000..2048,
+            1500..2600,
+            2040..past,
+            n - 3..past,
+        ];
+        for range in ranges {
+            let len = range.len();
+            let mut added: Components = std::array::from_fn(|_| vec![0.0; len]);
+            two.add_to(range.clone(), added.each_mut().map(|a| &mut a[..]));
+            let mut written: Components = std::array::from_fn(|_| vec![f32::NAN; len]);
+            two.write_to(range.clone(), written.each_mut().map(|a| &mut a[..]));
+            assert!(written == added, "{range:?}");
+            assert!(added[0].iter().any(|&f| f != 0.0), "{range:?}: no forces");
+        }
     }
 
     /// Block products against the plain per-spring sum, on one thread and on two.
