@@ -91,8 +91,9 @@ struct Buffers {
 
 #[derive(Clone, Debug, Default)]
 struct BlockBuffers {
-    /// The sums (built as the forces on first ends, less `second`).
-    sums: Components,
+    /// The sums at first ends (the block's sums are `first − second`, taken as they are
+    /// gathered).
+    first: Components,
     /// The forces on second ends (subtracted), summed apart so that one vector loop adds at
     /// both ends of a run, however near its offset.
     second: Components,
@@ -223,11 +224,15 @@ impl SpringRuns {
             |chunks| {
                 // SAFETY: each chunk is taken by one call only (see `each_chunk`).
                 let out = unsafe { chunks.forces.part(chunks.particles.clone()) };
-                self.cover_range(blocks, chunks.particles, |at, [sx, sy, sz]| {
-                    for (j, o) in out[at..at + sx.len()].iter_mut().enumerate() {
-                        *o += Vec3::new(sx[j], sy[j], sz[j]);
-                    }
-                });
+                self.cover_range(
+                    blocks,
+                    chunks.particles,
+                    |at, [sx, sy, sz], [tx, ty, tz]| {
+                        for (j, o) in out[at..at + sx.len()].iter_mut().enumerate() {
+                            *o += Vec3::new(sx[j] - tx[j], sy[j] - ty[j], sz[j] - tz[j]);
+                        }
+                    },
+                );
             },
             &mut f[..n],
         );
@@ -296,19 +301,21 @@ impl SpringRuns {
         let len = ox.len().min(oy.len()).min(oz.len());
         // With `write`, the particles `..done` (from the range's start) have had a sum.
         let mut done = if write { 0 } else { len };
-        self.cover_range(blocks, range, |at, sums| {
-            let end = at + sums[0].len();
+        self.cover_range(blocks, range, |at, first, second| {
+            let end = at + first[0].len();
             // Each block reaches from its first particle to at least the next block's: they
             // leave no gap.
             debug_assert!(done >= at, "a gap before {at}");
-            for (out, s) in [&mut *ox, &mut *oy, &mut *oz].into_iter().zip(sums) {
-                let fresh = done.clamp(at, end);
-                let (added, written) = out[at..end].split_at_mut(fresh - at);
-                for (o, &x) in added.iter_mut().zip(s) {
-                    *o += x;
+            let outs = [&mut *ox, &mut *oy, &mut *oz].into_iter();
+            for (out, (s, t)) in outs.zip(first.into_iter().zip(second)) {
+                let fresh = done.clamp(at, end) - at;
+                let (added, written) = out[at..end].split_at_mut(fresh);
+                for ((o, &s), &t) in added.iter_mut().zip(s).zip(t) {
+                    *o += s - t;
                 }
-                for (o, &x) in written.iter_mut().zip(&s[fresh - at..]) {
-                    *o = 0.0 + x;
+                let (s, t) = (&s[fresh..], &t[fresh..]);
+                for ((o, &s), &t) in written.iter_mut().zip(s).zip(t) {
+                    *o = 0.0 + (s - t);
                 }
             }
             done = done.max(end);
@@ -374,7 +381,7 @@ impl SpringRuns {
     fn size_buffers(&self, bufs: &mut Vec<BlockBuffers>) {
         bufs.resize_with(self.blocks.len(), Default::default);
         for (buf, block) in bufs.iter_mut().zip(&self.blocks) {
-            for sums in buf.sums.iter_mut().chain(&mut buf.second) {
+            for sums in buf.first.iter_mut().chain(&mut buf.second) {
                 sums.resize(block.hi - block.lo, 0.0);
             }
         }
@@ -390,23 +397,28 @@ impl SpringRuns {
         TwoPasses { runs: self, bufs }
     }
 
-    /// Calls `add(at, sums)` for each block's sums over the particles `lo..hi`, in block
-    /// order; `at` is where from `lo` they start.
+    /// Calls `add(at, first, second)` for each block's buffers over the particles `lo..hi`
+    /// (its sums are `first − second`), in block order; `at` is where from `lo` they start.
     fn cover_range(
         &self,
         buffers: &[BlockBuffers],
         std::ops::Range { start: lo, end: hi }: std::ops::Range<usize>,
-        mut add: impl FnMut(usize, [&[f32]; 3]),
+        mut add: impl FnMut(usize, [&[f32]; 3], [&[f32]; 3]),
     ) {
         let blocks = self.blocks.iter().zip(buffers);
         for (b, buf) in blocks.take_while(|(b, _)| b.lo < hi) {
             let (from, to) = (lo.max(b.lo), hi.min(b.hi));
             if from < to {
                 let range = from - b.lo..to - b.lo;
-                let s = &buf.sums;
+                let (f, t) = (&buf.first, &buf.second);
                 add(
                     from - lo,
-                    [&s[0][range.clone()], &s[1][range.clone()], &s[2][range]],
+                    [
+                        &f[0][range.clone()],
+                        &f[1][range.clone()],
+                        &f[2][range.clone()],
+                    ],
+                    [&t[0][range.clone()], &t[1][range.clone()], &t[2][range]],
                 );
             }
         }
@@ -435,12 +447,12 @@ impl SpringRuns {
         self.each_run(block, buf, pass);
     }
 
-    /// Fills one block's sums: [`RunPass::run`] for each of its runs, then
-    /// `sums = first ∓ second` ([`RunPass::combine`]). The first run writes its slices of
-    /// the buffers rather than adding to them, so only the rest of them is zeroed first.
+    /// Fills one block's buffers: [`RunPass::run`] for each of its runs. The first run
+    /// writes its slices of them rather than adding to them, so only the rest of them is
+    /// zeroed first.
     #[inline(always)]
     fn each_run(&self, block: &Block, buf: &mut BlockBuffers, pass: &impl RunPass) {
-        let (sums, second) = (&mut buf.sums, &mut buf.second);
+        let (sums, second) = (&mut buf.first, &mut buf.second);
         let runs = &self.runs[block.runs.clone()];
         let Some((first, rest)) = runs.split_first() else {
             sums.iter_mut()
@@ -458,12 +470,6 @@ impl SpringRuns {
         self.one_run::<true>(block, first, sums, second, pass);
         for r in rest {
             self.one_run::<false>(block, r, sums, second, pass);
-        }
-        for (s, t) in sums.iter_mut().zip(second.iter()) {
-            match pass.combine() {
-                Combine::Subtract => s.iter_mut().zip(t).for_each(|(s, &t)| *s -= t),
-                Combine::Add => s.iter_mut().zip(t).for_each(|(s, &t)| *s += t),
-            }
         }
     }
 
@@ -607,11 +613,10 @@ impl BlockPass<'_> {
 }
 
 /// What a block pass does with each run: `run` gets the run's two ranges of ends, its
-/// springs (run order) and its slices of the block's sums at its first and second ends,
-/// which it overwrites (`WRITE`: `0 + x`, the bits of adding to zero) or adds to.
+/// springs (run order) and its slices of the block's buffers at its first ends and at its
+/// second ends (where what it puts is subtracted), which it overwrites (`WRITE`: `0 + x`,
+/// the bits of adding to zero) or adds to.
 trait RunPass: Sync {
-    /// How the sums at second ends join those at first ends.
-    fn combine(&self) -> Combine;
     fn run<const WRITE: bool>(
         &self,
         ends: [Range<usize>; 2],
@@ -629,10 +634,6 @@ struct ForcePass<'a> {
 }
 
 impl RunPass for ForcePass<'_> {
-    fn combine(&self) -> Combine {
-        Combine::Subtract
-    }
-
     #[inline(always)]
     fn run<const WRITE: bool>(
         &self,
@@ -665,10 +666,6 @@ struct ProductPass<'a> {
 }
 
 impl RunPass for ProductPass<'_> {
-    fn combine(&self) -> Combine {
-        Combine::Add
-    }
-
     #[inline(always)]
     fn run<const WRITE: bool>(
         &self,
@@ -695,9 +692,10 @@ impl RunPass for ProductPass<'_> {
             f1[j] = was(f1[j]) + (al[j] * by[j] + db * ny[j]);
             f2[j] = was(f2[j]) + (al[j] * bz[j] + db * nz[j]);
             let da = be[j] * (nx[j] * ax[j] + ny[j] * ay[j] + nz[j] * az[j]);
-            t0[j] = was(t0[j]) + (al[j] * ax[j] + da * nx[j]);
-            t1[j] = was(t1[j]) + (al[j] * ay[j] + da * ny[j]);
-            t2[j] = was(t2[j]) + (al[j] * az[j] + da * nz[j]);
+            // Subtracted when gathered.
+            t0[j] = was(t0[j]) - (al[j] * ax[j] + da * nx[j]);
+            t1[j] = was(t1[j]) - (al[j] * ay[j] + da * ny[j]);
+            t2[j] = was(t2[j]) - (al[j] * az[j] + da * nz[j]);
         }
     }
 }
@@ -710,15 +708,6 @@ fn at<'a>(c: &'a Components, range: &Range<usize>) -> [&'a [f32]; 3] {
         &c[1][range.clone()],
         &c[2][range.clone()],
     ]
-}
-
-/// How a block's sums at second ends join those at first ends.
-#[derive(Clone, Copy)]
-enum Combine {
-    /// Forces: equal and opposite at the two ends.
-    Subtract,
-    /// Block products: each end gets its own.
-    Add,
 }
 
 /// The force on each spring's first end, for springs whose ends' positions and velocities
@@ -963,13 +952,13 @@ mod tests {
             runs.block_pass(block, buf, &pass);
             runs.each_run(block, twin, &pass);
             assert!(
-                buf.sums == twin.sums && buf.second == twin.second,
+                buf.first == twin.first && buf.second == twin.second,
                 "block at {}",
                 block.lo
             );
         }
         assert!(
-            buffers[0].sums[0].iter().any(|&f| f != 0.0),
+            buffers[0].first[0].iter().any(|&f| f != 0.0),
             "no forces at all"
         );
     }
