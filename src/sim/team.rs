@@ -188,6 +188,22 @@ impl Team {
             }
         });
     }
+
+    /// [`Team::run_pieces`] when `parallel` (and the team has helpers), else every piece in
+    /// order on the calling thread, as member 0: for work big enough to share only from
+    /// some size on.
+    pub fn run_pieces_if(
+        &self,
+        parallel: bool,
+        pieces: usize,
+        work: &(dyn Fn(usize, usize) + Sync),
+    ) {
+        if parallel && self.members() > 1 {
+            self.run_pieces(pieces, work);
+        } else {
+            (0..pieces).for_each(|piece| work(0, piece));
+        }
+    }
 }
 
 /// A counter alone on its cache line (two lines: neighbouring lines are fetched together).
@@ -510,6 +526,15 @@ mod tests {
         let order = Mutex::new(Vec::new());
         team.run_pieces(10, &|_, piece| order.lock().unwrap().push(piece));
         assert_eq!(order.into_inner().unwrap(), (0..10).collect::<Vec<_>>());
+        // Not shared out: every piece in order on the caller, as member 0.
+        team.shared.helpers_stay_away.store(false, Ordering::SeqCst);
+        let (caller, ran) = (std::thread::current().id(), Mutex::new(Vec::new()));
+        team.run_pieces_if(false, 6, &|member, piece| {
+            let here = std::thread::current().id() == caller;
+            ran.lock().unwrap().push((member, piece, here));
+        });
+        let want: Vec<_> = (0..6).map(|piece| (0, piece, true)).collect();
+        assert_eq!(ran.into_inner().unwrap(), want);
     }
 
     #[test]

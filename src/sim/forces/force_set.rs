@@ -249,8 +249,9 @@ impl ForceSet {
     /// which gets each range's forces as soon as they are summed, while they are still in
     /// the cache. Two team sections in all, where the term-by-term path takes one or two
     /// per term: the blocks of every spring term, then per range of particles each term in
-    /// order (the first overwriting the forces, or adding to zeros), and `then`. Both sections are cut into pieces that the
-    /// team's members take as they come ([`Team::run_pieces`]). A term's time is the calling
+    /// order (a spring term that comes first overwrites the forces; before any other term
+    /// they are zeroed), and `then`. Both sections are cut into pieces that the team's
+    /// members take as they come ([`Team::run_pieces`]). A term's time is the calling
     /// thread's time on the pieces it ran; their sum is returned. `None`, with nothing done,
     /// when a term does not [take components](Force::takes_components) or the arrays are
     /// shorter than the springs reach.
@@ -281,15 +282,15 @@ impl ForceSet {
         for comp in f.iter_mut() {
             comp.resize(n, 0.0);
         }
+        let springs_first = matches!(passes[0], Some((0, _)));
         let team = Team::current();
         let members = if n >= PARALLEL_ELEMENTS {
             team.members()
         } else {
             1
         };
-        let run = |pieces: usize, work: &(dyn Fn(usize, usize) + Sync)| match members {
-            1 => (0..pieces).for_each(|piece| work(0, piece)),
-            _ => team.run_pieces(pieces, work),
+        let run = |pieces: usize, work: &(dyn Fn(usize, usize) + Sync)| {
+            team.run_pieces_if(members > 1, pieces, work)
         };
         // The caller's time per term, nanoseconds.
         let took: [AtomicU64; MAX_TERMS] = std::array::from_fn(|_| AtomicU64::new(0));
@@ -324,14 +325,12 @@ impl ForceSet {
             let [fx, fy, fz] = std::array::from_fn(|c| unsafe { out[c].part(range.clone()) });
             let mass = &model.mass[range.clone()];
             let v = vel.each_ref().map(|v| &v[range.clone()]);
-            let mut pairs = passes.iter().flatten().peekable();
-            // The first term overwrites the forces when it is a spring term (the usual
-            // case); before any other, they are zeroed.
-            if !matches!(pairs.peek(), Some((0, _))) {
+            if !springs_first {
                 [&mut *fx, &mut *fy, &mut *fz]
                     .into_iter()
                     .for_each(|o| o.fill(0.0));
             }
+            let mut pairs = passes.iter().flatten().peekable();
             for (slot, term) in self.terms.iter().enumerate() {
                 let pair = pairs.next_if(|(at, _)| *at == slot);
                 timed(i, slot, &mut || {

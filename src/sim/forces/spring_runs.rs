@@ -37,9 +37,9 @@ const MAX_GAP: u32 = 8;
 /// The run-order index of such a filler.
 const GHOST: u32 = u32::MAX;
 
-/// Force chunks one call of a gather takes.
+/// One chunk of forces for a gather.
 struct Chunks<'a, 'b, T> {
-    /// The particles they hold (whole chunks of `BLOCK` but the last).
+    /// The particles it holds (`BLOCK` of them, fewer in the last chunk).
     particles: std::ops::Range<usize>,
     forces: &'a Disjoint<'b, T>,
 }
@@ -325,29 +325,22 @@ impl SpringRuns {
         }
     }
 
-    /// Calls `gather` for the `BLOCK`-particle chunks of `forces` (the first `n` particles'
-    /// forces): one chunk a piece of a team section ([`Team::run_pieces`]) when the blocks
-    /// are many enough, else all at once; every chunk's sum is the same whoever takes it.
+    /// Calls `gather` for each `BLOCK`-particle chunk of `forces` (the first `n` particles'
+    /// forces): one chunk a piece of a team section ([`Team::run_pieces_if`]) when the
+    /// blocks are many enough; every chunk's sum is the same whoever takes it.
     fn each_chunk<T: Send>(
         &self,
         n: usize,
         gather: impl Fn(Chunks<'_, '_, T>) + Sync,
         forces: &mut [T],
     ) {
-        let chunks = n.div_ceil(BLOCK);
         let forces = Disjoint::new(forces);
-        let take = |indices: Range<usize>| {
+        (Team::current()).run_pieces_if(self.parallel(), n.div_ceil(BLOCK), &|_, c| {
             gather(Chunks {
-                particles: indices.start * BLOCK..(indices.end * BLOCK).min(n),
+                particles: c * BLOCK..((c + 1) * BLOCK).min(n),
                 forces: &forces,
-            });
-        };
-        let team = Team::current();
-        if self.parallel() && team.members() > 1 {
-            team.run_pieces(chunks, &|_, c| take(c..c + 1));
-        } else {
-            take(0..chunks);
-        }
+            })
+        });
     }
 
     /// Whether the blocks are many enough to run in parallel.
@@ -356,25 +349,18 @@ impl SpringRuns {
     }
 
     /// Every block's sums by `pass` (which fills one block's buffers), one block a piece of a
-    /// team section ([`Team::run_pieces`]) when they are many enough.
+    /// team section ([`Team::run_pieces_if`]) when they are many enough.
     fn block_sums(
         &self,
         bufs: &mut Vec<BlockBuffers>,
         pass: impl Fn(&Block, &mut BlockBuffers) + Sync,
     ) {
         self.size_buffers(bufs);
-        let team = Team::current();
-        if self.parallel() && team.members() > 1 {
-            let bufs = Disjoint::new(&mut bufs[..]);
-            team.run_pieces(self.blocks.len(), &|_, b| {
-                // SAFETY: each piece runs once, so each block's buffer has one member.
-                pass(&self.blocks[b], unsafe { bufs.at(b) })
-            });
-        } else {
-            for (block, buf) in self.blocks.iter().zip(bufs.iter_mut()) {
-                pass(block, buf);
-            }
-        }
+        let bufs = Disjoint::new(&mut bufs[..]);
+        (Team::current()).run_pieces_if(self.parallel(), self.blocks.len(), &|_, b| {
+            // SAFETY: each piece runs once, so each block's buffer has one member.
+            pass(&self.blocks[b], unsafe { bufs.at(b) })
+        });
     }
 
     /// One buffer per block, each as long as the block's reach.
@@ -452,24 +438,24 @@ impl SpringRuns {
     /// zeroed first.
     #[inline(always)]
     fn each_run(&self, block: &Block, buf: &mut BlockBuffers, pass: &impl RunPass) {
-        let (sums, second) = (&mut buf.first, &mut buf.second);
-        let runs = &self.runs[block.runs.clone()];
-        let Some((first, rest)) = runs.split_first() else {
-            sums.iter_mut()
+        let BlockBuffers { first, second } = buf;
+        let Some((lead, rest)) = self.runs[block.runs.clone()].split_first() else {
+            first
+                .iter_mut()
                 .chain(second.iter_mut())
                 .for_each(|s| s.fill(0.0));
             return;
         };
-        let [at_a, at_b] = Self::slices(block, first);
-        for (buffer, written) in [(&mut *sums, at_a), (&mut *second, at_b)] {
+        let [at_a, at_b] = Self::slices(block, lead);
+        for (buffer, written) in [(&mut *first, at_a), (&mut *second, at_b)] {
             for s in buffer {
                 s[..written.start].fill(0.0);
                 s[written.end..].fill(0.0);
             }
         }
-        self.one_run::<true>(block, first, sums, second, pass);
+        self.one_run::<true>(block, lead, first, second, pass);
         for r in rest {
-            self.one_run::<false>(block, r, sums, second, pass);
+            self.one_run::<false>(block, r, first, second, pass);
         }
     }
 
@@ -487,7 +473,7 @@ impl SpringRuns {
         &self,
         block: &Block,
         r: &Run,
-        sums: &mut Components,
+        first: &mut Components,
         second: &mut Components,
         pass: &impl RunPass,
     ) {
@@ -495,7 +481,7 @@ impl SpringRuns {
         let springs = r.start as usize..r.start as usize + len;
         let ends = [a..a + len, a + off..a + off + len];
         let [at_a, at_b] = Self::slices(block, r);
-        let [s0, s1, s2] = sums;
+        let [s0, s1, s2] = first;
         let [t0, t1, t2] = second;
         pass.run::<WRITE>(
             ends,
