@@ -93,6 +93,47 @@ fn quads_give_shear_diagonals_and_generator_matches_its_obj() {
     );
 }
 
+/// Particles come in the order of the file's `v` statements, not in the order faces first
+/// use them (tobj's): here the faces start from the last vertex, and a second object shares
+/// two vertices with the first, which weld into the particles the first object made.
+#[test]
+fn particles_keep_the_files_vertex_order() {
+    let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 2 0 0\nv 2 1 0\n\
+                o first\nf 4 3 1\nf 4 1 2\n\
+                o second\nf 6 4 2\nf 2 5 6\n";
+    let mesh = obj_from_str(text, "order.obj").unwrap().mesh;
+    let x = |i: usize| mesh.positions[i].to_array();
+    let want = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [2.0, 1.0, 0.0],
+    ];
+    assert_eq!((0..6).map(x).collect::<Vec<_>>(), want);
+    assert_eq!(mesh.triangles[0], [3, 2, 0]);
+    assert_eq!(mesh.triangles[2], [5, 3, 1]);
+}
+
+/// A grid's particles are numbered row by row (`j·(quads + 1) + i`), as its vertices are
+/// written and as the peer frameworks number theirs: neighbours along a row are one apart
+/// and along a column one row apart, everywhere (the spring runs' vector loops rely on it).
+#[test]
+fn a_grid_is_numbered_row_by_row() {
+    let spec = GridSpec::square(8, 1.0, GridOrientation::Vertical, glam::Vec3::ZERO);
+    let mesh = spec.build().unwrap();
+    assert_eq!(mesh.positions, spec.polygons().positions);
+    let row = 9;
+    for &[a, b] in &mesh.edges {
+        let step = b - a;
+        assert!(
+            step == 1 && b % row != 0 || step == row || step == row + 1 || step == row - 1,
+            "edge {a}–{b}"
+        );
+    }
+}
+
 /// A quad's two diagonals are both shear springs, so shear stiffness is the same along
 /// both diagonal directions; bend pairs never repeat each other, an edge or a diagonal.
 #[test]

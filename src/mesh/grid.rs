@@ -120,8 +120,8 @@ impl GridSpec {
         let soup = self.polygons();
         let mut mesh = build_mesh(&soup, Path::new("<grid>"))?.mesh;
         if bends == GridBends::SkipOne {
-            // Welding numbers particles by first use in the faces, not row by row: find
-            // each grid vertex's particle by its (exactly kept) position.
+            // Find each grid vertex's particle by its (exactly kept) position: the
+            // numbering is welding's business.
             let key = |p: Vec3| p.to_array().map(f32::to_bits);
             let particle: rustc_hash::FxHashMap<[u32; 3], u32> = mesh
                 .positions

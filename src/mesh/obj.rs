@@ -20,7 +20,7 @@ use super::validate::validate;
 /// [`ObjError::CoordinateTooLarge`], [`ObjError::IndexOutOfRange`], [`ObjError::TooMany`],
 /// [`ObjError::Empty`] (no faces), [`ObjError::Malformed`].
 pub fn parse_obj(text: &str, path: &Path) -> Result<PolygonSoup, ObjError> {
-    validate(text, path)?;
+    let corners = validate(text, path)?;
     let options = tobj::LoadOptions {
         triangulate: false,
         single_index: false,
@@ -82,7 +82,46 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<PolygonSoup, ObjError> {
     if all_have_uvs {
         soup.uvs = Some(uvs);
     }
+    in_file_order(&mut soup, &models, &corners);
     Ok(soup)
+}
+
+/// Puts the soup's vertices back in the order of the file's `v` statements. tobj numbers
+/// each object's vertices by first use in its faces, which for a grid written row by row
+/// interleaves its first two rows; the file's order keeps neighbours' numbers a fixed step
+/// apart (see `SpringRuns`), and an exported cloth comes back numbered as it was.
+/// `corners` holds the file vertex of every face corner (from the validation scan); when
+/// tobj's corners do not match them one for one, the order is left as it is.
+fn in_file_order(soup: &mut PolygonSoup, models: &[tobj::Model], corners: &[u32]) {
+    let mut file_vertex = vec![u32::MAX; soup.positions.len()];
+    let (mut base, mut corner) = (0usize, 0usize);
+    for model in models {
+        for &i in &model.mesh.indices {
+            match (file_vertex.get_mut(base + i as usize), corners.get(corner)) {
+                (Some(slot), Some(&v)) if *slot == u32::MAX || *slot == v => *slot = v,
+                _ => return,
+            }
+            corner += 1;
+        }
+        base += model.mesh.positions.len() / 3;
+    }
+    if corner != corners.len() || file_vertex.contains(&u32::MAX) {
+        return;
+    }
+    // Stable: a vertex two objects share stays twice, its copies next to each other.
+    let mut order: Vec<u32> = (0..soup.positions.len() as u32).collect();
+    order.sort_by_key(|&i| file_vertex[i as usize]);
+    let mut new_index = vec![0u32; order.len()];
+    for (new, &old) in order.iter().enumerate() {
+        new_index[old as usize] = new as u32;
+    }
+    soup.positions = order.iter().map(|&i| soup.positions[i as usize]).collect();
+    if let Some(uvs) = &mut soup.uvs {
+        *uvs = order.iter().map(|&i| uvs[i as usize]).collect();
+    }
+    for i in &mut soup.face_indices {
+        *i = new_index[*i as usize];
+    }
 }
 
 /// Writes a polygon soup as OBJ text (`v`, optional `vt`, and `f` lines).

@@ -235,7 +235,7 @@ fn pieces(particles: usize, triangles: &[[u32; 3]]) -> usize {
         .count()
 }
 
-/// Keeps only particles that a kept triangle uses, renumbered in first-use order; returns
+/// Keeps only particles that a kept triangle uses, numbered in their order; returns
 /// their positions, UVs and how many were dropped.
 fn compact(
     positions: &[Vec3],
@@ -243,15 +243,17 @@ fn compact(
     tri: &mut Triangulation,
 ) -> (Vec<Vec3>, Vec<Vec2>, usize) {
     let mut remap = vec![u32::MAX; positions.len()];
+    for &i in tri.triangles.iter().flatten() {
+        remap[i as usize] = 0;
+    }
     let (mut kept_pos, mut kept_uv) = (Vec::new(), Vec::new());
+    for (old, new) in remap.iter_mut().enumerate().filter(|(_, n)| **n == 0) {
+        *new = kept_pos.len() as u32;
+        kept_pos.push(positions[old]);
+        kept_uv.push(uvs[old]);
+    }
     for i in tri.triangles.iter_mut().flatten() {
-        let old = *i as usize;
-        if remap[old] == u32::MAX {
-            remap[old] = kept_pos.len() as u32;
-            kept_pos.push(positions[old]);
-            kept_uv.push(uvs[old]);
-        }
-        *i = remap[old];
+        *i = remap[*i as usize];
     }
     for d in &mut tri.cross_diagonals {
         // Both corners belong to the quad's kept triangles, so both are mapped.

@@ -6,13 +6,14 @@ use std::path::Path;
 use super::error::ObjError;
 use super::limits::{MAX_COORDINATE, MAX_TRIANGLES, MAX_VERTICES};
 
-/// Checks `text`; `path` names it in errors.
+/// Checks `text`; `path` names it in errors. Returns the vertex (0-based, in the order of
+/// the `v` statements) of every face corner, in order.
 ///
 /// # Errors
 /// The first problem: [`ObjError::NotText`] (a NUL byte), [`ObjError::TooMany`],
 /// [`ObjError::Parse`], [`ObjError::NonFinite`], [`ObjError::CoordinateTooLarge`],
 /// [`ObjError::IndexOutOfRange`].
-pub fn validate(text: &str, path: &Path) -> Result<(), ObjError> {
+pub fn validate(text: &str, path: &Path) -> Result<Vec<u32>, ObjError> {
     if let Some(offset) = text.bytes().position(|b| b == 0) {
         return Err(ObjError::NotText {
             path: path.to_path_buf(),
@@ -21,6 +22,7 @@ pub fn validate(text: &str, path: &Path) -> Result<(), ObjError> {
     }
     let total_positions = count_statements(text, path)?;
     let mut positions_so_far = 0usize;
+    let mut corners = Vec::new();
     for (n, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
         let at = Line {
@@ -29,7 +31,7 @@ pub fn validate(text: &str, path: &Path) -> Result<(), ObjError> {
             text: line,
         };
         match words.next() {
-            Some("f") => at.face(words, positions_so_far, total_positions)?,
+            Some("f") => at.face(words, positions_so_far, total_positions, &mut corners)?,
             Some("v") => {
                 at.numbers(words, "vertex position", 3, true)?;
                 positions_so_far += 1;
@@ -39,7 +41,7 @@ pub fn validate(text: &str, path: &Path) -> Result<(), ObjError> {
             _ => {}
         }
     }
-    Ok(())
+    Ok(corners)
 }
 
 /// Counts `v` statements and the triangles faces will make, refusing a file over the limits
@@ -87,12 +89,13 @@ impl Line<'_> {
     }
 
     /// A face: at least 3 corners, each a vertex index that exists (1-based, or negative
-    /// counting back from the last vertex so far).
+    /// counting back from the last vertex so far), pushed to `out` 0-based.
     fn face<'w>(
         &self,
         words: impl Iterator<Item = &'w str>,
         positions_so_far: usize,
         total: usize,
+        out: &mut Vec<u32>,
     ) -> Result<(), ObjError> {
         let corners: Vec<&str> = words.collect();
         if corners.len() < 3 {
@@ -116,6 +119,7 @@ impl Line<'_> {
                     count: total,
                 });
             }
+            out.push(resolved as u32);
         }
         Ok(())
     }

@@ -9,7 +9,8 @@ use super::polygons::PolygonSoup;
 
 /// The soup's corners welded into particles.
 pub struct Welded {
-    /// One position per particle (its first corner's), in first-use order.
+    /// One position per particle (its earliest vertex's), in the order of the soup's
+    /// vertices (a file's `v` statements), whatever order the faces use them in.
     pub positions: Vec<Vec3>,
     /// One texture coordinate per particle (the first corner's; zero without UVs).
     pub uvs: Vec<Vec2>,
@@ -17,7 +18,8 @@ pub struct Welded {
     pub corners: Vec<u32>,
 }
 
-/// Welds the corners of `soup`: a corner joins the earliest particle within `relative` ×
+/// Welds the corners of `soup`: each vertex a face uses, in the soup's order, joins the
+/// earliest particle within `relative` ×
 /// the soup's bounding-box diagonal; 0 welds only bit-equal positions (−0 and +0 count as
 /// equal).
 ///
@@ -40,12 +42,15 @@ pub fn weld(soup: &PolygonSoup, relative: f32) -> Welded {
     // A position seen before gets the same particle: particles made since have larger
     // numbers, so the earliest within reach is still the one it found.
     let mut seen = vec![NONE; soup.positions.len()];
+    // The vertices the faces use, in the file's order: particles keep the order the
+    // vertices were written in (row by row for a grid), which keeps neighbours' numbers
+    // close together (see `SpringRuns`).
+    let mut used = vec![false; soup.positions.len()];
     for &i in &soup.face_indices {
-        if let Some(&id) = seen.get(i as usize).filter(|&&id| id != NONE) {
-            out.corners.push(id);
-            continue;
-        }
-        let p = soup.positions[i as usize];
+        used[i as usize] = true;
+    }
+    for i in (0..soup.positions.len()).filter(|&i| used[i]) {
+        let p = soup.positions[i];
         let (home, found) = if tolerance > 0.0 {
             let scaled = p / cell;
             let home = scaled.floor();
@@ -72,13 +77,14 @@ pub fn weld(soup: &PolygonSoup, relative: f32) -> Welded {
             let id = out.positions.len() as u32;
             out.positions.push(p);
             out.uvs
-                .push(soup.uvs.as_ref().map_or(Vec2::ZERO, |uv| uv[i as usize]));
+                .push(soup.uvs.as_ref().map_or(Vec2::ZERO, |uv| uv[i]));
             elder.push(cells.insert(home, id).unwrap_or(NONE));
             id
         });
-        seen[i as usize] = id;
-        out.corners.push(id);
+        seen[i] = id;
     }
+    out.corners
+        .extend(soup.face_indices.iter().map(|&i| seen[i as usize]));
     out
 }
 
@@ -100,21 +106,20 @@ fn chain<'a>(
 mod tests {
     use super::*;
 
-    /// The rule itself, corner by corner against every particle so far.
+    /// The rule itself: each used vertex in the soup's order against every particle so far.
     fn brute_force(positions: &[Vec3], corners: &[u32], tolerance: f32) -> (Vec<Vec3>, Vec<u32>) {
-        let (mut particles, mut out) = (Vec::<Vec3>::new(), Vec::new());
-        for &i in corners {
-            let p = positions[i as usize];
-            let id = particles
-                .iter()
-                .position(|q| q.distance(p) <= tolerance)
-                .unwrap_or_else(|| {
+        let mut particles = Vec::<Vec3>::new();
+        let mut id = vec![u32::MAX; positions.len()];
+        for (i, &p) in positions.iter().enumerate() {
+            if corners.contains(&(i as u32)) {
+                let found = particles.iter().position(|q| q.distance(p) <= tolerance);
+                id[i] = found.unwrap_or_else(|| {
                     particles.push(p);
                     particles.len() - 1
-                });
-            out.push(id as u32);
+                }) as u32;
+            }
         }
-        (particles, out)
+        (particles, corners.iter().map(|&i| id[i as usize]).collect())
     }
 
     #[test]
@@ -131,9 +136,10 @@ mod tests {
         }
         positions.push(Vec3::ZERO);
         positions.push(Vec3::ONE); // bounding box diagonal √3
-        // Every position once, then again in another order (shared corners, as a mesh has).
+        // Every third position backwards, then every position (shared corners, as a mesh
+        // has): particles still come in the positions' order, not in the corners'.
         let n = positions.len() as u32;
-        let corners: Vec<u32> = (0..n).chain((0..n).rev().step_by(3)).collect();
+        let corners: Vec<u32> = (0..n).rev().step_by(3).chain(0..n).collect();
         let soup = PolygonSoup {
             positions: positions.clone(),
             uvs: None,
