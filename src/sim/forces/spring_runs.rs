@@ -396,16 +396,7 @@ impl SpringRuns {
             let (from, to) = (lo.max(b.lo), hi.min(b.hi));
             if from < to {
                 let range = from - b.lo..to - b.lo;
-                let (f, t) = (&buf.first, &buf.second);
-                add(
-                    from - lo,
-                    [
-                        &f[0][range.clone()],
-                        &f[1][range.clone()],
-                        &f[2][range.clone()],
-                    ],
-                    [&t[0][range.clone()], &t[1][range.clone()], &t[2][range]],
-                );
+                add(from - lo, at(&buf.first, &range), at(&buf.second, &range));
             }
         }
     }
@@ -906,26 +897,37 @@ mod tests {
         assert!(x != got, "the strengths changed nothing");
     }
 
+    /// Springs of a `w` × `h` grid's stencil `offsets`, 1 cm apart with jittered depths,
+    /// rest lengths and velocities (from `seed`), and their positions and velocities on
+    /// component arrays.
+    fn jittered_grid(
+        w: usize,
+        h: usize,
+        seed: u64,
+        offsets: &[(usize, usize)],
+    ) -> (SpringRuns, Components, Components) {
+        let n = w * h;
+        let mut rnd = crate::test_rng::uniform(seed);
+        let pos: Vec<Vec3> = (0..n)
+            .map(|p| Vec3::new((p % w) as f32, -((p / w) as f32), rnd()) * 0.01)
+            .collect();
+        let vel: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
+        let (a, b) = stencil(w, h, offsets);
+        let rest: Vec<f32> = (0..a.len()).map(|_| 0.008 + 0.01 * rnd()).collect();
+        let (k, c) = (vec![400.0; a.len()], vec![0.02; a.len()]);
+        let (mut p, mut v) = (Components::default(), Components::default());
+        split(&pos, &mut p, n);
+        split(&vel, &mut v, n);
+        (SpringRuns::new(n, &a, &b, &rest, &k, &c), p, v)
+    }
+
     /// The block passes compiled plainly and for AVX2 with FMA (the one the CPU runs)
     /// give the same bits: the fused multiply-adds are exact either way. (On a CPU without
     /// AVX2 and FMA both sides are the plain build, and this proves nothing there; CI's
     /// machines have both.)
     #[test]
     fn the_plain_and_the_vector_build_give_the_same_bits() {
-        let (w, h) = (40usize, 30usize);
-        let n = w * h;
-        let mut rnd = crate::test_rng::uniform(7);
-        let pos: Vec<Vec3> = (0..n)
-            .map(|p| Vec3::new((p % w) as f32, -((p / w) as f32), rnd()) * 0.02)
-            .collect();
-        let vel: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
-        let (a, b) = stencil(w, h, &[(1, 0), (0, 1), (1, 1), (0, 2)]);
-        let rest: Vec<f32> = (0..a.len()).map(|_| 0.015 + 0.01 * rnd()).collect();
-        let (k, c) = (vec![500.0; a.len()], vec![0.01; a.len()]);
-        let runs = SpringRuns::new(n, &a, &b, &rest, &k, &c);
-        let (mut p, mut v) = (Components::default(), Components::default());
-        split(&pos, &mut p, n);
-        split(&vel, &mut v, n);
+        let (runs, p, v) = jittered_grid(40, 30, 7, &[(1, 0), (0, 1), (1, 1), (0, 2)]);
         let pass = ForcePass {
             runs: &runs,
             p: &p,
@@ -954,21 +956,9 @@ mod tests {
     /// span several, and reach past the last particle (which get zero).
     #[test]
     fn written_sums_are_the_added_ones_whatever_was_there() {
-        let (w, h) = (70usize, 40usize);
-        let n = w * h;
-        let mut rnd = crate::test_rng::uniform(31);
-        let pos: Vec<Vec3> = (0..n)
-            .map(|p| Vec3::new((p % w) as f32, -((p / w) as f32), rnd()) * 0.01)
-            .collect();
-        let vel: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
-        let (a, b) = stencil(w, h, &[(1, 0), (0, 1), (1, 1), (2, 0)]);
-        let rest: Vec<f32> = (0..a.len()).map(|_| 0.008 + 0.01 * rnd()).collect();
-        let (k, c) = (vec![400.0; a.len()], vec![0.02; a.len()]);
-        let runs = SpringRuns::new(n, &a, &b, &rest, &k, &c);
+        let (runs, p, v) = jittered_grid(70, 40, 31, &[(1, 0), (0, 1), (1, 1), (2, 0)]);
+        let n = runs.particles;
         assert!(runs.blocks.len() >= 3, "the test spans several blocks");
-        let (mut p, mut v) = (Components::default(), Components::default());
-        split(&pos, &mut p, n);
-        split(&vel, &mut v, n);
         let mut two = runs.two_passes();
         let blocks = two.blocks();
         (0..blocks.len()).for_each(|b| blocks.fill(b, &p, &v));
