@@ -399,18 +399,12 @@ fn component_arrays_match_the_general_path(n: u32) {
     let model = &scene.model;
     // The scene's terms (springs first: the fused path overwrites the forces with them),
     // springs and gravity alone, and gravity first (the forces zeroed before it).
+    let mut springs_and_gravity = scene.effects.clone();
+    springs_and_gravity.retain(|e| matches!(e, Effect::Springs | Effect::Gravity));
     let mut gravity_first = scene.effects.clone();
     gravity_first.retain(|e| !matches!(e, Effect::Gravity));
     gravity_first.insert(0, Effect::Gravity);
-    for effects in [
-        scene.effects.clone(),
-        {
-            let mut e = scene.effects.clone();
-            e.retain(|e| matches!(e, Effect::Springs | Effect::Gravity));
-            e
-        },
-        gravity_first,
-    ] {
+    for effects in [scene.effects.clone(), springs_and_gravity, gravity_first] {
         let forces = ForceSet::new(model, &scene.params, &effects);
         assert!(forces.takes_components(), "{effects:?}");
         let mut start = scene.initial.clone();

@@ -12,7 +12,7 @@ pub struct Welded {
     /// One position per particle (its earliest vertex's), in the order of the soup's
     /// vertices (a file's `v` statements), whatever order the faces use them in.
     pub positions: Vec<Vec3>,
-    /// One texture coordinate per particle (the first corner's; zero without UVs).
+    /// One texture coordinate per particle (its earliest vertex's; zero without UVs).
     pub uvs: Vec<Vec2>,
     /// Particle of every face corner, parallel to `PolygonSoup::face_indices`.
     pub corners: Vec<u32>,
