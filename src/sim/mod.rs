@@ -16,6 +16,7 @@ mod self_collision;
 mod stats;
 pub mod team;
 mod timings;
+mod wide;
 
 pub use backend::StepBackend;
 pub use cg::{CgOutcome, ConjugateGradient};

@@ -4,6 +4,7 @@
 use glam::Vec3;
 
 use super::super::team::{each_part, within};
+use super::super::wide::wide;
 use super::components::Components;
 use super::jacobian::SystemMatrix;
 
@@ -34,11 +35,16 @@ impl AirDamping {
     /// As [`AirDamping::add_forces_components`] for one range of particles: `mass`, `vel`
     /// and `f` are that range's.
     pub fn add_range(&self, mass: &[f32], vel: [&[f32]; 3], f: [&mut [f32]; 3]) {
-        for (f, v) in f.into_iter().zip(vel) {
-            for ((f, v), &m) in f.iter_mut().zip(v).zip(mass) {
-                *f -= (self.rate * m) * *v;
-            }
-        }
+        wide(
+            #[inline(always)]
+            || {
+                for (f, v) in f.into_iter().zip(vel) {
+                    for ((f, v), &m) in f.iter_mut().zip(v).zip(mass) {
+                        *f -= (self.rate * m) * *v;
+                    }
+                }
+            },
+        )
     }
 
     /// Adds `∂f_i/∂v_i = −c·m_i·I` (N·s/m), its only non-zero derivative, to the system.

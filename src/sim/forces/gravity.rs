@@ -3,6 +3,7 @@
 use glam::Vec3;
 
 use super::super::team::{each_part, within};
+use super::super::wide::wide;
 use super::components::Components;
 
 /// Uniform gravitational acceleration, m/s².
@@ -30,11 +31,16 @@ impl Gravity {
     /// As [`Gravity::add_forces_components`] for one range of particles: `mass` and `f` are
     /// that range's.
     pub fn add_range(&self, mass: &[f32], f: [&mut [f32]; 3]) {
-        for (f, g) in f.into_iter().zip(self.g.to_array()) {
-            for (f, &m) in f.iter_mut().zip(mass) {
-                *f += m * g;
-            }
-        }
+        wide(
+            #[inline(always)]
+            || {
+                for (f, g) in f.into_iter().zip(self.g.to_array()) {
+                    for (f, &m) in f.iter_mut().zip(mass) {
+                        *f += m * g;
+                    }
+                }
+            },
+        )
     }
 
     /// `−Σ m·g·x`, joules.

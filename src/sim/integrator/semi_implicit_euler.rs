@@ -8,6 +8,7 @@ use super::step::{Integrator, StepError, StepReport};
 use crate::cloth::ClothState;
 use crate::sim::forces::{Components, join, split};
 use crate::sim::team::Disjoint;
+use crate::sim::wide::wide;
 
 /// `v ← v + a(x, v)·h`, then `x ← x + v·h` with the new velocity.
 ///
@@ -146,20 +147,11 @@ impl Integrator for SemiImplicitEuler {
 /// `v`. Written to other arrays than it reads: in place, the compiler keeps the unmoved
 /// particles by masked stores, which are slow on some CPUs. Compiled plainly and for AVX2
 /// (picked at run time): the same IEEE operations either way, so the same bits.
-fn update([x, v, f]: [&[f32]; 3], w: &[f32], h: f32, out: [&mut [f32]; 2]) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU supports AVX2 (checked just above).
-        unsafe { update_avx2([x, v, f], w, h, out) };
-        return;
-    }
-    update_in([x, v, f], w, h, out);
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn update_avx2(now: [&[f32]; 3], w: &[f32], h: f32, out: [&mut [f32]; 2]) {
-    update_in(now, w, h, out);
+fn update(now: [&[f32]; 3], w: &[f32], h: f32, out: [&mut [f32]; 2]) {
+    wide(
+        #[inline(always)]
+        || update_in(now, w, h, out),
+    )
 }
 
 #[inline(always)]
