@@ -300,40 +300,50 @@ impl SpringRuns {
     ) {
         wide(
             #[inline(always)]
-            || {
-                let [ox, oy, oz] = out;
-                let len = ox.len().min(oy.len()).min(oz.len());
-                // With `write`, the particles `..done` (from the range's start) have had a sum.
-                let mut done = if write { 0 } else { len };
-                self.cover_range(
-                    blocks,
-                    range,
-                    #[inline(always)]
-                    |at, first, second| {
-                        let end = at + first[0].len();
-                        // Each block reaches from its first particle to at least the next block's: they
-                        // leave no gap.
-                        debug_assert!(done >= at, "a gap before {at}");
-                        let outs = [&mut *ox, &mut *oy, &mut *oz].into_iter();
-                        for (out, (s, t)) in outs.zip(first.into_iter().zip(second)) {
-                            let fresh = done.clamp(at, end) - at;
-                            let (added, written) = out[at..end].split_at_mut(fresh);
-                            for ((o, &s), &t) in added.iter_mut().zip(s).zip(t) {
-                                *o += s - t;
-                            }
-                            let (s, t) = (&s[fresh..], &t[fresh..]);
-                            for ((o, &s), &t) in written.iter_mut().zip(s).zip(t) {
-                                *o = 0.0 + (s - t);
-                            }
-                        }
-                        done = done.max(end);
-                    },
-                );
-                for out in [ox, oy, oz] {
-                    out[done.min(len)..len].fill(0.0);
-                }
-            },
+            || self.sum_blocks_in(blocks, range, out, write),
         )
+    }
+
+    /// [`SpringRuns::sum_blocks`]'s work, inlined into its AVX2 build.
+    #[inline(always)]
+    fn sum_blocks_in(
+        &self,
+        blocks: &[BlockBuffers],
+        range: Range<usize>,
+        out: [&mut [f32]; 3],
+        write: bool,
+    ) {
+        let [ox, oy, oz] = out;
+        let len = ox.len().min(oy.len()).min(oz.len());
+        // With `write`, the particles `..done` (from the range's start) have had a sum.
+        let mut done = if write { 0 } else { len };
+        self.cover_range(
+            blocks,
+            range,
+            #[inline(always)]
+            |at, first, second| {
+                let end = at + first[0].len();
+                // Each block reaches from its first particle to at least the next block's: they
+                // leave no gap.
+                debug_assert!(done >= at, "a gap before {at}");
+                let outs = [&mut *ox, &mut *oy, &mut *oz].into_iter();
+                for (out, (s, t)) in outs.zip(first.into_iter().zip(second)) {
+                    let fresh = done.clamp(at, end) - at;
+                    let (added, written) = out[at..end].split_at_mut(fresh);
+                    for ((o, &s), &t) in added.iter_mut().zip(s).zip(t) {
+                        *o += s - t;
+                    }
+                    let (s, t) = (&s[fresh..], &t[fresh..]);
+                    for ((o, &s), &t) in written.iter_mut().zip(s).zip(t) {
+                        *o = 0.0 + (s - t);
+                    }
+                }
+                done = done.max(end);
+            },
+        );
+        for out in [ox, oy, oz] {
+            out[done.min(len)..len].fill(0.0);
+        }
     }
 
     /// Calls `gather` for each `BLOCK`-particle chunk of `forces` (the first `n` particles'
