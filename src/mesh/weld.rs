@@ -19,9 +19,8 @@ pub struct Welded {
 }
 
 /// Welds the corners of `soup`: each vertex a face uses, in the soup's order, joins the
-/// earliest particle within `relative` ×
-/// the soup's bounding-box diagonal; 0 welds only bit-equal positions (−0 and +0 count as
-/// equal).
+/// earliest particle within `relative` × the soup's bounding-box diagonal; 0 welds only
+/// bit-equal positions (−0 and +0 count as equal).
 ///
 /// Candidates come from a spatial hash of cubes twice the tolerance across: a particle
 /// within the tolerance of a corner lies in the corner's cube or in the neighbour on the
