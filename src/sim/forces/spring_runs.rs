@@ -14,7 +14,7 @@
 //! give bit-identical forces.
 
 use super::super::team::{Disjoint, PARALLEL_ELEMENTS, Team};
-use super::super::wide::wide;
+use super::super::wide::{wide, wide_fma};
 use super::components::{Components, Scratch, split};
 use std::ops::Range;
 
@@ -423,27 +423,13 @@ impl SpringRuns {
         }
     }
 
-    /// One block's sums by `pass`, run by run (see [`SpringRuns::each_run`]).
-    ///
-    /// Compiled twice, plainly and for AVX2 with FMA (picked at run time): the same IEEE
-    /// operations in the same order either way, so the results are identical. The fused
-    /// multiply-adds are written out (`mul_add`): one instruction with FMA, a correctly
-    /// rounded library call (the same result, more slowly) without.
+    /// One block's sums by `pass`, run by run (see [`SpringRuns::each_run`]), compiled for
+    /// AVX2 with FMA where the CPU has them ([`wide_fma`]): the same bits either way.
     fn block_pass(&self, block: &Block, buf: &mut BlockBuffers, pass: &impl RunPass) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-        {
-            // SAFETY: the CPU supports AVX2 and FMA (checked just above).
-            unsafe { self.block_pass_avx2(block, buf, pass) };
-            return;
-        }
-        self.each_run(block, buf, pass);
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    fn block_pass_avx2(&self, block: &Block, buf: &mut BlockBuffers, pass: &impl RunPass) {
-        self.each_run(block, buf, pass);
+        wide_fma(
+            #[inline(always)]
+            || self.each_run(block, buf, pass),
+        )
     }
 
     /// Fills one block's buffers: [`RunPass::run`] for each of its runs. The first run
