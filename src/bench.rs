@@ -57,7 +57,9 @@ pub struct BenchRow {
     /// Particles per side.
     pub n: u32,
     pub integrator: String,
+    /// The backend's name ("cpu", "gpu").
     pub backend: String,
+    /// CPU threads that stepped the cloth (1 on the GPU: the thread that submits its work).
     pub threads: usize,
     pub substeps_per_frame: u32,
     /// Wall time of the whole run per substep: every pause a busy machine imposes counts.
@@ -127,10 +129,10 @@ fn central(sim: &Simulation) -> Vec<usize> {
 /// # Errors
 /// [`SceneError`] for a bad `n`.
 pub fn bench_one(n: u32, integrator: IntegratorKind) -> Result<BenchRow, SceneError> {
-    bench_with(n, integrator, |scene| Ok(Simulation::new(scene)), "cpu")
+    bench_with(n, integrator, |scene| Ok(Simulation::new(scene)))
 }
 
-/// As [`bench_one`], with the simulation built by `make` (another backend), named `backend`.
+/// As [`bench_one`], with the simulation built by `make` (another backend).
 ///
 /// # Errors
 /// [`SceneError`] for a bad `n`, or what `make` returns.
@@ -138,7 +140,6 @@ pub fn bench_with(
     n: u32,
     integrator: IntegratorKind,
     make: impl FnOnce(Scene) -> Result<Simulation, SceneError>,
-    backend: &str,
 ) -> Result<BenchRow, SceneError> {
     let start = Instant::now();
     let mut sim = make(bench_scene(n, integrator)?)?;
@@ -189,8 +190,8 @@ pub fn bench_with(
     Ok(BenchRow {
         n,
         integrator: integrator.name().to_string(),
-        backend: backend.to_string(),
-        threads: rayon::current_num_threads(),
+        backend: sim.backend_name().to_string(),
+        threads: sim.cpu_threads(),
         substeps_per_frame: substeps,
         us_per_substep: us,
         substeps_per_second: 1e6 / us,

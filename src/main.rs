@@ -622,7 +622,8 @@ fn bench(
         && let Some(k) = integrators.iter().find(|&&k| k != GPU_INTEGRATOR)
     {
         bail!(
-            "--backend gpu runs semi-implicit Euler only, not {}",
+            "--backend gpu runs {} only, not {}",
+            GPU_INTEGRATOR.name(),
             k.name()
         );
     }
@@ -660,16 +661,11 @@ fn bench(
                     // current on the thread that made it, and a pool's thread still tearing
                     // that down while the process exits corrupts the heap (a crash at exit
                     // in a few runs in a hundred).
-                    Backend::Gpu => clothsim::bench::bench_with(
-                        n,
-                        k,
-                        |scene| {
-                            gpu_simulation(scene, false)
-                                .map(|(sim, _)| sim)
-                                .map_err(|e| clothsim::scene::SceneError::Backend(format!("{e:#}")))
-                        },
-                        "gpu",
-                    )?,
+                    Backend::Gpu => clothsim::bench::bench_with(n, k, |scene| {
+                        gpu_simulation(scene, false)
+                            .map(|(sim, _)| sim)
+                            .map_err(|e| clothsim::scene::SceneError::Backend(format!("{e:#}")))
+                    })?,
                 };
                 if json {
                     println!("{}", serde_json::to_string(&row)?);

@@ -120,15 +120,10 @@ fn bench_gives_xpbd_the_sweeps_its_sag_needs() {
         "sag {} with the bench's sweeps",
         row.sag_m
     );
-    let one_sweep = clothsim::bench::bench_with(
-        32,
-        IntegratorKind::Xpbd,
-        |mut scene| {
-            scene.params.solver.xpbd_iterations = 1;
-            Ok(clothsim::scene::Simulation::new(scene))
-        },
-        "cpu",
-    )
+    let one_sweep = clothsim::bench::bench_with(32, IntegratorKind::Xpbd, |mut scene| {
+        scene.params.solver.xpbd_iterations = 1;
+        Ok(clothsim::scene::Simulation::new(scene))
+    })
     .expect("runs");
     assert_eq!(one_sweep.sag_ok, Some(false), "sag {}", one_sweep.sag_m);
     assert!(one_sweep.sag_m > row.sag_m, "one sweep is softer");
@@ -222,7 +217,7 @@ fn bench_cli_refuses_bad_thread_counts_and_gpu_integrators_in_one_line() {
         "rk4",
     ]);
     assert!(
-        err.contains("semi-implicit Euler only") && err.contains("rk4"),
+        err.contains("semi-implicit-euler only") && err.contains("rk4"),
         "{err}"
     );
     let err = run(&["bench", "--sizes", "8", "--backend", "tpu"]);

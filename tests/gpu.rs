@@ -77,7 +77,11 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
     let mut rk4 = Scene::builtin("hanging").expect("scene");
     rk4.params.integrator = IntegratorKind::Rk4;
     let err = gpu_support(&rk4.params, &rk4.effects).expect_err("RK4 is CPU only");
-    assert!(err.to_string().contains("semi-implicit Euler"), "{err}");
+    let err = err.to_string();
+    assert!(
+        err.contains("runs Semi-implicit Euler only, not RK4"),
+        "{err}"
+    );
     assert_eq!(Backend::default(), Backend::Cpu);
     // Switching the integrator of a running GPU simulation fails the next frame, with the
     // reason, and keeps the state.
@@ -89,7 +93,11 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
     params.integrator = IntegratorKind::Rk4;
     sim.set_params(params).expect("valid parameters");
     let err = sim.step_frame().expect_err("unsupported");
-    assert!(err.reason.contains("semi-implicit Euler"), "{}", err.reason);
+    assert!(
+        err.reason.contains("Semi-implicit Euler only, not RK4"),
+        "{}",
+        err.reason
+    );
     assert_eq!(sim.state().pos, before.pos);
 }
 
@@ -217,21 +225,27 @@ fn the_gpu_cloth_is_drawn_from_its_buffer_without_a_read_back() {
 
 /// The GPU's frames are only queued when the bench's clock stops after each: the row has
 /// the run's mean (the last frame waited for) but no median or best frame, and the same
-/// sag as the CPU row within the backends' agreement.
+/// sag as the CPU row within the backends' agreement. Each row names its backend and the
+/// CPU threads that stepped it: the pool's for the CPU, the one submitting thread for the
+/// GPU, whatever pool the bench runs in.
 #[test]
 fn gpu_bench_row_has_the_run_mean_but_no_frame_spread() {
-    let gpu = clothsim::bench::bench_with(
-        16,
-        IntegratorKind::SemiImplicitEuler,
-        |scene| {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(3)
+        .build()
+        .expect("a pool of 3");
+    let (gpu, cpu) = pool.install(|| {
+        let gpu = clothsim::bench::bench_with(16, IntegratorKind::SemiImplicitEuler, |scene| {
             gpu_simulation(scene, false)
                 .map(|(sim, _)| sim)
                 .map_err(|e| clothsim::scene::SceneError::Backend(format!("{e:#}")))
-        },
-        "gpu",
-    )
-    .expect("GPU bench on the software adapter");
-    let cpu = clothsim::bench::bench_one(16, IntegratorKind::SemiImplicitEuler).expect("cpu");
+        })
+        .expect("GPU bench on the software adapter");
+        let cpu = clothsim::bench::bench_one(16, IntegratorKind::SemiImplicitEuler).expect("cpu");
+        (gpu, cpu)
+    });
+    assert_eq!((gpu.backend.as_str(), gpu.threads), ("gpu", 1));
+    assert_eq!((cpu.backend.as_str(), cpu.threads), ("cpu", 3));
     assert!(gpu.finite && gpu.us_per_substep > 0.0);
     assert_eq!((gpu.median_frame_us, gpu.best_frame_us), (None, None));
     assert!(cpu.median_frame_us.is_some() && cpu.best_frame_us.is_some());

@@ -79,7 +79,8 @@ pub const GPU_INTEGRATOR: IntegratorKind = IntegratorKind::SemiImplicitEuler;
 pub fn gpu_support(params: &SimParams, effects: &[Effect]) -> Result<(), GpuError> {
     if params.integrator != GPU_INTEGRATOR {
         return Err(GpuError::Unsupported(format!(
-            "runs semi-implicit Euler only, not {}",
+            "runs {} only, not {}",
+            GPU_INTEGRATOR.label(),
             params.integrator.label()
         )));
     }
@@ -651,6 +652,11 @@ impl StepBackend for GpuStepper {
     fn state_behind(&self) -> bool {
         // After a failed read-back there is nothing more to read.
         self.behind && self.lost.is_none()
+    }
+
+    /// The calling thread records and submits the device's work.
+    fn cpu_threads(&self) -> usize {
+        1
     }
 }
 

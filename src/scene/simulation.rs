@@ -409,6 +409,11 @@ impl Simulation {
         self.backend.state_behind()
     }
 
+    /// CPU threads that step the cloth (one for the GPU backend: the thread that submits).
+    pub fn cpu_threads(&self) -> usize {
+        self.backend.cpu_threads()
+    }
+
     /// Before an edit that reads or replaces part of the state or the model: brings the state
     /// up to date with the backend's copy, so the edit starts from the latest frame and
     /// what the backend takes afterwards is the edited latest frame. A copy that cannot be

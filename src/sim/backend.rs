@@ -85,4 +85,11 @@ pub trait StepBackend: Send {
     fn state_behind(&self) -> bool {
         false
     }
+
+    /// CPU threads that step the cloth: the current rayon pool's (whose size picks the
+    /// team, [`super::team::Team::current`]) for a backend that steps on the CPU; a backend
+    /// that only records and submits a device's work uses the one thread that calls it.
+    fn cpu_threads(&self) -> usize {
+        rayon::current_num_threads()
+    }
 }
