@@ -602,6 +602,14 @@ fn point_on_cloth(harness: &Harness<'static, ClothApp>) -> (egui::Pos2, u32) {
     panic!("no cloth in the view");
 }
 
+/// Steps `frames` simulation frames one at a time (paused), then shows the result.
+fn step_frames(harness: &mut Harness<'static, ClothApp>, frames: usize) {
+    for _ in 0..frames {
+        harness.state_mut().step_once();
+    }
+    run_settled(harness, 1);
+}
+
 #[test]
 fn dragging_the_cloth_pulls_a_particle_and_ctrl_click_pins_it_under_every_integrator() {
     use clothsim::sim::IntegratorKind;
@@ -618,10 +626,11 @@ fn dragging_the_cloth_pulls_a_particle_and_ctrl_click_pins_it_under_every_integr
         };
         harness.state_mut().reset();
         harness.state_mut().apply_params(params);
-        harness.state_mut().transport.playing = true;
-        run_settled(&mut harness, 2);
+        // Stepped a frame at a time, not played: frames played follow the wall clock, and
+        // pointer moves that meet no frame between them add up to one long jump.
+        step_frames(&mut harness, 2);
         let (at, _) = point_on_cloth(&harness);
-        // Press on the cloth and drag 60 points to the right over a few frames.
+        // Press on the cloth and drag 60 points to the right, one simulated frame per move.
         harness.hover_at(at);
         harness.run_steps(1);
         let start = harness.state().sim().state().pos.clone();
@@ -630,6 +639,7 @@ fn dragging_the_cloth_pulls_a_particle_and_ctrl_click_pins_it_under_every_integr
         for k in 1..=6 {
             harness.hover_at(at + egui::vec2(10.0 * k as f32, 0.0));
             harness.run_steps(1);
+            harness.state_mut().step_once();
         }
         harness.state_mut().settle();
         // The particle picked where the drag began (the cloth moves meanwhile).
@@ -645,7 +655,9 @@ fn dragging_the_cloth_pulls_a_particle_and_ctrl_click_pins_it_under_every_integr
             "{kind:?}: moved {moved}"
         );
         harness.drop_at(at + egui::vec2(60.0, 0.0));
-        run_settled(&mut harness, 2);
+        harness.run_steps(1);
+        // Let go, it flies on with the pointer's velocity.
+        step_frames(&mut harness, 3);
         assert_eq!(harness.state().sim().grabbed(), None, "{kind:?}: let go");
         assert_eq!(harness.state().in_effect().integrator, kind);
 
