@@ -59,7 +59,8 @@ pub struct BenchRow {
     pub integrator: String,
     /// The backend's name ("cpu", "gpu").
     pub backend: String,
-    /// CPU threads that stepped the cloth (1 on the GPU: the thread that submits its work).
+    /// CPU threads that stepped the cloth: the team's members (the pool's size, at most 16),
+    /// 1 on the GPU (the thread that submits its work).
     pub threads: usize,
     pub substeps_per_frame: u32,
     /// Wall time of the whole run per substep: every pause a busy machine imposes counts.

@@ -129,6 +129,23 @@ fn bench_gives_xpbd_the_sweeps_its_sag_needs() {
     assert!(one_sweep.sag_m > row.sag_m, "one sweep is softer");
 }
 
+/// A row names the threads that step: the team's members, which the pool's size picks up
+/// to the team's limit of 16, not the pool's size beyond it.
+#[test]
+fn bench_rows_name_the_teams_threads_not_a_larger_pools() {
+    let threads_in = |pool: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(pool)
+            .build()
+            .expect("a pool");
+        pool.install(|| bench_one(8, IntegratorKind::SemiImplicitEuler))
+            .expect("runs")
+            .threads
+    };
+    assert_eq!(threads_in(3), 3);
+    assert_eq!(threads_in(17), 16);
+}
+
 #[test]
 fn bench_cli_prints_one_json_row_per_size_and_thread_count() {
     let out = Command::new(env!("CARGO_BIN_EXE_clothsim"))

@@ -86,10 +86,11 @@ pub trait StepBackend: Send {
         false
     }
 
-    /// CPU threads that step the cloth: the current rayon pool's (whose size picks the
-    /// team, [`super::team::Team::current`]) for a backend that steps on the CPU; a backend
-    /// that only records and submits a device's work uses the one thread that calls it.
+    /// CPU threads that may step the cloth: the members of the team the current rayon pool
+    /// picks ([`super::team::Team::current`], at most 16; a cloth too small to share steps
+    /// on the caller alone) for a backend that steps on the CPU; a backend that only records
+    /// and submits a device's work uses the one thread that calls it.
     fn cpu_threads(&self) -> usize {
-        rayon::current_num_threads()
+        super::team::Team::current().members()
     }
 }
