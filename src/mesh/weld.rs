@@ -38,8 +38,8 @@ pub fn weld(soup: &PolygonSoup, relative: f32) -> Welded {
         FxHashMap::with_capacity_and_hasher(soup.positions.len(), Default::default());
     let mut elder: Vec<u32> = Vec::new();
     let cell = 2.0 * tolerance;
-    // A position seen before gets the same particle: particles made since have larger
-    // numbers, so the earliest within reach is still the one it found.
+    // The particle of each vertex the faces use (each is welded once; its corners then
+    // read it here).
     let mut seen = vec![NONE; soup.positions.len()];
     // The vertices the faces use, in the file's order: particles keep the order the
     // vertices were written in (row by row for a grid), which keeps neighbours' numbers
