@@ -133,6 +133,20 @@ pub fn bench_one(n: u32, integrator: IntegratorKind) -> Result<BenchRow, SceneEr
     bench_with(n, integrator, |scene| Ok(Simulation::new(scene)))
 }
 
+/// As [`bench_one`] on the GPU backend, on a headless device of its own
+/// ([`crate::gpu::gpu_simulation`]; its state read back at the end only).
+///
+/// # Errors
+/// [`SceneError`] for a bad `n`; [`SceneError::Backend`] with the reason when there is no
+/// device or the GPU backend cannot run the scene.
+pub fn bench_gpu(n: u32, integrator: IntegratorKind) -> Result<BenchRow, SceneError> {
+    bench_with(n, integrator, |scene| {
+        crate::gpu::gpu_simulation(scene, false)
+            .map(|(sim, _)| sim)
+            .map_err(|e| SceneError::Backend(format!("{e:#}")))
+    })
+}
+
 /// As [`bench_one`], with the simulation built by `make` (another backend).
 ///
 /// # Errors

@@ -661,11 +661,7 @@ fn bench(
                     // current on the thread that made it, and a pool's thread still tearing
                     // that down while the process exits corrupts the heap (a crash at exit
                     // in a few runs in a hundred).
-                    Backend::Gpu => clothsim::bench::bench_with(n, k, |scene| {
-                        gpu_simulation(scene, false)
-                            .map(|(sim, _)| sim)
-                            .map_err(|e| clothsim::scene::SceneError::Backend(format!("{e:#}")))
-                    })?,
+                    Backend::Gpu => clothsim::bench::bench_gpu(n, k)?,
                 };
                 if json {
                     println!("{}", serde_json::to_string(&row)?);

@@ -235,12 +235,8 @@ fn gpu_bench_row_has_the_run_mean_but_no_frame_spread() {
         .build()
         .expect("a pool of 3");
     let (gpu, cpu) = pool.install(|| {
-        let gpu = clothsim::bench::bench_with(16, IntegratorKind::SemiImplicitEuler, |scene| {
-            gpu_simulation(scene, false)
-                .map(|(sim, _)| sim)
-                .map_err(|e| clothsim::scene::SceneError::Backend(format!("{e:#}")))
-        })
-        .expect("GPU bench on the software adapter");
+        let gpu = clothsim::bench::bench_gpu(16, IntegratorKind::SemiImplicitEuler)
+            .expect("GPU bench on the software adapter");
         let cpu = clothsim::bench::bench_one(16, IntegratorKind::SemiImplicitEuler).expect("cpu");
         (gpu, cpu)
     });
