@@ -12,10 +12,10 @@ struct Particle {
 }
 
 struct Neighbour {
+    // Low 28 bits: the other end's index; high 4 bits: the spring's strength class.
     other: u32,
+    // Rest length (m).
     rest: f32,
-    k: f32,
-    c: f32,
 }
 
 struct Collider {
@@ -42,6 +42,8 @@ struct Params {
 @group(0) @binding(2) var<storage, read_write> dst: array<Particle>;
 @group(0) @binding(3) var<storage, read> offsets: array<u32>;
 @group(0) @binding(4) var<storage, read> neighbours: array<Neighbour>;
+// Per strength class: x stiffness (N/m), y damping (N·s/m).
+@group(0) @binding(5) var<uniform> classes: array<vec4<f32>, 16>;
 
 // The first point where the segment a→b (relative to the centre) enters the sphere of
 // radius r, if it starts outside and crosses in during the segment.
@@ -89,12 +91,13 @@ fn substep(@builtin(global_invocation_id) id: vec3<u32>) {
     var f = vec3<f32>(0.0);
     for (var s = offsets[i]; s < offsets[i + 1u]; s = s + 1u) {
         let nb = neighbours[s];
-        let o = src[nb.other];
+        let o = src[nb.other & 0x0fffffffu];
+        let kc = classes[nb.other >> 28u];
         let d = o.x.xyz - x;
         let len = length(d);
         if (len > 1e-9) {
             let n = d / len;
-            f = f + (nb.k * (len - nb.rest) + nb.c * dot(o.v.xyz - v, n)) * n;
+            f = f + (kc.x * (len - nb.rest) + kc.y * dot(o.v.xyz - v, n)) * n;
         }
     }
     let h = params.gravity.w;

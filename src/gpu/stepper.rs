@@ -47,10 +47,78 @@ struct Particle {
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct Neighbour {
+    /// The other end's index in the low [`INDEX_BITS`] bits, its strength class (an index
+    /// into the class table) in the bits above.
     other: u32,
     rest: f32,
-    k: f32,
-    c: f32,
+}
+
+/// Bits of [`Neighbour::other`] that hold the other end's index: a cloth has fewer than
+/// 2²⁸ particles on the GPU backend.
+const INDEX_BITS: u32 = 28;
+/// Strength classes (distinct stiffness–damping pairs) the shader's table holds: one per
+/// spring kind of each spring term, so a handful in practice.
+const MAX_CLASSES: usize = 1 << (32 - INDEX_BITS);
+
+/// The springs as the shader reads them: per particle its range of `ends` (CSR offsets),
+/// each end its other particle and class, and the classes' stiffness and damping.
+struct PackedSprings {
+    offsets: Vec<u32>,
+    ends: Vec<Neighbour>,
+    classes: [[f32; 4]; MAX_CLASSES],
+}
+
+/// Packs the model's adjacency with `strengths`, each spring's index with its stiffness and
+/// damping (springs not listed are left out); more distinct strengths than the table holds
+/// are refused.
+fn pack_springs(
+    model: &ClothModel,
+    strengths: impl Iterator<Item = (usize, f32, f32)>,
+) -> Result<PackedSprings, GpuError> {
+    let s = &model.springs;
+    let mut pairs: Vec<[u32; 2]> = Vec::new();
+    let mut class: Vec<Option<u32>> = vec![None; s.len()];
+    for (e, k, c) in strengths {
+        let pair = [k.to_bits(), c.to_bits()];
+        let at = pairs.iter().position(|&p| p == pair).unwrap_or_else(|| {
+            pairs.push(pair);
+            pairs.len() - 1
+        });
+        class[e] = Some(at as u32);
+    }
+    if pairs.len() > MAX_CLASSES {
+        return Err(GpuError::Unsupported(format!(
+            "takes at most {MAX_CLASSES} distinct spring strengths (stiffness and damping), \
+             not {}",
+            pairs.len()
+        )));
+    }
+    let mut classes = [[0.0; 4]; MAX_CLASSES];
+    for (slot, &[k, c]) in classes.iter_mut().zip(&pairs) {
+        *slot = [f32::from_bits(k), f32::from_bits(c), 0.0, 0.0];
+    }
+    let adj = &model.adjacency;
+    let count = model.particle_count();
+    let mut offsets = Vec::with_capacity(count + 1);
+    let mut ends = Vec::with_capacity(adj.spring.len());
+    offsets.push(0u32);
+    for p in 0..count {
+        for slot in adj.range(p) {
+            let (e, other) = (adj.spring[slot] as usize, adj.other[slot]);
+            if let Some(c) = class[e].filter(|_| other as usize != p) {
+                ends.push(Neighbour {
+                    other: other | (c << INDEX_BITS),
+                    rest: s.rest[e],
+                });
+            }
+        }
+        offsets.push(ends.len() as u32);
+    }
+    Ok(PackedSprings {
+        offsets,
+        ends,
+        classes,
+    })
 }
 
 #[repr(C)]
@@ -115,6 +183,7 @@ pub struct GpuStepper {
     particles: [wgpu::Buffer; 2],
     offsets: wgpu::Buffer,
     neighbours: wgpu::Buffer,
+    classes: wgpu::Buffer,
     /// `groups[i]` reads `particles[i]` and writes the other.
     groups: [wgpu::BindGroup; 2],
     readback: wgpu::Buffer,
@@ -152,6 +221,12 @@ fn fits_buffers(limits: &wgpu::Limits, particles: u64, spring_ends: u64) -> Resu
         (particles * size_of::<Particle>() as u64, "particles' state"),
         (spring_ends * size_of::<Neighbour>() as u64, "spring ends"),
     ];
+    if particles > 1 << INDEX_BITS {
+        return Err(GpuError::Unsupported(format!(
+            "takes at most {} particles, not {particles}",
+            1u64 << INDEX_BITS
+        )));
+    }
     let mib = |bytes: u64| bytes as f64 / (1u64 << 20) as f64;
     match need.into_iter().find(|&(bytes, _)| bytes > most) {
         Some((bytes, what)) => Err(GpuError::Unsupported(format!(
@@ -216,23 +291,28 @@ impl GpuStepper {
             },
             count: None,
         };
+        let uniform_entry = wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cloth substep"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                uniform_entry,
                 storage(1, true),
                 storage(2, false),
                 storage(3, true),
                 storage(4, true),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    ..uniform_entry
+                },
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -276,6 +356,11 @@ impl GpuStepper {
             std::mem::size_of::<Params>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
+        let classes = small(
+            "spring classes",
+            (MAX_CLASSES * 16) as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
         let storage_dst = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
         let offsets = small("spring offsets", (count as u64 + 1) * 4, storage_dst);
         let neighbours = small(
@@ -313,6 +398,10 @@ impl GpuStepper {
                         binding: 4,
                         resource: neighbours.as_entire_binding(),
                     },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: classes.as_entire_binding(),
+                    },
                 ],
             })
         };
@@ -325,6 +414,7 @@ impl GpuStepper {
             particles,
             offsets,
             neighbours,
+            classes,
             groups,
             readback,
             display: None,
@@ -342,7 +432,10 @@ impl GpuStepper {
             stats: StepStats::default(),
         };
         stepper.configure(model, params, effects);
-        Ok(stepper)
+        match stepper.unsupported.take() {
+            Some(why) => Err(GpuError::Unsupported(why)),
+            None => Ok(stepper),
+        }
     }
 
     /// Stride of [`GpuStepper::display_buffer`], in `vec4`s per particle.
@@ -375,40 +468,18 @@ impl GpuStepper {
         display
     }
 
-    /// Sends each particle's springs (the model's adjacency, with the strengths of the
-    /// spring terms in `forces`; springs no term covers are left out).
-    fn upload_springs(&self, model: &ClothModel, forces: &ForceSet) {
-        let s = &model.springs;
-        let mut strength: Vec<Option<(f32, f32)>> = vec![None; s.len()];
-        for term in forces.springs() {
-            for (e, k, c) in term.each() {
-                strength[e] = Some((k, c));
-            }
-        }
-        let adj = &model.adjacency;
-        let mut offsets = Vec::with_capacity(self.count as usize + 1);
-        let mut flat = Vec::with_capacity(adj.spring.len());
-        offsets.push(0u32);
-        for p in 0..self.count as usize {
-            for slot in adj.range(p) {
-                let (e, other) = (adj.spring[slot] as usize, adj.other[slot]);
-                if let Some((k, c)) = strength[e].filter(|_| other as usize != p) {
-                    flat.push(Neighbour {
-                        other,
-                        rest: s.rest[e],
-                        k,
-                        c,
-                    });
-                }
-            }
-            offsets.push(flat.len() as u32);
-        }
+    /// Sends each particle's springs (see [`pack_springs`]).
+    fn upload_springs(&self, model: &ClothModel, forces: &ForceSet) -> Result<(), GpuError> {
+        let packed = pack_springs(model, forces.springs().flat_map(|t| t.each()))?;
         self.queue
-            .write_buffer(&self.offsets, 0, bytemuck::cast_slice(&offsets));
-        if !flat.is_empty() {
+            .write_buffer(&self.offsets, 0, bytemuck::cast_slice(&packed.offsets));
+        self.queue
+            .write_buffer(&self.classes, 0, bytemuck::cast_slice(&packed.classes));
+        if !packed.ends.is_empty() {
             self.queue
-                .write_buffer(&self.neighbours, 0, bytemuck::cast_slice(&flat));
+                .write_buffer(&self.neighbours, 0, bytemuck::cast_slice(&packed.ends));
         }
+        Ok(())
     }
 
     fn upload_state(&mut self, model: &ClothModel, state: &ClothState) {
@@ -526,9 +597,11 @@ impl StepBackend for GpuStepper {
     }
 
     fn configure(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]) {
-        self.unsupported = gpu_support(params, effects).err().map(|e| e.to_string());
         let forces = ForceSet::new(model, params, effects);
-        self.upload_springs(model, &forces);
+        self.unsupported = gpu_support(params, effects)
+            .and_then(|()| self.upload_springs(model, &forces))
+            .err()
+            .map(|e| e.to_string());
         let has = |want: fn(&Effect) -> bool| effects.iter().any(want);
         let g = if has(|e| matches!(e, Effect::Gravity)) {
             params.gravity
@@ -664,8 +737,9 @@ impl StepBackend for GpuStepper {
 mod tests {
     use super::*;
 
-    /// llvmpipe's 128 MiB binding: a 1 000 × 1 000 bench cloth's spring ends (16 bytes
-    /// each) do not fit and are refused with both sizes; the most that fits does.
+    /// llvmpipe's 128 MiB binding holds a 1 000 × 1 000 bench cloth's spring ends (8 bytes
+    /// each, 91.4 MiB); a 1 200 × 1 200 one's do not fit and are refused with both sizes;
+    /// the most that fits does.
     #[test]
     fn a_cloth_bigger_than_the_devices_buffers_is_refused_with_the_sizes() {
         let limits = wgpu::Limits {
@@ -673,11 +747,12 @@ mod tests {
             max_buffer_size: 256 << 20,
             ..wgpu::Limits::default()
         };
-        let (particles, ends) = (1_000_000, 11_980_004);
+        assert!(fits_buffers(&limits, 1_000_000, 11_980_004).is_ok());
+        let (particles, ends) = (1_440_000, 17_256_004);
         let err = fits_buffers(&limits, particles, ends).expect_err("too big");
         let text = err.to_string();
         assert!(
-            text.contains("182.8 MiB") && text.contains("128.0 MiB") && text.contains("spring"),
+            text.contains("131.7 MiB") && text.contains("128.0 MiB") && text.contains("spring"),
             "{text}"
         );
         let most = (128u64 << 20) / size_of::<Neighbour>() as u64;
@@ -690,5 +765,55 @@ mod tests {
         };
         assert!(fits_buffers(&small_buffers, particles, most).is_err());
         assert!(fits_buffers(&small_buffers, 3 << 20, 0).is_err());
+        // An index needs its 28 bits, whatever the buffers hold.
+        let huge = wgpu::Limits {
+            max_storage_buffer_binding_size: u64::MAX,
+            max_buffer_size: u64::MAX,
+            ..limits
+        };
+        assert!(fits_buffers(&huge, 1 << INDEX_BITS, 0).is_ok());
+        let err = fits_buffers(&huge, (1 << INDEX_BITS) + 1, 0).expect_err("too many");
+        assert!(err.to_string().contains("268435456 particles"), "{err}");
+    }
+
+    /// Every spring end carries its other particle, its rest length and the class whose
+    /// table entry is its kind's stiffness and damping, in the adjacency's order.
+    #[test]
+    fn each_spring_end_points_at_its_kinds_strengths() {
+        let scene = crate::scene::Scene::builtin("sphere-drop").expect("scene");
+        let (model, params) = (&scene.model, &scene.params);
+        let forces = ForceSet::new(model, params, &scene.effects);
+        let packed = pack_springs(model, forces.springs().flat_map(|t| t.each())).expect("fits");
+        let adj = &model.adjacency;
+        let mut used = std::collections::BTreeSet::new();
+        for p in 0..model.particle_count() {
+            let range = packed.offsets[p] as usize..packed.offsets[p + 1] as usize;
+            let slots: Vec<usize> = adj.range(p).collect();
+            assert_eq!(range.len(), slots.len(), "particle {p}");
+            for (end, slot) in packed.ends[range].iter().zip(slots) {
+                let e = adj.spring[slot] as usize;
+                let kind = model.springs.kind[e].index();
+                let class = (end.other >> INDEX_BITS) as usize;
+                used.insert(class);
+                assert_eq!(end.other & ((1 << INDEX_BITS) - 1), adj.other[slot]);
+                assert_eq!(end.rest, model.springs.rest[e]);
+                let [k, c, ..] = packed.classes[class];
+                assert_eq!((k, c), (params.stiffness[kind], params.damping[kind]));
+            }
+        }
+        assert_eq!(used.len(), 3, "one class per kind: {used:?}");
+    }
+
+    /// Seventeen distinct strengths do not fit the table of sixteen and are refused.
+    #[test]
+    fn more_strengths_than_the_table_holds_are_refused() {
+        let scene = crate::scene::Scene::builtin("sphere-drop").expect("scene");
+        let model = &scene.model;
+        let strengths = |n: usize| (0..model.springs.len()).map(move |e| (e, (e % n) as f32, 0.0));
+        assert!(pack_springs(model, strengths(MAX_CLASSES)).is_ok());
+        let err = pack_springs(model, strengths(MAX_CLASSES + 1))
+            .err()
+            .expect("refused");
+        assert!(err.to_string().contains("at most 16 distinct"), "{err}");
     }
 }
