@@ -60,12 +60,15 @@ const INDEX_BITS: u32 = 28;
 /// spring kind of each spring term, so a handful in practice.
 const MAX_CLASSES: usize = 1 << (32 - INDEX_BITS);
 
+/// Per strength class `[stiffness, damping, 0, 0]`: the shader's uniform `classes`.
+type ClassTable = [[f32; 4]; MAX_CLASSES];
+
 /// The springs as the shader reads them: per particle its range of `ends` (CSR offsets),
 /// each end its other particle and class, and the classes' stiffness and damping.
 struct PackedSprings {
     offsets: Vec<u32>,
     ends: Vec<Neighbour>,
-    classes: [[f32; 4]; MAX_CLASSES],
+    classes: ClassTable,
 }
 
 /// Packs the model's adjacency with `strengths`, each spring's index with its stiffness and
@@ -80,20 +83,22 @@ fn pack_springs(
     let mut class: Vec<Option<u32>> = vec![None; s.len()];
     for (e, k, c) in strengths {
         let pair = [k.to_bits(), c.to_bits()];
-        let at = pairs.iter().position(|&p| p == pair).unwrap_or_else(|| {
-            pairs.push(pair);
-            pairs.len() - 1
-        });
+        let at = match pairs.iter().position(|&p| p == pair) {
+            Some(at) => at,
+            None if pairs.len() == MAX_CLASSES => {
+                return Err(GpuError::Unsupported(format!(
+                    "takes at most {MAX_CLASSES} distinct spring strengths (stiffness and \
+                     damping); this cloth has more"
+                )));
+            }
+            None => {
+                pairs.push(pair);
+                pairs.len() - 1
+            }
+        };
         class[e] = Some(at as u32);
     }
-    if pairs.len() > MAX_CLASSES {
-        return Err(GpuError::Unsupported(format!(
-            "takes at most {MAX_CLASSES} distinct spring strengths (stiffness and damping), \
-             not {}",
-            pairs.len()
-        )));
-    }
-    let mut classes = [[0.0; 4]; MAX_CLASSES];
+    let mut classes: ClassTable = [[0.0; 4]; MAX_CLASSES];
     for (slot, &[k, c]) in classes.iter_mut().zip(&pairs) {
         *slot = [f32::from_bits(k), f32::from_bits(c), 0.0, 0.0];
     }
@@ -217,16 +222,16 @@ fn fits_buffers(limits: &wgpu::Limits, particles: u64, spring_ends: u64) -> Resu
     let most = limits
         .max_storage_buffer_binding_size
         .min(limits.max_buffer_size);
-    let need = [
-        (particles * size_of::<Particle>() as u64, "particles' state"),
-        (spring_ends * size_of::<Neighbour>() as u64, "spring ends"),
-    ];
     if particles > 1 << INDEX_BITS {
         return Err(GpuError::Unsupported(format!(
             "takes at most {} particles, not {particles}",
             1u64 << INDEX_BITS
         )));
     }
+    let need = [
+        (particles * size_of::<Particle>() as u64, "particles' state"),
+        (spring_ends * size_of::<Neighbour>() as u64, "spring ends"),
+    ];
     let mib = |bytes: u64| bytes as f64 / (1u64 << 20) as f64;
     match need.into_iter().find(|&(bytes, _)| bytes > most) {
         Some((bytes, what)) => Err(GpuError::Unsupported(format!(
@@ -358,7 +363,7 @@ impl GpuStepper {
         );
         let classes = small(
             "spring classes",
-            (MAX_CLASSES * 16) as u64,
+            size_of::<ClassTable>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
         let storage_dst = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
