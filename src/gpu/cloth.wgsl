@@ -3,6 +3,7 @@
 // add gravity and air damping, step the velocity then the position, then resolve the
 // sphere and plane colliders against the path of the substep, with friction.
 // Reads `src`, writes `dst`; the host swaps them every substep (ping-pong).
+// The host prepends `INDEX_BITS` and `CLASSES` (src/gpu/stepper.rs's constants).
 
 struct Particle {
     // xyz: position (m); w: inverse mass (1/kg), 0 for a pinned particle.
@@ -12,7 +13,7 @@ struct Particle {
 }
 
 struct Neighbour {
-    // Low 28 bits: the other end's index; high 4 bits: the spring's strength class.
+    // Low INDEX_BITS bits: the other end's index; the bits above: the strength class.
     other: u32,
     // Rest length (m).
     rest: f32,
@@ -43,7 +44,7 @@ struct Params {
 @group(0) @binding(3) var<storage, read> offsets: array<u32>;
 @group(0) @binding(4) var<storage, read> neighbours: array<Neighbour>;
 // Per strength class: x stiffness (N/m), y damping (N·s/m).
-@group(0) @binding(5) var<uniform> classes: array<vec4<f32>, 16>;
+@group(0) @binding(5) var<uniform> classes: array<vec4<f32>, CLASSES>;
 
 // The first point where the segment a→b (relative to the centre) enters the sphere of
 // radius r, if it starts outside and crosses in during the segment.
@@ -91,8 +92,8 @@ fn substep(@builtin(global_invocation_id) id: vec3<u32>) {
     var f = vec3<f32>(0.0);
     for (var s = offsets[i]; s < offsets[i + 1u]; s = s + 1u) {
         let nb = neighbours[s];
-        let o = src[nb.other & 0x0fffffffu];
-        let kc = classes[nb.other >> 28u];
+        let o = src[nb.other & ((1u << INDEX_BITS) - 1u)];
+        let kc = classes[nb.other >> INDEX_BITS];
         let d = o.x.xyz - x;
         let len = length(d);
         if (len > 1e-9) {

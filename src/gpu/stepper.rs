@@ -53,8 +53,8 @@ struct Neighbour {
     rest: f32,
 }
 
-/// Bits of [`Neighbour::other`] that hold the other end's index: a cloth has fewer than
-/// 2²⁸ particles on the GPU backend.
+/// Bits of [`Neighbour::other`] that hold the other end's index: a cloth has at most 2²⁸
+/// particles on the GPU backend. The shader is given this and [`MAX_CLASSES`] as constants.
 const INDEX_BITS: u32 = 28;
 /// Strength classes (distinct stiffness–damping pairs) the shader's table holds: one per
 /// spring kind of each spring term, so a handful in practice.
@@ -284,7 +284,14 @@ impl GpuStepper {
         fits_buffers(&limits, count as u64, spring_ends)?;
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("cloth substep"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("cloth.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(
+                format!(
+                    "const INDEX_BITS: u32 = {INDEX_BITS}u;\n\
+                     const CLASSES: u32 = {MAX_CLASSES}u;\n{}",
+                    include_str!("cloth.wgsl")
+                )
+                .into(),
+            ),
         });
         let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
             binding,
