@@ -56,8 +56,8 @@ struct Neighbour {
 /// Bits of [`Neighbour::other`] that hold the other end's index: a cloth has at most 2²⁸
 /// particles on the GPU backend. The shader is given this and [`MAX_CLASSES`] as constants.
 const INDEX_BITS: u32 = 28;
-/// Strength classes (distinct stiffness–damping pairs) the shader's table holds: one per
-/// spring kind of each spring term, so a handful in practice.
+/// Strength classes (distinct stiffness–damping pairs) the shader's table holds: a cloth
+/// has at most one per spring kind (3) of each spring term (springs, bend springs).
 const MAX_CLASSES: usize = 1 << (32 - INDEX_BITS);
 
 /// Per strength class `[stiffness, damping, 0, 0]`: the shader's uniform `classes`.
