@@ -102,10 +102,10 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
 }
 
 /// A parameter change on a running GPU simulation reaches the shader: new spring
-/// strengths, substeps and gravity, then a pin and a push, applied mid-run on both backends,
-/// keep them together. Also when the GPU's state is not read back every frame (as the app
-/// runs it): each edit must start from the GPU's latest frame, not from the stale copy on
-/// the CPU.
+/// strengths, substeps and gravity, then a pin and a push, then one kind's strengths alone,
+/// applied mid-run on both backends, keep them together. Also when the GPU's state is not
+/// read back every frame (as the app runs it): each edit must start from the GPU's latest
+/// frame, not from the stale copy on the CPU.
 #[test]
 fn a_parameter_change_mid_run_reaches_the_gpu() {
     for read_every_frame in [true, false] {
@@ -136,6 +136,14 @@ fn parameter_change_mid_run(read_every_frame: bool) {
         }
         sim.modify_state(|s| s.vel[20] += glam::Vec3::new(0.0, 0.0, 0.5));
         for _ in 0..5 {
+            sim.step_frame().expect("frame");
+        }
+        // One kind's strengths apart from the others' (the GPU packs its springs anew).
+        let mut params = sim.params().clone();
+        params.stiffness[1] *= 0.25;
+        params.damping[1] *= 4.0;
+        sim.set_params(params).expect("valid");
+        for _ in 0..10 {
             sim.step_frame().expect("frame");
         }
     }

@@ -63,27 +63,35 @@ const MAX_CLASSES: usize = 1 << (32 - INDEX_BITS);
 /// Per strength class `[stiffness, damping, 0, 0]`: the shader's uniform `classes`.
 type ClassTable = [[f32; 4]; MAX_CLASSES];
 
-/// The springs as the shader reads them: per particle its range of `ends` (CSR offsets),
-/// each end its other particle and class, and the classes' stiffness and damping.
-struct PackedSprings {
-    offsets: Vec<u32>,
-    ends: Vec<Neighbour>,
-    classes: ClassTable,
+/// Which strength class each spring has ([`NO_CLASS`]: not sent), and the classes'
+/// stiffness and damping: what decides the spring ends' bits besides the model.
+struct SpringClasses {
+    of_spring: Vec<u8>,
+    table: ClassTable,
 }
 
-/// Packs the model's adjacency with `strengths`, each spring's index with its stiffness and
-/// damping (springs not listed are left out); more distinct strengths than the table holds
-/// are refused.
-fn pack_springs(
+/// The class of a spring the shader does not get.
+const NO_CLASS: u8 = u8::MAX;
+const _: () = assert!(MAX_CLASSES <= NO_CLASS as usize, "a class index fits a u8");
+
+/// Sorts the springs of `strengths` (each spring's index with its stiffness and damping;
+/// springs not listed are left out) into classes of equal strengths, numbered in the order
+/// they first appear, so that changing strengths that keep which springs share a class
+/// changes only the table. More distinct strengths than the table holds are refused.
+fn classify(
     model: &ClothModel,
     strengths: impl Iterator<Item = (usize, f32, f32)>,
-) -> Result<PackedSprings, GpuError> {
-    let s = &model.springs;
+) -> Result<SpringClasses, GpuError> {
     let mut pairs: Vec<[u32; 2]> = Vec::new();
-    let mut class: Vec<Option<u32>> = vec![None; s.len()];
+    let mut of_spring = vec![NO_CLASS; model.springs.len()];
+    // Springs of one kind mostly come together: the last one's class is tried first.
+    let mut last = 0;
     for (e, k, c) in strengths {
         let pair = [k.to_bits(), c.to_bits()];
-        let at = match pairs.iter().position(|&p| p == pair) {
+        let found = (pairs.get(last) == Some(&pair))
+            .then_some(last)
+            .or_else(|| pairs.iter().position(|&p| p == pair));
+        let at = match found {
             Some(at) => at,
             None if pairs.len() == MAX_CLASSES => {
                 return Err(GpuError::Unsupported(format!(
@@ -96,12 +104,25 @@ fn pack_springs(
                 pairs.len() - 1
             }
         };
-        class[e] = Some(at as u32);
+        of_spring[e] = at as u8;
+        last = at;
     }
-    let mut classes: ClassTable = [[0.0; 4]; MAX_CLASSES];
-    for (slot, &[k, c]) in classes.iter_mut().zip(&pairs) {
+    let mut table: ClassTable = [[0.0; 4]; MAX_CLASSES];
+    for (slot, &[k, c]) in table.iter_mut().zip(&pairs) {
         *slot = [f32::from_bits(k), f32::from_bits(c), 0.0, 0.0];
     }
+    Ok(SpringClasses { of_spring, table })
+}
+
+/// The springs as the shader reads them: per particle its range of `ends` (CSR offsets),
+/// each end its other particle and class.
+struct PackedSprings {
+    offsets: Vec<u32>,
+    ends: Vec<Neighbour>,
+}
+
+/// Packs the model's adjacency: each end of a spring that has a class, with the class.
+fn pack_springs(model: &ClothModel, class: &[u8]) -> PackedSprings {
     let adj = &model.adjacency;
     let count = model.particle_count();
     let mut offsets = Vec::with_capacity(count + 1);
@@ -110,20 +131,16 @@ fn pack_springs(
     for p in 0..count {
         for slot in adj.range(p) {
             let (e, other) = (adj.spring[slot] as usize, adj.other[slot]);
-            if let Some(c) = class[e].filter(|_| other as usize != p) {
+            if class[e] != NO_CLASS && other as usize != p {
                 ends.push(Neighbour {
-                    other: other | (c << INDEX_BITS),
-                    rest: s.rest[e],
+                    other: other | (u32::from(class[e]) << INDEX_BITS),
+                    rest: model.springs.rest[e],
                 });
             }
         }
         offsets.push(ends.len() as u32);
     }
-    Ok(PackedSprings {
-        offsets,
-        ends,
-        classes,
-    })
+    PackedSprings { offsets, ends }
 }
 
 #[repr(C)]
@@ -213,6 +230,10 @@ pub struct GpuStepper {
     lost: Option<String>,
     timings: PhaseTimings,
     stats: StepStats,
+    /// The class of each spring as the device's ends hold it (`None` before the first
+    /// upload), and how many times the ends were sent.
+    sent: Option<Vec<u8>>,
+    ends_sent: u32,
 }
 
 /// Whether the stepper's largest storage buffers (the particles' state, and a record per
@@ -442,6 +463,8 @@ impl GpuStepper {
             lost: None,
             timings: PhaseTimings::default(),
             stats: StepStats::default(),
+            sent: None,
+            ends_sent: 0,
         };
         stepper.configure(model, params, effects);
         match stepper.unsupported.take() {
@@ -480,17 +503,24 @@ impl GpuStepper {
         display
     }
 
-    /// Sends each particle's springs (see [`pack_springs`]).
-    fn upload_springs(&self, model: &ClothModel, forces: &ForceSet) -> Result<(), GpuError> {
-        let packed = pack_springs(model, forces.springs().flat_map(|t| t.each()))?;
+    /// Sends the springs' class table, and their ends (see [`pack_springs`]) when which
+    /// springs share a class changed since the last upload: a strength change that keeps
+    /// them (a slider moving one kind's stiffness) sends 256 bytes, not every end again.
+    fn upload_springs(&mut self, model: &ClothModel, forces: &ForceSet) -> Result<(), GpuError> {
+        let classes = classify(model, forces.springs().flat_map(|t| t.each()))?;
         self.queue
-            .write_buffer(&self.offsets, 0, bytemuck::cast_slice(&packed.offsets));
-        self.queue
-            .write_buffer(&self.classes, 0, bytemuck::cast_slice(&packed.classes));
-        if !packed.ends.is_empty() {
+            .write_buffer(&self.classes, 0, bytemuck::cast_slice(&classes.table));
+        if self.sent.as_ref() != Some(&classes.of_spring) {
+            let packed = pack_springs(model, &classes.of_spring);
             self.queue
-                .write_buffer(&self.neighbours, 0, bytemuck::cast_slice(&packed.ends));
+                .write_buffer(&self.offsets, 0, bytemuck::cast_slice(&packed.offsets));
+            if !packed.ends.is_empty() {
+                self.queue
+                    .write_buffer(&self.neighbours, 0, bytemuck::cast_slice(&packed.ends));
+            }
+            self.ends_sent += 1;
         }
+        self.sent = Some(classes.of_spring);
         Ok(())
     }
 
@@ -795,7 +825,8 @@ mod tests {
         let scene = crate::scene::Scene::builtin("sphere-drop").expect("scene");
         let (model, params) = (&scene.model, &scene.params);
         let forces = ForceSet::new(model, params, &scene.effects);
-        let packed = pack_springs(model, forces.springs().flat_map(|t| t.each())).expect("fits");
+        let classes = classify(model, forces.springs().flat_map(|t| t.each())).expect("fits");
+        let packed = pack_springs(model, &classes.of_spring);
         let adj = &model.adjacency;
         let mut used = std::collections::BTreeSet::new();
         for p in 0..model.particle_count() {
@@ -809,7 +840,7 @@ mod tests {
                 used.insert(class);
                 assert_eq!(end.other & ((1 << INDEX_BITS) - 1), adj.other[slot]);
                 assert_eq!(end.rest, model.springs.rest[e]);
-                let [k, c, ..] = packed.classes[class];
+                let [k, c, ..] = classes.table[class];
                 assert_eq!((k, c), (params.stiffness[kind], params.damping[kind]));
             }
         }
@@ -822,10 +853,42 @@ mod tests {
         let scene = crate::scene::Scene::builtin("sphere-drop").expect("scene");
         let model = &scene.model;
         let strengths = |n: usize| (0..model.springs.len()).map(move |e| (e, (e % n) as f32, 0.0));
-        assert!(pack_springs(model, strengths(MAX_CLASSES)).is_ok());
-        let err = pack_springs(model, strengths(MAX_CLASSES + 1))
+        assert!(classify(model, strengths(MAX_CLASSES)).is_ok());
+        let err = classify(model, strengths(MAX_CLASSES + 1))
             .err()
             .expect("refused");
         assert!(err.to_string().contains("at most 16 distinct"), "{err}");
+    }
+
+    /// A strength change that keeps which springs share a class (every kind scaled alike,
+    /// or the damping of a kind that has a class of its own) sends only the class table;
+    /// one that splits or merges classes sends the ends again, once.
+    #[test]
+    fn the_spring_ends_are_sent_again_only_when_their_classes_change() {
+        use crate::render::{AdapterPreference, Gpu};
+        let gpu = Gpu::headless(AdapterPreference::Any).expect("an adapter");
+        let scene = crate::bench::bench_scene(8, crate::sim::IntegratorKind::SemiImplicitEuler)
+            .expect("scene");
+        let (model, effects) = (&scene.model, &scene.effects);
+        let mut params = scene.params.clone();
+        let mut stepper = GpuStepper::new(&gpu.device, &gpu.queue, model, &params, effects, true)
+            .expect("stepper");
+        let mut change = |edit: &dyn Fn(&mut SimParams), sends: u32| {
+            edit(&mut params);
+            stepper.configure(model, &params, effects);
+            assert_eq!(stepper.ends_sent, sends, "after {:?}", params.stiffness);
+        };
+        change(&|_| (), 1);
+        change(&|p| p.stiffness = p.stiffness.map(|k| 3.0 * k), 1);
+        // The shear springs leave the one class all kinds shared: a class of their own,
+        // whose damping then moves alone.
+        change(&|p| p.stiffness[1] *= 0.5, 2);
+        change(&|p| p.damping[1] *= 2.0, 2);
+        // The structural springs leave the bend springs' class.
+        change(&|p| p.stiffness[0] *= 2.0, 3);
+        // Back to one stiffness (shear still damped apart), then one strength: merges.
+        change(&|p| p.stiffness = [p.stiffness[0]; 3], 4);
+        change(&|p| p.damping = [p.damping[0]; 3], 5);
+        change(&|_| (), 5);
     }
 }
