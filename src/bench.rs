@@ -59,8 +59,9 @@ pub struct BenchRow {
     pub integrator: String,
     /// The backend's name ("cpu", "gpu").
     pub backend: String,
-    /// CPU threads that stepped the cloth: the team's members (the pool's size, at most 16),
-    /// 1 on the GPU (the thread that submits its work).
+    /// CPU threads the solver may share a step among: the team's members (the pool's size,
+    /// at most 16; a cloth under [`crate::sim::team::PARALLEL_ELEMENTS`] particles, 64 × 64,
+    /// still steps on one of them), 1 on the GPU (the thread that submits its work).
     pub threads: usize,
     pub substeps_per_frame: u32,
     /// Wall time of the whole run per substep: every pause a busy machine imposes counts.

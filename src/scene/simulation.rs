@@ -409,7 +409,8 @@ impl Simulation {
         self.backend.state_behind()
     }
 
-    /// CPU threads that step the cloth (one for the GPU backend: the thread that submits).
+    /// CPU threads that may step the cloth (see [`StepBackend::cpu_threads`]; one for the GPU
+    /// backend: the thread that submits).
     pub fn cpu_threads(&self) -> usize {
         self.backend.cpu_threads()
     }
