@@ -117,7 +117,7 @@ impl DihedralBending {
     }
 
     /// Adds `−∂E/∂x = −2k·w·(θ − θ₀)·∂θ/∂x` (N) to `f`, limited for a wing nearly collapsed
-    /// onto its hinge (see [`wing_limit`]).
+    /// onto its hinge (see `wing_limit`).
     pub fn add_forces(&self, model: &ClothModel, pos: &[Vec3], f: &mut [Vec3]) {
         for (h, (&rest, &w)) in model.hinges.iter().zip(self.rest.iter().zip(&self.weight)) {
             let [x0, x1, a, b] = h.map(|i| pos[i as usize]);

@@ -35,7 +35,7 @@ impl SpringBlock {
         self.alpha * Mat3::IDENTITY + Mat3::from_cols(bn * self.n.x, bn * self.n.y, bn * self.n.z)
     }
 
-    /// `[α, β, n.x, n.y, n.z]`: the numbers [`SpringRuns::add_block_products`] reads per
+    /// `[α, β, n.x, n.y, n.z]`: the numbers `SpringRuns::add_block_products` reads per
     /// spring.
     pub fn numbers(&self) -> [f32; 5] {
         [self.alpha, self.beta, self.n.x, self.n.y, self.n.z]

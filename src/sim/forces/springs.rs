@@ -153,7 +153,7 @@ impl SpringForce {
         self.runs(springs).add_forces_components(pos, vel, f);
     }
 
-    /// The forces in two passes (see [`SpringRuns::two_passes`]).
+    /// The forces in two passes (see `SpringRuns::two_passes`).
     pub fn two_passes<'a>(&'a self, springs: &Springs) -> TwoPasses<'a> {
         self.runs(springs).two_passes()
     }
