@@ -14,6 +14,12 @@
 //! its own, claims and runs those no helper came for. On a virtual machine whose cores other
 //! guests also use, a helper is now and then held off its core for milliseconds; the section
 //! then takes twice the caller's time instead of waiting for it.
+//!
+//! On such a machine the helpers do not always pay: in a busy spell a 64 × 64 cloth stepped
+//! faster on one thread than on two in 9 of 12 alternating runs. So a team times its
+//! sections and, now and then, runs a short window of them on the caller alone ([`Pace`]);
+//! while that is faster, the caller goes on alone, and tries its helpers again later. Which
+//! way a section runs never changes its result (the shares are the same either way).
 
 use std::any::Any;
 use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
@@ -57,7 +63,8 @@ pub struct Team {
     shared: Arc<Shared>,
     helpers: Vec<JoinHandle<()>>,
     /// Taken by the caller of a section: a second caller at the same time runs alone.
-    busy: Mutex<()>,
+    /// Holds the timing that decides whether the helpers pay.
+    busy: Mutex<Pace>,
 }
 
 impl Team {
@@ -90,7 +97,7 @@ impl Team {
         Self {
             shared,
             helpers,
-            busy: Mutex::new(()),
+            busy: Mutex::new(Pace::default()),
         }
     }
 
@@ -117,7 +124,7 @@ impl Team {
     /// thread's), the caller runs every member's share itself, in order. A panic in any
     /// share is passed on after all are done.
     pub fn run(&self, section: &Section<'_>) {
-        let _busy = match self.busy.try_lock() {
+        let mut pace = match self.busy.try_lock() {
             Ok(guard) => guard,
             // A share panicked last time; the team itself is fine.
             Err(TryLockError::Poisoned(poisoned)) => poisoned.into_inner(),
@@ -128,6 +135,12 @@ impl Team {
         };
         if self.helpers.is_empty() {
             section(0);
+            return;
+        }
+        let start = Instant::now();
+        if pace.runs_alone() {
+            (0..self.members()).for_each(section);
+            pace.record(start.elapsed());
             return;
         }
         let shared = &*self.shared;
@@ -153,6 +166,7 @@ impl Team {
             }
         }
         drop(waiting);
+        pace.record(start.elapsed());
         let panic = shared
             .panic
             .lock()
@@ -202,6 +216,89 @@ impl Team {
             self.run_pieces(pieces, work);
         } else {
             (0..pieces).for_each(|piece| work(0, piece));
+        }
+    }
+}
+
+/// Sections over which a team's time per section is measured.
+const WINDOW: u32 = 64;
+/// Windows run the chosen way between two that try the other, after a switch; each probe
+/// that loses doubles it, up to [`PROBE_EVERY_MOST`].
+const PROBE_EVERY: u32 = 8;
+/// The most windows between two probes (at N = 64 about 2 000 substeps, a tenth of a second).
+const PROBE_EVERY_MOST: u32 = 64;
+
+/// Whether a team's sections run shared with its helpers or on the caller alone, chosen by
+/// timing. Now and then a window of [`WINDOW`] sections tries the other way, which is taken
+/// when it took at least 10 % less time than the last window run the chosen way (a probe
+/// that has used up that time ends early, lost). Probes come [`PROBE_EVERY`] windows after a switch and ever more rarely while they
+/// lose: each costs the slower way's time for one window and the helpers' caches warmed
+/// again, which at one probe in nine windows added 2–3 µs to a 30 µs substep.
+#[derive(Debug, Default)]
+struct Pace {
+    /// The way chosen: the caller alone (the helpers did not pay when last tried).
+    alone: bool,
+    /// The current window tries the way not chosen.
+    probing: bool,
+    /// Sections in the current window so far, and the time they took.
+    sections: u32,
+    spent: Duration,
+    /// Windows run the chosen way since the last probe, and how many come between probes
+    /// now (0 until the first probe: [`PROBE_EVERY`]).
+    since_probe: u32,
+    probe_every: u32,
+    /// Time per section of the last window run the chosen way.
+    chosen: Option<Duration>,
+    /// The shared way's fastest time per section lately (rising 1 % a window): a shared
+    /// window 25 % slower than this has a busy machine behind it.
+    quiet: Option<Duration>,
+}
+
+impl Pace {
+    /// Whether the next section runs on the caller alone.
+    fn runs_alone(&self) -> bool {
+        self.alone != self.probing
+    }
+
+    /// Counts a section that took `took`, run the way [`Pace::runs_alone`] said.
+    fn record(&mut self, took: Duration) {
+        self.spent += took;
+        self.sections += 1;
+        // A clear win only: the two ways' times swing from window to window, and a switch
+        // on noise would run the slower way until the next probe. A probe that has spent
+        // what would lose already ends at once (the slower way costs only until then).
+        let to_beat = self.chosen.map(|chosen| chosen * WINDOW * 9 / 10);
+        let lost = self.probing && to_beat.is_some_and(|to_beat| self.spent >= to_beat);
+        if self.sections < WINDOW && !lost {
+            return;
+        }
+        let per_section = self.spent / WINDOW;
+        (self.sections, self.spent) = (0, Duration::ZERO);
+        if self.probing {
+            self.probing = false;
+            if lost || to_beat.is_none() {
+                self.probe_every = (self.probe_every.max(PROBE_EVERY) * 2).min(PROBE_EVERY_MOST);
+            } else {
+                self.alone = !self.alone;
+                self.chosen = Some(per_section);
+                self.probe_every = PROBE_EVERY;
+            }
+        } else {
+            self.chosen = Some(per_section);
+            if !self.alone {
+                let lately = self.quiet.map_or(per_section, |quiet| quiet * 101 / 100);
+                self.quiet = Some(lately.min(per_section));
+            }
+            self.since_probe += 1;
+            // Sharing is probed only once it has slowed (a quiet machine pays nothing for
+            // probes), at the start, and now and then whatever the times say.
+            let slowed = self.alone
+                || self.probe_every == 0
+                || self.since_probe >= 8 * PROBE_EVERY_MOST
+                || self.quiet.is_some_and(|quiet| per_section * 4 > quiet * 5);
+            if slowed && self.since_probe >= self.probe_every.max(PROBE_EVERY) {
+                (self.since_probe, self.probing) = (0, true);
+            }
         }
     }
 }
@@ -535,6 +632,129 @@ mod tests {
         });
         let want: Vec<_> = (0..6).map(|piece| (0, piece, true)).collect();
         assert_eq!(ran.into_inner().unwrap(), want);
+    }
+
+    /// Feeds `pace` one window of sections that take `micros` each, until it ends; returns
+    /// whether they ran alone (the same for the whole window).
+    fn window(pace: &mut Pace, micros: u64) -> bool {
+        let alone = pace.runs_alone();
+        for _ in 0..WINDOW {
+            assert_eq!(pace.runs_alone(), alone, "a window runs one way");
+            pace.record(Duration::from_micros(micros));
+            if pace.sections == 0 {
+                break;
+            }
+        }
+        alone
+    }
+
+    /// A probe that cannot win any more ends early: here after the 18 µs sections have
+    /// used up 90 % of a 10 µs window (32 of 64), and the team shares again.
+    #[test]
+    fn a_losing_probe_ends_as_soon_as_it_has_lost() {
+        let mut pace = Pace::default();
+        for _ in 0..PROBE_EVERY * WINDOW {
+            pace.record(Duration::from_micros(10));
+        }
+        assert!(pace.runs_alone(), "probing");
+        let mut sections = 0;
+        while pace.runs_alone() {
+            pace.record(Duration::from_micros(18));
+            sections += 1;
+        }
+        assert_eq!(sections, 32);
+        assert!(!pace.alone);
+    }
+
+    /// Story: the helpers pay in a quiet spell, stop paying in a busy one and pay again
+    /// after it; the team follows within one probe each time, and a probe that loses
+    /// changes nothing.
+    #[test]
+    fn a_team_runs_alone_while_its_helpers_do_not_pay_and_shares_again_when_they_do() {
+        let mut pace = Pace::default();
+        // Quiet: shared takes 10 µs a section, alone 18. The first probe (after eight
+        // windows) loses, and while sharing keeps its pace no other comes.
+        let probe_at = PROBE_EVERY as usize;
+        let ways: Vec<bool> = (0..100)
+            .map(|_| {
+                let alone = pace.runs_alone();
+                window(&mut pace, if alone { 18 } else { 10 })
+            })
+            .collect();
+        let want: Vec<bool> = (0..100).map(|w| w == probe_at).collect();
+        assert_eq!(ways, want, "one probe, at the start");
+        // Busy: shared now takes 30 µs, alone 20. The team probes at once and goes alone,
+        // probing sharing ever more rarely.
+        let most = PROBE_EVERY_MOST as usize;
+        let ways: Vec<bool> = (0..2 * most)
+            .map(|_| {
+                let alone = pace.runs_alone();
+                window(&mut pace, if alone { 20 } else { 30 })
+            })
+            .collect();
+        let first_alone = ways.iter().position(|&a| a).expect("goes alone");
+        assert_eq!(first_alone, 1, "{ways:?}");
+        let shared_probes = ways[first_alone..].iter().filter(|&&a| !a).count();
+        assert!((1..=4).contains(&shared_probes), "{ways:?}");
+        assert!(pace.alone);
+        // Quiet again: sharing wins its next probe (at most PROBE_EVERY_MOST windows on),
+        // and the team shares from then on, with no probe while it keeps its pace.
+        let ways: Vec<bool> = (0..2 * most)
+            .map(|_| {
+                let alone = pace.runs_alone();
+                window(&mut pace, if alone { 18 } else { 10 })
+            })
+            .collect();
+        let first_shared = ways.iter().position(|&a| !a).expect("shares again");
+        assert!(first_shared <= most, "{ways:?}");
+        assert!(ways[first_shared..].iter().all(|&a| !a), "{ways:?}");
+        assert!(!pace.alone, "{ways:?}");
+    }
+
+    /// Story: the machine keeps the helper slow (each of its shares takes a millisecond, the
+    /// caller's a few microseconds); after one probe the team runs its sections on the
+    /// caller alone, every share still once.
+    #[test]
+    fn a_team_whose_helper_is_slow_goes_on_alone() {
+        let team = Team::new(2);
+        let caller = std::thread::current().id();
+        let on_helper = AtomicUsize::new(0);
+        let shares = AtomicUsize::new(0);
+        let section = |_: usize| {
+            if std::thread::current().id() == caller {
+                let start = Instant::now();
+                while start.elapsed() < Duration::from_micros(20) {
+                    std::hint::spin_loop();
+                }
+            } else {
+                on_helper.fetch_add(1, Ordering::SeqCst);
+                std::thread::sleep(Duration::from_millis(1));
+            }
+            shares.fetch_add(1, Ordering::SeqCst);
+        };
+        let sections = (PROBE_EVERY + 1) * WINDOW;
+        for _ in 0..sections {
+            team.run(&section);
+        }
+        assert!(
+            on_helper.load(Ordering::SeqCst) > 0,
+            "the helper took part at first"
+        );
+        assert!(
+            team.busy.lock().unwrap().alone,
+            "alone after the first probe"
+        );
+        let before = on_helper.load(Ordering::SeqCst);
+        for _ in 0..(PROBE_EVERY - 1) * WINDOW {
+            team.run(&section);
+        }
+        assert_eq!(
+            on_helper.load(Ordering::SeqCst),
+            before,
+            "no share on the helper"
+        );
+        let total = (2 * PROBE_EVERY * WINDOW) as usize * 2;
+        assert_eq!(shares.load(Ordering::SeqCst), total, "every share once");
     }
 
     #[test]
