@@ -17,7 +17,7 @@
 //!
 //! On such a machine the helpers do not always pay: in a busy spell a 64 × 64 cloth stepped
 //! faster on one thread than on two in 9 of 12 alternating runs. So a team times its
-//! sections and, now and then, runs a short window of them on the caller alone ([`Pace`]);
+//! sections and, now and then, runs a short window of them on the caller alone (`Pace`);
 //! while that is faster, the caller goes on alone, and tries its helpers again later. Which
 //! way a section runs never changes its result (the shares are the same either way).
 
