@@ -231,9 +231,11 @@ const PROBE_EVERY_MOST: u32 = 64;
 /// Whether a team's sections run shared with its helpers or on the caller alone, chosen by
 /// timing. Now and then a window of [`WINDOW`] sections tries the other way, which is taken
 /// when it took at least 10 % less time than the last window run the chosen way (a probe
-/// that has used up that time ends early, lost). Probes come [`PROBE_EVERY`] windows after a switch and ever more rarely while they
-/// lose: each costs the slower way's time for one window and the helpers' caches warmed
-/// again, which at one probe in nine windows added 2–3 µs to a 30 µs substep.
+/// that has used up that time ends early, lost). Probes come [`PROBE_EVERY`] windows after
+/// a switch and ever more rarely while they lose; while sharing, they come only once its
+/// windows have slowed (and at the start, and every 512 windows). Each costs the slower
+/// way's time and the helpers' caches warmed again: at one probe in nine windows that
+/// added about 3 µs to a 30 µs substep.
 #[derive(Debug, Default)]
 struct Pace {
     /// The way chosen: the caller alone (the helpers did not pay when last tried).
