@@ -61,7 +61,8 @@ pub struct BenchRow {
     pub backend: String,
     /// CPU threads the solver may share a step among: the team's members (the pool's size,
     /// at most 16; a cloth under [`crate::sim::team::PARALLEL_ELEMENTS`] particles, 64 × 64,
-    /// still steps on one of them), 1 on the GPU (the thread that submits its work).
+    /// still steps on one of them, and the team runs on one while the others do not pay),
+    /// 1 on the GPU (the thread that submits its work).
     pub threads: usize,
     pub substeps_per_frame: u32,
     /// Wall time of the whole run per substep: every pause a busy machine imposes counts.

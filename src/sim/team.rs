@@ -121,8 +121,9 @@ impl Team {
 
     /// Runs `section(i)` for every member `i` at the same time, the caller taking `i = 0`,
     /// and returns when all are done. If another section of this team is running (another
-    /// thread's), the caller runs every member's share itself, in order. A panic in any
-    /// share is passed on after all are done.
+    /// thread's), or while the helpers do not pay (timed: see `Pace`), the caller runs
+    /// every member's share itself, in order. A panic in any share is passed on after all
+    /// are done.
     pub fn run(&self, section: &Section<'_>) {
         let mut pace = match self.busy.try_lock() {
             Ok(guard) => guard,
