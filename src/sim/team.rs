@@ -714,6 +714,32 @@ mod tests {
         assert!(!pace.alone, "{ways:?}");
     }
 
+    /// Story: sharing keeps its pace, so the slow-down gate never opens, but running alone
+    /// has become faster (the first probe lost); the probe that comes every
+    /// `8 × PROBE_EVERY_MOST` windows whatever the times say finds it, and the team goes
+    /// alone.
+    #[test]
+    fn a_steady_team_still_tries_alone_now_and_then() {
+        let mut pace = Pace::default();
+        let mut alone_from = None;
+        for w in 0..600 {
+            let alone = pace.runs_alone();
+            if alone && w > PROBE_EVERY as usize && alone_from.is_none() {
+                alone_from = Some(w);
+            }
+            // Alone loses the first probe (18 µs), and would win every later one (8 µs).
+            let micros = match (alone, w <= PROBE_EVERY as usize) {
+                (false, _) => 10,
+                (true, true) => 18,
+                (true, false) => 8,
+            };
+            window(&mut pace, micros);
+        }
+        let rechecked = PROBE_EVERY + 1 + 8 * PROBE_EVERY_MOST;
+        assert_eq!(alone_from, Some(rechecked as usize));
+        assert!(pace.alone);
+    }
+
     /// Story: the machine keeps the helper slow (each of its shares takes a millisecond, the
     /// caller's a few microseconds); after one probe the team runs its sections on the
     /// caller alone, every share still once.
