@@ -103,9 +103,10 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
 
 /// A parameter change on a running GPU simulation reaches the shader: new spring
 /// strengths, substeps and gravity, then a pin and a push, then one kind's strengths alone,
-/// applied mid-run on both backends, keep them together. Also when the GPU's state is not
-/// read back every frame (as the app runs it): each edit must start from the GPU's latest
-/// frame, not from the stale copy on the CPU.
+/// applied mid-run on both backends, keep them together, and so does a new density. Also when
+/// the GPU's state is not read back every frame (as the app runs it): each edit must start
+/// from the GPU's latest frame, not from the stale copy on the CPU, and a change of strengths
+/// or gravity reads nothing back.
 #[test]
 fn a_parameter_change_mid_run_reaches_the_gpu() {
     for read_every_frame in [true, false] {
@@ -125,7 +126,13 @@ fn parameter_change_mid_run(read_every_frame: bool) {
         params.stiffness = params.stiffness.map(|k| 3.0 * k);
         params.substeps = 24;
         params.gravity = glam::Vec3::new(2.0, -5.0, 1.0);
+        let behind = sim.state_behind();
         sim.set_params(params).expect("valid");
+        assert_eq!(
+            sim.state_behind(),
+            behind,
+            "a new stiffness reads nothing back"
+        );
         for _ in 0..20 {
             sim.step_frame().expect("frame");
         }
@@ -143,7 +150,15 @@ fn parameter_change_mid_run(read_every_frame: bool) {
         params.stiffness[1] *= 0.25;
         params.damping[1] *= 4.0;
         sim.set_params(params).expect("valid");
-        for _ in 0..10 {
+        for _ in 0..5 {
+            sim.step_frame().expect("frame");
+        }
+        // A new density rescales the masses of the latest frame, read back first.
+        let mut params = sim.params().clone();
+        params.density *= 1.5;
+        sim.set_params(params).expect("valid");
+        assert!(!sim.state_behind(), "the masses change on the latest state");
+        for _ in 0..5 {
             sim.step_frame().expect("frame");
         }
     }

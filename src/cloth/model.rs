@@ -146,6 +146,11 @@ impl ClothModel {
         self.rest_positions.len()
     }
 
+    /// The index of the first bend spring (the bend springs are the last ones).
+    pub fn bend_start(&self) -> usize {
+        self.springs.len() - self.bend_springs
+    }
+
     /// Recomputes masses from an areal density, kg/m²: each triangle gives a third of its
     /// mass to each corner; then every particle is raised to at least [`MASS_FLOOR`] of the
     /// mean particle mass and all are rescaled to keep the total ρ·A. (A vertex that only

@@ -3,7 +3,7 @@
 // add gravity and air damping, step the velocity then the position, then resolve the
 // sphere and plane colliders against the path of the substep, with friction.
 // Reads `src`, writes `dst`; the host swaps them every substep (ping-pong).
-// The host prepends `INDEX_BITS` and `CLASSES` (src/gpu/stepper.rs's constants).
+// The host prepends `CLASS_BITS` and `CLASSES` (src/gpu/stepper.rs's constants).
 
 struct Particle {
     // xyz: position (m); w: inverse mass (1/kg), 0 for a pinned particle.
@@ -13,7 +13,7 @@ struct Particle {
 }
 
 struct Neighbour {
-    // Low INDEX_BITS bits: the other end's index; the bits above: the strength class.
+    // Low CLASS_BITS bits: the strength class; the bits above: the other end's index.
     other: u32,
     // Rest length (m).
     rest: f32,
@@ -92,8 +92,8 @@ fn substep(@builtin(global_invocation_id) id: vec3<u32>) {
     var f = vec3<f32>(0.0);
     for (var s = offsets[i]; s < offsets[i + 1u]; s = s + 1u) {
         let nb = neighbours[s];
-        let o = src[nb.other & ((1u << INDEX_BITS) - 1u)];
-        let kc = classes[nb.other >> INDEX_BITS];
+        let o = src[nb.other >> CLASS_BITS];
+        let kc = classes[nb.other & (CLASSES - 1u)];
         let d = o.x.xyz - x;
         let len = length(d);
         if (len > 1e-9) {

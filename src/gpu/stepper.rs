@@ -10,9 +10,10 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
 use crate::cloth::{ClothModel, ClothState};
+use crate::mesh::SpringKind;
 use crate::render::map_read;
 use crate::sim::{
-    BendingModel, Collider, Diverged, Effect, ForceSet, FrameOutcome, IntegratorKind, PhaseTimings,
+    BendingModel, Collider, Diverged, Effect, FrameOutcome, IntegratorKind, PhaseTimings,
     SimParams, StepBackend, StepError, StepReport, StepStats, colliders_of,
 };
 
@@ -47,71 +48,93 @@ struct Particle {
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct Neighbour {
-    /// The other end's index in the low [`INDEX_BITS`] bits, its strength class (an index
-    /// into the class table) in the bits above.
+    /// The other end's index in the high bits, its strength class (an index into the
+    /// class table) in the low [`CLASS_BITS`] (see [`end_bits`]).
     other: u32,
     rest: f32,
 }
 
-/// Bits of [`Neighbour::other`] that hold the other end's index: a cloth has at most 2²⁸
-/// particles on the GPU backend. The shader is given this and [`MAX_CLASSES`] as constants.
-const INDEX_BITS: u32 = 28;
+/// Low bits of [`Neighbour::other`] that hold the strength class; the other end's index
+/// takes the 28 above, so a cloth has at most 2²⁸ particles on the GPU backend. The shader
+/// is given this and [`MAX_CLASSES`] as constants.
+const CLASS_BITS: u32 = 4;
 /// Strength classes (distinct stiffness–damping pairs) the shader's table holds: a cloth
-/// has at most one per spring kind (3) of each spring term (springs, bend springs).
-const MAX_CLASSES: usize = 1 << (32 - INDEX_BITS);
+/// has at most one per spring kind (3), which leaves room for strengths set otherwise.
+const MAX_CLASSES: usize = 1 << CLASS_BITS;
+/// Particles a cloth may have on the GPU backend.
+const MAX_PARTICLES: u64 = 1 << (32 - CLASS_BITS);
+
+/// A spring end's [`Neighbour::other`]: the index shifted up, the class below it. The class
+/// sits low so that a shader that decodes either half wrongly reads another particle or
+/// another class for every end (with the index low, a dropped mask would be hidden by
+/// 32-bit address arithmetic that wraps the class bits away).
+fn end_bits(other: u32, class: u8) -> u32 {
+    (other << CLASS_BITS) | u32::from(class)
+}
 
 /// Per strength class `[stiffness, damping, 0, 0]`: the shader's uniform `classes`.
 type ClassTable = [[f32; 4]; MAX_CLASSES];
 
-/// Which strength class each spring has ([`NO_CLASS`]: not sent), and the classes'
-/// stiffness and damping: what decides the spring ends' bits besides the model.
-struct SpringClasses {
-    of_spring: Vec<u8>,
-    table: ClassTable,
+/// What decides the spring ends' bits besides the model: whether each spring term (the
+/// structural and shear springs; the bend springs, the model's last) is sent, and each
+/// spring kind's class. A spring's stiffness and damping are its kind's, so the classes
+/// are the distinct pairs among the kinds, and a strength change is known to keep the ends
+/// as they are from three numbers, without a pass over the springs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct EndsKey {
+    terms: [bool; 2],
+    of_kind: [u8; 3],
 }
 
 /// The class of a spring the shader does not get.
 const NO_CLASS: u8 = u8::MAX;
-const _: () = assert!(MAX_CLASSES <= NO_CLASS as usize, "a class index fits a u8");
+const _: () = assert!(
+    SpringKind::ALL.len() <= MAX_CLASSES,
+    "every kind can have a class of its own"
+);
 
-/// Sorts the springs of `strengths` (each spring's index with its stiffness and damping;
-/// springs not listed are left out) into classes of equal strengths, numbered in the order
-/// they first appear, so that changing strengths that keep which springs share a class
-/// changes only the table. More distinct strengths than the table holds are refused.
-fn classify(
-    model: &ClothModel,
-    strengths: impl Iterator<Item = (usize, f32, f32)>,
-) -> Result<SpringClasses, GpuError> {
-    let mut pairs: Vec<[u32; 2]> = Vec::new();
-    let mut of_spring = vec![NO_CLASS; model.springs.len()];
-    // Springs of one kind mostly come together: the last one's class is tried first.
-    let mut last = 0;
-    for (e, k, c) in strengths {
-        let pair = [k.to_bits(), c.to_bits()];
-        let found = (pairs.get(last) == Some(&pair))
-            .then_some(last)
-            .or_else(|| pairs.iter().position(|&p| p == pair));
-        let at = match found {
+impl EndsKey {
+    /// The class of spring `e` of `model`, or [`NO_CLASS`] if its term is not sent.
+    fn class_of(&self, model: &ClothModel, e: usize) -> u8 {
+        if self.terms[usize::from(e >= model.bend_start())] {
+            self.of_kind[model.springs.kind[e].index()]
+        } else {
+            NO_CLASS
+        }
+    }
+}
+
+/// Whether `effects` has one that `want` picks.
+fn lists(effects: &[Effect], want: fn(&Effect) -> bool) -> bool {
+    effects.iter().any(want)
+}
+
+/// Sorts the spring kinds into classes of equal stiffness and damping, numbered in kind
+/// order, for the spring terms `effects` turn on: the ends' key and the class table.
+fn classify(params: &SimParams, effects: &[Effect]) -> (EndsKey, ClassTable) {
+    let terms = [
+        lists(effects, |e| matches!(e, Effect::Springs)),
+        lists(effects, |e| {
+            matches!(e, Effect::Bending(BendingModel::Springs))
+        }),
+    ];
+    let mut table: ClassTable = [[0.0; 4]; MAX_CLASSES];
+    let mut classes = 0;
+    let mut of_kind = [NO_CLASS; 3];
+    for kind in SpringKind::ALL.map(SpringKind::index) {
+        let entry = [params.stiffness[kind], params.damping[kind], 0.0, 0.0];
+        let same = |t: &[f32; 4]| t.map(f32::to_bits) == entry.map(f32::to_bits);
+        let class = match table[..classes].iter().position(same) {
             Some(at) => at,
-            None if pairs.len() == MAX_CLASSES => {
-                return Err(GpuError::Unsupported(format!(
-                    "takes at most {MAX_CLASSES} distinct spring strengths (stiffness and \
-                     damping); this cloth has more"
-                )));
-            }
             None => {
-                pairs.push(pair);
-                pairs.len() - 1
+                table[classes] = entry;
+                classes += 1;
+                classes - 1
             }
         };
-        of_spring[e] = at as u8;
-        last = at;
+        of_kind[kind] = class as u8;
     }
-    let mut table: ClassTable = [[0.0; 4]; MAX_CLASSES];
-    for (slot, &[k, c]) in table.iter_mut().zip(&pairs) {
-        *slot = [f32::from_bits(k), f32::from_bits(c), 0.0, 0.0];
-    }
-    Ok(SpringClasses { of_spring, table })
+    (EndsKey { terms, of_kind }, table)
 }
 
 /// The springs as the shader reads them: per particle its range of `ends` (CSR offsets),
@@ -121,8 +144,9 @@ struct PackedSprings {
     ends: Vec<Neighbour>,
 }
 
-/// Packs the model's adjacency: each end of a spring that has a class, with the class.
-fn pack_springs(model: &ClothModel, class: &[u8]) -> PackedSprings {
+/// Packs the model's adjacency: each end of a spring that `key` gives a class, with the
+/// class.
+fn pack_springs(model: &ClothModel, key: &EndsKey) -> PackedSprings {
     let adj = &model.adjacency;
     let count = model.particle_count();
     let mut offsets = Vec::with_capacity(count + 1);
@@ -131,9 +155,10 @@ fn pack_springs(model: &ClothModel, class: &[u8]) -> PackedSprings {
     for p in 0..count {
         for slot in adj.range(p) {
             let (e, other) = (adj.spring[slot] as usize, adj.other[slot]);
-            if class[e] != NO_CLASS && other as usize != p {
+            let class = key.class_of(model, e);
+            if class != NO_CLASS && other as usize != p {
                 ends.push(Neighbour {
-                    other: other | (u32::from(class[e]) << INDEX_BITS),
+                    other: end_bits(other, class),
                     rest: model.springs.rest[e],
                 });
             }
@@ -230,9 +255,9 @@ pub struct GpuStepper {
     lost: Option<String>,
     timings: PhaseTimings,
     stats: StepStats,
-    /// The class of each spring as the device's ends hold it (`None` before the first
+    /// The key the device's spring ends were packed with (`None` before the first
     /// upload), and how many times the ends were sent.
-    sent: Option<Vec<u8>>,
+    sent: Option<EndsKey>,
     ends_sent: u32,
 }
 
@@ -243,10 +268,9 @@ fn fits_buffers(limits: &wgpu::Limits, particles: u64, spring_ends: u64) -> Resu
     let most = limits
         .max_storage_buffer_binding_size
         .min(limits.max_buffer_size);
-    if particles > 1 << INDEX_BITS {
+    if particles > MAX_PARTICLES {
         return Err(GpuError::Unsupported(format!(
-            "takes at most {} particles, not {particles}",
-            1u64 << INDEX_BITS
+            "takes at most {MAX_PARTICLES} particles, not {particles}"
         )));
     }
     let need = [
@@ -307,7 +331,7 @@ impl GpuStepper {
             label: Some("cloth substep"),
             source: wgpu::ShaderSource::Wgsl(
                 format!(
-                    "const INDEX_BITS: u32 = {INDEX_BITS}u;\n\
+                    "const CLASS_BITS: u32 = {CLASS_BITS}u;\n\
                      const CLASSES: u32 = {MAX_CLASSES}u;\n{}",
                     include_str!("cloth.wgsl")
                 )
@@ -505,13 +529,14 @@ impl GpuStepper {
 
     /// Sends the springs' class table, and their ends (see [`pack_springs`]) when which
     /// springs share a class changed since the last upload: a strength change that keeps
-    /// them (a slider moving one kind's stiffness) sends 256 bytes, not every end again.
-    fn upload_springs(&mut self, model: &ClothModel, forces: &ForceSet) -> Result<(), GpuError> {
-        let classes = classify(model, forces.springs().flat_map(|t| t.each()))?;
+    /// them (a slider moving one kind's stiffness) sends 256 bytes, not every end again,
+    /// and costs no pass over the springs.
+    fn upload_springs(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]) {
+        let (key, table) = classify(params, effects);
         self.queue
-            .write_buffer(&self.classes, 0, bytemuck::cast_slice(&classes.table));
-        if self.sent.as_ref() != Some(&classes.of_spring) {
-            let packed = pack_springs(model, &classes.of_spring);
+            .write_buffer(&self.classes, 0, bytemuck::cast_slice(&table));
+        if self.sent != Some(key) {
+            let packed = pack_springs(model, &key);
             self.queue
                 .write_buffer(&self.offsets, 0, bytemuck::cast_slice(&packed.offsets));
             if !packed.ends.is_empty() {
@@ -519,9 +544,8 @@ impl GpuStepper {
                     .write_buffer(&self.neighbours, 0, bytemuck::cast_slice(&packed.ends));
             }
             self.ends_sent += 1;
+            self.sent = Some(key);
         }
-        self.sent = Some(classes.of_spring);
-        Ok(())
     }
 
     fn upload_state(&mut self, model: &ClothModel, state: &ClothState) {
@@ -639,18 +663,16 @@ impl StepBackend for GpuStepper {
     }
 
     fn configure(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]) {
-        let forces = ForceSet::new(model, params, effects);
-        self.unsupported = gpu_support(params, effects)
-            .and_then(|()| self.upload_springs(model, &forces))
-            .err()
-            .map(|e| e.to_string());
-        let has = |want: fn(&Effect) -> bool| effects.iter().any(want);
-        let g = if has(|e| matches!(e, Effect::Gravity)) {
+        self.unsupported = gpu_support(params, effects).err().map(|e| e.to_string());
+        if self.unsupported.is_none() {
+            self.upload_springs(model, params, effects);
+        }
+        let g = if lists(effects, |e| matches!(e, Effect::Gravity)) {
             params.gravity
         } else {
             Vec3::ZERO
         };
-        let drag = if has(|e| matches!(e, Effect::AirDamping)) {
+        let drag = if lists(effects, |e| matches!(e, Effect::AirDamping)) {
             params.air_damping
         } else {
             0.0
@@ -691,8 +713,8 @@ impl StepBackend for GpuStepper {
         self.params.gravity[3] = self.substep_length();
         self.queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
-        // Masses or pins may have changed with the parameters: send the state again.
-        self.upload = true;
+        // The state on the device stays as it is: masses and pins change through the
+        // caller's state, which then calls `invalidate`.
     }
 
     fn invalidate(&mut self) {
@@ -813,51 +835,56 @@ mod tests {
             max_buffer_size: u64::MAX,
             ..limits
         };
-        assert!(fits_buffers(&huge, 1 << INDEX_BITS, 0).is_ok());
-        let err = fits_buffers(&huge, (1 << INDEX_BITS) + 1, 0).expect_err("too many");
+        assert!(fits_buffers(&huge, MAX_PARTICLES, 0).is_ok());
+        let err = fits_buffers(&huge, MAX_PARTICLES + 1, 0).expect_err("too many");
         assert!(err.to_string().contains("268435456 particles"), "{err}");
     }
 
-    /// Every spring end carries its other particle, its rest length and the class whose
-    /// table entry is its kind's stiffness and damping, in the adjacency's order.
-    #[test]
-    fn each_spring_end_points_at_its_kinds_strengths() {
-        let scene = crate::scene::Scene::builtin("sphere-drop").expect("scene");
-        let (model, params) = (&scene.model, &scene.params);
-        let forces = ForceSet::new(model, params, &scene.effects);
-        let classes = classify(model, forces.springs().flat_map(|t| t.each())).expect("fits");
-        let packed = pack_springs(model, &classes.of_spring);
-        let adj = &model.adjacency;
-        let mut used = std::collections::BTreeSet::new();
-        for p in 0..model.particle_count() {
-            let range = packed.offsets[p] as usize..packed.offsets[p + 1] as usize;
-            let slots: Vec<usize> = adj.range(p).collect();
-            assert_eq!(range.len(), slots.len(), "particle {p}");
-            for (end, slot) in packed.ends[range].iter().zip(slots) {
-                let e = adj.spring[slot] as usize;
-                let kind = model.springs.kind[e].index();
-                let class = (end.other >> INDEX_BITS) as usize;
-                used.insert(class);
-                assert_eq!(end.other & ((1 << INDEX_BITS) - 1), adj.other[slot]);
-                assert_eq!(end.rest, model.springs.rest[e]);
-                let [k, c, ..] = classes.table[class];
-                assert_eq!((k, c), (params.stiffness[kind], params.damping[kind]));
-            }
-        }
-        assert_eq!(used.len(), 3, "one class per kind: {used:?}");
+    /// `effects` without bending.
+    fn unbent(effects: &[Effect]) -> Vec<Effect> {
+        (effects.iter())
+            .filter(|e| !matches!(e, Effect::Bending(_)))
+            .cloned()
+            .collect()
     }
 
-    /// Seventeen distinct strengths do not fit the table of sixteen and are refused.
+    /// Every spring end the CPU's force set has carries its other particle, its rest length
+    /// and the class whose table entry is that spring's stiffness and damping there, in the
+    /// adjacency's order; with the bend springs switched off, their ends are not sent.
     #[test]
-    fn more_strengths_than_the_table_holds_are_refused() {
+    fn each_spring_end_points_at_the_strengths_the_cpu_gives_its_spring() {
+        use crate::sim::ForceSet;
         let scene = crate::scene::Scene::builtin("sphere-drop").expect("scene");
-        let model = &scene.model;
-        let strengths = |n: usize| (0..model.springs.len()).map(move |e| (e, (e % n) as f32, 0.0));
-        assert!(classify(model, strengths(MAX_CLASSES)).is_ok());
-        let err = classify(model, strengths(MAX_CLASSES + 1))
-            .err()
-            .expect("refused");
-        assert!(err.to_string().contains("at most 16 distinct"), "{err}");
+        let (model, params) = (&scene.model, &scene.params);
+        let unbent = unbent(&scene.effects);
+        for (effects, classes) in [(&scene.effects, 3), (&unbent, 2)] {
+            let forces = ForceSet::new(model, params, effects);
+            let strengths: std::collections::HashMap<usize, (f32, f32)> = (forces.springs())
+                .flat_map(|t| t.each())
+                .map(|(e, k, c)| (e, (k, c)))
+                .collect();
+            let (key, table) = classify(params, effects);
+            let packed = pack_springs(model, &key);
+            let adj = &model.adjacency;
+            let mut used = std::collections::BTreeSet::new();
+            for p in 0..model.particle_count() {
+                let range = packed.offsets[p] as usize..packed.offsets[p + 1] as usize;
+                let slots: Vec<usize> = (adj.range(p))
+                    .filter(|&slot| strengths.contains_key(&(adj.spring[slot] as usize)))
+                    .collect();
+                assert_eq!(range.len(), slots.len(), "particle {p}");
+                for (end, slot) in packed.ends[range].iter().zip(slots) {
+                    let e = adj.spring[slot] as usize;
+                    let class = (end.other % MAX_CLASSES as u32) as usize;
+                    used.insert(class);
+                    assert_eq!(end.other >> CLASS_BITS, adj.other[slot]);
+                    assert_eq!(end.rest, model.springs.rest[e]);
+                    let [k, c, ..] = table[class];
+                    assert_eq!((k, c), strengths[&e], "spring {e}");
+                }
+            }
+            assert_eq!(used.len(), classes, "one class per kind sent: {used:?}");
+        }
     }
 
     /// A strength change that keeps which springs share a class (every kind scaled alike,
@@ -890,5 +917,9 @@ mod tests {
         change(&|p| p.stiffness = [p.stiffness[0]; 3], 4);
         change(&|p| p.damping = [p.damping[0]; 3], 5);
         change(&|_| (), 5);
+        // The bend springs switched off: their ends go.
+        let unbent = unbent(effects);
+        stepper.configure(model, &params, &unbent);
+        assert_eq!(stepper.ends_sent, 6);
     }
 }

@@ -230,14 +230,16 @@ impl Simulation {
 
     /// Replaces the parameters of the running simulation. The state, the time, the
     /// timings and the substeps the guard raised are kept (unless `substeps` itself changed);
-    /// a new density rescales the masses.
+    /// a new density rescales the masses. Only that reads back a backend's copy of the
+    /// state: a slider moving a stiffness on the GPU backend sends the new strengths and
+    /// nothing else.
     ///
     /// # Errors
     /// [`SceneError::Params`] naming the bad value; nothing changes then.
     pub fn set_params(&mut self, params: SimParams) -> Result<(), SceneError> {
         params.validate().map_err(SceneError::Params)?;
-        self.before_edit();
         if params.density != self.params.density {
+            self.before_edit();
             self.model.set_density(params.density);
             self.backend.invalidate();
         }
@@ -248,9 +250,9 @@ impl Simulation {
     }
 
     /// Replaces the effect list (switches forces on or off, moves or retunes colliders).
-    /// Returns warnings about it (a sphere smaller than the particle spacing).
+    /// Returns warnings about it (a sphere smaller than the particle spacing). The state,
+    /// and a backend's copy of it, are left as they are.
     pub fn set_effects(&mut self, effects: Vec<Effect>) -> Vec<String> {
-        self.before_edit();
         self.effects = effects;
         let warnings = small_sphere_warnings(&self.colliders(), &self.model);
         self.backend

@@ -17,7 +17,9 @@ pub trait StepBackend: Send {
 
     /// Applies new parameters and effects to the running backend, keeping what they do not
     /// make stale (the substeps the guard raised stay unless the requested count changed;
-    /// timings and statistics stay).
+    /// timings and statistics stay). The state is not the caller's to hand over here: a
+    /// backend that holds a copy of it keeps stepping that copy until
+    /// [`StepBackend::invalidate`].
     fn configure(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]);
 
     /// The state or the model changed outside stepping (reset, pins, density, a drag):

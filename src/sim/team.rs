@@ -279,7 +279,9 @@ impl Pace {
         (self.sections, self.spent) = (0, Duration::ZERO);
         if self.probing {
             self.probing = false;
-            if lost || to_beat.is_none() {
+            // A probe comes after a window run the chosen way, so it had a time to beat: a
+            // probe that did not lose won.
+            if lost {
                 self.probe_every = (self.probe_every.max(PROBE_EVERY) * 2).min(PROBE_EVERY_MOST);
             } else {
                 self.alone = !self.alone;

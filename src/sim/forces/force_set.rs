@@ -99,8 +99,7 @@ impl ForceSet {
             Force::Bending(b) => Some(b),
             _ => None,
         });
-        // The bend springs are the last ones.
-        let bend_start = model.springs.len() - model.bend_springs;
+        let bend_start = model.bend_start();
         let (stiffness, damping) = (params.stiffness, params.damping);
         let springs = |kept: Option<&SpringForce>, range: std::ops::Range<usize>| {
             let mut s = kept
