@@ -207,3 +207,82 @@ fn range(values: &[f64], below: f64, above: f64) -> (f64, f64) {
         (1e-3, 1.0)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::sweep::{Point, Reference};
+
+    fn pixels_of(buffer: &[u8], kind: IntegratorKind) -> usize {
+        let (r, g, b) = integrator_color(kind);
+        buffer.chunks_exact(3).filter(|p| *p == [r, g, b]).count()
+    }
+
+    /// Every integrator in its own decade of cost and error, three stable steps each (and
+    /// one unstable run for Verlet): nothing overlaps, so each colour's area is its own.
+    fn separated() -> AccuracyReport {
+        let mut points = Vec::new();
+        for (i, kind) in IntegratorKind::ALL.into_iter().enumerate() {
+            for (j, step) in [1.0, 2.0, 4.0].into_iter().enumerate() {
+                let decade = 10f64.powi(i as i32);
+                points.push(Point {
+                    integrator: kind,
+                    dt: 1e-3 / step,
+                    steps: 100,
+                    substeps_per_frame: step,
+                    rms_error: 1e-2 / decade / step,
+                    max_error: 1e-2 / decade / step,
+                    energy_drift: 0.0,
+                    stable: true,
+                    wall_s_per_sim_s: decade * (1.0 + 2.0 * j as f64),
+                    force_evals_per_step: 1.0,
+                    solver_iterations_per_step: 0.0,
+                });
+            }
+        }
+        let mut unstable = points[6].clone();
+        unstable.stable = false;
+        unstable.wall_s_per_sim_s = 0.5;
+        points.push(unstable);
+        AccuracyReport {
+            scene: "test".into(),
+            particles: 81,
+            size: 1.0,
+            seconds: 0.2,
+            tolerance: 1e-4,
+            reference: Reference {
+                integrator: IntegratorKind::Rk4,
+                dt: 1e-5,
+                check_rms: 1e-10,
+                check_max: 1e-10,
+                peak_kinetic: 1.0,
+            },
+            points,
+            limits: Vec::new(),
+            frontier: Vec::new(),
+            recommendation: None,
+        }
+    }
+
+    #[test]
+    fn every_integrator_is_drawn_in_its_own_colour_with_a_marker_per_step() {
+        let report = separated();
+        let buffer = draw(&report).unwrap();
+        let (w, h) = PLOT_SIZE;
+        assert_eq!(buffer.len(), (w * h * 3) as usize);
+        // A 6-pixel filled circle covers about 110 pixels, a legend line 60: three markers,
+        // their line and the legend are well above 300 in every colour.
+        for kind in IntegratorKind::ALL {
+            let n = pixels_of(&buffer, kind);
+            assert!(n > 300, "{kind}: only {n} pixels of its colour");
+        }
+        // The markers are there, not only the lines: dropping a point loses about a marker.
+        let mut fewer = report.clone();
+        fewer
+            .points
+            .retain(|p| !(p.integrator == IntegratorKind::Rk4 && p.substeps_per_frame == 2.0));
+        let lost = pixels_of(&buffer, IntegratorKind::Rk4) as f64
+            - pixels_of(&draw(&fewer).unwrap(), IntegratorKind::Rk4) as f64;
+        assert!(lost > 60.0, "dropping a point lost only {lost} pixels");
+    }
+}
