@@ -104,19 +104,12 @@ impl EndsKey {
     }
 }
 
-/// Whether `effects` has one that `want` picks.
-fn lists(effects: &[Effect], want: fn(&Effect) -> bool) -> bool {
-    effects.iter().any(want)
-}
-
 /// Sorts the spring kinds into classes of equal stiffness and damping, numbered in kind
 /// order, for the spring terms `effects` turn on: the ends' key and the class table.
 fn classify(params: &SimParams, effects: &[Effect]) -> (EndsKey, ClassTable) {
     let terms = [
-        lists(effects, |e| matches!(e, Effect::Springs)),
-        lists(effects, |e| {
-            matches!(e, Effect::Bending(BendingModel::Springs))
-        }),
+        effects.contains(&Effect::Springs),
+        effects.contains(&Effect::Bending(BendingModel::Springs)),
     ];
     let mut table: ClassTable = [[0.0; 4]; MAX_CLASSES];
     let mut classes = 0;
@@ -667,12 +660,12 @@ impl StepBackend for GpuStepper {
         if self.unsupported.is_none() {
             self.upload_springs(model, params, effects);
         }
-        let g = if lists(effects, |e| matches!(e, Effect::Gravity)) {
+        let g = if effects.contains(&Effect::Gravity) {
             params.gravity
         } else {
             Vec3::ZERO
         };
-        let drag = if lists(effects, |e| matches!(e, Effect::AirDamping)) {
+        let drag = if effects.contains(&Effect::AirDamping) {
             params.air_damping
         } else {
             0.0
