@@ -35,32 +35,15 @@ pub fn recommend(points: &[Point], frontier: &[usize], tolerance: f64) -> Option
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::IntegratorKind;
-
-    fn point(cost: f64, error: f64, stable: bool) -> Point {
-        Point {
-            integrator: IntegratorKind::Rk4,
-            dt: 1e-3,
-            steps: 1,
-            substeps_per_frame: 1.0,
-            rms_error: error,
-            max_error: error,
-            energy_drift: 0.0,
-            stable,
-            wall_s_per_sim_s: cost,
-            force_evals_per_step: 1.0,
-            solver_iterations_per_step: 0.0,
-        }
-    }
 
     #[test]
     fn the_frontier_keeps_only_undominated_stable_points() {
         let points = [
-            point(1.0, 0.1, true),
-            point(2.0, 0.2, true), // dearer and worse than the first: dominated
-            point(3.0, 0.01, true),
-            point(0.5, 1e-9, false), // cheap and exact, but unstable
-            point(4.0, 0.001, true),
+            Point::at(1.0, 0.1, true),
+            Point::at(2.0, 0.2, true), // dearer and worse than the first: dominated
+            Point::at(3.0, 0.01, true),
+            Point::at(0.5, 1e-9, false), // cheap and exact, but unstable
+            Point::at(4.0, 0.001, true),
         ];
         assert_eq!(frontier(&points), vec![0, 2, 4]);
     }
@@ -68,9 +51,9 @@ mod tests {
     #[test]
     fn the_choice_is_the_cheapest_point_within_tolerance() {
         let points = [
-            point(1.0, 0.1, true),
-            point(3.0, 0.01, true),
-            point(4.0, 0.001, true),
+            Point::at(1.0, 0.1, true),
+            Point::at(3.0, 0.01, true),
+            Point::at(4.0, 0.001, true),
         ];
         let f = frontier(&points);
         assert_eq!(recommend(&points, &f, 0.05), Some(1));

@@ -225,18 +225,12 @@ mod tests {
         for (i, kind) in IntegratorKind::ALL.into_iter().enumerate() {
             for (j, step) in [1.0, 2.0, 4.0].into_iter().enumerate() {
                 let decade = 10f64.powi(i as i32);
+                let cost = decade * (1.0 + 2.0 * j as f64);
                 points.push(Point {
                     integrator: kind,
                     dt: 1e-3 / step,
-                    steps: 100,
                     substeps_per_frame: step,
-                    rms_error: 1e-2 / decade / step,
-                    max_error: 1e-2 / decade / step,
-                    energy_drift: 0.0,
-                    stable: true,
-                    wall_s_per_sim_s: decade * (1.0 + 2.0 * j as f64),
-                    force_evals_per_step: 1.0,
-                    solver_iterations_per_step: 0.0,
+                    ..Point::at(cost, 1e-2 / decade / step, true)
                 });
             }
         }

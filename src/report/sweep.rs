@@ -121,6 +121,26 @@ pub struct Point {
     pub solver_iterations_per_step: f64,
 }
 
+#[cfg(test)]
+impl Point {
+    /// An RK4 point of this cost and error (tests: the rest are placeholders).
+    pub(crate) fn at(cost: f64, error: f64, stable: bool) -> Self {
+        Self {
+            integrator: IntegratorKind::Rk4,
+            dt: 1e-3,
+            steps: 1,
+            substeps_per_frame: 1.0,
+            rms_error: error,
+            max_error: error,
+            energy_drift: 0.0,
+            stable,
+            wall_s_per_sim_s: cost,
+            force_evals_per_step: 1.0,
+            solver_iterations_per_step: 0.0,
+        }
+    }
+}
+
 /// The reference trajectory and how well it is converged.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Reference {
