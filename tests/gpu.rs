@@ -4,7 +4,7 @@
 use clothsim::gpu::{Backend, gpu_simulation, gpu_support};
 use clothsim::render::{AdapterPreference, Gpu};
 use clothsim::scene::{Scene, Simulation};
-use clothsim::sim::IntegratorKind;
+use clothsim::sim::{Effect, IntegratorKind};
 
 /// The largest distance between the same particle in `a` and `b`, metres.
 fn farthest(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
@@ -102,11 +102,12 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
 }
 
 /// A parameter change on a running GPU simulation reaches the shader: new spring
-/// strengths, substeps and gravity, then a pin and a push, then one kind's strengths alone,
+/// strengths, substeps and gravity, then a pin and a push, then one kind's strengths alone
+/// and two effects switched off,
 /// applied mid-run on both backends, keep them together, and so does a new density. Also when
 /// the GPU's state is not read back every frame (as the app runs it): each edit must start
-/// from the GPU's latest frame, not from the stale copy on the CPU, and a change of strengths
-/// or gravity reads nothing back.
+/// from the GPU's latest frame, not from the stale copy on the CPU, and a change of strengths,
+/// gravity or effects reads nothing back.
 #[test]
 fn a_parameter_change_mid_run_reaches_the_gpu() {
     for read_every_frame in [true, false] {
@@ -145,11 +146,20 @@ fn parameter_change_mid_run(read_every_frame: bool) {
         for _ in 0..5 {
             sim.step_frame().expect("frame");
         }
-        // One kind's strengths apart from the others' (the GPU packs its springs anew).
+        // One kind's strengths apart from the others' (the GPU packs its springs anew), and
+        // the bend springs and air damping switched off: the GPU keeps stepping its own
+        // state, read nothing back.
         let mut params = sim.params().clone();
         params.stiffness[1] *= 0.25;
         params.damping[1] *= 4.0;
         sim.set_params(params).expect("valid");
+        let mut effects = sim.effects().to_vec();
+        let all = effects.len();
+        effects.retain(|e| !matches!(e, Effect::Bending(_) | Effect::AirDamping));
+        assert_eq!(effects.len(), all - 2, "{effects:?}");
+        let behind = sim.state_behind();
+        sim.set_effects(effects);
+        assert_eq!(sim.state_behind(), behind, "new effects read nothing back");
         for _ in 0..5 {
             sim.step_frame().expect("frame");
         }
