@@ -16,5 +16,5 @@ pub use file::{
 };
 pub use registry::{BUILTIN_SCENES, scenario, scenarios};
 pub use scene::{DEFAULT_CLOTH_NAME, DEFAULT_CLOTH_OBJ, Scene};
-pub use simulation::Simulation;
+pub use simulation::{GRAB_WINDOW, Simulation};
 pub use summary::{PhaseSummary, RunSummary};

@@ -13,6 +13,10 @@ use super::error::SceneError;
 use super::file::SceneFile;
 use super::scene::Scene;
 
+/// How far back, in simulated seconds, the pointer's velocity is measured for a held
+/// particle (see [`Simulation::grab`]).
+pub const GRAB_WINDOW: f64 = 0.1;
+
 /// Scene data, live state, parameters, effects and the backend that steps them.
 pub struct Simulation {
     /// The file the scene was built from, for saving the current setup.
@@ -27,6 +31,9 @@ pub struct Simulation {
     toggled_pins: Vec<u32>,
     /// The particle being dragged, held where the pointer puts it.
     grabbed: Option<u32>,
+    /// Where the pointer held it lately, `(simulated time, target)` oldest first: the
+    /// samples of the last [`GRAB_WINDOW`] and the newest one before that.
+    grab_trail: Vec<(f64, glam::Vec3)>,
     model: ClothModel,
     initial: ClothState,
     state: ClothState,
@@ -67,6 +74,7 @@ impl Simulation {
             pins_enabled: true,
             toggled_pins: Vec::new(),
             grabbed: None,
+            grab_trail: Vec::new(),
             state: scene.initial.clone(),
             initial: scene.initial,
             model: scene.model,
@@ -104,6 +112,7 @@ impl Simulation {
             pins_enabled: self.pins_enabled,
             toggled_pins: self.toggled_pins.clone(),
             grabbed: self.grabbed,
+            grab_trail: self.grab_trail.clone(),
             model: self.model.clone(),
             initial: self.initial.clone(),
             state: self.state.clone(),
@@ -289,9 +298,14 @@ impl Simulation {
         self.refresh_pins();
     }
 
-    /// Holds particle `p` at `target` (metres), moved there from where it was over one
-    /// frame; it stays held until [`Simulation::release`]. Works under every integrator: a
-    /// held particle is pinned, and its velocity is what the pointer gives it.
+    /// Holds particle `p` at `target` (metres) until [`Simulation::release`]. Works under
+    /// every integrator: a held particle is pinned, and its velocity is the pointer's.
+    ///
+    /// That velocity is measured in simulated time: the way from where the pointer held it
+    /// [`GRAB_WINDOW`] ago (or at its last call before that) to `target`. So it does not
+    /// depend on how many frames the window draws per simulated frame, and one jittery
+    /// sample barely moves it. A first call, or calls while the clock stands still, count
+    /// the move from where the particle is as one frame's.
     pub fn grab(&mut self, p: u32, target: glam::Vec3) {
         if p as usize >= self.model.particle_count() || !target.is_finite() {
             return;
@@ -299,17 +313,32 @@ impl Simulation {
         self.before_edit();
         if self.grabbed != Some(p) {
             self.grabbed = Some(p);
+            self.grab_trail.clear();
             self.refresh_pins();
         }
-        let dt = self.params.dt;
+        let now = self.state.time;
+        // A reset turns the clock back: samples from "the future" no longer count.
+        self.grab_trail.retain(|&(t, _)| t <= now);
+        while self.grab_trail.len() > 1 && now - self.grab_trail[1].0 >= GRAB_WINDOW {
+            self.grab_trail.remove(0);
+        }
         let i = p as usize;
-        self.state.vel[i] = (target - self.state.pos[i]) / dt;
+        self.state.vel[i] = match self.grab_trail.first() {
+            Some(&(t, from)) if t < now => (target - from) / (now - t) as f32,
+            _ => (target - self.state.pos[i]) / self.params.dt,
+        };
         self.state.pos[i] = target;
+        match self.grab_trail.last_mut() {
+            Some(last) if last.0 == now => last.1 = target,
+            _ => self.grab_trail.push((now, target)),
+        }
         self.backend.invalidate();
     }
 
-    /// Lets go of the held particle; it flies on with the pointer's last velocity.
+    /// Lets go of the held particle; it flies on at the pointer's velocity (see
+    /// [`Simulation::grab`]).
     pub fn release(&mut self) {
+        self.grab_trail.clear();
         if self.grabbed.take().is_some() {
             self.refresh_pins();
         }
