@@ -17,6 +17,36 @@ use super::scene::Scene;
 /// particle (see [`Simulation::grab`]).
 pub const GRAB_WINDOW: f64 = 0.1;
 
+/// The particle the pointer holds, and where the pointer held it lately.
+#[derive(Clone, Debug)]
+struct Held {
+    particle: u32,
+    /// `(simulated time, target)`, oldest first: the samples of the last [`GRAB_WINDOW`]
+    /// and the newest one before that.
+    trail: Vec<(f64, glam::Vec3)>,
+}
+
+impl Held {
+    /// Records that the pointer holds the particle at `target` at simulated time `now`, and
+    /// returns the pointer's velocity since the trail's first sample (`None` if the clock
+    /// has not moved since it).
+    fn follow(&mut self, now: f64, target: glam::Vec3) -> Option<glam::Vec3> {
+        // A reset turns the clock back: samples from "the future" no longer count.
+        self.trail.retain(|&(t, _)| t <= now);
+        let old = (self.trail.iter()).rposition(|&(t, _)| now - t >= GRAB_WINDOW);
+        self.trail.drain(..old.unwrap_or(0));
+        let velocity = match self.trail.first() {
+            Some(&(t, from)) if t < now => Some((target - from) / (now - t) as f32),
+            _ => None,
+        };
+        match self.trail.last_mut() {
+            Some(last) if last.0 == now => last.1 = target,
+            _ => self.trail.push((now, target)),
+        }
+        velocity
+    }
+}
+
 /// Scene data, live state, parameters, effects and the backend that steps them.
 pub struct Simulation {
     /// The file the scene was built from, for saving the current setup.
@@ -30,10 +60,7 @@ pub struct Simulation {
     /// Particles the user pinned or unpinned by hand (toggled on top of the scene's).
     toggled_pins: Vec<u32>,
     /// The particle being dragged, held where the pointer puts it.
-    grabbed: Option<u32>,
-    /// Where the pointer held it lately, `(simulated time, target)` oldest first: the
-    /// samples of the last [`GRAB_WINDOW`] and the newest one before that.
-    grab_trail: Vec<(f64, glam::Vec3)>,
+    held: Option<Held>,
     model: ClothModel,
     initial: ClothState,
     state: ClothState,
@@ -73,8 +100,7 @@ impl Simulation {
             scenario_pins: scene.pins,
             pins_enabled: true,
             toggled_pins: Vec::new(),
-            grabbed: None,
-            grab_trail: Vec::new(),
+            held: None,
             state: scene.initial.clone(),
             initial: scene.initial,
             model: scene.model,
@@ -111,8 +137,7 @@ impl Simulation {
             scenario_pins: self.scenario_pins.clone(),
             pins_enabled: self.pins_enabled,
             toggled_pins: self.toggled_pins.clone(),
-            grabbed: self.grabbed,
-            grab_trail: self.grab_trail.clone(),
+            held: self.held.clone(),
             model: self.model.clone(),
             initial: self.initial.clone(),
             state: self.state.clone(),
@@ -311,42 +336,32 @@ impl Simulation {
             return;
         }
         self.before_edit();
-        if self.grabbed != Some(p) {
-            self.grabbed = Some(p);
-            self.grab_trail.clear();
+        if self.grabbed() != Some(p) {
+            self.held = Some(Held {
+                particle: p,
+                trail: Vec::new(),
+            });
             self.refresh_pins();
         }
         let now = self.state.time;
-        // A reset turns the clock back: samples from "the future" no longer count.
-        self.grab_trail.retain(|&(t, _)| t <= now);
-        while self.grab_trail.len() > 1 && now - self.grab_trail[1].0 >= GRAB_WINDOW {
-            self.grab_trail.remove(0);
-        }
+        let pointer = self.held.as_mut().and_then(|h| h.follow(now, target));
         let i = p as usize;
-        self.state.vel[i] = match self.grab_trail.first() {
-            Some(&(t, from)) if t < now => (target - from) / (now - t) as f32,
-            _ => (target - self.state.pos[i]) / self.params.dt,
-        };
+        self.state.vel[i] = pointer.unwrap_or((target - self.state.pos[i]) / self.params.dt);
         self.state.pos[i] = target;
-        match self.grab_trail.last_mut() {
-            Some(last) if last.0 == now => last.1 = target,
-            _ => self.grab_trail.push((now, target)),
-        }
         self.backend.invalidate();
     }
 
     /// Lets go of the held particle; it flies on at the pointer's velocity (see
     /// [`Simulation::grab`]).
     pub fn release(&mut self) {
-        self.grab_trail.clear();
-        if self.grabbed.take().is_some() {
+        if self.held.take().is_some() {
             self.refresh_pins();
         }
     }
 
     /// The particle being held, if any.
     pub fn grabbed(&self) -> Option<u32> {
-        self.grabbed
+        self.held.as_ref().map(|h| h.particle)
     }
 
     /// Pins in force: the scene's (when enabled), toggled by hand, and the held particle.
@@ -365,7 +380,7 @@ impl Simulation {
                 None => pins.push(p),
             }
         }
-        let held: Vec<u32> = self.grabbed.into_iter().collect();
+        let held: Vec<u32> = self.grabbed().into_iter().collect();
         pins.extend(held.iter().copied());
         let newly_pinned: Vec<u32> = pins
             .iter()
