@@ -93,40 +93,42 @@ fn a_grabbed_particle_follows_the_pointer_and_pulls_the_cloth_under_every_integr
     }
 }
 
-/// Holds the bottom-middle particle of `sim` and moves the pointer along `path` (metres
-/// from where the particle was, as a function of the simulated seconds since), sampling it
-/// every `every` frames for `frames` frames and once more at the end; then lets go.
-/// Returns the particle and its velocity as it was let go.
-fn fling(
-    sim: &mut Simulation,
-    every: usize,
-    frames: usize,
-    path: impl Fn(f64) -> Vec3,
-) -> (u32, Vec3) {
-    let (p, _) = bottom_middle(sim);
+/// Holds particle `p` of `sim` and moves the pointer along `path` (metres from where the
+/// particle was, as a function of the simulated seconds since), sampling it every `every`
+/// frames for `frames` frames (a multiple of `every`) and at the end.
+fn drag(sim: &mut Simulation, p: u32, every: usize, frames: usize, path: impl Fn(f64) -> Vec3) {
+    assert_eq!(frames % every, 0);
     let (start, t0) = (sim.state().pos[p as usize], sim.state().time);
     for k in 0..=frames {
-        if k % every == 0 || k == frames {
+        if k % every == 0 {
             sim.grab(p, start + path(sim.state().time - t0));
         }
         if k < frames {
             sim.step_frame().unwrap();
         }
     }
+}
+
+/// [`drag`]s the bottom-middle particle, then lets go; returns its velocity as it was let go.
+fn fling(sim: &mut Simulation, every: usize, frames: usize, path: impl Fn(f64) -> Vec3) -> Vec3 {
+    let (p, _) = bottom_middle(sim);
+    drag(sim, p, every, frames, path);
     sim.release();
-    (p, sim.state().vel[p as usize])
+    sim.state().vel[p as usize]
 }
 
 /// Letting go flings the particle on at the pointer's velocity over its last tenth of a
 /// simulated second: the same whether the window sampled the pointer every frame or every
-/// second or third one (a frame's move over one frame's time would double or triple it),
-/// barely moved by one jittery sample, nothing once the pointer has stopped.
+/// second, third or ninth one (a frame's move over one frame's time would be 2–9 times it),
+/// barely moved by one jittery sample, nothing once the pointer has stopped, and nothing
+/// from before a reset.
 #[test]
 fn a_released_particle_flies_on_at_the_pointers_recent_velocity() {
     let speed = Vec3::new(0.0, 0.0, 0.5);
-    for every in [1, 2, 3] {
+    // (Every ninth frame is further apart than the window: the sample before it counts.)
+    for every in [1, 2, 3, 9] {
         let mut sim = hanging(IntegratorKind::SemiImplicitEuler);
-        let (_, v) = fling(&mut sim, every, 12, |t| speed * t as f32);
+        let v = fling(&mut sim, every, 18, |t| speed * t as f32);
         assert!(
             (v - speed).length() < 1e-3,
             "sampled every {every} frames: let go at {v} m/s, the pointer moved at {speed}"
@@ -135,7 +137,7 @@ fn a_released_particle_flies_on_at_the_pointers_recent_velocity() {
     // The last sample 2 mm off the line: one frame's move would be off by 0.12 m/s.
     let mut sim = hanging(IntegratorKind::SemiImplicitEuler);
     let last = 12.0 / 60.0;
-    let (_, v) = fling(&mut sim, 1, 12, |t| {
+    let v = fling(&mut sim, 1, 12, |t| {
         speed * t as f32 + Vec3::Y * if t > last - 1e-3 { 0.002 } else { 0.0 }
     });
     let off = (v - speed).length();
@@ -147,8 +149,22 @@ fn a_released_particle_flies_on_at_the_pointers_recent_velocity() {
     let mut sim = hanging(IntegratorKind::SemiImplicitEuler);
     let stop = 6.0 / 60.0;
     let frames = 6 + (GRAB_WINDOW * 60.0).ceil() as usize;
-    let (_, v) = fling(&mut sim, 1, frames, |t| speed * t.min(stop) as f32);
+    let v = fling(&mut sim, 1, frames, |t| speed * t.min(stop) as f32);
     assert_eq!(v, Vec3::ZERO, "let go after the pointer stopped");
+    // A reset while holding turns the clock back: the pointer's moves from before it (later
+    // on the clock) no longer count, and sampling every other frame still gives its speed.
+    let mut sim = hanging(IntegratorKind::SemiImplicitEuler);
+    let (p, _) = bottom_middle(&sim);
+    drag(&mut sim, p, 1, 6, |t| -speed * t as f32);
+    sim.reset();
+    // (Let go within the window: earlier samples would still be in it.)
+    drag(&mut sim, p, 2, 4, |t| speed * t as f32);
+    sim.release();
+    let v = sim.state().vel[p as usize];
+    assert!(
+        (v - speed).length() < 1e-3,
+        "after a reset: let go at {v} m/s"
+    );
 }
 
 #[test]
