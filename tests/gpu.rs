@@ -103,11 +103,10 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
 
 /// A parameter change on a running GPU simulation reaches the shader: new spring
 /// strengths, substeps and gravity, then a pin and a push, then one kind's strengths alone
-/// and two effects switched off,
-/// applied mid-run on both backends, keep them together, and so does a new density. Also when
-/// the GPU's state is not read back every frame (as the app runs it): each edit must start
-/// from the GPU's latest frame, not from the stale copy on the CPU, and a change of strengths,
-/// gravity or effects reads nothing back.
+/// and two effects switched off, applied mid-run on both backends, keep them together, and
+/// so does a new density. Also when the GPU's state is not read back every frame (as the
+/// app runs it): each edit must start from the GPU's latest frame, not from the stale copy
+/// on the CPU, and a change of strengths, gravity or effects reads nothing back.
 #[test]
 fn a_parameter_change_mid_run_reaches_the_gpu() {
     for read_every_frame in [true, false] {

@@ -778,7 +778,8 @@ mod tests {
             "alone after the first probe"
         );
         let before = on_helper.load(Ordering::SeqCst);
-        for _ in 0..(PROBE_EVERY - 1) * WINDOW {
+        let later = (PROBE_EVERY - 1) * WINDOW;
+        for _ in 0..later {
             team.run(&section);
         }
         assert_eq!(
@@ -786,7 +787,7 @@ mod tests {
             before,
             "no share on the helper"
         );
-        let total = (2 * PROBE_EVERY * WINDOW) as usize * 2;
+        let total = (sections + later) as usize * team.members();
         assert_eq!(shares.load(Ordering::SeqCst), total, "every share once");
     }
 
