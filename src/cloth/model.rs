@@ -167,14 +167,16 @@ impl ClothModel {
                 self.mass[i as usize] += third;
             }
         }
-        let total: f32 = self.mass.iter().sum();
+        // Summed in f64: in f32 a million small masses lose about 1 % to rounding (each
+        // addend is a few dozen ulps of the running total near 1 kg).
+        let total = sum_f64(&self.mass);
         if self.masses == MassDistribution::Uniform {
             let each = total / self.mass.len().max(1) as f32;
             self.mass.iter_mut().for_each(|m| *m = each);
         } else if total > 0.0 {
             let floor = MASS_FLOOR * total / self.mass.len() as f32;
             self.mass.iter_mut().for_each(|m| *m = m.max(floor));
-            let scale = total / self.mass.iter().sum::<f32>();
+            let scale = total / sum_f64(&self.mass);
             self.mass.iter_mut().for_each(|m| *m *= scale);
         }
         let pins = std::mem::take(&mut self.pins);
@@ -203,6 +205,11 @@ impl ClothModel {
 
     /// Total mass, kg.
     pub fn total_mass(&self) -> f32 {
-        self.mass.iter().sum()
+        sum_f64(&self.mass)
     }
+}
+
+/// The sum of `values`, accumulated in f64.
+fn sum_f64(values: &[f32]) -> f32 {
+    values.iter().map(|&v| f64::from(v)).sum::<f64>() as f32
 }
