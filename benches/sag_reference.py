@@ -77,7 +77,8 @@ def sag(n, dtype, defines=()):
     x, v = x0.astype(t), cp.zeros((n * n, 3), dtype=t)
     start = x.copy()
     xn, vn = cp.empty_like(x), cp.empty_like(v)
-    dt = t(1.0 / (60 * n))
+    sub = int(os.environ.get("SUB", "1"))  # substeps per frame: N × SUB
+    dt = t(1.0 / (60 * n * sub))
     args = (cp.int32(n), cp.float64(h), t(500.0), t(0.01), t(n * n), dt,
             t(math.exp(-4.0 * float(dt))), t(9.81), start)
     blocks = (n * n + 127) // 128
@@ -86,7 +87,7 @@ def sag(n, dtype, defines=()):
     y0 = float(x0[centre, 1].mean())
     trace = int(os.environ.get("TRACE", "0"))
     for frame in range(1, 121):
-        for _ in range(n):
+        for _ in range(n * sub):
             kernel((blocks,), (128,), (x, v, xn, vn) + args)
             x, xn, v, vn = xn, x, vn, v
         if trace and frame % trace == 0:
