@@ -83,7 +83,7 @@ type ClassTable = [[f32; 4]; MAX_CLASSES];
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct EndsKey {
     terms: [bool; 2],
-    of_kind: [u8; 3],
+    of_kind: [u8; SpringKind::ALL.len()],
 }
 
 /// The class of a spring the shader does not get.
@@ -113,7 +113,7 @@ fn classify(params: &SimParams, effects: &[Effect]) -> (EndsKey, ClassTable) {
     ];
     let mut table: ClassTable = [[0.0; 4]; MAX_CLASSES];
     let mut classes = 0;
-    let mut of_kind = [NO_CLASS; 3];
+    let mut of_kind = [NO_CLASS; SpringKind::ALL.len()];
     for kind in SpringKind::ALL.map(SpringKind::index) {
         let entry = [params.stiffness[kind], params.damping[kind], 0.0, 0.0];
         let same = |t: &[f32; 4]| t.map(f32::to_bits) == entry.map(f32::to_bits);
