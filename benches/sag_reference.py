@@ -8,6 +8,11 @@ Euler with N substeps per 1/60 s frame), one CUDA thread per particle gathering 
 springs, so a substep is one launch. It exists to say which answer is right where the
 float32 solvers disagree (N = 700): the float64 run is the reference, the float32 run shows
 how far rounding alone moves the same arithmetic. Prints one line per run: N, type, sag (m).
+
+A run is N:TYPE, optionally followed by :LINEAR_DRAG (air damping as −rate·v inside the
+acceleration, as clothsim does, instead of a factor after it) and :REST_FROM_POS (rest
+lengths from the float32 start positions), the variants that were ruled out as causes.
+SUB=k takes k times the substeps (a converged answer); TRACE=f prints the sag every f frames.
 """
 
 import math
