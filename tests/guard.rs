@@ -43,6 +43,47 @@ fn when_nothing_saves_a_frame_the_rollback_is_exact() {
     assert_eq!(events.last().unwrap().action, GuardAction::GaveUp);
 }
 
+/// Story: a hard pull raised the limits (the stretch a drag makes is the user's doing, not a
+/// blow-up). Raised, they still catch one before anything becomes non-finite: with the
+/// cloth held stretched past the default strain limit, explicit Euler at the scene's 48
+/// substeps (it needs about 8 × as many) is stopped by a limit in its first frame, rolled
+/// back exactly, with the particle still held.
+#[test]
+fn a_blow_up_is_still_caught_while_a_pull_holds_the_cloth_stretched() {
+    let mut sim = hanging(|_| {});
+    sim.run(0.5);
+    let pos = &sim.state().pos;
+    let p = (0..pos.len())
+        .min_by(|&a, &b| pos[a].y.total_cmp(&pos[b].y))
+        .unwrap() as u32;
+    let start = pos[p as usize];
+    for k in 1..=30 {
+        sim.grab(
+            p,
+            start + glam::Vec3::new(0.0, 0.0, 4.0) * (k as f32 / 60.0),
+        );
+        sim.step_frame().unwrap();
+    }
+    assert!(sim.take_guard_events().is_empty(), "the pull alone is fine");
+    let mut params = sim.params().clone();
+    params.integrator = IntegratorKind::ExplicitEuler;
+    params.guard = GuardPolicy {
+        max_refinements: 0,
+        fallback: None,
+        ..GuardPolicy::default()
+    };
+    sim.set_params(params).unwrap();
+    let (before, time) = (bits(&sim), sim.state().time);
+    let err = sim.step_frame().unwrap_err().to_string();
+    assert_eq!(bits(&sim), before, "the state is exactly the frame's start");
+    assert_eq!(sim.state().time, time);
+    assert_eq!(sim.grabbed(), Some(p));
+    assert!(
+        !err.contains("non-finite") && err.contains("limit"),
+        "caught by a limit while still finite: {err}"
+    );
+}
+
 /// At 100 × the stiffness symplectic Euler would need about 10 × the substeps; one
 /// refinement (2 ×) is not enough, so the guard falls back to implicit Euler, which stays.
 #[test]

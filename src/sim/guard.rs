@@ -22,7 +22,9 @@ pub struct GuardPolicy {
     /// Smallest limit on the relative extension of a spring (default 1: twice its rest
     /// length; cloth stays within a few percent). The limit in force is raised to `headroom`
     /// times the stretch of a structural spring carrying the whole cloth's weight, so soft
-    /// chains that really do stretch a lot are not mistaken for blow-ups.
+    /// chains that really do stretch a lot are not mistaken for blow-ups, and to `headroom`
+    /// times the largest stretch when the limits are derived (after a drag or an edit), so
+    /// a cloth the user pulls hard is not either.
     pub max_strain: f32,
     /// Safety factor on the speed and kinetic-energy limits derived from the scene (default 4).
     pub headroom: f32,
@@ -103,8 +105,9 @@ pub struct GuardLimits {
 impl GuardLimits {
     /// Limits for `state` of `model` under `gravity` with spring `stiffness` (per kind,
     /// N/m), among `colliders`, with an ambient `wind` speed (m/s): the speeds and energy
-    /// the scene can reach by falling, being thrown or being dragged, and the stretch of a
-    /// structural spring carrying the whole weight, times the policy's headroom.
+    /// the scene can reach by falling, being thrown, being dragged or springing back from
+    /// the stretch it has, and the larger of the stretch of a structural spring carrying
+    /// the whole weight and the largest stretch it has, times the policy's headroom.
     pub fn derive(
         policy: &GuardPolicy,
         model: &ClothModel,
@@ -135,24 +138,33 @@ impl GuardLimits {
         let height = (hi - lo).length() + (lo.y - bottom).max(0.0);
         let fall = (2.0 * gravity.length() * height).sqrt();
         let pushed = state.max_speed() + surface + wind;
+        let free = || (model.mass.iter().zip(&model.inv_mass)).filter(|(_, w)| **w > 0.0);
+        let mass: f64 = free().map(|(m, _)| *m as f64).sum();
+        // What the frame starts with is the user's doing (a drag, an edit, the scene as
+        // loaded), never the integrator's: the springs' stretch and the energy stored in it
+        // count as reachable, and a stretched cloth let go can fling its lightest particle
+        // at up to the speed that energy gives it.
+        let elastic = spring_energy(model, state, stiffness);
+        let lightest = free().map(|(m, _)| *m).fold(f32::INFINITY, f32::min);
+        let flung = if lightest > 0.0 && lightest.is_finite() {
+            (2.0 * elastic / lightest as f64).sqrt() as f32
+        } else {
+            0.0
+        };
         let speed = policy
             .max_speed
-            .unwrap_or(policy.headroom * (fall + pushed) + 1.0);
-        let mass: f64 = model
-            .mass
-            .iter()
-            .zip(&model.inv_mass)
-            .filter(|(_, w)| **w > 0.0)
-            .map(|(m, _)| *m as f64)
-            .sum();
+            .unwrap_or(policy.headroom * (fall + pushed + flung) + 1.0);
         let available = state.kinetic_energy(model)
+            + elastic
             + mass * gravity.length() as f64 * height as f64
             + 0.5 * mass * (pushed as f64).powi(2);
+        let weight = mass as f32 * gravity.length();
         Self {
             speed,
-            strain: policy.max_strain.max(
-                policy.headroom * weight_strain(model, stiffness, mass as f32 * gravity.length()),
-            ),
+            strain: policy
+                .max_strain
+                .max(policy.headroom * weight_strain(model, stiffness, weight))
+                .max(policy.headroom * max_strain(model, state)),
             kinetic_energy: policy.headroom as f64 * available + 1e-9,
         }
     }
@@ -172,6 +184,30 @@ fn weight_strain(model: &ClothModel, stiffness: [f32; 3], weight: f32) -> f32 {
     } else {
         0.0
     }
+}
+
+/// The largest relative extension of a spring in `state` (0 when none is stretched).
+fn max_strain(model: &ClothModel, state: &ClothState) -> f32 {
+    let s = &model.springs;
+    (0..s.len())
+        .map(|e| {
+            state.pos[s.a[e] as usize].distance(state.pos[s.b[e] as usize]) / s.rest[e].max(1e-12)
+                - 1.0
+        })
+        .fold(0.0f32, f32::max)
+}
+
+/// The springs' elastic energy `Σ ½k(|d| − l₀)²` in `state` with `stiffness` per kind,
+/// joules (summed in f64).
+fn spring_energy(model: &ClothModel, state: &ClothState, stiffness: [f32; 3]) -> f64 {
+    let s = &model.springs;
+    (0..s.len())
+        .map(|e| {
+            let stretch =
+                state.pos[s.a[e] as usize].distance(state.pos[s.b[e] as usize]) - s.rest[e];
+            0.5 * stiffness[s.kind[e].index()] as f64 * (stretch as f64).powi(2)
+        })
+        .sum()
 }
 
 /// What went wrong in a frame.
@@ -232,13 +268,7 @@ pub fn check(model: &ClothModel, state: &ClothState, limits: &GuardLimits) -> Op
             limit: limits.speed,
         });
     }
-    let s = &model.springs;
-    let strain = (0..s.len())
-        .map(|e| {
-            state.pos[s.a[e] as usize].distance(state.pos[s.b[e] as usize]) / s.rest[e].max(1e-12)
-                - 1.0
-        })
-        .fold(0.0f32, f32::max);
+    let strain = max_strain(model, state);
     if strain > limits.strain {
         return Some(Trouble::Strain {
             strain,
