@@ -28,7 +28,6 @@ pub struct CpuStepper {
     colliders: Vec<Collider>,
     solver: SolverConfig,
     gravity: glam::Vec3,
-    stiffness: [f32; 3],
     dt: f32,
     /// Substeps per frame the parameters ask for.
     requested: u32,
@@ -58,7 +57,6 @@ impl CpuStepper {
             colliders: Vec::new(),
             solver: params.solver,
             gravity: params.gravity,
-            stiffness: params.stiffness,
             dt: params.dt,
             requested: 0,
             substeps: 1,
@@ -305,7 +303,6 @@ impl StepBackend for CpuStepper {
         self.integrator.forces_changed();
         self.solver = params.solver;
         self.gravity = params.gravity;
-        self.stiffness = params.stiffness;
         self.dt = params.dt;
         self.offset = params.collision_offset;
         if self.guard.policy != params.guard {
@@ -389,7 +386,7 @@ impl StepBackend for CpuStepper {
                 model,
                 state,
                 self.gravity,
-                self.stiffness,
+                &self.forces,
                 &self.colliders,
                 wind,
             ));

@@ -7,6 +7,7 @@ use crate::cloth::{ClothModel, ClothState};
 use crate::mesh::{SpringKind, bounds};
 
 use super::collider::Collider;
+use super::forces::ForceSet;
 use super::integrator::{IntegratorKind, StepError};
 
 /// What the guard may do. Part of [`super::SimParams`].
@@ -103,8 +104,8 @@ pub struct GuardLimits {
 }
 
 impl GuardLimits {
-    /// Limits for `state` of `model` under `gravity` with spring `stiffness` (per kind,
-    /// N/m), among `colliders`, with an ambient `wind` speed (m/s): the speeds and energy
+    /// Limits for `state` of `model` under `gravity` with the spring terms of `forces`,
+    /// among `colliders`, with an ambient `wind` speed (m/s): the speeds and energy
     /// the scene can reach by falling, being thrown, being dragged or springing back from
     /// the stretch it has, and the larger of the stretch of a structural spring carrying
     /// the whole weight and the largest stretch it has, times the policy's headroom.
@@ -113,7 +114,7 @@ impl GuardLimits {
         model: &ClothModel,
         state: &ClothState,
         gravity: Vec3,
-        stiffness: [f32; 3],
+        forces: &ForceSet,
         colliders: &[Collider],
         wind: f32,
     ) -> Self {
@@ -144,7 +145,9 @@ impl GuardLimits {
         // loaded), never the integrator's: the springs' stretch and the energy stored in it
         // count as reachable, and a stretched cloth let go can fling its lightest particle
         // at up to the speed that energy gives it.
-        let elastic = spring_energy(model, state, stiffness);
+        let elastic: f64 = (forces.springs())
+            .map(|s| s.potential_energy(&model.springs, &state.pos))
+            .sum();
         let lightest = free().map(|(m, _)| *m).fold(f32::INFINITY, f32::min);
         let flung = if lightest > 0.0 && lightest.is_finite() {
             (2.0 * elastic / lightest as f64).sqrt() as f32
@@ -163,7 +166,7 @@ impl GuardLimits {
             speed,
             strain: policy
                 .max_strain
-                .max(policy.headroom * weight_strain(model, stiffness, weight))
+                .max(policy.headroom * weight_strain(model, forces, weight))
                 .max(policy.headroom * max_strain(model, state)),
             kinetic_energy: policy.headroom as f64 * available + 1e-9,
         }
@@ -172,12 +175,11 @@ impl GuardLimits {
 
 /// Relative stretch of the weakest structural spring (the smallest k·l) pulled by `weight`
 /// newtons; 0 without structural springs of positive stiffness.
-fn weight_strain(model: &ClothModel, stiffness: [f32; 3], weight: f32) -> f32 {
+fn weight_strain(model: &ClothModel, forces: &ForceSet, weight: f32) -> f32 {
     let s = &model.springs;
-    let k = stiffness[SpringKind::Structural.index()];
-    let weakest = (0..s.len())
-        .filter(|&e| s.kind[e] == SpringKind::Structural)
-        .map(|e| k * s.rest[e])
+    let weakest = (forces.springs().flat_map(|t| t.each()))
+        .filter(|&(e, _, _)| s.kind[e] == SpringKind::Structural)
+        .map(|(e, k, _)| k * s.rest[e])
         .fold(f32::INFINITY, f32::min);
     if weakest.is_finite() && weakest > 0.0 {
         weight / weakest
@@ -195,19 +197,6 @@ fn max_strain(model: &ClothModel, state: &ClothState) -> f32 {
                 - 1.0
         })
         .fold(0.0f32, f32::max)
-}
-
-/// The springs' elastic energy `Σ ½k(|d| − l₀)²` in `state` with `stiffness` per kind,
-/// joules (summed in f64).
-fn spring_energy(model: &ClothModel, state: &ClothState, stiffness: [f32; 3]) -> f64 {
-    let s = &model.springs;
-    (0..s.len())
-        .map(|e| {
-            let stretch =
-                state.pos[s.a[e] as usize].distance(state.pos[s.b[e] as usize]) - s.rest[e];
-            0.5 * stiffness[s.kind[e].index()] as f64 * (stretch as f64).powi(2)
-        })
-        .sum()
 }
 
 /// What went wrong in a frame.
