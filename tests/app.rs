@@ -813,3 +813,26 @@ fn the_window_is_cleared_to_the_panels_colour_in_either_theme() {
         );
     }
 }
+
+#[test]
+fn a_self_collision_thicker_than_the_cloth_is_refused_and_the_effects_stay() {
+    let mut harness = harness();
+    harness.state_mut().set_scenario("self-fold");
+    harness.run_steps(1);
+    let before = harness.state().sim().effects().to_vec();
+    let mut thick = before.clone();
+    for e in &mut thick {
+        if let clothsim::sim::Effect::SelfCollision(s) = e {
+            s.thickness = 0.1;
+        }
+    }
+    harness.state_mut().apply_effects(thick);
+    harness.run_steps(1);
+    assert_eq!(harness.state().sim().effects(), before);
+    let error = last_error(&harness);
+    assert!(
+        error.contains("`thickness` = 0.1 m") && error.contains("shortest rest edge"),
+        "{error}"
+    );
+    harness.get_by_label_contains("shortest rest edge");
+}

@@ -81,6 +81,31 @@ fn a_bad_file_is_one_line_on_stderr_naming_file_and_problem() {
 }
 
 #[test]
+fn a_self_collision_thicker_than_the_cloth_is_one_line_naming_file_line_and_lengths() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("thick.toml");
+    std::fs::write(
+        &path,
+        "name = \"thick\"\n[cloth]\ngrid = { quads = 20, size = 1.0 }\n\
+         [[effects]]\ntype = \"self-collision\"\nthickness = 0.2\n",
+    )
+    .unwrap();
+    let file = path.to_str().unwrap();
+    for args in [&["simulate", "--scene", file][..], &["scenes", file]] {
+        let out = clothsim(args);
+        assert!(!out.status.success(), "{args:?}: must fail");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr.trim_end().lines().count(), 1, "one line: {stderr}");
+        assert!(
+            stderr.contains("thick.toml:6:1")
+                && stderr.contains("0.2 m")
+                && stderr.contains("0.05 m"),
+            "{stderr}"
+        );
+    }
+}
+
+#[test]
 fn simulate_json_has_the_documented_keys() {
     let v = json(&clothsim(&[
         "simulate",

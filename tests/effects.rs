@@ -7,7 +7,10 @@ use clothsim::cloth::{ClothModel, ClothState};
 use clothsim::mesh::{GridOrientation, GridSpec};
 use clothsim::scene::{Scene, SceneFile, Simulation};
 use clothsim::sim::forces::{DihedralBending, hinge_angle};
-use clothsim::sim::{BendingModel, Collider, Effect, SelfCollision, SelfContacts, Wind};
+use clothsim::sim::{
+    BendingModel, CELLS_PER_TRIANGLE, Collider, ContactError, Effect, SelfCollision, SelfContacts,
+    Wind,
+};
 use glam::{Quat, Vec3};
 
 /// Deterministic pseudo-random numbers in [−1, 1].
@@ -395,7 +398,7 @@ fn flag_run(wind: Option<Vec3>, seconds: f64) -> (Vec<f32>, Vec<f32>) {
         }
         None => effects.retain(|e| !matches!(e, Effect::Wind(_))),
     }
-    sim.set_effects(effects);
+    sim.set_effects(effects).unwrap();
     let rest = sim.model().rest_positions.clone();
     let right = rest.iter().map(|p| p.x).fold(f32::MIN, f32::max);
     let free_edge: Vec<usize> = (0..rest.len())
@@ -560,7 +563,7 @@ fn self_fold(with_self_collision: bool, seconds: f64) -> (usize, Simulation) {
     if !with_self_collision {
         let mut effects = sim.effects().to_vec();
         effects.retain(|e| !matches!(e, Effect::SelfCollision(_)));
-        sim.set_effects(effects);
+        sim.set_effects(effects).unwrap();
     }
     let substeps = (seconds / sim.substep_length() as f64).round() as usize;
     let cell = 0.03;
@@ -647,7 +650,7 @@ fn self_collision_work_grows_linearly_with_the_particle_count() {
         let (model, mut state) = folded_sheet(quads, params.thickness);
         let start = state.pos.clone();
         let mut solver = SelfContacts::default();
-        solver.resolve(&params, &model, &start, &mut state);
+        solver.resolve(&params, &model, &start, &mut state).unwrap();
         let n = model.particle_count() as f64;
         per_particle.push(solver.work.candidates as f64 / n);
         assert!(solver.work.contacts > 0);
@@ -689,11 +692,87 @@ fn the_spatial_hash_misses_no_contact() {
     assert!(before > 100, "{before} pairs in contact to start with");
     let start = state.pos.clone();
     let mut solver = SelfContacts::default();
-    solver.resolve(&params, &model, &start, &mut state);
+    solver.resolve(&params, &model, &start, &mut state).unwrap();
     // One pass separates every pair it finds to the thickness; a pair the broad phase
     // missed would still be at 60 % of it.
     let left = close_pairs(&model, &state.pos, 0.8 * params.thickness);
     assert_eq!(left, 0, "pairs still overlapping after one pass");
+}
+
+/// A folded sheet stretched along x by a factor growing from 1 to `stretch` across it, so
+/// its triangles are of every size from the rest size up (the hash's levels all in use).
+fn stretched_sheet(quads: u32, thickness: f32, stretch: f32) -> (ClothModel, ClothState) {
+    let (model, mut state) = folded_sheet(quads, thickness);
+    for p in &mut state.pos {
+        let t = p.x + 0.5;
+        p.x = t * (1.0 + (stretch - 1.0) * t);
+    }
+    (model, state)
+}
+
+#[test]
+fn stretched_triangles_are_binned_at_their_own_scale_and_no_contact_is_missed() {
+    let params = SelfCollision {
+        thickness: 0.02,
+        friction: 0.0,
+    };
+    let (model, mut state) = stretched_sheet(12, params.thickness, 200.0);
+    let before = close_pairs(&model, &state.pos, params.thickness);
+    assert!(before > 100, "{before} pairs in contact to start with");
+    let start = state.pos.clone();
+    let mut solver = SelfContacts::default();
+    solver.resolve(&params, &model, &start, &mut state).unwrap();
+    let left = close_pairs(&model, &state.pos, 0.8 * params.thickness);
+    assert_eq!(left, 0, "pairs still overlapping after one pass");
+    assert!(solver.table_len() <= CELLS_PER_TRIANGLE * model.triangles.len());
+}
+
+/// Story: self-collision binned each triangle into every cell of its box; a cloth that blew
+/// up within a frame had boxes billions of cells wide, and a 60 × 60 cloth aborted on an
+/// 8 GB allocation. However far the particles are flung, the table now holds at most eight
+/// entries a triangle; a non-finite position, or a triangle a million cells wide, is refused.
+#[test]
+fn the_broad_phase_table_is_bounded_by_the_triangle_count_however_the_cloth_is_spread() {
+    let params = SelfCollision::default();
+    let (model, rest) = folded_sheet(16, params.thickness);
+    let bound = CELLS_PER_TRIANGLE * model.triangles.len();
+    let mut solver = SelfContacts::default();
+    // Each particle flung by a pseudo-random offset up to `reach` metres.
+    for reach in [0.3f32, 3.0, 300.0, 3e4] {
+        let mut state = rest.clone();
+        for (i, p) in state.pos.iter_mut().enumerate() {
+            // In [-1, 1], cubed: most particles move a little, a few far.
+            let r = |k: u32| {
+                let h = (i as u32).wrapping_mul(2654435761) ^ k.wrapping_mul(40503);
+                let u = (h.wrapping_mul(2246822519) >> 8) as f32 / (1u32 << 24) as f32;
+                (2.0 * u - 1.0).powi(3)
+            };
+            *p += reach * Vec3::new(r(1), r(2), r(3));
+        }
+        let start = state.pos.clone();
+        solver.resolve(&params, &model, &start, &mut state).unwrap();
+        assert!(
+            solver.table_len() <= bound,
+            "{} entries for {} triangles at {reach} m",
+            solver.table_len(),
+            model.triangles.len()
+        );
+    }
+    let mut state = rest.clone();
+    state.pos[7].y = f32::NAN;
+    let start = state.pos.clone();
+    let err = solver
+        .resolve(&params, &model, &start, &mut state)
+        .unwrap_err();
+    assert_eq!(err, ContactError::NonFinite { particle: 7 });
+    let mut state = rest.clone();
+    state.pos[7].y = 1e9;
+    let start = state.pos.clone();
+    let err = solver
+        .resolve(&params, &model, &start, &mut state)
+        .unwrap_err();
+    assert!(matches!(err, ContactError::Extent { .. }), "{err}");
+    assert_eq!(state.pos, start, "nothing moved");
 }
 
 fn point_triangle_distance(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
@@ -715,7 +794,7 @@ fn phases_of(scene: &str, change: impl FnOnce(&mut Vec<Effect>)) -> Vec<String> 
     let mut sim = Simulation::new(Scene::builtin(scene).unwrap());
     let mut effects = sim.effects().to_vec();
     change(&mut effects);
-    sim.set_effects(effects);
+    sim.set_effects(effects).unwrap();
     sim.run(0.1).phases.into_keys().collect()
 }
 
@@ -785,7 +864,7 @@ fn an_absent_effect_changes_nothing_and_a_present_one_does() {
         if !bending {
             effects.retain(|e| *e != Effect::Bending(BendingModel::Springs));
         }
-        sim.set_effects(effects);
+        sim.set_effects(effects).unwrap();
         sim.run(0.5);
         sim.state().pos.clone()
     };

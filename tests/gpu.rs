@@ -157,7 +157,7 @@ fn parameter_change_mid_run(read_every_frame: bool) {
         effects.retain(|e| !matches!(e, Effect::Bending(_) | Effect::AirDamping));
         assert_eq!(effects.len(), all - 2, "{effects:?}");
         let behind = sim.state_behind();
-        sim.set_effects(effects);
+        sim.set_effects(effects).unwrap();
         assert_eq!(sim.state_behind(), behind, "new effects read nothing back");
         for _ in 0..5 {
             sim.step_frame().expect("frame");

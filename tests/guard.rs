@@ -2,7 +2,9 @@
 //! recovers, and what it records.
 
 use clothsim::scene::{Scene, Simulation};
-use clothsim::sim::{FrameOutcome, GuardAction, GuardPolicy, IntegratorKind};
+use clothsim::sim::{
+    Cause, Effect, FrameOutcome, GuardAction, GuardPolicy, IntegratorKind, SelfCollision,
+};
 
 fn hanging(configure: impl FnOnce(&mut Scene)) -> Simulation {
     let mut scene = Scene::builtin("hanging").unwrap();
@@ -84,7 +86,7 @@ fn a_blow_up_is_still_caught_while_a_pull_holds_the_cloth_stretched() {
     );
 }
 
-/// At 100 × the stiffness symplectic Euler would need about 10 × the substeps; one
+/// At 100 × the stiffness symplectic Euler would need about 6 × the substeps; one
 /// refinement (2 ×) is not enough, so the guard falls back to implicit Euler, which stays.
 #[test]
 fn the_fallback_integrator_saves_what_refinement_cannot() {
@@ -216,4 +218,268 @@ fn a_bad_policy_is_refused_by_name() {
     params.guard.max_strain = -1.0;
     let err = sim.set_params(params).unwrap_err().to_string();
     assert!(err.contains("guard.max_strain"), "{err}");
+}
+
+fn builtin(name: &str, configure: impl FnOnce(&mut Scene)) -> Simulation {
+    let mut scene = Scene::builtin(name).unwrap();
+    configure(&mut scene);
+    Simulation::new(scene)
+}
+
+/// Story: a 60 × 60 `self-fold` (symplectic Euler at 48 substeps, past its stable step from
+/// about 54 × 54) aborted on an 8 GB allocation: the state grew by orders of magnitude
+/// within one frame, and self-collision binned every substep's triangles into every cell of
+/// their boxes, billions of them, before the guard looked at the frame's end. Now each
+/// substep meets the guard's speed and energy limits before contacts read it, and the table
+/// holds at most eight entries a triangle. The same failure, made small: `self-fold` at 8 ×
+/// the stiffness (ωh ≈ 2.6 at 48 substeps).
+#[test]
+fn a_cloth_diverging_with_self_collision_is_rolled_back_not_aborted() {
+    let mut sim = builtin("self-fold", |s| {
+        s.params.stiffness = s.params.stiffness.map(|k| k * 8.0)
+    });
+    let triangles = sim.model().triangles.len() as u64;
+    let outcome = sim.step_frame().expect("refining saves the frame");
+    assert_eq!(outcome, FrameOutcome::Refined { from: 48, to: 96 });
+    assert!(sim.state().is_finite());
+    let events = sim.take_guard_events();
+    let reason = events[0].reason.as_deref().unwrap_or_default();
+    assert!(
+        reason.contains("m/s") || reason.contains(" J "),
+        "stopped by the speed or energy limit, still finite: {reason}"
+    );
+    // The failed try stopped at the substep that broke a limit: fewer than its 48
+    // self-collision passes, then the 96 of the frame redone.
+    let passes = sim.take_timings().get("self-collision").unwrap().calls;
+    assert!(passes > 96 && passes < 48 + 96, "{passes} passes");
+    let work = sim.self_collision_work().unwrap();
+    assert!(work.binned <= 8 * triangles, "{} entries", work.binned);
+}
+
+/// With the guard off nothing checks the substeps, and the blow-up reaches self-collision,
+/// which refuses it (a non-finite or absurdly spread state) instead of allocating for it:
+/// the frame fails with a message, and the process lives.
+#[test]
+fn with_the_guard_off_self_collision_refuses_a_blown_up_state() {
+    let mut sim = builtin("self-fold", |s| {
+        s.params.stiffness = s.params.stiffness.map(|k| k * 8.0);
+        s.params.guard.enabled = false;
+    });
+    let triangles = sim.model().triangles.len() as u64;
+    let mut failed = None;
+    for _ in 0..10 {
+        if let Err(e) = sim.step_frame() {
+            failed = Some(e);
+            break;
+        }
+        let work = sim.self_collision_work().unwrap();
+        assert!(work.binned <= 8 * triangles, "{} entries", work.binned);
+    }
+    let err = failed.expect("the blow-up ends in an error").to_string();
+    assert!(err.contains("contact detection refused"), "{err}");
+}
+
+/// A 20 × 20 cloth of 1 m with gravity and nothing else.
+fn falling(integrator: IntegratorKind) -> Simulation {
+    let text = "name = \"fall\"\n[cloth]\ngrid = { quads = 20, size = 1.0 }\n\
+                center = [0.0, 1.0, 0.0]\n[[effects]]\ntype = \"gravity\"\n";
+    let file = clothsim::scene::SceneFile::parse(text, std::path::Path::new("fall.toml")).unwrap();
+    let mut scene = Scene::from_file(file, None).unwrap();
+    scene.params.integrator = integrator;
+    Simulation::new(scene)
+}
+
+/// Story: the speed and energy limits came from the scene's height at the start, so a cloth
+/// in free fall was stopped as "diverged" after 1.07 s (5.6 m), under every integrator.
+/// Gravity may turn any height fallen into motion: ten seconds (490 m) pass untouched.
+#[test]
+fn a_free_fall_of_any_length_is_never_taken_for_a_blow_up() {
+    for kind in IntegratorKind::ALL {
+        let mut sim = falling(kind);
+        let top = sim.state().pos.iter().map(|p| p.y).fold(f32::MIN, f32::max);
+        let summary = sim.run(10.0);
+        assert!(
+            summary.error.is_none() && summary.guard_events.is_empty(),
+            "{kind}: {:?} {:?}",
+            summary.error,
+            summary.guard_events
+        );
+        let now = sim.state().pos.iter().map(|p| p.y).fold(f32::MIN, f32::max);
+        let fallen = (top - now) as f64;
+        let expected = 0.5 * 9.81 * 10.0f64.powi(2);
+        assert!(
+            (fallen / expected - 1.0).abs() < 0.01,
+            "{kind}: fell {fallen} m, not {expected} m"
+        );
+    }
+}
+
+/// The fall's allowance does not blind the guard: springs made 1000 × stiffer two seconds
+/// into the fall (20 m/s, 20 m down), with one particle nudged (a flat cloth falls rigidly,
+/// exciting nothing), blow up under every integrator that can, and the guard stops the frame
+/// and rolls it back. Checked substep by substep, the speed or energy limit stops it while
+/// the state is still finite, before the strain check at the frame's end; symplectic Euler
+/// takes a frame's substeps together when nothing acts between them, and is checked at the
+/// frame's end (nothing in between reads its positions), so it is run again with a ground
+/// far below, which makes it go substep by substep.
+#[test]
+fn a_blow_up_during_a_fall_is_still_caught_by_the_limits() {
+    let explicit = [
+        IntegratorKind::ExplicitEuler,
+        IntegratorKind::SemiImplicitEuler,
+        IntegratorKind::Verlet,
+        IntegratorKind::Rk2,
+        IntegratorKind::Rk4,
+    ];
+    for (kind, ground) in explicit
+        .map(|k| (k, false))
+        .into_iter()
+        .chain([(IntegratorKind::SemiImplicitEuler, true)])
+    {
+        let mut sim = falling(kind);
+        if ground {
+            let mut effects = sim.effects().to_vec();
+            effects.push(Effect::Collider(clothsim::sim::Collider::Plane {
+                point: glam::Vec3::new(0.0, -1000.0, 0.0),
+                normal: glam::Vec3::Y,
+                friction: 0.5,
+            }));
+            sim.set_effects(effects).unwrap();
+        }
+        assert!(sim.run(2.0).guard_events.is_empty(), "{kind}");
+        let mut params = sim.params().clone();
+        params.stiffness = params.stiffness.map(|k| k * 1000.0);
+        params.guard = GuardPolicy {
+            max_refinements: 0,
+            fallback: None,
+            ..GuardPolicy::default()
+        };
+        sim.set_params(params).unwrap();
+        sim.modify_state(|s| s.vel[0].x += 0.1);
+        let before = bits(&sim);
+        let err = (0..5)
+            .find_map(|_| sim.step_frame().err())
+            .unwrap_or_else(|| panic!("{kind}: the blow-up is caught"))
+            .to_string();
+        let batched = kind == IntegratorKind::SemiImplicitEuler && !ground;
+        assert!(
+            batched || err.contains("m/s (limit") || err.contains("J (limit"),
+            "{kind}: a speed or energy limit: {err}"
+        );
+        assert_eq!(
+            bits(&sim),
+            before,
+            "{kind}: rolled back to the frame's start"
+        );
+    }
+}
+
+/// Story: every frame nothing saved told the user to lower the stiffness. Now the guard
+/// works out each explicit method's stable step on the cloth's stiffest spring vibration
+/// and names the substeps it needs, and they are the right ones: a run at a tenth more
+/// stays put, one at a fifth fewer blows up.
+#[test]
+fn the_message_names_the_substeps_each_explicit_method_needs_and_they_suffice() {
+    for kind in [
+        IntegratorKind::ExplicitEuler,
+        IntegratorKind::SemiImplicitEuler,
+        IntegratorKind::Verlet,
+        IntegratorKind::Rk2,
+        IntegratorKind::Rk4,
+    ] {
+        let mut sim = hanging(|s| {
+            s.params.integrator = kind;
+            s.params.substeps = 4;
+            s.params.guard.max_refinements = 1;
+            s.params.guard.fallback = None;
+        });
+        let err = (0..60)
+            .find_map(|_| sim.step_frame().err())
+            .expect("diverges");
+        let Cause::Substeps {
+            needed: Some(needed),
+            tried: 8,
+            ..
+        } = err.cause
+        else {
+            panic!("{kind}: {err}")
+        };
+        let text = err.to_string();
+        assert!(
+            text.contains("Too few substeps") && text.contains(&format!("about {needed} substeps")),
+            "{text}"
+        );
+        let run = |substeps: f64| {
+            let mut sim = hanging(|s| {
+                s.params.integrator = kind;
+                s.params.substeps = substeps as u32;
+                s.params.guard.enabled = false;
+            });
+            let summary = sim.run(1.0);
+            summary.finite && summary.max_speed < 5.0
+        };
+        assert!(
+            run((1.1 * needed as f64).ceil()),
+            "{kind}: {needed} + 10 % is stable"
+        );
+        assert!(
+            !run((0.8 * needed as f64).floor()),
+            "{kind}: {needed} − 20 % is not"
+        );
+    }
+}
+
+/// A thickness the cloth cannot take (refused in files and the app, but a scene built in
+/// code can hold one) is named as the cause, with both lengths, not the stiffness.
+#[test]
+fn a_self_collision_thicker_than_the_cloth_is_named_as_the_cause() {
+    let mut sim = hanging(|s| {
+        s.effects.push(Effect::SelfCollision(SelfCollision {
+            thickness: 0.2,
+            friction: 0.3,
+        }))
+    });
+    let err = (0..60)
+        .find_map(|_| sim.step_frame().err())
+        .expect("diverges");
+    assert!(matches!(err.cause, Cause::Thickness(_)), "{err}");
+    let text = err.to_string();
+    assert!(
+        text.contains("`thickness` = 0.2 m") && text.contains("0.0417 m"),
+        "{text}"
+    );
+}
+
+/// A pull faster than the cloth can follow is named as the cause when nothing else is seen:
+/// the flag's corner dragged at 32 m/s, until the wind's drag on its metres-long triangles
+/// runs away under symplectic Euler (whose substeps are plenty for the springs).
+#[test]
+fn a_pull_the_cloth_cannot_follow_is_named_as_the_cause() {
+    let mut sim = builtin("flag", |s| {
+        s.params.guard = GuardPolicy {
+            max_refinements: 0,
+            fallback: None,
+            ..GuardPolicy::default()
+        }
+    });
+    let pos = &sim.state().pos;
+    let p = (0..pos.len())
+        .min_by(|&a, &b| pos[a].y.total_cmp(&pos[b].y))
+        .unwrap() as u32;
+    let start = pos[p as usize];
+    let err = (1..=60)
+        .find_map(|k| {
+            sim.grab(p, start + glam::Vec3::new(0.0, 0.0, 32.0 * k as f32 / 60.0));
+            sim.step_frame().err()
+        })
+        .expect("the pull tears the flag");
+    assert_eq!(err.cause, Cause::Pull, "{err}");
+    assert!(err.to_string().contains("held particle"), "{err}");
+    // The springs alone are within symplectic Euler's stable step: without the grab the
+    // stiffness would have been named.
+    let forces = clothsim::sim::ForceSet::new(sim.model(), sim.params(), sim.effects());
+    let (model, dt) = (sim.model(), sim.params().dt);
+    let kind = IntegratorKind::SemiImplicitEuler;
+    let springs_alone = Cause::substeps(kind, model, &forces, &sim.state().pos, 0.0, dt, 48);
+    assert!(springs_alone.is_none(), "{springs_alone:?}");
 }

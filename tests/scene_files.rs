@@ -302,7 +302,7 @@ fn a_saved_setup_reloads_as_it_was_running() {
     effects.push(Effect::Wind(Wind::default()));
     effects.push(Effect::Bending(BendingModel::Dihedral { stiffness: 0.004 }));
     effects.retain(|e| *e != Effect::Bending(BendingModel::Springs));
-    sim.set_effects(effects.clone());
+    sim.set_effects(effects.clone()).unwrap();
     sim.toggle_pin(3);
     let path = dir.path().join("saved.toml");
     std::fs::write(&path, sim.scene_file().to_toml()).unwrap();
@@ -333,4 +333,59 @@ fn an_exported_obj_reimports_with_the_same_counts_and_positions() {
     // come back bit for bit (Rust prints the shortest decimal that reads back the same).
     assert_eq!(back.mesh.positions, sim.state().pos);
     assert_eq!(back.mesh.triangles, sim.model().triangles);
+}
+
+/// Story: a 20 × 20 cloth of 1 m with a self-collision thickness of 0.2 m (four times its
+/// spacing) aborted under symplectic Euler, and under implicit Euler the guard gave up at
+/// t = 0 advising a lower stiffness: every particle started inside its neighbours'
+/// triangles. A thickness at or above the shortest rest edge is refused, naming both.
+#[test]
+fn a_self_collision_thicker_than_the_cloths_edges_is_refused_naming_both_lengths() {
+    let grid = |thickness: f32| {
+        format!(
+            "name = \"t\"\n[cloth]\ngrid = {{ quads = 20, size = 1.0 }}\n\
+             [[effects]]\ntype = \"gravity\"\n\
+             [[effects]]\ntype = \"self-collision\"\nthickness = {thickness}\n"
+        )
+    };
+    let (line, column, message) = parse_error(&grid(0.2));
+    assert_eq!((line, column), (8, 1));
+    assert!(
+        message.starts_with("`thickness` = 0.2 m") && message.contains("0.05 m"),
+        "{message}"
+    );
+    // Just below the edge is the user's call; at the edge it is refused.
+    SceneFile::parse(&grid(0.049), Path::new("t.toml")).expect("below the edge");
+    parse_error(&grid(0.05));
+
+    // An OBJ cloth's edges are known once it is imported: the error names the cloth.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy("assets/cloth.obj", dir.path().join("c.obj")).unwrap();
+    let path = dir.path().join("s.toml");
+    std::fs::write(
+        &path,
+        "name = \"s\"\n[cloth]\nobj = \"c.obj\"\n\
+         [[effects]]\ntype = \"self-collision\"\nthickness = 0.05\n",
+    )
+    .unwrap();
+    let err = Scene::open(path.to_str().unwrap()).unwrap_err();
+    let text = err.to_string();
+    assert!(matches!(err, SceneError::Thickness { .. }), "{err:?}");
+    assert!(
+        text.contains("c.obj") && text.contains("0.05 m") && text.contains("0.0417 m"),
+        "{text}"
+    );
+
+    // A running simulation refuses it too, and keeps its effects.
+    let mut sim = Simulation::new(Scene::builtin("self-fold").unwrap());
+    let before = sim.effects().to_vec();
+    let mut effects = before.clone();
+    for e in &mut effects {
+        if let Effect::SelfCollision(s) = e {
+            s.thickness = 0.2;
+        }
+    }
+    let err = sim.set_effects(effects).unwrap_err().to_string();
+    assert!(err.contains("0.2 m") && err.contains("0.0417 m"), "{err}");
+    assert_eq!(sim.effects(), before);
 }

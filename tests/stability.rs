@@ -398,7 +398,7 @@ fn strong_gusting_wind_flaps_the_flag_hard_without_blowing_up() {
             peak_wind = w.peak_speed();
         }
     }
-    sim.set_effects(effects);
+    sim.set_effects(effects).unwrap();
     let (mut strain, mut speed, mut flapping) = (0.0f32, 0.0f32, 0.0f32);
     for _ in 0..10 {
         let summary = sim.run(0.5);

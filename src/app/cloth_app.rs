@@ -361,10 +361,17 @@ impl ClothApp {
         }
     }
 
-    /// Applies an edited effect list (collider settings) to the running simulation.
+    /// Applies an edited effect list (collider settings) to the running simulation; a
+    /// refused list (a self-collision thickness the cloth cannot take) is reported and the
+    /// effects stay as they were.
     pub fn apply_effects(&mut self, effects: Vec<Effect>) {
-        for warning in self.edit(move |s| s.set_effects(effects.clone())) {
-            self.message(Level::Warning, warning);
+        match self.edit(move |s| s.set_effects(effects.clone())) {
+            Ok(warnings) => {
+                for warning in warnings {
+                    self.message(Level::Warning, warning);
+                }
+            }
+            Err(e) => self.message(Level::Error, format!("{e}; the effects are kept")),
         }
     }
 

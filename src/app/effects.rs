@@ -6,7 +6,7 @@ use glam::Vec3;
 
 use crate::mesh::{SpringKind, bounds};
 use crate::scene::Simulation;
-use crate::sim::{BendingModel, Collider, Effect, SelfCollision, SimParams, Wind};
+use crate::sim::{BendingModel, Collider, Effect, SelfCollision, SimParams, Wind, shortest_edge};
 
 use super::cloth_app::ClothApp;
 
@@ -61,16 +61,10 @@ impl Addable {
             Addable::Bending => Effect::Bending(BendingModel::Springs),
             Addable::Wind => Effect::Wind(Wind::default()),
             // Well under the shortest edge, so neighbours are not pushed apart.
-            Addable::SelfCollision => {
-                let model = sim.model();
-                let shortest = model.springs.rest[..model.mesh_edges]
-                    .iter()
-                    .fold(f32::INFINITY, |a, &b| a.min(b));
-                Effect::SelfCollision(SelfCollision {
-                    thickness: (0.25 * shortest).clamp(1e-4, 0.05),
-                    ..SelfCollision::default()
-                })
-            }
+            Addable::SelfCollision => Effect::SelfCollision(SelfCollision {
+                thickness: (0.25 * shortest_edge(sim.model())).min(0.05),
+                ..SelfCollision::default()
+            }),
             // Just under the cloth's middle, so it falls onto it.
             Addable::Sphere => {
                 let radius = 0.25 * size;
@@ -96,6 +90,7 @@ pub fn effects_section(ui: &mut egui::Ui, app: &mut ClothApp) {
     let mut params = app.sim.params().clone();
     let mut effects = app.sim.effects().to_vec();
     let (mut params_changed, mut effects_changed) = (false, false);
+    let edge = shortest_edge(app.sim.model());
     let mut remove = None;
     for (i, effect) in effects.iter_mut().enumerate() {
         ui.push_id(i, |ui| {
@@ -111,7 +106,7 @@ pub fn effects_section(ui: &mut egui::Ui, app: &mut ClothApp) {
                     remove = Some(i);
                 }
             });
-            let (p, e) = effect_controls(ui, effect, &mut params);
+            let (p, e) = effect_controls(ui, effect, &mut params, edge);
             params_changed |= p;
             effects_changed |= e;
         });
@@ -156,8 +151,14 @@ fn title(effect: &Effect) -> &'static str {
     }
 }
 
-/// Controls of one effect; returns whether the parameters and whether the effect changed.
-fn effect_controls(ui: &mut egui::Ui, effect: &mut Effect, params: &mut SimParams) -> (bool, bool) {
+/// Controls of one effect on a cloth whose shortest rest edge is `edge` metres; returns
+/// whether the parameters and whether the effect changed.
+fn effect_controls(
+    ui: &mut egui::Ui,
+    effect: &mut Effect,
+    params: &mut SimParams,
+    edge: f32,
+) -> (bool, bool) {
     let (mut p, mut e) = (false, false);
     match effect {
         Effect::Gravity => {
@@ -216,7 +217,8 @@ fn effect_controls(ui: &mut egui::Ui, effect: &mut Effect, params: &mut SimParam
         Effect::SelfCollision(s) => {
             e |= ui
                 .add(
-                    Slider::new(&mut s.thickness, 1e-4..=0.1)
+                    // Below the shortest edge: a thicker cloth is refused.
+                    Slider::new(&mut s.thickness, 1e-4..=(0.95 * edge).clamp(2e-4, 0.1))
                         .logarithmic(true)
                         .suffix(" m")
                         .text("thickness"),

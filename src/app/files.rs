@@ -72,7 +72,12 @@ impl ClothApp {
         if let Err(e) = sim.set_params(self.sim.params().clone()) {
             return self.message(Level::Error, e.to_string());
         }
-        let _ = sim.set_effects(self.sim.effects().to_vec());
+        // The current effects, unless they do not fit the new cloth (a self-collision
+        // thicker than its edges): then the scene's own, and the user is told.
+        let mut notes = sim.warnings().to_vec();
+        if let Err(e) = sim.set_effects(self.sim.effects().to_vec()) {
+            notes.push(format!("{e}; the scene's own effects are used"));
+        }
         sim.set_pins_enabled(self.sim.pins_enabled());
         let mut text = format!(
             "loaded {name}: {} particles, {} triangles",
@@ -80,10 +85,10 @@ impl ClothApp {
             sim.model().triangles.len()
         );
         // Import notes (dropped faces and the like) stay visible with the result.
-        let level = if sim.warnings().is_empty() {
+        let level = if notes.is_empty() {
             Level::Info
         } else {
-            text += &format!(" ({})", sim.warnings().join("; "));
+            text += &format!(" ({})", notes.join("; "));
             Level::Warning
         };
         self.message(level, text);

@@ -13,7 +13,7 @@ use crate::cloth::{ClothModel, ClothState};
 use crate::mesh::SpringKind;
 use crate::render::map_read;
 use crate::sim::{
-    BendingModel, Collider, Diverged, Effect, FrameOutcome, IntegratorKind, PhaseTimings,
+    BendingModel, Cause, Collider, Diverged, Effect, FrameOutcome, IntegratorKind, PhaseTimings,
     SimParams, StepBackend, StepError, StepReport, StepStats, colliders_of,
 };
 
@@ -728,6 +728,7 @@ impl StepBackend for GpuStepper {
                 reason: e.to_string(),
                 substeps: self.substeps,
                 fallback: String::new(),
+                cause: Cause::Backend,
             })?;
         state.time = end;
         Ok(FrameOutcome::Stepped)

@@ -25,6 +25,13 @@ pub enum SceneError {
         column: usize,
         message: String,
     },
+    /// A self-collision thickness the cloth cannot take (at or above its shortest rest
+    /// edge); `cloth` names the cloth.
+    #[error("{cloth}: {error}")]
+    Thickness {
+        cloth: String,
+        error: crate::sim::TooThick,
+    },
     /// The pins do not fit the cloth.
     #[error("{0}")]
     Pins(String),

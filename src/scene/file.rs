@@ -451,6 +451,22 @@ impl SceneFile {
                 _ => {}
             }
         }
+        // A grid's shortest rest edge is known before it is built (an OBJ's is checked when
+        // the scene is built).
+        if let Some(g) = &self.cloth.grid {
+            let ([qx, qy], [sx, sy]) = (g.quads.pair(), g.size.pair());
+            let edge = (sx / qx as f32).min(sy / qy as f32);
+            for (i, e) in self.effects.iter().enumerate() {
+                if let EffectSpec::SelfCollision(s) = e
+                    && let Err(too_thick) = s.fits(edge)
+                {
+                    // Named as the file names it: `thickness` = …
+                    let message = too_thick.to_string();
+                    let message = message.trim_start_matches("self-collision ");
+                    return bad(Some(i), "thickness", message);
+                }
+            }
+        }
         // Solver and material values, checked as the simulation will check them.
         if let Err(message) = self.params().validate() {
             let name = message.split('`').nth(1).unwrap_or("solver").to_string();

@@ -9,7 +9,7 @@ use crate::cloth::{ClothModel, ClothState};
 use crate::mesh::{
     self, ClothMesh, GridOrientation, GridSpec, ImportOptions, MeshBuild, bounds, thinnest_axis,
 };
-use crate::sim::{Collider, Effect, SimParams};
+use crate::sim::{Collider, Effect, SimParams, thickness_fits};
 
 use super::error::SceneError;
 use super::file::{Corner, Edge, LoadedSceneFile, PinSpec, SceneFile};
@@ -176,7 +176,8 @@ impl Scene {
     /// Places `cloth` as `file` says, pins it, and builds model and initial state.
     ///
     /// # Errors
-    /// [`SceneError::Pins`] for a pin index the cloth does not have.
+    /// [`SceneError::Pins`] for a pin index the cloth does not have,
+    /// [`SceneError::Thickness`] for a self-collision thickness the cloth cannot take.
     pub fn with_mesh(
         file: SceneFile,
         cloth: &MeshBuild,
@@ -191,10 +192,15 @@ impl Scene {
         if file.material.masses != model.masses {
             model.set_mass_distribution(file.material.masses);
         }
+        let effects = file.effects();
+        thickness_fits(&effects, &model).map_err(|error| SceneError::Thickness {
+            cloth: cloth_name.to_string(),
+            error,
+        })?;
         let initial = ClothState::at_rest(&model);
         Ok(Scene {
             scenario: file.name.clone(),
-            effects: file.effects(),
+            effects,
             file,
             cloth_name: cloth_name.to_string(),
             model,

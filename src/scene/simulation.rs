@@ -4,9 +4,9 @@
 
 use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{
-    Collider, CpuStepper, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent, IntegratorKind,
-    PhaseTimings, SimParams, StepBackend, StepError, StepReport, StepStats, colliders_of,
-    small_sphere_warnings,
+    Cause, Collider, CpuStepper, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent,
+    IntegratorKind, PhaseTimings, SimParams, StepBackend, StepError, StepReport, StepStats,
+    colliders_of, small_sphere_warnings, thickness_fits,
 };
 
 use super::error::SceneError;
@@ -286,12 +286,20 @@ impl Simulation {
     /// Replaces the effect list (switches forces on or off, moves or retunes colliders).
     /// Returns warnings about it (a sphere smaller than the particle spacing). The state,
     /// and a backend's copy of it, are left as they are.
-    pub fn set_effects(&mut self, effects: Vec<Effect>) -> Vec<String> {
+    ///
+    /// # Errors
+    /// [`SceneError::Thickness`] for a self-collision thickness at or above the cloth's
+    /// shortest rest edge; nothing changes then.
+    pub fn set_effects(&mut self, effects: Vec<Effect>) -> Result<Vec<String>, SceneError> {
+        thickness_fits(&effects, &self.model).map_err(|error| SceneError::Thickness {
+            cloth: self.cloth_name.clone(),
+            error,
+        })?;
         self.effects = effects;
         let warnings = small_sphere_warnings(&self.colliders(), &self.model);
         self.backend
             .configure(&self.model, &self.params, &self.effects);
-        warnings
+        Ok(warnings)
     }
 
     /// The scenario's pins (whether or not they are enabled).
@@ -424,9 +432,20 @@ impl Simulation {
     /// Advances one frame (`params.dt`).
     ///
     /// # Errors
-    /// [`Diverged`]: the state is left at the frame's start.
+    /// [`Diverged`]: the state is left at the frame's start. Its cause is the held
+    /// particle's pull where the backend saw nothing more specific.
     pub fn step_frame(&mut self) -> Result<FrameOutcome, Diverged> {
-        let out = self.backend.frame(&self.model, &mut self.state)?;
+        let out = self
+            .backend
+            .frame(&self.model, &mut self.state)
+            .map_err(|mut e| {
+                // The backend cannot see a grab; with nothing more specific, the pull is the
+                // likely cause.
+                if self.held.is_some() && e.cause == Cause::Stiffness {
+                    e.cause = Cause::Pull;
+                }
+                e
+            })?;
         self.frames += 1;
         Ok(out)
     }

@@ -8,6 +8,7 @@ use crate::cloth::{ClothModel, ClothState};
 
 use super::backend::StepBackend;
 use super::collider::{Collider, colliders_of};
+use super::diagnosis::Cause;
 use super::effect::{Effect, wind_of};
 use super::forces::ForceSet;
 use super::guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check};
@@ -16,7 +17,7 @@ use super::integrator::{
     Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport,
 };
 use super::params::{SimParams, SolverConfig};
-use super::self_collision::{SelfCollision, SelfContacts};
+use super::self_collision::{SelfCollision, SelfContacts, shortest_edge};
 use super::stats::StepStats;
 use super::timings::PhaseTimings;
 
@@ -46,6 +47,8 @@ pub struct CpuStepper {
     self_contacts: SelfContacts,
     /// Fastest the wind gets, m/s (for the guard's speed limit).
     wind: f32,
+    /// Air damping in effect, 1/s (0 without the effect; for the guard's diagnosis).
+    air_damping: f32,
 }
 
 impl CpuStepper {
@@ -70,6 +73,7 @@ impl CpuStepper {
             self_collision: None,
             self_contacts: SelfContacts::default(),
             wind: 0.0,
+            air_damping: 0.0,
         };
         stepper.configure(model, params, effects);
         stepper
@@ -84,16 +88,78 @@ impl CpuStepper {
         !self.colliders.is_empty() || self.self_collision.is_some()
     }
 
-    /// Integrates one substep and charges its phases; the colliders are not applied.
-    fn integrate(
+    /// Integrates one substep and charges its phases; the contacts are not resolved (see
+    /// [`CpuStepper::resolve_contacts`]).
+    fn advance(
         &mut self,
         model: &ClothModel,
         state: &mut ClothState,
-        h: f32,
     ) -> Result<StepReport, StepError> {
-        self.integrate_with(model, state, |integrator, ctx, state| {
+        let h = self.substep_length();
+        if self.contacts_exist() {
+            self.substep_start.clone_from(&state.pos);
+        }
+        self.forces.set_time(state.time);
+        let report = self.integrate_with(model, state, |integrator, ctx, state| {
             integrator.step(ctx, state, h)
-        })
+        })?;
+        self.stats.record(&report);
+        Ok(report)
+    }
+
+    /// Resolves the colliders and self-collision after a substep, from the paths since its
+    /// start, and charges their phases.
+    ///
+    /// # Errors
+    /// [`StepError::Contact`] when self-collision refuses a state that has blown up.
+    fn resolve_contacts(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+    ) -> Result<(), StepError> {
+        if !self.contacts_exist() {
+            return Ok(());
+        }
+        let mut contacts = 0;
+        let start = &self.substep_start;
+        for c in &self.colliders {
+            contacts += self
+                .timings
+                .time(c.phase(), || c.resolve(model, start, state, self.offset));
+        }
+        if let Some(params) = &self.self_collision {
+            let solver = &mut self.self_contacts;
+            contacts += self.timings.time("self-collision", || {
+                solver.resolve(params, model, start, state)
+            })?;
+        }
+        if contacts > 0 {
+            // Contacts changed positions and velocities after the integrator's step.
+            self.integrator.invalidate();
+        }
+        Ok(())
+    }
+
+    /// The likely cause of a frame that failed from positions `pos` at up to `tried`
+    /// substeps per frame: a self-collision thickness the cloth cannot take, an explicit
+    /// integrator past its stable step, or else the stiffness.
+    fn diagnose(&self, model: &ClothModel, pos: &[glam::Vec3], tried: u32) -> Cause {
+        if let Some(s) = &self.self_collision
+            && let Err(too_thick) = s.fits(shortest_edge(model))
+        {
+            return Cause::Thickness(too_thick);
+        }
+        let kind = self.integrator.kind();
+        Cause::substeps(
+            kind,
+            model,
+            &self.forces,
+            pos,
+            self.air_damping,
+            self.dt,
+            tried,
+        )
+        .unwrap_or(Cause::Stiffness)
     }
 
     /// Runs `steps` (the integrator's work) on `state` and charges its phases.
@@ -128,11 +194,15 @@ impl CpuStepper {
 
     /// A frame's substeps: taken together where the integrator has a way to
     /// ([`Integrator::steps`]) and nothing acts between them (no contacts), else one by one.
+    /// One by one, each substep is `checked` against the guard's limits before contacts read
+    /// its positions: a state that blew up within the frame reaches the guard at once,
+    /// never contact detection.
     fn frame_substeps(
         &mut self,
         model: &ClothModel,
         state: &mut ClothState,
-    ) -> Result<(), StepError> {
+        checked: bool,
+    ) -> Result<(), Trouble> {
         let count = self.substeps;
         if count > 1 && !self.contacts_exist() {
             let h = self.substep_length();
@@ -145,8 +215,14 @@ impl CpuStepper {
                 return Ok(());
             }
         }
+        let limits = self.guard.limits.filter(|_| checked);
+        let depth = limits.map_or(0.0, |l| l.depth_of(state));
         for _ in 0..count {
-            self.substep(model, state)?;
+            self.advance(model, state)?;
+            if let Some(trouble) = limits.and_then(|l| l.check_substep(model, state, depth)) {
+                return Err(trouble);
+            }
+            self.resolve_contacts(model, state)?;
         }
         Ok(())
     }
@@ -159,7 +235,7 @@ impl CpuStepper {
         state: &mut ClothState,
         end: f64,
     ) -> Result<(), Trouble> {
-        self.frame_substeps(model, state)?;
+        self.frame_substeps(model, state, true)?;
         // Whole frames end on the frame clock, however the substeps' lengths rounded.
         state.time = end;
         let limits = self.guard.limits.as_ref().ok_or(Trouble::NonFinite)?;
@@ -263,6 +339,7 @@ impl CpuStepper {
             reason: last.to_string(),
             substeps: tried,
             fallback,
+            cause: self.diagnose(model, &state.pos, tried),
         })
     }
 
@@ -296,6 +373,11 @@ impl StepBackend for CpuStepper {
             _ => None,
         });
         self.wind = wind_of(effects).map_or(0.0, |w| w.peak_speed());
+        self.air_damping = if effects.contains(&Effect::AirDamping) {
+            params.air_damping
+        } else {
+            0.0
+        };
         if self.integrator.kind() != params.integrator {
             self.integrator = params.integrator.build();
         }
@@ -327,33 +409,8 @@ impl StepBackend for CpuStepper {
         model: &ClothModel,
         state: &mut ClothState,
     ) -> Result<StepReport, StepError> {
-        let h = self.substep_length();
-        let contacts_exist = self.contacts_exist();
-        if contacts_exist {
-            self.substep_start.clone_from(&state.pos);
-        }
-        self.forces.set_time(state.time);
-        let report = self.integrate(model, state, h)?;
-        self.stats.record(&report);
-        if contacts_exist {
-            let mut contacts = 0;
-            let start = &self.substep_start;
-            for c in &self.colliders {
-                contacts += self
-                    .timings
-                    .time(c.phase(), || c.resolve(model, start, state, self.offset));
-            }
-            if let Some(params) = &self.self_collision {
-                let solver = &mut self.self_contacts;
-                contacts += self.timings.time("self-collision", || {
-                    solver.resolve(params, model, start, state)
-                });
-            }
-            if contacts > 0 {
-                // Contacts changed positions and velocities after the integrator's step.
-                self.integrator.invalidate();
-            }
-        }
+        let report = self.advance(model, state)?;
+        self.resolve_contacts(model, state)?;
         Ok(report)
     }
 
@@ -369,13 +426,17 @@ impl StepBackend for CpuStepper {
     ) -> Result<FrameOutcome, Diverged> {
         let end = state.time + self.dt as f64;
         if !self.guard.policy.enabled {
-            // With the guard off a failed solve is all there is to report.
-            self.frame_substeps(model, state).map_err(|e| Diverged {
-                time: state.time,
-                reason: e.to_string(),
-                substeps: self.substeps,
-                fallback: String::new(),
-            })?;
+            // With the guard off a failed step is all there is to report.
+            self.frame_start.clone_from(state);
+            if let Err(trouble) = self.frame_substeps(model, state, false) {
+                return Err(Diverged {
+                    time: state.time,
+                    reason: trouble.to_string(),
+                    substeps: self.substeps,
+                    fallback: String::new(),
+                    cause: self.diagnose(model, &self.frame_start.pos, self.substeps),
+                });
+            }
             state.time = end;
             return Ok(FrameOutcome::Stepped);
         }

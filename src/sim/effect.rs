@@ -2,7 +2,8 @@
 
 use super::collider::Collider;
 use super::forces::Wind;
-use super::self_collision::SelfCollision;
+use super::self_collision::{SelfCollision, TooThick, shortest_edge};
+use crate::cloth::ClothModel;
 
 /// How a cloth resists bending.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -49,5 +50,17 @@ pub fn wind_of(effects: &[Effect]) -> Option<Wind> {
     effects.iter().find_map(|e| match e {
         Effect::Wind(w) => Some(*w),
         _ => None,
+    })
+}
+
+/// Checks every self-collision among `effects` against `model`'s shortest rest edge.
+///
+/// # Errors
+/// [`TooThick`] for a thickness at or above it.
+pub fn thickness_fits(effects: &[Effect], model: &ClothModel) -> Result<(), TooThick> {
+    let edge = shortest_edge(model);
+    effects.iter().try_for_each(|e| match e {
+        Effect::SelfCollision(s) => s.fits(edge),
+        _ => Ok(()),
     })
 }

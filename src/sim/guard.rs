@@ -7,8 +7,10 @@ use crate::cloth::{ClothModel, ClothState};
 use crate::mesh::{SpringKind, bounds};
 
 use super::collider::Collider;
+use super::diagnosis::Cause;
 use super::forces::ForceSet;
 use super::integrator::{IntegratorKind, StepError};
+use super::wide::wide;
 
 /// What the guard may do. Part of [`super::SimParams`].
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -93,14 +95,82 @@ impl GuardPolicy {
 }
 
 /// The limits a healthy frame stays within, derived from the scene.
+///
+/// The speed and kinetic-energy limits grow with how far the cloth has fallen below the
+/// lowest point they counted on (the cloth's own bottom or the lowest collider under it):
+/// gravity legitimately turns that height into motion, so a free fall of any length is never
+/// taken for a blow-up, while a blow-up, whose speeds grow far faster than a fall's, is.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GuardLimits {
-    /// m/s.
+    /// m/s, before any fall below `floor` (fixed when the policy gives `max_speed`).
     pub speed: f32,
     /// Relative extension.
     pub strain: f32,
-    /// Joules.
+    /// Joules, before any fall below `floor`.
     pub kinetic_energy: f64,
+    /// Unit vector against gravity (+y without gravity).
+    pub up: Vec3,
+    /// Height along `up` (m) of the lowest point the limits counted on.
+    pub floor: f32,
+    /// How the limits grow with the depth fallen below `floor`.
+    fall: Fall,
+}
+
+/// What a fall below the floor adds to the limits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Fall {
+    /// |g|, m/s².
+    gravity: f32,
+    /// Mass of the free particles, kg.
+    mass: f64,
+    headroom: f32,
+    /// The height the derived speed limit lets the cloth fall, m, and the rest of its
+    /// speed (thrown, dragged, flung), m/s; `None` when the policy fixes the speed.
+    derived_speed: Option<(f32, f32)>,
+}
+
+/// The bits of `f32::INFINITY`: a magnitude's bits at or above it are an infinity or NaN.
+const INFINITY_BITS: u32 = 0x7f80_0000;
+
+/// The largest magnitude among `values`, as IEEE bits without the sign (an integer
+/// maximum: no order to keep, so the loop vectorises).
+#[inline(always)]
+fn largest_magnitude_bits(values: &[f32]) -> u32 {
+    values
+        .iter()
+        .fold(0u32, |m, v| m.max(v.to_bits() & 0x7fff_ffff))
+}
+
+/// One pass over the state: what the checks need.
+struct Motion {
+    finite: bool,
+    /// Fastest particle, m/s.
+    speed: f32,
+    /// Joules.
+    joules: f64,
+    /// Lowest particle's height along the limits' `up`, m.
+    lowest: f32,
+}
+
+impl Motion {
+    fn of(model: &ClothModel, state: &ClothState, up: Vec3) -> Self {
+        let mut m = Motion {
+            finite: true,
+            speed: 0.0,
+            joules: 0.0,
+            lowest: f32::INFINITY,
+        };
+        let mut fastest = 0.0f32;
+        for ((x, v), &mass) in state.pos.iter().zip(&state.vel).zip(&model.mass) {
+            m.finite &= x.is_finite() && v.is_finite();
+            let v2 = v.length_squared();
+            fastest = fastest.max(v2);
+            m.joules += 0.5 * mass as f64 * v2 as f64;
+            m.lowest = m.lowest.min(up.dot(*x));
+        }
+        m.speed = fastest.sqrt();
+        m
+    }
 }
 
 impl GuardLimits {
@@ -118,8 +188,12 @@ impl GuardLimits {
         colliders: &[Collider],
         wind: f32,
     ) -> Self {
+        let g = gravity.length();
+        let up = if g > 0.0 { -gravity / g } else { Vec3::Y };
         let (lo, hi) = bounds(&state.pos);
-        let mut bottom = lo.y;
+        let lowest = (state.pos.iter()).fold(f32::INFINITY, |m, x| m.min(up.dot(*x)));
+        let lowest = if lowest.is_finite() { lowest } else { 0.0 };
+        let mut bottom = lowest;
         let mut surface = 0.0f32;
         for c in colliders {
             match *c {
@@ -129,15 +203,15 @@ impl GuardLimits {
                     spin,
                     ..
                 } => {
-                    bottom = bottom.min(center.y - radius);
+                    bottom = bottom.min(up.dot(center) - radius);
                     surface = surface.max(spin.length() * radius);
                 }
-                Collider::Plane { point, .. } => bottom = bottom.min(point.y),
+                Collider::Plane { point, .. } => bottom = bottom.min(up.dot(point)),
             }
         }
         // The cloth can fall its own size plus down to the lowest thing below it.
-        let height = (hi - lo).length() + (lo.y - bottom).max(0.0);
-        let fall = (2.0 * gravity.length() * height).sqrt();
+        let height = (hi - lo).length() + (lowest - bottom).max(0.0);
+        let fall = (2.0 * g * height).sqrt();
         let pushed = state.max_speed() + surface + wind;
         let free = || (model.mass.iter().zip(&model.inv_mass)).filter(|(_, w)| **w > 0.0);
         let mass: f64 = free().map(|(m, _)| *m as f64).sum();
@@ -159,9 +233,9 @@ impl GuardLimits {
             .unwrap_or(policy.headroom * (fall + pushed + flung) + 1.0);
         let available = state.kinetic_energy(model)
             + elastic
-            + mass * gravity.length() as f64 * height as f64
+            + mass * g as f64 * height as f64
             + 0.5 * mass * (pushed as f64).powi(2);
-        let weight = mass as f32 * gravity.length();
+        let weight = mass as f32 * g;
         Self {
             speed,
             strain: policy
@@ -169,7 +243,96 @@ impl GuardLimits {
                 .max(policy.headroom * weight_strain(model, forces, weight))
                 .max(policy.headroom * max_strain(model, state)),
             kinetic_energy: policy.headroom as f64 * available + 1e-9,
+            up,
+            floor: bottom,
+            fall: Fall {
+                gravity: g,
+                mass,
+                headroom: policy.headroom,
+                derived_speed: policy
+                    .max_speed
+                    .is_none()
+                    .then_some((height, pushed + flung)),
+            },
         }
+    }
+
+    /// The speed limit (m/s) once the cloth's lowest point is `depth` metres below the floor.
+    pub fn speed_at(&self, depth: f32) -> f32 {
+        match self.fall.derived_speed {
+            Some((height, rest)) if depth > 0.0 => {
+                let fall = (2.0 * self.fall.gravity * (height + depth)).sqrt();
+                self.fall.headroom * (fall + rest) + 1.0
+            }
+            _ => self.speed,
+        }
+    }
+
+    /// The kinetic-energy limit (J) once the cloth's lowest point is `depth` metres below
+    /// the floor: the potential energy such a fall releases, with the headroom, is added.
+    pub fn kinetic_energy_at(&self, depth: f32) -> f64 {
+        let released = self.fall.mass * self.fall.gravity as f64 * depth.max(0.0) as f64;
+        self.kinetic_energy + self.fall.headroom as f64 * released
+    }
+
+    /// How far `state`'s lowest particle is below the floor, m (0 above it).
+    pub fn depth_of(&self, state: &ClothState) -> f32 {
+        let lowest = (state.pos.iter()).fold(f32::INFINITY, |m, x| m.min(self.up.dot(*x)));
+        (self.floor - lowest).max(0.0)
+    }
+
+    /// The limits one substep must keep, checked before anything reads positions to decide
+    /// its work (contact detection), with the cloth at least `depth` metres below the floor
+    /// (its depth at the frame's start; it only grows in a fall). A cheap bound first: the
+    /// largest velocity component's magnitude times √3 is at least the fastest speed, and
+    /// an integer maximum over the values' bits (order-free, so it vectorises) is at or
+    /// above the bits of infinity for a non-finite one. Only when that bound alarms is the
+    /// state measured exactly, for finiteness, speed and kinetic energy; the strain is left
+    /// to [`check`] at the frame's end.
+    pub fn check_substep(
+        &self,
+        model: &ClothModel,
+        state: &ClothState,
+        depth: f32,
+    ) -> Option<Trouble> {
+        let (vel, pos) = wide(|| {
+            (
+                largest_magnitude_bits(bytemuck::cast_slice(&state.vel)),
+                largest_magnitude_bits(bytemuck::cast_slice(&state.pos)),
+            )
+        });
+        // Slightly above √3, so rounding cannot put the bound under the speed.
+        let bound = 1.7321 * f32::from_bits(vel);
+        if vel < INFINITY_BITS && pos < INFINITY_BITS && bound <= self.speed_at(depth) {
+            return None;
+        }
+        let motion = Motion::of(model, state, self.up);
+        self.motion_trouble(&motion)
+            .or_else(|| self.energy_trouble(&motion))
+    }
+
+    /// How far the lowest particle is below the floor, m (0 above it).
+    fn depth(&self, motion: &Motion) -> f32 {
+        (self.floor - motion.lowest).max(0.0)
+    }
+
+    fn motion_trouble(&self, motion: &Motion) -> Option<Trouble> {
+        if !motion.finite {
+            return Some(Trouble::NonFinite);
+        }
+        let limit = self.speed_at(self.depth(motion));
+        (motion.speed > limit).then_some(Trouble::Speed {
+            speed: motion.speed,
+            limit,
+        })
+    }
+
+    fn energy_trouble(&self, motion: &Motion) -> Option<Trouble> {
+        let limit = self.kinetic_energy_at(self.depth(motion));
+        (motion.joules > limit).then_some(Trouble::KineticEnergy {
+            joules: motion.joules,
+            limit,
+        })
     }
 }
 
@@ -245,17 +408,11 @@ impl From<StepError> for Trouble {
     }
 }
 
-/// The first limit `state` breaks, if any.
+/// The first limit `state` breaks, if any: non-finite, speed, strain, kinetic energy.
 pub fn check(model: &ClothModel, state: &ClothState, limits: &GuardLimits) -> Option<Trouble> {
-    if !state.is_finite() {
-        return Some(Trouble::NonFinite);
-    }
-    let speed = state.max_speed();
-    if speed > limits.speed {
-        return Some(Trouble::Speed {
-            speed,
-            limit: limits.speed,
-        });
+    let motion = Motion::of(model, state, limits.up);
+    if let Some(trouble) = limits.motion_trouble(&motion) {
+        return Some(trouble);
     }
     let strain = max_strain(model, state);
     if strain > limits.strain {
@@ -264,14 +421,7 @@ pub fn check(model: &ClothModel, state: &ClothState, limits: &GuardLimits) -> Op
             limit: limits.strain,
         });
     }
-    let joules = state.kinetic_energy(model);
-    if joules > limits.kinetic_energy {
-        return Some(Trouble::KineticEnergy {
-            joules,
-            limit: limits.kinetic_energy,
-        });
-    }
-    None
+    limits.energy_trouble(&motion)
 }
 
 /// What the guard did.
@@ -334,8 +484,7 @@ impl std::fmt::Display for GuardEvent {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error(
     "the simulation diverged at t = {time:.3} s ({reason}) even with {substeps} substeps per \
-     frame{fallback}; the state was rolled back to the last good frame. Lower the stiffness, \
-     raise the substeps, or choose implicit Euler."
+     frame{fallback}; the state was rolled back to the last good frame. {cause}"
 )]
 pub struct Diverged {
     pub time: f64,
@@ -343,6 +492,8 @@ pub struct Diverged {
     pub substeps: u32,
     /// ", and with the fallback integrator" when it was tried.
     pub fallback: String,
+    /// What the guard can see behind it, with what to do.
+    pub cause: Cause,
 }
 
 /// What happened in a frame that succeeded.

@@ -6,6 +6,7 @@ mod cg;
 mod collider;
 mod constraints;
 mod cpu_stepper;
+mod diagnosis;
 mod effect;
 pub mod forces;
 mod guard;
@@ -23,13 +24,17 @@ pub use cg::{CgOutcome, ConjugateGradient};
 pub use collider::{Collider, colliders_of, min_collider_distance, small_sphere_warnings};
 pub use constraints::DistanceConstraints;
 pub use cpu_stepper::CpuStepper;
-pub use effect::{BendingModel, Effect, wind_of};
+pub use diagnosis::{Cause, Vibration, stiffest_vibration};
+pub use effect::{BendingModel, Effect, thickness_fits, wind_of};
 pub use forces::{Force, ForceSet, JacobianMode, SystemMatrix, Wind};
 pub use guard::{
     Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, GuardPolicy, Trouble, check,
 };
 pub use integrator::{Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport};
 pub use params::{SimParams, SolverConfig};
-pub use self_collision::{SelfCollision, SelfContacts, SelfWork};
+pub use self_collision::{
+    CELLS_PER_TRIANGLE, ContactError, SelfCollision, SelfContacts, SelfWork, TooThick,
+    shortest_edge,
+};
 pub use stats::StepStats;
 pub use timings::{Phase, PhaseTimings};

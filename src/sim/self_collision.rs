@@ -1,7 +1,8 @@
 //! Self-collision: particle against triangle, so cloth folds onto itself without passing
-//! through itself. Candidates come from a spatial hash (triangles binned by their box grown
-//! by the thickness, sorted by cell), so the work grows with the particle count, not its
-//! square.
+//! through itself. Candidates come from a hierarchical spatial hash (triangles binned by
+//! their box grown by the thickness, sorted by cell, each at the level whose cells are as
+//! large as the box), so the work grows with the particle count, not its square, and the
+//! table holds at most eight entries a triangle however the cloth is stretched.
 
 use glam::Vec3;
 
@@ -12,10 +13,66 @@ use crate::cloth::{ClothModel, ClothState};
 #[serde(default, deny_unknown_fields)]
 pub struct SelfCollision {
     /// Particles are kept this far from every triangle they are not a corner of, metres
-    /// (keep it below the particle spacing).
+    /// (below the cloth's shortest rest edge, which [`SelfCollision::fits`] checks; a
+    /// quarter of it is a good start).
     pub thickness: f32,
     /// Coulomb friction between layers (dimensionless).
     pub friction: f32,
+}
+
+/// A self-collision thickness the cloth cannot take: at or above its shortest rest edge,
+/// every particle would start inside its neighbours' triangles and be pushed off them.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "self-collision `thickness` = {} m is not below the cloth's shortest rest edge, {} m: \
+     every particle would start in contact with its neighbours' triangles and be pushed off \
+     them; use at most a quarter of the edge ({} m)",
+    significant(*thickness),
+    significant(*edge),
+    significant(0.25 * edge)
+)]
+pub struct TooThick {
+    /// The thickness asked for, metres.
+    pub thickness: f32,
+    /// The cloth's shortest rest edge, metres.
+    pub edge: f32,
+}
+
+/// `x` to three significant digits, without trailing zeros (0.0416666 → "0.0417").
+fn significant(x: f32) -> String {
+    if !(x.is_finite() && x > 0.0) {
+        return x.to_string();
+    }
+    let decimals = (2 - x.log10().floor() as i32).max(0) as usize;
+    let text = format!("{x:.decimals$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    }
+}
+
+impl SelfCollision {
+    /// Checks the thickness against a cloth whose shortest rest edge is `edge` metres.
+    ///
+    /// # Errors
+    /// [`TooThick`] when the thickness is at or above the edge.
+    pub fn fits(&self, edge: f32) -> Result<(), TooThick> {
+        if self.thickness >= edge {
+            return Err(TooThick {
+                thickness: self.thickness,
+                edge,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The shortest rest length among the cloth's mesh edges, metres (infinite without edges).
+pub fn shortest_edge(model: &ClothModel) -> f32 {
+    model.springs.rest[..model.mesh_edges.min(model.springs.len())]
+        .iter()
+        .fold(f32::INFINITY, |m, &r| m.min(r))
 }
 
 impl Default for SelfCollision {
@@ -34,24 +91,56 @@ pub struct SelfWork {
     pub candidates: u64,
     /// Pairs that were closer than the thickness.
     pub contacts: u64,
+    /// Entries in the spatial hash's table (at most [`CELLS_PER_TRIANGLE`] per triangle).
+    pub binned: u64,
+}
+
+/// Levels of the hierarchical hash: a triangle goes to the first level whose cells (the base
+/// cell times 2^level) hold its box in at most two cells along each axis, so it is binned in
+/// at most eight. A box wider than the base cell times 2^`MAX_LEVEL` (a million times the
+/// cloth's own scale) is a state that has blown up, refused rather than binned.
+const MAX_LEVEL: u32 = 20;
+
+/// Most cells one triangle is binned in: two along each axis.
+pub const CELLS_PER_TRIANGLE: usize = 8;
+
+/// A state contact detection cannot bin.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ContactError {
+    #[error("particle {particle} has a non-finite position")]
+    NonFinite { particle: usize },
+    #[error(
+        "triangle {triangle} spans {extent:.3e} m, more than a million times the cloth's \
+         cell of {cell:.3e} m: the state has blown up"
+    )]
+    Extent {
+        triangle: usize,
+        extent: f32,
+        cell: f32,
+    },
 }
 
 /// Reusable buffers of the spatial hash.
 #[derive(Clone, Debug, Default)]
 pub struct SelfContacts {
-    /// (cell key, triangle), sorted by key.
+    /// (cell key, triangle), sorted by key: at most [`CELLS_PER_TRIANGLE`] per triangle.
     bins: Vec<(u64, u32)>,
+    /// Bit `l` is set when some triangle is binned at level `l`.
+    levels: u32,
     pub work: SelfWork,
 }
 
-fn cell_key(c: [i32; 3]) -> u64 {
-    // Three coordinates wrapped into 21 bits each: distinct cells rarely share a key, and a
-    // shared key only adds candidates.
+/// The key of cell `c` at `level`: three coordinates wrapped into 21 bits each, mixed with
+/// the level. Distinct cells rarely share a key, and a shared key only adds candidates.
+fn cell_key(c: [i32; 3], level: u32) -> u64 {
     let w = |x: i32| (x as u64) & 0x1F_FFFF;
-    w(c[0]) | (w(c[1]) << 21) | (w(c[2]) << 42)
+    (w(c[0]) | (w(c[1]) << 21) | (w(c[2]) << 42))
+        ^ (level as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
 }
 
 fn cell_of(p: Vec3, size: f32) -> [i32; 3] {
+    // Float-to-int casts saturate: a far-away point lands in an edge cell, which only adds
+    // candidates.
     (p / size).floor().as_ivec3().to_array()
 }
 
@@ -99,67 +188,117 @@ impl SelfContacts {
     /// over a triangle is pushed out along the triangle's normal, one beside it away from
     /// its closest point; particle and triangle share the correction by inverse mass.
     /// Approaching relative velocity is removed and friction applied. Returns the contacts.
+    ///
+    /// # Errors
+    /// [`ContactError`] for a state that has blown up (a non-finite position, or a triangle
+    /// a million times wider than the cloth's scale); nothing is binned or moved then.
     pub fn resolve(
         &mut self,
         params: &SelfCollision,
         model: &ClothModel,
         start: &[Vec3],
         state: &mut ClothState,
-    ) -> usize {
+    ) -> Result<usize, ContactError> {
         let thickness = params.thickness;
         if thickness <= 0.0 || model.triangles.is_empty() {
-            return 0;
+            return Ok(0);
         }
-        let cell = self.bin(model, &state.pos, thickness);
-        let mut work = SelfWork::default();
+        let cell = self.bin(model, &state.pos, thickness)?;
+        let mut work = SelfWork {
+            binned: self.bins.len() as u64,
+            ..SelfWork::default()
+        };
         for p in 0..state.pos.len() {
             if model.inv_mass[p] == 0.0 {
                 continue;
             }
-            let key = cell_key(cell_of(state.pos[p], cell));
-            let first = self.bins.partition_point(|&(k, _)| k < key);
-            for slot in first..self.bins.len() {
-                let (k, t) = self.bins[slot];
-                if k != key {
-                    break;
-                }
-                let tri = model.triangles[t as usize];
-                if tri.contains(&(p as u32)) {
-                    continue;
-                }
-                work.candidates += 1;
-                if push_apart(params, model, start, state, p, tri) {
-                    work.contacts += 1;
+            let mut levels = self.levels;
+            while levels != 0 {
+                let level = levels.trailing_zeros();
+                levels &= levels - 1;
+                let size = cell * (1u32 << level) as f32;
+                let key = cell_key(cell_of(state.pos[p], size), level);
+                let first = self.bins.partition_point(|&(k, _)| k < key);
+                for slot in first..self.bins.len() {
+                    let (k, t) = self.bins[slot];
+                    if k != key {
+                        break;
+                    }
+                    let tri = model.triangles[t as usize];
+                    if tri.contains(&(p as u32)) {
+                        continue;
+                    }
+                    work.candidates += 1;
+                    if push_apart(params, model, start, state, p, tri) {
+                        work.contacts += 1;
+                    }
                 }
             }
         }
         self.work = work;
-        work.contacts as usize
+        Ok(work.contacts as usize)
     }
 
-    /// Bins every triangle into the cells its box, grown by the thickness, touches; returns
-    /// the cell size (twice the longest rest edge or the thickness, whichever is larger).
-    fn bin(&mut self, model: &ClothModel, pos: &[Vec3], thickness: f32) -> f32 {
+    /// Entries in the hash's table now: at most [`CELLS_PER_TRIANGLE`] per triangle,
+    /// whatever the positions.
+    pub fn table_len(&self) -> usize {
+        self.bins.len()
+    }
+
+    /// Bins every triangle into the cells its box, grown by the thickness, touches, at the
+    /// first level where that is at most two cells along each axis; returns the base cell
+    /// size (twice the longest rest edge or the thickness, whichever is larger).
+    fn bin(
+        &mut self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        thickness: f32,
+    ) -> Result<f32, ContactError> {
+        if let Some(particle) = pos.iter().position(|p| !p.is_finite()) {
+            return Err(ContactError::NonFinite { particle });
+        }
         let longest = model.springs.rest[..model.mesh_edges.min(model.springs.len())]
             .iter()
             .fold(0.0f32, |m, &r| m.max(r));
         let cell = (2.0 * longest).max(2.0 * thickness).max(1e-6);
         self.bins.clear();
+        self.levels = 0;
+        let grow = Vec3::splat(thickness);
         for (t, tri) in model.triangles.iter().enumerate() {
             let [a, b, c] = tri.map(|i| pos[i as usize]);
-            let lo = cell_of(a.min(b).min(c) - Vec3::splat(thickness), cell);
-            let hi = cell_of(a.max(b).max(c) + Vec3::splat(thickness), cell);
+            let (lo, hi) = (a.min(b).min(c) - grow, a.max(b).max(c) + grow);
+            let (level, lo, hi) = level_of(lo, hi, cell).ok_or(ContactError::Extent {
+                triangle: t,
+                extent: (hi - lo).max_element(),
+                cell,
+            })?;
+            self.levels |= 1 << level;
             for x in lo[0]..=hi[0] {
                 for y in lo[1]..=hi[1] {
                     for z in lo[2]..=hi[2] {
-                        self.bins.push((cell_key([x, y, z]), t as u32));
+                        self.bins.push((cell_key([x, y, z], level), t as u32));
                     }
                 }
             }
         }
         self.bins.sort_unstable();
-        cell
+        Ok(cell)
     }
+}
+
+/// The first level at which the box `lo..hi` lies in at most two cells along each axis, with
+/// the first and last cell it touches; `None` past [`MAX_LEVEL`].
+fn level_of(lo: Vec3, hi: Vec3, cell: f32) -> Option<(u32, [i32; 3], [i32; 3])> {
+    let extent = (hi - lo).max_element();
+    (0..=MAX_LEVEL).find_map(|level| {
+        let size = cell * (1u32 << level) as f32;
+        if extent > size {
+            return None;
+        }
+        let (first, last) = (cell_of(lo, size), cell_of(hi, size));
+        let narrow = (0..3).all(|i| i64::from(last[i]) - i64::from(first[i]) <= 1);
+        narrow.then_some((level, first, last))
+    })
 }
 
 /// Resolves particle `p` against triangle `tri` if closer than the thickness; returns

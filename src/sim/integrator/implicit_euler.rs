@@ -81,7 +81,9 @@ impl ImplicitEuler {
                 Err(StepError::Breakdown { iterations } | StepError::NonFinite { iterations }) => {
                     (*iterations, None, false)
                 }
-                Err(StepError::Unsupported(_) | StepError::Device(_)) => (0, None, false),
+                Err(StepError::Unsupported(_) | StepError::Device(_) | StepError::Contact(_)) => {
+                    (0, None, false)
+                }
             };
             (out, iterations, residual, converged)
         });

@@ -9,6 +9,7 @@ mod kind;
 mod rk2;
 mod rk4;
 mod semi_implicit_euler;
+mod stability;
 mod step;
 mod velocity_verlet;
 mod xpbd;

@@ -1,6 +1,7 @@
 //! The integrator interface: one substep in, a report or a typed failure out.
 
 use crate::cloth::ClothState;
+use crate::sim::self_collision::ContactError;
 
 use super::context::StepContext;
 use super::kind::IntegratorKind;
@@ -36,6 +37,10 @@ pub enum StepError {
     /// The device stepping the cloth failed (a GPU read-back, say).
     #[error("the device failed: {0}")]
     Device(String),
+    /// Contact detection refused a state that has blown up (non-finite, or spread over
+    /// absurd distances) instead of allocating for it.
+    #[error("contact detection refused the state: {0}")]
+    Contact(#[from] ContactError),
 }
 
 /// Advances a cloth state by one substep of `h` seconds.
