@@ -687,16 +687,25 @@ fn the_spatial_hash_misses_no_contact() {
         thickness: 0.02,
         friction: 0.0,
     };
-    let (model, mut state) = folded_sheet(12, params.thickness);
-    let before = close_pairs(&model, &state.pos, params.thickness);
+    let (model, state) = folded_sheet(12, params.thickness);
+    one_pass_separates_every_pair(&params, &model, state);
+}
+
+/// One pass separates every pair it finds to the thickness; a pair the broad phase missed
+/// would still be at 60 % of it. Returns the solver, for its table.
+fn one_pass_separates_every_pair(
+    params: &SelfCollision,
+    model: &ClothModel,
+    mut state: ClothState,
+) -> SelfContacts {
+    let before = close_pairs(model, &state.pos, params.thickness);
     assert!(before > 100, "{before} pairs in contact to start with");
     let start = state.pos.clone();
     let mut solver = SelfContacts::default();
-    solver.resolve(&params, &model, &start, &mut state).unwrap();
-    // One pass separates every pair it finds to the thickness; a pair the broad phase
-    // missed would still be at 60 % of it.
-    let left = close_pairs(&model, &state.pos, 0.8 * params.thickness);
+    solver.resolve(params, model, &start, &mut state).unwrap();
+    let left = close_pairs(model, &state.pos, 0.8 * params.thickness);
     assert_eq!(left, 0, "pairs still overlapping after one pass");
+    solver
 }
 
 /// A folded sheet stretched along x by a factor growing from 1 to `stretch` across it, so
@@ -716,14 +725,8 @@ fn stretched_triangles_are_binned_at_their_own_scale_and_no_contact_is_missed() 
         thickness: 0.02,
         friction: 0.0,
     };
-    let (model, mut state) = stretched_sheet(12, params.thickness, 200.0);
-    let before = close_pairs(&model, &state.pos, params.thickness);
-    assert!(before > 100, "{before} pairs in contact to start with");
-    let start = state.pos.clone();
-    let mut solver = SelfContacts::default();
-    solver.resolve(&params, &model, &start, &mut state).unwrap();
-    let left = close_pairs(&model, &state.pos, 0.8 * params.thickness);
-    assert_eq!(left, 0, "pairs still overlapping after one pass");
+    let (model, state) = stretched_sheet(12, params.thickness, 200.0);
+    let solver = one_pass_separates_every_pair(&params, &model, state);
     assert!(solver.table_len() <= CELLS_PER_TRIANGLE * model.triangles.len());
 }
 
