@@ -67,7 +67,7 @@ pub struct BenchRow {
     /// The backend's name ("cpu", "gpu").
     pub backend: String,
     /// CPU threads the solver may share a step among: the team's members (the pool's size,
-    /// at most 16; a cloth under [`crate::sim::team::PARALLEL_ELEMENTS`] particles, 64 × 64,
+    /// at most 16; a cloth under [`crate::parallel::PARALLEL_ELEMENTS`] particles, 64 × 64,
     /// still steps on one of them, and the team runs on one while the others do not pay),
     /// 1 on the GPU (the thread that submits its work).
     pub threads: usize,

@@ -27,6 +27,7 @@ pub mod cloth;
 pub mod gpu;
 pub mod mesh;
 pub mod output;
+pub mod parallel;
 pub mod render;
 pub mod report;
 pub mod scene;

@@ -382,7 +382,7 @@ fn xpbd_matches_spring_statics_and_approaches_the_inextensible_limit() {
 /// parallel size and on two above it (the spring blocks and the ranges shared out).
 #[test]
 fn semi_implicit_euler_on_component_arrays_matches_the_general_path_bit_for_bit() {
-    const { assert!(64 * 64 >= clothsim::sim::team::PARALLEL_ELEMENTS) };
+    const { assert!(64 * 64 >= clothsim::parallel::PARALLEL_ELEMENTS) };
     for (n, threads) in [(24, 1), (64, 2)] {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -478,7 +478,7 @@ fn xpbd_on_two_threads_gives_the_same_bits_as_on_one() {
 #[test]
 fn semi_implicit_euler_on_two_threads_gives_the_same_bits_as_on_one() {
     let n = 96;
-    assert!((n * n) as usize >= clothsim::sim::team::PARALLEL_ELEMENTS);
+    assert!((n * n) as usize >= clothsim::parallel::PARALLEL_ELEMENTS);
     same_bits_on_two_threads(n, IntegratorKind::SemiImplicitEuler, |sim| {
         for _ in 0..3 {
             sim.step_frame().unwrap();

@@ -1,7 +1,7 @@
 //! Particle → spring adjacency in compressed sparse row form, for per-particle gathers
 //! (each particle sums over its own springs: parallel without write conflicts).
 
-use super::model::Springs;
+use super::springs::Springs;
 
 /// For particle `p`, its springs are `spring[offsets[p]..offsets[p+1]]` and the particle at
 /// the other end of each is in `other` at the same place. `sign` is +1 where `p` is the

@@ -2,8 +2,10 @@
 
 mod adjacency;
 mod model;
+mod springs;
 mod state;
 
 pub use adjacency::Adjacency;
-pub use model::{ClothModel, MASS_FLOOR, MassDistribution, Springs};
+pub use model::{ClothModel, MASS_FLOOR, MassDistribution};
+pub use springs::Springs;
 pub use state::ClothState;

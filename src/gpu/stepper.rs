@@ -888,8 +888,8 @@ mod tests {
     fn the_spring_ends_are_sent_again_only_when_their_classes_change() {
         use crate::render::{AdapterPreference, Gpu};
         let gpu = Gpu::headless(AdapterPreference::Any).expect("an adapter");
-        let scene = crate::bench::bench_scene(8, crate::sim::IntegratorKind::SemiImplicitEuler)
-            .expect("scene");
+        // The bench scene: one stiffness and damping for every kind of spring.
+        let scene = crate::scene::Scene::builtin("hanging-bench").expect("scene");
         let (model, effects) = (&scene.model, &scene.effects);
         let mut params = scene.params.clone();
         let mut stepper = GpuStepper::new(&gpu.device, &gpu.queue, model, &params, effects, true)

@@ -9,40 +9,10 @@ use glam::{Vec2, Vec3};
 use super::bounds::bbox_diagonal;
 use super::error::ObjError;
 use super::polygons::PolygonSoup;
+use super::spring_kind::SpringKind;
 use super::triangulate::{Triangulation, triangulate};
 use super::uv::planar_uvs;
 use super::weld::weld;
-
-/// What a spring models. Structural springs are polygon sides; shear springs are the
-/// diagonals of quads (both of them) and of other polygons (the fan's); a bend spring joins
-/// the two vertices opposite an interior edge.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
-)]
-pub enum SpringKind {
-    Structural,
-    Shear,
-    Bend,
-}
-
-impl SpringKind {
-    /// All kinds, in the order per-kind parameter arrays use.
-    pub const ALL: [SpringKind; 3] = [SpringKind::Structural, SpringKind::Shear, SpringKind::Bend];
-
-    /// Index into per-kind parameter arrays.
-    pub fn index(self) -> usize {
-        self as usize
-    }
-
-    /// Lower-case name for tables and JSON.
-    pub fn name(self) -> &'static str {
-        match self {
-            SpringKind::Structural => "structural",
-            SpringKind::Shear => "shear",
-            SpringKind::Bend => "bend",
-        }
-    }
-}
 
 /// Cloth topology in its rest shape. Valid by construction: every particle belongs to at
 /// least one triangle of positive area, indices are in range, edges are unique, and no

@@ -5,7 +5,7 @@ use rustc_hash::FxHashSet;
 
 use glam::Vec3;
 
-use super::topology::SpringKind;
+use super::spring_kind::SpringKind;
 
 /// Triangles of a polygon soup, with what each side of each triangle is.
 #[derive(Default)]

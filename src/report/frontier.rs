@@ -1,6 +1,6 @@
 //! The cost–accuracy frontier and the choice made from it.
 
-use super::sweep::Point;
+use super::point::Point;
 
 /// Indices of the stable points on the Pareto frontier, cheapest first: each is more
 /// accurate (smaller maximum error) than every cheaper stable point.

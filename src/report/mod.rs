@@ -6,6 +6,7 @@ mod files;
 mod frontier;
 mod measure;
 mod plot;
+mod point;
 mod sweep;
 mod table;
 
@@ -14,8 +15,9 @@ pub use files::write_report;
 pub use frontier::{frontier, recommend};
 pub use measure::{BLOW_UP_SPEED, Record, Trajectory, position_error, run, undamped};
 pub use plot::{PLOT_SIZE, draw, integrator_color};
+pub use point::Point;
 pub use sweep::{
-    AccuracyReport, DEFAULT_SUBSTEPS, DEFAULT_TOLERANCE, Point, Progress, REFERENCE_REFINEMENT,
-    Reference, StableLimit, SweepConfig, measure, sweep,
+    AccuracyReport, DEFAULT_SUBSTEPS, DEFAULT_TOLERANCE, Progress, REFERENCE_REFINEMENT, Reference,
+    StableLimit, SweepConfig, measure, sweep,
 };
 pub use table::{CSV_COLUMNS, choice_sentence, csv, markdown};

@@ -211,7 +211,8 @@ fn range(values: &[f64], below: f64, above: f64) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::sweep::{Point, Reference};
+    use crate::report::point::Point;
+    use crate::report::sweep::Reference;
 
     fn pixels_of(buffer: &[u8], kind: IntegratorKind) -> usize {
         let (r, g, b) = integrator_color(kind);

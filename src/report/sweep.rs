@@ -8,6 +8,7 @@ use crate::sim::IntegratorKind;
 use super::error::ReportError;
 use super::frontier::{frontier, recommend};
 use super::measure::{Record, Trajectory, position_error, run, undamped};
+use super::point::Point;
 
 /// What to sweep.
 #[derive(Clone, Debug, PartialEq)]
@@ -91,53 +92,6 @@ impl SweepConfig {
             return bad("at least one sample time is needed".into());
         }
         Ok(())
-    }
-}
-
-/// One integrator at one step size.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct Point {
-    pub integrator: IntegratorKind,
-    /// The step taken, seconds.
-    pub dt: f64,
-    /// Steps taken over the run.
-    pub steps: u64,
-    /// The scene's frame time ÷ dt: the substeps per frame that give this step.
-    pub substeps_per_frame: f64,
-    /// Position error against the reference: the largest over sample times of the RMS over
-    /// particles, as a fraction of the cloth's size.
-    pub rms_error: f64,
-    /// The same for the maximum over particles.
-    pub max_error: f64,
-    /// Energy drift on the undamped scene: largest deviation of the total energy from its
-    /// start (gain or loss), as a fraction of the reference's peak kinetic energy.
-    pub energy_drift: f64,
-    /// Finite throughout, with energy bounded (it never gained more than the reference's
-    /// peak kinetic energy) and error below the cloth's size.
-    pub stable: bool,
-    /// Wall-clock seconds per simulated second.
-    pub wall_s_per_sim_s: f64,
-    pub force_evals_per_step: f64,
-    pub solver_iterations_per_step: f64,
-}
-
-#[cfg(test)]
-impl Point {
-    /// An RK4 point of this cost and error (tests: the rest are placeholders).
-    pub(crate) fn at(cost: f64, error: f64, stable: bool) -> Self {
-        Self {
-            integrator: IntegratorKind::Rk4,
-            dt: 1e-3,
-            steps: 1,
-            substeps_per_frame: 1.0,
-            rms_error: error,
-            max_error: error,
-            energy_drift: 0.0,
-            stable,
-            wall_s_per_sim_s: cost,
-            force_evals_per_step: 1.0,
-            solver_iterations_per_step: 0.0,
-        }
     }
 }
 

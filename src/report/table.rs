@@ -2,7 +2,8 @@
 
 use std::fmt::Write;
 
-use super::sweep::{AccuracyReport, Point};
+use super::point::Point;
+use super::sweep::AccuracyReport;
 
 /// CSV columns, in order.
 pub const CSV_COLUMNS: [&str; 12] = [

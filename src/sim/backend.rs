@@ -89,10 +89,10 @@ pub trait StepBackend: Send {
     }
 
     /// CPU threads that may step the cloth: the members of the team the current rayon pool
-    /// picks ([`super::team::Team::current`], at most 16; a cloth too small to share steps
+    /// picks ([`crate::parallel::Team::current`], at most 16; a cloth too small to share steps
     /// on the caller alone) for a backend that steps on the CPU; a backend that only records
     /// and submits a device's work uses the one thread that calls it.
     fn cpu_threads(&self) -> usize {
-        super::team::Team::current().members()
+        crate::parallel::Team::current().members()
     }
 }

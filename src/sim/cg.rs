@@ -5,10 +5,9 @@ use glam::{Mat3, Vec3};
 
 use crate::cloth::ClothModel;
 
-use super::forces::{
-    Blocks, Components, SystemMatrix, SystemProduct, blocks_times, split, split_blocks, zeroed,
-};
+use super::forces::{SystemMatrix, SystemProduct};
 use super::integrator::StepError;
+use super::kernels::{Blocks, Components, blocks_times, split, split_blocks, zeroed};
 
 /// How a solve ended.
 #[derive(Clone, Copy, Debug, PartialEq)]

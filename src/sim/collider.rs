@@ -186,14 +186,3 @@ pub fn small_sphere_warnings(colliders: &[Collider], model: &ClothModel) -> Vec<
         })
         .collect()
 }
-
-/// The colliders among `effects`, in order.
-pub fn colliders_of(effects: &[super::Effect]) -> Vec<Collider> {
-    effects
-        .iter()
-        .filter_map(|e| match e {
-            super::Effect::Collider(c) => Some(*c),
-            _ => None,
-        })
-        .collect()
-}

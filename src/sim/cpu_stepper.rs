@@ -7,9 +7,9 @@ use std::time::{Duration, Instant};
 use crate::cloth::{ClothModel, ClothState};
 
 use super::backend::StepBackend;
-use super::collider::{Collider, colliders_of};
+use super::collider::Collider;
 use super::diagnosis::Cause;
-use super::effect::{Effect, wind_of};
+use super::effect::{Effect, colliders_of, wind_of};
 use super::forces::ForceSet;
 use super::guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check};
 use super::guard_state::GuardState;

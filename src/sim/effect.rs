@@ -64,3 +64,14 @@ pub fn thickness_fits(effects: &[Effect], model: &ClothModel) -> Result<(), TooT
         _ => Ok(()),
     })
 }
+
+/// The colliders among `effects`, in order.
+pub fn colliders_of(effects: &[Effect]) -> Vec<Collider> {
+    effects
+        .iter()
+        .filter_map(|e| match e {
+            Effect::Collider(c) => Some(*c),
+            _ => None,
+        })
+        .collect()
+}

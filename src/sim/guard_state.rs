@@ -3,7 +3,8 @@
 
 use crate::cloth::ClothState;
 
-use super::guard::{GuardEvent, GuardLimits, GuardPolicy};
+use super::guard::{GuardEvent, GuardLimits};
+use super::guard_policy::GuardPolicy;
 
 /// What the guard keeps between frames.
 #[derive(Clone, Debug)]

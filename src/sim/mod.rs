@@ -10,26 +10,25 @@ mod diagnosis;
 mod effect;
 pub mod forces;
 mod guard;
+mod guard_policy;
 mod guard_state;
 pub mod integrator;
+pub mod kernels;
 mod params;
 mod self_collision;
 mod stats;
-pub mod team;
 mod timings;
-mod wide;
 
 pub use backend::StepBackend;
 pub use cg::{CgOutcome, ConjugateGradient};
-pub use collider::{Collider, colliders_of, min_collider_distance, small_sphere_warnings};
+pub use collider::{Collider, min_collider_distance, small_sphere_warnings};
 pub use constraints::DistanceConstraints;
 pub use cpu_stepper::CpuStepper;
 pub use diagnosis::{Cause, Vibration, stiffest_vibration};
-pub use effect::{BendingModel, Effect, thickness_fits, wind_of};
+pub use effect::{BendingModel, Effect, colliders_of, thickness_fits, wind_of};
 pub use forces::{Force, ForceSet, JacobianMode, SystemMatrix, Wind};
-pub use guard::{
-    Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, GuardPolicy, Trouble, check,
-};
+pub use guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check};
+pub use guard_policy::GuardPolicy;
 pub use integrator::{Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport};
 pub use params::{SimParams, SolverConfig};
 pub use self_collision::{

@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 
-use super::guard::GuardPolicy;
+use super::guard_policy::GuardPolicy;
 use super::integrator::IntegratorKind;
 
 /// Every tunable number of the solver. Units are SI; each field says how it affects

@@ -3,10 +3,10 @@
 
 use glam::Vec3;
 
-use super::super::team::{each_part, within};
-use super::super::wide::wide;
-use super::components::Components;
 use super::jacobian::SystemMatrix;
+use crate::parallel::wide;
+use crate::parallel::{each_part, within};
+use crate::sim::kernels::Components;
 
 /// Air damping rate, 1/s.
 #[derive(Clone, Copy, Debug, PartialEq)]

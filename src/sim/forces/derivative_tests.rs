@@ -4,11 +4,11 @@
 use glam::Vec3;
 
 use super::{
-    AirDamping, Components, Force, ForceSet, Gravity, JacobianMode, SpringForce, SystemMatrix,
-    SystemProduct, split,
+    AirDamping, Force, ForceSet, Gravity, JacobianMode, SpringForce, SystemMatrix, SystemProduct,
 };
 use crate::cloth::ClothModel;
 use crate::mesh::{GridOrientation, GridSpec};
+use crate::sim::kernels::{Components, split};
 
 /// A small deterministic generator (xorshift), so the tests need no dependency.
 struct Rng(u64);

@@ -5,13 +5,13 @@ use glam::Vec3;
 use crate::cloth::ClothModel;
 
 use super::air_damping::AirDamping;
-use super::components::Components;
 use super::dihedral::DihedralBending;
 use super::gravity::Gravity;
 use super::jacobian::{JacobianMode, SystemMatrix};
-use super::spring_runs::TwoPasses;
 use super::springs::SpringForce;
 use super::wind::Wind;
+use crate::sim::kernels::Components;
+use crate::sim::kernels::TwoPasses;
 
 /// How a term takes part in the fused path ([`Force::fused`]).
 pub enum Fused<'a> {

@@ -10,15 +10,14 @@ use crate::cloth::ClothModel;
 use super::super::constraints::DistanceConstraints;
 use super::super::effect::{BendingModel, Effect};
 use super::super::params::SimParams;
-use super::super::team::{Disjoint, PARALLEL_ELEMENTS, Team, share};
 use super::air_damping::AirDamping;
-use super::components::{Components, Scratch, split, zeroed};
 use super::dihedral::DihedralBending;
 use super::force::{Force, Fused};
 use super::gravity::Gravity;
 use super::jacobian::{JacobianMode, SystemMatrix};
-use super::spring_runs::{BlockPass, TwoPasses};
 use super::springs::SpringForce;
+use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team, share};
+use crate::sim::kernels::{BlockPass, Components, Scratch, TwoPasses, split, zeroed};
 
 /// Spring terms the fused path takes (a scene has two at most: springs and bend springs).
 const FUSED_PAIR_TERMS: usize = 2;

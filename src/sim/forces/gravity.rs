@@ -2,9 +2,9 @@
 
 use glam::Vec3;
 
-use super::super::team::{each_part, within};
-use super::super::wide::wide;
-use super::components::Components;
+use crate::parallel::wide;
+use crate::parallel::{each_part, within};
+use crate::sim::kernels::Components;
 
 /// Uniform gravitational acceleration, m/s².
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -5,8 +5,7 @@ use glam::{Mat3, Vec3};
 
 use crate::cloth::{ClothModel, Springs};
 
-use super::components::{Blocks, Components, blocks_times, split_blocks};
-use super::spring_runs::{Projectors, SpringRuns};
+use crate::sim::kernels::{Blocks, Components, Projectors, SpringRuns, blocks_times, split_blocks};
 
 /// Which derivative a force term reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

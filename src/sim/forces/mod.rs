@@ -2,18 +2,15 @@
 //! together and is the one place forces become accelerations.
 
 mod air_damping;
-mod components;
 mod dihedral;
 mod force;
 mod force_set;
 mod gravity;
 mod jacobian;
-mod spring_runs;
 mod springs;
 mod wind;
 
 pub use air_damping::AirDamping;
-pub use components::{Blocks, Components, blocks_times, join, split, split_blocks, zeroed};
 pub use dihedral::{DihedralBending, hinge_angle};
 pub use force::Force;
 pub use force_set::{ForceSet, TermTimes, to_accelerations};

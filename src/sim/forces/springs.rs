@@ -12,8 +12,7 @@ use glam::{Mat3, Vec3};
 
 use crate::cloth::Springs;
 
-use super::components::Components;
-use super::spring_runs::{SpringRuns, TwoPasses};
+use crate::sim::kernels::{Components, SpringRuns, TwoPasses};
 
 use super::jacobian::{JacobianMode, SpringBlock, SystemMatrix};
 use crate::sim::constraints::DistanceConstraints;
@@ -155,7 +154,7 @@ impl SpringForce {
 
     /// The forces in two passes (see `SpringRuns::two_passes`).
     pub fn two_passes<'a>(&'a self, springs: &Springs) -> TwoPasses<'a> {
-        self.runs(springs).two_passes()
+        TwoPasses::of(self.runs(springs))
     }
 
     /// `Σ ½k(|d| − l₀)²`, joules.

@@ -7,9 +7,10 @@ use glam::Vec3;
 
 use crate::cloth::ClothModel;
 
-use super::super::forces::{Components, Force, ForceSet, TermTimes};
+use super::super::forces::{Force, ForceSet, TermTimes};
 use super::super::params::SolverConfig;
-use super::step::StepReport;
+use super::report::StepReport;
+use crate::sim::kernels::Components;
 
 /// Work done inside one step, filled by [`StepContext`] and read by the stepper, which
 /// charges it to the phases.

@@ -6,7 +6,8 @@ use super::super::cg::{CgOutcome, ConjugateGradient};
 use super::super::forces::SystemMatrix;
 use super::context::StepContext;
 use super::kind::IntegratorKind;
-use super::step::{Integrator, StepError, StepReport};
+use super::report::{StepError, StepReport};
+use super::step::Integrator;
 use crate::cloth::ClothState;
 
 /// One linearised backward-Euler step: solve

@@ -1,14 +1,5 @@
 //! The integrators a user can choose, by name.
 
-use super::explicit_euler::ExplicitEuler;
-use super::implicit_euler::ImplicitEuler;
-use super::rk2::Rk2;
-use super::rk4::Rk4;
-use super::semi_implicit_euler::SemiImplicitEuler;
-use super::step::Integrator;
-use super::velocity_verlet::VelocityVerlet;
-use super::xpbd::Xpbd;
-
 /// The integrators a user can choose.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -79,19 +70,6 @@ impl IntegratorKind {
             | IntegratorKind::Xpbd => 1,
             IntegratorKind::Verlet | IntegratorKind::Rk2 => 2,
             IntegratorKind::Rk4 => 4,
-        }
-    }
-
-    /// A fresh integrator of this kind.
-    pub fn build(self) -> Box<dyn Integrator> {
-        match self {
-            IntegratorKind::ExplicitEuler => Box::new(ExplicitEuler::default()),
-            IntegratorKind::SemiImplicitEuler => Box::new(SemiImplicitEuler::default()),
-            IntegratorKind::Verlet => Box::new(VelocityVerlet::default()),
-            IntegratorKind::Rk2 => Box::new(Rk2::default()),
-            IntegratorKind::Rk4 => Box::new(Rk4::default()),
-            IntegratorKind::ImplicitEuler => Box::new(ImplicitEuler::default()),
-            IntegratorKind::Xpbd => Box::new(Xpbd::default()),
         }
     }
 }

@@ -4,7 +4,8 @@ use glam::Vec3;
 
 use super::context::StepContext;
 use super::kind::IntegratorKind;
-use super::step::{Integrator, StepError, StepReport};
+use super::report::{StepError, StepReport};
+use super::step::Integrator;
 use crate::cloth::ClothState;
 
 /// Midpoint rule: a half step of explicit Euler to `(x_m, v_m)`, then the whole step with

@@ -4,7 +4,8 @@ use glam::Vec3;
 
 use super::context::StepContext;
 use super::kind::IntegratorKind;
-use super::step::{Integrator, StepError, StepReport};
+use super::report::{StepError, StepReport};
+use super::step::Integrator;
 use crate::cloth::ClothState;
 
 /// Four slopes — at the start, twice at the midpoint, at the end — weighted 1:2:2:1.

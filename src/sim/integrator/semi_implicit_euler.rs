@@ -4,11 +4,12 @@ use glam::Vec3;
 
 use super::context::StepContext;
 use super::kind::IntegratorKind;
-use super::step::{Integrator, StepError, StepReport};
+use super::report::{StepError, StepReport};
+use super::step::Integrator;
 use crate::cloth::ClothState;
-use crate::sim::forces::{Components, join, split};
-use crate::sim::team::Disjoint;
-use crate::sim::wide::wide;
+use crate::parallel::Disjoint;
+use crate::parallel::wide;
+use crate::sim::kernels::{Components, join, split};
 
 /// `v ← v + a(x, v)·h`, then `x ← x + v·h` with the new velocity.
 ///

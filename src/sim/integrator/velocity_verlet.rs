@@ -4,7 +4,8 @@ use glam::Vec3;
 
 use super::context::StepContext;
 use super::kind::IntegratorKind;
-use super::step::{Integrator, StepError, StepReport};
+use super::report::{StepError, StepReport};
+use super::step::Integrator;
 use crate::cloth::ClothState;
 
 /// `x ← x + v·h + ½a·h²`, `a' = a(x', v + a·h)`, `v ← v + ½(a + a')·h`.

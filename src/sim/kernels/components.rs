@@ -5,7 +5,7 @@ use std::sync::{Mutex, MutexGuard};
 
 use glam::{Mat3, Vec3};
 
-use super::super::team::each_part;
+use crate::parallel::each_part;
 
 /// x, y and z of a list of vectors, one array each (all the same length).
 pub type Components = [Vec<f32>; 3];

@@ -10,7 +10,7 @@
 //! their fused multiply-adds out (`mul_add`): one instruction with FMA, a correctly
 //! rounded library call (the same result, more slowly) without, so the same bits too.
 
-/// Runs `work`, compiled for AVX2 when the CPU has it (see the [module](self)).
+/// Runs `work`, compiled for AVX2 when the CPU has it (see the notes at the top of `parallel/wide.rs`).
 #[inline(always)]
 pub fn wide<R>(work: impl FnOnce() -> R) -> R {
     #[cfg(target_arch = "x86_64")]
@@ -27,7 +27,7 @@ fn wide_avx2<R>(work: impl FnOnce() -> R) -> R {
     work()
 }
 
-/// Runs `work`, compiled for AVX2 and FMA when the CPU has both (see the [module](self)).
+/// Runs `work`, compiled for AVX2 and FMA when the CPU has both (see the notes at the top of `parallel/wide.rs`).
 #[inline(always)]
 pub fn wide_fma<R>(work: impl FnOnce() -> R) -> R {
     #[cfg(target_arch = "x86_64")]

@@ -1,0 +1,16 @@
+//! Execution, apart from physics: the thread team that runs a step's parallel sections,
+//! the slices its members share, and loops compiled for wider vector units. Nothing here
+//! knows what it computes.
+
+mod disjoint;
+mod pace;
+mod parts;
+mod ranges;
+mod team;
+mod wide;
+
+pub use disjoint::Disjoint;
+pub use parts::{PARALLEL_ELEMENTS, each_part, within};
+pub use ranges::share;
+pub use team::Team;
+pub use wide::{wide, wide_fma};

@@ -1,0 +1,158 @@
+//! What a block pass computes for each run of springs: their forces, or their system
+//! blocks times a vector. Each is one loop over contiguous arrays that the compiler
+//! vectorises.
+
+use std::ops::Range;
+
+use super::components::Components;
+
+/// Springs' system blocks `α·I + β·n nᵀ` in run order: `[α, β, n.x, n.y, n.z]`
+/// ([`SpringBlock::numbers`](crate::sim::forces::SpringBlock::numbers)), one array each
+/// ([`SpringRuns::add_block_products`](super::SpringRuns::add_block_products)).
+pub type Projectors = [Vec<f32>; 5];
+
+/// What a block pass does with each run: `run` gets the run's two ranges of ends, its
+/// springs (run order) and its slices of the block's buffers at its first ends and at its
+/// second ends (where what it puts is subtracted), which it overwrites (`WRITE`: `0 + x`,
+/// the bits of adding to zero) or adds to.
+pub(super) trait RunPass: Sync {
+    fn run<const WRITE: bool>(
+        &self,
+        ends: [Range<usize>; 2],
+        springs: Range<usize>,
+        first: [&mut [f32]; 3],
+        second: [&mut [f32]; 3],
+    );
+}
+
+/// The spring forces (see [`kernel`]).
+pub(super) struct ForcePass<'a> {
+    pub(super) rest: &'a [f32],
+    pub(super) k: &'a [f32],
+    pub(super) c: &'a [f32],
+    pub(super) p: &'a Components,
+    pub(super) v: &'a Components,
+}
+
+impl RunPass for ForcePass<'_> {
+    #[inline(always)]
+    fn run<const WRITE: bool>(
+        &self,
+        [ea, eb]: [Range<usize>; 2],
+        springs: Range<usize>,
+        first: [&mut [f32]; 3],
+        second: [&mut [f32]; 3],
+    ) {
+        let (p, v) = (self.p, self.v);
+        kernel::<WRITE>(
+            at(p, &ea),
+            at(p, &eb),
+            at(v, &ea),
+            at(v, &eb),
+            [
+                &self.rest[springs.clone()],
+                &self.k[springs.clone()],
+                &self.c[springs],
+            ],
+            first,
+            second,
+        );
+    }
+}
+
+/// Block products `S_e·u_other` at both ends (see
+/// [`SpringRuns::add_block_products`](super::SpringRuns::add_block_products)).
+pub(super) struct ProductPass<'a> {
+    pub(super) s: &'a Projectors,
+    pub(super) u: &'a Components,
+}
+
+impl RunPass for ProductPass<'_> {
+    #[inline(always)]
+    fn run<const WRITE: bool>(
+        &self,
+        [ea, eb]: [Range<usize>; 2],
+        springs: Range<usize>,
+        first: [&mut [f32]; 3],
+        second: [&mut [f32]; 3],
+    ) {
+        let (s, u) = (self.s, self.u);
+        let n = springs.len();
+        let [al, be, nx, ny, nz]: [&[f32]; 5] =
+            std::array::from_fn(|k| &s[k][springs.clone()][..n]);
+        let [ax, ay, az] = at(u, &(ea.start..ea.start + n));
+        let [bx, by, bz] = at(u, &(eb.start..eb.start + n));
+        let [f0, f1, f2] = first;
+        let [t0, t1, t2] = second;
+        let (f0, f1, f2) = (&mut f0[..n], &mut f1[..n], &mut f2[..n]);
+        let (t0, t1, t2) = (&mut t0[..n], &mut t1[..n], &mut t2[..n]);
+        let was = |o: f32| if WRITE { 0.0 } else { o };
+        for j in 0..n {
+            // S·w = α·w + β(n·w)·n.
+            let db = be[j] * (nx[j] * bx[j] + ny[j] * by[j] + nz[j] * bz[j]);
+            f0[j] = was(f0[j]) + (al[j] * bx[j] + db * nx[j]);
+            f1[j] = was(f1[j]) + (al[j] * by[j] + db * ny[j]);
+            f2[j] = was(f2[j]) + (al[j] * bz[j] + db * nz[j]);
+            let da = be[j] * (nx[j] * ax[j] + ny[j] * ay[j] + nz[j] * az[j]);
+            // Subtracted when gathered.
+            t0[j] = was(t0[j]) - (al[j] * ax[j] + da * nx[j]);
+            t1[j] = was(t1[j]) - (al[j] * ay[j] + da * ny[j]);
+            t2[j] = was(t2[j]) - (al[j] * az[j] + da * nz[j]);
+        }
+    }
+}
+
+/// The particles `range` of each component.
+#[inline(always)]
+pub(super) fn at<'a>(c: &'a Components, range: &Range<usize>) -> [&'a [f32]; 3] {
+    [
+        &c[0][range.clone()],
+        &c[1][range.clone()],
+        &c[2][range.clone()],
+    ]
+}
+
+/// The force on each spring's first end, for springs whose ends' positions and velocities
+/// are given per component: `[k(|d| − l₀) + c(v_b − v_a)·d̂] d̂`, zero for coincident ends;
+/// added to `first` (at the first ends) and to `second` (at the second ends, where it is
+/// subtracted later). Computed as `g·d` with `g = [k(|d| − l₀) + c((v_b − v_a)·d)/|d|]/|d|`,
+/// with fused multiply-adds: 27 operations a spring where `n = d/|d|` first took 36.
+/// `WRITE`: overwrites `first` and `second` instead (with `g·d + 0`, the same bits as
+/// adding to zeroed sums).
+#[inline(always)]
+fn kernel<const WRITE: bool>(
+    xa: [&[f32]; 3],
+    xb: [&[f32]; 3],
+    va: [&[f32]; 3],
+    vb: [&[f32]; 3],
+    params: [&[f32]; 3],
+    first: [&mut [f32]; 3],
+    second: [&mut [f32]; 3],
+) {
+    let n = first[0].len();
+    let [ox, oy, oz] = first;
+    let (ox, oy, oz) = (&mut ox[..n], &mut oy[..n], &mut oz[..n]);
+    let [tx, ty, tz] = second;
+    let (tx, ty, tz) = (&mut tx[..n], &mut ty[..n], &mut tz[..n]);
+    let (xax, xay, xaz) = (&xa[0][..n], &xa[1][..n], &xa[2][..n]);
+    let (xbx, xby, xbz) = (&xb[0][..n], &xb[1][..n], &xb[2][..n]);
+    let (vax, vay, vaz) = (&va[0][..n], &va[1][..n], &va[2][..n]);
+    let (vbx, vby, vbz) = (&vb[0][..n], &vb[1][..n], &vb[2][..n]);
+    let (rest, k, c) = (&params[0][..n], &params[1][..n], &params[2][..n]);
+    for j in 0..n {
+        let (dx, dy, dz) = (xbx[j] - xax[j], xby[j] - xay[j], xbz[j] - xaz[j]);
+        let len = dz.mul_add(dz, dy.mul_add(dy, dx * dx)).sqrt();
+        let inv = if len > 1e-9 { 1.0 / len } else { 0.0 };
+        let (ux, uy, uz) = (vbx[j] - vax[j], vby[j] - vay[j], vbz[j] - vaz[j]);
+        let along = uz.mul_add(dz, uy.mul_add(dy, ux * dx));
+        let s = c[j].mul_add(along * inv, k[j] * (len - rest[j]));
+        let g = s * inv;
+        let was = |o: f32| if WRITE { 0.0 } else { o };
+        ox[j] = g.mul_add(dx, was(ox[j]));
+        oy[j] = g.mul_add(dy, was(oy[j]));
+        oz[j] = g.mul_add(dz, was(oz[j]));
+        tx[j] = g.mul_add(dx, was(tx[j]));
+        ty[j] = g.mul_add(dy, was(ty[j]));
+        tz[j] = g.mul_add(dz, was(tz[j]));
+    }
+}

@@ -1,0 +1,346 @@
+//! The spring runs against the plain formula, on every layout, both builds, both passes.
+
+use super::*;
+use crate::sim::forces::SpringBlock;
+use crate::sim::kernels::TwoPasses;
+
+/// The plain spring formula, spring by spring.
+fn reference(
+    a: &[u32],
+    b: &[u32],
+    rest: &[f32],
+    k: &[f32],
+    c: &[f32],
+    pos: &[Vec3],
+    vel: &[Vec3],
+) -> Vec<Vec3> {
+    let mut f = vec![Vec3::ZERO; pos.len()];
+    for e in 0..a.len() {
+        let (ia, ib) = (a[e] as usize, b[e] as usize);
+        let d = pos[ib] - pos[ia];
+        let len = d.length();
+        if len > 1e-9 {
+            let n = d / len;
+            let t = (k[e] * (len - rest[e]) + c[e] * (vel[ib] - vel[ia]).dot(n)) * n;
+            f[ia] += t;
+            f[ib] -= t;
+        }
+    }
+    f
+}
+
+/// The springs of a `w` × `h` grid's stencil `offsets` (columns, rows), from each
+/// particle to its neighbour.
+fn stencil(w: usize, h: usize, offsets: &[(usize, usize)]) -> (Vec<u32>, Vec<u32>) {
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    for p in 0..w * h {
+        for &(di, dj) in offsets {
+            let (i, j) = (p % w + di, p / w + dj);
+            if i < w && j < h {
+                a.push(p as u32);
+                b.push((j * w + i) as u32);
+            }
+        }
+    }
+    (a, b)
+}
+
+/// `start` plus the forces, computed on component arrays.
+fn on_components(runs: &SpringRuns, pos: &[Vec3], vel: &[Vec3], start: &[Vec3]) -> Vec<Vec3> {
+    let n = pos.len();
+    let (mut p, mut v, mut f) = <(Components, Components, Components)>::default();
+    split(pos, &mut p, n);
+    split(vel, &mut v, n);
+    split(start, &mut f, n);
+    runs.add_forces_components(&p, &v, &mut f);
+    (0..n)
+        .map(|i| Vec3::new(f[0][i], f[1][i], f[2][i]))
+        .collect()
+}
+
+/// A scrambled cloth: a grid's stencil springs (long runs) plus random ones (runs of
+/// one), in shuffled order and with ends swapped, over several blocks.
+#[test]
+fn runs_give_the_springs_forces_on_any_layout() {
+    let (w, h) = (70usize, 40usize);
+    let n = w * h;
+    let mut rnd = crate::test_rng::uniform(12345);
+    let pos: Vec<Vec3> = (0..n)
+        .map(|p| {
+            Vec3::new((p % w) as f32 * 0.01, (p / w) as f32 * -0.01, 0.0)
+                + 0.002 * Vec3::new(rnd(), rnd(), rnd())
+        })
+        .collect();
+    let vel: Vec<Vec3> = (0..n)
+        .map(|_| Vec3::new(rnd(), rnd(), rnd()) - 0.5)
+        .collect();
+    let (mut a, mut b) = stencil(w, h, &[(1, 0), (0, 1), (1, 1), (2, 0)]);
+    for _ in 0..500 {
+        a.push((rnd() * n as f32) as u32 % n as u32);
+        b.push((rnd() * n as f32) as u32 % n as u32);
+    }
+    // Shuffle and swap ends.
+    for e in (1..a.len()).rev() {
+        let o = (rnd() * e as f32) as usize;
+        a.swap(e, o);
+        b.swap(e, o);
+        if rnd() < 0.5 {
+            std::mem::swap(&mut a[e], &mut b[e]);
+        }
+    }
+    let rest: Vec<f32> = a
+        .iter()
+        .zip(&b)
+        .map(|(&i, &j)| pos[i as usize].distance(pos[j as usize]) * (0.9 + 0.2 * rnd()))
+        .collect();
+    let k: Vec<f32> = (0..a.len()).map(|_| 100.0 + 400.0 * rnd()).collect();
+    let c: Vec<f32> = (0..a.len()).map(|_| 0.05 * rnd()).collect();
+    let runs = SpringRuns::new(n, &a, &b, &rest, &k, &c);
+    assert!(runs.blocks.len() >= 3, "the test spans several blocks");
+    assert!(
+        runs.run_count() < a.len() / 5,
+        "grid springs fall into long runs"
+    );
+    let want = reference(&a, &b, &rest, &k, &c, &pos, &vel);
+    let start = vec![Vec3::new(0.5, -1.0, 2.0); n];
+    let mut got = start.clone();
+    runs.add_forces(&pos, &vel, &mut got);
+    let scale = want.iter().map(|f| f.length()).fold(0.0, f32::max);
+    for p in 0..n {
+        let err = (got[p] - start[p] - want[p]).length();
+        assert!(
+            err <= 1e-5 * scale,
+            "particle {p}: {} vs {}",
+            got[p] - start[p],
+            want[p]
+        );
+    }
+    // The same again (buffers reused), and with the blocks in parallel on one thread and
+    // on two: identical bits.
+    let mut again = start.clone();
+    runs.add_forces(&pos, &vel, &mut again);
+    assert!(got == again, "a rerun changed the forces");
+    for threads in [1, 2] {
+        // A fresh copy: no sums left over from another run can hide a block not done.
+        let parallel = runs.clone().parallel_from(1);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut out = start.clone();
+        pool.install(|| parallel.add_forces(&pos, &vel, &mut out));
+        assert!(
+            got == out,
+            "parallel blocks on {threads} threads changed the forces"
+        );
+        let fresh = runs.clone().parallel_from(1);
+        let out = pool.install(|| on_components(&fresh, &pos, &vel, &start));
+        assert!(got == out, "on components, {threads} threads");
+    }
+    // On component arrays: the same bits.
+    assert!(got == on_components(&runs, &pos, &vel, &start));
+    // Buffers reused at another state: the forces there, as from runs never used (each
+    // block's first run overwrites its slices, the rest of its buffers is zeroed).
+    let moved: Vec<Vec3> = (pos.iter().enumerate())
+        .map(|(p, x)| *x * 1.02 + Vec3::new(0.0, 0.0, 0.001 * (p % 3) as f32))
+        .collect();
+    let (mut reused, mut fresh) = (start.clone(), start.clone());
+    runs.add_forces(&moved, &vel, &mut reused);
+    SpringRuns::new(n, &a, &b, &rest, &k, &c).add_forces(&moved, &vel, &mut fresh);
+    assert!(
+        reused == fresh,
+        "sums of the last state stayed in the buffers"
+    );
+    assert!(reused != got, "the moved state gave the same forces");
+    // New strengths without rebuilding the runs: the same as runs built with them.
+    let stiffer: Vec<f32> = k.iter().map(|k| 2.0 * k).collect();
+    let mut changed = runs.clone();
+    changed.set_strengths(&stiffer, &c);
+    let rebuilt = SpringRuns::new(n, &a, &b, &rest, &stiffer, &c);
+    let (mut x, mut y) = (start.clone(), start.clone());
+    changed.add_forces(&pos, &vel, &mut x);
+    rebuilt.add_forces(&pos, &vel, &mut y);
+    assert!(x == y, "new strengths differ from runs built with them");
+    assert!(x != got, "the strengths changed nothing");
+}
+
+/// Springs of a `w` × `h` grid's stencil `offsets`, 1 cm apart with jittered depths,
+/// rest lengths and velocities (from `seed`), and their positions and velocities on
+/// component arrays.
+fn jittered_grid(
+    w: usize,
+    h: usize,
+    seed: u64,
+    offsets: &[(usize, usize)],
+) -> (SpringRuns, Components, Components) {
+    let n = w * h;
+    let mut rnd = crate::test_rng::uniform(seed);
+    let pos: Vec<Vec3> = (0..n)
+        .map(|p| Vec3::new((p % w) as f32, -((p / w) as f32), rnd()) * 0.01)
+        .collect();
+    let vel: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
+    let (a, b) = stencil(w, h, offsets);
+    let rest: Vec<f32> = (0..a.len()).map(|_| 0.008 + 0.01 * rnd()).collect();
+    let (k, c) = (vec![400.0; a.len()], vec![0.02; a.len()]);
+    let (mut p, mut v) = (Components::default(), Components::default());
+    split(&pos, &mut p, n);
+    split(&vel, &mut v, n);
+    (SpringRuns::new(n, &a, &b, &rest, &k, &c), p, v)
+}
+
+/// The block passes compiled plainly and for AVX2 with FMA (the one the CPU runs)
+/// give the same bits: the fused multiply-adds are exact either way. (On a CPU without
+/// AVX2 and FMA both sides are the plain build, and this proves nothing there; CI's
+/// machines have both.)
+#[test]
+fn the_plain_and_the_vector_build_give_the_same_bits() {
+    let (runs, p, v) = jittered_grid(40, 30, 7, &[(1, 0), (0, 1), (1, 1), (0, 2)]);
+    let pass = runs.force_pass(&p, &v);
+    let mut buffers = Vec::new();
+    runs.size_buffers(&mut buffers);
+    let mut plain = buffers.clone();
+    for (block, (buf, twin)) in runs.blocks.iter().zip(buffers.iter_mut().zip(&mut plain)) {
+        runs.block_pass(block, buf, &pass);
+        runs.each_run(block, twin, &pass);
+        assert!(
+            buf.first == twin.first && buf.second == twin.second,
+            "block at {}",
+            block.lo
+        );
+    }
+    assert!(
+        buffers[0].first[0].iter().any(|&f| f != 0.0),
+        "no forces at all"
+    );
+}
+
+/// [`TwoPasses::write_to`] overwrites what was there with the bits
+/// [`TwoPasses::add_to`] adds to zeros: over ranges that start and end inside blocks,
+/// span several, and reach past the last particle (which get zero).
+#[test]
+fn written_sums_are_the_added_ones_whatever_was_there() {
+    let (runs, p, v) = jittered_grid(70, 40, 31, &[(1, 0), (0, 1), (1, 1), (2, 0)]);
+    let n = runs.particles;
+    assert!(runs.blocks.len() >= 3, "the test spans several blocks");
+    let mut two = TwoPasses::of(&runs);
+    let blocks = two.blocks();
+    (0..blocks.len()).for_each(|b| blocks.fill(b, &p, &v));
+    let past = n + 40;
+    let ranges = [
+        0..past,
+        5..1000,
+        1000..2048,
+        1500..2600,
+        2040..past,
+        n - 3..past,
+    ];
+    for range in ranges {
+        let len = range.len();
+        let mut added: Components = std::array::from_fn(|_| vec![0.0; len]);
+        two.add_to(range.clone(), added.each_mut().map(|a| &mut a[..]));
+        let mut written: Components = std::array::from_fn(|_| vec![f32::NAN; len]);
+        two.write_to(range.clone(), written.each_mut().map(|a| &mut a[..]));
+        assert!(written == added, "{range:?}");
+        assert!(added[0].iter().any(|&f| f != 0.0), "{range:?}: no forces");
+    }
+}
+
+/// Block products against the plain per-spring sum, on one thread and on two.
+#[test]
+fn block_products_are_each_springs_block_times_the_other_end() {
+    let (w, h) = (60usize, 50usize);
+    let n = w * h;
+    let mut rnd = crate::test_rng::uniform(99);
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    for p in 0..n {
+        for (di, dj) in [(1, 0), (0, 1), (1, 1), (0, 2)] {
+            let (i, j) = (p % w + di, p / w + dj);
+            if i < w && j < h {
+                // Ends in either order.
+                let q = (j * w + i) as u32;
+                let (x, y) = if rnd() < 0.5 {
+                    (p as u32, q)
+                } else {
+                    (q, p as u32)
+                };
+                a.push(x);
+                b.push(y);
+            }
+        }
+    }
+    // Random α, β and (not unit) n: every number of a block weighs in.
+    let blocks: Vec<SpringBlock> = (0..a.len())
+        .map(|_| SpringBlock {
+            alpha: rnd() - 0.5,
+            beta: rnd() - 0.5,
+            n: Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5),
+        })
+        .collect();
+    let u: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
+    let mut want = vec![Vec3::ZERO; n];
+    for e in 0..a.len() {
+        let (i, j) = (a[e] as usize, b[e] as usize);
+        want[i] += blocks[e].matrix() * u[j];
+        want[j] += blocks[e].matrix() * u[i];
+    }
+    let zero = vec![0.0; a.len()];
+    let runs = SpringRuns::new(n, &a, &b, &zero, &zero, &zero);
+    let mut s: Projectors = Default::default();
+    runs.in_order(|e| blocks[e].numbers(), &mut s);
+    let mut uc = Components::default();
+    split(&u, &mut uc, n);
+    let product = |runs: &SpringRuns| {
+        let mut out = Components::default();
+        crate::sim::kernels::zeroed(&mut out, n);
+        runs.add_block_products(&s, &uc, &mut out);
+        out
+    };
+    let got = product(&runs);
+    let scale = want.iter().map(|v| v.length()).fold(0.0, f32::max);
+    for p in 0..n {
+        let g = Vec3::new(got[0][p], got[1][p], got[2][p]);
+        assert!((g - want[p]).length() <= 1e-5 * scale, "particle {p}");
+    }
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let parallel = runs.clone().parallel_from(1);
+        assert!(
+            pool.install(|| product(&parallel)) == got,
+            "{threads} threads"
+        );
+    }
+}
+
+/// A plain grid's stencil: the ends of its rows are filled, so each offset is one run
+/// per block, not one per row; the fillers add nothing.
+#[test]
+fn row_ends_are_filled_so_each_offset_is_one_run_per_block() {
+    let (w, h) = (50usize, 60usize);
+    let n = w * h;
+    let offsets = [(1, 0), (0, 1), (1, 1), (2, 0)];
+    let (a, b) = stencil(w, h, &offsets);
+    let pos: Vec<Vec3> = (0..n)
+        .map(|p| Vec3::new((p % w) as f32, (p / w) as f32, (p % 7) as f32) * 0.01)
+        .collect();
+    let vel: Vec<Vec3> = (0..n).map(|p| Vec3::splat((p % 5) as f32 - 2.0)).collect();
+    let rest = vec![0.008; a.len()];
+    let (k, c) = (vec![300.0; a.len()], vec![0.02; a.len()]);
+    let runs = SpringRuns::new(n, &a, &b, &rest, &k, &c);
+    assert!(
+        runs.run_count() <= offsets.len() * runs.blocks.len(),
+        "{} runs for {} offsets in {} blocks",
+        runs.run_count(),
+        offsets.len(),
+        runs.blocks.len()
+    );
+    let want = reference(&a, &b, &rest, &k, &c, &pos, &vel);
+    let mut got = vec![Vec3::ZERO; n];
+    runs.add_forces(&pos, &vel, &mut got);
+    let scale = want.iter().map(|f| f.length()).fold(0.0, f32::max);
+    for p in 0..n {
+        assert!((got[p] - want[p]).length() <= 1e-5 * scale, "particle {p}");
+    }
+}
