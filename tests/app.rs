@@ -19,7 +19,7 @@ fn harness() -> Harness<'static, ClothApp> {
 fn harness_in_tempdir() -> (tempfile::TempDir, Harness<'static, ClothApp>) {
     let dir = tempfile::tempdir().unwrap();
     let mut harness = harness();
-    harness.state_mut().capture_dir = dir.path().to_path_buf();
+    harness.state_mut().recording.capture_dir = dir.path().to_path_buf();
     (dir, harness)
 }
 
@@ -341,7 +341,7 @@ fn a_bad_parameter_is_refused_and_the_simulation_keeps_its_own() {
 #[test]
 fn a_failed_capture_is_reported_and_loses_nothing() {
     let mut harness = harness();
-    harness.state_mut().capture_dir = std::path::PathBuf::from("/no/such/folder");
+    harness.state_mut().recording.capture_dir = std::path::PathBuf::from("/no/such/folder");
     let particles = harness.state().sim().model().particle_count();
     click_capture(&mut harness);
     harness.state_mut().finish_writes();
@@ -354,7 +354,7 @@ fn a_failed_capture_is_reported_and_loses_nothing() {
     assert_eq!(harness.state().sim().model().particle_count(), particles);
     // The app goes on: a capture to a good folder works.
     let dir = tempfile::tempdir().unwrap();
-    harness.state_mut().capture_dir = dir.path().to_path_buf();
+    harness.state_mut().recording.capture_dir = dir.path().to_path_buf();
     click_capture(&mut harness);
     harness.state_mut().finish_writes();
     assert!(dir.path().join("clothsim-capture-0001.png").is_file());
@@ -484,7 +484,7 @@ fn save_scene_writes_a_file_that_reopens_as_the_same_setup() {
     let mut harness = harness();
     harness.get_by_label("flag").click();
     harness.run_steps(2);
-    harness.state_mut().save_path = path.to_string_lossy().into_owned();
+    harness.state_mut().panels.side.scene.save_path = path.to_string_lossy().into_owned();
     harness.get_by_label("Save scene").click();
     harness.run_steps(2);
     assert!(path.is_file(), "{:?}", harness.state().messages);
@@ -495,7 +495,7 @@ fn save_scene_writes_a_file_that_reopens_as_the_same_setup() {
     assert_eq!(harness.state().sim().scenario(), "flag");
     assert_eq!(harness.state().sim().effects(), &effects[..]);
     // An unwritable path is an error and writes nothing.
-    harness.state_mut().save_path = "/no/such/dir/s.toml".into();
+    harness.state_mut().panels.side.scene.save_path = "/no/such/dir/s.toml".into();
     harness.get_by_label("Save scene").click();
     harness.run_steps(2);
     assert!(last_error(&harness).contains("/no/such/dir"));
@@ -765,7 +765,7 @@ fn the_antialiasing_setting_redraws_the_view_with_that_many_samples() {
     harness.run_steps(2);
     assert_eq!(harness.state().view_samples(), Some(1));
     // Asking for more than the adapter has gives the most it has.
-    harness.state_mut().samples = 16;
+    harness.state_mut().view.samples = 16;
     harness.run_steps(2);
     assert_eq!(harness.state().view_samples(), Some(4));
 }

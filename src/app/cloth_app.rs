@@ -11,24 +11,13 @@ use crate::view;
 
 use super::accuracy::AccuracyWindow;
 use super::background::{Load, PngWriter};
+use super::messages::{Level, Message};
+use super::panel::{Action, Panel, PanelContext, Status};
+use super::panels::{SidePanel, StatusBar, TransportBar, drop_hint};
+use super::pointer::{Pointer, particle_at};
 use super::stepping::{InEffect, News, SimThread};
 use super::transport::Transport;
 use super::viewport::Viewport;
-
-/// How serious a status message is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Level {
-    Info,
-    Warning,
-    Error,
-}
-
-/// A message shown in the status area.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Message {
-    pub level: Level,
-    pub text: String,
-}
 
 /// Smoothed per-frame statistics.
 #[derive(Clone, Debug, Default)]
@@ -42,62 +31,83 @@ pub struct Stats {
 /// How long "slower than real time" stays shown after the simulation last fell behind.
 const BEHIND_SHOWN: Duration = Duration::from_secs(1);
 
-/// The eframe application.
-pub struct ClothApp {
-    /// The UI's replica of the simulation: what is shown and edited. The copy that steps
-    /// lives on its own thread (see [`super::stepping`]); change both through the app's
-    /// methods, never this one alone.
-    pub(super) sim: Simulation,
-    pub(super) stepping: SimThread,
-    /// What the stepping copy has in effect (backend, substeps, integrator).
-    in_effect: InEffect,
-    /// When the simulation last ran slower than real time.
-    last_behind: Option<Instant>,
-    /// A cloth the user opened (unplaced, with its name): a scenario switch places it again.
-    /// `None`: each scene brings its own cloth.
-    pub(super) custom_cloth: Option<(MeshBuild, String)>,
-    /// Width / height of the 3D view when last drawn, for framing the camera.
-    pub(super) view_aspect: f32,
-    /// Where the 3D view was last drawn, in points.
-    pub(super) view_rect: Option<egui::Rect>,
-    pub transport: Transport,
+/// The 3D view: how it is drawn and looked at.
+pub struct ViewState {
     pub camera: OrbitCamera,
     pub options: RenderOptions,
     /// Antialiasing: MSAA samples per pixel of the 3D view (the quality setting; 1 is the
     /// fastest on a software adapter).
     pub samples: u32,
     /// The MSAA counts the adapter supports, ascending.
-    pub(super) sample_choices: Vec<u32>,
-    /// Print each UI frame's wall time to stderr (`frame_ms …`; the window sets it from
-    /// `CLOTHSIM_FRAME_TIMES`), for measuring frame rates.
-    pub(super) log_frame_times: bool,
-    pub(super) render_state: Option<egui_wgpu::RenderState>,
+    sample_choices: Vec<u32>,
+    /// Width / height of the 3D view when last drawn, for framing the camera.
+    aspect: f32,
+    /// Where the 3D view was last drawn, in points.
+    rect: Option<egui::Rect>,
+    render_state: Option<egui_wgpu::RenderState>,
     /// "name (backend, type)" of the adapter drawing the view, shown in the status bar.
-    pub(super) adapter: Option<String>,
+    adapter: Option<String>,
     pub(super) viewport: Option<Viewport>,
     /// The GPU backend's display buffer (on the view's device), drawn from while the
     /// stepping copy runs on the GPU: the view then reads nothing back.
     gpu_display: Option<wgpu::Buffer>,
     /// The view was last drawn from `gpu_display`.
     drawn_from_gpu: bool,
-    pub(super) loading: Option<Load>,
-    pub(super) writer: PngWriter,
+    pointer: Pointer,
+    /// Print each UI frame's wall time to stderr (`frame_ms …`; the window sets it from
+    /// `CLOTHSIM_FRAME_TIMES`), for measuring frame rates.
+    pub log_frame_times: bool,
+}
+
+/// Captures and recordings, and the thread that writes them.
+pub struct Recording {
     /// Where captures and recordings go.
     pub capture_dir: PathBuf,
     pub(super) capture_requested: bool,
-    /// Next frame number while recording a PNG sequence.
-    pub(super) recording: Option<(PathBuf, u64)>,
+    /// The folder of a PNG sequence being recorded, and its next frame number.
+    pub(super) sequence: Option<(PathBuf, u64)>,
     /// The GIF being recorded and when its last frame was drawn.
     pub(super) gif: Option<(PathBuf, Option<Instant>)>,
-    /// A particle being dragged with the pointer: its index and the plane it moves in.
-    pub(super) grab: Option<super::pointer::Grab>,
+    pub(super) writer: PngWriter,
+}
+
+/// Files being opened, and the cloth the user opened.
+#[derive(Default)]
+pub struct Loading {
+    pub(super) load: Option<Load>,
+    /// A cloth the user opened (unplaced, with its name): a scenario switch places it again.
+    /// `None`: each scene brings its own cloth.
+    pub(super) custom_cloth: Option<(MeshBuild, String)>,
+}
+
+/// The window's panels.
+#[derive(Default)]
+pub struct Panels {
+    pub transport: TransportBar,
+    pub status: StatusBar,
+    pub side: SidePanel,
+}
+
+/// The eframe application.
+pub struct ClothApp {
+    /// The UI's replica of the simulation: what is shown and edited. The copy that steps
+    /// lives on its own thread (see [`super::stepping`]). Read it through
+    /// [`ClothApp::sim`]; change it only through [`ClothApp::edit`] (and
+    /// [`ClothApp::replace_sim`] for a new scene), which change both copies alike.
+    sim: Simulation,
+    stepping: SimThread,
+    /// What the stepping copy has in effect (backend, substeps, integrator).
+    in_effect: InEffect,
+    /// When the simulation last ran slower than real time.
+    last_behind: Option<Instant>,
+    pub transport: Transport,
+    pub view: ViewState,
+    pub recording: Recording,
+    pub(super) loading: Loading,
     pub messages: Vec<Message>,
     pub stats: Stats,
     pub(super) last_update: Option<Instant>,
-    /// Text of the "open" path field (an OBJ cloth or a `.toml` scene).
-    pub open_path: String,
-    /// Text of the "save scene" path field.
-    pub save_path: String,
+    pub panels: Panels,
     /// The accuracy-versus-cost sweep of the current scene.
     pub accuracy: AccuracyWindow,
 }
@@ -115,40 +125,42 @@ impl ClothApp {
             stepping,
             last_behind: None,
             sim,
-            custom_cloth: None,
-            view_aspect: DEFAULT_ASPECT,
-            view_rect: None,
             transport: Transport::default(),
-            camera,
-            options: RenderOptions::default(),
-            samples: render_state.as_ref().map_or(1, default_samples),
-            sample_choices: render_state.as_ref().map_or_else(
-                || vec![1],
-                |rs| crate::render::supported_sample_counts(&rs.adapter),
-            ),
-            adapter: render_state
-                .as_ref()
-                .map(|rs| crate::render::describe_adapter(&rs.adapter)),
-            render_state,
-            viewport: None,
-            gpu_display: None,
-            drawn_from_gpu: false,
-            loading: None,
-            writer: PngWriter::default(),
-            capture_dir: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
-            capture_requested: false,
-            recording: None,
-            gif: None,
-            grab: None,
+            view: ViewState {
+                camera,
+                options: RenderOptions::default(),
+                samples: render_state.as_ref().map_or(1, default_samples),
+                sample_choices: render_state.as_ref().map_or_else(
+                    || vec![1],
+                    |rs| crate::render::supported_sample_counts(&rs.adapter),
+                ),
+                aspect: DEFAULT_ASPECT,
+                rect: None,
+                adapter: render_state
+                    .as_ref()
+                    .map(|rs| crate::render::describe_adapter(&rs.adapter)),
+                render_state,
+                viewport: None,
+                gpu_display: None,
+                drawn_from_gpu: false,
+                pointer: Pointer::default(),
+                log_frame_times: false,
+            },
+            recording: Recording {
+                capture_dir: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
+                capture_requested: false,
+                sequence: None,
+                gif: None,
+                writer: PngWriter::default(),
+            },
+            loading: Loading::default(),
             messages: Vec::new(),
             stats: Stats::default(),
             last_update: None,
-            log_frame_times: false,
-            open_path: String::new(),
-            save_path: "scene.toml".into(),
+            panels: Panels::default(),
             accuracy: AccuracyWindow::default(),
         };
-        if app.render_state.is_none() {
+        if app.view.render_state.is_none() {
             app.message(
                 Level::Warning,
                 "no wgpu renderer: the 3D view and capture are unavailable".into(),
@@ -183,7 +195,7 @@ impl ClothApp {
 
     /// The adapter drawing the 3D view, if any.
     pub fn adapter(&self) -> Option<&str> {
-        self.adapter.as_deref()
+        self.view.adapter.as_deref()
     }
 
     pub fn cloth_name(&self) -> &str {
@@ -239,7 +251,7 @@ impl ClothApp {
         let copy = sim.fork();
         self.sim = sim;
         // The new copy steps on the CPU.
-        self.gpu_display = None;
+        self.view.gpu_display = None;
         let sent = self.stepping.edit_state(Box::new(move |s| {
             *s = copy;
             None
@@ -275,22 +287,22 @@ impl ClothApp {
     /// Where the 3D view was last drawn, in points (`None` before the first frame or
     /// without a renderer).
     pub fn view_rect(&self) -> Option<egui::Rect> {
-        self.view_rect
+        self.view.rect
     }
 
     /// Whether the user opened a cloth that replaces each scene's own.
     pub fn has_custom_cloth(&self) -> bool {
-        self.custom_cloth.is_some()
+        self.loading.custom_cloth.is_some()
     }
 
     pub fn is_loading(&self) -> bool {
-        self.loading.is_some()
+        self.loading.load.is_some()
     }
 
     /// Switches scenario. A cloth the user opened is kept; otherwise the scene brings its
     /// own. Parameters and effects become the scenario's; the camera frames the new scene.
     pub fn set_scenario(&mut self, name: &str) {
-        let scene = match &self.custom_cloth {
+        let scene = match &self.loading.custom_cloth {
             Some((cloth, cloth_name)) => Scene::with_cloth(name, cloth, cloth_name),
             None => Scene::builtin(name),
         };
@@ -298,7 +310,7 @@ impl ClothApp {
             Ok(scene) => {
                 self.replace_sim(Simulation::new(scene));
                 self.reset_camera();
-                self.recording = None;
+                self.recording.sequence = None;
             }
             Err(e) => self.message(Level::Error, e.to_string()),
         }
@@ -310,7 +322,7 @@ impl ClothApp {
         use crate::gpu::{Backend, GpuStepper};
         match backend {
             Backend::Cpu => {
-                self.gpu_display = None;
+                self.view.gpu_display = None;
                 let sent = self.stepping.edit(Box::new(|s| {
                     (s.use_cpu().err()).map(|e| format!("{e}; staying on the GPU"))
                 }));
@@ -318,7 +330,7 @@ impl ClothApp {
                 self.message(Level::Info, "stepping on the CPU".into());
             }
             Backend::Gpu => {
-                let Some(rs) = &self.render_state else {
+                let Some(rs) = &self.view.render_state else {
                     self.message(
                         Level::Error,
                         "no wgpu device: the GPU backend is unavailable".into(),
@@ -330,7 +342,7 @@ impl ClothApp {
                 // Not read back every frame: the view draws from the stepper's display buffer.
                 match GpuStepper::new(&rs.device, &rs.queue, model, params, effects, false) {
                     Ok(mut stepper) => {
-                        self.gpu_display = Some(stepper.display_buffer());
+                        self.view.gpu_display = Some(stepper.display_buffer());
                         // The stepping copy moves to the GPU; the replica never steps.
                         let sent = self.stepping.edit(Box::new(move |s| {
                             s.set_backend(Box::new(stepper))
@@ -350,7 +362,7 @@ impl ClothApp {
 
     /// Frames the current scene with its default camera.
     pub fn reset_camera(&mut self) {
-        self.camera = view::default_camera(&self.sim, self.view_aspect);
+        self.view.camera = view::default_camera(&self.sim, self.view.aspect);
     }
 
     /// Applies edited parameters to the running simulation; a bad value is reported and
@@ -382,7 +394,7 @@ impl ClothApp {
 
     /// Back to each scene's own cloth.
     pub fn use_default_cloth(&mut self) {
-        self.custom_cloth = None;
+        self.loading.custom_cloth = None;
         let scenario = self.sim.scenario().to_string();
         self.set_scenario(&scenario);
     }
@@ -462,25 +474,24 @@ impl ClothApp {
 
     /// The MSAA count in use: the one asked for, or the largest supported below it.
     pub fn samples_in_use(&self) -> u32 {
-        let fits = self.sample_choices.iter().filter(|&&n| n <= self.samples);
-        fits.max().copied().unwrap_or(1)
+        samples_in_use(&self.view.sample_choices, self.view.samples)
     }
 
     /// Whether the 3D view was last drawn straight from the GPU backend's buffer (the
     /// stepping copy runs on the GPU; nothing was read back to draw it).
     pub fn drawn_from_gpu(&self) -> bool {
-        self.drawn_from_gpu
+        self.view.drawn_from_gpu
     }
 
     /// MSAA samples of the 3D view as last drawn (`None` before the first draw or without a
     /// renderer).
     pub fn view_samples(&self) -> Option<u32> {
-        self.viewport.as_ref().map(Viewport::samples)
+        self.view.viewport.as_ref().map(Viewport::samples)
     }
 
     /// Draws the 3D view into the available space and handles capture.
     fn viewport_ui(&mut self, ui: &mut egui::Ui) {
-        let Some(rs) = self.render_state.clone() else {
+        let Some(rs) = self.view.render_state.clone() else {
             ui.centered_and_justified(|ui| ui.label("No wgpu renderer: 3D view unavailable."));
             return;
         };
@@ -492,40 +503,128 @@ impl ClothApp {
         );
         // A new quality setting takes a new target (and pipelines for it).
         let samples = self.samples_in_use();
-        if let Some(old) = self.viewport.take_if(|v| v.samples() != samples) {
+        if let Some(old) = self.view.viewport.take_if(|v| v.samples() != samples) {
             // (Its image would stay shown, and its target alive, until the new one replaces it.)
             old.free(&rs);
         }
-        if self.viewport.is_none() {
+        if self.view.viewport.is_none() {
             match Viewport::new(&rs, w, h, samples) {
-                Ok(v) => self.viewport = Some(v),
+                Ok(v) => self.view.viewport = Some(v),
                 Err(e) => {
                     ui.label(format!("3D view unavailable: {e}"));
                     return;
                 }
             }
         }
-        let Some(viewport) = self.viewport.as_mut() else {
+        let Some(viewport) = self.view.viewport.as_mut() else {
             return;
         };
-        self.view_aspect = w as f32 / h as f32;
+        self.view.aspect = w as f32 / h as f32;
         let mut frame = view::frame(&self.sim);
         if self.in_effect.on_gpu() {
-            frame.device_positions = self.gpu_display.as_ref().map(|buffer| DevicePositions {
-                buffer,
-                stride: crate::gpu::GpuStepper::DISPLAY_STRIDE,
-            });
+            frame.device_positions = self
+                .view
+                .gpu_display
+                .as_ref()
+                .map(|buffer| DevicePositions {
+                    buffer,
+                    stride: crate::gpu::GpuStepper::DISPLAY_STRIDE,
+                });
         }
-        self.drawn_from_gpu = frame.device_positions.is_some();
-        if let Err(e) = viewport.draw(&rs, w, h, &frame, &self.camera, &self.options) {
+        self.view.drawn_from_gpu = frame.device_positions.is_some();
+        if let Err(e) = viewport.draw(&rs, w, h, &frame, &self.view.camera, &self.view.options) {
             ui.label(format!("3D view: {e}"));
             return;
         }
         let (rect, response) = ui.allocate_exact_size(size, egui::Sense::click_and_drag());
         viewport.paint(ui.painter(), rect);
-        self.view_rect = Some(response.rect);
-        self.pointer_input(ui, &response);
+        self.view.rect = Some(response.rect);
+        if Pointer::presses(ui, &response) {
+            self.catch_up();
+        }
+        let mut actions = Vec::new();
+        let view = &mut self.view;
+        (view.pointer).input(ui, &response, &mut view.camera, &self.sim, &mut actions);
+        self.apply_all(actions);
         self.capture_drawn(&rs);
+    }
+
+    /// Draws one of the panels (`which` picks it) from what the window shows, then carries
+    /// out what it asked for.
+    fn show_panel(&mut self, ui: &mut egui::Ui, which: fn(&mut Panels) -> &mut dyn Panel) {
+        let mut actions = Vec::new();
+        let status = Status {
+            in_effect: self.in_effect,
+            playing: self.transport.playing,
+            speed: self.transport.speed,
+            behind: self.transport.behind,
+            fps: self.stats.fps,
+            phase_ms: &self.stats.phase_ms,
+            adapter: self.view.adapter.as_deref(),
+            message: self.messages.last(),
+            loading: self.loading.load.is_some(),
+            recording: self.recording.sequence.is_some(),
+            recording_gif: self.recording.gif.is_some(),
+            custom_cloth: self.loading.custom_cloth.is_some(),
+            samples_in_use: samples_in_use(&self.view.sample_choices, self.view.samples),
+            sample_choices: &self.view.sample_choices,
+        };
+        let mut ctx = PanelContext::new(&self.sim, status, &mut self.view.options, &mut actions);
+        which(&mut self.panels).ui(ui, &mut ctx);
+        self.apply_all(actions);
+    }
+
+    fn apply_all(&mut self, actions: Vec<Action>) {
+        for action in actions {
+            self.apply(action);
+        }
+    }
+
+    /// Does what a panel or the pointer asked for, through the functions that keep the
+    /// window's copy of the simulation and the stepping copy in step.
+    pub fn apply(&mut self, action: Action) {
+        match action {
+            Action::SetPlaying(playing) => self.set_playing(playing),
+            Action::StepOnce => self.step_once(),
+            Action::Reset => self.reset(),
+            Action::SetSpeed(speed) => self.transport.speed = speed,
+            Action::Capture => self.request_capture(),
+            Action::OpenAccuracy => self.accuracy.open = true,
+            Action::ToggleRecording => self.toggle_recording(),
+            Action::ToggleGif => self.toggle_gif(),
+            Action::SetScenario(name) => self.set_scenario(&name),
+            Action::Open(path) => self.open_path(path),
+            Action::UseDefaultCloth => self.use_default_cloth(),
+            Action::SaveScene(path) => self.save_scene(&path),
+            Action::ExportObj => self.export_obj(),
+            Action::SetPinsEnabled(enabled) => self.set_pins_enabled(enabled),
+            Action::SetBackend(backend) => self.set_backend(backend),
+            Action::ApplyParams(params) => self.apply_params(params),
+            Action::ApplyEffects(effects) => self.apply_effects(effects),
+            Action::SetSamples(samples) => self.view.samples = samples,
+            Action::ResetCamera => self.reset_camera(),
+            Action::DismissMessages => self.messages.clear(),
+            Action::TogglePin(p) => self.edit(move |s| s.toggle_pin(p)),
+            Action::Grab { particle, target } => self.edit(move |s| s.grab(particle, target)),
+            Action::Release => self.edit(Simulation::release),
+            Action::Tell(level, text) => self.message(level, text),
+        }
+    }
+
+    /// The particle under the pointer at `at` in the view `rect`, and where it is.
+    pub fn particle_at(&self, rect: egui::Rect, at: egui::Pos2) -> Option<(u32, glam::Vec3)> {
+        particle_at(&self.view.camera, &self.sim, rect, at)
+    }
+
+    /// Before picking or exporting: on the GPU backend the replica's state is read back only
+    /// now and then (the view draws from the GPU's buffer); bring it to the latest frame so
+    /// the pointer picks, and an export writes, the cloth as it is drawn. One read-back.
+    pub(super) fn catch_up(&mut self) {
+        if self.in_effect().on_gpu() {
+            let sent = self.stepping.catch_up();
+            self.report_sent(sent);
+            self.poll_stepping();
+        }
     }
 
     /// One UI frame: input, simulation, panels, viewport.
@@ -538,7 +637,7 @@ impl ClothApp {
         if wall_dt > 0.0 {
             self.stats.fps = 0.9 * self.stats.fps + 0.1 / wall_dt;
         }
-        if self.log_frame_times {
+        if self.view.log_frame_times {
             eprintln!("frame_ms {:.2}", wall_dt * 1000.0);
         }
 
@@ -567,24 +666,25 @@ impl ClothApp {
         let frame = egui::Frame::side_top_panel(ui.style()).fill(egui::Color32::TRANSPARENT);
         egui::Panel::top("transport")
             .frame(frame)
-            .show(ui, |ui| super::controls::transport_bar(ui, self));
+            .show(ui, |ui| self.show_panel(ui, |p| &mut p.transport));
         egui::Panel::bottom("status")
             .frame(frame)
-            .show(ui, |ui| super::controls::status_bar(ui, self));
+            .show(ui, |ui| self.show_panel(ui, |p| &mut p.status));
         egui::Panel::left("controls")
             .frame(frame)
             .resizable(true)
             .default_size(300.0)
-            .show(ui, |ui| super::controls::side_panel(ui, self));
+            .show(ui, |ui| self.show_panel(ui, |p| &mut p.side));
         egui::CentralPanel::no_frame().show(ui, |ui| self.viewport_ui(ui));
         self.accuracy_ui(ui.ctx());
 
         let hovering = ui.input(|i| !i.raw.hovered_files.is_empty());
         if hovering {
-            super::controls::drop_hint(ui);
+            drop_hint(ui);
         }
-        let busy =
-            self.loading.is_some() || self.writer.pending() > 0 || self.accuracy.is_running();
+        let busy = self.loading.load.is_some()
+            || self.recording.writer.pending() > 0
+            || self.accuracy.is_running();
         if self.transport.playing || busy {
             ui.ctx().request_repaint();
         } else {
@@ -617,7 +717,7 @@ impl ClothApp {
     pub fn shutdown(&mut self) {
         // Quitting right after a capture or while recording must not lose frames.
         self.finish_writes();
-        if let (Some(v), Some(rs)) = (self.viewport.take(), &self.render_state) {
+        if let (Some(v), Some(rs)) = (self.view.viewport.take(), &self.view.render_state) {
             v.free(rs);
         }
     }
@@ -651,6 +751,12 @@ fn default_samples(rs: &egui_wgpu::RenderState) -> u32 {
     } else {
         DEFAULT_SAMPLES
     }
+}
+
+/// The largest of `choices` at most `asked` (1 if none is).
+fn samples_in_use(choices: &[u32], asked: u32) -> u32 {
+    let fits = choices.iter().filter(|&&n| n <= asked);
+    fits.max().copied().unwrap_or(1)
 }
 
 /// Width / height assumed for framing before the 3D view was first drawn.

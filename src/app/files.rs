@@ -6,19 +6,20 @@ use std::path::{Path, PathBuf};
 use crate::scene::{Scene, Simulation};
 
 use super::background::{Load, Loaded};
-use super::cloth_app::{ClothApp, Level, next_free};
+use super::cloth_app::{ClothApp, next_free};
+use super::messages::Level;
 
 impl ClothApp {
     /// Starts loading `path` in the background: a `.toml` scene file replaces the scene, an
     /// OBJ replaces the cloth. What the app has stays until the load succeeds.
     pub fn open_path(&mut self, path: PathBuf) {
         self.message(Level::Info, format!("loading {} …", path.display()));
-        self.loading = Some(Load::start(path));
+        self.loading.load = Some(Load::start(path));
     }
 
     /// Waits for a running load (tests, or when the caller must know the outcome).
     pub fn finish_loading(&mut self) {
-        if let Some(load) = self.loading.take()
+        if let Some(load) = self.loading.load.take()
             && let Some(result) = load.wait()
         {
             self.apply_loaded(&load.path, result);
@@ -26,10 +27,12 @@ impl ClothApp {
     }
 
     pub(super) fn poll_loading(&mut self) {
-        let Some(load) = &self.loading else { return };
+        let Some(load) = &self.loading.load else {
+            return;
+        };
         let Some(result) = load.poll() else { return };
         let path = load.path.clone();
-        self.loading = None;
+        self.loading.load = None;
         self.apply_loaded(&path, result);
     }
 
@@ -51,7 +54,7 @@ impl ClothApp {
                     scene.model.particle_count()
                 );
                 // A scene file brings its own cloth.
-                self.custom_cloth = None;
+                self.loading.custom_cloth = None;
                 self.replace_sim(Simulation::new(*scene));
                 self.message(Level::Info, text);
                 self.reset_camera();
@@ -63,22 +66,22 @@ impl ClothApp {
     /// A new cloth keeps the scenario, its effects and the current parameters.
     fn use_cloth(&mut self, path: &Path, build: crate::mesh::MeshBuild) {
         let name = path.display().to_string();
-        let scene = match Scene::with_cloth(self.sim.scenario(), &build, &name) {
+        let scene = match Scene::with_cloth(self.sim().scenario(), &build, &name) {
             Ok(scene) => scene,
             Err(e) => return self.message(Level::Error, e.to_string()),
         };
         let mut sim = Simulation::new(scene);
         // The current parameters were validated when they were set.
-        if let Err(e) = sim.set_params(self.sim.params().clone()) {
+        if let Err(e) = sim.set_params(self.sim().params().clone()) {
             return self.message(Level::Error, e.to_string());
         }
         // The current effects, unless they do not fit the new cloth (a self-collision
         // thicker than its edges): then the scene's own, and the user is told.
         let mut notes = sim.warnings().to_vec();
-        if let Err(e) = sim.set_effects(self.sim.effects().to_vec()) {
+        if let Err(e) = sim.set_effects(self.sim().effects().to_vec()) {
             notes.push(format!("{e}; the scene's own effects are used"));
         }
-        sim.set_pins_enabled(self.sim.pins_enabled());
+        sim.set_pins_enabled(self.sim().pins_enabled());
         let mut text = format!(
             "loaded {name}: {} particles, {} triangles",
             sim.model().particle_count(),
@@ -92,7 +95,7 @@ impl ClothApp {
             Level::Warning
         };
         self.message(level, text);
-        self.custom_cloth = Some((build, name));
+        self.loading.custom_cloth = Some((build, name));
         self.replace_sim(sim);
         self.reset_camera();
     }
@@ -100,7 +103,7 @@ impl ClothApp {
     /// Writes the current setup (cloth, placement, parameters, effects, pins) as a scene
     /// file; a failure is reported and nothing is left half-written.
     pub fn save_scene(&mut self, path: &Path) {
-        let text = self.sim.scene_file().to_toml();
+        let text = self.sim().scene_file().to_toml();
         match crate::output::write_bytes(path, text.as_bytes()) {
             Ok(()) => self.message(Level::Info, format!("saved scene to {}", path.display())),
             Err(e) => self.message(Level::Error, e.to_string()),
@@ -110,8 +113,8 @@ impl ClothApp {
     /// Writes the cloth as it is now as `clothsim-export-NNNN.obj` in the capture folder.
     pub fn export_obj(&mut self) {
         self.catch_up();
-        let path = next_free(&self.capture_dir, "clothsim-export", ".obj");
-        match crate::output::write_bytes(&path, self.sim.export_obj().as_bytes()) {
+        let path = next_free(&self.recording.capture_dir, "clothsim-export", ".obj");
+        match crate::output::write_bytes(&path, self.sim().export_obj().as_bytes()) {
             Ok(()) => self.message(Level::Info, format!("exported {}", path.display())),
             Err(e) => self.message(Level::Error, e.to_string()),
         }

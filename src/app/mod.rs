@@ -4,9 +4,10 @@
 mod accuracy;
 mod background;
 mod cloth_app;
-mod controls;
-mod effects;
 mod files;
+mod messages;
+mod panel;
+mod panels;
 mod pointer;
 mod record;
 mod stepping;
@@ -15,7 +16,13 @@ mod viewport;
 mod window;
 
 pub use accuracy::AccuracyWindow;
-pub use cloth_app::{ClothApp, Level, Message, Stats};
+pub use cloth_app::{ClothApp, Loading, Panels, Recording, Stats, ViewState};
+pub use messages::{Level, Message};
+pub use panel::{Action, Panel, PanelContext, Status};
+pub use panels::{
+    EffectsPanel, MaterialPanel, ScenePanel, SidePanel, SolverPanel, StatusBar, TransportBar,
+    ViewPanel,
+};
 pub use stepping::InEffect;
 pub use transport::Transport;
 pub use window::{device_descriptor, run, with_compute_limits};

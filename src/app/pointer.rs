@@ -4,8 +4,11 @@
 use glam::Vec3;
 
 use crate::mesh::pick;
+use crate::render::OrbitCamera;
+use crate::scene::Simulation;
 
-use super::cloth_app::{ClothApp, Level};
+use super::messages::Level;
+use super::panel::Action;
 use super::viewport::camera_input;
 
 /// A particle held by the pointer, moving in the plane through where it was grabbed that
@@ -17,88 +20,103 @@ pub struct Grab {
     pub plane_normal: Vec3,
 }
 
-impl ClothApp {
-    /// The ray through the pointer at `at` (points) in the view `rect`.
-    fn pointer_ray(&self, rect: egui::Rect, at: egui::Pos2) -> (Vec3, Vec3) {
-        let rel = at - rect.min;
-        self.camera
-            .ray(rel.x, rel.y, rect.width().max(1.0), rect.height().max(1.0))
+/// The pointer over the 3D view, and the particle it holds.
+#[derive(Debug, Default)]
+pub struct Pointer {
+    grab: Option<Grab>,
+}
+
+/// The ray through the pointer at `at` (points) in the view `rect` of `camera`.
+fn pointer_ray(camera: &OrbitCamera, rect: egui::Rect, at: egui::Pos2) -> (Vec3, Vec3) {
+    let rel = at - rect.min;
+    camera.ray(rel.x, rel.y, rect.width().max(1.0), rect.height().max(1.0))
+}
+
+/// The particle of `sim` under the pointer at `at` in the view `rect`: the nearest corner of
+/// the first triangle it hits, and where that particle is.
+pub fn particle_at(
+    camera: &OrbitCamera,
+    sim: &Simulation,
+    rect: egui::Rect,
+    at: egui::Pos2,
+) -> Option<(u32, Vec3)> {
+    let (origin, direction) = pointer_ray(camera, rect, at);
+    let (model, pos) = (sim.model(), &sim.state().pos);
+    let hit = pick(origin, direction, pos, &model.triangles)?;
+    let p = hit.nearest_corner(&model.triangles);
+    Some((p, pos[p as usize]))
+}
+
+impl Pointer {
+    /// Whether the pointer presses on the cloth's view this frame (a grab or a pin may
+    /// follow): the app brings its copy of the state up to date first, so the pointer picks
+    /// the cloth as it is drawn.
+    pub fn presses(ui: &egui::Ui, response: &egui::Response) -> bool {
+        let (ctrl, shift) = ui.input(|i| (i.modifiers.command, i.modifiers.shift));
+        (response.drag_started_by(egui::PointerButton::Primary) && !shift)
+            || (response.clicked() && ctrl)
     }
 
-    /// The particle under the pointer: the nearest corner of the first triangle it hits.
-    pub fn particle_at(&self, rect: egui::Rect, at: egui::Pos2) -> Option<(u32, Vec3)> {
-        let (origin, direction) = self.pointer_ray(rect, at);
-        let model = self.sim.model();
-        let pos = &self.sim.state().pos;
-        let hit = pick(origin, direction, pos, &model.triangles)?;
-        let p = hit.nearest_corner(&model.triangles);
-        Some((p, pos[p as usize]))
-    }
-
-    /// Before picking or exporting: on the GPU backend the replica's state is read back only
-    /// now and then (the view draws from the GPU's buffer); bring it to the latest frame so
-    /// the pointer picks, and an export writes, the cloth as it is drawn. One read-back.
-    pub(super) fn catch_up(&mut self) {
-        if self.in_effect().on_gpu() {
-            let sent = self.stepping.catch_up();
-            self.report_sent(sent);
-            self.poll_stepping();
-        }
-    }
-
-    pub(super) fn pointer_input(&mut self, ui: &egui::Ui, response: &egui::Response) {
+    /// Turns this frame's pointer input over the view into actions: a Ctrl-click pins or
+    /// frees a particle, a drag from the cloth holds the particle under the pointer where
+    /// the pointer moves it, a drag elsewhere orbits `camera`.
+    pub fn input(
+        &mut self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        camera: &mut OrbitCamera,
+        sim: &Simulation,
+        actions: &mut Vec<Action>,
+    ) {
         let rect = response.rect;
-        let ctrl = ui.input(|i| i.modifiers.command);
-        let shift = ui.input(|i| i.modifiers.shift);
-        let pressed = (response.drag_started_by(egui::PointerButton::Primary) && !shift)
-            || (response.clicked() && ctrl);
-        if pressed {
-            self.catch_up();
-        }
+        let (ctrl, shift) = ui.input(|i| (i.modifiers.command, i.modifiers.shift));
         if response.clicked() && ctrl {
             if let Some(at) = response.interact_pointer_pos()
-                && let Some((p, _)) = self.particle_at(rect, at)
+                && let Some((p, _)) = particle_at(camera, sim, rect, at)
             {
-                self.edit(move |s| s.toggle_pin(p));
-                let state = if self.sim.model().pins.contains(&p) {
-                    "pinned"
-                } else {
+                let now = if sim.model().pins.contains(&p) {
                     "freed"
+                } else {
+                    "pinned"
                 };
-                self.message(Level::Info, format!("{state} particle {p}"));
+                actions.push(Action::TogglePin(p));
+                actions.push(Action::Tell(Level::Info, format!("{now} particle {p}")));
             }
             return;
         }
         if response.drag_started_by(egui::PointerButton::Primary)
-            && !ui.input(|i| i.modifiers.shift)
+            && !shift
             && let Some(at) = response.interact_pointer_pos()
-            && let Some((particle, point)) = self.particle_at(rect, at)
+            && let Some((particle, point)) = particle_at(camera, sim, rect, at)
         {
             self.grab = Some(Grab {
                 particle,
                 plane_point: point,
-                plane_normal: self.camera.forward(),
+                plane_normal: camera.forward(),
             });
         }
         match self.grab {
             Some(grab) if response.dragged_by(egui::PointerButton::Primary) => {
                 if let Some(at) = response.interact_pointer_pos() {
-                    let (origin, direction) = self.pointer_ray(rect, at);
+                    let (origin, direction) = pointer_ray(camera, rect, at);
                     let across = direction.dot(grab.plane_normal);
                     if across.abs() > 1e-6 {
                         let t = (grab.plane_point - origin).dot(grab.plane_normal) / across;
-                        let (p, target) = (grab.particle, origin + t * direction);
-                        self.edit(move |s| s.grab(p, target));
+                        let target = origin + t * direction;
+                        actions.push(Action::Grab {
+                            particle: grab.particle,
+                            target,
+                        });
                     }
                 }
             }
             Some(_) => {
                 self.grab = None;
-                self.edit(|s| s.release());
+                actions.push(Action::Release);
             }
             None => {
-                if camera_input(ui, response, &mut self.camera) {
-                    self.reset_camera();
+                if camera_input(ui, response, camera) {
+                    actions.push(Action::ResetCamera);
                 }
             }
         }

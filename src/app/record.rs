@@ -4,28 +4,29 @@
 use std::time::Instant;
 
 use super::background::Written;
-use super::cloth_app::{ClothApp, Level, next_free};
+use super::cloth_app::{ClothApp, next_free};
+use super::messages::Level;
 
 impl ClothApp {
-    /// Captures the next drawn frame to a PNG in [`ClothApp::capture_dir`].
+    /// Captures the next drawn frame to a PNG in [`Recording::capture_dir`](super::cloth_app::Recording::capture_dir).
     pub fn request_capture(&mut self) {
-        self.capture_requested = true;
+        self.recording.capture_requested = true;
     }
 
     /// Starts or stops writing every drawn frame to a new numbered folder.
     pub fn toggle_recording(&mut self) {
-        if let Some((dir, n)) = self.recording.take() {
+        if let Some((dir, n)) = self.recording.sequence.take() {
             self.message(
                 Level::Info,
                 format!("recorded {n} frames to {}", dir.display()),
             );
             return;
         }
-        let dir = next_free(&self.capture_dir, "clothsim-recording", "");
+        let dir = next_free(&self.recording.capture_dir, "clothsim-recording", "");
         match std::fs::create_dir_all(&dir) {
             Ok(()) => {
                 self.message(Level::Info, format!("recording to {}", dir.display()));
-                self.recording = Some((dir, 0));
+                self.recording.sequence = Some((dir, 0));
             }
             Err(e) => self.message(
                 Level::Error,
@@ -35,49 +36,49 @@ impl ClothApp {
     }
 
     pub fn is_recording(&self) -> bool {
-        self.recording.is_some()
+        self.recording.sequence.is_some()
     }
 
     /// Starts or stops recording what the view shows as an animated GIF
     /// (`clothsim-recording-NNNN.gif` in the capture folder).
     pub fn toggle_gif(&mut self) {
-        match self.gif.take() {
+        match self.recording.gif.take() {
             Some((path, _)) => {
-                self.writer.gif_finish(path.clone());
+                self.recording.writer.gif_finish(path.clone());
                 self.message(Level::Info, format!("finishing {} …", path.display()));
             }
             None => {
-                let path = next_free(&self.capture_dir, "clothsim-recording", ".gif");
+                let path = next_free(&self.recording.capture_dir, "clothsim-recording", ".gif");
                 self.message(
                     Level::Info,
                     format!("recording a GIF to {}", path.display()),
                 );
-                self.gif = Some((path, None));
+                self.recording.gif = Some((path, None));
             }
         }
     }
 
     pub fn is_recording_gif(&self) -> bool {
-        self.gif.is_some()
+        self.recording.gif.is_some()
     }
 
     /// Images queued for writing.
     pub fn pending_writes(&self) -> usize {
-        self.writer.pending()
+        self.recording.writer.pending()
     }
 
     /// Blocks until queued files are written, then reports them (tests, shutdown).
     pub fn finish_writes(&mut self) {
-        if let Some((path, _)) = self.gif.take() {
-            self.writer.gif_finish(path);
+        if let Some((path, _)) = self.recording.gif.take() {
+            self.recording.writer.gif_finish(path);
         }
-        let done = self.writer.wait_all();
+        let done = self.recording.writer.wait_all();
         self.report_writes(done);
     }
 
     /// Collects finished writes into messages.
     pub(super) fn poll_writes(&mut self) {
-        let done = self.writer.finished();
+        let done = self.recording.writer.finished();
         self.report_writes(done);
     }
 
@@ -90,8 +91,8 @@ impl ClothApp {
                 // Recorded frames are summarised when recording stops.
                 Ok(()) => {}
                 Err(e) => {
-                    self.recording = None;
-                    self.gif = None;
+                    self.recording.sequence = None;
+                    self.recording.gif = None;
                     self.message(Level::Error, e.to_string());
                 }
             }
@@ -100,11 +101,11 @@ impl ClothApp {
 
     /// Reads back the frame just drawn when a capture or a recording wants it.
     pub(super) fn capture_drawn(&mut self, rs: &egui_wgpu::RenderState) {
-        let capture = std::mem::take(&mut self.capture_requested);
-        if !capture && self.recording.is_none() && self.gif.is_none() {
+        let capture = std::mem::take(&mut self.recording.capture_requested);
+        if !capture && self.recording.sequence.is_none() && self.recording.gif.is_none() {
             return;
         }
-        let Some(viewport) = self.viewport.as_ref() else {
+        let Some(viewport) = self.view.viewport.as_ref() else {
             return;
         };
         let image = match viewport.read(rs) {
@@ -112,20 +113,25 @@ impl ClothApp {
             Err(e) => return self.message(Level::Error, e.to_string()),
         };
         if capture {
-            let path = next_free(&self.capture_dir, "clothsim-capture", ".png");
-            self.writer.submit(image.clone(), path, true);
+            let path = next_free(&self.recording.capture_dir, "clothsim-capture", ".png");
+            self.recording.writer.submit(image.clone(), path, true);
         }
-        if let Some((dir, n)) = &mut self.recording {
-            self.writer
-                .submit(image.clone(), dir.join(format!("frame_{n:05}.png")), false);
+        if let Some((dir, n)) = &mut self.recording.sequence {
+            self.recording.writer.submit(
+                image.clone(),
+                dir.join(format!("frame_{n:05}.png")),
+                false,
+            );
             *n += 1;
         }
-        if let Some((path, last)) = &mut self.gif {
+        if let Some((path, last)) = &mut self.recording.gif {
             // Each frame shows for as long as it was on screen.
             let now = Instant::now();
             let seconds = last.map_or(1.0 / 30.0, |t| now.duration_since(t).as_secs_f64());
             *last = Some(now);
-            self.writer.gif_frame(image, path.clone(), seconds);
+            self.recording
+                .writer
+                .gif_frame(image, path.clone(), seconds);
         }
     }
 }

@@ -66,7 +66,7 @@ pub fn run(obj: Option<PathBuf>) -> eframe::Result {
         options,
         Box::new(move |cc| {
             let mut app = super::ClothApp::new(cc.wgpu_render_state.clone(), obj.as_deref());
-            app.log_frame_times = std::env::var_os("CLOTHSIM_FRAME_TIMES").is_some();
+            app.view.log_frame_times = std::env::var_os("CLOTHSIM_FRAME_TIMES").is_some();
             Ok(Box::new(app))
         }),
     )

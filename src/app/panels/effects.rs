@@ -8,7 +8,8 @@ use crate::mesh::{SpringKind, bounds};
 use crate::scene::Simulation;
 use crate::sim::{BendingModel, Collider, Effect, SelfCollision, SimParams, Wind, shortest_edge};
 
-use super::cloth_app::ClothApp;
+use super::super::panel::{Action, Panel, PanelContext};
+use super::sliders::spring_sliders;
 
 /// Dihedral stiffness offered when switching from bend springs, N·m.
 const DEFAULT_DIHEDRAL_STIFFNESS: f32 = 2e-3;
@@ -85,57 +86,63 @@ impl Addable {
     }
 }
 
-pub fn effects_section(ui: &mut egui::Ui, app: &mut ClothApp) {
-    ui.heading("Effects");
-    let mut params = app.sim.params().clone();
-    let mut effects = app.sim.effects().to_vec();
-    let (mut params_changed, mut effects_changed) = (false, false);
-    let edge = shortest_edge(app.sim.model());
-    let mut remove = None;
-    for (i, effect) in effects.iter_mut().enumerate() {
-        ui.push_id(i, |ui| {
-            ui.horizontal(|ui| {
-                ui.label(RichText::new(title(effect)).strong());
-                // The springs are the cloth itself.
-                if !matches!(effect, Effect::Springs)
-                    && ui
-                        .small_button("Remove")
-                        .on_hover_text("stop simulating this effect")
-                        .clicked()
-                {
-                    remove = Some(i);
+/// The Effects section.
+#[derive(Default)]
+pub struct EffectsPanel;
+
+impl Panel for EffectsPanel {
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &mut PanelContext<'_>) {
+        ui.heading("Effects");
+        let mut params = ctx.sim.params().clone();
+        let mut effects = ctx.sim.effects().to_vec();
+        let (mut params_changed, mut effects_changed) = (false, false);
+        let edge = shortest_edge(ctx.sim.model());
+        let mut remove = None;
+        for (i, effect) in effects.iter_mut().enumerate() {
+            ui.push_id(i, |ui| {
+                ui.horizontal(|ui| {
+                    ui.label(RichText::new(title(effect)).strong());
+                    // The springs are the cloth itself.
+                    if !matches!(effect, Effect::Springs)
+                        && ui
+                            .small_button("Remove")
+                            .on_hover_text("stop simulating this effect")
+                            .clicked()
+                    {
+                        remove = Some(i);
+                    }
+                });
+                let (p, e) = effect_controls(ui, effect, &mut params, edge);
+                params_changed |= p;
+                effects_changed |= e;
+            });
+        }
+        if let Some(i) = remove {
+            effects.remove(i);
+            effects_changed = true;
+        }
+        let mut added = None;
+        egui::ComboBox::from_label("Add effect")
+            .selected_text("choose…")
+            .show_ui(ui, |ui| {
+                for (label, kind) in ADDABLE {
+                    if !kind.present(&effects) && ui.selectable_label(false, label).clicked() {
+                        added = Some(kind);
+                    }
                 }
             });
-            let (p, e) = effect_controls(ui, effect, &mut params, edge);
-            params_changed |= p;
-            effects_changed |= e;
-        });
+        if let Some(kind) = added {
+            effects.push(kind.create(ctx.sim));
+            effects_changed = true;
+        }
+        if params_changed {
+            ctx.ask(Action::ApplyParams(params));
+        }
+        if effects_changed {
+            ctx.ask(Action::ApplyEffects(effects));
+        }
+        ui.separator();
     }
-    if let Some(i) = remove {
-        effects.remove(i);
-        effects_changed = true;
-    }
-    let mut added = None;
-    egui::ComboBox::from_label("Add effect")
-        .selected_text("choose…")
-        .show_ui(ui, |ui| {
-            for (label, kind) in ADDABLE {
-                if !kind.present(&effects) && ui.selectable_label(false, label).clicked() {
-                    added = Some(kind);
-                }
-            }
-        });
-    if let Some(kind) = added {
-        effects.push(kind.create(&app.sim));
-        effects_changed = true;
-    }
-    if params_changed {
-        app.apply_params(params);
-    }
-    if effects_changed {
-        app.apply_effects(effects);
-    }
-    ui.separator();
 }
 
 fn title(effect: &Effect) -> &'static str {
@@ -199,7 +206,7 @@ fn effect_controls(
             }
             match model {
                 BendingModel::Springs => {
-                    p |= super::controls::spring_sliders(ui, params, SpringKind::Bend, "");
+                    p |= spring_sliders(ui, params, SpringKind::Bend, "");
                 }
                 BendingModel::Dihedral { stiffness } => {
                     e |= ui

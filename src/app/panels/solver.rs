@@ -1,0 +1,82 @@
+//! The Solver section: backend, integrator, time step, substeps.
+
+use egui::RichText;
+
+use crate::gpu::Backend;
+use crate::sim::IntegratorKind;
+
+use super::super::panel::{Action, Panel, PanelContext};
+
+/// The Solver section.
+#[derive(Default)]
+pub struct SolverPanel;
+
+impl Panel for SolverPanel {
+    fn ui(&mut self, ui: &mut egui::Ui, ctx: &mut PanelContext<'_>) {
+        ui.heading("Solver");
+        let in_effect = ctx.status.in_effect;
+        ui.horizontal(|ui| {
+            ui.label("Backend");
+            let on_gpu = in_effect.on_gpu();
+            if ui.selectable_label(!on_gpu, "CPU").clicked() && on_gpu {
+                ctx.ask(Action::SetBackend(Backend::Cpu));
+            }
+            if ui
+                .selectable_label(on_gpu, "GPU")
+                .on_hover_text(
+                    "wgpu compute: semi-implicit Euler, springs, gravity, air damping, pins, \
+                     spheres and planes",
+                )
+                .clicked()
+                && !on_gpu
+            {
+                ctx.ask(Action::SetBackend(Backend::Gpu));
+            }
+        });
+        let mut params = ctx.sim.params().clone();
+        let mut changed = false;
+        for kind in IntegratorKind::ALL {
+            changed |= ui
+                .radio_value(&mut params.integrator, kind, kind.label())
+                .changed();
+        }
+        egui::Grid::new("solver").num_columns(2).show(ui, |ui| {
+            let label = ui.label("Time step");
+            changed |= ui
+                .add(
+                    egui::DragValue::new(&mut params.dt)
+                        .range(1e-4..=0.1)
+                        .speed(1e-4)
+                        .suffix(" s")
+                        .max_decimals(5),
+                )
+                .labelled_by(label.id)
+                .changed();
+            ui.end_row();
+            let label = ui.label("Substeps");
+            ui.horizontal(|ui| {
+                changed |= ui
+                    .add(egui::DragValue::new(&mut params.substeps).range(1..=2000))
+                    .labelled_by(label.id)
+                    .changed();
+                if in_effect.substeps != params.substeps {
+                    ui.label(
+                        RichText::new(format!("in effect: {}", in_effect.substeps))
+                            .color(egui::Color32::from_rgb(230, 160, 40)),
+                    )
+                    .on_hover_text(
+                        "the stability guard raised the substeps after a diverging frame",
+                    );
+                }
+            });
+            ui.end_row();
+            ui.label("Substep");
+            ui.label(format!("{:.3} ms", 1e3 * in_effect.substep_length));
+            ui.end_row();
+        });
+        if changed {
+            ctx.ask(Action::ApplyParams(params));
+        }
+        ui.separator();
+    }
+}
