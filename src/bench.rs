@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use crate::gpu::GpuError;
 use crate::scene::{OneOrTwo, Scene, SceneError, Simulation, scenario};
 use crate::sim::IntegratorKind;
 
@@ -92,16 +93,26 @@ pub struct BenchRow {
     pub startup_ms: f64,
 }
 
+/// Why a bench run could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    #[error("the bench cloth needs at least 3 × 3 particles, got {0}")]
+    TooSmall(u32),
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// No device, or a scene the GPU backend cannot run.
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+}
+
 /// The bench scene at `n × n` particles for `integrator`: the built-in file with its grid
 /// and substeps changed.
 ///
 /// # Errors
-/// [`SceneError`] if `n < 3`.
-pub fn bench_scene(n: u32, integrator: IntegratorKind) -> Result<Scene, SceneError> {
+/// [`BenchError::TooSmall`] if `n < 3`.
+pub fn bench_scene(n: u32, integrator: IntegratorKind) -> Result<Scene, BenchError> {
     if n < 3 {
-        return Err(SceneError::Pins(format!(
-            "the bench cloth needs at least 3 × 3 particles, got {n}"
-        )));
+        return Err(BenchError::TooSmall(n));
     }
     let mut file = scenario(BENCH_SCENE)
         .ok_or_else(|| SceneError::UnknownScenario {
@@ -119,7 +130,7 @@ pub fn bench_scene(n: u32, integrator: IntegratorKind) -> Result<Scene, SceneErr
     }
     // Timed as it stands: nothing rolls back or refines behind the figures.
     file.solver.guard.enabled = false;
-    Scene::from_file(file, None)
+    Ok(Scene::from_file(file, None)?)
 }
 
 /// The 4 particles nearest the middle of the cloth's rest shape.
@@ -137,8 +148,8 @@ fn central(sim: &Simulation) -> Vec<usize> {
 /// rayon pool and times it.
 ///
 /// # Errors
-/// [`SceneError`] for a bad `n`.
-pub fn bench_one(n: u32, integrator: IntegratorKind) -> Result<BenchRow, SceneError> {
+/// [`BenchError`] for a bad `n`.
+pub fn bench_one(n: u32, integrator: IntegratorKind) -> Result<BenchRow, BenchError> {
     bench_with(n, integrator, |scene| Ok(Simulation::new(scene)))
 }
 
@@ -146,25 +157,23 @@ pub fn bench_one(n: u32, integrator: IntegratorKind) -> Result<BenchRow, SceneEr
 /// ([`crate::gpu::gpu_simulation`]; its state read back at the end only).
 ///
 /// # Errors
-/// [`SceneError`] for a bad `n`; [`SceneError::Backend`] with the reason when there is no
+/// [`BenchError`] for a bad `n`; [`BenchError::Gpu`] with the reason when there is no
 /// device or the GPU backend cannot run the scene.
-pub fn bench_gpu(n: u32, integrator: IntegratorKind) -> Result<BenchRow, SceneError> {
+pub fn bench_gpu(n: u32, integrator: IntegratorKind) -> Result<BenchRow, BenchError> {
     bench_with(n, integrator, |scene| {
-        crate::gpu::gpu_simulation(scene, false)
-            .map(|(sim, _)| sim)
-            .map_err(|e| SceneError::Backend(format!("{e:#}")))
+        Ok(crate::gpu::gpu_simulation(scene, false).map(|(sim, _)| sim)?)
     })
 }
 
 /// As [`bench_one`], with the simulation built by `make` (another backend).
 ///
 /// # Errors
-/// [`SceneError`] for a bad `n`, or what `make` returns.
+/// [`BenchError`] for a bad `n`, or what `make` returns.
 pub fn bench_with(
     n: u32,
     integrator: IntegratorKind,
-    make: impl FnOnce(Scene) -> Result<Simulation, SceneError>,
-) -> Result<BenchRow, SceneError> {
+    make: impl FnOnce(Scene) -> Result<Simulation, BenchError>,
+) -> Result<BenchRow, BenchError> {
     let start = Instant::now();
     let mut sim = make(bench_scene(n, integrator)?)?;
     let mut finite = sim.substep().is_ok();

@@ -64,6 +64,24 @@ fn sim_cloth_and_mesh_use_no_graphics_or_window_crate() {
     }
 }
 
+/// `anyhow` is for the binary's edges (its `main` and the command line); the library returns
+/// typed errors a caller can act on.
+#[test]
+fn only_the_command_line_uses_anyhow() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let bad: Vec<String> = offending_lines("", &["anyhow"])
+        .into_iter()
+        .filter(|line| {
+            let file = line.split(':').next().unwrap_or_default();
+            let file = Path::new(file)
+                .strip_prefix(&root)
+                .unwrap_or(Path::new(file));
+            !(file.starts_with("cli") || file == Path::new("main.rs"))
+        })
+        .collect();
+    assert!(bad.is_empty(), "{}", bad.join("\n"));
+}
+
 // ------------------------------------------------------------ import cycles between files
 
 /// Which crate a module lives in: the library, or the binary (`main.rs` and the modules it

@@ -389,3 +389,16 @@ fn a_self_collision_thicker_than_the_cloths_edges_is_refused_naming_both_lengths
     assert!(err.contains("0.2 m") && err.contains("0.0417 m"), "{err}");
     assert_eq!(sim.effects(), before);
 }
+
+/// Story: `Scene::from_file` panicked ("unreachable") on a `SceneFile` built in code with
+/// neither `obj` nor `grid`; `SceneFile::parse` refuses such a file, code could still make
+/// one. It is an error naming the scene now.
+#[test]
+fn a_scene_file_built_in_code_without_a_cloth_is_an_error_not_a_panic() {
+    let mut file = clothsim::scene::scenario("hanging").unwrap().clone();
+    file.cloth.grid = None;
+    file.cloth.obj = None;
+    let err = Scene::from_file(file, None).unwrap_err();
+    assert!(matches!(err, SceneError::NoCloth { .. }), "{err:?}");
+    assert!(err.to_string().contains("`hanging` has no cloth"), "{err}");
+}

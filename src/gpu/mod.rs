@@ -31,7 +31,7 @@ pub enum Backend {
 pub fn gpu_simulation(
     scene: Scene,
     read_every_frame: bool,
-) -> anyhow::Result<(Simulation, String)> {
+) -> Result<(Simulation, String), GpuError> {
     gpu_support(&scene.params, &scene.effects)?;
     let gpu = Gpu::headless(AdapterPreference::Any)?;
     let stepper = GpuStepper::new(

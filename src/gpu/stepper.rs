@@ -36,6 +36,15 @@ pub enum GpuError {
     Unsupported(String),
     #[error("the GPU backend could not read its state back: {0}")]
     Readback(String),
+    /// No adapter or device to step on (what the device layer said).
+    #[error("no GPU device: {0}")]
+    Device(String),
+}
+
+impl From<crate::render::RenderError> for GpuError {
+    fn from(e: crate::render::RenderError) -> Self {
+        GpuError::Device(e.to_string())
+    }
 }
 
 #[repr(C)]

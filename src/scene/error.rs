@@ -1,6 +1,9 @@
 //! Errors of building a scene or changing a running simulation.
 
+use glam::Vec3;
+
 use crate::mesh::ObjError;
+use crate::sim::ParamError;
 
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
@@ -10,7 +13,7 @@ pub enum SceneError {
     UnknownScenario { name: String, available: String },
     /// A parameter set was refused; the simulation keeps the parameters it had.
     #[error("{0}; the previous parameters are kept")]
-    Params(String),
+    Params(#[from] ParamError),
     /// A scene file could not be read.
     #[error("{path}: cannot read the scene file: {detail}")]
     Read {
@@ -33,9 +36,24 @@ pub enum SceneError {
         error: crate::sim::TooThick,
     },
     /// The pins do not fit the cloth.
-    #[error("{0}")]
-    Pins(String),
-    /// The step backend cannot run the scene (or could not start).
-    #[error("{0}")]
-    Backend(String),
+    #[error(transparent)]
+    Pins(#[from] PinError),
+    /// A scene file built in code names no cloth (`cloth.obj` or `cloth.grid`).
+    #[error("the scene `{scene}` has no cloth: give `obj` or `grid` in [cloth]")]
+    NoCloth { scene: String },
+}
+
+/// Pins that do not fit the cloth.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PinError {
+    #[error("pin index {index} does not exist: the cloth has {particles} particles")]
+    NoSuchParticle { index: u32, particles: usize },
+    /// An empty region is a mistake (a typo in a bound), not a wish for no pins.
+    #[error("the pin region from {min} to {max} holds no particle: the cloth spans {lo} to {hi}")]
+    EmptyRegion {
+        min: Vec3,
+        max: Vec3,
+        lo: Vec3,
+        hi: Vec3,
+    },
 }

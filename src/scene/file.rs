@@ -468,27 +468,23 @@ impl SceneFile {
             }
         }
         // Solver and material values, checked as the simulation will check them.
-        if let Err(message) = self.params().validate() {
-            let name = message.split('`').nth(1).unwrap_or("solver").to_string();
+        if let Err(e) = self.params().validate() {
             let in_effect = |pick: fn(&EffectSpec) -> bool| self.effects.iter().position(pick);
-            let (index, key) = match name.as_str() {
+            let (index, key) = match e.name {
                 "air_damping" => (
                     in_effect(|e| matches!(e, EffectSpec::AirDamping { .. })),
-                    "rate".to_string(),
+                    "rate",
                 ),
                 "gravity" => (
                     in_effect(|e| matches!(e, EffectSpec::Gravity { .. })),
-                    "acceleration".to_string(),
+                    "acceleration",
                 ),
                 // `solver.tolerance` is `tolerance` in [solver], `guard.x` is `x` in [solver.guard].
-                other => (None, other.rsplit('.').next().unwrap_or(other).to_string()),
+                other => (None, other.rsplit('.').next().unwrap_or(other)),
             };
             // Named as the file names it.
-            let detail = message
-                .strip_prefix("parameter ")
-                .unwrap_or(&message)
-                .replacen(&format!("`{name}`"), &format!("`{key}`"), 1);
-            return Err((index, key, detail));
+            let detail = format!("`{key}` = {} {}", e.value, e.rule);
+            return Err((index, key.to_string(), detail));
         }
         Ok(())
     }

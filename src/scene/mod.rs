@@ -9,7 +9,7 @@ mod scene;
 mod simulation;
 mod summary;
 
-pub use error::SceneError;
+pub use error::{PinError, SceneError};
 pub use file::{
     BendingKind, ClothSpec, Corner, DEFAULT_DIHEDRAL_STIFFNESS, Edge, EffectSpec, GridShape,
     LoadedSceneFile, MaterialSpec, OneOrTwo, PerKind, PinSpec, Region, SceneFile, SolverSpec,

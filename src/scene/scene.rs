@@ -11,7 +11,7 @@ use crate::mesh::{
 };
 use crate::sim::{Collider, Effect, SimParams, thickness_fits};
 
-use super::error::SceneError;
+use super::error::{PinError, SceneError};
 use super::file::{Corner, Edge, LoadedSceneFile, PinSpec, SceneFile};
 use super::registry::{BUILTIN_SCENES, scenario};
 
@@ -132,7 +132,12 @@ impl Scene {
                 let name = format!("{qx}×{qy}-quad grid, {sx}×{sy} m");
                 (MeshBuild::from(mesh), name)
             }
-            (None, None) => unreachable!("SceneFile::check requires a cloth"),
+            // `SceneFile::parse` refuses this; a file built in code may still have it.
+            (None, None) => {
+                return Err(SceneError::NoCloth {
+                    scene: file.name.clone(),
+                });
+            }
         };
         Self::with_mesh(file, &cloth, &name)
     }
@@ -319,10 +324,11 @@ fn pins(
         }
     }
     if let Some(&bad) = spec.indices.iter().find(|&&i| i as usize >= pos.len()) {
-        return Err(SceneError::Pins(format!(
-            "pin index {bad} does not exist: the cloth has {} particles",
-            pos.len()
-        )));
+        return Err(PinError::NoSuchParticle {
+            index: bad,
+            particles: pos.len(),
+        }
+        .into());
     }
     out.extend_from_slice(&spec.indices);
     if let Some(r) = spec.region {
@@ -336,9 +342,7 @@ fn pins(
         );
         // An empty region is a mistake (a typo in a bound), not a wish for no pins.
         if out.len() == before {
-            return Err(SceneError::Pins(format!(
-                "the pin region from {min} to {max} holds no particle: the cloth spans {lo} to {hi}"
-            )));
+            return Err(PinError::EmptyRegion { min, max, lo, hi }.into());
         }
     }
     out.sort_unstable();

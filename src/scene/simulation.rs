@@ -271,7 +271,7 @@ impl Simulation {
     /// # Errors
     /// [`SceneError::Params`] naming the bad value; nothing changes then.
     pub fn set_params(&mut self, params: SimParams) -> Result<(), SceneError> {
-        params.validate().map_err(SceneError::Params)?;
+        params.validate()?;
         if params.density != self.params.density {
             self.before_edit();
             self.model.set_density(params.density);

@@ -1,6 +1,7 @@
 //! What the stability guard may do: its policy, plain data.
 
 use super::integrator::IntegratorKind;
+use super::param_error::ParamError;
 
 /// What the guard may do. Part of [`super::SimParams`].
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -54,31 +55,35 @@ impl GuardPolicy {
     /// Checks the policy's numbers.
     ///
     /// # Errors
-    /// A message naming the bad field.
-    pub fn validate(&self) -> Result<(), String> {
+    /// [`ParamError`] naming the bad field.
+    pub fn validate(&self) -> Result<(), ParamError> {
         if let Some(v) = self.max_speed
             && !(v.is_finite() && v > 0.0)
         {
-            return Err(format!("parameter `guard.max_speed` = {v} must be > 0 m/s"));
+            return Err(ParamError::new("guard.max_speed", v, "must be > 0 m/s"));
         }
         for (name, v) in [
             ("guard.max_strain", self.max_strain),
             ("guard.headroom", self.headroom),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("parameter `{name}` = {v} must be > 0"));
+                return Err(ParamError::new(name, v, "must be > 0"));
             }
         }
         if self.max_refinements > 10 {
-            return Err(format!(
-                "parameter `guard.max_refinements` = {} must be at most 10 (1024× the substeps)",
-                self.max_refinements
+            return Err(ParamError::new(
+                "guard.max_refinements",
+                self.max_refinements,
+                "must be at most 10 (1024× the substeps)",
             ));
         }
-        if self.recover_after == 0 || self.checkpoint_frames == 0 {
-            return Err(
-                "parameters `guard.recover_after` and `guard.checkpoint_frames` must be ≥ 1".into(),
-            );
+        for (name, v) in [
+            ("guard.recover_after", self.recover_after),
+            ("guard.checkpoint_frames", self.checkpoint_frames),
+        ] {
+            if v == 0 {
+                return Err(ParamError::new(name, v, "must be ≥ 1"));
+            }
         }
         Ok(())
     }

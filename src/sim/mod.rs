@@ -14,6 +14,7 @@ mod guard_policy;
 mod guard_state;
 pub mod integrator;
 pub mod kernels;
+mod param_error;
 mod params;
 mod self_collision;
 mod stats;
@@ -30,6 +31,7 @@ pub use forces::{Force, ForceSet, JacobianMode, SystemMatrix, Wind};
 pub use guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check};
 pub use guard_policy::GuardPolicy;
 pub use integrator::{Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport};
+pub use param_error::ParamError;
 pub use params::{SimParams, SolverConfig};
 pub use self_collision::{
     CELLS_PER_TRIANGLE, ContactError, SelfCollision, SelfContacts, SelfWork, TooThick,

@@ -4,6 +4,7 @@ use glam::Vec3;
 
 use super::guard_policy::GuardPolicy;
 use super::integrator::IntegratorKind;
+use super::param_error::ParamError;
 
 /// Every tunable number of the solver. Units are SI; each field says how it affects
 /// stability.
@@ -94,8 +95,8 @@ impl SimParams {
     /// Checks that every number is finite and in range.
     ///
     /// # Errors
-    /// A message naming the parameter and the allowed range.
-    pub fn validate(&self) -> Result<(), String> {
+    /// [`ParamError`] naming the parameter and the allowed range.
+    pub fn validate(&self) -> Result<(), ParamError> {
         // `(name, value, allowed, what is allowed)`; NaN and infinities are never allowed.
         let checks = [
             (
@@ -121,8 +122,10 @@ impl SimParams {
         ];
         for (name, value, ok, allowed) in checks {
             if !(value.is_finite() && ok) {
-                return Err(format!(
-                    "parameter `{name}` = {value} is out of range ({allowed})"
+                return Err(ParamError::new(
+                    name,
+                    value,
+                    format!("is out of range ({allowed})"),
                 ));
             }
         }
@@ -131,17 +134,20 @@ impl SimParams {
             ("damping", self.damping, "N·s/m"),
         ] {
             if let Some(v) = values.into_iter().find(|v| !(v.is_finite() && *v >= 0.0)) {
-                return Err(format!(
-                    "parameter `{name}` = {v} is out of range (≥ 0 {unit})"
+                return Err(ParamError::new(
+                    name,
+                    v,
+                    format!("is out of range (≥ 0 {unit})"),
                 ));
             }
         }
         self.guard.validate()?;
         let solver = &self.solver;
         if !(solver.tolerance.is_finite() && solver.tolerance > 0.0 && solver.tolerance < 1.0) {
-            return Err(format!(
-                "parameter `solver.tolerance` = {} is out of range (0 < tolerance < 1)",
-                solver.tolerance
+            return Err(ParamError::new(
+                "solver.tolerance",
+                solver.tolerance,
+                "is out of range (0 < tolerance < 1)",
             ));
         }
         for (name, value) in [
@@ -150,19 +156,21 @@ impl SimParams {
             ("solver.xpbd_iterations", solver.xpbd_iterations),
         ] {
             if !(1..=10_000).contains(&value) {
-                return Err(format!("parameter `{name}` = {value} must be in 1..=10000"));
+                return Err(ParamError::new(name, value, "must be in 1..=10000"));
             }
         }
         if !(solver.newton_tolerance.is_finite() && solver.newton_tolerance > 0.0) {
-            return Err(format!(
-                "parameter `solver.newton_tolerance` = {} must be > 0",
-                solver.newton_tolerance
+            return Err(ParamError::new(
+                "solver.newton_tolerance",
+                solver.newton_tolerance,
+                "must be > 0",
             ));
         }
         if self.substeps == 0 || self.substeps > 100_000 {
-            return Err(format!(
-                "parameter `substeps` = {} must be in 1..=100000",
-                self.substeps
+            return Err(ParamError::new(
+                "substeps",
+                self.substeps,
+                "must be in 1..=100000",
             ));
         }
         Ok(())
@@ -195,7 +203,11 @@ mod tests {
             let mut p = SimParams::default();
             spoil(&mut p);
             let err = p.validate().expect_err(name);
-            assert!(err.contains(&format!("`{name}`")), "{name}: {err}");
+            assert_eq!(err.name, name);
+            assert!(
+                err.to_string().contains(&format!("`{name}`")),
+                "{name}: {err}"
+            );
         }
     }
 }

@@ -1,0 +1,43 @@
+//! `clothsim accuracy`: what accuracy costs in time, written as CSV, Markdown and PNG.
+
+use anyhow::{Context, Result};
+
+use clothsim::mesh;
+use clothsim::scene::Scene;
+
+/// Sweeps `scene` (with the OBJ cloth `obj`, if given) as `config` says and writes the report
+/// into `out`.
+pub fn accuracy(
+    scene: &str,
+    obj: Option<&std::path::Path>,
+    config: &clothsim::report::SweepConfig,
+    out: &std::path::Path,
+) -> Result<()> {
+    config.validate()?;
+    let scene = Scene::open_with_obj(scene, obj, &mesh::ImportOptions::default())?;
+    // Fail on an unusable output directory before a minute of work, not after it.
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("{}: cannot create the output directory", out.display()))?;
+    let bar = indicatif::ProgressBar::new(1);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} [{elapsed}]")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let report = clothsim::report::sweep(&scene, config, &mut |p| {
+        bar.set_length(p.total as u64);
+        bar.set_position(p.done as u64);
+        bar.set_message(p.what.clone());
+        true
+    })?;
+    bar.finish_and_clear();
+    let files = clothsim::report::write_report(&report, out)?;
+    println!(
+        "for a tolerance of {} of the cloth's size: {}",
+        config.tolerance,
+        clothsim::report::choice_sentence(&report)
+    );
+    for f in files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,224 @@
+//! The command line: the subcommands and the arguments they share.
+
+use std::path::PathBuf;
+
+use anyhow::{Result, bail};
+use clap::{Parser, Subcommand};
+
+use clothsim::gpu::{Backend, gpu_simulation};
+use clothsim::mesh;
+use clothsim::scene::{Scene, Simulation};
+use clothsim::sim::IntegratorKind;
+
+#[derive(Parser)]
+#[command(
+    name = "clothsim",
+    version,
+    about = "Cloth simulator and viewer",
+    args_conflicts_with_subcommands = true
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// Open the GUI with this OBJ file as the cloth (no subcommand: the GUI).
+    pub obj: Option<PathBuf>,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Topology of an OBJ cloth: particles, triangles, edges, springs by kind.
+    Info {
+        file: PathBuf,
+        /// Print one JSON object.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        import: ImportArgs,
+    },
+    /// List the built-in scenes, or check scene files and list what they hold.
+    Scenes {
+        /// Scene files (.toml) to check; none lists the built-in scenes.
+        files: Vec<PathBuf>,
+    },
+    /// Run a scene headless and print a summary.
+    Simulate {
+        #[command(flatten)]
+        run: RunArgs,
+        /// Print one JSON object.
+        #[arg(long)]
+        json: bool,
+        /// Write the cloth as it is at the end as an OBJ file.
+        #[arg(long)]
+        export_obj: Option<PathBuf>,
+    },
+    /// Render the state after --seconds to a PNG, or every K frames to a numbered sequence.
+    Render {
+        #[command(flatten)]
+        run: RunArgs,
+        /// Image size WIDTHxHEIGHT in pixels.
+        #[arg(long, default_value = "1280x720")]
+        size: String,
+        /// Comma-separated overlays: springs, strain, bend, particles, wireframe, no-mesh, no-checker.
+        #[arg(long, default_value = "")]
+        overlay: String,
+        /// Output PNG (single image).
+        #[arg(long, required_unless_present_any = ["out_dir", "gif"], conflicts_with_all = ["out_dir", "every", "gif"])]
+        out: Option<PathBuf>,
+        /// Write a frame every K simulation frames (with --out-dir or --gif).
+        #[arg(long)]
+        every: Option<u32>,
+        /// Directory for the frame sequence (frame_00000.png, …); must exist.
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
+        /// An animated GIF of the run (every K-th frame with --every).
+        #[arg(long)]
+        gif: Option<PathBuf>,
+    },
+    /// What accuracy costs in time: every integrator × step size against a reference;
+    /// writes accuracy.csv, accuracy.md and accuracy.png.
+    Accuracy {
+        /// A built-in scene (see `clothsim scenes`) or a scene file (.toml).
+        #[arg(long, default_value = "hanging")]
+        scene: String,
+        /// Use this OBJ cloth instead of the scene's own.
+        #[arg(long)]
+        obj: Option<PathBuf>,
+        /// Comma-separated integrators (default: all seven).
+        #[arg(long, value_delimiter = ',')]
+        integrators: Option<Vec<IntegratorKind>>,
+        /// Comma-separated step sizes in seconds (default: 1/60 s over 3, 6, … 384 substeps).
+        #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+        dts: Option<Vec<f64>>,
+        /// Simulated seconds of each run.
+        #[arg(long, default_value_t = 0.25, allow_negative_numbers = true)]
+        seconds: f64,
+        /// Largest acceptable max position error, as a fraction of the cloth's size.
+        #[arg(long, default_value_t = clothsim::report::DEFAULT_TOLERANCE, allow_negative_numbers = true)]
+        tolerance: f64,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Speed on the `hanging-bench` scene: µs per substep and the sag after 2 s for each
+    /// size × integrator × thread count (the scene the peer frameworks run too). µs per
+    /// substep over the whole run, in its median frame and in its fastest frame.
+    Bench {
+        /// Comma-separated particles per side.
+        #[arg(long, value_delimiter = ',', default_value = "32,64,128,256")]
+        sizes: Vec<u32>,
+        /// Comma-separated integrators [default: semi-implicit-euler,implicit-euler,xpbd;
+        /// with --backend gpu, semi-implicit-euler, the one it runs].
+        #[arg(long, value_delimiter = ',')]
+        integrators: Option<Vec<IntegratorKind>>,
+        /// Comma-separated thread counts.
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
+        /// Print one JSON object per row.
+        #[arg(long)]
+        json: bool,
+        /// cpu, or gpu (semi-implicit Euler on wgpu compute; --threads does not apply).
+        #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+        backend: Backend,
+    },
+    /// Write a rectangular grid cloth as an OBJ file (quads: diagonals become shear springs).
+    Grid {
+        /// Quads along each side.
+        #[arg(long, default_value_t = 24)]
+        quads: u32,
+        /// Side length, metres.
+        #[arg(long, default_value_t = 1.0)]
+        size: f32,
+        /// Write triangles instead of quads.
+        #[arg(long)]
+        triangles: bool,
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+/// How an OBJ cloth is imported.
+#[derive(clap::Args)]
+pub struct ImportArgs {
+    /// Weld corners closer than this fraction of the cloth's size (0: only identical ones).
+    #[arg(long, default_value_t = mesh::ImportOptions::default().weld_tolerance, allow_negative_numbers = true)]
+    pub weld_tolerance: f32,
+}
+
+impl ImportArgs {
+    /// The import options, checked.
+    pub fn options(&self) -> Result<mesh::ImportOptions> {
+        if !(self.weld_tolerance.is_finite() && (0.0..0.1).contains(&self.weld_tolerance)) {
+            bail!(
+                "--weld-tolerance must be a fraction of the cloth's size in 0..0.1, got {}",
+                self.weld_tolerance
+            );
+        }
+        Ok(mesh::ImportOptions {
+            weld_tolerance: self.weld_tolerance,
+        })
+    }
+}
+
+/// What every simulating subcommand takes.
+#[derive(clap::Args)]
+pub struct RunArgs {
+    /// A built-in scene (see `clothsim scenes`) or a scene file (.toml).
+    #[arg(long, default_value = "hanging")]
+    pub scene: String,
+    /// Use this OBJ cloth instead of the scene's own.
+    #[arg(long)]
+    pub obj: Option<PathBuf>,
+    /// Integrator: explicit-euler, semi-implicit-euler, verlet, rk2, rk4, implicit-euler, xpbd.
+    #[arg(long)]
+    pub integrator: Option<IntegratorKind>,
+    /// Simulated seconds.
+    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
+    pub seconds: f64,
+    /// Frame time step, seconds.
+    #[arg(long, allow_negative_numbers = true)]
+    pub dt: Option<f32>,
+    /// Substeps per frame.
+    #[arg(long)]
+    pub substeps: Option<u32>,
+    /// What steps the cloth: cpu (every integrator and effect) or gpu (wgpu compute:
+    /// semi-implicit Euler, springs, gravity, air damping, pins, spheres, planes).
+    #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+    pub backend: Backend,
+    #[command(flatten)]
+    pub import: ImportArgs,
+}
+
+impl RunArgs {
+    /// The simulation the arguments describe, on the backend they ask for.
+    pub fn simulation(&self) -> Result<Simulation> {
+        let mut scene =
+            Scene::open_with_obj(&self.scene, self.obj.as_deref(), &self.import.options()?)?;
+        if let Some(k) = self.integrator {
+            scene.params.integrator = k;
+        }
+        if let Some(dt) = self.dt {
+            scene.params.dt = dt;
+        }
+        if let Some(s) = self.substeps {
+            scene.params.substeps = s;
+        }
+        scene.params.validate().map_err(anyhow::Error::msg)?;
+        if !(self.seconds.is_finite() && self.seconds >= 0.0) {
+            bail!(
+                "--seconds must be a finite number ≥ 0, got {}",
+                self.seconds
+            );
+        }
+        for w in &scene.warnings {
+            eprintln!("warning: {}: {w}", scene.cloth_name);
+        }
+        match self.backend {
+            Backend::Cpu => Ok(Simulation::new(scene)),
+            Backend::Gpu => {
+                let (sim, adapter) = gpu_simulation(scene, true)?;
+                eprintln!("note: stepping on the GPU: {adapter}");
+                Ok(sim)
+            }
+        }
+    }
+}

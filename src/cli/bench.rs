@@ -1,0 +1,106 @@
+//! `clothsim bench`: the speed of the bench cloth per size, integrator and thread count.
+
+use anyhow::{Context, Result, bail};
+
+use clothsim::gpu::{Backend, GPU_INTEGRATOR};
+use clothsim::sim::IntegratorKind;
+
+/// Runs and prints one row per thread count × size × integrator (JSON with `json`).
+pub fn bench(
+    sizes: &[u32],
+    integrators: &[IntegratorKind],
+    threads: &[usize],
+    json: bool,
+    backend: Backend,
+) -> Result<()> {
+    if let Some(&n) = sizes.iter().find(|&&n| !(3..=2048).contains(&n)) {
+        bail!("--sizes: {n} particles per side is outside 3..=2048");
+    }
+    if let Some(&t) = threads.iter().find(|&&t| !(1..=256).contains(&t)) {
+        bail!("--threads: {t} is outside 1..=256");
+    }
+    if backend == Backend::Gpu
+        && let Some(k) = integrators.iter().find(|&&k| k != GPU_INTEGRATOR)
+    {
+        bail!(
+            "--backend gpu runs {} only, not {}",
+            GPU_INTEGRATOR.name(),
+            k.name()
+        );
+    }
+    if !json {
+        println!(
+            "{:>5} {:<20} {:>7} {:>9} {:>12} {:>9} {:>9} {:>12} {:>10} {:>10}  sag",
+            "N",
+            "integrator",
+            "threads",
+            "substeps",
+            "µs/substep",
+            "median fr",
+            "best fr",
+            "substeps/s",
+            "sag m",
+            "reference",
+        );
+    }
+    // The GPU rows do not depend on the CPU threads: once.
+    let threads = if backend == Backend::Gpu {
+        &threads[..threads.len().min(1)]
+    } else {
+        threads
+    };
+    for &t in threads {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .with_context(|| format!("cannot start {t} threads"))?;
+        for &n in sizes {
+            for &k in integrators {
+                let row = match backend {
+                    Backend::Cpu => pool.install(|| clothsim::bench::bench_one(n, k))?,
+                    // On this thread, not the pool's: a GL device (llvmpipe through EGL) is
+                    // current on the thread that made it, and a pool's thread still tearing
+                    // that down while the process exits corrupts the heap (a crash at exit
+                    // in a few runs in a hundred).
+                    Backend::Gpu => clothsim::bench::bench_gpu(n, k)?,
+                };
+                if json {
+                    println!("{}", serde_json::to_string(&row)?);
+                } else {
+                    let verdict = match (row.finite, row.sag_ok, row.sag_error) {
+                        (false, _, _) => "diverged".to_string(),
+                        (true, Some(ok), Some(e)) => {
+                            format!(
+                                "{:.2} % off{}",
+                                100.0 * e,
+                                if ok {
+                                    ""
+                                } else {
+                                    " (too far: the speed does not count)"
+                                }
+                            )
+                        }
+                        _ => "no reference".to_string(),
+                    };
+                    let frame = |us: Option<f64>| us.map_or("—".into(), |us| format!("{us:.1}"));
+                    println!(
+                        "{:>5} {:<20} {:>7} {:>9} {:>12.1} {:>9} {:>9} {:>12.0} {:>10.5} {:>10}  {}",
+                        row.n,
+                        row.integrator,
+                        row.threads,
+                        row.substeps_per_frame,
+                        row.us_per_substep,
+                        frame(row.median_frame_us),
+                        frame(row.best_frame_us),
+                        row.substeps_per_second,
+                        row.sag_m,
+                        row.reference_sag_m
+                            .map_or("—".into(), |r| format!("{r:.5}")),
+                        verdict
+                    );
+                }
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,95 @@
+//! Runs the command line's subcommand (or the GUI without one).
+
+use anyhow::Result;
+
+use clothsim::gpu::{Backend, GPU_INTEGRATOR};
+
+use super::accuracy::accuracy;
+use super::args::{Cli, Command};
+use super::bench::bench;
+use super::grid::grid;
+use super::info::info;
+use super::render::{Output, render};
+use super::scenes::scenes;
+use super::simulate::simulate;
+
+/// Runs what `cli` asks for.
+///
+/// # Errors
+/// Whatever the subcommand met, as one message.
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        None => clothsim::app::run(cli.obj).map_err(|e| {
+            anyhow::anyhow!(
+                "cannot open the window: {e}. Headless use: `clothsim --help` lists the subcommands"
+            )
+        }),
+        Some(Command::Info { file, json, import }) => info(&file, json, &import.options()?),
+        Some(Command::Scenes { files }) => scenes(&files),
+        Some(Command::Simulate {
+            run,
+            json,
+            export_obj,
+        }) => simulate(&run, json, export_obj.as_deref()),
+        Some(Command::Render {
+            run,
+            size,
+            overlay,
+            out,
+            every,
+            out_dir,
+            gif,
+        }) => render(
+            &run,
+            &size,
+            &overlay,
+            Output {
+                png: out.as_deref(),
+                every,
+                dir: out_dir.as_deref(),
+                gif: gif.as_deref(),
+            },
+        ),
+        Some(Command::Accuracy {
+            scene,
+            obj,
+            integrators,
+            dts,
+            seconds,
+            tolerance,
+            out,
+        }) => {
+            let mut config = clothsim::report::SweepConfig {
+                seconds,
+                tolerance,
+                ..Default::default()
+            };
+            if let Some(list) = integrators {
+                config.integrators = list;
+            }
+            if let Some(list) = dts {
+                config.dts = list;
+            }
+            accuracy(&scene, obj.as_deref(), &config, &out)
+        }
+        Some(Command::Grid {
+            quads,
+            size,
+            triangles,
+            out,
+        }) => grid(quads, size, triangles, &out),
+        Some(Command::Bench {
+            sizes,
+            integrators,
+            threads,
+            json,
+            backend,
+        }) => {
+            let integrators = integrators.unwrap_or_else(|| match backend {
+                Backend::Cpu => clothsim::bench::BENCH_INTEGRATORS.to_vec(),
+                Backend::Gpu => vec![GPU_INTEGRATOR],
+            });
+            bench(&sizes, &integrators, &threads, json, backend)
+        }
+    }
+}

@@ -1,0 +1,24 @@
+//! A parameter out of its range: which one, its value, and what it must be.
+
+/// A parameter out of its range ([`super::SimParams::validate`]).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("parameter `{name}` = {value} {rule}")]
+pub struct ParamError {
+    /// The parameter as [`super::SimParams`] names it: `dt`, `stiffness`,
+    /// `solver.tolerance`, `guard.headroom`, …
+    pub name: &'static str,
+    /// Its value, as written.
+    pub value: String,
+    /// What it must be: "is out of range (0 < dt ≤ 1 s)", "must be > 0", …
+    pub rule: String,
+}
+
+impl ParamError {
+    pub fn new(name: &'static str, value: impl std::fmt::Display, rule: impl Into<String>) -> Self {
+        Self {
+            name,
+            value: value.to_string(),
+            rule: rule.into(),
+        }
+    }
+}
