@@ -3,8 +3,9 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 
+use clothsim::device::AdapterPreference;
 use clothsim::mesh::{GridOrientation, GridSpec, MeshBuild};
-use clothsim::render::{AdapterPreference, Offscreen, RenderOptions};
+use clothsim::render::{Offscreen, RenderOptions};
 use clothsim::scene::{Scene, Simulation};
 use clothsim::view;
 

@@ -1,8 +1,8 @@
 //! The GPU backend (wgpu compute, run here on the software adapter) against the CPU solver:
 //! the same scene after the same simulated time.
 
+use clothsim::device::{AdapterPreference, HeadlessDevice};
 use clothsim::gpu::{Backend, gpu_simulation, gpu_support};
-use clothsim::render::{AdapterPreference, Gpu};
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::{Effect, IntegratorKind};
 
@@ -193,8 +193,9 @@ fn parameter_change_mid_run(read_every_frame: bool) {
 /// of the state read back afterwards, and not that of the stale copy on the CPU.
 #[test]
 fn the_gpu_cloth_is_drawn_from_its_buffer_without_a_read_back() {
+    use clothsim::device::AdapterPreference;
     use clothsim::gpu::GpuStepper;
-    use clothsim::render::{AdapterPreference, DevicePositions, Offscreen, RenderOptions};
+    use clothsim::render::{DevicePositions, Offscreen, RenderOptions};
     use clothsim::view;
 
     let mut off = Offscreen::new(160, 120, AdapterPreference::Software).expect("offscreen");
@@ -311,7 +312,7 @@ fn gpu_bench_cli_defaults_to_the_integrator_it_runs() {
 /// first is built (91.4 MiB) and the second refused (131.7 MiB).
 #[test]
 fn a_cloth_is_refused_with_its_size_exactly_where_the_device_cannot_bind_its_springs() {
-    let gpu = Gpu::headless(AdapterPreference::Any).expect("an adapter");
+    let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
     let limits = gpu.device.limits();
     let most = (limits.max_storage_buffer_binding_size).min(limits.max_buffer_size);
     drop(gpu);

@@ -64,6 +64,68 @@ fn sim_cloth_and_mesh_use_no_graphics_or_window_crate() {
     }
 }
 
+/// The renderer and the GPU backend meet only in the device layer below them: neither
+/// names the other.
+#[test]
+fn render_and_gpu_reach_each_other_only_through_the_device_layer() {
+    for (dir, other) in [("render", "gpu"), ("gpu", "render")] {
+        let words = [format!("crate::{other}"), format!("super::super::{other}")];
+        let words: Vec<&str> = words.iter().map(String::as_str).collect();
+        let bad = offending_lines(dir, &words);
+        assert!(bad.is_empty(), "{}", bad.join("\n"));
+    }
+}
+
+/// A folder's `mod.rs` (and `lib.rs`) only declares its files and re-exports what they
+/// define: code lives in a file named after what it is.
+#[test]
+fn module_files_only_declare_and_re_export() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut bad = Vec::new();
+    for (file, text) in sources("") {
+        let name = Path::new(&file).file_name().unwrap_or_default();
+        if name != "mod.rs" && Path::new(&file) != root.join("lib.rs") {
+            continue;
+        }
+        let ast = syn::parse_file(&text).unwrap_or_else(|e| panic!("{file}: {e}"));
+        for item in &ast.items {
+            let allowed = match item {
+                syn::Item::Mod(m) => m.content.is_none(),
+                syn::Item::Use(_) => true,
+                _ => false,
+            };
+            if !allowed {
+                bad.push(format!("{file}: {}", quote_item(item)));
+            }
+        }
+    }
+    assert!(bad.is_empty(), "{}", bad.join("\n"));
+}
+
+/// What kind of item `item` is, for a message.
+fn quote_item(item: &syn::Item) -> &'static str {
+    match item {
+        syn::Item::Fn(_) => "a function",
+        syn::Item::Struct(_) | syn::Item::Enum(_) | syn::Item::Union(_) => "a type",
+        syn::Item::Impl(_) => "an impl",
+        syn::Item::Mod(_) => "an inline module",
+        _ => "an item that is neither `mod` nor `use`",
+    }
+}
+
+/// No source file is longer than 800 lines, its tests included: a longer one holds more
+/// than one concept (split it, or move its tests to a sibling file).
+#[test]
+fn no_source_file_is_over_800_lines() {
+    let long: Vec<String> = sources("")
+        .into_iter()
+        .map(|(file, text)| (file, text.lines().count()))
+        .filter(|&(_, lines)| lines > 800)
+        .map(|(file, lines)| format!("{file}: {lines} lines"))
+        .collect();
+    assert!(long.is_empty(), "{}", long.join("\n"));
+}
+
 /// `anyhow` is for the binary's edges (its `main` and the command line); the library returns
 /// typed errors a caller can act on.
 #[test]

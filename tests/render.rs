@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
+use clothsim::device::AdapterPreference;
 use clothsim::render::{
-    AdapterPreference, CLEAR_COLOR, Offscreen, OrbitCamera, RenderError, RenderOptions, RgbaImage,
-    save_png,
+    CLEAR_COLOR, Offscreen, OrbitCamera, RenderError, RenderOptions, RgbaImage, save_png,
 };
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::Collider;

@@ -138,7 +138,7 @@ impl ClothApp {
                 rect: None,
                 adapter: render_state
                     .as_ref()
-                    .map(|rs| crate::render::describe_adapter(&rs.adapter)),
+                    .map(|rs| crate::device::describe_adapter(&rs.adapter)),
                 render_state,
                 viewport: None,
                 gpu_display: None,

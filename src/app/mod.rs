@@ -25,4 +25,4 @@ pub use panels::{
 };
 pub use stepping::InEffect;
 pub use transport::Transport;
-pub use window::{device_descriptor, run, with_compute_limits};
+pub use window::{run, with_compute_limits};

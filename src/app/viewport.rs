@@ -280,7 +280,8 @@ impl egui_wgpu::CallbackTrait for PaintView {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::{AdapterPreference, Gpu, RgbaImage, read_texture};
+    use crate::device::{AdapterPreference, HeadlessDevice};
+    use crate::render::{RgbaImage, read_texture};
 
     /// An image whose neighbouring texels all differ, running through every byte value.
     fn pattern(width: u32, height: u32) -> RgbaImage {
@@ -303,7 +304,7 @@ mod tests {
         canvas: (u32, u32),
         at: (f32, f32),
     ) -> RgbaImage {
-        let gpu = Gpu::headless(AdapterPreference::Software).expect("software adapter");
+        let gpu = HeadlessDevice::open(AdapterPreference::Software).expect("software adapter");
         let (device, queue) = (&gpu.device, &gpu.queue);
         let extent = |(width, height)| wgpu::Extent3d {
             width,

@@ -27,7 +27,8 @@ pub struct Output<'a> {
 
 /// Renders the run as `output` asks, `size` pixels, with `overlay`s.
 pub fn render(args: &RunArgs, size: &str, overlay: &str, output: Output<'_>) -> Result<()> {
-    use clothsim::render::{AdapterPreference, GifWriter, Offscreen, RenderOptions, save_png};
+    use clothsim::device::AdapterPreference;
+    use clothsim::render::{GifWriter, Offscreen, RenderOptions, save_png};
     let (width, height) = parse_size(size)?;
     let options = RenderOptions::default()
         .with_overlays(overlay)

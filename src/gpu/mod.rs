@@ -1,47 +1,18 @@
 //! The GPU step backend: semi-implicit Euler for the mass-spring cloth in a wgpu compute
 //! shader. It sits beside the CPU solver (which knows nothing of graphics) and plugs into
-//! [`crate::scene::Simulation`] through the same [`crate::sim::StepBackend`] seam.
+//! [`crate::scene::Simulation`] through the same [`crate::sim::StepBackend`] seam. What it
+//! runs (`support`), how it lays the cloth out (`packing`), its kernel (`kernel`) and the
+//! stepper that drives them (`stepper`) are files of their own; it reaches the device
+//! through [`crate::device`] only.
 
+mod backend;
+mod error;
+mod kernel;
+mod packing;
 mod stepper;
+mod support;
 
-pub use stepper::{GPU_INTEGRATOR, GpuError, GpuStepper, gpu_support};
-
-use crate::render::{AdapterPreference, Gpu, describe_adapter};
-use crate::scene::{Scene, Simulation};
-
-/// Which backend steps a simulation.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Backend {
-    /// The CPU solver: every integrator and effect, with the stability guard.
-    #[default]
-    Cpu,
-    /// wgpu compute: semi-implicit Euler, springs, gravity, air damping, pins, spheres and
-    /// planes.
-    Gpu,
-}
-
-/// A simulation of `scene` on its own headless GPU device (the first adapter the system
-/// offers, a software one if that is all there is). With `read_every_frame`, the
-/// simulation's state is current after every frame; without, after
-/// [`Simulation::sync_state`]. Returns the simulation and the adapter's description.
-///
-/// # Errors
-/// No adapter or device, or a scene the GPU backend cannot run (said in the message).
-pub fn gpu_simulation(
-    scene: Scene,
-    read_every_frame: bool,
-) -> Result<(Simulation, String), GpuError> {
-    gpu_support(&scene.params, &scene.effects)?;
-    let gpu = Gpu::headless(AdapterPreference::Any)?;
-    let stepper = GpuStepper::new(
-        &gpu.device,
-        &gpu.queue,
-        &scene.model,
-        &scene.params,
-        &scene.effects,
-        read_every_frame,
-    )?;
-    let adapter = describe_adapter(&gpu.adapter);
-    Ok((Simulation::with_backend(scene, Box::new(stepper)), adapter))
-}
+pub use backend::{Backend, gpu_simulation};
+pub use error::GpuError;
+pub use stepper::GpuStepper;
+pub use support::{GPU_INTEGRATOR, gpu_support};

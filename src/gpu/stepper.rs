@@ -6,21 +6,24 @@
 
 use std::time::Instant;
 
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Zeroable;
 use glam::Vec3;
 
 use crate::cloth::{ClothModel, ClothState};
-use crate::mesh::SpringKind;
-use crate::render::map_read;
+use crate::device::map_read;
 use crate::sim::{
-    BendingModel, Cause, Collider, Diverged, Effect, FrameOutcome, IntegratorKind, PhaseTimings,
-    SimParams, StepBackend, StepError, StepReport, StepStats, colliders_of,
+    Cause, Collider, Diverged, Effect, FrameOutcome, IntegratorKind, PhaseTimings, SimParams,
+    StepBackend, StepError, StepReport, StepStats, colliders_of,
 };
 
-/// Particles per workgroup (the shader's `@workgroup_size`).
-const WORKGROUP: u32 = 64;
-/// Colliders the shader has room for.
-const MAX_COLLIDERS: usize = 4;
+use super::error::GpuError;
+use super::kernel::{Bindings, SubstepKernel, WORKGROUP};
+use super::packing::{
+    ClassTable, EndsKey, GpuCollider, MAX_COLLIDERS, Neighbour, Params, Particle, classify,
+    pack_springs,
+};
+use super::support::{GPU_INTEGRATOR, check_device, fits_buffers, gpu_support};
+
 /// What one GPU substep is: one force evaluation, no solve.
 const SUBSTEP: StepReport = StepReport {
     force_evals: 1,
@@ -28,199 +31,6 @@ const SUBSTEP: StepReport = StepReport {
     residual: None,
     converged: true,
 };
-
-/// Why the GPU backend cannot run a scene.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum GpuError {
-    #[error("the GPU backend {0}")]
-    Unsupported(String),
-    #[error("the GPU backend could not read its state back: {0}")]
-    Readback(String),
-    /// No adapter or device to step on (what the device layer said).
-    #[error("no GPU device: {0}")]
-    Device(String),
-}
-
-impl From<crate::render::RenderError> for GpuError {
-    fn from(e: crate::render::RenderError) -> Self {
-        GpuError::Device(e.to_string())
-    }
-}
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct Particle {
-    x: [f32; 4],
-    v: [f32; 4],
-}
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct Neighbour {
-    /// The other end's index in the high bits, its strength class (an index into the
-    /// class table) in the low [`CLASS_BITS`] (see [`end_bits`]).
-    other: u32,
-    rest: f32,
-}
-
-/// Low bits of [`Neighbour::other`] that hold the strength class; the other end's index
-/// takes the 28 above, so a cloth has at most 2²⁸ particles on the GPU backend. The shader
-/// is given this and [`MAX_CLASSES`] as constants.
-const CLASS_BITS: u32 = 4;
-/// Strength classes (distinct stiffness–damping pairs) the shader's table holds: a cloth
-/// has at most one per spring kind (3), which leaves room for strengths set otherwise.
-const MAX_CLASSES: usize = 1 << CLASS_BITS;
-/// Particles a cloth may have on the GPU backend.
-const MAX_PARTICLES: u64 = 1 << (32 - CLASS_BITS);
-
-/// A spring end's [`Neighbour::other`]: the index shifted up, the class below it. The class
-/// sits low so that a shader that decodes either half wrongly reads another particle or
-/// another class for every end (with the index low, a dropped mask would be hidden by
-/// 32-bit address arithmetic that wraps the class bits away).
-fn end_bits(other: u32, class: u8) -> u32 {
-    (other << CLASS_BITS) | u32::from(class)
-}
-
-/// Per strength class `[stiffness, damping, 0, 0]`: the shader's uniform `classes`.
-type ClassTable = [[f32; 4]; MAX_CLASSES];
-
-/// What decides the spring ends' bits besides the model: whether each spring term (the
-/// structural and shear springs; the bend springs, the model's last) is sent, and each
-/// spring kind's class. A spring's stiffness and damping are its kind's, so the classes
-/// are the distinct pairs among the kinds, and a strength change is known to keep the ends
-/// as they are from three numbers, without a pass over the springs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct EndsKey {
-    terms: [bool; 2],
-    of_kind: [u8; SpringKind::ALL.len()],
-}
-
-/// The class of a spring the shader does not get.
-const NO_CLASS: u8 = u8::MAX;
-const _: () = assert!(
-    SpringKind::ALL.len() <= MAX_CLASSES,
-    "every kind can have a class of its own"
-);
-
-impl EndsKey {
-    /// The class of spring `e` of `model`, or [`NO_CLASS`] if its term is not sent.
-    fn class_of(&self, model: &ClothModel, e: usize) -> u8 {
-        if self.terms[usize::from(e >= model.bend_start())] {
-            self.of_kind[model.springs.kind[e].index()]
-        } else {
-            NO_CLASS
-        }
-    }
-}
-
-/// Sorts the spring kinds into classes of equal stiffness and damping, numbered in kind
-/// order, for the spring terms `effects` turn on: the ends' key and the class table.
-fn classify(params: &SimParams, effects: &[Effect]) -> (EndsKey, ClassTable) {
-    let terms = [
-        effects.contains(&Effect::Springs),
-        effects.contains(&Effect::Bending(BendingModel::Springs)),
-    ];
-    let mut table: ClassTable = [[0.0; 4]; MAX_CLASSES];
-    let mut classes = 0;
-    let mut of_kind = [NO_CLASS; SpringKind::ALL.len()];
-    for kind in SpringKind::ALL.map(SpringKind::index) {
-        let entry = [params.stiffness[kind], params.damping[kind], 0.0, 0.0];
-        let same = |t: &[f32; 4]| t.map(f32::to_bits) == entry.map(f32::to_bits);
-        let class = match table[..classes].iter().position(same) {
-            Some(at) => at,
-            None => {
-                table[classes] = entry;
-                classes += 1;
-                classes - 1
-            }
-        };
-        of_kind[kind] = class as u8;
-    }
-    (EndsKey { terms, of_kind }, table)
-}
-
-/// The springs as the shader reads them: per particle its range of `ends` (CSR offsets),
-/// each end its other particle and class.
-struct PackedSprings {
-    offsets: Vec<u32>,
-    ends: Vec<Neighbour>,
-}
-
-/// Packs the model's adjacency: each end of a spring that `key` gives a class, with the
-/// class.
-fn pack_springs(model: &ClothModel, key: &EndsKey) -> PackedSprings {
-    let adj = &model.adjacency;
-    let count = model.particle_count();
-    let mut offsets = Vec::with_capacity(count + 1);
-    let mut ends = Vec::with_capacity(adj.spring.len());
-    offsets.push(0u32);
-    for p in 0..count {
-        for slot in adj.range(p) {
-            let (e, other) = (adj.spring[slot] as usize, adj.other[slot]);
-            let class = key.class_of(model, e);
-            if class != NO_CLASS && other as usize != p {
-                ends.push(Neighbour {
-                    other: end_bits(other, class),
-                    rest: model.springs.rest[e],
-                });
-            }
-        }
-        offsets.push(ends.len() as u32);
-    }
-    PackedSprings { offsets, ends }
-}
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct GpuCollider {
-    info: [f32; 4],
-    a: [f32; 4],
-    b: [f32; 4],
-}
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct Params {
-    gravity: [f32; 4],
-    drag: [f32; 4],
-    counts: [u32; 4],
-    colliders: [GpuCollider; MAX_COLLIDERS],
-}
-
-/// The one integrator the GPU backend runs.
-pub const GPU_INTEGRATOR: IntegratorKind = IntegratorKind::SemiImplicitEuler;
-
-/// What of `params` and `effects` the GPU backend cannot run, if anything: it runs
-/// semi-implicit Euler with gravity, springs (and bend springs), air damping, pins and up
-/// to four sphere and plane colliders.
-pub fn gpu_support(params: &SimParams, effects: &[Effect]) -> Result<(), GpuError> {
-    if params.integrator != GPU_INTEGRATOR {
-        return Err(GpuError::Unsupported(format!(
-            "runs {} only, not {}",
-            GPU_INTEGRATOR.label(),
-            params.integrator.label()
-        )));
-    }
-    for e in effects {
-        let missing = match e {
-            Effect::Wind(_) => Some("wind"),
-            Effect::SelfCollision(_) => Some("self-collision"),
-            Effect::Bending(BendingModel::Dihedral { .. }) => Some("dihedral bending"),
-            _ => None,
-        };
-        if let Some(what) = missing {
-            return Err(GpuError::Unsupported(format!(
-                "has no {what}; run this scene on the CPU backend"
-            )));
-        }
-    }
-    if colliders_of(effects).len() > MAX_COLLIDERS {
-        return Err(GpuError::Unsupported(format!(
-            "takes at most {MAX_COLLIDERS} colliders"
-        )));
-    }
-    Ok(())
-}
 
 /// Steps a cloth with semi-implicit Euler on a wgpu device (see the module documentation).
 pub struct GpuStepper {
@@ -263,35 +73,6 @@ pub struct GpuStepper {
     ends_sent: u32,
 }
 
-/// Whether the stepper's largest storage buffers (the particles' state, and a record per
-/// spring end) fit what one binding and one buffer of a device with `limits` may hold: a
-/// cloth too big for the device is refused with the sizes, not left to a validation panic.
-fn fits_buffers(limits: &wgpu::Limits, particles: u64, spring_ends: u64) -> Result<(), GpuError> {
-    let most = limits
-        .max_storage_buffer_binding_size
-        .min(limits.max_buffer_size);
-    if particles > MAX_PARTICLES {
-        return Err(GpuError::Unsupported(format!(
-            "takes at most {MAX_PARTICLES} particles, not {particles}"
-        )));
-    }
-    let need = [
-        (particles * size_of::<Particle>() as u64, "particles' state"),
-        (spring_ends * size_of::<Neighbour>() as u64, "spring ends"),
-    ];
-    let mib = |bytes: u64| bytes as f64 / (1u64 << 20) as f64;
-    match need.into_iter().find(|&(bytes, _)| bytes > most) {
-        Some((bytes, what)) => Err(GpuError::Unsupported(format!(
-            "needs {:.1} MiB ({bytes} bytes) in one storage buffer for this cloth's {what} \
-             ({particles} particles, {spring_ends} spring ends); this device binds at most \
-             {:.1} MiB ({most} bytes)",
-            mib(bytes),
-            mib(most)
-        ))),
-        None => Ok(()),
-    }
-}
-
 impl GpuStepper {
     /// A stepper on `device` for `model` with `params` and `effects`. With
     /// `read_every_frame`, [`StepBackend::frame`] leaves the new state in the caller's
@@ -310,83 +91,11 @@ impl GpuStepper {
     ) -> Result<Self, GpuError> {
         gpu_support(params, effects)?;
         let limits = device.limits();
-        let storage = limits.max_storage_buffers_per_shader_stage;
-        if storage < 4 {
-            return Err(GpuError::Unsupported(format!(
-                "needs 4 storage buffers in a compute shader; this device offers {storage}"
-            )));
-        }
         let count = model.particle_count() as u32;
-        let groups = limits.max_compute_workgroups_per_dimension as u64 * WORKGROUP as u64;
-        if limits.max_compute_workgroup_size_x < WORKGROUP
-            || limits.max_compute_invocations_per_workgroup < WORKGROUP
-            || (count as u64) > groups
-        {
-            return Err(GpuError::Unsupported(format!(
-                "needs compute workgroups of {WORKGROUP} for {count} particles, which this \
-                 device does not offer"
-            )));
-        }
+        check_device(&limits, count)?;
         let spring_ends = model.springs.len() as u64 * 2;
         fits_buffers(&limits, count as u64, spring_ends)?;
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("cloth substep"),
-            source: wgpu::ShaderSource::Wgsl(
-                format!(
-                    "const CLASS_BITS: u32 = {CLASS_BITS}u;\n\
-                     const CLASSES: u32 = {MAX_CLASSES}u;\n{}",
-                    include_str!("cloth.wgsl")
-                )
-                .into(),
-            ),
-        });
-        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let uniform_entry = wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("cloth substep"),
-            entries: &[
-                uniform_entry,
-                storage(1, true),
-                storage(2, false),
-                storage(3, true),
-                storage(4, true),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    ..uniform_entry
-                },
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("cloth substep"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("cloth substep"),
-            layout: Some(&pipeline_layout),
-            module: &shader,
-            entry_point: Some("substep"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let kernel = SubstepKernel::new(device);
         let bytes = (count.max(1) as u64) * std::mem::size_of::<Particle>() as u64;
         let particle_buffer = |label| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -433,42 +142,23 @@ impl GpuStepper {
             wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         );
         let group = |from: usize| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("cloth substep"),
-                layout: &layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: uniform.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: particles[from].as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: particles[1 - from].as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: offsets.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 4,
-                        resource: neighbours.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 5,
-                        resource: classes.as_entire_binding(),
-                    },
-                ],
-            })
+            kernel.bind(
+                device,
+                &Bindings {
+                    params: &uniform,
+                    src: &particles[from],
+                    dst: &particles[1 - from],
+                    offsets: &offsets,
+                    neighbours: &neighbours,
+                    classes: &classes,
+                },
+            )
         };
         let groups = [group(0), group(1)];
         let mut stepper = Self {
             device: device.clone(),
             queue: queue.clone(),
-            pipeline,
+            pipeline: kernel.pipeline,
             uniform,
             particles,
             offsets,
@@ -803,45 +493,7 @@ impl StepBackend for GpuStepper {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// llvmpipe's 128 MiB binding holds a 1 000 × 1 000 bench cloth's spring ends (8 bytes
-    /// each, 91.4 MiB); a 1 200 × 1 200 one's do not fit and are refused with both sizes;
-    /// the most that fits does.
-    #[test]
-    fn a_cloth_bigger_than_the_devices_buffers_is_refused_with_the_sizes() {
-        let limits = wgpu::Limits {
-            max_storage_buffer_binding_size: 128 << 20,
-            max_buffer_size: 256 << 20,
-            ..wgpu::Limits::default()
-        };
-        assert!(fits_buffers(&limits, 1_000_000, 11_980_004).is_ok());
-        let (particles, ends) = (1_440_000, 17_256_004);
-        let err = fits_buffers(&limits, particles, ends).expect_err("too big");
-        let text = err.to_string();
-        assert!(
-            text.contains("131.7 MiB") && text.contains("128.0 MiB") && text.contains("spring"),
-            "{text}"
-        );
-        let most = (128u64 << 20) / size_of::<Neighbour>() as u64;
-        assert!(fits_buffers(&limits, particles, most).is_ok());
-        assert!(fits_buffers(&limits, particles, most + 1).is_err());
-        // The smaller of the two limits counts.
-        let small_buffers = wgpu::Limits {
-            max_buffer_size: 64 << 20,
-            ..limits
-        };
-        assert!(fits_buffers(&small_buffers, particles, most).is_err());
-        assert!(fits_buffers(&small_buffers, 3 << 20, 0).is_err());
-        // An index needs its 28 bits, whatever the buffers hold.
-        let huge = wgpu::Limits {
-            max_storage_buffer_binding_size: u64::MAX,
-            max_buffer_size: u64::MAX,
-            ..limits
-        };
-        assert!(fits_buffers(&huge, MAX_PARTICLES, 0).is_ok());
-        let err = fits_buffers(&huge, MAX_PARTICLES + 1, 0).expect_err("too many");
-        assert!(err.to_string().contains("268435456 particles"), "{err}");
-    }
+    use crate::gpu::packing::{CLASS_BITS, MAX_CLASSES};
 
     /// `effects` without bending.
     fn unbent(effects: &[Effect]) -> Vec<Effect> {
@@ -895,8 +547,8 @@ mod tests {
     /// one that splits or merges classes sends the ends again, once.
     #[test]
     fn the_spring_ends_are_sent_again_only_when_their_classes_change() {
-        use crate::render::{AdapterPreference, Gpu};
-        let gpu = Gpu::headless(AdapterPreference::Any).expect("an adapter");
+        use crate::device::{AdapterPreference, HeadlessDevice};
+        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
         // The bench scene: one stiffness and damping for every kind of spring.
         let scene = crate::scene::Scene::builtin("hanging-bench").expect("scene");
         let (model, effects) = (&scene.model, &scene.effects);

@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use crate::device::map_read;
 use crate::output::write_atomically;
 
 use super::error::RenderError;
@@ -26,24 +27,6 @@ pub fn strip_row_padding(data: &[u8], width: u32, height: u32, padded_row: u32) 
 pub fn padded_bytes_per_row(width: u32) -> u32 {
     let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     (width * 4).div_ceil(align) * align
-}
-
-/// Maps `slice` of a `MAP_READ` buffer for reading and waits until it is (after the
-/// commands that fill it were submitted).
-///
-/// # Errors
-/// [`RenderError::Readback`] when the device fails or the mapping is refused.
-pub fn map_read(device: &wgpu::Device, slice: &wgpu::BufferSlice<'_>) -> Result<(), RenderError> {
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
-    rx.recv()
-        .map_err(|e| RenderError::Readback(e.to_string()))?
-        .map_err(|e| RenderError::Readback(e.to_string()))
 }
 
 /// Copies the target's resolved colour texture to memory (blocks until the GPU is done).

@@ -6,8 +6,8 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use super::buffer::GrowBuffer;
 use super::frame::{DevicePositions, Frame};
+use crate::device::GrowBuffer;
 
 const SOURCE: &str = include_str!("../../shaders/display.wgsl");
 /// Invocations per workgroup (the shader's `@workgroup_size`).

@@ -2,17 +2,13 @@
 
 use std::path::PathBuf;
 
+use crate::device::DeviceError;
+
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
-    /// No graphics adapter at all.
-    #[error(
-        "no graphics adapter found ({detail}). On Linux without a GPU install Mesa's software \
-         rasteriser (Debian: `apt-get install libegl1 libgl1-mesa-dri`), or pick a backend with \
-         WGPU_BACKEND=vulkan|gl"
-    )]
-    NoAdapter { detail: String },
-    #[error("the graphics device could not be created: {0}")]
-    Device(String),
+    /// The device layer failed: no adapter, no device, a failed read-back.
+    #[error(transparent)]
+    Device(#[from] DeviceError),
     #[error("reading the rendered image back failed: {0}")]
     Readback(String),
     /// The directory of an output file does not exist.

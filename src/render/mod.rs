@@ -1,10 +1,8 @@
 //! Rendering with wgpu. Everything is drawn into an offscreen [`RenderTarget`]; the GUI shows
 //! its texture, capture reads it back, golden tests compare it.
 
-mod buffer;
 mod camera;
 mod capture;
-mod device;
 mod display;
 mod error;
 mod frame;
@@ -18,10 +16,8 @@ mod target;
 
 pub use camera::OrbitCamera;
 pub use capture::{
-    RgbaImage, map_read, padded_bytes_per_row, read_target, read_texture, save_png,
-    strip_row_padding,
+    RgbaImage, padded_bytes_per_row, read_target, read_texture, save_png, strip_row_padding,
 };
-pub use device::{AdapterPreference, Gpu, describe_adapter};
 pub use error::RenderError;
 pub use frame::{DevicePositions, Frame, Shape, SpringLines};
 pub use gif::GifWriter;

@@ -2,15 +2,15 @@
 
 use super::camera::OrbitCamera;
 use super::capture::{RgbaImage, read_target};
-use super::device::{AdapterPreference, Gpu};
 use super::error::RenderError;
 use super::frame::Frame;
 use super::options::RenderOptions;
 use super::renderer::Renderer;
 use super::target::{RenderTarget, supported_sample_count};
+use crate::device::{AdapterPreference, HeadlessDevice};
 
 pub struct Offscreen {
-    pub gpu: Gpu,
+    pub gpu: HeadlessDevice,
     pub renderer: Renderer,
     pub target: RenderTarget,
 }
@@ -25,7 +25,7 @@ impl Offscreen {
         height: u32,
         preference: AdapterPreference,
     ) -> Result<Self, RenderError> {
-        let gpu = Gpu::headless(preference)?;
+        let gpu = HeadlessDevice::open(preference)?;
         let samples = supported_sample_count(&gpu.adapter);
         let target = RenderTarget::new(&gpu.device, width, height, samples)?;
         let renderer = Renderer::new(&gpu.device, samples);

@@ -7,7 +7,6 @@ use wgpu::util::DeviceExt;
 
 use crate::mesh::{SpringKind, vertex_normals};
 
-use super::buffer::GrowBuffer;
 use super::camera::OrbitCamera;
 use super::display::{DisplayPass, LineSpec, Outputs, PARTICLE_COLOR, PINNED_COLOR};
 use super::frame::{Frame, Shape};
@@ -17,6 +16,7 @@ use super::geometry::{
 use super::options::{RenderOptions, SpringColoring};
 use super::pipelines::Pipelines;
 use super::target::RenderTarget;
+use crate::device::GrowBuffer;
 
 /// Background, sRGB-encoded (it is written to the target as is): linear (0.10, 0.11, 0.13).
 pub const CLEAR_COLOR: wgpu::Color = wgpu::Color {
@@ -495,13 +495,12 @@ mod tests {
     use glam::Vec2;
 
     use super::*;
+    use crate::device::{AdapterPreference, HeadlessDevice, map_read};
     use crate::mesh::{GridOrientation, GridSpec};
-    use crate::render::{
-        AdapterPreference, DevicePositions, Gpu, RgbaImage, SpringLines, map_read, read_target,
-    };
+    use crate::render::{DevicePositions, RgbaImage, SpringLines, read_target};
 
     /// The first `floats` floats of `buffer`, read back.
-    fn read_floats(gpu: &Gpu, buffer: &GrowBuffer, floats: usize) -> Vec<f32> {
+    fn read_floats(gpu: &HeadlessDevice, buffer: &GrowBuffer, floats: usize) -> Vec<f32> {
         let bytes = (floats * 4) as u64;
         let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("test readback"),
@@ -525,7 +524,7 @@ mod tests {
         image: RgbaImage,
     }
 
-    fn draw(gpu: &Gpu, renderer: &mut Renderer, frame: &Frame<'_>) -> Drawn {
+    fn draw(gpu: &HeadlessDevice, renderer: &mut Renderer, frame: &Frame<'_>) -> Drawn {
         let options = RenderOptions {
             wireframe: true,
             springs: true,
@@ -559,7 +558,7 @@ mod tests {
     /// same positions; and after its triangles change, and from another buffer, still does.
     #[test]
     fn drawing_from_device_positions_matches_drawing_from_the_cpu() {
-        let gpu = Gpu::headless(AdapterPreference::Software).expect("software adapter");
+        let gpu = HeadlessDevice::open(AdapterPreference::Software).expect("software adapter");
         let mesh = GridSpec::square(8, 1.0, GridOrientation::Vertical, Vec3::ZERO)
             .build()
             .expect("grid");

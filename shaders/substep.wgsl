@@ -3,7 +3,12 @@
 // add gravity and air damping, step the velocity then the position, then resolve the
 // sphere and plane colliders against the path of the substep, with friction.
 // Reads `src`, writes `dst`; the host swaps them every substep (ping-pong).
-// The host prepends `CLASS_BITS` and `CLASSES` (src/gpu/stepper.rs's constants).
+// The constants below are the host's (src/gpu/packing.rs; a test compares them).
+
+// Low bits of a spring end's `other` that hold its strength class.
+const CLASS_BITS: u32 = 4u;
+// Strength classes the table holds: 1 << CLASS_BITS.
+const CLASSES: u32 = 16u;
 
 struct Particle {
     // xyz: position (m); w: inverse mass (1/kg), 0 for a pinned particle.

@@ -1,9 +1,10 @@
 //! Headless adapter and device selection.
 
-use super::error::RenderError;
+use super::error::DeviceError;
+use super::limits::compute_limits;
 
 /// A wgpu instance, adapter, device and queue made without any window.
-pub struct Gpu {
+pub struct HeadlessDevice {
     pub instance: wgpu::Instance,
     pub adapter: wgpu::Adapter,
     pub device: wgpu::Device,
@@ -19,7 +20,7 @@ pub enum AdapterPreference {
     Any,
 }
 
-impl Gpu {
+impl HeadlessDevice {
     /// Creates a device without a display handle. The backend can be pinned with the
     /// `WGPU_BACKEND` environment variable; unpinned, [`AdapterPreference::Software`] tries
     /// the GL backend first and takes it only if it is a software rasteriser (Mesa's
@@ -27,8 +28,8 @@ impl Gpu {
     /// lost the device on the first render target (seen on an H100).
     ///
     /// # Errors
-    /// [`RenderError::NoAdapter`] with what was tried, or [`RenderError::Device`].
-    pub fn headless(preference: AdapterPreference) -> Result<Gpu, RenderError> {
+    /// [`DeviceError::NoAdapter`] with what was tried, or [`DeviceError::Open`].
+    pub fn open(preference: AdapterPreference) -> Result<HeadlessDevice, DeviceError> {
         let from_env = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
         let pinned = std::env::var_os("WGPU_BACKEND").is_some();
         // (instance, whether only a software adapter will do)
@@ -53,11 +54,11 @@ impl Gpu {
                         describe_adapter(&adapter)
                     ));
                 }
-                Ok(adapter) => return Self::open(instance, adapter),
+                Ok(adapter) => return Self::with_adapter(instance, adapter),
                 Err(e) => failures.push(format!("{backends:?}: {e}")),
             }
         }
-        Err(RenderError::NoAdapter {
+        Err(DeviceError::NoAdapter {
             detail: failures.join("; "),
         })
     }
@@ -79,20 +80,18 @@ impl Gpu {
         }
     }
 
-    fn open(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu, RenderError> {
-        // Large cloths on the GPU backend need storage buffers as large as the adapter has.
-        let available = adapter.limits();
-        let mut limits = wgpu::Limits::downlevel_defaults().using_resolution(available.clone());
-        limits.max_storage_buffer_binding_size = available.max_storage_buffer_binding_size;
-        limits.max_buffer_size = available.max_buffer_size;
+    fn with_adapter(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+    ) -> Result<HeadlessDevice, DeviceError> {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("clothsim device"),
             required_features: wgpu::Features::empty(),
-            required_limits: limits,
+            required_limits: compute_limits(&adapter),
             ..Default::default()
         }))
-        .map_err(|e| RenderError::Device(e.to_string()))?;
-        Ok(Gpu {
+        .map_err(|e| DeviceError::Open(e.to_string()))?;
+        Ok(HeadlessDevice {
             instance,
             adapter,
             device,

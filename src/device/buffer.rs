@@ -2,6 +2,7 @@
 
 use wgpu::util::DeviceExt;
 
+/// A device buffer written in place, grown (reallocated) only when the data outgrow it.
 pub struct GrowBuffer {
     label: &'static str,
     usage: wgpu::BufferUsages,
@@ -79,11 +80,11 @@ impl GrowBuffer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::{AdapterPreference, Gpu};
+    use crate::device::{AdapterPreference, HeadlessDevice};
 
     #[test]
     fn reallocates_only_to_grow() {
-        let gpu = Gpu::headless(AdapterPreference::Software).expect("software adapter");
+        let gpu = HeadlessDevice::open(AdapterPreference::Software).expect("software adapter");
         let (device, queue) = (&gpu.device, &gpu.queue);
         let mut buffer = GrowBuffer::new(device, "test", wgpu::BufferUsages::VERTEX, 1024);
         assert!(

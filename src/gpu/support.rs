@@ -1,0 +1,143 @@
+//! What the GPU backend runs, and whether a device can hold a cloth.
+
+use crate::sim::{BendingModel, Effect, IntegratorKind, SimParams, colliders_of};
+
+use super::error::GpuError;
+use super::kernel::WORKGROUP;
+use super::packing::{MAX_COLLIDERS, MAX_PARTICLES, Neighbour, Particle};
+
+/// The one integrator the GPU backend runs.
+pub const GPU_INTEGRATOR: IntegratorKind = IntegratorKind::SemiImplicitEuler;
+
+/// What of `params` and `effects` the GPU backend cannot run, if anything: it runs
+/// semi-implicit Euler with gravity, springs (and bend springs), air damping, pins and up
+/// to four sphere and plane colliders.
+pub fn gpu_support(params: &SimParams, effects: &[Effect]) -> Result<(), GpuError> {
+    if params.integrator != GPU_INTEGRATOR {
+        return Err(GpuError::Unsupported(format!(
+            "runs {} only, not {}",
+            GPU_INTEGRATOR.label(),
+            params.integrator.label()
+        )));
+    }
+    for e in effects {
+        // Every effect by name: a new one must say whether the GPU runs it.
+        let missing = match e {
+            Effect::Gravity | Effect::Springs | Effect::AirDamping => None,
+            Effect::Bending(BendingModel::Springs) | Effect::Collider(_) => None,
+            Effect::Bending(BendingModel::Dihedral { .. }) => Some("dihedral bending"),
+            Effect::Wind(_) => Some("wind"),
+            Effect::SelfCollision(_) => Some("self-collision"),
+        };
+        if let Some(what) = missing {
+            return Err(GpuError::Unsupported(format!(
+                "has no {what}; run this scene on the CPU backend"
+            )));
+        }
+    }
+    if colliders_of(effects).len() > MAX_COLLIDERS {
+        return Err(GpuError::Unsupported(format!(
+            "takes at most {MAX_COLLIDERS} colliders"
+        )));
+    }
+    Ok(())
+}
+
+/// Whether a device with `limits` gives the shader what it needs for `count` particles:
+/// four storage buffers in a compute stage, and workgroups of [`WORKGROUP`] enough of them.
+pub(super) fn check_device(limits: &wgpu::Limits, count: u32) -> Result<(), GpuError> {
+    let storage = limits.max_storage_buffers_per_shader_stage;
+    if storage < 4 {
+        return Err(GpuError::Unsupported(format!(
+            "needs 4 storage buffers in a compute shader; this device offers {storage}"
+        )));
+    }
+    let groups = limits.max_compute_workgroups_per_dimension as u64 * WORKGROUP as u64;
+    if limits.max_compute_workgroup_size_x < WORKGROUP
+        || limits.max_compute_invocations_per_workgroup < WORKGROUP
+        || (count as u64) > groups
+    {
+        return Err(GpuError::Unsupported(format!(
+            "needs compute workgroups of {WORKGROUP} for {count} particles, which this \
+         device does not offer"
+        )));
+    }
+    Ok(())
+}
+
+/// Whether the stepper's largest storage buffers (the particles' state, and a record per
+/// spring end) fit what one binding and one buffer of a device with `limits` may hold: a
+/// cloth too big for the device is refused with the sizes, not left to a validation panic.
+pub(super) fn fits_buffers(
+    limits: &wgpu::Limits,
+    particles: u64,
+    spring_ends: u64,
+) -> Result<(), GpuError> {
+    let most = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size);
+    if particles > MAX_PARTICLES {
+        return Err(GpuError::Unsupported(format!(
+            "takes at most {MAX_PARTICLES} particles, not {particles}"
+        )));
+    }
+    let need = [
+        (particles * size_of::<Particle>() as u64, "particles' state"),
+        (spring_ends * size_of::<Neighbour>() as u64, "spring ends"),
+    ];
+    let mib = |bytes: u64| bytes as f64 / (1u64 << 20) as f64;
+    match need.into_iter().find(|&(bytes, _)| bytes > most) {
+        Some((bytes, what)) => Err(GpuError::Unsupported(format!(
+            "needs {:.1} MiB ({bytes} bytes) in one storage buffer for this cloth's {what} \
+             ({particles} particles, {spring_ends} spring ends); this device binds at most \
+             {:.1} MiB ({most} bytes)",
+            mib(bytes),
+            mib(most)
+        ))),
+        None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// llvmpipe's 128 MiB binding holds a 1 000 × 1 000 bench cloth's spring ends (8 bytes
+    /// each, 91.4 MiB); a 1 200 × 1 200 one's do not fit and are refused with both sizes;
+    /// the most that fits does.
+    #[test]
+    fn a_cloth_bigger_than_the_devices_buffers_is_refused_with_the_sizes() {
+        let limits = wgpu::Limits {
+            max_storage_buffer_binding_size: 128 << 20,
+            max_buffer_size: 256 << 20,
+            ..wgpu::Limits::default()
+        };
+        assert!(fits_buffers(&limits, 1_000_000, 11_980_004).is_ok());
+        let (particles, ends) = (1_440_000, 17_256_004);
+        let err = fits_buffers(&limits, particles, ends).expect_err("too big");
+        let text = err.to_string();
+        assert!(
+            text.contains("131.7 MiB") && text.contains("128.0 MiB") && text.contains("spring"),
+            "{text}"
+        );
+        let most = (128u64 << 20) / size_of::<Neighbour>() as u64;
+        assert!(fits_buffers(&limits, particles, most).is_ok());
+        assert!(fits_buffers(&limits, particles, most + 1).is_err());
+        // The smaller of the two limits counts.
+        let small_buffers = wgpu::Limits {
+            max_buffer_size: 64 << 20,
+            ..limits
+        };
+        assert!(fits_buffers(&small_buffers, particles, most).is_err());
+        assert!(fits_buffers(&small_buffers, 3 << 20, 0).is_err());
+        // An index needs its 28 bits, whatever the buffers hold.
+        let huge = wgpu::Limits {
+            max_storage_buffer_binding_size: u64::MAX,
+            max_buffer_size: u64::MAX,
+            ..limits
+        };
+        assert!(fits_buffers(&huge, MAX_PARTICLES, 0).is_ok());
+        let err = fits_buffers(&huge, MAX_PARTICLES + 1, 0).expect_err("too many");
+        assert!(err.to_string().contains("268435456 particles"), "{err}");
+    }
+}
