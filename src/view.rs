@@ -6,7 +6,7 @@ use glam::{Quat, Vec3};
 
 use crate::render::{Frame, OrbitCamera, Shape, SpringLines};
 use crate::scene::Simulation;
-use crate::sim::Collider;
+use crate::sim::Effect;
 
 /// The frame to draw for `sim`'s current state.
 pub fn frame(sim: &Simulation) -> Frame<'_> {
@@ -24,29 +24,34 @@ pub fn frame(sim: &Simulation) -> Frame<'_> {
             kind: &springs.kind,
         },
         pinned: &model.pins,
-        shapes: shapes(&sim.colliders(), sim.state().time),
+        shapes: shapes(sim.effects(), sim.state().time),
     }
 }
 
-/// The colliders as shapes to draw at simulated time `time` (spinning spheres turned).
-pub fn shapes(colliders: &[Collider], time: f64) -> Vec<Shape> {
-    colliders
+/// The solids among `effects` as shapes to draw at simulated time `time` (spinning spheres
+/// turned).
+pub fn shapes(effects: &[Effect], time: f64) -> Vec<Shape> {
+    effects
         .iter()
-        .map(|c| match *c {
-            Collider::Sphere {
-                center,
-                radius,
-                spin,
-                ..
-            } => Shape::Sphere {
-                center,
-                radius,
+        .filter_map(|e| match e {
+            Effect::Sphere(s) => Some(Shape::Sphere {
+                center: s.center,
+                radius: s.radius,
                 rotation: Quat::from_axis_angle(
-                    spin.try_normalize().unwrap_or(Vec3::Y),
-                    spin.length() * time as f32,
+                    s.spin.try_normalize().unwrap_or(Vec3::Y),
+                    s.spin.length() * time as f32,
                 ),
-            },
-            Collider::Plane { point, normal, .. } => Shape::Plane { point, normal },
+            }),
+            Effect::Plane(p) => Some(Shape::Plane {
+                point: p.point,
+                normal: p.unit_normal(),
+            }),
+            Effect::Springs(_)
+            | Effect::Gravity(_)
+            | Effect::AirDamping(_)
+            | Effect::Bending(_)
+            | Effect::Wind(_)
+            | Effect::SelfCollision(_) => None,
         })
         .collect()
 }

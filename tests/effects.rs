@@ -8,7 +8,7 @@ use clothsim::mesh::{GridOrientation, GridSpec};
 use clothsim::scene::{Scene, SceneFile, Simulation};
 use clothsim::sim::forces::{DihedralBending, hinge_angle};
 use clothsim::sim::{
-    BendingModel, CELLS_PER_TRIANGLE, Collider, ContactError, Effect, SelfCollision, SelfContacts,
+    BendingModel, CELLS_PER_TRIANGLE, ContactError, Effect, ForceTerm, SelfCollision, SelfContacts,
     Wind,
 };
 use glam::{Quat, Vec3};
@@ -650,7 +650,15 @@ fn self_collision_work_grows_linearly_with_the_particle_count() {
         let (model, mut state) = folded_sheet(quads, params.thickness);
         let start = state.pos.clone();
         let mut solver = SelfContacts::default();
-        solver.resolve(&params, &model, &start, &mut state).unwrap();
+        solver
+            .resolve(
+                params.thickness,
+                params.friction,
+                &model,
+                &start,
+                &mut state,
+            )
+            .unwrap();
         let n = model.particle_count() as f64;
         per_particle.push(solver.work.candidates as f64 / n);
         assert!(solver.work.contacts > 0);
@@ -702,7 +710,9 @@ fn one_pass_separates_every_pair(
     assert!(before > 100, "{before} pairs in contact to start with");
     let start = state.pos.clone();
     let mut solver = SelfContacts::default();
-    solver.resolve(params, model, &start, &mut state).unwrap();
+    solver
+        .resolve(params.thickness, params.friction, model, &start, &mut state)
+        .unwrap();
     let left = close_pairs(model, &state.pos, 0.8 * params.thickness);
     assert_eq!(left, 0, "pairs still overlapping after one pass");
     solver
@@ -753,7 +763,15 @@ fn the_broad_phase_table_is_bounded_by_the_triangle_count_however_the_cloth_is_s
             *p += reach * Vec3::new(r(1), r(2), r(3));
         }
         let start = state.pos.clone();
-        solver.resolve(&params, &model, &start, &mut state).unwrap();
+        solver
+            .resolve(
+                params.thickness,
+                params.friction,
+                &model,
+                &start,
+                &mut state,
+            )
+            .unwrap();
         assert!(
             solver.table_len() <= bound,
             "{} entries for {} triangles at {reach} m",
@@ -765,14 +783,26 @@ fn the_broad_phase_table_is_bounded_by_the_triangle_count_however_the_cloth_is_s
     state.pos[7].y = f32::NAN;
     let start = state.pos.clone();
     let err = solver
-        .resolve(&params, &model, &start, &mut state)
+        .resolve(
+            params.thickness,
+            params.friction,
+            &model,
+            &start,
+            &mut state,
+        )
         .unwrap_err();
     assert_eq!(err, ContactError::NonFinite { particle: 7 });
     let mut state = rest.clone();
     state.pos[7].y = 1e9;
     let start = state.pos.clone();
     let err = solver
-        .resolve(&params, &model, &start, &mut state)
+        .resolve(
+            params.thickness,
+            params.friction,
+            &model,
+            &start,
+            &mut state,
+        )
         .unwrap_err();
     assert!(matches!(err, ContactError::Extent { .. }), "{err}");
     assert_eq!(state.pos, start, "nothing moved");
@@ -835,12 +865,7 @@ fn only_the_effects_a_scene_lists_appear_as_phases() {
     });
     assert!(!limp.contains(&"bending".into()), "{limp:?}");
     let weightless = phases_of("sphere-drop", |e| {
-        e.retain(|e| {
-            !matches!(
-                e,
-                Effect::Gravity | Effect::Collider(Collider::Sphere { .. })
-            )
-        })
+        e.retain(|e| !matches!(e, Effect::Gravity(_) | Effect::Sphere(_)))
     });
     assert!(!weightless.contains(&"gravity".into()) && !weightless.contains(&"sphere".into()));
 }

@@ -331,7 +331,7 @@ fn a_blow_up_during_a_fall_is_still_caught_by_the_limits() {
         let mut sim = falling(kind);
         if ground {
             let mut effects = sim.effects().to_vec();
-            effects.push(Effect::Collider(clothsim::sim::Collider::Plane {
+            effects.push(Effect::Plane(clothsim::sim::Plane {
                 point: glam::Vec3::new(0.0, -1000.0, 0.0),
                 normal: glam::Vec3::Y,
                 friction: 0.5,

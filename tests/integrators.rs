@@ -8,7 +8,9 @@ use clothsim::cloth::{ClothModel, ClothState, Springs};
 use clothsim::mesh::{GridOrientation, GridSpec, MeshBuild, SpringKind};
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::forces::SpringForce;
-use clothsim::sim::{Force, ForceSet, IntegratorKind, SolverConfig, StepContext, StepMeter};
+use clothsim::sim::{
+    Effect, Force, ForceSet, IntegratorKind, SolverConfig, StepContext, StepMeter,
+};
 
 const K: f32 = 100.0;
 const M: f32 = 1.0;
@@ -34,11 +36,10 @@ fn oscillator_energies(kind: IntegratorKind, z: f32, steps: usize) -> Vec<f64> {
         vec![M, M],
         &[0],
     );
-    let forces = ForceSet::from_terms(vec![Force::Springs(SpringForce::new(
-        &model.springs,
-        [K; 3],
-        [0.0; 3],
-    ))]);
+    let forces = ForceSet::from_terms(vec![Force::new(
+        "springs",
+        SpringForce::new(&model.springs, [K; 3], [0.0; 3]),
+    )]);
     let h = z / (K / M).sqrt();
     let mut state = ClothState::at_rest(&model);
     state.pos[1].x += X0;
@@ -152,7 +153,11 @@ fn undamped_hanging(quads: u32) -> Scene {
         .unwrap();
     let cloth = MeshBuild::from(mesh);
     let mut scene = Scene::with_cloth("hanging", &cloth, "grid").unwrap();
-    scene.params.air_damping = 0.0;
+    for e in &mut scene.effects {
+        if let Effect::AirDamping(a) = e {
+            a.rate = 0.0;
+        }
+    }
     scene.params.damping = [0.0; 3];
     scene
 }
@@ -312,13 +317,12 @@ fn xpbd_chain_extension(k: f32, substeps: u32) -> f32 {
         substeps,
         stiffness: [k; 3],
         damping: [0.5; 3],
-        air_damping: 1.0,
         ..Default::default()
     };
     let effects = [
-        clothsim::sim::Effect::Gravity,
-        clothsim::sim::Effect::Springs,
-        clothsim::sim::Effect::AirDamping,
+        Effect::Gravity(Default::default()),
+        Effect::Springs(Default::default()),
+        Effect::AirDamping(clothsim::sim::AirDamping { rate: 1.0 }),
     ];
     let mut stepper = clothsim::sim::CpuStepper::new(&model, &params, &effects);
     let mut state = ClothState::at_rest(&model);
@@ -400,10 +404,10 @@ fn component_arrays_match_the_general_path(n: u32) {
     // The scene's terms (springs first: the fused path overwrites the forces with them),
     // springs and gravity alone, and gravity first (the forces zeroed before it).
     let mut springs_and_gravity = scene.effects.clone();
-    springs_and_gravity.retain(|e| matches!(e, Effect::Springs | Effect::Gravity));
+    springs_and_gravity.retain(|e| matches!(e, Effect::Springs(_) | Effect::Gravity(_)));
     let mut gravity_first = scene.effects.clone();
-    gravity_first.retain(|e| !matches!(e, Effect::Gravity));
-    gravity_first.insert(0, Effect::Gravity);
+    gravity_first.retain(|e| !matches!(e, Effect::Gravity(_)));
+    gravity_first.insert(0, Effect::Gravity(Default::default()));
     for effects in [scene.effects.clone(), springs_and_gravity, gravity_first] {
         let forces = ForceSet::new(model, &scene.params, &effects);
         assert!(forces.takes_components(), "{effects:?}");

@@ -7,8 +7,8 @@ use clothsim::mesh::SpringKind;
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::forces::SpringForce;
 use clothsim::sim::{
-    Collider, CpuStepper, Effect, Force, ForceSet, FrameOutcome, IntegratorKind, SimParams,
-    SolverConfig, StepBackend, StepContext, StepMeter,
+    AirDamping, CpuStepper, Effect, Force, ForceSet, FrameOutcome, Gravity, IntegratorKind, Plane,
+    SimParams, SolverConfig, Sphere, StepBackend, StepContext, StepMeter,
 };
 
 /// A model of point masses joined by structural springs, built by hand (no triangles).
@@ -37,7 +37,10 @@ fn params(integrator: IntegratorKind, dt: f32, substeps: u32) -> SimParams {
 fn free_fall_matches_half_g_t_squared() {
     for kind in IntegratorKind::ALL {
         let mut scene = Scene::builtin("sphere-drop").unwrap();
-        scene.effects = vec![Effect::Gravity, Effect::Springs];
+        scene.effects = vec![
+            Effect::Gravity(Gravity::default()),
+            Effect::Springs(Default::default()),
+        ];
         scene.params.integrator = kind;
         let mut sim = Simulation::new(scene);
         let start = sim.state().pos.clone();
@@ -103,8 +106,11 @@ fn hanging_chain_extension_matches_statics() {
         let mut p = params(kind, 0.01, 10);
         p.stiffness = [k; 3];
         p.damping = [0.5; 3];
-        p.air_damping = 1.0;
-        let effects = [Effect::Gravity, Effect::Springs, Effect::AirDamping];
+        let effects = [
+            Effect::Gravity(Gravity::default()),
+            Effect::Springs(Default::default()),
+            Effect::AirDamping(AirDamping { rate: 1.0 }),
+        ];
         let mut stepper = CpuStepper::new(&model, &p, &effects);
         let mut state = ClothState::at_rest(&model);
         for _ in 0..3000 {
@@ -130,11 +136,10 @@ fn oscillator(kind: IntegratorKind, omega_h: f32, steps: usize) -> (Vec<f64>, f3
         m,
         &[0],
     );
-    let forces = ForceSet::from_terms(vec![Force::Springs(SpringForce::new(
-        &model.springs,
-        [k; 3],
-        [0.0; 3],
-    ))]);
+    let forces = ForceSet::from_terms(vec![Force::new(
+        "springs",
+        SpringForce::new(&model.springs, [k; 3], [0.0; 3]),
+    )]);
     let mut state = ClothState::at_rest(&model);
     state.pos[1].x += amplitude;
     let mut integrator = kind.build();
@@ -242,7 +247,7 @@ fn sphere_drop_never_penetrates_and_comes_to_rest() {
         let mut scene = Scene::with_cloth("sphere-drop", &coarse_cloth(), "grid").unwrap();
         scene.params.integrator = kind;
         scene.params.substeps = substeps_for(kind);
-        let Some(&mut Collider::Sphere { center, radius, .. }) = scene.sphere_mut() else {
+        let Some(&mut Sphere { center, radius, .. }) = scene.sphere_mut() else {
             panic!("sphere-drop has a sphere")
         };
         let mut sim = Simulation::new(scene);
@@ -283,11 +288,11 @@ fn sphere_drop_never_penetrates_and_comes_to_rest() {
 fn spin_angular_momentum(friction: f32, ground_friction: f32) -> f64 {
     let mut scene = Scene::builtin("rotating-sphere").unwrap();
     for effect in &mut scene.effects {
-        if let Effect::Collider(Collider::Plane { friction, .. }) = effect {
+        if let Effect::Plane(Plane { friction, .. }) = effect {
             *friction = ground_friction;
         }
     }
-    let Some(Collider::Sphere {
+    let Some(Sphere {
         center,
         spin,
         friction: mu,
@@ -462,12 +467,16 @@ fn verlet_after_a_contact_uses_the_post_contact_acceleration() {
         substeps: 1,
         ..SimParams::default()
     };
-    let ground = Collider::Plane {
+    let ground = Plane {
         point: Vec3::ZERO,
         normal: Vec3::Y,
         friction: 0.5,
     };
-    let effects = [Effect::Gravity, Effect::Springs, Effect::Collider(ground)];
+    let effects = [
+        Effect::Gravity(Gravity::default()),
+        Effect::Springs(Default::default()),
+        Effect::Plane(ground),
+    ];
     let mut state = ClothState::at_rest(&model);
     state.vel[1] = Vec3::new(1.0, -1.0, 0.0);
     let mut stepper = CpuStepper::new(&model, &params, &effects);
@@ -510,8 +519,7 @@ fn changing_a_parameter_keeps_the_guards_substeps_the_time_and_the_state() {
     assert!(raised > 12, "the guard raised the substeps to {raised}");
     let (time, frames, state) = (sim.state().time, sim.frames(), sim.state().clone());
     let mut params = sim.params().clone();
-    params.air_damping = 0.9;
-    params.gravity.y = -9.0;
+    params.density *= 1.2;
     params.integrator = IntegratorKind::Verlet;
     sim.set_params(params.clone()).unwrap();
     assert_eq!(sim.substeps(), raised, "the guard's substeps stay");

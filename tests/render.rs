@@ -12,7 +12,7 @@ use clothsim::render::{
     CLEAR_COLOR, Offscreen, OrbitCamera, RenderError, RenderOptions, RgbaImage, save_png,
 };
 use clothsim::scene::{Scene, Simulation};
-use clothsim::sim::Collider;
+use clothsim::sim::Effect;
 use clothsim::view;
 
 /// Draws `sim` with its scene's default camera.
@@ -222,11 +222,9 @@ fn sphere_is_visible_in_sphere_drop() {
     let image = off
         .render(&view::frame(&sim), &camera, &RenderOptions::default())
         .unwrap();
-    let sphere = sim
-        .colliders()
-        .iter()
-        .find_map(|c| match *c {
-            Collider::Sphere { center, radius, .. } => Some((center, radius)),
+    let sphere = (sim.effects().iter())
+        .find_map(|e| match e {
+            Effect::Sphere(s) => Some((s.center, s.radius)),
             _ => None,
         })
         .unwrap();

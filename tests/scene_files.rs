@@ -5,7 +5,7 @@ use std::path::Path;
 
 use clothsim::mesh::load_obj;
 use clothsim::scene::{BUILTIN_SCENES, Scene, SceneError, SceneFile, Simulation, scenarios};
-use clothsim::sim::{BendingModel, Collider, Effect, IntegratorKind, Wind};
+use clothsim::sim::{BendingModel, ClothSprings, Effect, Gravity, IntegratorKind, Sphere, Wind};
 use glam::Vec3;
 
 /// A minimal valid scene with `extra` appended.
@@ -171,7 +171,6 @@ fn a_scene_file_builds_its_cloth_pins_solver_material_and_effects() {
         (IntegratorKind::Rk4, 0.01, 30)
     );
     assert_eq!((p.density, p.stiffness), (0.3, [300.0, 100.0, 5.0]));
-    assert_eq!(p.gravity, Vec3::new(0.0, -3.0, 0.0));
     // The top corners of a vertical 4×4-quad cloth centred at y = 2, and particle 12.
     let pinned: Vec<Vec3> = scene
         .pins
@@ -191,15 +190,17 @@ fn a_scene_file_builds_its_cloth_pins_solver_material_and_effects() {
     assert_eq!(
         scene.effects,
         vec![
-            Effect::Springs,
-            Effect::Gravity,
+            Effect::Springs(ClothSprings),
+            Effect::Gravity(Gravity {
+                acceleration: Vec3::new(0.0, -3.0, 0.0),
+            }),
             Effect::Bending(BendingModel::Dihedral { stiffness: 0.01 }),
             Effect::Wind(Wind {
                 velocity: Vec3::new(0.0, 0.0, 5.0),
                 gust: 0.0,
                 ..Wind::default()
             }),
-            Effect::Collider(Collider::Sphere {
+            Effect::Sphere(Sphere {
                 center: Vec3::new(0.0, 1.0, 0.0),
                 radius: 0.25,
                 spin: Vec3::new(0.0, 2.0, 0.0),
@@ -294,11 +295,16 @@ fn a_saved_setup_reloads_as_it_was_running() {
     params.integrator = IntegratorKind::ImplicitEuler;
     params.substeps = 7;
     params.stiffness = [321.0, 123.0, 12.0];
-    params.air_damping = 0.25;
-    params.gravity = Vec3::new(0.0, -5.0, 0.0);
     sim.set_params(params.clone()).unwrap();
     let mut effects = sim.effects().to_vec();
-    effects.retain(|e| !matches!(e, Effect::Collider(Collider::Plane { .. })));
+    for e in &mut effects {
+        match e {
+            Effect::AirDamping(a) => a.rate = 0.25,
+            Effect::Gravity(g) => g.acceleration = Vec3::new(0.0, -5.0, 0.0),
+            _ => {}
+        }
+    }
+    effects.retain(|e| !matches!(e, Effect::Plane(_)));
     effects.push(Effect::Wind(Wind::default()));
     effects.push(Effect::Bending(BendingModel::Dihedral { stiffness: 0.004 }));
     effects.retain(|e| *e != Effect::Bending(BendingModel::Springs));

@@ -6,7 +6,7 @@ use glam::Vec3;
 
 use clothsim::mesh::{GridOrientation, GridSpec, SpringKind};
 use clothsim::scene::{Scene, Simulation};
-use clothsim::sim::{Collider, Effect, IntegratorKind};
+use clothsim::sim::{Effect, IntegratorKind, Sphere, air_damping_of, gravity_of};
 
 /// Largest relative extension of the structural springs.
 fn max_strain(sim: &Simulation) -> f32 {
@@ -58,7 +58,7 @@ const PATH_TOLERANCE: f32 = 1e-5;
 /// Substep by substep for `seconds`, checking that no particle's path crosses a collider
 /// surface; returns the largest total energy seen (J) and the largest structural strain.
 fn run_checking_paths(sim: &mut Simulation, seconds: f64) -> (f64, f32) {
-    let colliders = sim.colliders();
+    let solids: Vec<Effect> = sim.solids().cloned().collect();
     let steps = (seconds / sim.substep_length() as f64).round() as usize;
     let (mut energy, mut strain) = (sim.energy(), 0.0f32);
     for step in 0..steps {
@@ -66,17 +66,19 @@ fn run_checking_paths(sim: &mut Simulation, seconds: f64) -> (f64, f32) {
         sim.substep().unwrap();
         let state = sim.state();
         assert!(state.is_finite(), "substep {step}: non-finite");
-        for c in &colliders {
+        for c in &solids {
             for (i, (a, b)) in before.iter().zip(&state.pos).enumerate() {
-                let crossed = match *c {
-                    Collider::Sphere { center, radius, .. } => {
-                        segment_enters_sphere(*a, *b, center, radius - PATH_TOLERANCE)
+                let crossed = match c {
+                    Effect::Sphere(s) => {
+                        segment_enters_sphere(*a, *b, s.center, s.radius - PATH_TOLERANCE)
                     }
                     // A path crosses a plane exactly when an end is behind it.
-                    Collider::Plane { point, normal, .. } => {
+                    Effect::Plane(p) => {
+                        let (point, normal) = (p.point, p.unit_normal());
                         (*a - point).dot(normal) < -PATH_TOLERANCE
                             || (*b - point).dot(normal) < -PATH_TOLERANCE
                     }
+                    other => panic!("not a solid: {other:?}"),
                 };
                 assert!(
                     !crossed,
@@ -156,9 +158,7 @@ fn cloth_thrown_at_10_m_s_onto_a_sphere_never_passes_through_and_comes_to_rest()
 #[test]
 fn cloth_dropped_flat_onto_the_ground_lies_flat_on_it() {
     let mut scene = Scene::builtin("sphere-drop").unwrap();
-    scene
-        .effects
-        .retain(|e| !matches!(e, Effect::Collider(Collider::Sphere { .. })));
+    scene.effects.retain(|e| !matches!(e, Effect::Sphere(_)));
     let offset = scene.params.collision_offset;
     let mut sim = Simulation::new(scene);
     let start = sim.energy();
@@ -181,7 +181,7 @@ fn cloth_dropped_flat_onto_the_ground_lies_flat_on_it() {
 #[test]
 fn a_sphere_spinning_at_20_rad_s_under_resting_cloth_drags_it_without_blowing_up() {
     let mut scene = Scene::builtin("rotating-sphere").unwrap();
-    let Some(Collider::Sphere { spin, radius, .. }) = scene.sphere_mut() else {
+    let Some(Sphere { spin, radius, .. }) = scene.sphere_mut() else {
         panic!("rotating-sphere has a sphere")
     };
     *spin = Vec3::new(0.0, 20.0, 0.0);
@@ -327,8 +327,8 @@ fn releasing_all_pins_mid_run_lets_the_cloth_fall_freely() {
     );
     // Internal forces cancel: the centre of mass falls like a stone, slowed only by the
     // air damping (0.5/s): x(t) = x₀ + (v₀ − g/c)(1 − e^(−ct))/c + g·t/c.
-    let c = sim.params().air_damping;
-    let g = sim.params().gravity.y;
+    let c = air_damping_of(sim.effects());
+    let g = gravity_of(sim.effects()).y;
     let decay = (1.0 - (-c * t as f32).exp()) / c;
     let expected = c0.y + (v0.y - g / c) * decay + g / c * t as f32;
     let fell = centre(&sim).y;
@@ -348,7 +348,7 @@ fn a_fast_particle_cannot_pass_through_a_small_sphere() {
         vec![1e-3],
         &[],
     );
-    let sphere = Collider::Sphere {
+    let sphere = Sphere {
         center: Vec3::ZERO,
         radius: 0.005,
         spin: Vec3::ZERO,
@@ -360,7 +360,7 @@ fn a_fast_particle_cannot_pass_through_a_small_sphere() {
         collision_offset: 0.001,
         ..Default::default()
     };
-    let mut stepper = clothsim::sim::CpuStepper::new(&model, &params, &[Effect::Collider(sphere)]);
+    let mut stepper = clothsim::sim::CpuStepper::new(&model, &params, &[Effect::Sphere(sphere)]);
     let mut state = clothsim::cloth::ClothState::at_rest(&model);
     // 50 m/s: 17 mm per substep, more than the sphere's 10 mm diameter.
     state.vel[0] = Vec3::new(0.0, 0.0, 50.0);

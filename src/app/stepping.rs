@@ -405,21 +405,25 @@ mod tests {
         // third frame.
         thread.advance(3).unwrap();
         thread.settle();
+        // More air damping, 0.5 → 2 1/s.
+        let more_drag = |s: &mut Simulation| {
+            let mut effects = s.effects().to_vec();
+            for e in &mut effects {
+                if let crate::sim::Effect::AirDamping(a) = e {
+                    a.rate = 2.0;
+                }
+            }
+            s.set_effects(effects)
+        };
         thread
-            .edit(Box::new(|s| {
-                let mut p = s.params().clone();
-                p.air_damping = 2.0;
-                s.set_params(p).err().map(|e| e.to_string())
-            }))
+            .edit(Box::new(move |s| more_drag(s).err().map(|e| e.to_string())))
             .unwrap();
         thread.advance(2).unwrap();
         let (taken, _) = settled(&mut thread, &mut replica);
         for _ in 0..3 {
             direct.step_frame().unwrap();
         }
-        let mut p = direct.params().clone();
-        p.air_damping = 2.0;
-        direct.set_params(p).unwrap();
+        more_drag(&mut direct).unwrap();
         for _ in 0..2 {
             direct.step_frame().unwrap();
         }

@@ -81,7 +81,7 @@ impl EndsKey {
 /// order, for the spring terms `effects` turn on: the ends' key and the class table.
 pub(super) fn classify(params: &SimParams, effects: &[Effect]) -> (EndsKey, ClassTable) {
     let terms = [
-        effects.contains(&Effect::Springs),
+        effects.iter().any(|e| matches!(e, Effect::Springs(_))),
         effects.contains(&Effect::Bending(BendingModel::Springs)),
     ];
     let mut table: ClassTable = [[0.0; 4]; MAX_CLASSES];
@@ -149,4 +149,35 @@ pub(super) struct Params {
     pub(super) drag: [f32; 4],
     pub(super) counts: [u32; 4],
     pub(super) colliders: [GpuCollider; MAX_COLLIDERS],
+}
+
+/// The solids among `effects` as the shader reads them (the first [`MAX_COLLIDERS`]), and
+/// how many there are. A plane's normal is made unit here.
+pub(super) fn pack_solids(effects: &[Effect]) -> ([GpuCollider; MAX_COLLIDERS], u32) {
+    let mut out = [GpuCollider::zeroed(); MAX_COLLIDERS];
+    let solids = effects.iter().filter_map(|e| match e {
+        Effect::Sphere(s) => Some(GpuCollider {
+            info: [1.0, s.radius, s.friction, 0.0],
+            a: s.center.extend(0.0).to_array(),
+            b: s.spin.extend(0.0).to_array(),
+        }),
+        Effect::Plane(p) => Some(GpuCollider {
+            info: [2.0, 0.0, p.friction, 0.0],
+            a: p.point.extend(0.0).to_array(),
+            b: p.unit_normal().extend(0.0).to_array(),
+        }),
+        // What is not a solid takes no slot (`gpu_support` refuses what the GPU lacks).
+        Effect::Springs(_)
+        | Effect::Gravity(_)
+        | Effect::AirDamping(_)
+        | Effect::Bending(_)
+        | Effect::Wind(_)
+        | Effect::SelfCollision(_) => None,
+    });
+    let mut count = 0;
+    for (slot, solid) in out.iter_mut().zip(solids) {
+        *slot = solid;
+        count += 1;
+    }
+    (out, count)
 }

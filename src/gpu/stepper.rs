@@ -12,15 +12,14 @@ use glam::Vec3;
 use crate::cloth::{ClothModel, ClothState};
 use crate::device::map_read;
 use crate::sim::{
-    Cause, Collider, Diverged, Effect, FrameOutcome, IntegratorKind, PhaseTimings, SimParams,
-    StepBackend, StepError, StepReport, StepStats, colliders_of,
+    Cause, Diverged, Effect, FrameOutcome, IntegratorKind, PhaseTimings, SimParams, StepBackend,
+    StepError, StepReport, StepStats, air_damping_of, gravity_of,
 };
 
 use super::error::GpuError;
 use super::kernel::{Bindings, SubstepKernel, WORKGROUP};
 use super::packing::{
-    ClassTable, EndsKey, GpuCollider, MAX_COLLIDERS, Neighbour, Params, Particle, classify,
-    pack_springs,
+    ClassTable, EndsKey, Neighbour, Params, Particle, classify, pack_solids, pack_springs,
 };
 use super::support::{GPU_INTEGRATOR, check_device, fits_buffers, gpu_support};
 
@@ -359,46 +358,13 @@ impl StepBackend for GpuStepper {
         if self.unsupported.is_none() {
             self.upload_springs(model, params, effects);
         }
-        let g = if effects.contains(&Effect::Gravity) {
-            params.gravity
-        } else {
-            Vec3::ZERO
-        };
-        let drag = if effects.contains(&Effect::AirDamping) {
-            params.air_damping
-        } else {
-            0.0
-        };
-        let mut out = [GpuCollider::zeroed(); MAX_COLLIDERS];
-        let colliders = colliders_of(effects);
-        for (slot, c) in out.iter_mut().zip(&colliders) {
-            *slot = match *c {
-                Collider::Sphere {
-                    center,
-                    radius,
-                    spin,
-                    friction,
-                } => GpuCollider {
-                    info: [1.0, radius, friction, 0.0],
-                    a: center.extend(0.0).to_array(),
-                    b: spin.extend(0.0).to_array(),
-                },
-                Collider::Plane {
-                    point,
-                    normal,
-                    friction,
-                } => GpuCollider {
-                    info: [2.0, 0.0, friction, 0.0],
-                    a: point.extend(0.0).to_array(),
-                    b: normal.extend(0.0).to_array(),
-                },
-            };
-        }
+        let (g, drag) = (gravity_of(effects), air_damping_of(effects));
+        let (solids, count) = pack_solids(effects);
         self.params = Params {
             gravity: [g.x, g.y, g.z, 0.0],
             drag: [drag, params.collision_offset, 0.0, 0.0],
-            counts: [self.count, colliders.len().min(MAX_COLLIDERS) as u32, 0, 0],
-            colliders: out,
+            counts: [self.count, count, 0, 0],
+            colliders: solids,
         };
         self.dt = params.dt;
         self.substeps = params.substeps.max(1);

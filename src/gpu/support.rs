@@ -1,6 +1,6 @@
 //! What the GPU backend runs, and whether a device can hold a cloth.
 
-use crate::sim::{BendingModel, Effect, IntegratorKind, SimParams, colliders_of};
+use crate::sim::{Effect, IntegratorKind, SimParams};
 
 use super::error::GpuError;
 use super::kernel::WORKGROUP;
@@ -21,21 +21,14 @@ pub fn gpu_support(params: &SimParams, effects: &[Effect]) -> Result<(), GpuErro
         )));
     }
     for e in effects {
-        // Every effect by name: a new one must say whether the GPU runs it.
-        let missing = match e {
-            Effect::Gravity | Effect::Springs | Effect::AirDamping => None,
-            Effect::Bending(BendingModel::Springs) | Effect::Collider(_) => None,
-            Effect::Bending(BendingModel::Dihedral { .. }) => Some("dihedral bending"),
-            Effect::Wind(_) => Some("wind"),
-            Effect::SelfCollision(_) => Some("self-collision"),
-        };
-        if let Some(what) = missing {
+        if let Err(what) = e.on_gpu() {
             return Err(GpuError::Unsupported(format!(
                 "has no {what}; run this scene on the CPU backend"
             )));
         }
     }
-    if colliders_of(effects).len() > MAX_COLLIDERS {
+    let solids = (effects.iter()).filter(|e| matches!(e, Effect::Sphere(_) | Effect::Plane(_)));
+    if solids.count() > MAX_COLLIDERS {
         return Err(GpuError::Unsupported(format!(
             "takes at most {MAX_COLLIDERS} colliders"
         )));

@@ -79,9 +79,10 @@ impl Trajectory {
 /// inelastic, stay).
 pub fn undamped(scene: &Scene) -> Scene {
     let mut scene = scene.clone();
-    scene.params.air_damping = 0.0;
     scene.params.damping = [0.0; 3];
-    scene.effects.retain(|e| *e != Effect::AirDamping);
+    scene
+        .effects
+        .retain(|e| !matches!(e, Effect::AirDamping(_)));
     scene
 }
 

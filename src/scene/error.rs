@@ -28,6 +28,12 @@ pub enum SceneError {
         column: usize,
         message: String,
     },
+    /// An effect's value out of range; the simulation keeps the effects it had.
+    #[error("`{effect}`: {error}; the previous effects are kept")]
+    Effect {
+        effect: &'static str,
+        error: ParamError,
+    },
     /// A self-collision thickness the cloth cannot take (at or above its shortest rest
     /// edge); `cloth` names the cloth.
     #[error("{cloth}: {error}")]

@@ -4,15 +4,11 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use crate::cloth::MassDistribution;
 use crate::mesh::{GridBends, GridOrientation};
-use crate::sim::{
-    BendingModel, Collider, Effect, GuardPolicy, IntegratorKind, SelfCollision, SimParams,
-    SolverConfig, Wind,
-};
+use crate::sim::{ClothSprings, Effect, GuardPolicy, IntegratorKind, SimParams, SolverConfig};
 
 use super::error::SceneError;
 
@@ -30,8 +26,9 @@ pub struct SceneFile {
     pub solver: SolverSpec,
     #[serde(default)]
     pub material: MaterialSpec,
+    /// The effects the scene lists (never the cloth's springs, which every scene has).
     #[serde(default)]
-    pub effects: Vec<EffectSpec>,
+    pub effects: Vec<Effect>,
 }
 
 /// The cloth: an OBJ file or a generated grid, and where it goes.
@@ -224,69 +221,6 @@ impl Default for MaterialSpec {
     }
 }
 
-/// How a scene bends.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum BendingKind {
-    Springs,
-    Dihedral,
-}
-
-/// One effect and its parameters.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
-pub enum EffectSpec {
-    Gravity {
-        /// m/s².
-        #[serde(default = "standard_gravity")]
-        acceleration: [f32; 3],
-    },
-    AirDamping {
-        /// 1/s.
-        rate: f32,
-    },
-    Bending {
-        model: BendingKind,
-        /// N·m for dihedral bending; for springs the material's `stiffness.bend` applies.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        stiffness: Option<f32>,
-    },
-    Wind(Wind),
-    Sphere {
-        center: [f32; 3],
-        radius: f32,
-        /// rad/s about each axis.
-        #[serde(default)]
-        spin: [f32; 3],
-        #[serde(default = "default_friction")]
-        friction: f32,
-    },
-    Plane {
-        #[serde(default)]
-        point: [f32; 3],
-        #[serde(default = "up")]
-        normal: [f32; 3],
-        #[serde(default = "default_friction")]
-        friction: f32,
-    },
-    SelfCollision(SelfCollision),
-}
-
-fn standard_gravity() -> [f32; 3] {
-    [0.0, -9.81, 0.0]
-}
-
-fn up() -> [f32; 3] {
-    [0.0, 1.0, 0.0]
-}
-
-fn default_friction() -> f32 {
-    0.5
-}
-
-/// Default dihedral bending stiffness, N·m.
-pub const DEFAULT_DIHEDRAL_STIFFNESS: f32 = 2e-3;
-
 /// A scene file read from disk: the parsed file and where it was (for relative paths).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LoadedSceneFile {
@@ -424,31 +358,9 @@ impl SceneFile {
             return bad(None, "center", "must be finite metres");
         }
         for (i, e) in self.effects.iter().enumerate() {
-            let at = Some(i);
-            match e {
-                EffectSpec::Sphere { radius, .. } if !(radius.is_finite() && *radius > 0.0) => {
-                    return bad(at, "radius", "must be positive metres");
-                }
-                EffectSpec::Plane { normal, .. } if Vec3::from(*normal).length() < 1e-6 => {
-                    return bad(at, "normal", "must not be zero");
-                }
-                EffectSpec::Bending {
-                    model: BendingKind::Dihedral,
-                    stiffness: Some(k),
-                } if !(k.is_finite() && *k >= 0.0) => {
-                    return bad(at, "stiffness", "must be ≥ 0 N·m");
-                }
-                EffectSpec::SelfCollision(s) if !(s.thickness.is_finite() && s.thickness > 0.0) => {
-                    return bad(at, "thickness", "must be positive metres");
-                }
-                EffectSpec::Wind(w) if !(w.velocity.is_finite() && w.gust_period > 0.0) => {
-                    return bad(
-                        at,
-                        "velocity",
-                        "wind needs a finite velocity and a positive gust_period",
-                    );
-                }
-                _ => {}
+            if let Err(e) = e.check() {
+                let detail = format!("`{}` = {} {}", e.name, e.value, e.rule);
+                return Err((Some(i), e.name.to_string(), detail));
             }
         }
         // A grid's shortest rest edge is known before it is built (an OBJ's is checked when
@@ -457,7 +369,7 @@ impl SceneFile {
             let ([qx, qy], [sx, sy]) = (g.quads.pair(), g.size.pair());
             let edge = (sx / qx as f32).min(sy / qy as f32);
             for (i, e) in self.effects.iter().enumerate() {
-                if let EffectSpec::SelfCollision(s) = e
+                if let Effect::SelfCollision(s) = e
                     && let Err(too_thick) = s.fits(edge)
                 {
                     // Named as the file names it: `thickness` = …
@@ -469,22 +381,10 @@ impl SceneFile {
         }
         // Solver and material values, checked as the simulation will check them.
         if let Err(e) = self.params().validate() {
-            let in_effect = |pick: fn(&EffectSpec) -> bool| self.effects.iter().position(pick);
-            let (index, key) = match e.name {
-                "air_damping" => (
-                    in_effect(|e| matches!(e, EffectSpec::AirDamping { .. })),
-                    "rate",
-                ),
-                "gravity" => (
-                    in_effect(|e| matches!(e, EffectSpec::Gravity { .. })),
-                    "acceleration",
-                ),
-                // `solver.tolerance` is `tolerance` in [solver], `guard.x` is `x` in [solver.guard].
-                other => (None, other.rsplit('.').next().unwrap_or(other)),
-            };
-            // Named as the file names it.
+            // `solver.tolerance` is `tolerance` in [solver], `guard.x` is `x` in [solver.guard].
+            let key = e.name.rsplit('.').next().unwrap_or(e.name);
             let detail = format!("`{key}` = {} {}", e.value, e.rule);
-            return Err((index, key.to_string(), detail));
+            return Err((None, key.to_string(), detail));
         }
         Ok(())
     }
@@ -492,8 +392,7 @@ impl SceneFile {
     /// The simulation parameters the file gives.
     pub fn params(&self) -> SimParams {
         let s = &self.solver;
-        let defaults = SimParams::default();
-        let mut p = SimParams {
+        SimParams {
             dt: s.dt,
             substeps: s.substeps,
             integrator: s.integrator,
@@ -509,58 +408,14 @@ impl SceneFile {
                 newton_tolerance: s.newton_tolerance,
                 xpbd_iterations: s.xpbd_iterations,
             },
-            // Without the effect the strength is unused; keep the defaults for the sliders.
-            gravity: defaults.gravity,
-            air_damping: defaults.air_damping,
-        };
-        for e in &self.effects {
-            match e {
-                EffectSpec::Gravity { acceleration } => p.gravity = Vec3::from(*acceleration),
-                EffectSpec::AirDamping { rate } => p.air_damping = *rate,
-                _ => {}
-            }
         }
-        p
     }
 
     /// The effects the file lists, with the cloth's springs first.
     pub fn effects(&self) -> Vec<Effect> {
-        let mut out = vec![Effect::Springs];
-        for e in &self.effects {
-            out.push(match e {
-                EffectSpec::Gravity { .. } => Effect::Gravity,
-                EffectSpec::AirDamping { .. } => Effect::AirDamping,
-                EffectSpec::Bending { model, stiffness } => Effect::Bending(match model {
-                    BendingKind::Springs => BendingModel::Springs,
-                    BendingKind::Dihedral => BendingModel::Dihedral {
-                        stiffness: stiffness.unwrap_or(DEFAULT_DIHEDRAL_STIFFNESS),
-                    },
-                }),
-                EffectSpec::Wind(w) => Effect::Wind(*w),
-                EffectSpec::Sphere {
-                    center,
-                    radius,
-                    spin,
-                    friction,
-                } => Effect::Collider(Collider::Sphere {
-                    center: Vec3::from(*center),
-                    radius: *radius,
-                    spin: Vec3::from(*spin),
-                    friction: *friction,
-                }),
-                EffectSpec::Plane {
-                    point,
-                    normal,
-                    friction,
-                } => Effect::Collider(Collider::Plane {
-                    point: Vec3::from(*point),
-                    normal: Vec3::from(*normal).normalize(),
-                    friction: *friction,
-                }),
-                EffectSpec::SelfCollision(s) => Effect::SelfCollision(*s),
-            });
-        }
-        out
+        std::iter::once(Effect::Springs(ClothSprings))
+            .chain(self.effects.iter().cloned())
+            .collect()
     }
 
     /// This file with its solver, material, effects and pins replaced by those of a running
@@ -590,49 +445,9 @@ impl SceneFile {
             damping: params.damping.into(),
             masses: self.material.masses,
         };
-        file.effects = effects
-            .iter()
-            .filter_map(|e| {
-                Some(match e {
-                    Effect::Springs => return None,
-                    Effect::Gravity => EffectSpec::Gravity {
-                        acceleration: params.gravity.to_array(),
-                    },
-                    Effect::AirDamping => EffectSpec::AirDamping {
-                        rate: params.air_damping,
-                    },
-                    Effect::Bending(BendingModel::Springs) => EffectSpec::Bending {
-                        model: BendingKind::Springs,
-                        stiffness: None,
-                    },
-                    Effect::Bending(BendingModel::Dihedral { stiffness }) => EffectSpec::Bending {
-                        model: BendingKind::Dihedral,
-                        stiffness: Some(*stiffness),
-                    },
-                    Effect::Wind(w) => EffectSpec::Wind(*w),
-                    Effect::SelfCollision(s) => EffectSpec::SelfCollision(*s),
-                    Effect::Collider(Collider::Sphere {
-                        center,
-                        radius,
-                        spin,
-                        friction,
-                    }) => EffectSpec::Sphere {
-                        center: center.to_array(),
-                        radius: *radius,
-                        spin: spin.to_array(),
-                        friction: *friction,
-                    },
-                    Effect::Collider(Collider::Plane {
-                        point,
-                        normal,
-                        friction,
-                    }) => EffectSpec::Plane {
-                        point: point.to_array(),
-                        normal: normal.to_array(),
-                        friction: *friction,
-                    },
-                })
-            })
+        file.effects = (effects.iter())
+            .filter(|e| !matches!(e, Effect::Springs(_)))
+            .cloned()
             .collect();
         if let Some(pins) = pins {
             file.pins = PinSpec {

@@ -3,7 +3,7 @@
 use glam::{Quat, Vec3};
 
 use crate::mesh::bounds;
-use crate::sim::Collider;
+use crate::sim::Effect;
 
 use super::simulation::Simulation;
 
@@ -43,16 +43,15 @@ impl Simulation {
     fn fall_points(&self) -> Vec<Vec3> {
         let (mut lo, mut hi) = bounds(&self.initial().pos);
         let size = (hi - lo).max_element();
-        let colliders = self.colliders();
-        let ground = colliders.iter().find_map(|c| match *c {
-            Collider::Plane { point, normal, .. } if normal.y > 0.9 => Some(point.y),
+        let ground = self.effects().iter().find_map(|e| match e {
+            Effect::Plane(p) if p.unit_normal().y > 0.9 => Some(p.point.y),
             _ => None,
         });
         let mut landed = false;
-        for c in &colliders {
-            if let Collider::Sphere { center, radius, .. } = *c {
-                lo = lo.min(center - Vec3::splat(radius));
-                hi = hi.max(center + Vec3::splat(radius));
+        for e in self.effects() {
+            if let Effect::Sphere(s) = e {
+                lo = lo.min(s.center - Vec3::splat(s.radius));
+                hi = hi.max(s.center + Vec3::splat(s.radius));
                 landed = true;
             }
         }

@@ -9,7 +9,7 @@ use crate::cloth::{ClothModel, ClothState};
 use crate::mesh::{
     self, ClothMesh, GridOrientation, GridSpec, ImportOptions, MeshBuild, bounds, thinnest_axis,
 };
-use crate::sim::{Collider, Effect, SimParams, thickness_fits};
+use crate::sim::{Effect, SimParams, Sphere, thickness_fits};
 
 use super::error::{PinError, SceneError};
 use super::file::{Corner, Edge, LoadedSceneFile, PinSpec, SceneFile};
@@ -217,9 +217,9 @@ impl Scene {
     }
 
     /// The sphere collider, if the scene has one (to adjust before simulating).
-    pub fn sphere_mut(&mut self) -> Option<&mut Collider> {
+    pub fn sphere_mut(&mut self) -> Option<&mut Sphere> {
         self.effects.iter_mut().find_map(|e| match e {
-            Effect::Collider(c @ Collider::Sphere { .. }) => Some(c),
+            Effect::Sphere(s) => Some(s),
             _ => None,
         })
     }

@@ -4,9 +4,9 @@
 
 use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{
-    Cause, Collider, CpuStepper, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent,
-    IntegratorKind, PhaseTimings, SimParams, StepBackend, StepError, StepReport, StepStats,
-    colliders_of, small_sphere_warnings, thickness_fits,
+    Cause, CpuStepper, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent, IntegratorKind,
+    PhaseTimings, SimParams, StepBackend, StepError, StepReport, StepStats, small_sphere_warnings,
+    thickness_fits,
 };
 
 use super::error::SceneError;
@@ -88,10 +88,7 @@ impl Simulation {
     /// The simulation of `scene` on `backend`, configured for it.
     fn assemble(scene: Scene, backend: Box<dyn StepBackend>) -> Self {
         let mut warnings = scene.warnings;
-        warnings.extend(small_sphere_warnings(
-            &colliders_of(&scene.effects),
-            &scene.model,
-        ));
+        warnings.extend(small_sphere_warnings(&scene.effects, &scene.model));
         Self {
             file: scene.file,
             scenario: scene.scenario,
@@ -199,9 +196,9 @@ impl Simulation {
         &self.effects
     }
 
-    /// The colliders among the effects.
-    pub fn colliders(&self) -> Vec<Collider> {
-        colliders_of(&self.effects)
+    /// The solids among the effects (spheres, planes): what a particle may not enter.
+    pub fn solids(&self) -> impl Iterator<Item = &Effect> {
+        self.effects.iter().filter(|e| e.is_solid())
     }
 
     /// Frames advanced since the last reset.
@@ -288,15 +285,22 @@ impl Simulation {
     /// and a backend's copy of it, are left as they are.
     ///
     /// # Errors
-    /// [`SceneError::Thickness`] for a self-collision thickness at or above the cloth's
-    /// shortest rest edge; nothing changes then.
+    /// [`SceneError::Effect`] for a value out of range, [`SceneError::Thickness`] for a
+    /// self-collision thickness at or above the cloth's shortest rest edge; nothing changes
+    /// then.
     pub fn set_effects(&mut self, effects: Vec<Effect>) -> Result<Vec<String>, SceneError> {
+        for effect in &effects {
+            effect.check().map_err(|error| SceneError::Effect {
+                effect: effect.phase(),
+                error,
+            })?;
+        }
         thickness_fits(&effects, &self.model).map_err(|error| SceneError::Thickness {
             cloth: self.cloth_name.clone(),
             error,
         })?;
         self.effects = effects;
-        let warnings = small_sphere_warnings(&self.colliders(), &self.model);
+        let warnings = small_sphere_warnings(&self.effects, &self.model);
         self.backend
             .configure(&self.model, &self.params, &self.effects);
         Ok(warnings)

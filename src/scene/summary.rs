@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use crate::mesh::SpringKind;
-use crate::sim::{FrameOutcome, GuardEvent, min_collider_distance};
+use crate::sim::{FrameOutcome, GuardEvent, min_surface_distance};
 
 use super::simulation::Simulation;
 
@@ -127,7 +127,7 @@ impl Simulation {
             requested_substeps: self.params().substeps,
             finite: state.is_finite(),
             max_speed: state.max_speed(),
-            min_collider_distance: min_collider_distance(&self.colliders(), &state.pos),
+            min_collider_distance: min_surface_distance(self.effects(), &state.pos),
             kinetic_energy: state.kinetic_energy(model),
             wall_seconds,
             refined_frames: 0,

@@ -3,7 +3,7 @@
 
 use crate::cloth::{ClothModel, ClothState};
 
-use super::effect::Effect;
+use super::effects::Effect;
 use super::guard::{Diverged, FrameOutcome, GuardEvent};
 use super::integrator::{IntegratorKind, StepError, StepReport};
 use super::params::SimParams;
@@ -67,7 +67,7 @@ pub trait StepBackend: Send {
     fn integrator(&self) -> IntegratorKind;
 
     /// The work of the last self-collision pass, when the scene has self-collision.
-    fn self_collision_work(&self) -> Option<super::self_collision::SelfWork> {
+    fn self_collision_work(&self) -> Option<super::self_contacts::SelfWork> {
         None
     }
 

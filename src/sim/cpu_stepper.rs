@@ -1,4 +1,4 @@
-//! The CPU step backend: an integrator, the scene's forces and its colliders, advanced in
+//! The CPU step backend: an integrator, the scene's forces and its contacts, advanced in
 //! fixed substeps, with a guard that rolls back a diverging frame and retries it with more
 //! substeps. It charges the time of every step to phases.
 
@@ -7,9 +7,10 @@ use std::time::{Duration, Instant};
 use crate::cloth::{ClothModel, ClothState};
 
 use super::backend::StepBackend;
-use super::collider::Collider;
 use super::diagnosis::Cause;
-use super::effect::{Effect, colliders_of, wind_of};
+use super::effects::{
+    ContactPass, Effect, SelfCollision, air_damping_of, gravity_of, shortest_edge,
+};
 use super::forces::ForceSet;
 use super::guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check};
 use super::guard_state::GuardState;
@@ -17,7 +18,7 @@ use super::integrator::{
     Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport,
 };
 use super::params::{SimParams, SolverConfig};
-use super::self_collision::{SelfCollision, SelfContacts, shortest_edge};
+use super::self_contacts::{SelfContacts, SelfWork};
 use super::stats::StepStats;
 use super::timings::PhaseTimings;
 
@@ -26,7 +27,11 @@ use super::timings::PhaseTimings;
 pub struct CpuStepper {
     integrator: Box<dyn Integrator>,
     forces: ForceSet,
-    colliders: Vec<Collider>,
+    /// The effects that act after each substep: solids in the scene's order, then
+    /// self-collision.
+    contacts: Vec<Effect>,
+    /// The scene's effects, for the guard's limits.
+    effects: Vec<Effect>,
     solver: SolverConfig,
     gravity: glam::Vec3,
     dt: f32,
@@ -45,8 +50,6 @@ pub struct CpuStepper {
     substep_start: Vec<glam::Vec3>,
     self_collision: Option<SelfCollision>,
     self_contacts: SelfContacts,
-    /// Fastest the wind gets, m/s (for the guard's speed limit).
-    wind: f32,
     /// Air damping in effect, 1/s (0 without the effect; for the guard's diagnosis).
     air_damping: f32,
 }
@@ -57,9 +60,10 @@ impl CpuStepper {
         let mut stepper = Self {
             integrator: params.integrator.build(),
             forces: ForceSet::default(),
-            colliders: Vec::new(),
+            contacts: Vec::new(),
+            effects: Vec::new(),
             solver: params.solver,
-            gravity: params.gravity,
+            gravity: glam::Vec3::ZERO,
             dt: params.dt,
             requested: 0,
             substeps: 1,
@@ -72,20 +76,15 @@ impl CpuStepper {
             substep_start: Vec::new(),
             self_collision: None,
             self_contacts: SelfContacts::default(),
-            wind: 0.0,
             air_damping: 0.0,
         };
         stepper.configure(model, params, effects);
         stepper
     }
 
-    pub fn colliders(&self) -> &[Collider] {
-        &self.colliders
-    }
-
-    /// Whether anything acts on the state after each substep (colliders, self-collision).
+    /// Whether anything acts on the state after each substep (solids, self-collision).
     fn contacts_exist(&self) -> bool {
-        !self.colliders.is_empty() || self.self_collision.is_some()
+        !self.contacts.is_empty()
     }
 
     /// Integrates one substep and charges its phases; the contacts are not resolved (see
@@ -107,7 +106,7 @@ impl CpuStepper {
         Ok(report)
     }
 
-    /// Resolves the colliders and self-collision after a substep, from the paths since its
+    /// Resolves the contacts (solids, then self-collision) after a substep, from the paths since its
     /// start, and charges their phases.
     ///
     /// # Errors
@@ -121,17 +120,15 @@ impl CpuStepper {
             return Ok(());
         }
         let mut contacts = 0;
-        let start = &self.substep_start;
-        for c in &self.colliders {
-            contacts += self
-                .timings
-                .time(c.phase(), || c.resolve(model, start, state, self.offset));
-        }
-        if let Some(params) = &self.self_collision {
-            let solver = &mut self.self_contacts;
-            contacts += self.timings.time("self-collision", || {
-                solver.resolve(params, model, start, state)
-            })?;
+        let mut pass = ContactPass {
+            model,
+            start: &self.substep_start,
+            state,
+            offset: self.offset,
+            self_contacts: &mut self.self_contacts,
+        };
+        for c in &self.contacts {
+            contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
         }
         if contacts > 0 {
             // Contacts changed positions and velocities after the integrator's step.
@@ -367,24 +364,23 @@ impl StepBackend for CpuStepper {
 
     fn configure(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]) {
         self.forces.configure(model, params, effects);
-        self.colliders = colliders_of(effects);
+        self.contacts = effects.iter().filter(|e| e.is_contact()).cloned().collect();
+        // Self-collision last, after the solids have moved what they touch.
+        self.contacts
+            .sort_by_key(|e| matches!(e, Effect::SelfCollision(_)));
         self.self_collision = effects.iter().find_map(|e| match e {
             Effect::SelfCollision(s) => Some(*s),
             _ => None,
         });
-        self.wind = wind_of(effects).map_or(0.0, |w| w.peak_speed());
-        self.air_damping = if effects.contains(&Effect::AirDamping) {
-            params.air_damping
-        } else {
-            0.0
-        };
+        self.effects = effects.to_vec();
+        self.air_damping = air_damping_of(effects);
         if self.integrator.kind() != params.integrator {
             self.integrator = params.integrator.build();
         }
         // New strengths make whatever the integrator kept or derived stale.
         self.integrator.forces_changed();
         self.solver = params.solver;
-        self.gravity = params.gravity;
+        self.gravity = gravity_of(effects);
         self.dt = params.dt;
         self.offset = params.collision_offset;
         if self.guard.policy != params.guard {
@@ -441,15 +437,13 @@ impl StepBackend for CpuStepper {
             return Ok(FrameOutcome::Stepped);
         }
         if self.guard.limits.is_none() {
-            let wind = self.wind;
             self.guard.limits = Some(GuardLimits::derive(
                 &self.guard.policy,
                 model,
                 state,
                 self.gravity,
                 &self.forces,
-                &self.colliders,
-                wind,
+                &self.effects,
             ));
         }
         self.frame_start.clone_from(state);
@@ -488,7 +482,7 @@ impl StepBackend for CpuStepper {
         self.integrator.kind()
     }
 
-    fn self_collision_work(&self) -> Option<super::self_collision::SelfWork> {
+    fn self_collision_work(&self) -> Option<SelfWork> {
         self.self_collision.map(|_| self.self_contacts.work)
     }
 }

@@ -5,9 +5,9 @@ use glam::Vec3;
 
 use crate::cloth::ClothModel;
 
+use super::effects::TooThick;
 use super::forces::ForceSet;
 use super::integrator::IntegratorKind;
-use super::self_collision::TooThick;
 
 /// Power-iteration sweeps for the stiffest vibration: the estimate (a Rayleigh quotient,
 /// never above the true value) is within a few percent of it on a grid cloth by then.

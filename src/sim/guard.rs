@@ -6,8 +6,8 @@ use glam::Vec3;
 use crate::cloth::{ClothModel, ClothState};
 use crate::mesh::{SpringKind, bounds};
 
-use super::collider::Collider;
 use super::diagnosis::Cause;
+use super::effects::{Effect, Gravity};
 use super::forces::ForceSet;
 use super::guard_policy::GuardPolicy;
 use super::integrator::{IntegratorKind, StepError};
@@ -94,18 +94,18 @@ impl Motion {
 
 impl GuardLimits {
     /// Limits for `state` of `model` under `gravity` with the spring terms of `forces`,
-    /// among `colliders`, with an ambient `wind` speed (m/s): the speeds and energy
-    /// the scene can reach by falling, being thrown, being dragged or springing back from
-    /// the stretch it has, and the larger of the stretch of a structural spring carrying
-    /// the whole weight and the largest stretch it has, times the policy's headroom.
+    /// among `effects` (their solids' lowest points and fastest surfaces, the fastest
+    /// wind): the speeds and energy the scene can reach by falling, being thrown, being
+    /// dragged or springing back from the stretch it has, and the larger of the stretch of
+    /// a structural spring carrying the whole weight and the largest stretch it has, times
+    /// the policy's headroom.
     pub fn derive(
         policy: &GuardPolicy,
         model: &ClothModel,
         state: &ClothState,
         gravity: Vec3,
         forces: &ForceSet,
-        colliders: &[Collider],
-        wind: f32,
+        effects: &[Effect],
     ) -> Self {
         let g = gravity.length();
         let up = if g > 0.0 { -gravity / g } else { Vec3::Y };
@@ -113,20 +113,13 @@ impl GuardLimits {
         let lowest = (state.pos.iter()).fold(f32::INFINITY, |m, x| m.min(up.dot(*x)));
         let lowest = if lowest.is_finite() { lowest } else { 0.0 };
         let mut bottom = lowest;
-        let mut surface = 0.0f32;
-        for c in colliders {
-            match *c {
-                Collider::Sphere {
-                    center,
-                    radius,
-                    spin,
-                    ..
-                } => {
-                    bottom = bottom.min(up.dot(center) - radius);
-                    surface = surface.max(spin.length() * radius);
-                }
-                Collider::Plane { point, .. } => bottom = bottom.min(up.dot(point)),
+        let (mut surface, mut wind) = (0.0f32, 0.0f32);
+        for share in effects.iter().map(|e| e.guard(up)) {
+            if let Some(floor) = share.floor {
+                bottom = bottom.min(floor);
             }
+            surface = surface.max(share.surface_speed);
+            wind = wind.max(share.flow_speed);
         }
         // The cloth can fall its own size plus down to the lowest thing below it.
         let height = (hi - lo).length() + (lowest - bottom).max(0.0);
@@ -138,9 +131,7 @@ impl GuardLimits {
         // loaded), never the integrator's: the springs' stretch and the energy stored in it
         // count as reachable, and a stretched cloth let go can fling its lightest particle
         // at up to the speed that energy gives it.
-        let elastic: f64 = (forces.springs())
-            .map(|s| s.potential_energy(&model.springs, &state.pos))
-            .sum();
+        let elastic = stored_energy(model, forces, &state.pos);
         let lightest = free().map(|(m, _)| *m).fold(f32::INFINITY, f32::min);
         let flung = if lightest > 0.0 && lightest.is_finite() {
             (2.0 * elastic / lightest as f64).sqrt() as f32
@@ -253,6 +244,15 @@ impl GuardLimits {
             limit,
         })
     }
+}
+
+/// The energy stored in the cloth at `pos`, joules: every conservative term's but gravity's
+/// (the height the cloth can fall accounts for that), so the springs' and the hinges'.
+fn stored_energy(model: &ClothModel, forces: &ForceSet, pos: &[Vec3]) -> f64 {
+    (forces.terms().iter())
+        .filter(|t| t.get::<Gravity>().is_none())
+        .map(|t| t.potential_energy(model, pos))
+        .sum()
 }
 
 /// Relative stretch of the weakest structural spring (the smallest k·l) pulled by `weight`

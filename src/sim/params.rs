@@ -1,7 +1,5 @@
 //! Simulation parameters, in SI units, with the defaults the scenarios start from.
 
-use glam::Vec3;
-
 use super::guard_policy::GuardPolicy;
 use super::integrator::IntegratorKind;
 use super::param_error::ParamError;
@@ -18,17 +16,12 @@ pub struct SimParams {
     /// when stiffening the cloth or lightening it.
     pub substeps: u32,
     pub integrator: IntegratorKind,
-    /// Gravitational acceleration, m/s² (default −9.81 ŷ).
-    pub gravity: Vec3,
     /// Spring stiffness per kind `[structural, shear, bend]`, N/m. Higher is stiffer and needs
     /// more substeps.
     pub stiffness: [f32; 3],
     /// Spring damping per kind along the spring, N·s/m. Damps stretching oscillations;
     /// excessive values also limit the stable step.
     pub damping: [f32; 3],
-    /// Air damping, 1/s (default 0.5): every free particle feels `−air_damping · v` per unit
-    /// mass, so a swinging cloth loses most of its motion within a few seconds.
-    pub air_damping: f32,
     /// Areal density of the cloth, kg/m² (default 0.2, a light cotton). Changing it rebuilds
     /// the masses.
     pub density: f32,
@@ -79,10 +72,8 @@ impl Default for SimParams {
             dt: 1.0 / 60.0,
             substeps: 48,
             integrator: IntegratorKind::SemiImplicitEuler,
-            gravity: Vec3::new(0.0, -9.81, 0.0),
             stiffness: [400.0, 150.0, 20.0],
             damping: [0.02, 0.01, 0.002],
-            air_damping: 0.5,
             density: 0.2,
             collision_offset: 0.01,
             guard: GuardPolicy::default(),
@@ -104,13 +95,6 @@ impl SimParams {
                 self.dt,
                 self.dt > 0.0 && self.dt <= 1.0,
                 "0 < dt ≤ 1 s",
-            ),
-            ("gravity", self.gravity.length(), true, "finite"),
-            (
-                "air_damping",
-                self.air_damping,
-                self.air_damping >= 0.0,
-                "≥ 0 1/s",
             ),
             ("density", self.density, self.density > 0.0, "> 0 kg/m²"),
             (
@@ -189,15 +173,13 @@ mod tests {
     #[test]
     fn each_bad_value_is_named() {
         type Spoil = fn(&mut SimParams);
-        let cases: [(&str, Spoil); 8] = [
+        let cases: [(&str, Spoil); 6] = [
             ("dt", |p| p.dt = 0.0),
             ("dt", |p| p.dt = f32::NAN),
             ("substeps", |p| p.substeps = 0),
-            ("gravity", |p| p.gravity.y = f32::INFINITY),
             ("stiffness", |p| p.stiffness[1] = -1.0),
             ("damping", |p| p.damping[2] = f32::NAN),
             ("density", |p| p.density = 0.0),
-            ("air_damping", |p| p.air_damping = -0.1),
         ];
         for (name, spoil) in cases {
             let mut p = SimParams::default();

@@ -5,86 +5,13 @@ use egui::{DragValue, RichText, Slider};
 use glam::Vec3;
 
 use crate::mesh::{SpringKind, bounds};
-use crate::scene::Simulation;
-use crate::sim::{BendingModel, Collider, Effect, SelfCollision, SimParams, Wind, shortest_edge};
+use crate::sim::{
+    BendingModel, ClothBox, DEFAULT_DIHEDRAL_STIFFNESS, Effect, Plane, SimParams, Sphere, Wind,
+    shortest_edge,
+};
 
 use super::super::panel::{Action, Panel, PanelContext};
 use super::sliders::spring_sliders;
-
-/// Dihedral stiffness offered when switching from bend springs, N·m.
-const DEFAULT_DIHEDRAL_STIFFNESS: f32 = 2e-3;
-
-/// What a user can add, with the label of its menu entry.
-const ADDABLE: [(&str, Addable); 7] = [
-    ("Gravity", Addable::Gravity),
-    ("Air damping", Addable::AirDamping),
-    ("Bending (springs)", Addable::Bending),
-    ("Wind", Addable::Wind),
-    ("Self-collision", Addable::SelfCollision),
-    ("Sphere", Addable::Sphere),
-    ("Ground plane", Addable::Plane),
-];
-
-#[derive(Clone, Copy, PartialEq)]
-enum Addable {
-    Gravity,
-    AirDamping,
-    Bending,
-    Wind,
-    SelfCollision,
-    Sphere,
-    Plane,
-}
-
-impl Addable {
-    /// Whether the scene already has one (one of each, except spheres).
-    fn present(self, effects: &[Effect]) -> bool {
-        effects.iter().any(|e| {
-            matches!(
-                (self, e),
-                (Addable::Gravity, Effect::Gravity)
-                    | (Addable::AirDamping, Effect::AirDamping)
-                    | (Addable::Bending, Effect::Bending(_))
-                    | (Addable::Wind, Effect::Wind(_))
-                    | (Addable::SelfCollision, Effect::SelfCollision(_))
-                    | (Addable::Plane, Effect::Collider(Collider::Plane { .. }))
-            )
-        })
-    }
-
-    /// The effect with sensible settings for the cloth as it is now.
-    fn create(self, sim: &Simulation) -> Effect {
-        let (lo, hi) = bounds(&sim.state().pos);
-        let size = (hi - lo).max_element().max(0.1);
-        match self {
-            Addable::Gravity => Effect::Gravity,
-            Addable::AirDamping => Effect::AirDamping,
-            Addable::Bending => Effect::Bending(BendingModel::Springs),
-            Addable::Wind => Effect::Wind(Wind::default()),
-            // Well under the shortest edge, so neighbours are not pushed apart.
-            Addable::SelfCollision => Effect::SelfCollision(SelfCollision {
-                thickness: (0.25 * shortest_edge(sim.model())).min(0.05),
-                ..SelfCollision::default()
-            }),
-            // Just under the cloth's middle, so it falls onto it.
-            Addable::Sphere => {
-                let radius = 0.25 * size;
-                let mid = 0.5 * (lo + hi);
-                Effect::Collider(Collider::Sphere {
-                    center: Vec3::new(mid.x, lo.y - 0.05 * size - radius, mid.z),
-                    radius,
-                    spin: Vec3::ZERO,
-                    friction: 0.5,
-                })
-            }
-            Addable::Plane => Effect::Collider(Collider::Plane {
-                point: Vec3::new(0.0, lo.y - 0.5 * size, 0.0),
-                normal: Vec3::Y,
-                friction: 0.5,
-            }),
-        }
-    }
-}
 
 /// The Effects section.
 #[derive(Default)]
@@ -101,9 +28,9 @@ impl Panel for EffectsPanel {
         for (i, effect) in effects.iter_mut().enumerate() {
             ui.push_id(i, |ui| {
                 ui.horizontal(|ui| {
-                    ui.label(RichText::new(title(effect)).strong());
+                    ui.label(RichText::new(effect.title()).strong());
                     // The springs are the cloth itself.
-                    if !matches!(effect, Effect::Springs)
+                    if !matches!(effect, Effect::Springs(_))
                         && ui
                             .small_button("Remove")
                             .on_hover_text("stop simulating this effect")
@@ -125,14 +52,17 @@ impl Panel for EffectsPanel {
         egui::ComboBox::from_label("Add effect")
             .selected_text("choose…")
             .show_ui(ui, |ui| {
-                for (label, kind) in ADDABLE {
-                    if !kind.present(&effects) && ui.selectable_label(false, label).clicked() {
-                        added = Some(kind);
+                for kind in Effect::addable() {
+                    let cloth = cloth_box(ctx);
+                    let effect = (kind.make)(&cloth);
+                    let present = effects.iter().any(|e| e.same_kind(&effect));
+                    if (kind.many || !present) && ui.selectable_label(false, kind.title).clicked() {
+                        added = Some(effect);
                     }
                 }
             });
-        if let Some(kind) = added {
-            effects.push(kind.create(ctx.sim));
+        if let Some(effect) = added {
+            effects.push(effect);
             effects_changed = true;
         }
         if params_changed {
@@ -145,16 +75,13 @@ impl Panel for EffectsPanel {
     }
 }
 
-fn title(effect: &Effect) -> &'static str {
-    match effect {
-        Effect::Gravity => "Gravity",
-        Effect::Springs => "Springs (structural, shear)",
-        Effect::AirDamping => "Air damping",
-        Effect::Bending(_) => "Bending",
-        Effect::Wind(_) => "Wind",
-        Effect::SelfCollision(_) => "Self-collision",
-        Effect::Collider(Collider::Sphere { .. }) => "Sphere",
-        Effect::Collider(Collider::Plane { .. }) => "Ground plane",
+/// The cloth as the suggested settings of a new effect see it.
+fn cloth_box(ctx: &PanelContext<'_>) -> ClothBox {
+    let (lo, hi) = bounds(&ctx.sim.state().pos);
+    ClothBox {
+        lo,
+        hi,
+        shortest_edge: shortest_edge(ctx.sim.model()),
     }
 }
 
@@ -168,22 +95,22 @@ fn effect_controls(
 ) -> (bool, bool) {
     let (mut p, mut e) = (false, false);
     match effect {
-        Effect::Gravity => {
-            p |= ui
+        Effect::Gravity(g) => {
+            e |= ui
                 .add(
-                    Slider::new(&mut params.gravity.y, -30.0..=0.0)
+                    Slider::new(&mut g.acceleration.y, -30.0..=0.0)
                         .suffix(" m/s²")
                         .text("g"),
                 )
                 .changed();
         }
-        Effect::Springs => {
+        Effect::Springs(_) => {
             ui.label(RichText::new("stiffness and damping: Material").weak());
         }
-        Effect::AirDamping => {
-            p |= ui
+        Effect::AirDamping(a) => {
+            e |= ui
                 .add(
-                    Slider::new(&mut params.air_damping, 0.0..=5.0)
+                    Slider::new(&mut a.rate, 0.0..=5.0)
                         .suffix(" 1/s")
                         .text("rate"),
                 )
@@ -235,7 +162,8 @@ fn effect_controls(
                 .add(Slider::new(&mut s.friction, 0.0..=2.0).text("friction μ"))
                 .changed();
         }
-        Effect::Collider(collider) => e |= collider_controls(ui, collider),
+        Effect::Sphere(sphere) => e |= sphere_controls(ui, sphere),
+        Effect::Plane(plane) => e |= plane_controls(ui, plane),
     }
     (p, e)
 }
@@ -290,59 +218,53 @@ fn wind_controls(ui: &mut egui::Ui, wind: &mut Wind) -> bool {
     changed
 }
 
-fn collider_controls(ui: &mut egui::Ui, collider: &mut Collider) -> bool {
+fn sphere_controls(ui: &mut egui::Ui, sphere: &mut Sphere) -> bool {
     let mut changed = false;
-    match collider {
-        Collider::Sphere {
-            center,
-            radius,
-            spin,
-            friction,
-        } => {
-            ui.horizontal(|ui| {
-                ui.label("centre");
-                for c in [&mut center.x, &mut center.y, &mut center.z] {
-                    changed |= ui.add(DragValue::new(c).speed(0.01).suffix(" m")).changed();
-                }
-            });
-            // A signed rate about an axis that points up (or along +x, +z when level).
-            let mut axis = spin.try_normalize().unwrap_or(Vec3::Y);
-            if axis.dot(Vec3::new(1e-3, 1.0, 1e-6)) < 0.0 {
-                axis = -axis;
-            }
-            let mut rate = spin.dot(axis);
-            changed |= ui
-                .add(Slider::new(radius, 0.01..=2.0).suffix(" m").text("radius"))
-                .changed();
-            if ui
-                .add(
-                    Slider::new(&mut rate, -10.0..=10.0)
-                        .suffix(" rad/s")
-                        .text("spin"),
-                )
-                .changed()
-            {
-                *spin = axis * rate;
-                changed = true;
-            }
-            changed |= ui
-                .add(Slider::new(friction, 0.0..=2.0).text("friction μ"))
-                .changed();
+    ui.horizontal(|ui| {
+        ui.label("centre");
+        let c = &mut sphere.center;
+        for c in [&mut c.x, &mut c.y, &mut c.z] {
+            changed |= ui.add(DragValue::new(c).speed(0.01).suffix(" m")).changed();
         }
-        Collider::Plane {
-            point, friction, ..
-        } => {
-            changed |= ui
-                .add(
-                    Slider::new(&mut point.y, -5.0..=5.0)
-                        .suffix(" m")
-                        .text("height"),
-                )
-                .changed();
-            changed |= ui
-                .add(Slider::new(friction, 0.0..=2.0).text("friction μ"))
-                .changed();
-        }
+    });
+    // A signed rate about an axis that points up (or along +x, +z when level).
+    let mut axis = sphere.spin.try_normalize().unwrap_or(Vec3::Y);
+    if axis.dot(Vec3::new(1e-3, 1.0, 1e-6)) < 0.0 {
+        axis = -axis;
+    }
+    let mut rate = sphere.spin.dot(axis);
+    changed |= ui
+        .add(
+            Slider::new(&mut sphere.radius, 0.01..=2.0)
+                .suffix(" m")
+                .text("radius"),
+        )
+        .changed();
+    if ui
+        .add(
+            Slider::new(&mut rate, -10.0..=10.0)
+                .suffix(" rad/s")
+                .text("spin"),
+        )
+        .changed()
+    {
+        sphere.spin = axis * rate;
+        changed = true;
     }
     changed
+        | ui.add(Slider::new(&mut sphere.friction, 0.0..=2.0).text("friction μ"))
+            .changed()
+}
+
+fn plane_controls(ui: &mut egui::Ui, plane: &mut Plane) -> bool {
+    let height = ui
+        .add(
+            Slider::new(&mut plane.point.y, -5.0..=5.0)
+                .suffix(" m")
+                .text("height"),
+        )
+        .changed();
+    height
+        | ui.add(Slider::new(&mut plane.friction, 0.0..=2.0).text("friction μ"))
+            .changed()
 }

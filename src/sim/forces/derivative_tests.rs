@@ -3,11 +3,10 @@
 
 use glam::Vec3;
 
-use super::{
-    AirDamping, Force, ForceSet, Gravity, JacobianMode, SpringForce, SystemMatrix, SystemProduct,
-};
+use super::{Force, ForceSet, JacobianMode, SpringForce, SystemMatrix, SystemProduct};
 use crate::cloth::ClothModel;
 use crate::mesh::{GridOrientation, GridSpec};
+use crate::sim::effects::{AirDamping, Gravity};
 use crate::sim::kernels::{Components, split};
 
 /// A small deterministic generator (xorshift), so the tests need no dependency.
@@ -49,22 +48,21 @@ fn random_state(model: &ClothModel, rng: &mut Rng) -> (Vec<Vec3>, Vec<Vec3>) {
     (pos, rng.vecs(model.particle_count(), 1.0))
 }
 
+/// The springs, with damping well above the defaults, so the dashpot's direction term
+/// matters.
+fn spring_term(model: &ClothModel) -> SpringForce {
+    SpringForce::new(&model.springs, [400.0, 150.0, 20.0], [0.5, 0.3, 0.1])
+}
+
 fn springs(model: &ClothModel) -> Force {
-    // Damping well above the defaults, so the dashpot's direction term matters.
-    Force::Springs(SpringForce::new(
-        &model.springs,
-        [400.0, 150.0, 20.0],
-        [0.5, 0.3, 0.1],
-    ))
+    Force::new("springs", spring_term(model))
 }
 
 fn every_term(model: &ClothModel) -> Vec<Force> {
     vec![
-        Force::Gravity(Gravity {
-            g: Vec3::new(0.0, -9.81, 0.0),
-        }),
+        Force::new("gravity", Gravity::default()),
         springs(model),
-        Force::AirDamping(AirDamping { rate: 0.7 }),
+        Force::new("air-damping", AirDamping { rate: 0.7 }),
     ]
 }
 
@@ -174,7 +172,7 @@ fn spring_velocity_derivative_matches_finite_differences() {
 
 #[test]
 fn air_damping_derivatives_match_finite_differences() {
-    let term = || vec![Force::AirDamping(AirDamping { rate: 0.7 })];
+    let term = || vec![Force::new("air-damping", AirDamping { rate: 0.7 })];
     let err = worst_error(term(), Wrt::Velocity, JacobianMode::Exact, 10);
     assert!(err <= 1e-3, "∂f/∂v relative error {err}");
     let err = worst_error(term(), Wrt::Position, JacobianMode::Exact, 10);
@@ -183,11 +181,7 @@ fn air_damping_derivatives_match_finite_differences() {
 
 #[test]
 fn gravity_has_zero_derivatives() {
-    let term = || {
-        vec![Force::Gravity(Gravity {
-            g: Vec3::new(0.0, -9.81, 0.0),
-        })]
-    };
+    let term = || vec![Force::new("gravity", Gravity::default())];
     for wrt in [Wrt::Position, Wrt::Velocity] {
         let err = worst_error(term(), wrt, JacobianMode::Exact, 5);
         assert!(
@@ -227,9 +221,7 @@ fn the_definite_form_is_not_the_exact_derivative() {
 #[test]
 fn both_forms_agree_for_stretched_springs_at_rest() {
     let model = small_cloth();
-    let Force::Springs(s) = springs(&model) else {
-        unreachable!()
-    };
+    let s = spring_term(&model);
     let pos: Vec<Vec3> = model.rest_positions.iter().map(|&p| p * 1.1).collect();
     let vel = vec![Vec3::new(0.3, -0.2, 0.1); model.particle_count()];
     for e in 0..model.springs.len() {

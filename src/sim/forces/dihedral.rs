@@ -7,6 +7,8 @@ use glam::Vec3;
 
 use crate::cloth::ClothModel;
 
+use super::force_term::ForceTerm;
+
 /// The hinges of a cloth with their rest angles and weights, and a stiffness (N·m).
 #[derive(Clone, Debug, PartialEq)]
 pub struct DihedralBending {
@@ -133,5 +135,15 @@ impl DihedralBending {
                 f[i as usize] += scale * g;
             }
         }
+    }
+}
+
+impl ForceTerm for DihedralBending {
+    fn add_forces(&self, model: &ClothModel, pos: &[Vec3], _vel: &[Vec3], _t: f64, f: &mut [Vec3]) {
+        DihedralBending::add_forces(self, model, pos, f);
+    }
+
+    fn potential_energy(&self, model: &ClothModel, pos: &[Vec3]) -> f64 {
+        DihedralBending::potential_energy(self, model, pos)
     }
 }

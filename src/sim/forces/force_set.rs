@@ -8,12 +8,10 @@ use glam::Vec3;
 use crate::cloth::ClothModel;
 
 use super::super::constraints::DistanceConstraints;
-use super::super::effect::{BendingModel, Effect};
+use super::super::effects::Effect;
 use super::super::params::SimParams;
-use super::air_damping::AirDamping;
-use super::dihedral::DihedralBending;
-use super::force::{Force, Fused};
-use super::gravity::Gravity;
+use super::force::Force;
+use super::force_term::Fused;
 use super::jacobian::{JacobianMode, SystemMatrix};
 use super::springs::SpringForce;
 use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team, share};
@@ -28,7 +26,7 @@ const PIECES_PER_MEMBER: usize = 4;
 const MAX_TERMS: usize = 8;
 
 /// The scene's force terms, built from its effect list: an absent effect has no term.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Debug, Default)]
 pub struct ForceSet {
     terms: Vec<Force>,
     /// Simulated time the forces are evaluated at (the wind's gusts move with it), seconds.
@@ -82,54 +80,14 @@ impl ForceSet {
         self.time = time;
     }
 
-    /// Rebuilds the term list for `effects` and `params`, keeping the per-spring expansion
-    /// when the spring strengths did not change.
+    /// Rebuilds the term list for `effects` and `params`: each effect's term
+    /// ([`Effect::force`]), keeping what the terms before derived (the springs' expansion
+    /// and runs, the hinges' rest angles) where it still holds.
     pub fn configure(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]) {
         let old = std::mem::take(&mut self.terms);
-        let kept_springs = old.iter().find_map(|t| match t {
-            Force::Springs(s) => Some(s),
-            _ => None,
-        });
-        let kept_bend_springs = old.iter().find_map(|t| match t {
-            Force::BendSprings(s) => Some(s),
-            _ => None,
-        });
-        let kept_bending = old.iter().find_map(|t| match t {
-            Force::Bending(b) => Some(b),
-            _ => None,
-        });
-        let bend_start = model.bend_start();
-        let (stiffness, damping) = (params.stiffness, params.damping);
-        let springs = |kept: Option<&SpringForce>, range: std::ops::Range<usize>| {
-            let mut s = kept
-                .filter(|s| s.range() == range)
-                .cloned()
-                .unwrap_or_else(|| SpringForce::over(&model.springs, range, stiffness, damping));
-            s.set_strengths(&model.springs, stiffness, damping);
-            s
-        };
-        for effect in effects {
-            let term = match effect {
-                Effect::Gravity => Force::Gravity(Gravity { g: params.gravity }),
-                Effect::AirDamping => Force::AirDamping(AirDamping {
-                    rate: params.air_damping,
-                }),
-                Effect::Springs => Force::Springs(springs(kept_springs, 0..bend_start)),
-                Effect::Bending(BendingModel::Springs) => {
-                    Force::BendSprings(springs(kept_bend_springs, bend_start..model.springs.len()))
-                }
-                Effect::Bending(BendingModel::Dihedral { stiffness }) => {
-                    let mut b = kept_bending
-                        .cloned()
-                        .unwrap_or_else(|| DihedralBending::new(model, *stiffness));
-                    b.set_stiffness(*stiffness);
-                    Force::Bending(b)
-                }
-                Effect::Wind(w) => Force::Wind(*w),
-                Effect::SelfCollision(_) | Effect::Collider(_) => continue,
-            };
-            self.terms.push(term);
-        }
+        self.terms = (effects.iter())
+            .filter_map(|e| e.force(model, params, &old))
+            .collect();
     }
 
     pub fn terms(&self) -> &[Force] {
@@ -138,10 +96,7 @@ impl ForceSet {
 
     /// The spring terms (structural and shear, and bend springs when present).
     pub fn springs(&self) -> impl Iterator<Item = &SpringForce> {
-        self.terms.iter().filter_map(|t| match t {
-            Force::Springs(s) | Force::BendSprings(s) => Some(s),
-            _ => None,
-        })
+        self.terms.iter().filter_map(Force::springs)
     }
 
     /// The springs as distance constraints (empty without springs).
@@ -214,10 +169,10 @@ impl ForceSet {
         }
     }
 
-    /// Whether every term [takes components](Force::takes_components), so that
+    /// Whether every term [takes components](super::ForceTerm::takes_components), so that
     /// [`ForceSet::forces_components_timed`] gives the whole force.
     pub fn takes_components(&self) -> bool {
-        self.terms.iter().all(Force::takes_components)
+        self.terms.iter().all(|t| t.takes_components())
     }
 
     /// As [`ForceSet::forces_timed`] (all terms) with positions, velocities and forces
@@ -237,7 +192,13 @@ impl ForceSet {
         self.each_term(
             |_| true,
             Some(times),
-            |term| whole &= term.add_forces_components(model, pos, vel, f),
+            |term| {
+                if term.takes_components() {
+                    term.add_forces_components(model, pos, vel, f);
+                } else {
+                    whole = false;
+                }
+            },
         );
         whole
     }
@@ -251,7 +212,7 @@ impl ForceSet {
     /// they are zeroed), and `then`. Both sections are cut into pieces that the team's
     /// members take as they come ([`Team::run_pieces`]). A term's time is the calling
     /// thread's time on the pieces it ran; their sum is returned. `None`, with nothing done,
-    /// when a term does not [take components](Force::takes_components) or the arrays are
+    /// when a term does not [take components](super::ForceTerm::takes_components) or the arrays are
     /// shorter than the springs reach.
     pub fn fused_components(
         &self,

@@ -10,10 +10,11 @@ use std::sync::OnceLock;
 
 use glam::{Mat3, Vec3};
 
-use crate::cloth::Springs;
+use crate::cloth::{ClothModel, Springs};
 
 use crate::sim::kernels::{Components, SpringRuns, TwoPasses};
 
+use super::force_term::{ForceTerm, Fused};
 use super::jacobian::{JacobianMode, SpringBlock, SystemMatrix};
 use crate::sim::constraints::DistanceConstraints;
 
@@ -300,4 +301,65 @@ fn apply_pair(springs: &Springs, e: usize, block: Mat3, u: &[Vec3], out: &mut [V
     let t = block * (u[b] - u[a]);
     out[a] += t;
     out[b] -= t;
+}
+
+impl ForceTerm for SpringForce {
+    fn add_forces(&self, model: &ClothModel, pos: &[Vec3], vel: &[Vec3], _t: f64, f: &mut [Vec3]) {
+        SpringForce::add_forces(self, &model.springs, pos, vel, f);
+    }
+
+    fn takes_components(&self) -> bool {
+        true
+    }
+
+    fn add_forces_components(
+        &self,
+        model: &ClothModel,
+        pos: &Components,
+        vel: &Components,
+        f: &mut Components,
+    ) {
+        SpringForce::add_forces_components(self, &model.springs, pos, vel, f);
+    }
+
+    fn fused<'a>(&'a self, model: &ClothModel) -> Fused<'a> {
+        Fused::TwoPasses(self.two_passes(&model.springs))
+    }
+
+    fn potential_energy(&self, model: &ClothModel, pos: &[Vec3]) -> f64 {
+        SpringForce::potential_energy(self, &model.springs, pos)
+    }
+
+    fn add_df_dx(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        u: &[Vec3],
+        mode: JacobianMode,
+        out: &mut [Vec3],
+    ) {
+        SpringForce::add_df_dx(self, &model.springs, pos, vel, u, mode, out);
+    }
+
+    fn add_df_dv(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        u: &[Vec3],
+        out: &mut [Vec3],
+    ) {
+        SpringForce::add_df_dv(self, &model.springs, pos, vel, u, out);
+    }
+
+    fn add_to_system(
+        &self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        vel: &[Vec3],
+        sys: &mut SystemMatrix,
+    ) {
+        SpringForce::add_to_system(self, &model.springs, pos, vel, sys);
+    }
 }

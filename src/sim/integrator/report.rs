@@ -1,6 +1,6 @@
 //! What a step reports: its cost, or why it could not be taken.
 
-use crate::sim::self_collision::ContactError;
+use crate::sim::self_contacts::ContactError;
 
 /// What one step cost.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

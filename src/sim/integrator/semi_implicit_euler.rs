@@ -123,7 +123,7 @@ impl Integrator for SemiImplicitEuler {
     }
 
     /// On component arrays from the first step to the last (no term that takes them
-    /// depends on time: [`Force::takes_components`](crate::sim::forces::Force::takes_components)).
+    /// depends on time: [`ForceTerm::takes_components`](crate::sim::forces::ForceTerm::takes_components)).
     fn steps(
         &mut self,
         ctx: &mut StepContext<'_>,

@@ -112,7 +112,7 @@ impl Integrator for Xpbd {
             self.scaled.h = None;
             self.built = true;
         }
-        let not_springs = |t: &Force| !matches!(t, Force::Springs(_) | Force::BendSprings(_));
+        let not_springs = |t: &Force| t.springs().is_none();
         ctx.forces_where(&state.pos, &state.vel, not_springs, &mut self.force);
         let w = &model.inv_mass;
         self.moved.clear();

@@ -1,5 +1,5 @@
-//! Self-collision: particle against triangle, so cloth folds onto itself without passing
-//! through itself. Candidates come from a hierarchical spatial hash (triangles binned by
+//! Self-collision's solver: particle against triangle, so cloth folds onto itself without
+//! passing through itself. Candidates come from a hierarchical spatial hash (triangles binned by
 //! their box grown by the thickness, sorted by cell, each at the level whose cells are as
 //! large as the box), so the work grows with the particle count, not its square, and the
 //! table holds at most eight entries a triangle however the cloth is stretched.
@@ -7,82 +7,6 @@
 use glam::Vec3;
 
 use crate::cloth::{ClothModel, ClothState};
-
-/// The cloth's thickness against itself and its friction.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct SelfCollision {
-    /// Particles are kept this far from every triangle they are not a corner of, metres
-    /// (below the cloth's shortest rest edge, which [`SelfCollision::fits`] checks; a
-    /// quarter of it is a good start).
-    pub thickness: f32,
-    /// Coulomb friction between layers (dimensionless).
-    pub friction: f32,
-}
-
-/// A self-collision thickness the cloth cannot take: at or above its shortest rest edge,
-/// every particle would start inside its neighbours' triangles and be pushed off them.
-#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
-#[error(
-    "self-collision `thickness` = {} m is not below the cloth's shortest rest edge, {} m: \
-     every particle would start in contact with its neighbours' triangles and be pushed off \
-     them; use at most a quarter of the edge ({} m)",
-    significant(*thickness),
-    significant(*edge),
-    significant(0.25 * edge)
-)]
-pub struct TooThick {
-    /// The thickness asked for, metres.
-    pub thickness: f32,
-    /// The cloth's shortest rest edge, metres.
-    pub edge: f32,
-}
-
-/// `x` to three significant digits, without trailing zeros (0.0416666 → "0.0417").
-fn significant(x: f32) -> String {
-    if !(x.is_finite() && x > 0.0) {
-        return x.to_string();
-    }
-    let decimals = (2 - x.log10().floor() as i32).max(0) as usize;
-    let text = format!("{x:.decimals$}");
-    if text.contains('.') {
-        text.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        text
-    }
-}
-
-impl SelfCollision {
-    /// Checks the thickness against a cloth whose shortest rest edge is `edge` metres.
-    ///
-    /// # Errors
-    /// [`TooThick`] when the thickness is at or above the edge.
-    pub fn fits(&self, edge: f32) -> Result<(), TooThick> {
-        if self.thickness >= edge {
-            return Err(TooThick {
-                thickness: self.thickness,
-                edge,
-            });
-        }
-        Ok(())
-    }
-}
-
-/// The shortest rest length among the cloth's mesh edges, metres (infinite without edges).
-pub fn shortest_edge(model: &ClothModel) -> f32 {
-    model.springs.rest[..model.mesh_edges.min(model.springs.len())]
-        .iter()
-        .fold(f32::INFINITY, |m, &r| m.min(r))
-}
-
-impl Default for SelfCollision {
-    fn default() -> Self {
-        Self {
-            thickness: 0.01,
-            friction: 0.3,
-        }
-    }
-}
 
 /// Work done by the last resolve: for cost checks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -183,23 +107,24 @@ fn closest_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, [f32; 3]) {
 }
 
 impl SelfContacts {
-    /// Keeps every particle at least `params.thickness` from every triangle it is not a
+    /// Keeps every particle at least `thickness` (m) from every triangle it is not a
     /// corner of, on the side it was on at the start of the substep (`start`): a particle
     /// over a triangle is pushed out along the triangle's normal, one beside it away from
     /// its closest point; particle and triangle share the correction by inverse mass.
-    /// Approaching relative velocity is removed and friction applied. Returns the contacts.
+    /// Approaching relative velocity is removed and Coulomb `friction` applied. Returns the
+    /// contacts.
     ///
     /// # Errors
     /// [`ContactError`] for a state that has blown up (a non-finite position, or a triangle
     /// a million times wider than the cloth's scale); nothing is binned or moved then.
     pub fn resolve(
         &mut self,
-        params: &SelfCollision,
+        thickness: f32,
+        friction: f32,
         model: &ClothModel,
         start: &[Vec3],
         state: &mut ClothState,
     ) -> Result<usize, ContactError> {
-        let thickness = params.thickness;
         if thickness <= 0.0 || model.triangles.is_empty() {
             return Ok(0);
         }
@@ -229,7 +154,7 @@ impl SelfContacts {
                         continue;
                     }
                     work.candidates += 1;
-                    if push_apart(params, model, start, state, p, tri) {
+                    if push_apart([thickness, friction], model, start, state, p, tri) {
                         work.contacts += 1;
                     }
                 }
@@ -301,10 +226,10 @@ fn level_of(lo: Vec3, hi: Vec3, cell: f32) -> Option<(u32, [i32; 3], [i32; 3])> 
     })
 }
 
-/// Resolves particle `p` against triangle `tri` if closer than the thickness; returns
-/// whether it was.
+/// Resolves particle `p` against triangle `tri` if closer than `thickness`, with `friction`;
+/// returns whether it was.
 fn push_apart(
-    params: &SelfCollision,
+    [thickness, friction]: [f32; 2],
     model: &ClothModel,
     start: &[Vec3],
     state: &mut ClothState,
@@ -317,7 +242,7 @@ fn push_apart(
     let (closest, bary) = closest_on_triangle(x, a, b, c);
     let gap = x - closest;
     let dist = gap.length();
-    if dist >= params.thickness {
+    if dist >= thickness {
         return false;
     }
     let normal = (b - a).cross(c - a).normalize_or_zero();
@@ -340,7 +265,7 @@ fn push_apart(
     } else {
         normal
     };
-    let depth = params.thickness - gap.dot(direction);
+    let depth = thickness - gap.dot(direction);
     if depth <= 0.0 {
         return false;
     }
@@ -372,7 +297,7 @@ fn push_apart(
         let sliding = relative - approach * direction;
         let speed = sliding.length();
         let friction = if speed > 0.0 {
-            (params.friction * -approach / speed).min(1.0)
+            (friction * -approach / speed).min(1.0)
         } else {
             0.0
         };

@@ -4,6 +4,11 @@
 use glam::Vec3;
 
 use crate::cloth::ClothModel;
+use crate::sim::forces::{Force, ForceTerm};
+use crate::sim::param_error::ParamError;
+use crate::sim::params::SimParams;
+
+use super::effect_kind::{ClothBox, EffectKind, GuardShare};
 
 /// Wind with gusts, and the cloth's aerodynamic coefficients.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -72,16 +77,11 @@ impl Wind {
         );
         turned * speed * (1.0 + self.gust * strength)
     }
+}
 
+impl ForceTerm for Wind {
     /// Adds each triangle's drag and lift (N), a third to each corner, at time `t`.
-    pub fn add_forces(
-        &self,
-        model: &ClothModel,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        t: f64,
-        f: &mut [Vec3],
-    ) {
+    fn add_forces(&self, model: &ClothModel, pos: &[Vec3], vel: &[Vec3], t: f64, f: &mut [Vec3]) {
         let half_rho = 0.5 * self.air_density;
         for tri in &model.triangles {
             let [a, b, c] = tri.map(|i| i as usize);
@@ -110,5 +110,59 @@ impl Wind {
             f[b] += share;
             f[c] += share;
         }
+    }
+}
+
+impl EffectKind for Wind {
+    const NAME: &'static str = "wind";
+    const TITLE: &'static str = "Wind";
+    const MANY: bool = false;
+    const ADDABLE: bool = true;
+
+    fn check(&self) -> Result<(), ParamError> {
+        if !self.velocity.is_finite() {
+            return Err(ParamError::new(
+                "velocity",
+                self.velocity,
+                "must be finite m/s",
+            ));
+        }
+        if !(self.gust_period.is_finite() && self.gust_period > 0.0) {
+            return Err(ParamError::new(
+                "gust_period",
+                self.gust_period,
+                "must be > 0 s",
+            ));
+        }
+        for (key, value) in [
+            ("gust", self.gust),
+            ("drag", self.drag),
+            ("lift", self.lift),
+            ("air_density", self.air_density),
+        ] {
+            if !value.is_finite() {
+                return Err(ParamError::new(key, value, "must be finite"));
+            }
+        }
+        Ok(())
+    }
+
+    fn force(&self, _model: &ClothModel, _params: &SimParams, _kept: &[Force]) -> Option<Force> {
+        Some(Force::new(Self::NAME, *self))
+    }
+
+    fn guard(&self, _up: Vec3) -> GuardShare {
+        GuardShare {
+            flow_speed: self.peak_speed(),
+            ..GuardShare::default()
+        }
+    }
+
+    fn on_gpu(&self) -> Result<(), &'static str> {
+        Err("wind")
+    }
+
+    fn suggested(_cloth: &ClothBox) -> Self {
+        Self::default()
     }
 }

@@ -1,0 +1,53 @@
+//! The cloth's structural and shear springs: the cloth itself, in every scene (its
+//! stiffness and damping per kind are the material's).
+
+use crate::cloth::ClothModel;
+use crate::sim::forces::{Force, SpringForce};
+use crate::sim::params::SimParams;
+
+use super::effect_kind::{ClothBox, EffectKind};
+
+/// The structural and shear springs (every spring before the bend springs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ClothSprings;
+
+/// The springs of `model` over `range` with the material's strengths, reusing a spring
+/// term among `kept` over the same range (its regrouped runs) when there is one.
+pub(super) fn spring_term(
+    model: &ClothModel,
+    params: &SimParams,
+    kept: &[Force],
+    range: std::ops::Range<usize>,
+) -> SpringForce {
+    let (stiffness, damping) = (params.stiffness, params.damping);
+    let mut s = (kept.iter())
+        .filter_map(Force::springs)
+        .find(|s| s.range() == range)
+        .cloned()
+        .unwrap_or_else(|| SpringForce::over(&model.springs, range, stiffness, damping));
+    s.set_strengths(&model.springs, stiffness, damping);
+    s
+}
+
+impl EffectKind for ClothSprings {
+    const NAME: &'static str = "springs";
+    const TITLE: &'static str = "Springs (structural, shear)";
+    const MANY: bool = false;
+    const ADDABLE: bool = false;
+
+    fn force(&self, model: &ClothModel, params: &SimParams, kept: &[Force]) -> Option<Force> {
+        let range = 0..model.bend_start();
+        Some(Force::new(
+            Self::NAME,
+            spring_term(model, params, kept, range),
+        ))
+    }
+
+    fn on_gpu(&self) -> Result<(), &'static str> {
+        Ok(())
+    }
+
+    fn suggested(_cloth: &ClothBox) -> Self {
+        Self
+    }
+}

@@ -1,0 +1,125 @@
+//! Uniform gravity: `f = m·g`. Its derivatives are zero.
+
+use glam::Vec3;
+
+use crate::cloth::ClothModel;
+use crate::parallel::wide;
+use crate::parallel::{each_part, within};
+use crate::sim::forces::{Force, ForceTerm, Fused};
+use crate::sim::kernels::Components;
+use crate::sim::param_error::ParamError;
+use crate::sim::params::SimParams;
+
+use super::effect_kind::{ClothBox, EffectKind};
+
+/// Uniform gravitational acceleration.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Gravity {
+    /// m/s² (default 9.81 down the y axis).
+    pub acceleration: Vec3,
+}
+
+impl Default for Gravity {
+    fn default() -> Self {
+        Self {
+            acceleration: Vec3::new(0.0, -9.81, 0.0),
+        }
+    }
+}
+
+impl Gravity {
+    /// As [`ForceTerm::add_forces_components`] for one range of particles: `mass` and `f`
+    /// are that range's.
+    pub fn add_range(&self, mass: &[f32], f: [&mut [f32]; 3]) {
+        wide(
+            #[inline(always)]
+            || {
+                for (f, g) in f.into_iter().zip(self.acceleration.to_array()) {
+                    for (f, &m) in f.iter_mut().zip(mass) {
+                        *f += m * g;
+                    }
+                }
+            },
+        )
+    }
+}
+
+impl ForceTerm for Gravity {
+    /// Adds `m·g` (N) to every particle's force.
+    fn add_forces(
+        &self,
+        model: &ClothModel,
+        _pos: &[Vec3],
+        _vel: &[Vec3],
+        _t: f64,
+        f: &mut [Vec3],
+    ) {
+        for (f, &m) in f.iter_mut().zip(&model.mass) {
+            *f += m * self.acceleration;
+        }
+    }
+
+    fn takes_components(&self) -> bool {
+        true
+    }
+
+    fn add_forces_components(
+        &self,
+        model: &ClothModel,
+        _pos: &Components,
+        _vel: &Components,
+        f: &mut Components,
+    ) {
+        let [f0, f1, f2] = f;
+        each_part([f0, f1, f2], |range, f| {
+            self.add_range(within(&model.mass, range), f)
+        });
+    }
+
+    fn fused<'a>(&'a self, _model: &ClothModel) -> Fused<'a> {
+        Fused::Pointwise
+    }
+
+    fn add_pointwise(&self, mass: &[f32], _vel: [&[f32]; 3], f: [&mut [f32]; 3]) {
+        self.add_range(mass, f);
+    }
+
+    /// `−Σ m·g·x`, joules.
+    fn potential_energy(&self, model: &ClothModel, pos: &[Vec3]) -> f64 {
+        -pos.iter()
+            .zip(&model.mass)
+            .map(|(p, &m)| m as f64 * self.acceleration.dot(*p) as f64)
+            .sum::<f64>()
+    }
+}
+
+impl EffectKind for Gravity {
+    const NAME: &'static str = "gravity";
+    const TITLE: &'static str = "Gravity";
+    const MANY: bool = false;
+    const ADDABLE: bool = true;
+
+    fn check(&self) -> Result<(), ParamError> {
+        if !self.acceleration.is_finite() {
+            return Err(ParamError::new(
+                "acceleration",
+                self.acceleration,
+                "is out of range (finite)",
+            ));
+        }
+        Ok(())
+    }
+
+    fn force(&self, _model: &ClothModel, _params: &SimParams, _kept: &[Force]) -> Option<Force> {
+        Some(Force::new(Self::NAME, *self))
+    }
+
+    fn on_gpu(&self) -> Result<(), &'static str> {
+        Ok(())
+    }
+
+    fn suggested(_cloth: &ClothBox) -> Self {
+        Self::default()
+    }
+}

@@ -1,0 +1,75 @@
+//! What a scene's effects add up to, for those who need one number from them.
+
+use glam::Vec3;
+
+use crate::cloth::ClothModel;
+
+use super::registry::Effect;
+use super::self_collision::{TooThick, shortest_edge};
+
+/// The gravitational acceleration among `effects` (zero without gravity), m/s².
+pub fn gravity_of(effects: &[Effect]) -> Vec3 {
+    effects
+        .iter()
+        .find_map(|e| match e {
+            Effect::Gravity(g) => Some(g.acceleration),
+            _ => None,
+        })
+        .unwrap_or(Vec3::ZERO)
+}
+
+/// The air damping rate among `effects` (0 without air damping), 1/s.
+pub fn air_damping_of(effects: &[Effect]) -> f32 {
+    effects
+        .iter()
+        .find_map(|e| match e {
+            Effect::AirDamping(a) => Some(a.rate),
+            _ => None,
+        })
+        .unwrap_or(0.0)
+}
+
+/// Checks every self-collision among `effects` against `model`'s shortest rest edge.
+///
+/// # Errors
+/// [`TooThick`] for a thickness at or above it.
+pub fn thickness_fits(effects: &[Effect], model: &ClothModel) -> Result<(), TooThick> {
+    let edge = shortest_edge(model);
+    effects.iter().try_for_each(|e| match e {
+        Effect::SelfCollision(s) => s.fits(edge),
+        _ => Ok(()),
+    })
+}
+
+/// Smallest signed distance from any particle to any solid's surface among `effects`,
+/// metres; `None` without solids.
+pub fn min_surface_distance(effects: &[Effect], pos: &[Vec3]) -> Option<f32> {
+    effects
+        .iter()
+        .flat_map(|e| pos.iter().filter_map(move |&p| e.surface(p).map(|s| s.0)))
+        .reduce(f32::min)
+}
+
+/// A warning for each sphere smaller than the cloth's particle spacing (its median spring
+/// rest length): collisions are per particle, so such a sphere can pass between particles
+/// and the cloth's triangles over it.
+pub fn small_sphere_warnings(effects: &[Effect], model: &ClothModel) -> Vec<String> {
+    let mut rest = model.springs.rest.clone();
+    if rest.is_empty() {
+        return Vec::new();
+    }
+    rest.sort_by(f32::total_cmp);
+    let spacing = rest[rest.len() / 2];
+    effects
+        .iter()
+        .filter_map(|e| match e {
+            Effect::Sphere(s) if s.radius < spacing => Some(format!(
+                "a sphere of radius {:.3} m is smaller than the cloth's particle spacing \
+                 ({spacing:.3} m): collisions are per particle, so the cloth's triangles can pass \
+                 over it; use a finer cloth or a larger sphere",
+                s.radius
+            )),
+            _ => None,
+        })
+        .collect()
+}

@@ -1,0 +1,29 @@
+//! Effects are data: one type per effect, one file each, made variants of [`Effect`] by the
+//! list in `registry.rs`. A scene lists the effects it uses and only those run.
+
+mod air_damping;
+mod bending;
+mod cloth_springs;
+mod effect_kind;
+mod gravity;
+mod list;
+mod plane;
+mod registry;
+mod self_collision;
+mod solid;
+mod sphere;
+mod wind;
+
+pub use air_damping::AirDamping;
+pub use bending::{BendingModel, DEFAULT_DIHEDRAL_STIFFNESS};
+pub use cloth_springs::ClothSprings;
+pub use effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
+pub use gravity::Gravity;
+pub use list::{
+    air_damping_of, gravity_of, min_surface_distance, small_sphere_warnings, thickness_fits,
+};
+pub use plane::Plane;
+pub use registry::{Addable, Effect};
+pub use self_collision::{SelfCollision, TooThick, shortest_edge};
+pub use sphere::Sphere;
+pub use wind::Wind;

@@ -1,0 +1,146 @@
+//! A sphere the cloth cannot enter, still or spinning about its centre.
+
+use glam::Vec3;
+
+use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
+use super::solid::{Solid, default_friction, resolve};
+use crate::sim::param_error::ParamError;
+use crate::sim::self_contacts::ContactError;
+
+/// A sphere spinning with angular velocity `spin` (zero for a still one).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sphere {
+    /// Metres.
+    pub center: Vec3,
+    /// Metres.
+    pub radius: f32,
+    /// rad/s about each axis (axis × rate; default still).
+    #[serde(default)]
+    pub spin: Vec3,
+    /// Coulomb friction coefficient (dimensionless, default 0.5).
+    #[serde(default = "default_friction")]
+    pub friction: f32,
+}
+
+impl Solid for Sphere {
+    #[inline]
+    fn surface_at(&self, p: Vec3) -> (f32, Vec3, Vec3) {
+        let r = p - self.center;
+        let len = r.length();
+        let n = if len > 1e-9 { r / len } else { Vec3::Y };
+        (len - self.radius, n, self.spin.cross(n * self.radius))
+    }
+
+    /// A path entering the sphere is caught at its first contact: the part of the move
+    /// that points into the surface after it is removed (the part along it is kept, so
+    /// cloth still slides) before the particle is pushed out to `offset`; so a fast
+    /// particle cannot pass through, however small the sphere.
+    #[inline]
+    fn catch(&self, from: Vec3, to: Vec3, offset: f32) -> Option<Vec3> {
+        let center = self.center;
+        let reach = self.radius + offset;
+        let entry = first_entry(from - center, to - center, reach);
+        if entry.is_none() && (to - center).length_squared() >= reach * reach {
+            return None;
+        }
+        // Keep the move's tangential part at the first contact, drop what points in.
+        let moved = match entry {
+            Some(hit) => {
+                let n = hit.normalize_or(Vec3::Y);
+                let rest = (to - center) - hit;
+                hit + rest - rest.dot(n).min(0.0) * n
+            }
+            None => to - center,
+        };
+        let len = moved.length();
+        let n = if len > 1e-9 { moved / len } else { Vec3::Y };
+        Some(center + n * reach.max(len))
+    }
+
+    #[inline]
+    fn friction(&self) -> f32 {
+        self.friction
+    }
+}
+
+/// The first point (relative to the sphere's centre) where the segment `a → b` enters the
+/// sphere of radius `r`, if `a` is outside it and the segment reaches it.
+#[inline]
+fn first_entry(a: Vec3, b: Vec3, r: f32) -> Option<Vec3> {
+    let d = b - a;
+    let (aa, dd) = (a.length_squared(), d.length_squared());
+    if aa < r * r || dd == 0.0 {
+        return None;
+    }
+    // |a + t·d|² = r²  ⇔  dd·t² + 2(a·d)·t + (aa − r²) = 0; the smaller root enters.
+    let half_b = a.dot(d);
+    let disc = half_b * half_b - dd * (aa - r * r);
+    if half_b >= 0.0 || disc < 0.0 {
+        return None;
+    }
+    let t = (-half_b - disc.sqrt()) / dd;
+    (0.0..=1.0).contains(&t).then(|| a + t * d)
+}
+
+impl EffectKind for Sphere {
+    const NAME: &'static str = "sphere";
+    const TITLE: &'static str = "Sphere";
+    const MANY: bool = true;
+    const ADDABLE: bool = true;
+
+    fn check(&self) -> Result<(), ParamError> {
+        if !(self.radius.is_finite() && self.radius > 0.0) {
+            return Err(ParamError::new(
+                "radius",
+                self.radius,
+                "must be positive metres",
+            ));
+        }
+        if !(self.center.is_finite() && self.spin.is_finite()) {
+            return Err(ParamError::new(
+                "center",
+                self.center,
+                "must be finite metres",
+            ));
+        }
+        Ok(())
+    }
+
+    fn is_contact(&self) -> bool {
+        true
+    }
+
+    fn resolve(&self, pass: &mut ContactPass<'_>) -> Result<usize, ContactError> {
+        Ok(resolve(self, pass))
+    }
+
+    fn surface(&self, p: Vec3) -> Option<(f32, Vec3, Vec3)> {
+        Some(self.surface_at(p))
+    }
+
+    fn guard(&self, up: Vec3) -> GuardShare {
+        GuardShare {
+            floor: Some(up.dot(self.center) - self.radius),
+            surface_speed: self.spin.length() * self.radius,
+            flow_speed: 0.0,
+        }
+    }
+
+    fn on_gpu(&self) -> Result<(), &'static str> {
+        Ok(())
+    }
+
+    /// Just under the cloth's middle, a quarter of its size across, so it falls onto it.
+    fn suggested(cloth: &ClothBox) -> Self {
+        let size = (cloth.hi - cloth.lo).max_element().max(0.1);
+        let radius = 0.25 * size;
+        let mid = 0.5 * (cloth.lo + cloth.hi);
+        Sphere {
+            center: Vec3::new(mid.x, cloth.lo.y - 0.05 * size - radius, mid.z),
+            radius,
+            spin: Vec3::ZERO,
+            friction: default_friction(),
+        }
+    }
+}
