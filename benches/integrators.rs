@@ -28,7 +28,7 @@ fn step(c: &mut Criterion) {
         group.sample_size(10);
         for n in [32u32, 64, 128] {
             let mut scene = Scene::with_cloth("hanging", &grid(n), "grid").expect("registered");
-            scene.params.integrator = kind;
+            scene.params.step.integrator = kind;
             let mut sim = Simulation::new(scene);
             // Start from a swinging state rather than the rest pose.
             for _ in 0..10 {

@@ -27,7 +27,7 @@ fn frame(c: &mut Criterion) {
             for n in [25u32, 50, 100] {
                 let mut scene =
                     Scene::with_cloth(&scenario.name, &grid(n), "grid").expect("registered");
-                scene.params.integrator = kind;
+                scene.params.step.integrator = kind;
                 let mut sim = Simulation::new(scene);
                 // Start from a moving, colliding state rather than the rest pose.
                 sim.run(0.25);

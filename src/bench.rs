@@ -184,7 +184,7 @@ pub fn bench_with(
         .map(|&p| sim.initial().pos[p].y as f64)
         .sum::<f64>()
         / 4.0;
-    let substeps = sim.params().substeps;
+    let substeps = sim.params().step.substeps;
     let frames = (BENCH_SECONDS * 60.0).round() as u64;
     let total = frames * substeps as u64;
     let timer = Instant::now();

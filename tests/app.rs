@@ -165,7 +165,7 @@ fn dropping_a_malformed_obj_shows_an_error_and_keeps_the_cloth() {
 #[test]
 fn pause_and_step_advances_exactly_one_frame() {
     let mut harness = harness();
-    let dt = harness.state().sim().params().dt as f64;
+    let dt = harness.state().sim().params().step.dt as f64;
     assert_eq!(harness.state().sim().frames(), 0);
     harness.get_by_label("Step").click();
     run_settled(&mut harness, 3);
@@ -259,8 +259,8 @@ fn the_accuracy_window_sweeps_in_the_background_and_applies_its_choice() {
     let mut harness = harness();
     // Start from parameters that are not among the sweep's choices.
     let mut params = harness.state().sim().params().clone();
-    params.integrator = clothsim::sim::IntegratorKind::Verlet;
-    params.substeps = 24;
+    params.step.integrator = clothsim::sim::IntegratorKind::Verlet;
+    params.step.substeps = 24;
     harness.state_mut().apply_params(params);
     harness.get_by_label("Accuracy").click();
     harness.run_steps(2);
@@ -314,10 +314,13 @@ fn the_accuracy_window_sweeps_in_the_background_and_applies_its_choice() {
     harness.get_by_label("Apply").click();
     harness.run_steps(2);
     let params = harness.state().sim().params();
-    assert_eq!(params.integrator, choice.integrator);
-    assert_eq!(params.substeps, choice.substeps_per_frame.round() as u32);
+    assert_eq!(params.step.integrator, choice.integrator);
+    assert_eq!(
+        params.step.substeps,
+        choice.substeps_per_frame.round() as u32
+    );
     assert_ne!(
-        (params.integrator, params.substeps),
+        (params.step.integrator, params.step.substeps),
         (clothsim::sim::IntegratorKind::Verlet, 24),
         "the choice replaced the parameters the sweep started from"
     );
@@ -329,7 +332,7 @@ fn a_bad_parameter_is_refused_and_the_simulation_keeps_its_own() {
     let mut harness = harness();
     let before = harness.state().sim().params().clone();
     let mut bad = before.clone();
-    bad.dt = f32::NAN;
+    bad.step.dt = f32::NAN;
     harness.state_mut().apply_params(bad);
     harness.run_steps(1);
     assert_eq!(harness.state().sim().params(), &before);
@@ -364,7 +367,7 @@ fn a_failed_capture_is_reported_and_loses_nothing() {
 fn the_guard_acting_is_shown_to_the_user() {
     let mut harness = harness();
     let mut params = harness.state().sim().params().clone();
-    params.substeps = 12;
+    params.step.substeps = 12;
     harness.state_mut().apply_params(params);
     for _ in 0..3 {
         harness.get_by_label("Step").click();
@@ -620,8 +623,8 @@ fn dragging_the_cloth_pulls_a_particle_and_ctrl_click_pins_it_under_every_integr
     let mut harness = harness();
     for kind in IntegratorKind::ALL {
         let mut params = harness.state().sim().params().clone();
-        params.integrator = kind;
-        params.substeps = match kind {
+        params.step.integrator = kind;
+        params.step.substeps = match kind {
             IntegratorKind::ExplicitEuler => 2400,
             IntegratorKind::Rk2 => 150,
             IntegratorKind::ImplicitEuler => 4,

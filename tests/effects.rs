@@ -404,7 +404,7 @@ fn flag_run(wind: Option<Vec3>, seconds: f64) -> (Vec<f32>, Vec<f32>) {
     let free_edge: Vec<usize> = (0..rest.len())
         .filter(|&i| rest[i].x > right - 1e-4)
         .collect();
-    let frames = (seconds / sim.params().dt as f64).round() as usize;
+    let frames = (seconds / sim.params().step.dt as f64).round() as usize;
     let (mut mean_x, mut edge_z) = (Vec::new(), Vec::new());
     for _ in 0..frames {
         sim.step_frame().expect("the flag is stable");

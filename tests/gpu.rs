@@ -48,7 +48,7 @@ fn gpu_and_cpu_agree_on_every_particle_of_the_hanging_cloth_after_one_second() {
 #[test]
 fn gpu_and_cpu_resolve_the_same_sphere_contacts_at_impact() {
     let scene = Scene::builtin("sphere-drop").expect("scene");
-    let offset = scene.params.collision_offset;
+    let offset = scene.params.contact.offset;
     let sphere = (scene.effects.iter())
         .find(|e| e.is_solid())
         .cloned()
@@ -72,14 +72,14 @@ fn gpu_and_cpu_resolve_the_same_sphere_contacts_at_impact() {
 #[test]
 fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
     let flag = Scene::builtin("flag").expect("scene");
-    let err = gpu_support(&flag.params, &flag.effects).expect_err("wind is CPU only");
+    let err = gpu_support(&flag.params.step, &flag.effects).expect_err("wind is CPU only");
     assert!(
         err.to_string().contains("wind") || err.to_string().contains("dihedral"),
         "{err}"
     );
     let mut rk4 = Scene::builtin("hanging").expect("scene");
-    rk4.params.integrator = IntegratorKind::Rk4;
-    let err = gpu_support(&rk4.params, &rk4.effects).expect_err("RK4 is CPU only");
+    rk4.params.step.integrator = IntegratorKind::Rk4;
+    let err = gpu_support(&rk4.params.step, &rk4.effects).expect_err("RK4 is CPU only");
     let err = err.to_string();
     assert!(
         err.contains("runs Semi-implicit Euler only, not RK4"),
@@ -93,7 +93,7 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
     sim.step_frame().expect("frame");
     let before = sim.state().clone();
     let mut params = sim.params().clone();
-    params.integrator = IntegratorKind::Rk4;
+    params.step.integrator = IntegratorKind::Rk4;
     sim.set_params(params).expect("valid parameters");
     let err = sim.step_frame().expect_err("unsupported");
     assert!(
@@ -126,8 +126,8 @@ fn parameter_change_mid_run(read_every_frame: bool) {
             sim.step_frame().expect("frame");
         }
         let mut params = sim.params().clone();
-        params.stiffness = params.stiffness.map(|k| 3.0 * k);
-        params.substeps = 24;
+        params.material.stiffness = params.material.stiffness.map(|k| 3.0 * k);
+        params.step.substeps = 24;
         let behind = sim.state_behind();
         sim.set_params(params).expect("valid");
         assert_eq!(
@@ -159,8 +159,8 @@ fn parameter_change_mid_run(read_every_frame: bool) {
         // the bend springs and air damping switched off: the GPU keeps stepping its own
         // state, read nothing back.
         let mut params = sim.params().clone();
-        params.stiffness[1] *= 0.25;
-        params.damping[1] *= 4.0;
+        params.material.stiffness[1] *= 0.25;
+        params.material.damping[1] *= 4.0;
         sim.set_params(params).expect("valid");
         let mut effects = sim.effects().to_vec();
         let all = effects.len();
@@ -174,7 +174,7 @@ fn parameter_change_mid_run(read_every_frame: bool) {
         }
         // A new density rescales the masses of the latest frame, read back first.
         let mut params = sim.params().clone();
-        params.density *= 1.5;
+        params.material.density *= 1.5;
         sim.set_params(params).expect("valid");
         assert!(!sim.state_behind(), "the masses change on the latest state");
         for _ in 0..5 {

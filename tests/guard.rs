@@ -27,8 +27,8 @@ fn bits(sim: &Simulation) -> Vec<u32> {
 #[test]
 fn when_nothing_saves_a_frame_the_rollback_is_exact() {
     let mut sim = hanging(|s| {
-        s.params.stiffness = [1e7; 3];
-        s.params.substeps = 2;
+        s.params.material.stiffness = [1e7; 3];
+        s.params.step.substeps = 2;
         s.params.guard = GuardPolicy {
             max_refinements: 1,
             fallback: None,
@@ -68,7 +68,7 @@ fn a_blow_up_is_still_caught_while_a_pull_holds_the_cloth_stretched() {
     }
     assert!(sim.take_guard_events().is_empty(), "the pull alone is fine");
     let mut params = sim.params().clone();
-    params.integrator = IntegratorKind::ExplicitEuler;
+    params.step.integrator = IntegratorKind::ExplicitEuler;
     params.guard = GuardPolicy {
         max_refinements: 0,
         fallback: None,
@@ -91,7 +91,7 @@ fn a_blow_up_is_still_caught_while_a_pull_holds_the_cloth_stretched() {
 #[test]
 fn the_fallback_integrator_saves_what_refinement_cannot() {
     let mut sim = hanging(|s| {
-        s.params.stiffness = s.params.stiffness.map(|k| k * 100.0);
+        s.params.material.stiffness = s.params.material.stiffness.map(|k| k * 100.0);
         s.params.guard.max_refinements = 1;
     });
     let summary = sim.run(1.0);
@@ -121,7 +121,8 @@ fn the_fallback_integrator_saves_what_refinement_cannot() {
 /// made everything after it 2–8× slower. Once the trouble has passed they come back down.
 #[test]
 fn substeps_come_back_down_once_the_trouble_has_passed() {
-    let mut sim = hanging(|s| s.params.stiffness = s.params.stiffness.map(|k| k * 16.0));
+    let mut sim =
+        hanging(|s| s.params.material.stiffness = s.params.material.stiffness.map(|k| k * 16.0));
     let mut raised = 0;
     for _ in 0..60 {
         if let Ok(FrameOutcome::Refined { to, .. }) = sim.step_frame() {
@@ -135,7 +136,7 @@ fn substeps_come_back_down_once_the_trouble_has_passed() {
     // The cloth softens again: after a second of healthy frames per halving the substeps
     // return to the requested 48.
     let mut params = sim.params().clone();
-    params.stiffness = [400.0, 150.0, 20.0];
+    params.material.stiffness = [400.0, 150.0, 20.0];
     sim.set_params(params).unwrap();
     assert_eq!(
         sim.substeps(),
@@ -169,7 +170,7 @@ fn substeps_come_back_down_once_the_trouble_has_passed() {
 /// at 48 and 96 substeps are 7 cm apart after 2 s.)
 #[test]
 fn a_rescued_run_leaves_no_trace_of_its_failed_tries() {
-    let mut rescued = hanging(|s| s.params.substeps = 12);
+    let mut rescued = hanging(|s| s.params.step.substeps = 12);
     let summary = rescued.run(2.0);
     let refined = summary
         .guard_events
@@ -184,7 +185,7 @@ fn a_rescued_run_leaves_no_trace_of_its_failed_tries() {
             .any(|e| e.action == GuardAction::Recovered)
     );
     assert_eq!(rescued.substeps(), 48);
-    let mut clean = hanging(|s| s.params.substeps = 48);
+    let mut clean = hanging(|s| s.params.step.substeps = 48);
     clean.run(2.0);
     let worst = rescued
         .state()
@@ -199,7 +200,7 @@ fn a_rescued_run_leaves_no_trace_of_its_failed_tries() {
 #[test]
 fn the_guard_can_be_switched_off() {
     let mut sim = hanging(|s| {
-        s.params.substeps = 2;
+        s.params.step.substeps = 2;
         s.params.guard.enabled = false;
     });
     let summary = sim.run(1.0);
@@ -236,7 +237,7 @@ fn builtin(name: &str, configure: impl FnOnce(&mut Scene)) -> Simulation {
 #[test]
 fn a_cloth_diverging_with_self_collision_is_rolled_back_not_aborted() {
     let mut sim = builtin("self-fold", |s| {
-        s.params.stiffness = s.params.stiffness.map(|k| k * 8.0)
+        s.params.material.stiffness = s.params.material.stiffness.map(|k| k * 8.0)
     });
     let triangles = sim.model().triangles.len() as u64;
     let outcome = sim.step_frame().expect("refining saves the frame");
@@ -262,7 +263,7 @@ fn a_cloth_diverging_with_self_collision_is_rolled_back_not_aborted() {
 #[test]
 fn with_the_guard_off_self_collision_refuses_a_blown_up_state() {
     let mut sim = builtin("self-fold", |s| {
-        s.params.stiffness = s.params.stiffness.map(|k| k * 8.0);
+        s.params.material.stiffness = s.params.material.stiffness.map(|k| k * 8.0);
         s.params.guard.enabled = false;
     });
     let triangles = sim.model().triangles.len() as u64;
@@ -285,7 +286,7 @@ fn falling(integrator: IntegratorKind) -> Simulation {
                 center = [0.0, 1.0, 0.0]\n[[effects]]\ntype = \"gravity\"\n";
     let file = clothsim::scene::SceneFile::parse(text, std::path::Path::new("fall.toml")).unwrap();
     let mut scene = Scene::from_file(file, None).unwrap();
-    scene.params.integrator = integrator;
+    scene.params.step.integrator = integrator;
     Simulation::new(scene)
 }
 
@@ -340,7 +341,7 @@ fn a_blow_up_during_a_fall_is_still_caught_by_the_limits() {
         }
         assert!(sim.run(2.0).guard_events.is_empty(), "{kind}");
         let mut params = sim.params().clone();
-        params.stiffness = params.stiffness.map(|k| k * 1000.0);
+        params.material.stiffness = params.material.stiffness.map(|k| k * 1000.0);
         params.guard = GuardPolicy {
             max_refinements: 0,
             fallback: None,
@@ -374,8 +375,8 @@ fn a_blow_up_during_a_fall_is_still_caught_by_the_limits() {
 fn the_message_names_the_substeps_each_explicit_method_needs_and_they_suffice() {
     for kind in explicit() {
         let mut sim = hanging(|s| {
-            s.params.integrator = kind;
-            s.params.substeps = 4;
+            s.params.step.integrator = kind;
+            s.params.step.substeps = 4;
             s.params.guard.max_refinements = 1;
             s.params.guard.fallback = None;
         });
@@ -397,8 +398,8 @@ fn the_message_names_the_substeps_each_explicit_method_needs_and_they_suffice() 
         );
         let run = |substeps: f64| {
             let mut sim = hanging(|s| {
-                s.params.integrator = kind;
-                s.params.substeps = substeps as u32;
+                s.params.step.integrator = kind;
+                s.params.step.substeps = substeps as u32;
                 s.params.guard.enabled = false;
             });
             let summary = sim.run(1.0);
@@ -463,8 +464,8 @@ fn a_pull_the_cloth_cannot_follow_is_named_as_the_cause() {
     assert!(err.to_string().contains("held particle"), "{err}");
     // The springs alone are within symplectic Euler's stable step: without the grab the
     // stiffness would have been named.
-    let forces = clothsim::sim::ForceSet::new(sim.model(), sim.params(), sim.effects());
-    let (model, dt) = (sim.model(), sim.params().dt);
+    let forces = clothsim::sim::ForceSet::new(sim.model(), &sim.params().material, sim.effects());
+    let (model, dt) = (sim.model(), sim.params().step.dt);
     let kind = IntegratorKind::SemiImplicitEuler;
     let springs_alone = Cause::substeps(kind, model, &forces, &sim.state().pos, 0.0, dt, 48);
     assert!(springs_alone.is_none(), "{springs_alone:?}");

@@ -158,16 +158,16 @@ fn undamped_hanging(quads: u32) -> Scene {
             a.rate = 0.0;
         }
     }
-    scene.params.damping = [0.0; 3];
+    scene.params.material.damping = [0.0; 3];
     scene
 }
 
 /// Positions after `seconds` in `steps` equal steps of `kind` (no guard).
 fn positions_after(scene: &Scene, kind: IntegratorKind, seconds: f32, steps: u32) -> Vec<Vec3> {
     let mut scene = scene.clone();
-    scene.params.integrator = kind;
-    scene.params.dt = seconds;
-    scene.params.substeps = steps;
+    scene.params.step.integrator = kind;
+    scene.params.step.dt = seconds;
+    scene.params.step.substeps = steps;
     let mut sim = Simulation::new(scene);
     for _ in 0..steps {
         sim.substep().unwrap();
@@ -210,7 +210,7 @@ fn halving_ratios(
 #[test]
 fn halving_the_step_divides_the_error_by_two_to_the_order() {
     let mut scene = undamped_hanging(6);
-    scene.params.stiffness = scene.params.stiffness.map(|k| k * 0.01);
+    scene.params.material.stiffness = scene.params.material.stiffness.map(|k| k * 0.01);
     let cases = [
         (IntegratorKind::ExplicitEuler, 0.5, [400, 800, 1600], 800),
         (
@@ -243,7 +243,7 @@ fn halving_the_step_divides_the_error_by_two_to_the_order() {
 /// structural strain.
 fn unguarded(scene: &Scene, kind: IntegratorKind, seconds: f64) -> (bool, f32, f32) {
     let mut scene = scene.clone();
-    scene.params.integrator = kind;
+    scene.params.step.integrator = kind;
     let mut sim = Simulation::new(scene);
     let steps = (seconds / sim.substep_length() as f64).round() as usize;
     let mut peak = 0.0f32;
@@ -274,7 +274,7 @@ fn max_strain(sim: &Simulation, kind: SpringKind) -> f32 {
 #[test]
 fn implicit_euler_survives_stiffness_where_every_explicit_method_blows_up() {
     let mut scene = Scene::builtin("hanging").unwrap();
-    scene.params.stiffness = scene.params.stiffness.map(|k| k * 100.0);
+    scene.params.material.stiffness = scene.params.material.stiffness.map(|k| k * 100.0);
     for kind in [
         IntegratorKind::ExplicitEuler,
         IntegratorKind::SemiImplicitEuler,
@@ -312,11 +312,16 @@ fn xpbd_chain_extension(k: f32, substeps: u32) -> f32 {
     }
     let model = ClothModel::from_springs(pos, springs, vec![m; N + 1], &[0]);
     let params = clothsim::sim::SimParams {
-        integrator: IntegratorKind::Xpbd,
-        dt: 0.01,
-        substeps,
-        stiffness: [k; 3],
-        damping: [0.5; 3],
+        step: clothsim::sim::StepConfig {
+            integrator: IntegratorKind::Xpbd,
+            dt: 0.01,
+            substeps,
+        },
+        material: clothsim::sim::Material {
+            stiffness: [k; 3],
+            damping: [0.5; 3],
+            ..Default::default()
+        },
         ..Default::default()
     };
     let effects = [
@@ -409,7 +414,7 @@ fn component_arrays_match_the_general_path(n: u32) {
     gravity_first.retain(|e| !matches!(e, Effect::Gravity(_)));
     gravity_first.insert(0, Effect::Gravity(Default::default()));
     for effects in [scene.effects.clone(), springs_and_gravity, gravity_first] {
-        let forces = ForceSet::new(model, &scene.params, &effects);
+        let forces = ForceSet::new(model, &scene.params.material, &effects);
         assert!(forces.takes_components(), "{effects:?}");
         let mut start = scene.initial.clone();
         for (p, v) in start.vel.iter_mut().enumerate() {
@@ -498,7 +503,7 @@ fn semi_implicit_euler_on_two_threads_gives_the_same_bits_as_on_one() {
 fn accelerations_on_component_arrays_match_the_general_path_bit_for_bit() {
     let scene = clothsim::bench::bench_scene(20, IntegratorKind::SemiImplicitEuler).unwrap();
     let model = &scene.model;
-    let forces = ForceSet::new(model, &scene.params, &scene.effects);
+    let forces = ForceSet::new(model, &scene.params.material, &scene.effects);
     assert!(forces.takes_components());
     let mut state = scene.initial.clone();
     for (p, v) in state.vel.iter_mut().enumerate() {
@@ -546,7 +551,7 @@ fn implicit_run_at(
 ) -> (ClothState, u32) {
     use clothsim::sim::Integrator;
     let scene = clothsim::bench::bench_scene(24, IntegratorKind::ImplicitEuler).unwrap();
-    let forces = ForceSet::new(&scene.model, &scene.params, &scene.effects);
+    let forces = ForceSet::new(&scene.model, &scene.params.material, &scene.effects);
     let (config, mut meter) = (SolverConfig::default(), StepMeter::default());
     let (mut state, mut iterations) = (start.clone(), 0);
     for _ in 0..steps {

@@ -23,9 +23,9 @@ fn hanging(kind: IntegratorKind) -> Simulation {
         None,
     )
     .unwrap();
-    scene.params.integrator = kind;
+    scene.params.step.integrator = kind;
     // Well inside each method's stable range for this cloth (see the accuracy report).
-    scene.params.substeps = match kind {
+    scene.params.step.substeps = match kind {
         IntegratorKind::ExplicitEuler => 1500,
         IntegratorKind::Rk2 => 120,
         IntegratorKind::ImplicitEuler => 4,

@@ -7,8 +7,9 @@ use clothsim::mesh::SpringKind;
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::forces::SpringForce;
 use clothsim::sim::{
-    AirDamping, CpuStepper, Effect, Force, ForceSet, FrameOutcome, Gravity, IntegratorKind, Plane,
-    SimParams, SolverConfig, Sphere, StepBackend, StepContext, StepMeter,
+    AirDamping, CpuStepper, Effect, Force, ForceSet, FrameOutcome, Gravity, IntegratorKind,
+    Material, Plane, SimParams, SolverConfig, Sphere, StepBackend, StepConfig, StepContext,
+    StepMeter,
 };
 
 /// A model of point masses joined by structural springs, built by hand (no triangles).
@@ -26,9 +27,11 @@ fn chain_model(pos: Vec<Vec3>, springs: &[(u32, u32)], mass: f32, pins: &[u32]) 
 
 fn params(integrator: IntegratorKind, dt: f32, substeps: u32) -> SimParams {
     SimParams {
-        integrator,
-        dt,
-        substeps,
+        step: StepConfig {
+            dt,
+            substeps,
+            integrator,
+        },
         ..SimParams::default()
     }
 }
@@ -41,7 +44,7 @@ fn free_fall_matches_half_g_t_squared() {
             Effect::Gravity(Gravity::default()),
             Effect::Springs(Default::default()),
         ];
-        scene.params.integrator = kind;
+        scene.params.step.integrator = kind;
         let mut sim = Simulation::new(scene);
         let start = sim.state().pos.clone();
         let t = 1.0;
@@ -66,7 +69,7 @@ fn free_fall_matches_half_g_t_squared() {
 fn pinned_particles_never_move() {
     for kind in IntegratorKind::ALL {
         let mut scene = Scene::builtin("hanging").unwrap();
-        scene.params.integrator = kind;
+        scene.params.step.integrator = kind;
         let pins = scene.model.pins.clone();
         assert_eq!(pins.len(), 2, "hanging pins two corners");
         let mut sim = Simulation::new(scene);
@@ -104,8 +107,8 @@ fn hanging_chain_extension_matches_statics() {
     let model = chain_model(pos, &springs, m, &[0]);
     for kind in IntegratorKind::ALL {
         let mut p = params(kind, 0.01, 10);
-        p.stiffness = [k; 3];
-        p.damping = [0.5; 3];
+        p.material.stiffness = [k; 3];
+        p.material.damping = [0.5; 3];
         let effects = [
             Effect::Gravity(Gravity::default()),
             Effect::Springs(Default::default()),
@@ -245,8 +248,8 @@ fn coarse_cloth() -> clothsim::mesh::MeshBuild {
 fn sphere_drop_never_penetrates_and_comes_to_rest() {
     for kind in IntegratorKind::ALL {
         let mut scene = Scene::with_cloth("sphere-drop", &coarse_cloth(), "grid").unwrap();
-        scene.params.integrator = kind;
-        scene.params.substeps = substeps_for(kind);
+        scene.params.step.integrator = kind;
+        scene.params.step.substeps = substeps_for(kind);
         let Some(&mut Sphere { center, radius, .. }) = scene.sphere_mut() else {
             panic!("sphere-drop has a sphere")
         };
@@ -341,7 +344,7 @@ fn a_frame_taken_whole_ends_where_its_substeps_one_by_one_do() {
     let held = 7;
     let make = || {
         let mut scene = Scene::builtin("hanging").unwrap();
-        scene.params.integrator = IntegratorKind::SemiImplicitEuler;
+        scene.params.step.integrator = IntegratorKind::SemiImplicitEuler;
         let mut sim = Simulation::new(scene);
         let target = sim.state().pos[held] + Vec3::new(0.0, 0.0, 0.05);
         sim.grab(held as u32, target);
@@ -365,7 +368,7 @@ fn a_frame_taken_whole_ends_where_its_substeps_one_by_one_do() {
     assert!(state_bits(whole.state()) == state_bits(single.state()));
     // (The substeps add up their f32 lengths; a frame ends on the frame clock.)
     assert!((whole.state().time - single.state().time).abs() < 1e-6);
-    assert!((whole.state().time - 3.0 * whole.params().dt as f64).abs() < 1e-9);
+    assert!((whole.state().time - 3.0 * whole.params().step.dt as f64).abs() < 1e-9);
     assert_eq!(whole.state().pos[held], target);
     assert_ne!(whole.state().vel[held], Vec3::ZERO);
     // And the cloth moved.
@@ -378,7 +381,7 @@ fn two_runs_are_bit_identical() {
         for kind in IntegratorKind::ALL {
             let run = || {
                 let mut scene = Scene::builtin(name).unwrap();
-                scene.params.integrator = kind;
+                scene.params.step.integrator = kind;
                 let mut sim = Simulation::new(scene);
                 sim.run(0.5);
                 sim.state().clone()
@@ -429,10 +432,8 @@ fn mass_is_lumped_from_areal_density() {
     let mut sim = Simulation::new(Scene::builtin("hanging").unwrap());
     assert!((sim.model().total_mass() - 0.2).abs() < 1e-4);
     // Changing the density rescales every mass and keeps the pins pinned.
-    let params = SimParams {
-        density: 0.5,
-        ..sim.params().clone()
-    };
+    let mut params = sim.params().clone();
+    params.material.density = 0.5;
     sim.set_params(params).unwrap();
     assert!((sim.model().total_mass() - 0.5).abs() < 1e-4);
     for &p in &sim.model().pins {
@@ -460,11 +461,16 @@ fn verlet_after_a_contact_uses_the_post_contact_acceleration() {
         &[0],
     );
     let params = SimParams {
-        integrator: IntegratorKind::Verlet,
-        stiffness: [50.0; 3],
-        damping: [2.0; 3],
-        dt: 0.01,
-        substeps: 1,
+        step: StepConfig {
+            integrator: IntegratorKind::Verlet,
+            dt: 0.01,
+            substeps: 1,
+        },
+        material: Material {
+            stiffness: [50.0; 3],
+            damping: [2.0; 3],
+            ..Material::default()
+        },
         ..SimParams::default()
     };
     let ground = Plane {
@@ -483,7 +489,7 @@ fn verlet_after_a_contact_uses_the_post_contact_acceleration() {
     stepper.substep(&model, &mut state).unwrap();
     let after_contact = state.clone();
     assert!(
-        (after_contact.pos[1].y - params.collision_offset).abs() < 1e-6,
+        (after_contact.pos[1].y - params.contact.offset).abs() < 1e-6,
         "the first substep ended in contact: y = {}",
         after_contact.pos[1].y
     );
@@ -500,7 +506,7 @@ fn verlet_after_a_contact_uses_the_post_contact_acceleration() {
 /// raised them.
 fn refined_hanging() -> Simulation {
     let mut scene = Scene::builtin("hanging").unwrap();
-    scene.params.substeps = 12;
+    scene.params.step.substeps = 12;
     let mut sim = Simulation::new(scene);
     for _ in 0..120 {
         match sim.step_frame() {
@@ -519,11 +525,15 @@ fn changing_a_parameter_keeps_the_guards_substeps_the_time_and_the_state() {
     assert!(raised > 12, "the guard raised the substeps to {raised}");
     let (time, frames, state) = (sim.state().time, sim.frames(), sim.state().clone());
     let mut params = sim.params().clone();
-    params.density *= 1.2;
-    params.integrator = IntegratorKind::Verlet;
+    params.material.density *= 1.2;
+    params.step.integrator = IntegratorKind::Verlet;
     sim.set_params(params.clone()).unwrap();
     assert_eq!(sim.substeps(), raised, "the guard's substeps stay");
-    assert_eq!(sim.params().substeps, 12, "and the request is still 12");
+    assert_eq!(
+        sim.params().step.substeps,
+        12,
+        "and the request is still 12"
+    );
     assert_eq!(sim.state(), &state, "the state stays");
     assert_eq!((sim.state().time, sim.frames()), (time, frames));
     assert!(
@@ -534,7 +544,7 @@ fn changing_a_parameter_keeps_the_guards_substeps_the_time_and_the_state() {
     sim.step_frame().unwrap();
     assert!(sim.state().time > time);
     // A new request for substeps is honoured as it stands.
-    params.substeps = 64;
+    params.step.substeps = 64;
     sim.set_params(params).unwrap();
     assert_eq!(sim.substeps(), 64);
 }
@@ -544,7 +554,7 @@ fn a_bad_parameter_is_refused_and_nothing_changes() {
     let mut sim = Simulation::new(Scene::builtin("hanging").unwrap());
     let before = sim.params().clone();
     let mut bad = before.clone();
-    bad.density = f32::NAN;
+    bad.material.density = f32::NAN;
     let err = sim.set_params(bad).unwrap_err().to_string();
     assert!(err.contains("`density`"), "{err}");
     assert_eq!(sim.params(), &before);

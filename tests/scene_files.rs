@@ -167,10 +167,13 @@ fn a_scene_file_builds_its_cloth_pins_solver_material_and_effects() {
     assert_eq!(scene.model.particle_count(), 25);
     let p = &scene.params;
     assert_eq!(
-        (p.integrator, p.dt, p.substeps),
+        (p.step.integrator, p.step.dt, p.step.substeps),
         (IntegratorKind::Rk4, 0.01, 30)
     );
-    assert_eq!((p.density, p.stiffness), (0.3, [300.0, 100.0, 5.0]));
+    assert_eq!(
+        (p.material.density, p.material.stiffness),
+        (0.3, [300.0, 100.0, 5.0])
+    );
     // The top corners of a vertical 4×4-quad cloth centred at y = 2, and particle 12.
     let pinned: Vec<Vec3> = scene
         .pins
@@ -292,9 +295,9 @@ fn a_saved_setup_reloads_as_it_was_running() {
     let mut sim = Simulation::new(Scene::builtin("sphere-drop").unwrap());
     // Change everything a user can change live.
     let mut params = sim.params().clone();
-    params.integrator = IntegratorKind::ImplicitEuler;
-    params.substeps = 7;
-    params.stiffness = [321.0, 123.0, 12.0];
+    params.step.integrator = IntegratorKind::ImplicitEuler;
+    params.step.substeps = 7;
+    params.material.stiffness = [321.0, 123.0, 12.0];
     sim.set_params(params.clone()).unwrap();
     let mut effects = sim.effects().to_vec();
     for e in &mut effects {

@@ -105,8 +105,8 @@ fn assert_passive(start: f64, peak: f64, what: &str) {
 #[test]
 fn stiff_cloth_at_100x_stiffness_with_implicit_euler_stays_calm() {
     let mut scene = Scene::builtin("hanging").unwrap();
-    scene.params.stiffness = scene.params.stiffness.map(|k| k * 100.0);
-    scene.params.integrator = IntegratorKind::ImplicitEuler;
+    scene.params.material.stiffness = scene.params.material.stiffness.map(|k| k * 100.0);
+    scene.params.step.integrator = IntegratorKind::ImplicitEuler;
     let mut sim = Simulation::new(scene);
     let start = sim.energy();
     let summary = sim.run(3.0);
@@ -122,7 +122,7 @@ fn stiff_cloth_at_100x_stiffness_with_implicit_euler_stays_calm() {
 #[test]
 fn an_explicit_integrator_beyond_its_limit_is_caught_and_the_run_finishes() {
     let mut scene = Scene::builtin("hanging").unwrap();
-    scene.params.substeps = 12;
+    scene.params.step.substeps = 12;
     let mut sim = Simulation::new(scene);
     let start = sim.energy();
     let summary = sim.run(3.0);
@@ -159,7 +159,7 @@ fn cloth_thrown_at_10_m_s_onto_a_sphere_never_passes_through_and_comes_to_rest()
 fn cloth_dropped_flat_onto_the_ground_lies_flat_on_it() {
     let mut scene = Scene::builtin("sphere-drop").unwrap();
     scene.effects.retain(|e| !matches!(e, Effect::Sphere(_)));
-    let offset = scene.params.collision_offset;
+    let offset = scene.params.contact.offset;
     let mut sim = Simulation::new(scene);
     let start = sim.energy();
     let (peak, strain) = run_checking_paths(&mut sim, 4.0);
@@ -355,9 +355,7 @@ fn a_fast_particle_cannot_pass_through_a_small_sphere() {
         friction: 0.0,
     };
     let params = clothsim::sim::SimParams {
-        dt: 1.0 / 60.0,
-        substeps: 48,
-        collision_offset: 0.001,
+        contact: clothsim::sim::ContactConfig { offset: 0.001 },
         ..Default::default()
     };
     let mut stepper = clothsim::sim::CpuStepper::new(&model, &params, &[Effect::Sphere(sphere)]);

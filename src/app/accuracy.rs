@@ -122,15 +122,14 @@ impl AccuracyWindow {
         recommend(&report.points, &report.frontier, self.tolerance).map(|i| &report.points[i])
     }
 
-    /// `params` with the chosen integrator and the substeps that give its step at `params.dt`.
+    /// `params` with the chosen integrator and the substeps that give its step at `params.step.dt`.
     pub fn applied(&self, params: &SimParams) -> Option<SimParams> {
         let p = self.choice()?;
-        let substeps = (params.dt as f64 / p.dt).round().max(1.0) as u32;
-        Some(SimParams {
-            integrator: p.integrator,
-            substeps,
-            ..params.clone()
-        })
+        let substeps = (params.step.dt as f64 / p.dt).round().max(1.0) as u32;
+        let mut applied = params.clone();
+        applied.step.integrator = p.integrator;
+        applied.step.substeps = substeps;
+        Some(applied)
     }
 
     /// Draws the window; returns parameters to apply when the user asked for it, and
@@ -169,7 +168,7 @@ impl AccuracyWindow {
                     }
                     match self.choice() {
                         Some(p) => {
-                            ui.label(format!("use {} at {:.0} substeps per frame", p.integrator.label(), params.dt as f64 / p.dt));
+                            ui.label(format!("use {} at {:.0} substeps per frame", p.integrator.label(), params.step.dt as f64 / p.dt));
                             if ui.button("Apply").clicked() {
                                 apply = self.applied(params);
                             }

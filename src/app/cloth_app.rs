@@ -655,7 +655,9 @@ impl ClothApp {
         self.poll_writes();
 
         self.poll_stepping();
-        let due = self.transport.credit(wall_dt, self.sim.params().dt as f64);
+        let due = self
+            .transport
+            .credit(wall_dt, self.sim.params().step.dt as f64);
         if due > 0 {
             let sent = self.stepping.advance(due);
             self.report_sent(sent);
@@ -705,8 +707,8 @@ impl ClothApp {
         if let Some(params) = apply {
             let text = format!(
                 "applied {} with {} substeps per frame",
-                params.integrator.label(),
-                params.substeps
+                params.step.integrator.label(),
+                params.step.substeps
             );
             self.apply_params(params);
             self.message(Level::Info, text);

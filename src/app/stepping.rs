@@ -477,7 +477,7 @@ mod tests {
             thread
                 .edit(Box::new(move |s| {
                     let mut p = s.params().clone();
-                    p.substeps = substeps;
+                    p.step.substeps = substeps;
                     s.set_params(p).err().map(|e| e.to_string())
                 }))
                 .unwrap();
@@ -510,8 +510,8 @@ mod tests {
     #[test]
     fn a_frame_that_cannot_be_saved_stops_the_stepping_and_says_why() {
         let mut scene = Scene::builtin("hanging").unwrap();
-        scene.params.integrator = IntegratorKind::ExplicitEuler;
-        scene.params.substeps = 1;
+        scene.params.step.integrator = IntegratorKind::ExplicitEuler;
+        scene.params.step.substeps = 1;
         scene.params.guard.max_refinements = 0;
         scene.params.guard.fallback = None;
         let mut replica = Simulation::new(scene);

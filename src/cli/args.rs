@@ -194,13 +194,13 @@ impl RunArgs {
         let mut scene =
             Scene::open_with_obj(&self.scene, self.obj.as_deref(), &self.import.options()?)?;
         if let Some(k) = self.integrator {
-            scene.params.integrator = k;
+            scene.params.step.integrator = k;
         }
         if let Some(dt) = self.dt {
-            scene.params.dt = dt;
+            scene.params.step.dt = dt;
         }
         if let Some(s) = self.substeps {
-            scene.params.substeps = s;
+            scene.params.step.substeps = s;
         }
         scene.params.validate().map_err(anyhow::Error::msg)?;
         if !(self.seconds.is_finite() && self.seconds >= 0.0) {

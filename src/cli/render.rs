@@ -47,7 +47,7 @@ pub fn render(args: &RunArgs, size: &str, overlay: &str, output: Output<'_>) -> 
     let mut sim = args.simulation()?;
     let camera = view::default_camera(&sim, width as f32 / height as f32);
     let mut offscreen = Offscreen::new(width, height, AdapterPreference::Any)?;
-    let frames = (args.seconds / sim.params().dt as f64).round() as u64;
+    let frames = (args.seconds / sim.params().step.dt as f64).round() as u64;
     if let Some(path) = output.png {
         for _ in 0..frames {
             sim.step_frame()?;
@@ -67,7 +67,7 @@ pub fn render(args: &RunArgs, size: &str, overlay: &str, output: Output<'_>) -> 
     let mut gif = match output.gif {
         Some(path) => Some(GifWriter::create(
             path,
-            every as f64 * sim.params().dt as f64,
+            every as f64 * sim.params().step.dt as f64,
         )?),
         None => None,
     };

@@ -6,7 +6,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::cloth::ClothModel;
 use crate::mesh::SpringKind;
-use crate::sim::{BendingModel, Effect, SimParams};
+use crate::sim::{BendingModel, Effect, Material};
 
 /// Colliders the shader has room for.
 pub(super) const MAX_COLLIDERS: usize = 4;
@@ -79,7 +79,7 @@ impl EndsKey {
 
 /// Sorts the spring kinds into classes of equal stiffness and damping, numbered in kind
 /// order, for the spring terms `effects` turn on: the ends' key and the class table.
-pub(super) fn classify(params: &SimParams, effects: &[Effect]) -> (EndsKey, ClassTable) {
+pub(super) fn classify(material: &Material, effects: &[Effect]) -> (EndsKey, ClassTable) {
     let terms = [
         effects.iter().any(|e| matches!(e, Effect::Springs(_))),
         effects.contains(&Effect::Bending(BendingModel::Springs)),
@@ -88,7 +88,7 @@ pub(super) fn classify(params: &SimParams, effects: &[Effect]) -> (EndsKey, Clas
     let mut classes = 0;
     let mut of_kind = [NO_CLASS; SpringKind::ALL.len()];
     for kind in SpringKind::ALL.map(SpringKind::index) {
-        let entry = [params.stiffness[kind], params.damping[kind], 0.0, 0.0];
+        let entry = [material.stiffness[kind], material.damping[kind], 0.0, 0.0];
         let same = |t: &[f32; 4]| t.map(f32::to_bits) == entry.map(f32::to_bits);
         let class = match table[..classes].iter().position(same) {
             Some(at) => at,

@@ -12,8 +12,8 @@ use glam::Vec3;
 use crate::cloth::{ClothModel, ClothState};
 use crate::device::map_read;
 use crate::sim::{
-    Cause, Diverged, Effect, FrameOutcome, IntegratorKind, PhaseTimings, SimParams, StepBackend,
-    StepError, StepReport, StepStats, air_damping_of, gravity_of,
+    Cause, Changes, Diverged, Effect, FrameOutcome, IntegratorKind, Material, PhaseTimings,
+    SimParams, StepBackend, StepError, StepReport, StepStats, air_damping_of, gravity_of,
 };
 
 use super::error::GpuError;
@@ -88,7 +88,7 @@ impl GpuStepper {
         effects: &[Effect],
         read_every_frame: bool,
     ) -> Result<Self, GpuError> {
-        gpu_support(params, effects)?;
+        gpu_support(&params.step, effects)?;
         let limits = device.limits();
         let count = model.particle_count() as u32;
         check_device(&limits, count)?;
@@ -169,8 +169,8 @@ impl GpuStepper {
             current: 0,
             count,
             params: Params::zeroed(),
-            dt: params.dt,
-            substeps: params.substeps.max(1),
+            dt: params.step.dt,
+            substeps: params.step.substeps.max(1),
             upload: true,
             behind: false,
             read_every_frame,
@@ -181,7 +181,7 @@ impl GpuStepper {
             sent: None,
             ends_sent: 0,
         };
-        stepper.configure(model, params, effects);
+        stepper.configure(model, params, effects, Changes::all());
         match stepper.unsupported.take() {
             Some(why) => Err(GpuError::Unsupported(why)),
             None => Ok(stepper),
@@ -222,8 +222,8 @@ impl GpuStepper {
     /// springs share a class changed since the last upload: a strength change that keeps
     /// them (a slider moving one kind's stiffness) sends 256 bytes, not every end again,
     /// and costs no pass over the springs.
-    fn upload_springs(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]) {
-        let (key, table) = classify(params, effects);
+    fn upload_springs(&mut self, model: &ClothModel, material: &Material, effects: &[Effect]) {
+        let (key, table) = classify(material, effects);
         self.queue
             .write_buffer(&self.classes, 0, bytemuck::cast_slice(&table));
         if self.sent != Some(key) {
@@ -353,24 +353,38 @@ impl StepBackend for GpuStepper {
         "gpu"
     }
 
-    fn configure(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]) {
-        self.unsupported = gpu_support(params, effects).err().map(|e| e.to_string());
-        if self.unsupported.is_none() {
-            self.upload_springs(model, params, effects);
+    fn configure(
+        &mut self,
+        model: &ClothModel,
+        params: &SimParams,
+        effects: &[Effect],
+        changes: Changes,
+    ) {
+        if changes.intersects(Changes::INTEGRATOR | Changes::EFFECTS) {
+            self.unsupported = gpu_support(&params.step, effects)
+                .err()
+                .map(|e| e.to_string());
         }
-        let (g, drag) = (gravity_of(effects), air_damping_of(effects));
-        let (solids, count) = pack_solids(effects);
-        self.params = Params {
-            gravity: [g.x, g.y, g.z, 0.0],
-            drag: [drag, params.collision_offset, 0.0, 0.0],
-            counts: [self.count, count, 0, 0],
-            colliders: solids,
-        };
-        self.dt = params.dt;
-        self.substeps = params.substeps.max(1);
+        if changes.intersects(Changes::EFFECTS | Changes::STRENGTHS) && self.unsupported.is_none() {
+            self.upload_springs(model, &params.material, effects);
+        }
+        if changes.contains(Changes::EFFECTS) {
+            let (g, drag) = (gravity_of(effects), air_damping_of(effects));
+            let (solids, count) = pack_solids(effects);
+            self.params.gravity = [g.x, g.y, g.z, 0.0];
+            self.params.drag[0] = drag;
+            self.params.counts = [self.count, count, 0, 0];
+            self.params.colliders = solids;
+        }
+        self.params.drag[1] = params.contact.offset;
+        self.dt = params.step.dt;
+        self.substeps = params.step.substeps.max(1);
         self.params.gravity[3] = self.substep_length();
-        self.queue
-            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+        if changes.intersects(Changes::EFFECTS | Changes::CONTACT | Changes::DT | Changes::SUBSTEPS)
+        {
+            self.queue
+                .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+        }
         // The state on the device stays as it is: masses and pins change through the
         // caller's state, which then calls `invalidate`.
     }
@@ -479,12 +493,12 @@ mod tests {
         let (model, params) = (&scene.model, &scene.params);
         let unbent = unbent(&scene.effects);
         for (effects, classes) in [(&scene.effects, 3), (&unbent, 2)] {
-            let forces = ForceSet::new(model, params, effects);
+            let forces = ForceSet::new(model, &params.material, effects);
             let strengths: std::collections::HashMap<usize, (f32, f32)> = (forces.springs())
                 .flat_map(|t| t.each())
                 .map(|(e, k, c)| (e, (k, c)))
                 .collect();
-            let (key, table) = classify(params, effects);
+            let (key, table) = classify(&params.material, effects);
             let packed = pack_springs(model, &key);
             let adj = &model.adjacency;
             let mut used = std::collections::BTreeSet::new();
@@ -522,25 +536,33 @@ mod tests {
         let mut stepper = GpuStepper::new(&gpu.device, &gpu.queue, model, &params, effects, true)
             .expect("stepper");
         let mut change = |edit: &dyn Fn(&mut SimParams), sends: u32| {
+            let before = params.clone();
             edit(&mut params);
-            stepper.configure(model, &params, effects);
-            assert_eq!(stepper.ends_sent, sends, "after {:?}", params.stiffness);
+            stepper.configure(model, &params, effects, before.changes_to(&params));
+            assert_eq!(
+                stepper.ends_sent, sends,
+                "after {:?}",
+                params.material.stiffness
+            );
         };
         change(&|_| (), 1);
-        change(&|p| p.stiffness = p.stiffness.map(|k| 3.0 * k), 1);
+        change(
+            &|p| p.material.stiffness = p.material.stiffness.map(|k| 3.0 * k),
+            1,
+        );
         // The shear springs leave the one class all kinds shared: a class of their own,
         // whose damping then moves alone.
-        change(&|p| p.stiffness[1] *= 0.5, 2);
-        change(&|p| p.damping[1] *= 2.0, 2);
+        change(&|p| p.material.stiffness[1] *= 0.5, 2);
+        change(&|p| p.material.damping[1] *= 2.0, 2);
         // The structural springs leave the bend springs' class.
-        change(&|p| p.stiffness[0] *= 2.0, 3);
+        change(&|p| p.material.stiffness[0] *= 2.0, 3);
         // Back to one stiffness (shear still damped apart), then one strength: merges.
-        change(&|p| p.stiffness = [p.stiffness[0]; 3], 4);
-        change(&|p| p.damping = [p.damping[0]; 3], 5);
+        change(&|p| p.material.stiffness = [p.material.stiffness[0]; 3], 4);
+        change(&|p| p.material.damping = [p.material.damping[0]; 3], 5);
         change(&|_| (), 5);
         // The bend springs switched off: their ends go.
         let unbent = unbent(effects);
-        stepper.configure(model, &params, &unbent);
+        stepper.configure(model, &params, &unbent, Changes::EFFECTS);
         assert_eq!(stepper.ends_sent, 6);
     }
 }

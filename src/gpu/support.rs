@@ -1,6 +1,6 @@
 //! What the GPU backend runs, and whether a device can hold a cloth.
 
-use crate::sim::{Effect, IntegratorKind, SimParams};
+use crate::sim::{Effect, IntegratorKind, StepConfig};
 
 use super::error::GpuError;
 use super::kernel::WORKGROUP;
@@ -9,15 +9,15 @@ use super::packing::{MAX_COLLIDERS, MAX_PARTICLES, Neighbour, Particle};
 /// The one integrator the GPU backend runs.
 pub const GPU_INTEGRATOR: IntegratorKind = IntegratorKind::SemiImplicitEuler;
 
-/// What of `params` and `effects` the GPU backend cannot run, if anything: it runs
+/// What of `step` and `effects` the GPU backend cannot run, if anything: it runs
 /// semi-implicit Euler with gravity, springs (and bend springs), air damping, pins and up
 /// to four sphere and plane colliders.
-pub fn gpu_support(params: &SimParams, effects: &[Effect]) -> Result<(), GpuError> {
-    if params.integrator != GPU_INTEGRATOR {
+pub fn gpu_support(step: &StepConfig, effects: &[Effect]) -> Result<(), GpuError> {
+    if step.integrator != GPU_INTEGRATOR {
         return Err(GpuError::Unsupported(format!(
             "runs {} only, not {}",
             GPU_INTEGRATOR.label(),
-            params.integrator.label()
+            step.integrator.label()
         )));
     }
     for e in effects {

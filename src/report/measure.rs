@@ -79,7 +79,7 @@ impl Trajectory {
 /// inelastic, stay).
 pub fn undamped(scene: &Scene) -> Scene {
     let mut scene = scene.clone();
-    scene.params.damping = [0.0; 3];
+    scene.params.material.damping = [0.0; 3];
     scene
         .effects
         .retain(|e| !matches!(e, Effect::AirDamping(_)));
@@ -100,9 +100,9 @@ pub fn run(
     let interval = seconds / samples as f64;
     let steps_per_sample = (interval / h).round().clamp(1.0, u32::MAX as f64) as u32;
     let mut scene = scene.clone();
-    scene.params.integrator = integrator;
-    scene.params.dt = interval as f32;
-    scene.params.substeps = steps_per_sample;
+    scene.params.step.integrator = integrator;
+    scene.params.step.dt = interval as f32;
+    scene.params.step.substeps = steps_per_sample;
     let mut sim = Simulation::new(scene);
     let mut out = Trajectory {
         integrator,

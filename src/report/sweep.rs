@@ -222,7 +222,7 @@ pub fn measure(
         integrator,
         dt: damped.h,
         steps: damped.steps,
-        substeps_per_frame: scene.params.dt as f64 / damped.h,
+        substeps_per_frame: scene.params.step.dt as f64 / damped.h,
         rms_error,
         max_error,
         energy_drift,

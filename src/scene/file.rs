@@ -8,7 +8,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::cloth::MassDistribution;
 use crate::mesh::{GridBends, GridOrientation};
-use crate::sim::{ClothSprings, Effect, GuardPolicy, IntegratorKind, SimParams, SolverConfig};
+use crate::sim::{
+    ClothSprings, ContactConfig, Effect, GuardPolicy, IntegratorKind, Material, SimParams,
+    SolverConfig, StepConfig,
+};
 
 use super::error::SceneError;
 
@@ -155,10 +158,10 @@ impl Default for SolverSpec {
     fn default() -> Self {
         let p = SimParams::default();
         Self {
-            integrator: p.integrator,
-            dt: p.dt,
-            substeps: p.substeps,
-            collision_offset: p.collision_offset,
+            integrator: p.step.integrator,
+            dt: p.step.dt,
+            substeps: p.step.substeps,
+            collision_offset: p.contact.offset,
             tolerance: p.solver.tolerance,
             max_iterations: p.solver.max_iterations,
             newton_iterations: p.solver.newton_iterations,
@@ -213,9 +216,9 @@ impl Default for MaterialSpec {
     fn default() -> Self {
         let p = SimParams::default();
         Self {
-            density: p.density,
-            stiffness: p.stiffness.into(),
-            damping: p.damping.into(),
+            density: p.material.density,
+            stiffness: p.material.stiffness.into(),
+            damping: p.material.damping.into(),
             masses: MassDistribution::Lumped,
         }
     }
@@ -393,13 +396,19 @@ impl SceneFile {
     pub fn params(&self) -> SimParams {
         let s = &self.solver;
         SimParams {
-            dt: s.dt,
-            substeps: s.substeps,
-            integrator: s.integrator,
-            stiffness: self.material.stiffness.into(),
-            damping: self.material.damping.into(),
-            density: self.material.density,
-            collision_offset: s.collision_offset,
+            step: StepConfig {
+                dt: s.dt,
+                substeps: s.substeps,
+                integrator: s.integrator,
+            },
+            material: Material {
+                stiffness: self.material.stiffness.into(),
+                damping: self.material.damping.into(),
+                density: self.material.density,
+            },
+            contact: ContactConfig {
+                offset: s.collision_offset,
+            },
             guard: s.guard.clone(),
             solver: SolverConfig {
                 tolerance: s.tolerance,
@@ -428,10 +437,10 @@ impl SceneFile {
     ) -> SceneFile {
         let mut file = self.clone();
         file.solver = SolverSpec {
-            integrator: params.integrator,
-            dt: params.dt,
-            substeps: params.substeps,
-            collision_offset: params.collision_offset,
+            integrator: params.step.integrator,
+            dt: params.step.dt,
+            substeps: params.step.substeps,
+            collision_offset: params.contact.offset,
             tolerance: params.solver.tolerance,
             max_iterations: params.solver.max_iterations,
             newton_iterations: params.solver.newton_iterations,
@@ -440,9 +449,9 @@ impl SceneFile {
             guard: params.guard.clone(),
         };
         file.material = MaterialSpec {
-            density: params.density,
-            stiffness: params.stiffness.into(),
-            damping: params.damping.into(),
+            density: params.material.density,
+            stiffness: params.material.stiffness.into(),
+            damping: params.material.damping.into(),
             masses: self.material.masses,
         };
         file.effects = (effects.iter())

@@ -193,7 +193,7 @@ impl Scene {
         place(&mut mesh, orientation, Vec3::from(file.cloth.center));
         let pins = pins(&file.pins, &mesh.positions, orientation)?;
         let params = file.params();
-        let mut model = ClothModel::new(&mesh, params.density, &pins);
+        let mut model = ClothModel::new(&mesh, params.material.density, &pins);
         if file.material.masses != model.masses {
             model.set_mass_distribution(file.material.masses);
         }

@@ -4,9 +4,9 @@
 
 use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{
-    Cause, CpuStepper, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent, IntegratorKind,
-    PhaseTimings, SimParams, StepBackend, StepError, StepReport, StepStats, small_sphere_warnings,
-    thickness_fits,
+    Cause, Changes, CpuStepper, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent,
+    IntegratorKind, PhaseTimings, SimParams, StepBackend, StepError, StepReport, StepStats,
+    small_sphere_warnings, thickness_fits,
 };
 
 use super::error::SceneError;
@@ -81,7 +81,7 @@ impl Simulation {
 
     /// Starts the scene on the given backend (configured here with the scene's parameters).
     pub fn with_backend(scene: Scene, mut backend: Box<dyn StepBackend>) -> Self {
-        backend.configure(&scene.model, &scene.params, &scene.effects);
+        backend.configure(&scene.model, &scene.params, &scene.effects, Changes::all());
         Self::assemble(scene, backend)
     }
 
@@ -115,7 +115,7 @@ impl Simulation {
     /// The old backend's state could not be read back; it stays in use.
     pub fn set_backend(&mut self, mut backend: Box<dyn StepBackend>) -> Result<(), StepError> {
         self.backend.sync(&self.model, &mut self.state)?;
-        backend.configure(&self.model, &self.params, &self.effects);
+        backend.configure(&self.model, &self.params, &self.effects, Changes::all());
         backend.invalidate();
         self.backend = backend;
         Ok(())
@@ -255,28 +255,34 @@ impl Simulation {
     /// joules.
     pub fn energy(&self) -> f64 {
         self.state.kinetic_energy(&self.model)
-            + ForceSet::new(&self.model, &self.params, &self.effects)
+            + ForceSet::new(&self.model, &self.params.material, &self.effects)
                 .potential_energy(&self.model, &self.state.pos)
     }
 
-    /// Replaces the parameters of the running simulation. The state, the time, the
-    /// timings and the substeps the guard raised are kept (unless `substeps` itself changed);
-    /// a new density rescales the masses. Only that reads back a backend's copy of the
-    /// state: a slider moving a stiffness on the GPU backend sends the new strengths and
-    /// nothing else.
+    /// Replaces the parameters of the running simulation; the backend redoes only what the
+    /// [changes](SimParams::changes_to) touch (a stiffness slider retunes the springs in
+    /// place and rebuilds nothing). The state, the time, the timings and the substeps the
+    /// guard raised are kept (unless `substeps` itself changed); an integrator the guard
+    /// fell back from is asked for again; a new density rescales the masses. Only that
+    /// reads back a backend's copy of the state: a slider moving a stiffness on the GPU
+    /// backend sends the new strengths and nothing else.
     ///
     /// # Errors
     /// [`SceneError::Params`] naming the bad value; nothing changes then.
     pub fn set_params(&mut self, params: SimParams) -> Result<(), SceneError> {
         params.validate()?;
-        if params.density != self.params.density {
+        let mut changes = self.params.changes_to(&params);
+        // Asking for the integrator the guard replaced asks for it once more.
+        if self.backend.integrator() != params.step.integrator {
+            changes |= Changes::INTEGRATOR;
+        }
+        if changes.contains(Changes::DENSITY) {
             self.before_edit();
-            self.model.set_density(params.density);
+            self.model.set_density(params.material.density);
             self.backend.invalidate();
         }
         self.params = params;
-        self.backend
-            .configure(&self.model, &self.params, &self.effects);
+        (self.backend).configure(&self.model, &self.params, &self.effects, changes);
         Ok(())
     }
 
@@ -301,8 +307,7 @@ impl Simulation {
         })?;
         self.effects = effects;
         let warnings = small_sphere_warnings(&self.effects, &self.model);
-        self.backend
-            .configure(&self.model, &self.params, &self.effects);
+        (self.backend).configure(&self.model, &self.params, &self.effects, Changes::EFFECTS);
         Ok(warnings)
     }
 
@@ -358,7 +363,7 @@ impl Simulation {
         let now = self.state.time;
         let pointer = self.held.as_mut().and_then(|h| h.follow(now, target));
         let i = p as usize;
-        self.state.vel[i] = pointer.unwrap_or((target - self.state.pos[i]) / self.params.dt);
+        self.state.vel[i] = pointer.unwrap_or((target - self.state.pos[i]) / self.params.step.dt);
         self.state.pos[i] = target;
         self.backend.invalidate();
     }
@@ -433,7 +438,7 @@ impl Simulation {
         self.backend.invalidate();
     }
 
-    /// Advances one frame (`params.dt`).
+    /// Advances one frame (`params.step.dt`).
     ///
     /// # Errors
     /// [`Diverged`]: the state is left at the frame's start. Its cause is the held

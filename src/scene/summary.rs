@@ -64,7 +64,7 @@ pub struct PhaseSummary {
 impl Simulation {
     /// Runs headless for `seconds` of simulated time (whole frames) and summarises.
     pub fn run(&mut self, seconds: f64) -> RunSummary {
-        let frames = (seconds / self.params().dt as f64).round().max(0.0) as u64;
+        let frames = (seconds / self.params().step.dt as f64).round().max(0.0) as u64;
         // Timings and counts gathered before the run are not the run's.
         self.take_timings();
         self.take_stats();
@@ -112,7 +112,7 @@ impl Simulation {
         RunSummary {
             scene: self.scenario().to_string(),
             cloth: self.cloth_name().to_string(),
-            integrator: self.params().integrator.name().to_string(),
+            integrator: self.params().step.integrator.name().to_string(),
             backend: self.backend_name().to_string(),
             particles: model.particle_count(),
             edges: model.mesh_edges,
@@ -122,9 +122,9 @@ impl Simulation {
             bend: count(SpringKind::Bend),
             simulated_seconds: state.time,
             frames: self.frames(),
-            dt: self.params().dt,
+            dt: self.params().step.dt,
             substeps: self.substeps(),
-            requested_substeps: self.params().substeps,
+            requested_substeps: self.params().step.substeps,
             finite: state.is_finite(),
             max_speed: state.max_speed(),
             min_collider_distance: min_surface_distance(self.effects(), &state.pos),

@@ -6,7 +6,7 @@ use crate::cloth::{ClothModel, ClothState};
 use super::effects::Effect;
 use super::guard::{Diverged, FrameOutcome, GuardEvent};
 use super::integrator::{IntegratorKind, StepError, StepReport};
-use super::params::SimParams;
+use super::params::{Changes, SimParams};
 use super::stats::StepStats;
 use super::timings::PhaseTimings;
 
@@ -15,18 +15,25 @@ pub trait StepBackend: Send {
     /// Short name for the UI and reports ("cpu", "gpu").
     fn name(&self) -> &'static str;
 
-    /// Applies new parameters and effects to the running backend, keeping what they do not
-    /// make stale (the substeps the guard raised stay unless the requested count changed;
-    /// timings and statistics stay). The state is not the caller's to hand over here: a
-    /// backend that holds a copy of it keeps stepping that copy until
+    /// Applies new parameters and effects to the running backend; `changes` says which
+    /// parts are new ([`Changes::all`] for a backend that has seen none), and only what
+    /// depends on them is redone (the substeps the guard raised stay unless the requested
+    /// count changed; timings and statistics stay). The state is not the caller's to hand
+    /// over here: a backend that holds a copy of it keeps stepping that copy until
     /// [`StepBackend::invalidate`].
-    fn configure(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]);
+    fn configure(
+        &mut self,
+        model: &ClothModel,
+        params: &SimParams,
+        effects: &[Effect],
+        changes: Changes,
+    );
 
     /// The state or the model changed outside stepping (reset, pins, density, a drag):
     /// whatever was kept from earlier steps is dropped.
     fn invalidate(&mut self);
 
-    /// One frame of `params.dt` seconds, under the stability guard.
+    /// One frame of `params.step.dt` seconds, under the stability guard.
     ///
     /// # Errors
     /// [`Diverged`] when no try succeeded; `state` is then the frame's start state.

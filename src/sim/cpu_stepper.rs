@@ -17,7 +17,7 @@ use super::guard_state::GuardState;
 use super::integrator::{
     Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport,
 };
-use super::params::{SimParams, SolverConfig};
+use super::params::{Changes, SimParams, SolverConfig};
 use super::self_contacts::{SelfContacts, SelfWork};
 use super::stats::StepStats;
 use super::timings::PhaseTimings;
@@ -58,16 +58,16 @@ impl CpuStepper {
     /// A stepper for `effects` with the strengths in `params`.
     pub fn new(model: &ClothModel, params: &SimParams, effects: &[Effect]) -> Self {
         let mut stepper = Self {
-            integrator: params.integrator.build(),
+            integrator: params.step.integrator.build(),
             forces: ForceSet::default(),
             contacts: Vec::new(),
             effects: Vec::new(),
             solver: params.solver,
             gravity: glam::Vec3::ZERO,
-            dt: params.dt,
+            dt: params.step.dt,
             requested: 0,
             substeps: 1,
-            offset: params.collision_offset,
+            offset: params.contact.offset,
             guard: GuardState::new(params.guard.clone()),
             timings: PhaseTimings::default(),
             stats: StepStats::default(),
@@ -78,7 +78,7 @@ impl CpuStepper {
             self_contacts: SelfContacts::default(),
             air_damping: 0.0,
         };
-        stepper.configure(model, params, effects);
+        stepper.configure(model, params, effects, Changes::all());
         stepper
     }
 
@@ -362,33 +362,47 @@ impl StepBackend for CpuStepper {
         "cpu"
     }
 
-    fn configure(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]) {
-        self.forces.configure(model, params, effects);
-        self.contacts = effects.iter().filter(|e| e.is_contact()).cloned().collect();
-        // Self-collision last, after the solids have moved what they touch.
-        self.contacts
-            .sort_by_key(|e| matches!(e, Effect::SelfCollision(_)));
-        self.self_collision = effects.iter().find_map(|e| match e {
-            Effect::SelfCollision(s) => Some(*s),
-            _ => None,
-        });
-        self.effects = effects.to_vec();
-        self.air_damping = air_damping_of(effects);
-        if self.integrator.kind() != params.integrator {
-            self.integrator = params.integrator.build();
+    fn configure(
+        &mut self,
+        model: &ClothModel,
+        params: &SimParams,
+        effects: &[Effect],
+        changes: Changes,
+    ) {
+        if changes.is_empty() {
+            return;
         }
-        // New strengths make whatever the integrator kept or derived stale.
-        self.integrator.forces_changed();
+        let forces_changed = (self.forces).apply(model, &params.material, effects, changes);
+        if changes.contains(Changes::EFFECTS) {
+            self.contacts = effects.iter().filter(|e| e.is_contact()).cloned().collect();
+            // Self-collision last, after the solids have moved what they touch.
+            self.contacts
+                .sort_by_key(|e| matches!(e, Effect::SelfCollision(_)));
+            self.self_collision = effects.iter().find_map(|e| match e {
+                Effect::SelfCollision(s) => Some(*s),
+                _ => None,
+            });
+            self.effects = effects.to_vec();
+            self.air_damping = air_damping_of(effects);
+            self.gravity = gravity_of(effects);
+        }
+        if changes.contains(Changes::INTEGRATOR) && self.integrator.kind() != params.step.integrator
+        {
+            self.integrator = params.step.integrator.build();
+        }
+        // New forces, strengths or masses make whatever the integrator derived stale.
+        if forces_changed || changes.contains(Changes::DENSITY) {
+            self.integrator.forces_changed();
+        }
         self.solver = params.solver;
-        self.gravity = gravity_of(effects);
-        self.dt = params.dt;
-        self.offset = params.collision_offset;
-        if self.guard.policy != params.guard {
+        self.dt = params.step.dt;
+        self.offset = params.contact.offset;
+        if changes.contains(Changes::GUARD) && self.guard.policy != params.guard {
             self.guard = GuardState::new(params.guard.clone());
         }
         // Limits and rollback points belong to the old parameters.
         self.guard.forget_history();
-        let requested = params.substeps.max(1);
+        let requested = params.step.substeps.max(1);
         if requested != self.requested {
             self.requested = requested;
             self.substeps = requested;

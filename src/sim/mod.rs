@@ -34,7 +34,7 @@ pub use guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Tr
 pub use guard_policy::GuardPolicy;
 pub use integrator::{Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport};
 pub use param_error::ParamError;
-pub use params::{SimParams, SolverConfig};
+pub use params::{Changes, ContactConfig, Material, SimParams, SolverConfig, StepConfig};
 pub use self_contacts::{CELLS_PER_TRIANGLE, ContactError, SelfContacts, SelfWork};
 pub use stats::StepStats;
 pub use timings::{Phase, PhaseTimings};

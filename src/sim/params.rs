@@ -4,18 +4,57 @@ use super::guard_policy::GuardPolicy;
 use super::integrator::IntegratorKind;
 use super::param_error::ParamError;
 
-/// Every tunable number of the solver. Units are SI; each field says how it affects
-/// stability.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+/// Every tunable number of the solver, by concern: each subsystem takes its own part. Units
+/// are SI; each field says how it affects stability.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SimParams {
+    /// Frame length, substeps and integrator.
+    pub step: StepConfig,
+    /// The cloth's springs and mass.
+    pub material: Material,
+    /// How contacts with solids are kept.
+    pub contact: ContactConfig,
+    /// What the stability guard checks and may do.
+    #[serde(default)]
+    pub guard: GuardPolicy,
+    /// How the integrators that solve something solve it.
+    #[serde(default)]
+    pub solver: SolverConfig,
+}
+
+/// How a frame is stepped.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StepConfig {
     /// Frame time step, seconds (default 1/60). The physics always advances in fixed steps of
     /// `dt / substeps`, never by the wall-clock frame time.
     pub dt: f32,
-    /// Substeps per frame (default 48; the default cloth is stable from about 40). Explicit integrators are stable while
-    /// `ω_max · dt/substeps ≲ 2`, with `ω_max ≈ 2·√(k/m)` for the stiffest spring; raise this
-    /// when stiffening the cloth or lightening it.
+    /// Substeps per frame (default 48; the default cloth is stable from about 40). Explicit
+    /// integrators are stable while `ω_max · dt/substeps ≲ 2`, with `ω_max ≈ 2·√(k/m)` for the
+    /// stiffest spring; raise this when stiffening the cloth or lightening it.
     pub substeps: u32,
     pub integrator: IntegratorKind,
+}
+
+impl Default for StepConfig {
+    fn default() -> Self {
+        Self {
+            dt: 1.0 / 60.0,
+            substeps: 48,
+            integrator: IntegratorKind::SemiImplicitEuler,
+        }
+    }
+}
+
+impl StepConfig {
+    /// Length of one substep, seconds.
+    pub fn substep_length(&self) -> f32 {
+        self.dt / self.substeps.max(1) as f32
+    }
+}
+
+/// The cloth's material: its springs' strengths and its mass.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Material {
     /// Spring stiffness per kind `[structural, shear, bend]`, N/m. Higher is stiffer and needs
     /// more substeps.
     pub stiffness: [f32; 3],
@@ -25,14 +64,80 @@ pub struct SimParams {
     /// Areal density of the cloth, kg/m² (default 0.2, a light cotton). Changing it rebuilds
     /// the masses.
     pub density: f32,
-    /// Collision thickness, metres: particles are kept this far outside collider surfaces.
-    pub collision_offset: f32,
-    /// What the stability guard checks and may do.
-    #[serde(default)]
-    pub guard: GuardPolicy,
-    /// How the integrators that solve something solve it.
-    #[serde(default)]
-    pub solver: SolverConfig,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Self {
+            stiffness: [400.0, 150.0, 20.0],
+            damping: [0.02, 0.01, 0.002],
+            density: 0.2,
+        }
+    }
+}
+
+/// How contacts with solids are kept.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ContactConfig {
+    /// Collision thickness, metres: particles are kept this far outside solids' surfaces
+    /// (`collision_offset` in scene files).
+    pub offset: f32,
+}
+
+impl Default for ContactConfig {
+    fn default() -> Self {
+        Self { offset: 0.01 }
+    }
+}
+
+bitflags::bitflags! {
+    /// What a new configuration changed, so that each subsystem redoes only what depends on
+    /// it: a stiffness slider retunes the springs in place and rebuilds nothing.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+    pub struct Changes: u16 {
+        /// The frame length.
+        const DT = 1;
+        /// The requested substeps per frame.
+        const SUBSTEPS = 1 << 1;
+        /// Which integrator.
+        const INTEGRATOR = 1 << 2;
+        /// Spring stiffness or damping.
+        const STRENGTHS = 1 << 3;
+        /// The areal density (the masses).
+        const DENSITY = 1 << 4;
+        /// The collision thickness against solids.
+        const CONTACT = 1 << 5;
+        /// The guard's policy.
+        const GUARD = 1 << 6;
+        /// The solvers' tolerances and caps.
+        const SOLVER = 1 << 7;
+        /// The effect list (an effect on or off, or its settings).
+        const EFFECTS = 1 << 8;
+    }
+}
+
+impl SimParams {
+    /// What going from `self` to `new` changes.
+    pub fn changes_to(&self, new: &SimParams) -> Changes {
+        let (a, b) = (self, new);
+        let flags = [
+            (Changes::DT, a.step.dt != b.step.dt),
+            (Changes::SUBSTEPS, a.step.substeps != b.step.substeps),
+            (Changes::INTEGRATOR, a.step.integrator != b.step.integrator),
+            (
+                Changes::STRENGTHS,
+                (a.material.stiffness, a.material.damping)
+                    != (b.material.stiffness, b.material.damping),
+            ),
+            (Changes::DENSITY, a.material.density != b.material.density),
+            (Changes::CONTACT, a.contact != b.contact),
+            (Changes::GUARD, a.guard != b.guard),
+            (Changes::SOLVER, a.solver != b.solver),
+        ];
+        (flags.into_iter())
+            .filter(|(_, changed)| *changed)
+            .fold(Changes::empty(), |all, (flag, _)| all | flag)
+    }
 }
 
 /// The configuration integrators take: linear-solver tolerance and caps.
@@ -66,22 +171,6 @@ impl Default for SolverConfig {
     }
 }
 
-impl Default for SimParams {
-    fn default() -> Self {
-        Self {
-            dt: 1.0 / 60.0,
-            substeps: 48,
-            integrator: IntegratorKind::SemiImplicitEuler,
-            stiffness: [400.0, 150.0, 20.0],
-            damping: [0.02, 0.01, 0.002],
-            density: 0.2,
-            collision_offset: 0.01,
-            guard: GuardPolicy::default(),
-            solver: SolverConfig::default(),
-        }
-    }
-}
-
 impl SimParams {
     /// Checks that every number is finite and in range.
     ///
@@ -92,15 +181,20 @@ impl SimParams {
         let checks = [
             (
                 "dt",
-                self.dt,
-                self.dt > 0.0 && self.dt <= 1.0,
+                self.step.dt,
+                self.step.dt > 0.0 && self.step.dt <= 1.0,
                 "0 < dt ≤ 1 s",
             ),
-            ("density", self.density, self.density > 0.0, "> 0 kg/m²"),
+            (
+                "density",
+                self.material.density,
+                self.material.density > 0.0,
+                "> 0 kg/m²",
+            ),
             (
                 "collision_offset",
-                self.collision_offset,
-                self.collision_offset >= 0.0,
+                self.contact.offset,
+                self.contact.offset >= 0.0,
                 "≥ 0 m",
             ),
         ];
@@ -114,8 +208,8 @@ impl SimParams {
             }
         }
         for (name, values, unit) in [
-            ("stiffness", self.stiffness, "N/m"),
-            ("damping", self.damping, "N·s/m"),
+            ("stiffness", self.material.stiffness, "N/m"),
+            ("damping", self.material.damping, "N·s/m"),
         ] {
             if let Some(v) = values.into_iter().find(|v| !(v.is_finite() && *v >= 0.0)) {
                 return Err(ParamError::new(
@@ -150,10 +244,10 @@ impl SimParams {
                 "must be > 0",
             ));
         }
-        if self.substeps == 0 || self.substeps > 100_000 {
+        if self.step.substeps == 0 || self.step.substeps > 100_000 {
             return Err(ParamError::new(
                 "substeps",
-                self.substeps,
+                self.step.substeps,
                 "must be in 1..=100000",
             ));
         }
@@ -174,12 +268,12 @@ mod tests {
     fn each_bad_value_is_named() {
         type Spoil = fn(&mut SimParams);
         let cases: [(&str, Spoil); 6] = [
-            ("dt", |p| p.dt = 0.0),
-            ("dt", |p| p.dt = f32::NAN),
-            ("substeps", |p| p.substeps = 0),
-            ("stiffness", |p| p.stiffness[1] = -1.0),
-            ("damping", |p| p.damping[2] = f32::NAN),
-            ("density", |p| p.density = 0.0),
+            ("dt", |p| p.step.dt = 0.0),
+            ("dt", |p| p.step.dt = f32::NAN),
+            ("substeps", |p| p.step.substeps = 0),
+            ("stiffness", |p| p.material.stiffness[1] = -1.0),
+            ("damping", |p| p.material.damping[2] = f32::NAN),
+            ("density", |p| p.material.density = 0.0),
         ];
         for (name, spoil) in cases {
             let mut p = SimParams::default();
@@ -190,6 +284,33 @@ mod tests {
                 err.to_string().contains(&format!("`{name}`")),
                 "{name}: {err}"
             );
+        }
+    }
+
+    /// Each setting is named by its own flag and no other; nothing changed is no flag.
+    #[test]
+    fn a_change_names_its_concern() {
+        type Edit = fn(&mut SimParams);
+        let cases: [(Changes, Edit); 10] = [
+            (Changes::DT, |p| p.step.dt *= 2.0),
+            (Changes::SUBSTEPS, |p| p.step.substeps += 1),
+            (Changes::INTEGRATOR, |p| {
+                p.step.integrator = IntegratorKind::ImplicitEuler;
+            }),
+            (Changes::STRENGTHS, |p| p.material.stiffness[2] += 1.0),
+            (Changes::STRENGTHS, |p| p.material.damping[0] += 1.0),
+            (Changes::DENSITY, |p| p.material.density += 0.1),
+            (Changes::CONTACT, |p| p.contact.offset += 0.001),
+            (Changes::GUARD, |p| p.guard.enabled = !p.guard.enabled),
+            (Changes::SOLVER, |p| p.solver.tolerance *= 0.5),
+            (Changes::SOLVER, |p| p.solver.xpbd_iterations += 1),
+        ];
+        let before = SimParams::default();
+        assert_eq!(before.changes_to(&before.clone()), Changes::empty());
+        for (flag, edit) in cases {
+            let mut after = before.clone();
+            edit(&mut after);
+            assert_eq!(before.changes_to(&after), flag, "{after:?}");
         }
     }
 }

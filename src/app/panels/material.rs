@@ -20,12 +20,12 @@ impl Panel for MaterialPanel {
         for kind in [SpringKind::Structural, SpringKind::Shear] {
             changed |= spring_sliders(ui, &mut params, kind, &format!("{} ", kind.name()));
         }
-        let density = Slider::new(&mut params.density, 0.01..=5.0)
+        let density = Slider::new(&mut params.material.density, 0.01..=5.0)
             .logarithmic(true)
             .suffix(" kg/m²")
             .text("density");
         changed |= ui.add(density).changed();
-        let offset = Slider::new(&mut params.collision_offset, 0.0..=0.05)
+        let offset = Slider::new(&mut params.contact.offset, 0.0..=0.05)
             .suffix(" m")
             .text("collision thickness");
         changed |= ui

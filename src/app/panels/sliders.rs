@@ -14,12 +14,12 @@ pub fn spring_sliders(
     prefix: &str,
 ) -> bool {
     let k = kind.index();
-    let stiffness = Slider::new(&mut params.stiffness[k], 0.0..=5000.0)
+    let stiffness = Slider::new(&mut params.material.stiffness[k], 0.0..=5000.0)
         .logarithmic(true)
         .suffix(" N/m")
         .text(format!("{prefix}stiffness"));
     let changed = ui.add(stiffness).changed();
-    let damping = Slider::new(&mut params.damping[k], 0.0..=2.0)
+    let damping = Slider::new(&mut params.material.damping[k], 0.0..=2.0)
         .logarithmic(true)
         .suffix(" N·s/m")
         .text(format!("{prefix}damping"));

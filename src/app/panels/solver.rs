@@ -37,14 +37,14 @@ impl Panel for SolverPanel {
         let mut changed = false;
         for kind in IntegratorKind::ALL {
             changed |= ui
-                .radio_value(&mut params.integrator, kind, kind.label())
+                .radio_value(&mut params.step.integrator, kind, kind.label())
                 .changed();
         }
         egui::Grid::new("solver").num_columns(2).show(ui, |ui| {
             let label = ui.label("Time step");
             changed |= ui
                 .add(
-                    egui::DragValue::new(&mut params.dt)
+                    egui::DragValue::new(&mut params.step.dt)
                         .range(1e-4..=0.1)
                         .speed(1e-4)
                         .suffix(" s")
@@ -56,10 +56,10 @@ impl Panel for SolverPanel {
             let label = ui.label("Substeps");
             ui.horizontal(|ui| {
                 changed |= ui
-                    .add(egui::DragValue::new(&mut params.substeps).range(1..=2000))
+                    .add(egui::DragValue::new(&mut params.step.substeps).range(1..=2000))
                     .labelled_by(label.id)
                     .changed();
-                if in_effect.substeps != params.substeps {
+                if in_effect.substeps != params.step.substeps {
                     ui.label(
                         RichText::new(format!("in effect: {}", in_effect.substeps))
                             .color(egui::Color32::from_rgb(230, 160, 40)),

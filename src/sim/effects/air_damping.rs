@@ -9,7 +9,7 @@ use crate::parallel::{each_part, within};
 use crate::sim::forces::{Force, ForceTerm, Fused, SystemMatrix};
 use crate::sim::kernels::Components;
 use crate::sim::param_error::ParamError;
-use crate::sim::params::SimParams;
+use crate::sim::params::Material;
 
 use super::effect_kind::{ClothBox, EffectKind};
 
@@ -124,7 +124,7 @@ impl EffectKind for AirDamping {
         Ok(())
     }
 
-    fn force(&self, _model: &ClothModel, _params: &SimParams, _kept: &[Force]) -> Option<Force> {
+    fn force(&self, _model: &ClothModel, _material: &Material, _kept: &[Force]) -> Option<Force> {
         Some(Force::new(Self::NAME, *self))
     }
 

@@ -4,7 +4,7 @@
 use crate::cloth::ClothModel;
 use crate::sim::forces::{DihedralBending, Force};
 use crate::sim::param_error::ParamError;
-use crate::sim::params::SimParams;
+use crate::sim::params::Material;
 
 use super::cloth_springs::spring_term;
 use super::effect_kind::{ClothBox, EffectKind};
@@ -48,11 +48,11 @@ impl EffectKind for BendingModel {
         }
     }
 
-    fn force(&self, model: &ClothModel, params: &SimParams, kept: &[Force]) -> Option<Force> {
+    fn force(&self, model: &ClothModel, material: &Material, kept: &[Force]) -> Option<Force> {
         Some(match *self {
             BendingModel::Springs => {
                 let range = model.bend_start()..model.springs.len();
-                Force::new(Self::NAME, spring_term(model, params, kept, range))
+                Force::new(Self::NAME, spring_term(model, material, kept, range))
             }
             BendingModel::Dihedral { stiffness } => {
                 let mut b = (kept.iter())

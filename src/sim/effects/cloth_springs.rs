@@ -3,7 +3,7 @@
 
 use crate::cloth::ClothModel;
 use crate::sim::forces::{Force, SpringForce};
-use crate::sim::params::SimParams;
+use crate::sim::params::Material;
 
 use super::effect_kind::{ClothBox, EffectKind};
 
@@ -15,11 +15,11 @@ pub struct ClothSprings;
 /// term among `kept` over the same range (its regrouped runs) when there is one.
 pub(super) fn spring_term(
     model: &ClothModel,
-    params: &SimParams,
+    material: &Material,
     kept: &[Force],
     range: std::ops::Range<usize>,
 ) -> SpringForce {
-    let (stiffness, damping) = (params.stiffness, params.damping);
+    let (stiffness, damping) = (material.stiffness, material.damping);
     let mut s = (kept.iter())
         .filter_map(Force::springs)
         .find(|s| s.range() == range)
@@ -35,11 +35,11 @@ impl EffectKind for ClothSprings {
     const MANY: bool = false;
     const ADDABLE: bool = false;
 
-    fn force(&self, model: &ClothModel, params: &SimParams, kept: &[Force]) -> Option<Force> {
+    fn force(&self, model: &ClothModel, material: &Material, kept: &[Force]) -> Option<Force> {
         let range = 0..model.bend_start();
         Some(Force::new(
             Self::NAME,
-            spring_term(model, params, kept, range),
+            spring_term(model, material, kept, range),
         ))
     }
 

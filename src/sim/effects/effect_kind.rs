@@ -7,7 +7,7 @@ use glam::Vec3;
 use crate::cloth::{ClothModel, ClothState};
 use crate::sim::forces::Force;
 use crate::sim::param_error::ParamError;
-use crate::sim::params::SimParams;
+use crate::sim::params::Material;
 use crate::sim::self_contacts::{ContactError, SelfContacts};
 
 /// What one substep's contact pass works on.
@@ -62,9 +62,9 @@ pub trait EffectKind: Sized {
         Ok(())
     }
 
-    /// The force term it adds to a step, built for `model` with the material in `params`
+    /// The force term it adds to a step, built for `model` with the cloth's `material`
     /// (from what `kept`, the terms before, already derived); `None`: no force.
-    fn force(&self, _model: &ClothModel, _params: &SimParams, _kept: &[Force]) -> Option<Force> {
+    fn force(&self, _model: &ClothModel, _material: &Material, _kept: &[Force]) -> Option<Force> {
         None
     }
 

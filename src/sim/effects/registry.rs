@@ -8,7 +8,7 @@ use glam::Vec3;
 use crate::cloth::ClothModel;
 use crate::sim::forces::Force;
 use crate::sim::param_error::ParamError;
-use crate::sim::params::SimParams;
+use crate::sim::params::Material;
 use crate::sim::self_contacts::ContactError;
 
 use super::air_damping::AirDamping;
@@ -76,8 +76,8 @@ macro_rules! effects {
             }
 
             /// Its force term, if it adds one ([`EffectKind::force`]).
-            pub fn force(&self, model: &ClothModel, params: &SimParams, kept: &[Force]) -> Option<Force> {
-                match self { $(Effect::$variant(e) => e.force(model, params, kept),)* }
+            pub fn force(&self, model: &ClothModel, material: &Material, kept: &[Force]) -> Option<Force> {
+                match self { $(Effect::$variant(e) => e.force(model, material, kept),)* }
             }
 
             /// Whether it is a solid the cloth may not enter (it has a [surface](EffectKind::surface)).

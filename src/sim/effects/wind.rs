@@ -6,7 +6,7 @@ use glam::Vec3;
 use crate::cloth::ClothModel;
 use crate::sim::forces::{Force, ForceTerm};
 use crate::sim::param_error::ParamError;
-use crate::sim::params::SimParams;
+use crate::sim::params::Material;
 
 use super::effect_kind::{ClothBox, EffectKind, GuardShare};
 
@@ -147,7 +147,7 @@ impl EffectKind for Wind {
         Ok(())
     }
 
-    fn force(&self, _model: &ClothModel, _params: &SimParams, _kept: &[Force]) -> Option<Force> {
+    fn force(&self, _model: &ClothModel, _material: &Material, _kept: &[Force]) -> Option<Force> {
         Some(Force::new(Self::NAME, *self))
     }
 

@@ -2,6 +2,9 @@
 
 use std::any::Any;
 
+use crate::cloth::ClothModel;
+use crate::sim::params::Material;
+
 use super::force_term::ForceTerm;
 use super::springs::SpringForce;
 
@@ -24,6 +27,11 @@ impl Force {
     /// The term's phase name in timings.
     pub fn phase(&self) -> &'static str {
         self.phase
+    }
+
+    /// Takes the material's new strengths ([`ForceTerm::retune`]).
+    pub fn retune(&mut self, model: &ClothModel, material: &Material) {
+        self.term.retune(model, material);
     }
 
     /// The term as its own type, if it is a `T`.

@@ -9,7 +9,7 @@ use crate::cloth::ClothModel;
 
 use super::super::constraints::DistanceConstraints;
 use super::super::effects::Effect;
-use super::super::params::SimParams;
+use super::super::params::{Changes, Material};
 use super::force::Force;
 use super::force_term::Fused;
 use super::jacobian::{JacobianMode, SystemMatrix};
@@ -60,10 +60,10 @@ impl TermTimes {
 }
 
 impl ForceSet {
-    /// The terms `effects` call for, with the strengths in `params`.
-    pub fn new(model: &ClothModel, params: &SimParams, effects: &[Effect]) -> Self {
+    /// The terms `effects` call for, with the cloth's `material`.
+    pub fn new(model: &ClothModel, material: &Material, effects: &[Effect]) -> Self {
         let mut set = Self::default();
-        set.configure(model, params, effects);
+        set.configure(model, material, effects);
         set
     }
 
@@ -80,14 +80,36 @@ impl ForceSet {
         self.time = time;
     }
 
-    /// Rebuilds the term list for `effects` and `params`: each effect's term
+    /// Rebuilds the term list for `effects` and `material`: each effect's term
     /// ([`Effect::force`]), keeping what the terms before derived (the springs' expansion
     /// and runs, the hinges' rest angles) where it still holds.
-    pub fn configure(&mut self, model: &ClothModel, params: &SimParams, effects: &[Effect]) {
+    pub fn configure(&mut self, model: &ClothModel, material: &Material, effects: &[Effect]) {
         let old = std::mem::take(&mut self.terms);
         self.terms = (effects.iter())
-            .filter_map(|e| e.force(model, params, &old))
+            .filter_map(|e| e.force(model, material, &old))
             .collect();
+    }
+
+    /// Takes what `changes` says changed: a new effect list rebuilds the terms
+    /// ([`ForceSet::configure`]), new spring strengths alone retune the terms in place, and
+    /// anything else leaves them be. Returns whether the terms changed.
+    pub fn apply(
+        &mut self,
+        model: &ClothModel,
+        material: &Material,
+        effects: &[Effect],
+        changes: Changes,
+    ) -> bool {
+        if changes.contains(Changes::EFFECTS) {
+            self.configure(model, material, effects);
+        } else if changes.contains(Changes::STRENGTHS) {
+            for term in &mut self.terms {
+                term.retune(model, material);
+            }
+        } else {
+            return false;
+        }
+        true
     }
 
     pub fn terms(&self) -> &[Force] {
@@ -420,5 +442,67 @@ impl ForceSet {
 pub fn to_accelerations(inv_mass: &[f32], f: &mut [Vec3]) {
     for (a, &w) in f.iter_mut().zip(inv_mass) {
         *a *= w;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    /// Where each term lives: the same address after a change means it was kept, not built.
+    fn addresses(set: &ForceSet) -> Vec<*const ()> {
+        (set.terms.iter())
+            .map(|t| std::ptr::from_ref::<dyn super::super::ForceTerm>(&**t).cast::<()>())
+            .collect()
+    }
+
+    fn forces(set: &ForceSet, model: &ClothModel, pos: &[Vec3], vel: &[Vec3]) -> Vec<Vec3> {
+        let mut f = Vec::new();
+        set.forces_where(model, pos, vel, |_| true, &mut f);
+        f
+    }
+
+    /// New strengths retune the terms where they are and give the forces a set built for
+    /// them gives; a change that is not the forces' leaves the terms be; a new effect list
+    /// builds them again.
+    #[test]
+    fn a_change_redoes_only_what_depends_on_it() {
+        let scene = Scene::builtin("sphere-drop").expect("scene");
+        let (model, effects) = (&scene.model, &scene.effects);
+        let mut material = scene.params.material;
+        let mut set = ForceSet::new(model, &material, effects);
+        let built = addresses(&set);
+        // A state that stretches the springs: the initial one, sheared and moving.
+        let pos: Vec<Vec3> = (scene.initial.pos.iter())
+            .map(|p| *p + Vec3::new(0.1 * p.y, 0.0, 0.05 * p.x))
+            .collect();
+        let vel: Vec<Vec3> = pos.iter().map(|p| Vec3::new(p.z, -p.x, 0.5)).collect();
+
+        material.stiffness[1] *= 3.0;
+        material.damping[0] *= 2.0;
+        assert!(set.apply(model, &material, effects, Changes::STRENGTHS));
+        assert_eq!(addresses(&set), built, "retuned in place");
+        let fresh = ForceSet::new(model, &material, effects);
+        assert_eq!(
+            forces(&set, model, &pos, &vel),
+            forces(&fresh, model, &pos, &vel)
+        );
+
+        let others = Changes::all() - Changes::STRENGTHS - Changes::EFFECTS;
+        assert!(!set.apply(model, &material, effects, others));
+        assert_eq!(addresses(&set), built);
+
+        let fewer: Vec<Effect> = (effects.iter())
+            .filter(|e| !matches!(e, Effect::Bending(_)))
+            .cloned()
+            .collect();
+        assert!(set.apply(model, &material, &fewer, Changes::EFFECTS));
+        assert_eq!(set.terms.len(), built.len() - 1);
+        let fresh = ForceSet::new(model, &material, &fewer);
+        assert_eq!(
+            forces(&set, model, &pos, &vel),
+            forces(&fresh, model, &pos, &vel)
+        );
     }
 }

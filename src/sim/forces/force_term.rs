@@ -6,6 +6,7 @@ use glam::Vec3;
 
 use crate::cloth::ClothModel;
 use crate::sim::kernels::{Components, TwoPasses};
+use crate::sim::params::Material;
 
 use super::jacobian::{JacobianMode, SystemMatrix};
 
@@ -53,6 +54,10 @@ pub trait ForceTerm: std::any::Any + Send + Sync + std::fmt::Debug {
     /// Adds a pointwise term's forces on one range of particles (`mass`, `vel` and `f` are
     /// that range's), the same bits as [`ForceTerm::add_forces_components`] there.
     fn add_pointwise(&self, _mass: &[f32], _vel: [&[f32]; 3], _f: [&mut [f32]; 3]) {}
+
+    /// Takes the material's new strengths in place (the springs do); a term whose strength
+    /// is its effect's own keeps it.
+    fn retune(&mut self, _model: &ClothModel, _material: &Material) {}
 
     /// Potential energy at `pos`, joules; zero for dissipative and driving terms.
     fn potential_energy(&self, _model: &ClothModel, _pos: &[Vec3]) -> f64 {

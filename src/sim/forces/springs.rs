@@ -17,6 +17,7 @@ use crate::sim::kernels::{Components, SpringRuns, TwoPasses};
 use super::force_term::{ForceTerm, Fused};
 use super::jacobian::{JacobianMode, SpringBlock, SystemMatrix};
 use crate::sim::constraints::DistanceConstraints;
+use crate::sim::params::Material;
 
 /// Springs with per-kind stiffness (N/m) and damping (N·s/m), expanded per spring, over a
 /// range of the model's springs: the structural and shear springs are one term, the bend
@@ -304,6 +305,10 @@ fn apply_pair(springs: &Springs, e: usize, block: Mat3, u: &[Vec3], out: &mut [V
 }
 
 impl ForceTerm for SpringForce {
+    fn retune(&mut self, model: &ClothModel, material: &Material) {
+        self.set_strengths(&model.springs, material.stiffness, material.damping);
+    }
+
     fn add_forces(&self, model: &ClothModel, pos: &[Vec3], vel: &[Vec3], _t: f64, f: &mut [Vec3]) {
         SpringForce::add_forces(self, &model.springs, pos, vel, f);
     }
