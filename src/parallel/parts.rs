@@ -15,11 +15,12 @@ pub const PARALLEL_ELEMENTS: usize = 4096;
 /// Calls `part(range, slices)` with `arrays` cut at `range`, for ranges that cover
 /// `0..len` (`len` the shortest array's length): one range per member of the current team,
 /// run in parallel, from [`PARALLEL_ELEMENTS`] elements on; else the one range `0..len`
-/// here. Ranges are whole cache lines (16 floats) long but the last. For loops in which
-/// each element's work is its own, so the result is the same however they are cut.
-pub fn each_part<const K: usize>(
-    arrays: [&mut [f32]; K],
-    part: impl Fn(std::ops::Range<usize>, [&mut [f32]; K]) + Sync,
+/// here. Ranges are whole cache lines (16 `f32`s, two lines of `f64`s) long but the last.
+/// For loops in which each element's work is its own, so the result is the same however
+/// they are cut.
+pub fn each_part<T: Send, const K: usize>(
+    arrays: [&mut [T]; K],
+    part: impl Fn(std::ops::Range<usize>, [&mut [T]; K]) + Sync,
 ) {
     const LINE: usize = 16;
     let len = arrays.iter().map(|a| a.len()).min().unwrap_or(0);

@@ -7,8 +7,11 @@ use glam::{Mat3, Vec3};
 
 use crate::parallel::each_part;
 
-/// x, y and z of a list of vectors, one array each (all the same length).
-pub type Components = [Vec<f32>; 3];
+use super::real::Real;
+
+/// x, y and z of a list of vectors, one array each (all the same length), in `f32` unless
+/// said otherwise.
+pub type Components<R = f32> = [Vec<R>; 3];
 
 /// Copies the first `n` vectors of `src` into `out`, one array per component.
 pub fn split(src: &[Vec3], out: &mut Components, n: usize) {
@@ -32,19 +35,19 @@ pub fn join(src: &Components, out: &mut [Vec3]) {
 }
 
 /// Sets `out` to `n` zero vectors (filled by the team from [`each_part`]'s threshold on).
-pub fn zeroed(out: &mut Components, n: usize) {
+pub fn zeroed<R: Real>(out: &mut Components<R>, n: usize) {
     for comp in out.iter_mut() {
-        comp.resize(n, 0.0);
+        comp.resize(n, R::ZERO);
     }
     let [x, y, z] = out;
     each_part([x, y, z], |_, parts| {
-        parts.into_iter().for_each(|p| p.fill(0.0))
+        parts.into_iter().for_each(|p| p.fill(R::ZERO))
     });
 }
 
 /// 3×3 blocks (one per particle or per spring) stored one array per entry, column-major:
 /// entry `3c + r` is row `r` of column `c`.
-pub type Blocks = [Vec<f32>; 9];
+pub type Blocks<R = f32> = [Vec<R>; 9];
 
 /// Sets `out` to `blocks`, one array per entry (sized first, then written in place: nine
 /// pushes a block, each checking its vector's capacity, cost more than making the blocks).
@@ -67,11 +70,11 @@ pub fn split_blocks(blocks: impl ExactSizeIterator<Item = Mat3>, out: &mut Block
 
 /// `out_i = combine(M_i·u_i, out_i)` for every particle `i` (`M` one block per particle).
 #[inline(always)]
-pub fn blocks_times(
-    m: &Blocks,
-    u: &Components,
-    out: &mut Components,
-    combine: impl Fn(f32, f32) -> f32,
+pub fn blocks_times<R: Real>(
+    m: &Blocks<R>,
+    u: &Components<R>,
+    out: &mut Components<R>,
+    combine: impl Fn(R, R) -> R,
 ) {
     let n = u[0].len().min(m[0].len());
     let (ux, uy, uz) = (&u[0][..n], &u[1][..n], &u[2][..n]);

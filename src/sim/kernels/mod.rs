@@ -3,6 +3,7 @@
 //! threads.
 
 mod components;
+mod real;
 mod run_pass;
 mod spring_runs;
 mod two_passes;
@@ -11,6 +12,7 @@ mod xpbd_lanes;
 pub use components::{
     Blocks, Components, Scratch, blocks_times, join, split, split_blocks, zeroed,
 };
+pub use real::Real;
 pub use run_pass::Projectors;
 pub use spring_runs::SpringRuns;
 pub use two_passes::{BlockPass, TwoPasses};

@@ -5,46 +5,47 @@
 use std::ops::Range;
 
 use super::components::Components;
+use super::real::Real;
 
 /// Springs' system blocks `α·I + β·n nᵀ` in run order: `[α, β, n.x, n.y, n.z]`
 /// ([`SpringBlock::numbers`](crate::sim::forces::SpringBlock::numbers)), one array each
 /// ([`SpringRuns::add_block_products`](super::SpringRuns::add_block_products)).
-pub type Projectors = [Vec<f32>; 5];
+pub type Projectors<R = f32> = [Vec<R>; 5];
 
 /// What a block pass does with each run: `run` gets the run's two ranges of ends, its
 /// springs (run order) and its slices of the block's buffers at its first ends and at its
 /// second ends (where what it puts is subtracted), which it overwrites (`WRITE`: `0 + x`,
 /// the bits of adding to zero) or adds to.
-pub(super) trait RunPass: Sync {
+pub(super) trait RunPass<R: Real>: Sync {
     fn run<const WRITE: bool>(
         &self,
         ends: [Range<usize>; 2],
         springs: Range<usize>,
-        first: [&mut [f32]; 3],
-        second: [&mut [f32]; 3],
+        first: [&mut [R]; 3],
+        second: [&mut [R]; 3],
     );
 }
 
 /// The spring forces (see [`kernel`]).
-pub(super) struct ForcePass<'a> {
-    pub(super) rest: &'a [f32],
-    pub(super) k: &'a [f32],
-    pub(super) c: &'a [f32],
-    pub(super) p: &'a Components,
-    pub(super) v: &'a Components,
+pub(super) struct ForcePass<'a, R: Real> {
+    pub(super) rest: &'a [R],
+    pub(super) k: &'a [R],
+    pub(super) c: &'a [R],
+    pub(super) p: &'a Components<R>,
+    pub(super) v: &'a Components<R>,
 }
 
-impl RunPass for ForcePass<'_> {
+impl<R: Real> RunPass<R> for ForcePass<'_, R> {
     #[inline(always)]
     fn run<const WRITE: bool>(
         &self,
         [ea, eb]: [Range<usize>; 2],
         springs: Range<usize>,
-        first: [&mut [f32]; 3],
-        second: [&mut [f32]; 3],
+        first: [&mut [R]; 3],
+        second: [&mut [R]; 3],
     ) {
         let (p, v) = (self.p, self.v);
-        kernel::<WRITE>(
+        kernel::<R, WRITE>(
             at(p, &ea),
             at(p, &eb),
             at(v, &ea),
@@ -62,31 +63,30 @@ impl RunPass for ForcePass<'_> {
 
 /// Block products `S_e·u_other` at both ends (see
 /// [`SpringRuns::add_block_products`](super::SpringRuns::add_block_products)).
-pub(super) struct ProductPass<'a> {
-    pub(super) s: &'a Projectors,
-    pub(super) u: &'a Components,
+pub(super) struct ProductPass<'a, R: Real> {
+    pub(super) s: &'a Projectors<R>,
+    pub(super) u: &'a Components<R>,
 }
 
-impl RunPass for ProductPass<'_> {
+impl<R: Real> RunPass<R> for ProductPass<'_, R> {
     #[inline(always)]
     fn run<const WRITE: bool>(
         &self,
         [ea, eb]: [Range<usize>; 2],
         springs: Range<usize>,
-        first: [&mut [f32]; 3],
-        second: [&mut [f32]; 3],
+        first: [&mut [R]; 3],
+        second: [&mut [R]; 3],
     ) {
         let (s, u) = (self.s, self.u);
         let n = springs.len();
-        let [al, be, nx, ny, nz]: [&[f32]; 5] =
-            std::array::from_fn(|k| &s[k][springs.clone()][..n]);
+        let [al, be, nx, ny, nz]: [&[R]; 5] = std::array::from_fn(|k| &s[k][springs.clone()][..n]);
         let [ax, ay, az] = at(u, &(ea.start..ea.start + n));
         let [bx, by, bz] = at(u, &(eb.start..eb.start + n));
         let [f0, f1, f2] = first;
         let [t0, t1, t2] = second;
         let (f0, f1, f2) = (&mut f0[..n], &mut f1[..n], &mut f2[..n]);
         let (t0, t1, t2) = (&mut t0[..n], &mut t1[..n], &mut t2[..n]);
-        let was = |o: f32| if WRITE { 0.0 } else { o };
+        let was = |o: R| if WRITE { R::ZERO } else { o };
         for j in 0..n {
             // S·w = α·w + β(n·w)·n.
             let db = be[j] * (nx[j] * bx[j] + ny[j] * by[j] + nz[j] * bz[j]);
@@ -104,7 +104,7 @@ impl RunPass for ProductPass<'_> {
 
 /// The particles `range` of each component.
 #[inline(always)]
-pub(super) fn at<'a>(c: &'a Components, range: &Range<usize>) -> [&'a [f32]; 3] {
+pub(super) fn at<'a, R>(c: &'a Components<R>, range: &Range<usize>) -> [&'a [R]; 3] {
     [
         &c[0][range.clone()],
         &c[1][range.clone()],
@@ -120,14 +120,14 @@ pub(super) fn at<'a>(c: &'a Components, range: &Range<usize>) -> [&'a [f32]; 3] 
 /// `WRITE`: overwrites `first` and `second` instead (with `g·d + 0`, the same bits as
 /// adding to zeroed sums).
 #[inline(always)]
-fn kernel<const WRITE: bool>(
-    xa: [&[f32]; 3],
-    xb: [&[f32]; 3],
-    va: [&[f32]; 3],
-    vb: [&[f32]; 3],
-    params: [&[f32]; 3],
-    first: [&mut [f32]; 3],
-    second: [&mut [f32]; 3],
+fn kernel<R: Real, const WRITE: bool>(
+    xa: [&[R]; 3],
+    xb: [&[R]; 3],
+    va: [&[R]; 3],
+    vb: [&[R]; 3],
+    params: [&[R]; 3],
+    first: [&mut [R]; 3],
+    second: [&mut [R]; 3],
 ) {
     let n = first[0].len();
     let [ox, oy, oz] = first;
@@ -142,12 +142,16 @@ fn kernel<const WRITE: bool>(
     for j in 0..n {
         let (dx, dy, dz) = (xbx[j] - xax[j], xby[j] - xay[j], xbz[j] - xaz[j]);
         let len = dz.mul_add(dz, dy.mul_add(dy, dx * dx)).sqrt();
-        let inv = if len > 1e-9 { 1.0 / len } else { 0.0 };
+        let inv = if len > R::TINY_LENGTH {
+            R::ONE / len
+        } else {
+            R::ZERO
+        };
         let (ux, uy, uz) = (vbx[j] - vax[j], vby[j] - vay[j], vbz[j] - vaz[j]);
         let along = uz.mul_add(dz, uy.mul_add(dy, ux * dx));
         let s = c[j].mul_add(along * inv, k[j] * (len - rest[j]));
         let g = s * inv;
-        let was = |o: f32| if WRITE { 0.0 } else { o };
+        let was = |o: R| if WRITE { R::ZERO } else { o };
         ox[j] = g.mul_add(dx, was(ox[j]));
         oy[j] = g.mul_add(dy, was(oy[j]));
         oz[j] = g.mul_add(dz, was(oz[j]));

@@ -21,6 +21,7 @@ use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
 use crate::parallel::{wide, wide_fma};
 
 use super::components::{Components, Scratch, split};
+use super::real::Real;
 use super::run_pass::{ForcePass, ProductPass, Projectors, RunPass, at};
 
 /// Particles per block (a block is one parallel task).
@@ -62,47 +63,48 @@ pub(super) struct Block {
     pub(super) hi: usize,
 }
 
-/// Springs regrouped for the fast path (see the module documentation).
+/// Springs regrouped for the fast path (see the module documentation), computing in `R`
+/// (`f32` unless said otherwise).
 #[derive(Clone, Debug, PartialEq)]
-pub struct SpringRuns {
+pub struct SpringRuns<R: Real = f32> {
     pub(super) particles: usize,
     /// For each place in run order, the index of its spring in the caller's arrays
     /// ([`GHOST`] for a filler).
     order: Vec<u32>,
     /// Blocks from which the blocks run in parallel ([`PARALLEL_BLOCKS`]; tests lower it).
     parallel_from: usize,
-    rest: Vec<f32>,
-    k: Vec<f32>,
-    c: Vec<f32>,
+    rest: Vec<R>,
+    k: Vec<R>,
+    c: Vec<R>,
     runs: Vec<Run>,
     pub(super) blocks: Vec<Block>,
-    pub(super) scratch: Scratch<Buffers>,
+    pub(super) scratch: Scratch<Buffers<R>>,
 }
 
 #[derive(Debug, Default)]
-pub(super) struct Buffers {
+pub(super) struct Buffers<R> {
     /// Positions and velocities, one array per component.
-    pos: Components,
-    vel: Components,
+    pos: Components<R>,
+    vel: Components<R>,
     /// Per block: its springs' forces summed over `lo..hi`.
-    pub(super) blocks: Vec<BlockBuffers>,
+    pub(super) blocks: Vec<BlockBuffers<R>>,
 }
 
 #[derive(Clone, Debug, Default)]
-pub(super) struct BlockBuffers {
+pub(super) struct BlockBuffers<R> {
     /// The sums at first ends (the block's sums are `first − second`, taken as they are
     /// gathered).
-    first: Components,
+    first: Components<R>,
     /// The forces on second ends (subtracted), summed apart so that one vector loop adds at
     /// both ends of a run, however near its offset.
-    second: Components,
+    second: Components<R>,
 }
 
-impl SpringRuns {
+impl<R: Real> SpringRuns<R> {
     /// Springs `a[e]`–`b[e]` with rest length, stiffness and damping per spring, over
     /// `particles` particles. A spring from a particle to itself exerts no force and is
     /// left out.
-    pub fn new(particles: usize, a: &[u32], b: &[u32], rest: &[f32], k: &[f32], c: &[f32]) -> Self {
+    pub fn new(particles: usize, a: &[u32], b: &[u32], rest: &[R], k: &[R], c: &[R]) -> Self {
         // The force on the lower-numbered end is the same whichever end is called first.
         let mut order: Vec<(u32, u32, usize)> = (0..a.len())
             .filter(|&e| a[e] != b[e])
@@ -177,15 +179,15 @@ impl SpringRuns {
 
     /// New stiffness and damping per spring (indexed as given to [`SpringRuns::new`]): the
     /// runs stay, only the values are put in run order again.
-    pub fn set_strengths(&mut self, k: &[f32], c: &[f32]) {
+    pub fn set_strengths(&mut self, k: &[R], c: &[R]) {
         self.k = self.pick(k);
         self.c = self.pick(c);
     }
 
     /// `v` (per spring, in the caller's order) in run order; 0 for gap fillers.
-    fn pick(&self, v: &[f32]) -> Vec<f32> {
+    fn pick(&self, v: &[R]) -> Vec<R> {
         (self.order.iter())
-            .map(|&e| if e == GHOST { 0.0 } else { v[e as usize] })
+            .map(|&e| if e == GHOST { R::ZERO } else { v[e as usize] })
             .collect()
     }
 
@@ -203,6 +205,315 @@ impl SpringRuns {
         self.runs.len()
     }
 
+    /// As [`SpringRuns::add_forces`] with positions, velocities and forces stored one array
+    /// per component (no copies made): the same operations in the same order, so the same
+    /// bits.
+    pub fn add_forces_components(
+        &self,
+        pos: &Components<R>,
+        vel: &Components<R>,
+        f: &mut Components<R>,
+    ) {
+        let n = (pos.iter().chain(vel).map(Vec::len))
+            .chain(f.iter().map(Vec::len))
+            .fold(self.particles, usize::min);
+        if self.runs.is_empty() || n < self.particles {
+            return;
+        }
+        let mut buffers = self.scratch.lock();
+        let blocks = &mut buffers.blocks;
+        let pass = self.force_pass(pos, vel);
+        self.block_sums(blocks, |block, buf| self.block_pass(block, buf, &pass));
+        self.gather_components(blocks, f, n);
+    }
+
+    /// Adds every block's sums to `f` (the first `n` particles).
+    fn gather_components(&self, blocks: &[BlockBuffers<R>], f: &mut Components<R>, n: usize) {
+        let [fx, fy, fz] = f;
+        let (fy, fz) = (Disjoint::new(&mut fy[..n]), Disjoint::new(&mut fz[..n]));
+        self.each_chunk(
+            n,
+            |chunks| {
+                let range = chunks.particles.clone();
+                // SAFETY: each chunk is taken by one call only (see `each_chunk`).
+                let out = unsafe {
+                    [
+                        chunks.forces.part(range.clone()),
+                        fy.part(range.clone()),
+                        fz.part(range.clone()),
+                    ]
+                };
+                self.add_sums(blocks, range, out);
+            },
+            &mut fx[..n],
+        );
+    }
+
+    /// Adds the blocks' sums over particles `range` to `out` (that range of the forces),
+    /// each block's in block order.
+    pub(super) fn add_sums(
+        &self,
+        blocks: &[BlockBuffers<R>],
+        range: Range<usize>,
+        out: [&mut [R]; 3],
+    ) {
+        self.sum_blocks(blocks, range, out, false);
+    }
+
+    /// As [`SpringRuns::add_sums`], but `write`: the first sum to reach each particle of
+    /// `out` overwrites it (`0 + x`, the bits of adding to zero), and the particles past
+    /// `range` (to the end of `out`) are set to zero; so `out` needs no zeroing first.
+    pub(super) fn sum_blocks(
+        &self,
+        blocks: &[BlockBuffers<R>],
+        range: Range<usize>,
+        out: [&mut [R]; 3],
+        write: bool,
+    ) {
+        wide(
+            #[inline(always)]
+            || self.sum_blocks_in(blocks, range, out, write),
+        )
+    }
+
+    /// [`SpringRuns::sum_blocks`]'s work, inlined into its AVX2 build.
+    #[inline(always)]
+    fn sum_blocks_in(
+        &self,
+        blocks: &[BlockBuffers<R>],
+        range: Range<usize>,
+        out: [&mut [R]; 3],
+        write: bool,
+    ) {
+        let [ox, oy, oz] = out;
+        let len = ox.len().min(oy.len()).min(oz.len());
+        // With `write`, the particles `..done` (from the range's start) have had a sum.
+        let mut done = if write { 0 } else { len };
+        self.cover_range(
+            blocks,
+            range,
+            #[inline(always)]
+            |at, first, second| {
+                let end = at + first[0].len();
+                // Each block reaches from its first particle to at least the next block's: they
+                // leave no gap.
+                debug_assert!(done >= at, "a gap before {at}");
+                let outs = [&mut *ox, &mut *oy, &mut *oz].into_iter();
+                for (out, (s, t)) in outs.zip(first.into_iter().zip(second)) {
+                    let fresh = done.clamp(at, end) - at;
+                    let (added, written) = out[at..end].split_at_mut(fresh);
+                    for ((o, &s), &t) in added.iter_mut().zip(s).zip(t) {
+                        *o += s - t;
+                    }
+                    let (s, t) = (&s[fresh..], &t[fresh..]);
+                    for ((o, &s), &t) in written.iter_mut().zip(s).zip(t) {
+                        *o = R::ZERO + (s - t);
+                    }
+                }
+                done = done.max(end);
+            },
+        );
+        for out in [ox, oy, oz] {
+            out[done.min(len)..len].fill(R::ZERO);
+        }
+    }
+
+    /// Calls `gather` for each `BLOCK`-particle chunk of `forces` (the first `n` particles'
+    /// forces): one chunk a piece of a team section ([`Team::run_pieces_if`]) when the
+    /// blocks are many enough; every chunk's sum is the same whoever takes it.
+    fn each_chunk<T: Send>(
+        &self,
+        n: usize,
+        gather: impl Fn(Chunks<'_, '_, T>) + Sync,
+        forces: &mut [T],
+    ) {
+        let forces = Disjoint::new(forces);
+        (Team::current()).run_pieces_if(self.parallel(), n.div_ceil(BLOCK), &|_, c| {
+            gather(Chunks {
+                particles: c * BLOCK..((c + 1) * BLOCK).min(n),
+                forces: &forces,
+            })
+        });
+    }
+
+    /// Whether the blocks are many enough to run in parallel.
+    fn parallel(&self) -> bool {
+        self.blocks.len() >= self.parallel_from
+    }
+
+    /// Every block's sums by `pass` (which fills one block's buffers), one block a piece of a
+    /// team section ([`Team::run_pieces_if`]) when they are many enough.
+    fn block_sums(
+        &self,
+        bufs: &mut Vec<BlockBuffers<R>>,
+        pass: impl Fn(&Block, &mut BlockBuffers<R>) + Sync,
+    ) {
+        self.size_buffers(bufs);
+        let bufs = Disjoint::new(&mut bufs[..]);
+        (Team::current()).run_pieces_if(self.parallel(), self.blocks.len(), &|_, b| {
+            // SAFETY: each piece runs once, so each block's buffer has one member.
+            pass(&self.blocks[b], unsafe { bufs.at(b) })
+        });
+    }
+
+    /// One buffer per block, each as long as the block's reach.
+    pub(super) fn size_buffers(&self, bufs: &mut Vec<BlockBuffers<R>>) {
+        bufs.resize_with(self.blocks.len(), Default::default);
+        for (buf, block) in bufs.iter_mut().zip(&self.blocks) {
+            for sums in buf.first.iter_mut().chain(&mut buf.second) {
+                sums.resize(block.hi - block.lo, R::ZERO);
+            }
+        }
+    }
+
+    /// The spring forces' pass over positions `p` and velocities `v` (all particles).
+    pub(super) fn force_pass<'a>(
+        &'a self,
+        p: &'a Components<R>,
+        v: &'a Components<R>,
+    ) -> ForcePass<'a, R> {
+        ForcePass {
+            rest: &self.rest,
+            k: &self.k,
+            c: &self.c,
+            p,
+            v,
+        }
+    }
+
+    /// Calls `add(at, first, second)` for each block's buffers over the particles `lo..hi`
+    /// (its sums are `first − second`), in block order; `at` is where from `lo` they start.
+    #[inline(always)]
+    fn cover_range(
+        &self,
+        buffers: &[BlockBuffers<R>],
+        std::ops::Range { start: lo, end: hi }: std::ops::Range<usize>,
+        mut add: impl FnMut(usize, [&[R]; 3], [&[R]; 3]),
+    ) {
+        let blocks = self.blocks.iter().zip(buffers);
+        for (b, buf) in blocks.take_while(|(b, _)| b.lo < hi) {
+            let (from, to) = (lo.max(b.lo), hi.min(b.hi));
+            if from < to {
+                let range = from - b.lo..to - b.lo;
+                add(from - lo, at(&buf.first, &range), at(&buf.second, &range));
+            }
+        }
+    }
+
+    /// One block's sums by `pass`, run by run (see [`SpringRuns::each_run`]), compiled for
+    /// AVX2 with FMA where the CPU has them ([`wide_fma`]): the same bits either way.
+    pub(super) fn block_pass(
+        &self,
+        block: &Block,
+        buf: &mut BlockBuffers<R>,
+        pass: &impl RunPass<R>,
+    ) {
+        wide_fma(
+            #[inline(always)]
+            || self.each_run(block, buf, pass),
+        )
+    }
+
+    /// Fills one block's buffers: [`RunPass::run`] for each of its runs. The first run
+    /// writes its slices of them rather than adding to them, so only the rest of them is
+    /// zeroed first.
+    #[inline(always)]
+    fn each_run(&self, block: &Block, buf: &mut BlockBuffers<R>, pass: &impl RunPass<R>) {
+        let BlockBuffers { first, second } = buf;
+        let Some((lead, rest)) = self.runs[block.runs.clone()].split_first() else {
+            first
+                .iter_mut()
+                .chain(second.iter_mut())
+                .for_each(|s| s.fill(R::ZERO));
+            return;
+        };
+        let [at_a, at_b] = Self::slices(block, lead);
+        for (buffer, written) in [(&mut *first, at_a), (&mut *second, at_b)] {
+            for s in buffer {
+                s[..written.start].fill(R::ZERO);
+                s[written.end..].fill(R::ZERO);
+            }
+        }
+        self.one_run::<true>(block, lead, first, second, pass);
+        for r in rest {
+            self.one_run::<false>(block, r, first, second, pass);
+        }
+    }
+
+    /// Where run `r` lands in its block's buffers: at its first ends and at its second.
+    #[inline(always)]
+    fn slices(block: &Block, r: &Run) -> [Range<usize>; 2] {
+        let (a, off, len) = (r.a as usize - block.lo, r.off as usize, r.len as usize);
+        [a..a + len, a + off..a + off + len]
+    }
+
+    /// Run `r` of `block` by `pass`, written into its slices of the buffers (`WRITE`) or
+    /// added to them.
+    #[inline(always)]
+    fn one_run<const WRITE: bool>(
+        &self,
+        block: &Block,
+        r: &Run,
+        first: &mut Components<R>,
+        second: &mut Components<R>,
+        pass: &impl RunPass<R>,
+    ) {
+        let (a, off, len) = (r.a as usize, r.off as usize, r.len as usize);
+        let springs = r.start as usize..r.start as usize + len;
+        let ends = [a..a + len, a + off..a + off + len];
+        let [at_a, at_b] = Self::slices(block, r);
+        let [s0, s1, s2] = first;
+        let [t0, t1, t2] = second;
+        pass.run::<WRITE>(
+            ends,
+            springs,
+            [&mut s0[at_a.clone()], &mut s1[at_a.clone()], &mut s2[at_a]],
+            [&mut t0[at_b.clone()], &mut t1[at_b.clone()], &mut t2[at_b]],
+        );
+    }
+
+    /// `K` numbers per spring (`value(e)` for spring `e` as given to [`SpringRuns::new`]) in
+    /// run order, one array each, zero for gap fillers.
+    pub fn in_order<const K: usize>(&self, value: impl Fn(usize) -> [R; K], out: &mut [Vec<R>; K]) {
+        let n = self.order.len();
+        for entry in out.iter_mut() {
+            entry.clear();
+            entry.resize(n, R::ZERO);
+        }
+        for (i, &e) in self.order.iter().enumerate() {
+            if e != GHOST {
+                for (entry, v) in out.iter_mut().zip(value(e as usize)) {
+                    entry[i] = v;
+                }
+            }
+        }
+    }
+
+    /// Adds `Σ_e S_e·u_other` to `out` at both ends of every spring `e`, with
+    /// `S_e = α·I + β·n nᵀ` as put in run order by [`SpringRuns::in_order`]
+    /// (`[α, β, n.x, n.y, n.z]`): the off-diagonal part of a matrix-vector product with the
+    /// implicit system (whose off-diagonal blocks are `−S_e`). In parallel as the forces
+    /// are, with the same result on any number of threads.
+    pub fn add_block_products(
+        &self,
+        s: &Projectors<R>,
+        u: &Components<R>,
+        out: &mut Components<R>,
+    ) {
+        let n = (u.iter().chain(out.iter()).map(Vec::len)).fold(self.particles, usize::min);
+        if self.runs.is_empty() || n < self.particles || s[0].len() != self.order.len() {
+            return;
+        }
+        let mut buffers = self.scratch.lock();
+        let blocks = &mut buffers.blocks;
+        let pass = ProductPass { s, u };
+        self.block_sums(blocks, |block, buf| self.block_pass(block, buf, &pass));
+        self.gather_components(blocks, out, n);
+    }
+}
+
+/// The `f32` runs also take the state as vectors.
+impl SpringRuns {
     /// Adds every spring's force (N) to `f` (indexed by particle).
     pub fn add_forces(&self, pos: &[Vec3], vel: &[Vec3], f: &mut [Vec3]) {
         let n = self.particles.min(pos.len()).min(vel.len()).min(f.len());
@@ -235,297 +546,6 @@ impl SpringRuns {
             },
             &mut f[..n],
         );
-    }
-
-    /// As [`SpringRuns::add_forces`] with positions, velocities and forces stored one array
-    /// per component (no copies made): the same operations in the same order, so the same
-    /// bits.
-    pub fn add_forces_components(&self, pos: &Components, vel: &Components, f: &mut Components) {
-        let n = (pos.iter().chain(vel).map(Vec::len))
-            .chain(f.iter().map(Vec::len))
-            .fold(self.particles, usize::min);
-        if self.runs.is_empty() || n < self.particles {
-            return;
-        }
-        let mut buffers = self.scratch.lock();
-        let blocks = &mut buffers.blocks;
-        let pass = self.force_pass(pos, vel);
-        self.block_sums(blocks, |block, buf| self.block_pass(block, buf, &pass));
-        self.gather_components(blocks, f, n);
-    }
-
-    /// Adds every block's sums to `f` (the first `n` particles).
-    fn gather_components(&self, blocks: &[BlockBuffers], f: &mut Components, n: usize) {
-        let [fx, fy, fz] = f;
-        let (fy, fz) = (Disjoint::new(&mut fy[..n]), Disjoint::new(&mut fz[..n]));
-        self.each_chunk(
-            n,
-            |chunks| {
-                let range = chunks.particles.clone();
-                // SAFETY: each chunk is taken by one call only (see `each_chunk`).
-                let out = unsafe {
-                    [
-                        chunks.forces.part(range.clone()),
-                        fy.part(range.clone()),
-                        fz.part(range.clone()),
-                    ]
-                };
-                self.add_sums(blocks, range, out);
-            },
-            &mut fx[..n],
-        );
-    }
-
-    /// Adds the blocks' sums over particles `range` to `out` (that range of the forces),
-    /// each block's in block order.
-    pub(super) fn add_sums(
-        &self,
-        blocks: &[BlockBuffers],
-        range: Range<usize>,
-        out: [&mut [f32]; 3],
-    ) {
-        self.sum_blocks(blocks, range, out, false);
-    }
-
-    /// As [`SpringRuns::add_sums`], but `write`: the first sum to reach each particle of
-    /// `out` overwrites it (`0 + x`, the bits of adding to zero), and the particles past
-    /// `range` (to the end of `out`) are set to zero; so `out` needs no zeroing first.
-    pub(super) fn sum_blocks(
-        &self,
-        blocks: &[BlockBuffers],
-        range: Range<usize>,
-        out: [&mut [f32]; 3],
-        write: bool,
-    ) {
-        wide(
-            #[inline(always)]
-            || self.sum_blocks_in(blocks, range, out, write),
-        )
-    }
-
-    /// [`SpringRuns::sum_blocks`]'s work, inlined into its AVX2 build.
-    #[inline(always)]
-    fn sum_blocks_in(
-        &self,
-        blocks: &[BlockBuffers],
-        range: Range<usize>,
-        out: [&mut [f32]; 3],
-        write: bool,
-    ) {
-        let [ox, oy, oz] = out;
-        let len = ox.len().min(oy.len()).min(oz.len());
-        // With `write`, the particles `..done` (from the range's start) have had a sum.
-        let mut done = if write { 0 } else { len };
-        self.cover_range(
-            blocks,
-            range,
-            #[inline(always)]
-            |at, first, second| {
-                let end = at + first[0].len();
-                // Each block reaches from its first particle to at least the next block's: they
-                // leave no gap.
-                debug_assert!(done >= at, "a gap before {at}");
-                let outs = [&mut *ox, &mut *oy, &mut *oz].into_iter();
-                for (out, (s, t)) in outs.zip(first.into_iter().zip(second)) {
-                    let fresh = done.clamp(at, end) - at;
-                    let (added, written) = out[at..end].split_at_mut(fresh);
-                    for ((o, &s), &t) in added.iter_mut().zip(s).zip(t) {
-                        *o += s - t;
-                    }
-                    let (s, t) = (&s[fresh..], &t[fresh..]);
-                    for ((o, &s), &t) in written.iter_mut().zip(s).zip(t) {
-                        *o = 0.0 + (s - t);
-                    }
-                }
-                done = done.max(end);
-            },
-        );
-        for out in [ox, oy, oz] {
-            out[done.min(len)..len].fill(0.0);
-        }
-    }
-
-    /// Calls `gather` for each `BLOCK`-particle chunk of `forces` (the first `n` particles'
-    /// forces): one chunk a piece of a team section ([`Team::run_pieces_if`]) when the
-    /// blocks are many enough; every chunk's sum is the same whoever takes it.
-    fn each_chunk<T: Send>(
-        &self,
-        n: usize,
-        gather: impl Fn(Chunks<'_, '_, T>) + Sync,
-        forces: &mut [T],
-    ) {
-        let forces = Disjoint::new(forces);
-        (Team::current()).run_pieces_if(self.parallel(), n.div_ceil(BLOCK), &|_, c| {
-            gather(Chunks {
-                particles: c * BLOCK..((c + 1) * BLOCK).min(n),
-                forces: &forces,
-            })
-        });
-    }
-
-    /// Whether the blocks are many enough to run in parallel.
-    fn parallel(&self) -> bool {
-        self.blocks.len() >= self.parallel_from
-    }
-
-    /// Every block's sums by `pass` (which fills one block's buffers), one block a piece of a
-    /// team section ([`Team::run_pieces_if`]) when they are many enough.
-    fn block_sums(
-        &self,
-        bufs: &mut Vec<BlockBuffers>,
-        pass: impl Fn(&Block, &mut BlockBuffers) + Sync,
-    ) {
-        self.size_buffers(bufs);
-        let bufs = Disjoint::new(&mut bufs[..]);
-        (Team::current()).run_pieces_if(self.parallel(), self.blocks.len(), &|_, b| {
-            // SAFETY: each piece runs once, so each block's buffer has one member.
-            pass(&self.blocks[b], unsafe { bufs.at(b) })
-        });
-    }
-
-    /// One buffer per block, each as long as the block's reach.
-    pub(super) fn size_buffers(&self, bufs: &mut Vec<BlockBuffers>) {
-        bufs.resize_with(self.blocks.len(), Default::default);
-        for (buf, block) in bufs.iter_mut().zip(&self.blocks) {
-            for sums in buf.first.iter_mut().chain(&mut buf.second) {
-                sums.resize(block.hi - block.lo, 0.0);
-            }
-        }
-    }
-
-    /// The spring forces' pass over positions `p` and velocities `v` (all particles).
-    pub(super) fn force_pass<'a>(&'a self, p: &'a Components, v: &'a Components) -> ForcePass<'a> {
-        ForcePass {
-            rest: &self.rest,
-            k: &self.k,
-            c: &self.c,
-            p,
-            v,
-        }
-    }
-
-    /// Calls `add(at, first, second)` for each block's buffers over the particles `lo..hi`
-    /// (its sums are `first − second`), in block order; `at` is where from `lo` they start.
-    #[inline(always)]
-    fn cover_range(
-        &self,
-        buffers: &[BlockBuffers],
-        std::ops::Range { start: lo, end: hi }: std::ops::Range<usize>,
-        mut add: impl FnMut(usize, [&[f32]; 3], [&[f32]; 3]),
-    ) {
-        let blocks = self.blocks.iter().zip(buffers);
-        for (b, buf) in blocks.take_while(|(b, _)| b.lo < hi) {
-            let (from, to) = (lo.max(b.lo), hi.min(b.hi));
-            if from < to {
-                let range = from - b.lo..to - b.lo;
-                add(from - lo, at(&buf.first, &range), at(&buf.second, &range));
-            }
-        }
-    }
-
-    /// One block's sums by `pass`, run by run (see [`SpringRuns::each_run`]), compiled for
-    /// AVX2 with FMA where the CPU has them ([`wide_fma`]): the same bits either way.
-    pub(super) fn block_pass(&self, block: &Block, buf: &mut BlockBuffers, pass: &impl RunPass) {
-        wide_fma(
-            #[inline(always)]
-            || self.each_run(block, buf, pass),
-        )
-    }
-
-    /// Fills one block's buffers: [`RunPass::run`] for each of its runs. The first run
-    /// writes its slices of them rather than adding to them, so only the rest of them is
-    /// zeroed first.
-    #[inline(always)]
-    fn each_run(&self, block: &Block, buf: &mut BlockBuffers, pass: &impl RunPass) {
-        let BlockBuffers { first, second } = buf;
-        let Some((lead, rest)) = self.runs[block.runs.clone()].split_first() else {
-            first
-                .iter_mut()
-                .chain(second.iter_mut())
-                .for_each(|s| s.fill(0.0));
-            return;
-        };
-        let [at_a, at_b] = Self::slices(block, lead);
-        for (buffer, written) in [(&mut *first, at_a), (&mut *second, at_b)] {
-            for s in buffer {
-                s[..written.start].fill(0.0);
-                s[written.end..].fill(0.0);
-            }
-        }
-        self.one_run::<true>(block, lead, first, second, pass);
-        for r in rest {
-            self.one_run::<false>(block, r, first, second, pass);
-        }
-    }
-
-    /// Where run `r` lands in its block's buffers: at its first ends and at its second.
-    #[inline(always)]
-    fn slices(block: &Block, r: &Run) -> [Range<usize>; 2] {
-        let (a, off, len) = (r.a as usize - block.lo, r.off as usize, r.len as usize);
-        [a..a + len, a + off..a + off + len]
-    }
-
-    /// Run `r` of `block` by `pass`, written into its slices of the buffers (`WRITE`) or
-    /// added to them.
-    #[inline(always)]
-    fn one_run<const WRITE: bool>(
-        &self,
-        block: &Block,
-        r: &Run,
-        first: &mut Components,
-        second: &mut Components,
-        pass: &impl RunPass,
-    ) {
-        let (a, off, len) = (r.a as usize, r.off as usize, r.len as usize);
-        let springs = r.start as usize..r.start as usize + len;
-        let ends = [a..a + len, a + off..a + off + len];
-        let [at_a, at_b] = Self::slices(block, r);
-        let [s0, s1, s2] = first;
-        let [t0, t1, t2] = second;
-        pass.run::<WRITE>(
-            ends,
-            springs,
-            [&mut s0[at_a.clone()], &mut s1[at_a.clone()], &mut s2[at_a]],
-            [&mut t0[at_b.clone()], &mut t1[at_b.clone()], &mut t2[at_b]],
-        );
-    }
-
-    /// `K` numbers per spring (`value(e)` for spring `e` as given to [`SpringRuns::new`]) in
-    /// run order, one array each, zero for gap fillers.
-    pub fn in_order<const K: usize>(
-        &self,
-        value: impl Fn(usize) -> [f32; K],
-        out: &mut [Vec<f32>; K],
-    ) {
-        let n = self.order.len();
-        for entry in out.iter_mut() {
-            entry.clear();
-            entry.resize(n, 0.0);
-        }
-        for (i, &e) in self.order.iter().enumerate() {
-            if e != GHOST {
-                for (entry, v) in out.iter_mut().zip(value(e as usize)) {
-                    entry[i] = v;
-                }
-            }
-        }
-    }
-
-    /// Adds `Σ_e S_e·u_other` to `out` at both ends of every spring `e`, with
-    /// `S_e = α·I + β·n nᵀ` as put in run order by [`SpringRuns::in_order`]
-    /// (`[α, β, n.x, n.y, n.z]`): the off-diagonal part of a matrix-vector product with the
-    /// implicit system (whose off-diagonal blocks are `−S_e`). In parallel as the forces
-    /// are, with the same result on any number of threads.
-    pub fn add_block_products(&self, s: &Projectors, u: &Components, out: &mut Components) {
-        let n = (u.iter().chain(out.iter()).map(Vec::len)).fold(self.particles, usize::min);
-        if self.runs.is_empty() || n < self.particles || s[0].len() != self.order.len() {
-            return;
-        }
-        let mut buffers = self.scratch.lock();
-        let blocks = &mut buffers.blocks;
-        let pass = ProductPass { s, u };
-        self.block_sums(blocks, |block, buf| self.block_pass(block, buf, &pass));
-        self.gather_components(blocks, out, n);
     }
 }
 

@@ -6,28 +6,29 @@ use std::ops::Range;
 use crate::parallel::Disjoint;
 
 use super::components::Components;
+use super::real::Real;
 use super::spring_runs::{BlockBuffers, Buffers, SpringRuns};
 
 /// The spring forces in two passes ([`TwoPasses::of`]): first every block's sums
 /// ([`TwoPasses::blocks`], shared out by blocks), then, per range of particles, their sum
 /// ([`TwoPasses::add_to`]).
-pub struct TwoPasses<'a> {
-    runs: &'a SpringRuns,
-    bufs: std::sync::MutexGuard<'a, Buffers>,
+pub struct TwoPasses<'a, R: Real = f32> {
+    runs: &'a SpringRuns<R>,
+    bufs: std::sync::MutexGuard<'a, Buffers<R>>,
 }
 
 /// The first pass of [`TwoPasses`], which team members share by blocks.
-pub struct BlockPass<'a> {
-    runs: &'a SpringRuns,
-    blocks: Disjoint<'a, BlockBuffers>,
+pub struct BlockPass<'a, R: Real = f32> {
+    runs: &'a SpringRuns<R>,
+    blocks: Disjoint<'a, BlockBuffers<R>>,
 }
 
-impl<'a> TwoPasses<'a> {
+impl<'a, R: Real> TwoPasses<'a, R> {
     /// The forces of `runs` in two passes, for a caller that runs them in its own team
     /// sections between other work (see [`ForceSet`](crate::sim::ForceSet)'s fused path):
     /// the buffers stay locked until the result is dropped. The same operations as
     /// [`SpringRuns::add_forces_components`], so the same bits.
-    pub fn of(runs: &'a SpringRuns) -> Self {
+    pub fn of(runs: &'a SpringRuns<R>) -> Self {
         let mut bufs = runs.scratch.lock();
         runs.size_buffers(&mut bufs.blocks);
         TwoPasses { runs, bufs }
@@ -39,7 +40,7 @@ impl<'a> TwoPasses<'a> {
     }
 
     /// The first pass, for the members of a section to share.
-    pub fn blocks(&mut self) -> BlockPass<'_> {
+    pub fn blocks(&mut self) -> BlockPass<'_, R> {
         BlockPass {
             runs: self.runs,
             blocks: Disjoint::new(&mut self.bufs.blocks[..]),
@@ -49,20 +50,20 @@ impl<'a> TwoPasses<'a> {
     /// Adds the forces on particles `range` to `f` (that range of the forces): each block's
     /// sums in block order, as [`SpringRuns::add_forces_components`] does. Particles past
     /// the springs' last one get nothing.
-    pub fn add_to(&self, range: Range<usize>, f: [&mut [f32]; 3]) {
+    pub fn add_to(&self, range: Range<usize>, f: [&mut [R]; 3]) {
         let end = range.end.min(self.runs.particles);
         (self.runs).add_sums(&self.bufs.blocks, range.start..end, f);
     }
 
     /// As [`TwoPasses::add_to`], but overwrites `f` (which needs no zeroing first): the
     /// same bits as adding to zeros. Particles past the springs' last one get zero.
-    pub fn write_to(&self, range: Range<usize>, f: [&mut [f32]; 3]) {
+    pub fn write_to(&self, range: Range<usize>, f: [&mut [R]; 3]) {
         let end = range.end.min(self.runs.particles).max(range.start);
         (self.runs).sum_blocks(&self.bufs.blocks, range.start..end, f, true);
     }
 }
 
-impl BlockPass<'_> {
+impl<R: Real> BlockPass<'_, R> {
     /// How many blocks there are to fill.
     pub fn len(&self) -> usize {
         self.runs.blocks.len()
@@ -76,7 +77,7 @@ impl BlockPass<'_> {
     /// Fills block `b`'s sums from positions and velocities `pos`, `vel` (all particles);
     /// nothing for a block past the last. Each block must be filled by one member only, and
     /// none may read the sums before all are filled.
-    pub fn fill(&self, b: usize, pos: &Components, vel: &Components) {
+    pub fn fill(&self, b: usize, pos: &Components<R>, vel: &Components<R>) {
         let runs = self.runs;
         let Some(block) = runs.blocks.get(b) else {
             return;
