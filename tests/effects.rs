@@ -626,6 +626,18 @@ fn without_self_collision_the_same_fold_passes_through_itself() {
     assert!(found > 10, "{found} crossings");
 }
 
+/// One self-collision pass of `solver` with `params` moving `state` from where it is now
+/// (its substep's start).
+fn one_pass(
+    solver: &mut SelfContacts,
+    params: &SelfCollision,
+    model: &ClothModel,
+    state: &mut ClothState,
+) -> Result<usize, ContactError> {
+    let start = state.pos.clone();
+    solver.resolve(params.thickness, params.friction, model, &start, state)
+}
+
 /// A square cloth of `quads`² quads folded in half: the back half lies over the front half
 /// at 60 % of the thickness, so every particle of the upper layer is in contact.
 fn folded_sheet(quads: u32, thickness: f32) -> (ClothModel, ClothState) {
@@ -648,17 +660,8 @@ fn self_collision_work_grows_linearly_with_the_particle_count() {
     let mut per_particle = Vec::new();
     for quads in [16, 32, 64] {
         let (model, mut state) = folded_sheet(quads, params.thickness);
-        let start = state.pos.clone();
         let mut solver = SelfContacts::default();
-        solver
-            .resolve(
-                params.thickness,
-                params.friction,
-                &model,
-                &start,
-                &mut state,
-            )
-            .unwrap();
+        one_pass(&mut solver, &params, &model, &mut state).unwrap();
         let n = model.particle_count() as f64;
         per_particle.push(solver.work.candidates as f64 / n);
         assert!(solver.work.contacts > 0);
@@ -708,11 +711,8 @@ fn one_pass_separates_every_pair(
 ) -> SelfContacts {
     let before = close_pairs(model, &state.pos, params.thickness);
     assert!(before > 100, "{before} pairs in contact to start with");
-    let start = state.pos.clone();
     let mut solver = SelfContacts::default();
-    solver
-        .resolve(params.thickness, params.friction, model, &start, &mut state)
-        .unwrap();
+    one_pass(&mut solver, params, model, &mut state).unwrap();
     let left = close_pairs(model, &state.pos, 0.8 * params.thickness);
     assert_eq!(left, 0, "pairs still overlapping after one pass");
     solver
@@ -762,16 +762,7 @@ fn the_broad_phase_table_is_bounded_by_the_triangle_count_however_the_cloth_is_s
             };
             *p += reach * Vec3::new(r(1), r(2), r(3));
         }
-        let start = state.pos.clone();
-        solver
-            .resolve(
-                params.thickness,
-                params.friction,
-                &model,
-                &start,
-                &mut state,
-            )
-            .unwrap();
+        one_pass(&mut solver, &params, &model, &mut state).unwrap();
         assert!(
             solver.table_len() <= bound,
             "{} entries for {} triangles at {reach} m",
@@ -779,33 +770,22 @@ fn the_broad_phase_table_is_bounded_by_the_triangle_count_however_the_cloth_is_s
             model.triangles.len()
         );
     }
-    let mut state = rest.clone();
-    state.pos[7].y = f32::NAN;
-    let start = state.pos.clone();
-    let err = solver
-        .resolve(
-            params.thickness,
-            params.friction,
-            &model,
-            &start,
-            &mut state,
-        )
-        .unwrap_err();
+    // Particle 7 sent to `y`: the pass refuses the state and moves nothing.
+    let mut refused = |y: f32| {
+        let mut state = rest.clone();
+        state.pos[7].y = y;
+        let bits = |pos: &[Vec3]| -> Vec<[u32; 3]> {
+            pos.iter().map(|p| p.to_array().map(f32::to_bits)).collect()
+        };
+        let start = bits(&state.pos);
+        let err = one_pass(&mut solver, &params, &model, &mut state).unwrap_err();
+        assert_eq!(bits(&state.pos), start, "nothing moved");
+        err
+    };
+    let err = refused(f32::NAN);
     assert_eq!(err, ContactError::NonFinite { particle: 7 });
-    let mut state = rest.clone();
-    state.pos[7].y = 1e9;
-    let start = state.pos.clone();
-    let err = solver
-        .resolve(
-            params.thickness,
-            params.friction,
-            &model,
-            &start,
-            &mut state,
-        )
-        .unwrap_err();
+    let err = refused(1e9);
     assert!(matches!(err, ContactError::Extent { .. }), "{err}");
-    assert_eq!(state.pos, start, "nothing moved");
 }
 
 fn point_triangle_distance(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {

@@ -66,9 +66,7 @@ impl GuardPolicy {
             ("guard.max_strain", self.max_strain),
             ("guard.headroom", self.headroom),
         ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(ParamError::new(name, v, "must be > 0"));
-            }
+            ParamError::require(v.is_finite() && v > 0.0, name, v, "must be > 0")?;
         }
         if self.max_refinements > 10 {
             return Err(ParamError::new(

@@ -21,4 +21,21 @@ impl ParamError {
             rule: rule.into(),
         }
     }
+
+    /// `Ok` where `ok` holds, else the error naming `name`, its `value` and its `rule`.
+    ///
+    /// # Errors
+    /// The [`ParamError`] when `ok` is false.
+    pub fn require(
+        ok: bool,
+        name: &'static str,
+        value: impl std::fmt::Display,
+        rule: impl Into<String>,
+    ) -> Result<(), Self> {
+        if ok {
+            Ok(())
+        } else {
+            Err(Self::new(name, value, rule))
+        }
+    }
 }

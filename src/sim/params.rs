@@ -199,13 +199,12 @@ impl SimParams {
             ),
         ];
         for (name, value, ok, allowed) in checks {
-            if !(value.is_finite() && ok) {
-                return Err(ParamError::new(
-                    name,
-                    value,
-                    format!("is out of range ({allowed})"),
-                ));
-            }
+            ParamError::require(
+                value.is_finite() && ok,
+                name,
+                value,
+                format!("is out of range ({allowed})"),
+            )?;
         }
         for (name, values, unit) in [
             ("stiffness", self.material.stiffness, "N/m"),
@@ -221,37 +220,36 @@ impl SimParams {
         }
         self.guard.validate()?;
         let solver = &self.solver;
-        if !(solver.tolerance.is_finite() && solver.tolerance > 0.0 && solver.tolerance < 1.0) {
-            return Err(ParamError::new(
-                "solver.tolerance",
-                solver.tolerance,
-                "is out of range (0 < tolerance < 1)",
-            ));
-        }
+        ParamError::require(
+            solver.tolerance.is_finite() && solver.tolerance > 0.0 && solver.tolerance < 1.0,
+            "solver.tolerance",
+            solver.tolerance,
+            "is out of range (0 < tolerance < 1)",
+        )?;
         for (name, value) in [
             ("solver.max_iterations", solver.max_iterations),
             ("solver.newton_iterations", solver.newton_iterations),
             ("solver.xpbd_iterations", solver.xpbd_iterations),
         ] {
-            if !(1..=10_000).contains(&value) {
-                return Err(ParamError::new(name, value, "must be in 1..=10000"));
-            }
+            ParamError::require(
+                (1..=10_000).contains(&value),
+                name,
+                value,
+                "must be in 1..=10000",
+            )?;
         }
-        if !(solver.newton_tolerance.is_finite() && solver.newton_tolerance > 0.0) {
-            return Err(ParamError::new(
-                "solver.newton_tolerance",
-                solver.newton_tolerance,
-                "must be > 0",
-            ));
-        }
-        if self.step.substeps == 0 || self.step.substeps > 100_000 {
-            return Err(ParamError::new(
-                "substeps",
-                self.step.substeps,
-                "must be in 1..=100000",
-            ));
-        }
-        Ok(())
+        ParamError::require(
+            solver.newton_tolerance.is_finite() && solver.newton_tolerance > 0.0,
+            "solver.newton_tolerance",
+            solver.newton_tolerance,
+            "must be > 0",
+        )?;
+        ParamError::require(
+            (1..=100_000).contains(&self.step.substeps),
+            "substeps",
+            self.step.substeps,
+            "must be in 1..=100000",
+        )
     }
 }
 

@@ -39,36 +39,30 @@ impl Panel for TransportBar {
             if ui.button("Capture PNG").clicked() {
                 ctx.ask(Action::Capture);
             }
-            if ui
-                .button("Accuracy")
-                .on_hover_text("What accuracy costs: every integrator and step size on this scene")
-                .clicked()
-            {
-                ctx.ask(Action::OpenAccuracy);
-            }
-            let record = if status.recording {
-                "Stop recording"
-            } else {
-                "Record"
+            let stop_or = |on: bool, stop: &'static str, start: &'static str| {
+                if on { stop } else { start }
             };
-            if ui
-                .button(record)
-                .on_hover_text("every drawn frame as a numbered PNG")
-                .clicked()
-            {
-                ctx.ask(Action::ToggleRecording);
-            }
-            let gif = if status.recording_gif {
-                "Stop GIF"
-            } else {
-                "Record GIF"
-            };
-            if ui
-                .button(gif)
-                .on_hover_text("what the view shows, as an animated GIF")
-                .clicked()
-            {
-                ctx.ask(Action::ToggleGif);
+            let buttons = [
+                (
+                    "Accuracy",
+                    "What accuracy costs: every integrator and step size on this scene",
+                    Action::OpenAccuracy,
+                ),
+                (
+                    stop_or(status.recording, "Stop recording", "Record"),
+                    "every drawn frame as a numbered PNG",
+                    Action::ToggleRecording,
+                ),
+                (
+                    stop_or(status.recording_gif, "Stop GIF", "Record GIF"),
+                    "what the view shows, as an animated GIF",
+                    Action::ToggleGif,
+                ),
+            ];
+            for (label, hover, action) in buttons {
+                if ui.button(label).on_hover_text(hover).clicked() {
+                    ctx.ask(action);
+                }
             }
             if status.behind {
                 ui.separator();

@@ -114,14 +114,12 @@ impl EffectKind for AirDamping {
     const ADDABLE: bool = true;
 
     fn check(&self) -> Result<(), ParamError> {
-        if !(self.rate.is_finite() && self.rate >= 0.0) {
-            return Err(ParamError::new(
-                "rate",
-                self.rate,
-                "is out of range (≥ 0 1/s)",
-            ));
-        }
-        Ok(())
+        ParamError::require(
+            self.rate.is_finite() && self.rate >= 0.0,
+            "rate",
+            self.rate,
+            "is out of range (≥ 0 1/s)",
+        )
     }
 
     fn force(&self, _model: &ClothModel, _material: &Material, _kept: &[Force]) -> Option<Force> {

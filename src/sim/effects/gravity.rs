@@ -101,14 +101,12 @@ impl EffectKind for Gravity {
     const ADDABLE: bool = true;
 
     fn check(&self) -> Result<(), ParamError> {
-        if !self.acceleration.is_finite() {
-            return Err(ParamError::new(
-                "acceleration",
-                self.acceleration,
-                "is out of range (finite)",
-            ));
-        }
-        Ok(())
+        ParamError::require(
+            self.acceleration.is_finite(),
+            "acceleration",
+            self.acceleration,
+            "is out of range (finite)",
+        )
     }
 
     fn force(&self, _model: &ClothModel, _material: &Material, _kept: &[Force]) -> Option<Force> {

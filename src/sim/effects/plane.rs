@@ -77,17 +77,18 @@ impl EffectKind for Plane {
     const ADDABLE: bool = true;
 
     fn check(&self) -> Result<(), ParamError> {
-        if !(self.normal.is_finite() && self.normal.length() >= 1e-6) {
-            return Err(ParamError::new("normal", self.normal, "must not be zero"));
-        }
-        if !self.point.is_finite() {
-            return Err(ParamError::new(
-                "point",
-                self.point,
-                "must be finite metres",
-            ));
-        }
-        Ok(())
+        ParamError::require(
+            self.normal.is_finite() && self.normal.length() >= 1e-6,
+            "normal",
+            self.normal,
+            "must not be zero",
+        )?;
+        ParamError::require(
+            self.point.is_finite(),
+            "point",
+            self.point,
+            "must be finite metres",
+        )
     }
 
     fn is_contact(&self) -> bool {

@@ -90,17 +90,18 @@ impl EffectKind for SelfCollision {
     const ADDABLE: bool = true;
 
     fn check(&self) -> Result<(), ParamError> {
-        if !(self.thickness.is_finite() && self.thickness > 0.0) {
-            return Err(ParamError::new(
-                "thickness",
-                self.thickness,
-                "must be positive metres",
-            ));
-        }
-        if !(self.friction.is_finite() && self.friction >= 0.0) {
-            return Err(ParamError::new("friction", self.friction, "must be ≥ 0"));
-        }
-        Ok(())
+        ParamError::require(
+            self.thickness.is_finite() && self.thickness > 0.0,
+            "thickness",
+            self.thickness,
+            "must be positive metres",
+        )?;
+        ParamError::require(
+            self.friction.is_finite() && self.friction >= 0.0,
+            "friction",
+            self.friction,
+            "must be ≥ 0",
+        )
     }
 
     fn is_contact(&self) -> bool {

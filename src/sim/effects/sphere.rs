@@ -90,21 +90,18 @@ impl EffectKind for Sphere {
     const ADDABLE: bool = true;
 
     fn check(&self) -> Result<(), ParamError> {
-        if !(self.radius.is_finite() && self.radius > 0.0) {
-            return Err(ParamError::new(
-                "radius",
-                self.radius,
-                "must be positive metres",
-            ));
-        }
-        if !(self.center.is_finite() && self.spin.is_finite()) {
-            return Err(ParamError::new(
-                "center",
-                self.center,
-                "must be finite metres",
-            ));
-        }
-        Ok(())
+        ParamError::require(
+            self.radius.is_finite() && self.radius > 0.0,
+            "radius",
+            self.radius,
+            "must be positive metres",
+        )?;
+        ParamError::require(
+            self.center.is_finite() && self.spin.is_finite(),
+            "center",
+            self.center,
+            "must be finite metres",
+        )
     }
 
     fn is_contact(&self) -> bool {

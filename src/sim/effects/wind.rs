@@ -120,29 +120,25 @@ impl EffectKind for Wind {
     const ADDABLE: bool = true;
 
     fn check(&self) -> Result<(), ParamError> {
-        if !self.velocity.is_finite() {
-            return Err(ParamError::new(
-                "velocity",
-                self.velocity,
-                "must be finite m/s",
-            ));
-        }
-        if !(self.gust_period.is_finite() && self.gust_period > 0.0) {
-            return Err(ParamError::new(
-                "gust_period",
-                self.gust_period,
-                "must be > 0 s",
-            ));
-        }
+        ParamError::require(
+            self.velocity.is_finite(),
+            "velocity",
+            self.velocity,
+            "must be finite m/s",
+        )?;
+        ParamError::require(
+            self.gust_period.is_finite() && self.gust_period > 0.0,
+            "gust_period",
+            self.gust_period,
+            "must be > 0 s",
+        )?;
         for (key, value) in [
             ("gust", self.gust),
             ("drag", self.drag),
             ("lift", self.lift),
             ("air_density", self.air_density),
         ] {
-            if !value.is_finite() {
-                return Err(ParamError::new(key, value, "must be finite"));
-            }
+            ParamError::require(value.is_finite(), key, value, "must be finite")?;
         }
         Ok(())
     }
