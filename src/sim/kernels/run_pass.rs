@@ -88,16 +88,20 @@ impl<R: Real> RunPass<R> for ProductPass<'_, R> {
         let (t0, t1, t2) = (&mut t0[..n], &mut t1[..n], &mut t2[..n]);
         let was = |o: R| if WRITE { R::ZERO } else { o };
         for j in 0..n {
-            // S·w = α·w + β(n·w)·n.
-            let db = be[j] * (nx[j] * bx[j] + ny[j] * by[j] + nz[j] * bz[j]);
-            f0[j] = was(f0[j]) + (al[j] * bx[j] + db * nx[j]);
-            f1[j] = was(f1[j]) + (al[j] * by[j] + db * ny[j]);
-            f2[j] = was(f2[j]) + (al[j] * bz[j] + db * nz[j]);
-            let da = be[j] * (nx[j] * ax[j] + ny[j] * ay[j] + nz[j] * az[j]);
+            // Every input read before any output is written: the compiler need not prove
+            // that the outputs alias none of them to keep them in registers.
+            let (al, be, u) = (al[j], be[j], [nx[j], ny[j], nz[j]]);
+            let (a, b) = ([ax[j], ay[j], az[j]], [bx[j], by[j], bz[j]]);
+            // S·w = α·w + β(n·w)·n, n = u.
+            let db = be * (u[0] * b[0] + u[1] * b[1] + u[2] * b[2]);
+            let da = be * (u[0] * a[0] + u[1] * a[1] + u[2] * a[2]);
+            f0[j] = was(f0[j]) + (al * b[0] + db * u[0]);
+            f1[j] = was(f1[j]) + (al * b[1] + db * u[1]);
+            f2[j] = was(f2[j]) + (al * b[2] + db * u[2]);
             // Subtracted when gathered.
-            t0[j] = was(t0[j]) - (al[j] * ax[j] + da * nx[j]);
-            t1[j] = was(t1[j]) - (al[j] * ay[j] + da * ny[j]);
-            t2[j] = was(t2[j]) - (al[j] * az[j] + da * nz[j]);
+            t0[j] = was(t0[j]) - (al * a[0] + da * u[0]);
+            t1[j] = was(t1[j]) - (al * a[1] + da * u[1]);
+            t2[j] = was(t2[j]) - (al * a[2] + da * u[2]);
         }
     }
 }
