@@ -390,8 +390,9 @@ impl StepBackend for CpuStepper {
         {
             self.integrator = params.step.integrator.build();
         }
-        // New forces, strengths or masses make whatever the integrator derived stale.
-        if forces_changed || changes.contains(Changes::DENSITY) {
+        // New forces or strengths make whatever the integrator derived stale (new masses
+        // come with `invalidate`).
+        if forces_changed {
             self.integrator.forces_changed();
         }
         self.solver = params.solver;
