@@ -14,6 +14,7 @@ mod guard_state;
 pub mod integrator;
 pub mod kernels;
 mod motion;
+pub mod obstacle;
 mod param_error;
 mod params;
 mod self_contacts;

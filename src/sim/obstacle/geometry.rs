@@ -1,0 +1,180 @@
+//! Points, segments and triangles: the closest point of a triangle to a point, and where a
+//! segment crosses a triangle.
+
+use glam::Vec3;
+
+/// The point of triangle `abc` closest to `p` (its inside, an edge or a corner).
+pub fn closest_on_triangle(p: Vec3, [a, b, c]: [Vec3; 3]) -> Vec3 {
+    // The Voronoi regions of the corners, then of the edges, then the inside.
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    a + ab * (vb * denom) + ac * (vc * denom)
+}
+
+/// Where, as a fraction of the way from `from` to `to`, the segment first crosses triangle
+/// `abc` (either side; touching counts), if it does.
+pub fn segment_crosses(from: Vec3, to: Vec3, [a, b, c]: [Vec3; 3]) -> Option<f32> {
+    let d = to - from;
+    let (e1, e2) = (b - a, c - a);
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    // Parallel to the plane (or a degenerate triangle): no single crossing point.
+    if det.abs() <= f32::EPSILON * e1.length_squared().max(e2.length_squared()) * d.length() {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = from - a;
+    let u = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let v = d.dot(q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    let t = e2.dot(q) * inv;
+    (0.0..=1.0).contains(&t).then_some(t)
+}
+
+/// The squared distance from `p` to the box `lo..hi` (0 inside).
+pub fn box_distance_squared(p: Vec3, lo: Vec3, hi: Vec3) -> f32 {
+    (lo - p).max(p - hi).max(Vec3::ZERO).length_squared()
+}
+
+/// Whether the segment from `from` to `to` meets the box `lo..hi`.
+pub fn segment_meets_box(from: Vec3, to: Vec3, lo: Vec3, hi: Vec3) -> bool {
+    let d = to - from;
+    let (mut t0, mut t1) = (0.0f32, 1.0f32);
+    for k in 0..3 {
+        if d[k].abs() < 1e-12 {
+            if from[k] < lo[k] || from[k] > hi[k] {
+                return false;
+            }
+            continue;
+        }
+        let inv = 1.0 / d[k];
+        let (a, b) = ((lo[k] - from[k]) * inv, (hi[k] - from[k]) * inv);
+        t0 = t0.max(a.min(b));
+        t1 = t1.min(a.max(b));
+        if t0 > t1 {
+            return false;
+        }
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const T: [Vec3; 3] = [
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+    ];
+
+    /// Each region of the triangle: above its inside, beside each edge, past each corner;
+    /// checked against a brute-force search over the triangle.
+    #[test]
+    fn the_closest_point_is_the_closest_of_all() {
+        let mut rnd = crate::test_rng::uniform(9);
+        for _ in 0..2000 {
+            let p = Vec3::new(rnd() * 3.0 - 1.0, rnd() * 3.0 - 1.0, rnd() * 2.0 - 1.0);
+            let q = closest_on_triangle(p, T);
+            let mut best = f32::INFINITY;
+            let n = 200;
+            for i in 0..=n {
+                for j in 0..=(n - i) {
+                    let s = T[0]
+                        + (T[1] - T[0]) * (i as f32 / n as f32)
+                        + (T[2] - T[0]) * (j as f32 / n as f32);
+                    best = best.min(p.distance(s));
+                }
+            }
+            assert!(p.distance(q) <= best + 1e-6, "{p}: {q}");
+            assert!(
+                p.distance(q) >= best - 0.01,
+                "{p}: {q} nearer than the grid allows"
+            );
+        }
+    }
+
+    #[test]
+    fn a_segment_crosses_where_it_meets_the_plane_inside_the_triangle() {
+        let down = |x: f32, y: f32| (Vec3::new(x, y, 1.0), Vec3::new(x, y, -3.0));
+        let (a, b) = down(0.25, 0.25);
+        assert_eq!(segment_crosses(a, b, T), Some(0.25));
+        assert_eq!(segment_crosses(b, a, T), Some(0.75), "from below too");
+        let (a, b) = down(0.75, 0.75);
+        assert_eq!(segment_crosses(a, b, T), None, "beside the hypotenuse");
+        let (a, _) = down(0.25, 0.25);
+        assert_eq!(
+            segment_crosses(a, Vec3::new(0.25, 0.25, 0.5), T),
+            None,
+            "short of it"
+        );
+        // Along the plane: no single point.
+        assert_eq!(
+            segment_crosses(Vec3::new(-1.0, 0.2, 0.0), Vec3::new(2.0, 0.2, 0.0), T),
+            None
+        );
+    }
+
+    #[test]
+    fn segments_and_points_meet_boxes_where_they_should() {
+        let (lo, hi) = (Vec3::ZERO, Vec3::ONE);
+        assert!(segment_meets_box(
+            Vec3::splat(-1.0),
+            Vec3::splat(2.0),
+            lo,
+            hi
+        ));
+        assert!(segment_meets_box(
+            Vec3::splat(0.5),
+            Vec3::splat(0.6),
+            lo,
+            hi
+        ));
+        assert!(!segment_meets_box(
+            Vec3::new(2.0, 0.5, 0.5),
+            Vec3::new(3.0, 0.5, 0.5),
+            lo,
+            hi
+        ));
+        assert!(!segment_meets_box(
+            Vec3::new(-1.0, 2.0, 0.5),
+            Vec3::new(2.0, 1.5, 0.5),
+            lo,
+            hi
+        ));
+        assert_eq!(box_distance_squared(Vec3::splat(0.5), lo, hi), 0.0);
+        assert_eq!(box_distance_squared(Vec3::new(3.0, 0.5, 2.0), lo, hi), 5.0);
+    }
+}

@@ -1,0 +1,9 @@
+//! Obstacles of any shape: triangle surfaces the cloth may not pass, with the tree that
+//! finds what a particle's move comes near.
+
+mod geometry;
+mod surface;
+mod tree;
+
+pub use surface::{Caught, Surface};
+pub use tree::{Nearest, TriangleTree};

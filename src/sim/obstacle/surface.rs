@@ -1,0 +1,214 @@
+//! An obstacle's surface in its own frame: its triangles, their normals and the tree over
+//! them, and where a particle's move across it ends.
+
+use glam::Vec3;
+
+use super::tree::{Nearest, TriangleTree};
+
+/// How many crossings one move may be caught at (a move that slides on into a second face
+/// after the first, as in a concave corner).
+const CROSSINGS: usize = 3;
+/// How many times the end of a move is pushed out of the thickness (two faces of a corner
+/// can each hold it within).
+const PUSHES: usize = 3;
+
+/// A triangle surface, fixed in its own frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Surface {
+    vertices: Vec<Vec3>,
+    triangles: Vec<[u32; 3]>,
+    /// Unit normal of each triangle (zero for a degenerate one).
+    normals: Vec<Vec3>,
+    tree: TriangleTree,
+}
+
+/// Where a caught move ends and the surface's normal there (pointing to the side the
+/// particle is kept on).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Caught {
+    pub at: Vec3,
+    pub normal: Vec3,
+}
+
+impl Surface {
+    /// The surface of `triangles` over `vertices` (every index must be in range).
+    pub fn new(vertices: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Self {
+        let corners: Vec<[Vec3; 3]> = (triangles.iter())
+            .map(|t| t.map(|i| vertices[i as usize]))
+            .collect();
+        let normals = (corners.iter())
+            .map(|[a, b, c]| (*b - *a).cross(*c - *a).normalize_or_zero())
+            .collect();
+        let tree = TriangleTree::new(&corners);
+        Self {
+            vertices,
+            triangles,
+            normals,
+            tree,
+        }
+    }
+
+    pub fn vertices(&self) -> &[Vec3] {
+        &self.vertices
+    }
+
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// The box around the surface (`None` without triangles).
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        self.tree.bounds()
+    }
+
+    /// The nearest point of the surface to `p` within `reach`.
+    pub fn nearest(&self, p: Vec3, reach: f32) -> Option<Nearest> {
+        self.tree.nearest(p, reach)
+    }
+
+    /// Where a particle moving from `from` to `to` ends, if its path crosses the surface or
+    /// ends within `thickness` of it: caught at its first crossing, `thickness` off the
+    /// surface on the side it came from, with the part of the rest of the move along the
+    /// surface kept (so it slides) and the part into it dropped; then pushed out to
+    /// `thickness` from the nearest point. `None`: the move stays clear.
+    pub fn catch(&self, from: Vec3, to: Vec3, thickness: f32) -> Option<Caught> {
+        let (lo, hi) = self.tree.bounds()?;
+        let pad = Vec3::splat(thickness);
+        if from.min(to).cmpgt(hi + pad).any() || from.max(to).cmplt(lo - pad).any() {
+            return None;
+        }
+        let (mut start, mut end) = (from, to);
+        let mut normal = None;
+        for _ in 0..CROSSINGS {
+            let Some((triangle, t)) = self.tree.first_crossing(start, end) else {
+                break;
+            };
+            let face = self.normals[triangle as usize];
+            let hit = start + (end - start) * t;
+            // The side it came from: where the move's start is, or against the move.
+            let side = match (start - hit).dot(face) {
+                s if s > 0.0 => 1.0,
+                s if s < 0.0 => -1.0,
+                _ => -(end - start).dot(face).signum(),
+            };
+            let n = face * side;
+            let rest = end - hit;
+            let along = rest - rest.dot(n).min(0.0) * n;
+            start = hit + n * thickness;
+            end = start + along;
+            normal = Some(n);
+        }
+        for _ in 0..PUSHES {
+            let Some(near) = self.tree.nearest(end, thickness) else {
+                break;
+            };
+            let away = end - near.point;
+            let n = if near.distance > thickness * 1e-3 {
+                away / near.distance
+            } else {
+                // On the surface: off it on the side of the start.
+                let face = self.normals[near.triangle as usize];
+                if (start - near.point).dot(face) >= 0.0 {
+                    face
+                } else {
+                    -face
+                }
+            };
+            if near.distance >= thickness * (1.0 - 1e-4) {
+                break;
+            }
+            end = near.point + n * thickness;
+            normal = Some(n);
+        }
+        normal.map(|normal| Caught { at: end, normal })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit square in the plane y = 0, two triangles.
+    fn square() -> Surface {
+        Surface::new(
+            vec![
+                Vec3::new(-0.5, 0.0, -0.5),
+                Vec3::new(0.5, 0.0, -0.5),
+                Vec3::new(0.5, 0.0, 0.5),
+                Vec3::new(-0.5, 0.0, 0.5),
+            ],
+            vec![[0, 2, 1], [0, 3, 2]],
+        )
+    }
+
+    /// A fast move through the square, from either side, ends `thickness` short of it on
+    /// the side it came from, keeping its sideways part.
+    #[test]
+    fn a_move_through_a_thin_square_is_caught_on_its_side() {
+        let s = square();
+        let d = 0.01;
+        for dir in [1.0f32, -1.0] {
+            let from = Vec3::new(0.1, 0.3 * dir, 0.0);
+            let to = Vec3::new(0.2, -0.3 * dir, 0.05);
+            let c = s.catch(from, to, d).expect("caught");
+            assert!((c.at.y - d * dir).abs() < 1e-6, "{dir}: {c:?}");
+            assert_eq!(c.normal, Vec3::Y * dir);
+            assert!((c.at.x - 0.2).abs() < 1e-6 && (c.at.z - 0.05).abs() < 1e-6);
+        }
+        // Beside the square: nothing.
+        assert_eq!(
+            s.catch(Vec3::new(0.7, 0.3, 0.0), Vec3::new(0.7, -0.3, 0.0), d),
+            None
+        );
+        // Staying clear above it.
+        assert_eq!(
+            s.catch(Vec3::new(0.0, 0.3, 0.0), Vec3::new(0.0, 0.1, 0.0), d),
+            None
+        );
+    }
+
+    /// A move that ends within the thickness (without crossing) is pushed out to it.
+    #[test]
+    fn a_move_ending_within_the_thickness_is_pushed_out() {
+        let s = square();
+        let c = s
+            .catch(Vec3::new(0.0, 0.2, 0.0), Vec3::new(0.0, 0.004, 0.0), 0.01)
+            .expect("caught");
+        assert!((c.at - Vec3::new(0.0, 0.01, 0.0)).length() < 1e-6);
+        // Near the square's edge, from beside it: pushed away from the edge.
+        let c = s
+            .catch(Vec3::new(0.6, 0.0, 0.0), Vec3::new(0.505, 0.0, 0.0), 0.01)
+            .expect("caught");
+        assert!((c.at - Vec3::new(0.51, 0.0, 0.0)).length() < 1e-6, "{c:?}");
+    }
+
+    /// Every query on a random soup of triangles agrees with testing every triangle.
+    #[test]
+    fn the_tree_finds_what_a_search_of_every_triangle_finds() {
+        use super::super::geometry::{closest_on_triangle, segment_crosses};
+        let mut rnd = crate::test_rng::uniform(4);
+        let mut v = || Vec3::new(rnd(), rnd(), rnd());
+        let corners: Vec<[Vec3; 3]> = (0..500)
+            .map(|_| {
+                let c = v() * 4.0;
+                [c, c + v() * 0.3, c + v() * 0.3]
+            })
+            .collect();
+        let tree = TriangleTree::new(&corners);
+        for _ in 0..300 {
+            let p = v() * 4.5 - 0.25;
+            let reach = 0.4;
+            let brute = (corners.iter().enumerate())
+                .map(|(i, t)| (i, p.distance(closest_on_triangle(p, *t))))
+                .filter(|(_, d)| *d <= reach)
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            let found = tree.nearest(p, reach);
+            assert_eq!(found.map(|n| n.distance), brute.map(|b| b.1), "{p}");
+            let q = v() * 4.5 - 0.25;
+            let brute = (corners.iter().enumerate())
+                .filter_map(|(i, t)| segment_crosses(p, q, *t).map(|t| (i as u32, t)))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            assert_eq!(tree.first_crossing(p, q).map(|c| c.1), brute.map(|b| b.1));
+        }
+    }
+}

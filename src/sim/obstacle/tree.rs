@@ -1,0 +1,221 @@
+//! A bounding-volume tree over an obstacle's triangles: the nearest triangle to a point
+//! within a distance, and the first triangle a segment crosses, each in about `log n` box
+//! tests. Built once for a rigid obstacle (its queries move into the obstacle's frame).
+
+use glam::Vec3;
+
+use super::geometry::{
+    box_distance_squared, closest_on_triangle, segment_crosses, segment_meets_box,
+};
+
+/// Triangles per leaf at most.
+const LEAF: usize = 4;
+
+/// A box and what it holds: `count` triangles from `first` (a leaf), or two children, the
+/// first right after it and the second at `first` (`count` 0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Node {
+    lo: Vec3,
+    hi: Vec3,
+    first: u32,
+    count: u32,
+}
+
+/// The tree, with the triangles' corners in leaf order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriangleTree {
+    nodes: Vec<Node>,
+    /// Corners of each triangle, in the tree's order.
+    corners: Vec<[Vec3; 3]>,
+    /// The triangle each place holds, as numbered when the tree was built.
+    index: Vec<u32>,
+}
+
+/// The nearest point of a surface to a query point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Nearest {
+    /// The triangle, as numbered when the tree was built.
+    pub triangle: u32,
+    pub point: Vec3,
+    pub distance: f32,
+}
+
+impl TriangleTree {
+    /// The tree over `triangles` (corners); degenerate triangles are kept (they are found
+    /// by nothing they do not touch).
+    pub fn new(triangles: &[[Vec3; 3]]) -> Self {
+        let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
+        let centre = |t: u32| {
+            let [a, b, c] = triangles[t as usize];
+            (a + b + c) / 3.0
+        };
+        let mut nodes = Vec::with_capacity(2 * triangles.len().div_ceil(LEAF));
+        if !triangles.is_empty() {
+            build(&mut nodes, &mut order, 0, triangles, &centre);
+        }
+        let corners = order.iter().map(|&t| triangles[t as usize]).collect();
+        Self {
+            nodes,
+            corners,
+            index: order,
+        }
+    }
+
+    /// How many triangles it holds.
+    pub fn len(&self) -> usize {
+        self.corners.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.corners.is_empty()
+    }
+
+    /// The box around every triangle (`None` when there is none).
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        self.nodes.first().map(|n| (n.lo, n.hi))
+    }
+
+    /// The point of the surface nearest to `p`, if one is within `reach`.
+    pub fn nearest(&self, p: Vec3, reach: f32) -> Option<Nearest> {
+        let mut best: Option<(u32, Vec3)> = None;
+        let mut best_d2 = reach * reach;
+        // Median splits keep the depth at about log₂(n / LEAF): 64 is never reached.
+        let mut stack = [0u32; 64];
+        let mut top = 0;
+        if self.nodes.is_empty()
+            || box_distance_squared(p, self.nodes[0].lo, self.nodes[0].hi) > best_d2
+        {
+            return None;
+        }
+        stack[0] = 0;
+        top += 1;
+        while top > 0 {
+            top -= 1;
+            let at = stack[top];
+            let node = self.nodes[at as usize];
+            if box_distance_squared(p, node.lo, node.hi) > best_d2 {
+                continue;
+            }
+            if node.count > 0 {
+                let places = node.first as usize..(node.first + node.count) as usize;
+                for place in places {
+                    let q = closest_on_triangle(p, self.corners[place]);
+                    let d2 = p.distance_squared(q);
+                    if d2 <= best_d2 {
+                        best_d2 = d2;
+                        best = Some((place as u32, q));
+                    }
+                }
+                continue;
+            }
+            // The nearer child last, so it is searched first.
+            let (one, two) = (at + 1, node.first);
+            let (first, second) = if self.box_d2(one, p) <= self.box_d2(two, p) {
+                (two, one)
+            } else {
+                (one, two)
+            };
+            stack[top] = first;
+            stack[top + 1] = second;
+            top += 2;
+        }
+        best.map(|(place, point)| Nearest {
+            triangle: self.index[place as usize],
+            point,
+            distance: best_d2.sqrt(),
+        })
+    }
+
+    /// The first triangle the segment from `from` to `to` crosses: its number and the
+    /// fraction of the way at which it does.
+    pub fn first_crossing(&self, from: Vec3, to: Vec3) -> Option<(u32, f32)> {
+        let mut best: Option<(u32, f32)> = None;
+        let mut stack = [0u32; 64];
+        let mut top = 0;
+        if self.nodes.is_empty() {
+            return None;
+        }
+        stack[0] = 0;
+        top += 1;
+        while top > 0 {
+            top -= 1;
+            let at = stack[top];
+            let node = self.nodes[at as usize];
+            // Only the part of the segment before the best crossing so far matters.
+            let end = best.map_or(to, |(_, t)| from + (to - from) * t);
+            if !segment_meets_box(from, end, node.lo, node.hi) {
+                continue;
+            }
+            if node.count > 0 {
+                let places = node.first as usize..(node.first + node.count) as usize;
+                for place in places {
+                    if let Some(t) = segment_crosses(from, to, self.corners[place])
+                        && best.is_none_or(|(_, b)| t < b)
+                    {
+                        best = Some((place as u32, t));
+                    }
+                }
+                continue;
+            }
+            stack[top] = node.first;
+            stack[top + 1] = at + 1;
+            top += 2;
+        }
+        best.map(|(place, t)| (self.index[place as usize], t))
+    }
+
+    fn box_d2(&self, node: u32, p: Vec3) -> f32 {
+        let n = self.nodes[node as usize];
+        box_distance_squared(p, n.lo, n.hi)
+    }
+}
+
+/// Builds the subtree over `order` (whose places start at `offset` in the final order) and
+/// returns its node's index.
+fn build(
+    nodes: &mut Vec<Node>,
+    order: &mut [u32],
+    offset: usize,
+    triangles: &[[Vec3; 3]],
+    centre: &impl Fn(u32) -> Vec3,
+) -> usize {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for &t in order.iter() {
+        for c in triangles[t as usize] {
+            lo = lo.min(c);
+            hi = hi.max(c);
+        }
+    }
+    let at = nodes.len();
+    nodes.push(Node {
+        lo,
+        hi,
+        first: offset as u32,
+        count: order.len() as u32,
+    });
+    if order.len() <= LEAF {
+        return at;
+    }
+    // Split at the median centre along the widest spread of centres.
+    let (mut clo, mut chi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for &t in order.iter() {
+        clo = clo.min(centre(t));
+        chi = chi.max(centre(t));
+    }
+    let spread = chi - clo;
+    let axis = if spread.x >= spread.y && spread.x >= spread.z {
+        0
+    } else if spread.y >= spread.z {
+        1
+    } else {
+        2
+    };
+    let mid = order.len() / 2;
+    order.select_nth_unstable_by(mid, |&a, &b| centre(a)[axis].total_cmp(&centre(b)[axis]));
+    let (left, right) = order.split_at_mut(mid);
+    build(nodes, left, offset, triangles, centre);
+    let second = build(nodes, right, offset + mid, triangles, centre);
+    nodes[at].first = second as u32;
+    nodes[at].count = 0;
+    at
+}
