@@ -46,7 +46,9 @@ pub fn shapes(effects: &[Effect], time: f64) -> Vec<Shape> {
                 point: p.point,
                 normal: p.unit_normal(),
             }),
-            Effect::Springs(_)
+            // Mesh obstacles are not drawn yet.
+            Effect::Obstacle(_)
+            | Effect::Springs(_)
             | Effect::Gravity(_)
             | Effect::AirDamping(_)
             | Effect::Bending(_)

@@ -166,8 +166,10 @@ pub(super) fn pack_solids(effects: &[Effect]) -> ([GpuCollider; MAX_COLLIDERS], 
             a: p.point.extend(0.0).to_array(),
             b: p.unit_normal().extend(0.0).to_array(),
         }),
-        // What is not a solid takes no slot (`gpu_support` refuses what the GPU lacks).
-        Effect::Springs(_)
+        // What is not a solid takes no slot, and `gpu_support` refuses what the GPU lacks
+        // (mesh obstacles).
+        Effect::Obstacle(_)
+        | Effect::Springs(_)
         | Effect::Gravity(_)
         | Effect::AirDamping(_)
         | Effect::Bending(_)

@@ -44,6 +44,9 @@ pub enum SceneError {
     /// The pins do not fit the cloth.
     #[error(transparent)]
     Pins(#[from] PinError),
+    /// An obstacle's mesh could not be read or placed.
+    #[error(transparent)]
+    Obstacle(#[from] crate::sim::ObstacleError),
     /// A scene file built in code names no cloth (`cloth.obj` or `cloth.grid`).
     #[error("the scene `{scene}` has no cloth: give `obj` or `grid` in [cloth]")]
     NoCloth { scene: String },

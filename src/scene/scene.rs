@@ -40,6 +40,16 @@ pub struct Scene {
     pub warnings: Vec<String>,
 }
 
+/// Reads the mesh of every obstacle `file` lists (`base`: where relative paths start).
+fn load_obstacles(file: &mut SceneFile, base: Option<&Path>) -> Result<(), SceneError> {
+    for effect in &mut file.effects {
+        if let Effect::Obstacle(obstacle) = effect {
+            obstacle.load(base)?;
+        }
+    }
+    Ok(())
+}
+
 impl Scene {
     /// A built-in scene.
     ///
@@ -82,6 +92,7 @@ impl Scene {
             Some(path) => {
                 let cloth = mesh::load_obj_with(path, options)?;
                 let mut file = file;
+                load_obstacles(&mut file, base.as_deref())?;
                 file.cloth.grid = None;
                 file.cloth.obj = Some(path.to_path_buf());
                 Self::with_mesh(file, &cloth, &path.display().to_string())
@@ -102,7 +113,8 @@ impl Scene {
     ///
     /// # Errors
     /// The cloth's [`mesh::ObjError`], or [`SceneError::Pins`].
-    pub fn from_file(file: SceneFile, base: Option<&Path>) -> Result<Scene, SceneError> {
+    pub fn from_file(mut file: SceneFile, base: Option<&Path>) -> Result<Scene, SceneError> {
+        load_obstacles(&mut file, base)?;
         let (cloth, name) = match (&file.cloth.obj, &file.cloth.grid) {
             (Some(obj), _) => {
                 let path = base.map_or_else(|| obj.clone(), |b| b.join(obj));

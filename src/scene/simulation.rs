@@ -5,8 +5,8 @@
 use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{
     Cause, Changes, CpuStepper, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent,
-    IntegratorKind, PhaseTimings, SimParams, StepBackend, StepError, StepReport, StepStats,
-    small_sphere_warnings, thickness_fits,
+    IntegratorKind, ParamError, PhaseTimings, SimParams, StepBackend, StepError, StepReport,
+    StepStats, small_sphere_warnings, thickness_fits,
 };
 
 use super::error::SceneError;
@@ -300,6 +300,14 @@ impl Simulation {
                 effect: effect.phase(),
                 error,
             })?;
+            if let Effect::Obstacle(o) = effect
+                && !o.is_loaded()
+            {
+                return Err(SceneError::Effect {
+                    effect: effect.phase(),
+                    error: ParamError::new("obj", o.obj.display(), "was not read: load it first"),
+                });
+            }
         }
         thickness_fits(&effects, &self.model).map_err(|error| SceneError::Thickness {
             cloth: self.cloth_name.clone(),

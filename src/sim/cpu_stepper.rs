@@ -123,6 +123,7 @@ impl CpuStepper {
         let mut pass = ContactPass {
             model,
             start: &self.substep_start,
+            substep: self.substep_length(),
             state,
             offset: self.offset,
             self_contacts: &mut self.self_contacts,

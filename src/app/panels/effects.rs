@@ -6,8 +6,8 @@ use glam::Vec3;
 
 use crate::mesh::{SpringKind, bounds};
 use crate::sim::{
-    BendingModel, ClothBox, DEFAULT_DIHEDRAL_STIFFNESS, Effect, Plane, SimParams, Sphere, Wind,
-    shortest_edge,
+    BendingModel, ClothBox, DEFAULT_DIHEDRAL_STIFFNESS, Effect, Obstacle, Plane, SimParams, Sphere,
+    Wind, shortest_edge,
 };
 
 use super::super::panel::{Action, Panel, PanelContext};
@@ -164,8 +164,43 @@ fn effect_controls(
         }
         Effect::Sphere(sphere) => e |= sphere_controls(ui, sphere),
         Effect::Plane(plane) => e |= plane_controls(ui, plane),
+        Effect::Obstacle(obstacle) => e |= obstacle_controls(ui, obstacle),
     }
     (p, e)
+}
+
+fn obstacle_controls(ui: &mut egui::Ui, obstacle: &mut Obstacle) -> bool {
+    let triangles = obstacle.placed().map_or(0, |p| p.surface.triangles().len());
+    ui.label(
+        RichText::new(format!(
+            "{} ({triangles} triangles)",
+            obstacle.obj.display()
+        ))
+        .weak(),
+    );
+    let mut changed = ui
+        .add(Slider::new(&mut obstacle.friction, 0.0..=2.0).text("friction μ"))
+        .changed();
+    let mut own = obstacle.thickness.is_some();
+    if ui
+        .checkbox(&mut own, "own thickness")
+        .on_hover_text("off: the solver's collision offset")
+        .changed()
+    {
+        obstacle.thickness = own.then_some(0.01);
+        changed = true;
+    }
+    if let Some(thickness) = &mut obstacle.thickness {
+        changed |= ui
+            .add(
+                Slider::new(thickness, 1e-4..=0.1)
+                    .logarithmic(true)
+                    .suffix(" m")
+                    .text("thickness"),
+            )
+            .changed();
+    }
+    changed
 }
 
 fn wind_controls(ui: &mut egui::Ui, wind: &mut Wind) -> bool {

@@ -15,6 +15,8 @@ pub struct ContactPass<'a> {
     pub model: &'a ClothModel,
     /// Positions at the substep's start: the paths contacts sweep end where `state` is now.
     pub start: &'a [Vec3],
+    /// The substep's length, seconds (it started at `state.time − substep`).
+    pub substep: f32,
     pub state: &'a mut ClothState,
     /// Collision thickness against colliders, metres.
     pub offset: f32,

@@ -7,6 +7,7 @@ mod cloth_springs;
 mod effect_kind;
 mod gravity;
 mod list;
+mod obstacle;
 mod plane;
 mod registry;
 mod self_collision;
@@ -22,6 +23,7 @@ pub use gravity::Gravity;
 pub use list::{
     air_damping_of, gravity_of, min_surface_distance, small_sphere_warnings, thickness_fits,
 };
+pub use obstacle::{Obstacle, ObstacleError, Placed, Shape};
 pub use plane::Plane;
 pub use registry::{Addable, Effect};
 pub use self_collision::{SelfCollision, TooThick, shortest_edge};

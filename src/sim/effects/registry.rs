@@ -16,6 +16,7 @@ use super::bending::BendingModel;
 use super::cloth_springs::ClothSprings;
 use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 use super::gravity::Gravity;
+use super::obstacle::Obstacle;
 use super::plane::Plane;
 use super::self_collision::SelfCollision;
 use super::sphere::Sphere;
@@ -144,4 +145,5 @@ effects! {
     SelfCollision(SelfCollision),
     Sphere(Sphere),
     Plane(Plane),
+    Obstacle(Obstacle),
 }

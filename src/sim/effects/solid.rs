@@ -25,6 +25,14 @@ pub(super) trait Solid {
     /// `offset` to the surface; `None` if it stays clear.
     fn catch(&self, from: Vec3, to: Vec3, offset: f32) -> Option<Vec3>;
 
+    /// Where a caught move ends, with the surface's normal and velocity there: by default
+    /// [`Solid::catch`], then [`Solid::surface_at`] where it ends.
+    fn contact(&self, from: Vec3, to: Vec3, offset: f32) -> Option<(Vec3, Vec3, Vec3)> {
+        let caught = self.catch(from, to, offset)?;
+        let (_, n, v_surface) = self.surface_at(caught);
+        Some((caught, n, v_surface))
+    }
+
     /// Coulomb friction coefficient (dimensionless, ≥ 0).
     fn friction(&self) -> f32;
 }
@@ -44,12 +52,11 @@ pub(super) fn resolve(solid: &impl Solid, pass: &mut ContactPass<'_>) -> usize {
         if w == 0.0 {
             continue;
         }
-        let Some(caught) = solid.catch(from, *x, offset) else {
+        let Some((caught, n, v_surface)) = solid.contact(from, *x, offset) else {
             continue;
         };
         contacts += 1;
         *x = caught;
-        let (_, n, v_surface) = solid.surface_at(caught);
         let v_rel = *v - v_surface;
         let vn = v_rel.dot(n);
         if vn < 0.0 {
