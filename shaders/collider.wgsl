@@ -3,7 +3,7 @@
 struct Solid {
     model: mat4x4<f32>,
     color: vec4<f32>,
-    // x: 0 = sphere pattern, 1 = ground grid; y: grid spacing in metres.
+    // x: 0 = sphere pattern, 1 = ground grid, 2 = plain (a mesh); y: grid spacing in metres.
     pattern: vec4<f32>,
 };
 
@@ -39,6 +39,11 @@ const PI: f32 = 3.14159265;
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     let n = normalize(in.normal);
     var base = solid.color.rgb;
+    if (solid.pattern.x > 1.5) {
+        // A mesh, perhaps open: each face lit from the side the eye sees.
+        let facing = select(-n, n, dot(n, globals.eye.xyz - in.world) >= 0.0);
+        return vec4<f32>(to_srgb(blinn_phong(base, facing, in.world, 24.0, 0.2)), 1.0);
+    }
     if (solid.pattern.x < 0.5) {
         // Eight longitude segments in object space: they rotate with the sphere.
         let lon = atan2(in.object.z, in.object.x);

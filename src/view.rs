@@ -2,9 +2,9 @@
 //! a simulation's current state and the camera that frames its scene. The renderer imports
 //! neither `sim` nor `scene`; callers (the app, the CLI, tests) build its input here.
 
-use glam::{Quat, Vec3};
+use glam::{Mat4, Quat, Vec3};
 
-use crate::render::{Frame, OrbitCamera, Shape, SpringLines};
+use crate::render::{Frame, MeshShape, OrbitCamera, Shape, SpringLines};
 use crate::scene::Simulation;
 use crate::sim::Effect;
 
@@ -25,7 +25,31 @@ pub fn frame(sim: &Simulation) -> Frame<'_> {
         },
         pinned: &model.pins,
         shapes: shapes(sim.effects(), sim.state().time),
+        meshes: meshes(sim.effects(), sim.state().time),
     }
+}
+
+/// The mesh obstacles among `effects` as meshes to draw, where their motion has them at
+/// simulated time `time`.
+pub fn meshes(effects: &[Effect], time: f64) -> Vec<MeshShape<'_>> {
+    (effects.iter())
+        .filter_map(|e| match e {
+            Effect::Obstacle(o) => o.placed(),
+            _ => None,
+        })
+        .map(|placed| {
+            let pose = placed.motion.at(time);
+            let pivot = placed.pivot;
+            MeshShape {
+                id: std::ptr::from_ref(placed) as usize,
+                vertices: placed.surface.vertices(),
+                triangles: placed.surface.triangles(),
+                transform: Mat4::from_translation(pivot + pose.translation)
+                    * Mat4::from_quat(pose.rotation)
+                    * Mat4::from_translation(-pivot),
+            }
+        })
+        .collect()
 }
 
 /// The solids among `effects` as shapes to draw at simulated time `time` (spinning spheres
@@ -46,7 +70,7 @@ pub fn shapes(effects: &[Effect], time: f64) -> Vec<Shape> {
                 point: p.point,
                 normal: p.unit_normal(),
             }),
-            // Mesh obstacles are not drawn yet.
+            // Mesh obstacles are drawn as meshes (`meshes`).
             Effect::Obstacle(_)
             | Effect::Springs(_)
             | Effect::Gravity(_)

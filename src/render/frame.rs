@@ -1,7 +1,7 @@
 //! What the renderer draws: a plain description of one frame, built by the caller. The
 //! renderer knows nothing of simulations or scenes.
 
-use glam::{Quat, Vec2, Vec3};
+use glam::{Mat4, Quat, Vec2, Vec3};
 
 use crate::mesh::SpringKind;
 
@@ -28,6 +28,17 @@ pub enum Shape {
     Plane { point: Vec3, normal: Vec3 },
 }
 
+/// A triangle mesh to draw (an obstacle), flat-shaded in its own colour: `id` names it
+/// while its vertices and triangles stay the same (the renderer keeps its buffers from
+/// frame to frame), `transform` places it.
+#[derive(Clone, Copy, Debug)]
+pub struct MeshShape<'a> {
+    pub id: usize,
+    pub vertices: &'a [Vec3],
+    pub triangles: &'a [[u32; 3]],
+    pub transform: Mat4,
+}
+
 /// Particle positions that live on the device the renderer draws with (the GPU backend's
 /// state): particle i's position, metres, is the xyz of the `vec4` at index `i · stride`.
 #[derive(Clone, Copy, Debug)]
@@ -51,4 +62,6 @@ pub struct Frame<'a> {
     /// Indices of pinned particles.
     pub pinned: &'a [u32],
     pub shapes: Vec<Shape>,
+    /// Meshes around it (obstacles).
+    pub meshes: Vec<MeshShape<'a>>,
 }

@@ -19,7 +19,7 @@ pub use capture::{
     RgbaImage, padded_bytes_per_row, read_target, read_texture, save_png, strip_row_padding,
 };
 pub use error::RenderError;
-pub use frame::{DevicePositions, Frame, Shape, SpringLines};
+pub use frame::{DevicePositions, Frame, MeshShape, Shape, SpringLines};
 pub use gif::GifWriter;
 pub use offscreen::Offscreen;
 pub use options::{RenderOptions, SpringColoring};

@@ -9,7 +9,7 @@ use crate::mesh::{SpringKind, vertex_normals};
 
 use super::camera::OrbitCamera;
 use super::display::{DisplayPass, LineSpec, Outputs, PARTICLE_COLOR, PINNED_COLOR};
-use super::frame::{Frame, Shape};
+use super::frame::{Frame, MeshShape, Shape};
 use super::geometry::{
     ClothVertex, ColorVertex, SolidVertex, ground_quad, triangle_edges, uv_sphere,
 };
@@ -75,6 +75,35 @@ impl StaticMesh {
     }
 }
 
+/// A flat-shaded mesh: each triangle's corners with its normal.
+fn flat_mesh(shape: &MeshShape<'_>) -> (Vec<SolidVertex>, Vec<u32>) {
+    let v = shape.vertices;
+    let vertices: Vec<SolidVertex> = (shape.triangles.iter())
+        .flat_map(|t| {
+            let [a, b, c] = t.map(|i| v.get(i as usize).copied().unwrap_or(Vec3::ZERO));
+            let normal = (b - a).cross(c - a).normalize_or_zero().to_array();
+            [a, b, c].map(|p| SolidVertex {
+                position: p.to_array(),
+                normal,
+            })
+        })
+        .collect();
+    let indices = (0..vertices.len() as u32).collect();
+    (vertices, indices)
+}
+
+/// What a collider slot draws.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum SolidDraw {
+    Sphere,
+    Ground,
+    /// The mesh at this place in `meshes`.
+    Mesh(usize),
+}
+
+/// Colour of obstacles, linear RGBA (a warm grey, apart from the cloth and the blue sphere).
+const OBSTACLE_COLOR: [f32; 4] = [0.62, 0.55, 0.45, 1.0];
+
 /// Per-collider uniform slot; slots are created when a scene has more colliders than before.
 struct SolidSlot {
     buffer: wgpu::Buffer,
@@ -104,9 +133,11 @@ pub struct Renderer {
     sphere: StaticMesh,
     ground: StaticMesh,
     solids: Vec<SolidSlot>,
+    /// The meshes drawn last frame, by their frame's `id` (kept while they are drawn).
+    meshes: Vec<(usize, StaticMesh)>,
     // Scratch reused every frame.
-    /// `(slot, is_sphere)` of the colliders to draw, in order.
-    solid_draws: Vec<(usize, bool)>,
+    /// `(slot, what)` of the colliders to draw, in order.
+    solid_draws: Vec<(usize, SolidDraw)>,
     normals: Vec<Vec3>,
     line_specs: Vec<LineSpec>,
     cloth_scratch: Vec<ClothVertex>,
@@ -160,6 +191,7 @@ impl Renderer {
             sphere: StaticMesh::new(device, "clothsim sphere", uv_sphere(32, 64)),
             ground: StaticMesh::new(device, "clothsim ground", ground_quad(GROUND_HALF_SIZE)),
             solids: Vec::new(),
+            meshes: Vec::new(),
             solid_draws: Vec::new(),
             pipelines,
             normals: Vec::new(),
@@ -251,11 +283,11 @@ impl Renderer {
             });
             pass.set_bind_group(0, &self.globals_bind_group, &[]);
             pass.set_pipeline(&self.pipelines.collider);
-            for &(slot, is_sphere) in &self.solid_draws {
-                let mesh = if is_sphere {
-                    &self.sphere
-                } else {
-                    &self.ground
+            for &(slot, what) in &self.solid_draws {
+                let mesh = match what {
+                    SolidDraw::Sphere => &self.sphere,
+                    SolidDraw::Ground => &self.ground,
+                    SolidDraw::Mesh(at) => &self.meshes[at].1,
                 };
                 pass.set_bind_group(1, &self.solids[slot].bind_group, &[]);
                 pass.set_vertex_buffer(0, mesh.vertices.slice(..));
@@ -419,7 +451,7 @@ impl Renderer {
 
     /// Writes one uniform slot per shape and lists them in `solid_draws`.
     fn upload_solids(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, frame: &Frame<'_>) {
-        while self.solids.len() < frame.shapes.len() {
+        while self.solids.len() < frame.shapes.len() + frame.meshes.len() {
             let buffer = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("clothsim solid"),
                 size: std::mem::size_of::<SolidRaw>() as u64,
@@ -463,8 +495,32 @@ impl Renderer {
                 },
             };
             queue.write_buffer(&self.solids[slot].buffer, 0, bytemuck::bytes_of(&raw));
-            self.solid_draws
-                .push((slot, matches!(shape, Shape::Sphere { .. })));
+            let what = match shape {
+                Shape::Sphere { .. } => SolidDraw::Sphere,
+                Shape::Plane { .. } => SolidDraw::Ground,
+            };
+            self.solid_draws.push((slot, what));
+        }
+        // Meshes: built when first drawn, dropped when a frame no longer has them.
+        self.meshes
+            .retain(|(id, _)| frame.meshes.iter().any(|m| m.id == *id));
+        for (k, shape) in frame.meshes.iter().enumerate() {
+            let at = match self.meshes.iter().position(|(id, _)| *id == shape.id) {
+                Some(at) => at,
+                None => {
+                    let mesh = StaticMesh::new(device, "clothsim obstacle", flat_mesh(shape));
+                    self.meshes.push((shape.id, mesh));
+                    self.meshes.len() - 1
+                }
+            };
+            let raw = SolidRaw {
+                model: shape.transform.to_cols_array_2d(),
+                color: OBSTACLE_COLOR,
+                pattern: [2.0, 0.0, 0.0, 0.0],
+            };
+            let slot = frame.shapes.len() + k;
+            queue.write_buffer(&self.solids[slot].buffer, 0, bytemuck::bytes_of(&raw));
+            self.solid_draws.push((slot, SolidDraw::Mesh(at)));
         }
     }
 }
@@ -623,6 +679,7 @@ mod tests {
             },
             pinned: &pinned,
             shapes: Vec::new(),
+            meshes: Vec::new(),
         };
         let (mut cpu, mut device) = (Renderer::new(&gpu.device, 1), Renderer::new(&gpu.device, 1));
         let half = &mesh.triangles[..mesh.triangles.len() / 2];

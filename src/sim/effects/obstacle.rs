@@ -154,6 +154,71 @@ struct Posed<'a> {
     friction: f32,
 }
 
+impl Posed<'_> {
+    /// Keeps every cloth edge (its structural and shear springs) the thickness from the
+    /// obstacle's sharp edges where it ends the substep: the two particles are moved apart
+    /// from the edge in proportion to how near each is to the nearest point, which moves by
+    /// exactly what was missing; their velocity towards the edge is removed, with Coulomb
+    /// friction along it. Returns how many cloth edges it moved.
+    fn push_edges(&self, pass: &mut ContactPass<'_>) -> usize {
+        let edges = self.placed.surface.sharp_edges();
+        if edges.is_empty() {
+            return 0;
+        }
+        let (pivot, thickness, mu) = (self.placed.pivot, pass.offset, self.friction);
+        let (springs, inv_mass) = (&pass.model.springs, &pass.model.inv_mass);
+        let state = &mut *pass.state;
+        let mut moved = 0;
+        for e in 0..pass.model.bend_start() {
+            let (i, j) = (springs.a[e] as usize, springs.b[e] as usize);
+            let free = [inv_mass[i] > 0.0, inv_mass[j] > 0.0].map(f32::from);
+            if free == [0.0, 0.0] {
+                continue;
+            }
+            let (a, b) = (state.pos[i], state.pos[j]);
+            let local = [a, b].map(|p| self.end.unapply(pivot, p));
+            let Some(hit) = edges.nearest(local[0], local[1], thickness) else {
+                continue;
+            };
+            let away = hit.on_segment - hit.on_edge;
+            if hit.distance <= thickness * 1e-3 || hit.distance >= thickness {
+                continue;
+            }
+            let n = self.end.rotation * (away / hit.distance);
+            let share = [1.0 - hit.along, hit.along];
+            let weight = share[0] * share[0] * free[0] + share[1] * share[1] * free[1];
+            if weight <= 0.0 {
+                continue;
+            }
+            let lift = (thickness - hit.distance) / weight;
+            let v_surface = self
+                .end
+                .velocity_at(pivot, self.end.apply(pivot, hit.on_edge));
+            for (k, p) in [i, j].into_iter().enumerate() {
+                let part = share[k] * free[k];
+                if part <= 0.0 {
+                    continue;
+                }
+                state.pos[p] += n * (lift * part);
+                let v_rel = state.vel[p] - v_surface;
+                let vn = v_rel.dot(n);
+                if vn < 0.0 {
+                    let v_t = v_rel - vn * n;
+                    let speed = v_t.length();
+                    let keep = if speed > 0.0 {
+                        (1.0 - mu * part * (-vn) / speed).max(0.0)
+                    } else {
+                        0.0
+                    };
+                    state.vel[p] = v_surface + (1.0 - part) * vn * n + keep * v_t;
+                }
+            }
+            moved += 1;
+        }
+        moved
+    }
+}
+
 impl Solid for Posed<'_> {
     fn surface_at(&self, p: Vec3) -> (f32, Vec3, Vec3) {
         let pivot = self.placed.pivot;
@@ -248,7 +313,7 @@ impl EffectKind for Obstacle {
         if let Some(thickness) = self.thickness {
             pass.offset = thickness;
         }
-        let moved = resolve(&posed, pass);
+        let moved = resolve(&posed, pass) + posed.push_edges(pass);
         pass.offset = offset;
         Ok(moved)
     }

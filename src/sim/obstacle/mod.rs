@@ -1,9 +1,11 @@
 //! Obstacles of any shape: triangle surfaces the cloth may not pass, with the tree that
 //! finds what a particle's move comes near.
 
+mod edges;
 mod geometry;
 mod surface;
 mod tree;
 
+pub use edges::{EdgeHit, SharpEdges};
 pub use surface::{Caught, Surface};
 pub use tree::{Nearest, TriangleTree};

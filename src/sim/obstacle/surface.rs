@@ -3,6 +3,7 @@
 
 use glam::Vec3;
 
+use super::edges::SharpEdges;
 use super::tree::{Nearest, TriangleTree};
 
 /// How many crossings one move may be caught at (a move that slides on into a second face
@@ -20,6 +21,7 @@ pub struct Surface {
     /// Unit normal of each triangle (zero for a degenerate one).
     normals: Vec<Vec3>,
     tree: TriangleTree,
+    edges: SharpEdges,
 }
 
 /// Where a caught move ends and the surface's normal there (pointing to the side the
@@ -36,15 +38,17 @@ impl Surface {
         let corners: Vec<[Vec3; 3]> = (triangles.iter())
             .map(|t| t.map(|i| vertices[i as usize]))
             .collect();
-        let normals = (corners.iter())
+        let normals: Vec<Vec3> = (corners.iter())
             .map(|[a, b, c]| (*b - *a).cross(*c - *a).normalize_or_zero())
             .collect();
         let tree = TriangleTree::new(&corners);
+        let edges = SharpEdges::of(&vertices, &triangles, &normals);
         Self {
             vertices,
             triangles,
             normals,
             tree,
+            edges,
         }
     }
 
@@ -54,6 +58,11 @@ impl Surface {
 
     pub fn triangles(&self) -> &[[u32; 3]] {
         &self.triangles
+    }
+
+    /// Its creases and borders.
+    pub fn sharp_edges(&self) -> &SharpEdges {
+        &self.edges
     }
 
     /// The box around the surface (`None` without triangles).

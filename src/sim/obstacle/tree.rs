@@ -164,6 +164,36 @@ impl TriangleTree {
         best.map(|(place, t)| (self.index[place as usize], t))
     }
 
+    /// Calls `visit` with the number of every triangle whose box meets the box `lo..hi`.
+    pub fn overlapping(&self, lo: Vec3, hi: Vec3, mut visit: impl FnMut(u32)) {
+        let meets = |n: &Node| n.lo.cmple(hi).all() && n.hi.cmpge(lo).all();
+        let mut stack = [0u32; 64];
+        let mut top = 0;
+        if self.nodes.first().is_some_and(meets) {
+            top = 1;
+        }
+        while top > 0 {
+            top -= 1;
+            let at = stack[top];
+            let node = self.nodes[at as usize];
+            if node.count > 0 {
+                for place in node.first..node.first + node.count {
+                    let [a, b, c] = self.corners[place as usize];
+                    if a.min(b).min(c).cmple(hi).all() && a.max(b).max(c).cmpge(lo).all() {
+                        visit(self.index[place as usize]);
+                    }
+                }
+                continue;
+            }
+            for child in [node.first, at + 1] {
+                if meets(&self.nodes[child as usize]) {
+                    stack[top] = child;
+                    top += 1;
+                }
+            }
+        }
+    }
+
     fn box_d2(&self, node: u32, p: Vec3) -> f32 {
         let n = self.nodes[node as usize];
         box_distance_squared(p, n.lo, n.hi)

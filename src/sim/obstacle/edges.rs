@@ -1,0 +1,177 @@
+//! An obstacle's sharp edges (its creases and its open borders), where a cloth edge can
+//! rest across it with both ends clear of its faces: a table's rim under a tablecloth.
+
+use std::collections::HashMap;
+
+use glam::Vec3;
+
+use super::tree::TriangleTree;
+
+/// Two faces meeting at less than this cosine between their normals (about 10°) make a
+/// sharp edge; flatter ones are covered by their faces. Unsigned: a mesh whose faces are
+/// not all wound the same way has no false creases.
+const CREASE_COS: f32 = 0.985;
+
+/// The sharp edges of a surface and a tree over them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SharpEdges {
+    edges: Vec<[Vec3; 2]>,
+    tree: TriangleTree,
+}
+
+/// The nearest points of a segment and a sharp edge.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeHit {
+    /// Where along the segment, 0 at its start and 1 at its end.
+    pub along: f32,
+    pub on_segment: Vec3,
+    pub on_edge: Vec3,
+    pub distance: f32,
+}
+
+impl SharpEdges {
+    /// The edges of `triangles` over `vertices` that border one triangle, or two whose
+    /// normals (`normals`, per triangle) differ by more than about 10°.
+    pub fn of(vertices: &[Vec3], triangles: &[[u32; 3]], normals: &[Vec3]) -> Self {
+        let mut faces: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+        for (t, tri) in triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                faces.entry((a.min(b), a.max(b))).or_default().push(t);
+            }
+        }
+        let mut keys: Vec<(u32, u32)> = (faces.iter())
+            .filter(|(_, f)| match f.as_slice() {
+                [one, two] => normals[*one].dot(normals[*two]).abs() < CREASE_COS,
+                _ => true,
+            })
+            .map(|(k, _)| *k)
+            .collect();
+        keys.sort_unstable();
+        let edges: Vec<[Vec3; 2]> = (keys.iter())
+            .map(|&(a, b)| [vertices[a as usize], vertices[b as usize]])
+            .filter(|[a, b]| a != b)
+            .collect();
+        let boxes: Vec<[Vec3; 3]> = edges.iter().map(|&[a, b]| [a, b, b]).collect();
+        Self {
+            tree: TriangleTree::new(&boxes),
+            edges,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.edges.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.edges.is_empty()
+    }
+
+    /// The sharp edge nearest to the segment from `a` to `b`, if one is within `reach`.
+    pub fn nearest(&self, a: Vec3, b: Vec3, reach: f32) -> Option<EdgeHit> {
+        let pad = Vec3::splat(reach);
+        let mut best: Option<EdgeHit> = None;
+        self.tree.overlapping(a.min(b) - pad, a.max(b) + pad, |e| {
+            let [p, q] = self.edges[e as usize];
+            let hit = closest_between(a, b, p, q);
+            if hit.distance <= reach && best.is_none_or(|b| hit.distance < b.distance) {
+                best = Some(hit);
+            }
+        });
+        best
+    }
+}
+
+/// The nearest points of the segments `a`–`b` and `p`–`q`.
+fn closest_between(a: Vec3, b: Vec3, p: Vec3, q: Vec3) -> EdgeHit {
+    let (d1, d2, r) = (b - a, q - p, a - p);
+    let (l1, l2, f) = (d1.dot(d1), d2.dot(d2), d2.dot(r));
+    let (s, t) = if l1 <= f32::EPSILON && l2 <= f32::EPSILON {
+        (0.0, 0.0)
+    } else if l1 <= f32::EPSILON {
+        (0.0, (f / l2).clamp(0.0, 1.0))
+    } else {
+        let c = d1.dot(r);
+        if l2 <= f32::EPSILON {
+            ((-c / l1).clamp(0.0, 1.0), 0.0)
+        } else {
+            let bb = d1.dot(d2);
+            let denom = l1 * l2 - bb * bb;
+            let mut s = if denom > f32::EPSILON * l1 * l2 {
+                ((bb * f - c * l2) / denom).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let mut t = (bb * s + f) / l2;
+            if t < 0.0 {
+                t = 0.0;
+                s = (-c / l1).clamp(0.0, 1.0);
+            } else if t > 1.0 {
+                t = 1.0;
+                s = ((bb - c) / l1).clamp(0.0, 1.0);
+            }
+            (s, t)
+        }
+    };
+    let (on_segment, on_edge) = (a + d1 * s, p + d2 * t);
+    EdgeHit {
+        along: s,
+        on_segment,
+        on_edge,
+        distance: on_segment.distance(on_edge),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The nearest points of two segments agree with a fine search along both.
+    #[test]
+    fn the_nearest_points_of_two_segments_are_the_nearest() {
+        let mut rnd = crate::test_rng::uniform(21);
+        let mut v = || Vec3::new(rnd(), rnd(), rnd());
+        for _ in 0..300 {
+            let (a, b, p, q) = (v(), v(), v(), v());
+            let hit = closest_between(a, b, p, q);
+            let n = 200;
+            let mut best = f32::INFINITY;
+            for i in 0..=n {
+                for j in 0..=n {
+                    let (s, t) = (i as f32 / n as f32, j as f32 / n as f32);
+                    best = best.min((a + (b - a) * s).distance(p + (q - p) * t));
+                }
+            }
+            assert!(hit.distance <= best + 1e-5, "{hit:?} vs {best}");
+            assert!(hit.distance >= best - 0.02, "{hit:?} vs {best}");
+        }
+    }
+
+    /// A box's twelve edges are sharp; the diagonals that split its square faces are not;
+    /// a lone triangle's three borders are.
+    #[test]
+    fn creases_and_borders_are_sharp_and_flat_diagonals_are_not() {
+        let v: Vec<Vec3> = (0..8)
+            .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32))
+            .collect();
+        let quads = [
+            [0, 1, 3, 2],
+            [4, 6, 7, 5],
+            [0, 4, 5, 1],
+            [2, 3, 7, 6],
+            [0, 2, 6, 4],
+            [1, 5, 7, 3],
+        ];
+        let t: Vec<[u32; 3]> = (quads.iter())
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect();
+        let normals: Vec<Vec3> = (t.iter())
+            .map(|t| {
+                let [a, b, c] = t.map(|i| v[i as usize]);
+                (b - a).cross(c - a).normalize()
+            })
+            .collect();
+        assert_eq!(SharpEdges::of(&v, &t, &normals).len(), 12);
+        assert_eq!(SharpEdges::of(&v, &t[..1], &normals[..1]).len(), 3);
+    }
+}
