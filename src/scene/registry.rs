@@ -23,10 +23,35 @@ pub static BUILTIN_SCENES: &[(&str, &str)] = &[
         include_str!("../../assets/scenes/self-fold.toml"),
     ),
     (
+        "tablecloth",
+        include_str!("../../assets/scenes/tablecloth.toml"),
+    ),
+    (
+        "carousel",
+        include_str!("../../assets/scenes/carousel.toml"),
+    ),
+    (
         "hanging-bench",
         include_str!("../../assets/scenes/hanging-bench.toml"),
     ),
 ];
+
+/// Name and text of every mesh the built-in scenes' obstacles use (`obj = "…"` in a built-in
+/// scene names one of these); written by `assets/meshes/generate.py`.
+pub static BUILTIN_MESHES: &[(&str, &str)] = &[
+    ("table.obj", include_str!("../../assets/meshes/table.obj")),
+    (
+        "turntable.obj",
+        include_str!("../../assets/meshes/turntable.obj"),
+    ),
+];
+
+/// The text of a built-in mesh by its name.
+pub fn builtin_mesh(name: &std::path::Path) -> Option<&'static str> {
+    (BUILTIN_MESHES.iter())
+        .find(|(n, _)| std::path::Path::new(n) == name)
+        .map(|(_, text)| *text)
+}
 
 /// The built-in scenes, parsed once. They are part of the program and checked by the test
 /// suite (`every_builtin_scene_file_parses`), so parsing them cannot fail at run time.

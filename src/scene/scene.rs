@@ -13,7 +13,7 @@ use crate::sim::{Effect, SimParams, Sphere, thickness_fits};
 
 use super::error::{PinError, SceneError};
 use super::file::{Corner, Edge, LoadedSceneFile, PinSpec, SceneFile};
-use super::registry::{BUILTIN_SCENES, scenario};
+use super::registry::{BUILTIN_SCENES, builtin_mesh, scenario};
 
 /// The default cloth: a 1 m × 1 m square of 24 × 24 quads (see `assets/README.md`).
 pub const DEFAULT_CLOTH_OBJ: &str = include_str!("../../assets/cloth.obj");
@@ -40,11 +40,15 @@ pub struct Scene {
     pub warnings: Vec<String>,
 }
 
-/// Reads the mesh of every obstacle `file` lists (`base`: where relative paths start).
+/// Reads the mesh of every obstacle `file` lists (`base`: where relative paths start; a
+/// built-in scene, without one, finds its meshes among the built-in ones).
 fn load_obstacles(file: &mut SceneFile, base: Option<&Path>) -> Result<(), SceneError> {
     for effect in &mut file.effects {
         if let Effect::Obstacle(obstacle) = effect {
-            obstacle.load(base)?;
+            match (base, builtin_mesh(&obstacle.obj)) {
+                (None, Some(text)) => obstacle.load_text(text)?,
+                _ => obstacle.load(base)?,
+            }
         }
     }
     Ok(())

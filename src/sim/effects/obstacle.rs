@@ -9,7 +9,7 @@ use glam::{Quat, Vec3};
 
 use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 use super::solid::{Solid, default_friction, resolve};
-use crate::mesh::{ObjError, read_obj};
+use crate::mesh::{ObjError, PolygonSoup, parse_obj, read_obj};
 use crate::sim::motion::{AxisAngle, Keyframe, Pose, RigidMotion};
 use crate::sim::obstacle::Surface;
 use crate::sim::param_error::ParamError;
@@ -115,12 +115,33 @@ impl Obstacle {
     /// placement or motion that [`EffectKind::check`] refuses.
     pub fn load(&mut self, base: Option<&Path>) -> Result<(), ObstacleError> {
         let path = base.map_or_else(|| self.obj.clone(), |b| b.join(&self.obj));
-        let setting = |error| ObstacleError::Setting {
+        self.check().map_err(|error| ObstacleError::Setting {
             path: path.clone(),
             error,
+        })?;
+        self.place(&read_obj(&path)?, &path)
+    }
+
+    /// As [`Obstacle::load`], from the text of its OBJ (a built-in mesh).
+    ///
+    /// # Errors
+    /// As [`Obstacle::load`].
+    pub fn load_text(&mut self, text: &str) -> Result<(), ObstacleError> {
+        let path = self.obj.clone();
+        self.check().map_err(|error| ObstacleError::Setting {
+            path: path.clone(),
+            error,
+        })?;
+        self.place(&parse_obj(text, &path)?, &path)
+    }
+
+    /// Places `soup` (read from `path`) as the obstacle says.
+    fn place(&mut self, soup: &PolygonSoup, path: &Path) -> Result<(), ObstacleError> {
+        let setting = |error| ObstacleError::Setting {
+            path: path.to_path_buf(),
+            error,
         };
-        self.check().map_err(setting)?;
-        let soup = read_obj(&path)?.triangulated();
+        let soup = soup.triangulated();
         let rotation = self.rotation();
         let vertices = (soup.positions.iter())
             .map(|&p| rotation * (p * self.scale) + self.translate)

@@ -4,6 +4,7 @@
 use glam::Vec3;
 
 use super::edges::SharpEdges;
+use super::geometry::{closest_on_triangle, segment_crosses};
 use super::tree::{Nearest, TriangleTree};
 
 /// How many crossings one move may be caught at (a move that slides on into a second face
@@ -12,6 +13,9 @@ const CROSSINGS: usize = 3;
 /// How many times the end of a move is pushed out of the thickness (two faces of a corner
 /// can each hold it within).
 const PUSHES: usize = 3;
+/// Triangles near one move that a catch holds at once (more: it walks the tree for each
+/// question instead).
+const NEAR: usize = 48;
 
 /// A triangle surface, fixed in its own frame.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -81,15 +85,68 @@ impl Surface {
     /// surface kept (so it slides) and the part into it dropped; then pushed out to
     /// `thickness` from the nearest point. `None`: the move stays clear.
     pub fn catch(&self, from: Vec3, to: Vec3, thickness: f32) -> Option<Caught> {
-        let (lo, hi) = self.tree.bounds()?;
-        let pad = Vec3::splat(thickness);
-        if from.min(to).cmpgt(hi + pad).any() || from.max(to).cmplt(lo - pad).any() {
+        // One walk of the tree for the triangles near the whole move; the tree is walked
+        // again for each question only when they are too many to hold, or the move ends
+        // less than the thickness inside the box they were gathered from (triangles
+        // outside it could then be within the thickness of the end).
+        let pad = Vec3::splat(1.25 * thickness);
+        let (lo, hi) = (from.min(to) - pad, from.max(to) + pad);
+        let mut found = [0u32; NEAR];
+        let mut count = 0;
+        self.tree.overlapping(lo, hi, |t| {
+            if let Some(slot) = found.get_mut(count) {
+                *slot = t;
+            }
+            count += 1;
+        });
+        if count == 0 {
             return None;
         }
+        let few = (count <= NEAR).then_some(&found[..count.min(NEAR)]);
+        let caught = self.catch_among(few, from, to, thickness);
+        match (few, caught) {
+            (Some(_), Some(c))
+                if c.at.cmplt(lo + pad * 0.8).any() || c.at.cmpgt(hi - pad * 0.8).any() =>
+            {
+                self.catch_among(None, from, to, thickness)
+            }
+            _ => caught,
+        }
+    }
+
+    /// [`Surface::catch`] over the triangles `few` (all of them, through the tree, when
+    /// `None`).
+    fn catch_among(
+        &self,
+        few: Option<&[u32]>,
+        from: Vec3,
+        to: Vec3,
+        thickness: f32,
+    ) -> Option<Caught> {
+        let corners = |t: u32| self.triangles[t as usize].map(|i| self.vertices[i as usize]);
+        let first_crossing = |a: Vec3, b: Vec3| match few {
+            None => self.tree.first_crossing(a, b),
+            Some(few) => (few.iter())
+                .filter_map(|&t| segment_crosses(a, b, corners(t)).map(|at| (t, at)))
+                .min_by(|x, y| x.1.total_cmp(&y.1)),
+        };
+        let nearest = |p: Vec3| match few {
+            None => self.tree.nearest(p, thickness),
+            Some(few) => (few.iter())
+                .map(|&t| (t, closest_on_triangle(p, corners(t))))
+                .map(|(t, q)| (t, q, p.distance(q)))
+                .filter(|(_, _, d)| *d <= thickness)
+                .min_by(|x, y| x.2.total_cmp(&y.2))
+                .map(|(triangle, point, distance)| Nearest {
+                    triangle,
+                    point,
+                    distance,
+                }),
+        };
         let (mut start, mut end) = (from, to);
         let mut normal = None;
         for _ in 0..CROSSINGS {
-            let Some((triangle, t)) = self.tree.first_crossing(start, end) else {
+            let Some((triangle, t)) = first_crossing(start, end) else {
                 break;
             };
             let face = self.normals[triangle as usize];
@@ -108,12 +165,14 @@ impl Surface {
             normal = Some(n);
         }
         for _ in 0..PUSHES {
-            let Some(near) = self.tree.nearest(end, thickness) else {
+            let Some(near) = nearest(end) else {
                 break;
             };
-            let away = end - near.point;
+            if near.distance >= thickness * (1.0 - 1e-4) {
+                break;
+            }
             let n = if near.distance > thickness * 1e-3 {
-                away / near.distance
+                (end - near.point) / near.distance
             } else {
                 // On the surface: off it on the side of the start.
                 let face = self.normals[near.triangle as usize];
@@ -123,9 +182,6 @@ impl Surface {
                     -face
                 }
             };
-            if near.distance >= thickness * (1.0 - 1e-4) {
-                break;
-            }
             end = near.point + n * thickness;
             normal = Some(n);
         }
