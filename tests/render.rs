@@ -102,6 +102,7 @@ fn golden_scenarios() {
         ("hanging", 4.0),
         ("sphere-drop", 1.5),
         ("rotating-sphere", 1.0),
+        ("tablecloth", 1.5),
     ] {
         let sim = simulate(name, seconds);
         let image = render_default(&mut off, &sim, &RenderOptions::default());
