@@ -129,6 +129,18 @@ type = "obstacle"
         "{err}"
     );
 
+    // A keyframe out of order in the second of two obstacles: its own line and column.
+    let text = format!(
+        "{base}obj = \"a.obj\"\nkeyframes = [ {{ time = 0.0 }}, {{ time = 1.0 }} ]\n\
+         [[effects]]\ntype = \"obstacle\"\nobj = \"b.obj\"\n\
+         keyframes = [ {{ time = 0.0 }},\n              {{ time = 2.0 }}, {{ time = 1.5 }} ]\n"
+    );
+    let err = SceneFile::parse(&text, &path).unwrap_err().to_string();
+    assert!(
+        err.contains("scene.toml:13:31:") && err.contains("keyframe 2: `time`"),
+        "{err}"
+    );
+
     // An obstacle built in code and never read is refused by a running simulation.
     let mut sim = Simulation::new(Scene::builtin("hanging").unwrap());
     let mut effects = sim.effects().to_vec();

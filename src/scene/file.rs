@@ -14,6 +14,7 @@ use crate::sim::{
 };
 
 use super::error::SceneError;
+use super::locate::{Step, find_key, line_column, locate};
 
 /// A scene file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -231,39 +232,9 @@ pub struct LoadedSceneFile {
     pub path: PathBuf,
 }
 
-/// Line and column (1-based) of byte `offset` in `text`.
-fn line_column(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-    (line, column)
-}
-
-/// The line of `key = …` inside the `index`-th `[[effects]]` table, or anywhere.
-fn locate_key(text: &str, index: Option<usize>, key: &str) -> (usize, usize) {
-    let mut offset = 0;
-    if let Some(i) = index
-        && let Some((at, _)) = text.match_indices("[[effects]]").nth(i)
-    {
-        offset = at;
-    }
-    line_column(text, find_key(text, offset, key).unwrap_or(offset))
-}
-
-/// Byte offset of the first `key = …` at or after `offset`.
-fn find_key(text: &str, offset: usize, key: &str) -> Option<usize> {
-    let offset = offset.min(text.len());
-    text[offset..]
-        .match_indices(key)
-        .map(|(at, _)| at + offset)
-        .find(|&at| {
-            // A whole key: not the tail of a longer one, and followed by `=`.
-            let whole = text[..at]
-                .chars()
-                .next_back()
-                .is_none_or(|c| !(c.is_alphanumeric() || c == '_' || c == '-'));
-            whole && text[at + key.len()..].trim_start().starts_with('=')
-        })
+/// The path to a key of `[cloth] grid`.
+fn grid_key(key: &'static str) -> Vec<Step> {
+    vec![Step::Key("cloth"), Step::Key("grid"), Step::Key(key)]
 }
 
 impl SceneFile {
@@ -289,8 +260,12 @@ impl SceneFile {
                 message: e.message().trim().replace('\n', " "),
             }
         })?;
-        file.check().map_err(|(index, key, message)| {
-            let (line, column) = locate_key(text, index, &key);
+        file.check().map_err(|(path_in_file, message)| {
+            let (line, column) = locate(text, &path_in_file);
+            let key = match path_in_file.last() {
+                Some(Step::Key(key)) => key,
+                _ => "keyframes",
+            };
             // A message that already names its key (`dt` = …) is shown as it is.
             let message = if message.starts_with('`') {
                 message
@@ -338,32 +313,39 @@ impl SceneFile {
         toml::to_string_pretty(self).unwrap_or_else(|e| format!("# cannot write scene: {e}\n"))
     }
 
-    /// Values the types cannot rule out: `(effect index, key, why)` of the first bad one.
-    fn check(&self) -> Result<(), (Option<usize>, String, String)> {
-        let bad = |index, key: &str, why: &str| Err((index, key.to_string(), why.to_string()));
+    /// Values the types cannot rule out: where the first bad one is and why.
+    fn check(&self) -> Result<(), (Vec<Step>, String)> {
+        use Step::{At, Key};
+        let bad = |path: Vec<Step>, why: &str| Err((path, why.to_string()));
         match (&self.cloth.obj, &self.cloth.grid) {
             (Some(_), Some(_)) | (None, None) => {
-                return bad(None, "cloth", "give exactly one of `obj` or `grid`");
+                return bad(vec![Key("cloth")], "give exactly one of `obj` or `grid`");
             }
             (None, Some(g)) => {
                 let [qx, qy] = g.quads.pair();
                 let [sx, sy] = g.size.pair();
                 if qx == 0 || qy == 0 || qx > 2048 || qy > 2048 {
-                    return bad(None, "quads", "must be in 1..=2048");
+                    return bad(grid_key("quads"), "must be in 1..=2048");
                 }
                 if !(sx.is_finite() && sy.is_finite() && sx > 0.0 && sy > 0.0) {
-                    return bad(None, "size", "must be positive metres");
+                    return bad(grid_key("size"), "must be positive metres");
                 }
             }
             (Some(_), None) => {}
         }
         if !self.cloth.center.iter().all(|c| c.is_finite()) {
-            return bad(None, "center", "must be finite metres");
+            return bad(vec![Key("cloth"), Key("center")], "must be finite metres");
         }
         for (i, e) in self.effects.iter().enumerate() {
             if let Err(e) = e.check() {
+                let mut path = vec![Key("effects"), At(i), Key(e.name)];
+                // A keyframe's problem is at that keyframe (its value is its place).
+                if let ("keyframes", Ok(k)) = (e.name, e.value.parse::<usize>()) {
+                    path.push(At(k));
+                    return bad(path, &e.rule);
+                }
                 let detail = format!("`{}` = {} {}", e.name, e.value, e.rule);
-                return Err((Some(i), e.name.to_string(), detail));
+                return Err((path, detail));
             }
         }
         // A grid's shortest rest edge is known before it is built (an OBJ's is checked when
@@ -378,16 +360,24 @@ impl SceneFile {
                     // Named as the file names it: `thickness` = …
                     let message = too_thick.to_string();
                     let message = message.trim_start_matches("self-collision ");
-                    return bad(Some(i), "thickness", message);
+                    return bad(vec![Key("effects"), At(i), Key("thickness")], message);
                 }
             }
         }
         // Solver and material values, checked as the simulation will check them.
         if let Err(e) = self.params().validate() {
-            // `solver.tolerance` is `tolerance` in [solver], `guard.x` is `x` in [solver.guard].
+            // `solver.tolerance` is `tolerance` in [solver], `guard.x` is `x` in
+            // [solver.guard], the material's are in [material].
             let key = e.name.rsplit('.').next().unwrap_or(e.name);
+            let path = match e.name.split_once('.') {
+                Some(("guard", _)) => vec![Key("solver"), Key("guard"), Key(key)],
+                _ if ["stiffness", "damping", "density"].contains(&key) => {
+                    vec![Key("material"), Key(key)]
+                }
+                _ => vec![Key("solver"), Key(key)],
+            };
             let detail = format!("`{key}` = {} {}", e.value, e.rule);
-            return Err((None, key.to_string(), detail));
+            return Err((path, detail));
         }
         Ok(())
     }

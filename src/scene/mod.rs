@@ -3,6 +3,7 @@
 mod error;
 mod file;
 mod framing;
+mod locate;
 mod registry;
 #[allow(clippy::module_inception)]
 mod scene;
