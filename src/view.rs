@@ -72,6 +72,7 @@ pub fn shapes(effects: &[Effect], time: f64) -> Vec<Shape> {
             }),
             // Mesh obstacles are drawn as meshes (`meshes`).
             Effect::Obstacle(_)
+            | Effect::Handle(_)
             | Effect::Springs(_)
             | Effect::Gravity(_)
             | Effect::AirDamping(_)

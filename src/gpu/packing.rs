@@ -169,6 +169,7 @@ pub(super) fn pack_solids(effects: &[Effect]) -> ([GpuCollider; MAX_COLLIDERS], 
         // What is not a solid takes no slot, and `gpu_support` refuses what the GPU lacks
         // (mesh obstacles).
         Effect::Obstacle(_)
+        | Effect::Handle(_)
         | Effect::Springs(_)
         | Effect::Gravity(_)
         | Effect::AirDamping(_)

@@ -57,6 +57,14 @@ pub enum SceneError {
 pub enum PinError {
     #[error("pin index {index} does not exist: the cloth has {particles} particles")]
     NoSuchParticle { index: u32, particles: usize },
+    /// A handle whose rules choose no particle (`handle` counts from 1, as in the file).
+    #[error("handle {handle} chooses no particle")]
+    EmptyHandle { handle: usize },
+    /// A particle both in a handle and in `[pins]`: it cannot both stay and move.
+    #[error(
+        "particle {particle} is both in handle {handle} and in [pins]; it cannot both stay and move"
+    )]
+    PinnedAndHandled { handle: usize, particle: u32 },
     /// An empty region is a mistake (a typo in a bound), not a wish for no pins.
     #[error("the pin region from {min} to {max} holds no particle: the cloth spans {lo} to {hi}")]
     EmptyRegion {

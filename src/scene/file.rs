@@ -9,8 +9,8 @@ use serde::{Deserialize, Serialize};
 use crate::cloth::MassDistribution;
 use crate::mesh::{GridBends, GridOrientation};
 use crate::sim::{
-    ClothSprings, ContactConfig, Effect, GuardPolicy, IntegratorKind, Material, SimParams,
-    SolverConfig, StepConfig,
+    ClothSprings, ContactConfig, Effect, GuardPolicy, IntegratorKind, Keyframe, Material,
+    RigidMotion, SimParams, SolverConfig, StepConfig,
 };
 
 use super::error::SceneError;
@@ -33,6 +33,41 @@ pub struct SceneFile {
     /// The effects the scene lists (never the cloth's springs, which every scene has).
     #[serde(default)]
     pub effects: Vec<Effect>,
+    /// Particles moved along keyframes (moving pins).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub handles: Vec<HandleSpec>,
+}
+
+/// A handle: particles chosen as `[pins]` chooses them, moved along keyframes about a pivot.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct HandleSpec {
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub corners: Vec<Corner>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub edges: Vec<Edge>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub indices: Vec<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub region: Option<Region>,
+    /// What its rotations turn about, metres (default: the chosen particles' centre at the
+    /// start).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pivot: Option<[f32; 3]>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub keyframes: Vec<Keyframe>,
+}
+
+impl HandleSpec {
+    /// The particles it chooses, as a pin rule.
+    pub fn selection(&self) -> PinSpec {
+        PinSpec {
+            corners: self.corners.clone(),
+            edges: self.edges.clone(),
+            indices: self.indices.clone(),
+            region: self.region,
+        }
+    }
 }
 
 /// The cloth: an OBJ file or a generated grid, and where it goes.
@@ -348,6 +383,19 @@ impl SceneFile {
                 return Err((path, detail));
             }
         }
+        for (h, handle) in self.handles.iter().enumerate() {
+            let at = |key| vec![Key("handles"), At(h), Key(key)];
+            if let Some(pivot) = handle.pivot
+                && !pivot.iter().all(|c| c.is_finite())
+            {
+                return bad(at("pivot"), "must be finite metres");
+            }
+            if let Err(e) = RigidMotion::new(&handle.keyframes) {
+                let mut path = at("keyframes");
+                path.push(At(e.index));
+                return bad(path, &e.to_string());
+            }
+        }
         // A grid's shortest rest edge is known before it is built (an OBJ's is checked when
         // the scene is built).
         if let Some(g) = &self.cloth.grid {
@@ -444,8 +492,9 @@ impl SceneFile {
             damping: params.material.damping.into(),
             masses: self.material.masses,
         };
+        // The springs are every scene's; handles are written as `[[handles]]`.
         file.effects = (effects.iter())
-            .filter(|e| !matches!(e, Effect::Springs(_)))
+            .filter(|e| !matches!(e, Effect::Springs(_) | Effect::Handle(_)))
             .cloned()
             .collect();
         if let Some(pins) = pins {

@@ -12,8 +12,8 @@ mod summary;
 
 pub use error::{PinError, SceneError};
 pub use file::{
-    ClothSpec, Corner, Edge, GridShape, LoadedSceneFile, MaterialSpec, OneOrTwo, PerKind, PinSpec,
-    Region, SceneFile, SolverSpec,
+    ClothSpec, Corner, Edge, GridShape, HandleSpec, LoadedSceneFile, MaterialSpec, OneOrTwo,
+    PerKind, PinSpec, Region, SceneFile, SolverSpec,
 };
 pub use registry::{BUILTIN_SCENES, scenario, scenarios};
 pub use scene::{DEFAULT_CLOTH_NAME, DEFAULT_CLOTH_OBJ, Scene};

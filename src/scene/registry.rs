@@ -30,6 +30,7 @@ pub static BUILTIN_SCENES: &[(&str, &str)] = &[
         "carousel",
         include_str!("../../assets/scenes/carousel.toml"),
     ),
+    ("twist", include_str!("../../assets/scenes/twist.toml")),
     (
         "hanging-bench",
         include_str!("../../assets/scenes/hanging-bench.toml"),

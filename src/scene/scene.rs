@@ -9,10 +9,10 @@ use crate::cloth::{ClothModel, ClothState};
 use crate::mesh::{
     self, ClothMesh, GridOrientation, GridSpec, ImportOptions, MeshBuild, bounds, thinnest_axis,
 };
-use crate::sim::{Effect, SimParams, Sphere, thickness_fits};
+use crate::sim::{Effect, Handle, ParamError, RigidMotion, SimParams, Sphere, thickness_fits};
 
 use super::error::{PinError, SceneError};
-use super::file::{Corner, Edge, LoadedSceneFile, PinSpec, SceneFile};
+use super::file::{Corner, Edge, HandleSpec, LoadedSceneFile, PinSpec, SceneFile};
 use super::registry::{BUILTIN_SCENES, builtin_mesh, scenario};
 
 /// The default cloth: a 1 m × 1 m square of 24 × 24 quads (see `assets/README.md`).
@@ -207,13 +207,20 @@ impl Scene {
         let mut mesh = cloth.mesh.clone();
         let orientation = file.cloth.orientation;
         place(&mut mesh, orientation, Vec3::from(file.cloth.center));
-        let pins = pins(&file.pins, &mesh.positions, orientation)?;
+        let mut pins = pins(&file.pins, &mesh.positions, orientation)?;
+        let handles = handles(&file.handles, &mesh.positions, orientation, &pins)?;
+        // Handled particles are pinned: the cloth does not move them, their handle does (and
+        // the Pins switch frees them as it frees pins).
+        pins.extend(handles.iter().flat_map(|h| h.particles.iter().copied()));
+        pins.sort_unstable();
+        pins.dedup();
         let params = file.params();
         let mut model = ClothModel::new(&mesh, params.material.density, &pins);
         if file.material.masses != model.masses {
             model.set_mass_distribution(file.material.masses);
         }
-        let effects = file.effects();
+        let mut effects = file.effects();
+        effects.extend(handles.into_iter().map(Effect::Handle));
         thickness_fits(&effects, &model).map_err(|error| SceneError::Thickness {
             cloth: cloth_name.to_string(),
             error,
@@ -285,6 +292,42 @@ fn depth(p: Vec3, lo: Vec3, hi: Vec3, orientation: GridOrientation) -> f32 {
         GridOrientation::Vertical => hi.y - p.y,
         GridOrientation::Horizontal => p.z - lo.z,
     }
+}
+
+/// The handles `specs` make of the cloth at `pos`: each one's particles, their places, its
+/// pivot (by default their centre) and its motion (checked when the file was read).
+fn handles(
+    specs: &[HandleSpec],
+    pos: &[Vec3],
+    orientation: GridOrientation,
+    pinned: &[u32],
+) -> Result<Vec<Handle>, SceneError> {
+    let mut out = Vec::with_capacity(specs.len());
+    for (i, spec) in specs.iter().enumerate() {
+        let particles = pins(&spec.selection(), pos, orientation)?;
+        if particles.is_empty() {
+            return Err(PinError::EmptyHandle { handle: i + 1 }.into());
+        }
+        if let Some(&particle) = particles.iter().find(|p| pinned.contains(p)) {
+            return Err(PinError::PinnedAndHandled {
+                handle: i + 1,
+                particle,
+            }
+            .into());
+        }
+        let rest: Vec<Vec3> = particles.iter().map(|&p| pos[p as usize]).collect();
+        let centre = rest.iter().sum::<Vec3>() / rest.len() as f32;
+        let motion = RigidMotion::new(&spec.keyframes).map_err(|e| {
+            SceneError::Params(ParamError::new("keyframes", e.index, e.to_string()))
+        })?;
+        out.push(Handle {
+            particles,
+            rest,
+            pivot: spec.pivot.map_or(centre, Vec3::from),
+            motion,
+        });
+    }
+    Ok(out)
 }
 
 /// The particles the pin rules select, sorted and unique.

@@ -230,8 +230,24 @@ impl Simulation {
     /// The current setup as a scene file: the scene's cloth and placement with the
     /// parameters, effects and pins in force now.
     pub fn scene_file(&self) -> SceneFile {
-        let pins = (self.model.pins != self.scenario_pins).then_some(self.model.pins.as_slice());
-        self.file.with_setup(&self.params, &self.effects, pins)
+        // Handled particles are pinned while their handle moves them; the file keeps them
+        // in its `[[handles]]`, not in `[pins]`.
+        let handled: Vec<u32> = (self.effects.iter())
+            .filter_map(|e| match e {
+                Effect::Handle(h) => Some(h.particles.iter().copied()),
+                _ => None,
+            })
+            .flatten()
+            .collect();
+        let pins: Vec<u32> = (self.model.pins.iter().copied())
+            .filter(|p| !handled.contains(p))
+            .collect();
+        let changed = self.model.pins != self.scenario_pins;
+        self.file.with_setup(
+            &self.params,
+            &self.effects,
+            changed.then_some(pins.as_slice()),
+        )
     }
 
     /// The cloth as it is now, as OBJ text: current positions, the triangles, the UVs.
@@ -415,6 +431,13 @@ impl Simulation {
         self.model.set_pins(&pins);
         for p in newly_pinned {
             self.state.vel[p as usize] = glam::Vec3::ZERO;
+        }
+        // A handle takes back what is pinned again at once, so that the next frame starts
+        // from where its motion has them (the guard then counts the stretch as given).
+        for effect in &self.effects {
+            if let Effect::Handle(handle) = effect {
+                handle.place(&self.model.inv_mass, &mut self.state);
+            }
         }
         self.backend.invalidate();
     }

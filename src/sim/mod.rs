@@ -28,7 +28,7 @@ pub use cpu_stepper::CpuStepper;
 pub use diagnosis::{Cause, Vibration, stiffest_vibration};
 pub use effects::{
     AirDamping, BendingModel, ClothBox, ClothSprings, DEFAULT_DIHEDRAL_STIFFNESS, Effect, Gravity,
-    Obstacle, ObstacleError, Plane, SelfCollision, Sphere, TooThick, Wind, air_damping_of,
+    Handle, Obstacle, ObstacleError, Plane, SelfCollision, Sphere, TooThick, Wind, air_damping_of,
     gravity_of, min_surface_distance, shortest_edge, small_sphere_warnings, thickness_fits,
 };
 pub use forces::{Force, ForceSet, ForceTerm, JacobianMode, SystemMatrix};

@@ -165,6 +165,16 @@ fn effect_controls(
         Effect::Sphere(sphere) => e |= sphere_controls(ui, sphere),
         Effect::Plane(plane) => e |= plane_controls(ui, plane),
         Effect::Obstacle(obstacle) => e |= obstacle_controls(ui, obstacle),
+        Effect::Handle(handle) => {
+            let until = handle.motion.end();
+            ui.label(
+                RichText::new(format!(
+                    "{} particles, moving until {until} s (Pins frees them)",
+                    handle.particles.len()
+                ))
+                .weak(),
+            );
+        }
     }
     (p, e)
 }

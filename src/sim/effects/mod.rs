@@ -6,6 +6,7 @@ mod bending;
 mod cloth_springs;
 mod effect_kind;
 mod gravity;
+mod handle;
 mod list;
 mod obstacle;
 mod plane;
@@ -20,6 +21,7 @@ pub use bending::{BendingModel, DEFAULT_DIHEDRAL_STIFFNESS};
 pub use cloth_springs::ClothSprings;
 pub use effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 pub use gravity::Gravity;
+pub use handle::Handle;
 pub use list::{
     air_damping_of, gravity_of, min_surface_distance, small_sphere_warnings, thickness_fits,
 };

@@ -16,6 +16,7 @@ use super::bending::BendingModel;
 use super::cloth_springs::ClothSprings;
 use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 use super::gravity::Gravity;
+use super::handle::Handle;
 use super::obstacle::Obstacle;
 use super::plane::Plane;
 use super::self_collision::SelfCollision;
@@ -146,4 +147,7 @@ effects! {
     Sphere(Sphere),
     Plane(Plane),
     Obstacle(Obstacle),
+    /// Particles moved along keyframes: from a scene file's `[[handles]]`, not its effects.
+    #[serde(skip)]
+    Handle(Handle),
 }
