@@ -77,6 +77,15 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
         err.to_string().contains("wind") || err.to_string().contains("dihedral"),
         "{err}"
     );
+    for (scene, what) in [("tablecloth", "mesh obstacles"), ("twist", "handles")] {
+        let mut scene = Scene::builtin(scene).expect("scene");
+        // Without the twist's self-collision, which is refused first.
+        scene
+            .effects
+            .retain(|e| !matches!(e, Effect::SelfCollision(_)));
+        let err = gpu_support(&scene.params.step, &scene.effects).expect_err(what);
+        assert!(err.to_string().contains(what), "{err}");
+    }
     let mut rk4 = Scene::builtin("hanging").expect("scene");
     rk4.params.step.integrator = IntegratorKind::Rk4;
     let err = gpu_support(&rk4.params.step, &rk4.effects).expect_err("RK4 is CPU only");
