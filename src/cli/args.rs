@@ -50,6 +50,13 @@ pub enum Command {
         /// Write the cloth as it is at the end as an OBJ file.
         #[arg(long)]
         export_obj: Option<PathBuf>,
+        /// Write the cloth, and each obstacle as placed, every K frames (with --out-dir).
+        #[arg(long, requires = "out_dir")]
+        every: Option<u32>,
+        /// Directory for the frames as OBJ files (cloth_00000.obj, obstacle-1_00000.obj, …,
+        /// numbered as `render --every` numbers its PNGs); must exist.
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
     },
     /// Render the state after --seconds to a PNG, or every K frames to a numbered sequence.
     Render {

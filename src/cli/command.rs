@@ -30,7 +30,14 @@ pub fn run(cli: Cli) -> Result<()> {
             run,
             json,
             export_obj,
-        }) => simulate(&run, json, export_obj.as_deref()),
+            every,
+            out_dir,
+        }) => simulate(
+            &run,
+            json,
+            export_obj.as_deref(),
+            out_dir.as_deref().map(|dir| (dir, every.unwrap_or(1))),
+        ),
         Some(Command::Render {
             run,
             size,

@@ -1,18 +1,47 @@
 //! `clothsim simulate`: a scene run headless, summarised.
 
+use std::path::Path;
+
 use anyhow::{Result, bail};
+use clothsim::mesh::{PolygonSoup, write_obj};
+use clothsim::scene::Simulation;
+use clothsim::view;
 
 use super::args::RunArgs;
 use super::paths::check_directory;
 
 /// Runs the scene and prints its summary (JSON with `json`); writes the cloth's end shape
-/// to `export` if given.
-pub fn simulate(args: &RunArgs, json: bool, export: Option<&std::path::Path>) -> Result<()> {
+/// to `export` if given, and with `frames` = `(dir, k)` the cloth and each obstacle every
+/// k frames into `dir`.
+pub fn simulate(
+    args: &RunArgs,
+    json: bool,
+    export: Option<&Path>,
+    frames: Option<(&Path, u32)>,
+) -> Result<()> {
     if let Some(path) = export {
         check_directory(path)?;
     }
+    if let Some((dir, _)) = frames
+        && !dir.is_dir()
+    {
+        bail!("--out-dir {}: not an existing directory", dir.display());
+    }
     let mut sim = args.simulation()?;
-    let summary = sim.run(args.seconds);
+    let mut written = 0u64;
+    let summary = sim.run_observed(args.seconds, |sim, frame| match frames {
+        Some((dir, every)) if frame % every.max(1) as u64 == 0 => {
+            write_frame(sim, dir, written)?;
+            written += 1;
+            anyhow::Ok(())
+        }
+        _ => Ok(()),
+    })?;
+    if let Some((dir, _)) = frames
+        && !json
+    {
+        println!("wrote {written} frames as OBJ files to {}", dir.display());
+    }
     if let Some(path) = export {
         clothsim::output::write_bytes(path, sim.export_obj().as_bytes())?;
         if !json {
@@ -65,6 +94,29 @@ pub fn simulate(args: &RunArgs, json: bool, export: Option<&std::path::Path>) ->
     }
     if let Some(e) = summary.error {
         bail!(e);
+    }
+    Ok(())
+}
+
+/// Writes the cloth as it is now as `cloth_NNNNN.obj` and each mesh obstacle, where its
+/// motion has it now, as `obstacle-K_NNNNN.obj` (K from 1, in the scene's order).
+fn write_frame(sim: &Simulation, dir: &Path, number: u64) -> Result<()> {
+    let cloth = dir.join(format!("cloth_{number:05}.obj"));
+    clothsim::output::write_bytes(&cloth, sim.export_obj().as_bytes())?;
+    for (k, mesh) in view::meshes(sim.effects(), sim.state().time)
+        .iter()
+        .enumerate()
+    {
+        let soup = PolygonSoup {
+            positions: (mesh.vertices.iter())
+                .map(|&v| mesh.transform.transform_point3(v))
+                .collect(),
+            uvs: None,
+            face_indices: mesh.triangles.iter().flatten().copied().collect(),
+            face_arities: vec![3; mesh.triangles.len()],
+        };
+        let path = dir.join(format!("obstacle-{}_{number:05}.obj", k + 1));
+        clothsim::output::write_bytes(&path, write_obj(&soup).as_bytes())?;
     }
     Ok(())
 }

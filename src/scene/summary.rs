@@ -64,6 +64,20 @@ pub struct PhaseSummary {
 impl Simulation {
     /// Runs headless for `seconds` of simulated time (whole frames) and summarises.
     pub fn run(&mut self, seconds: f64) -> RunSummary {
+        let run = self.run_observed(seconds, |_, _| Ok::<(), std::convert::Infallible>(()));
+        run.unwrap_or_else(|never| match never {})
+    }
+
+    /// As [`Simulation::run`], calling `observe` with the simulation and the frame's number
+    /// before the first frame (0) and after each (its wall time counts in the run's).
+    ///
+    /// # Errors
+    /// The first error `observe` returns; the run stops there.
+    pub fn run_observed<E>(
+        &mut self,
+        seconds: f64,
+        mut observe: impl FnMut(&Simulation, u64) -> Result<(), E>,
+    ) -> Result<RunSummary, E> {
         let frames = (seconds / self.params().step.dt as f64).round().max(0.0) as u64;
         // Timings and counts gathered before the run are not the run's.
         self.take_timings();
@@ -72,9 +86,13 @@ impl Simulation {
         let mut refined = 0;
         let mut error = None;
         let mut events = Vec::new();
-        for _ in 0..frames {
+        observe(self, 0)?;
+        for frame in 1..=frames {
             let outcome = self.step_frame();
             events.extend(self.take_guard_events());
+            if outcome.is_ok() {
+                observe(self, frame)?;
+            }
             match outcome {
                 Ok(FrameOutcome::Stepped | FrameOutcome::Recovered { .. }) => {}
                 Ok(FrameOutcome::Refined { .. } | FrameOutcome::FellBack { .. }) => refined += 1,
@@ -101,7 +119,7 @@ impl Simulation {
         summary.refined_frames = refined;
         summary.guard_events = events;
         summary.error = error;
-        summary
+        Ok(summary)
     }
 
     /// The current state's summary; `wall_seconds` as given.
