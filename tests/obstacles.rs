@@ -470,3 +470,27 @@ obj = "top.obj"
     let below = pos.iter().filter(|p| p.y < lo.y - 0.05).count();
     assert!(below > 50, "{below} particles below the top");
 }
+
+/// A cloth placed through an obstacle at the start is warned about, naming the obstacle and
+/// what meets it; the tablecloth, above its table, is not.
+#[test]
+fn an_obstacle_that_meets_the_cloth_at_the_start_is_warned_about() {
+    let clear = Simulation::new(Scene::builtin("tablecloth").unwrap());
+    assert!(
+        !clear.warnings().iter().any(|w| w.contains("obstacle")),
+        "{:?}",
+        clear.warnings()
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let (v, t) = cuboid(Vec3::new(-0.3, 0.45, -0.3), Vec3::new(0.3, 0.5, 0.3));
+    write_obj(&dir.path().join("top.obj"), &v, &t);
+    let through = Simulation::new(scene(
+        dir.path(),
+        "name = \"through\"\n[cloth]\ngrid = { quads = 10, size = 1.0 }\ncenter = [0.0, 0.48, 0.0]\n\
+         [[effects]]\ntype = \"obstacle\"\nobj = \"top.obj\"\n",
+    ));
+    let warning = (through.warnings().iter())
+        .find(|w| w.contains("top.obj"))
+        .unwrap_or_else(|| panic!("{:?}", through.warnings()));
+    assert!(warning.contains("already meets the cloth"), "{warning}");
+}

@@ -6,7 +6,7 @@ use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{
     Cause, Changes, CpuStepper, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent,
     IntegratorKind, ParamError, PhaseTimings, SimParams, StepBackend, StepError, StepReport,
-    StepStats, small_sphere_warnings, thickness_fits,
+    StepStats, obstacle_overlap_warnings, small_sphere_warnings, thickness_fits,
 };
 
 use super::error::SceneError;
@@ -89,6 +89,13 @@ impl Simulation {
     fn assemble(scene: Scene, backend: Box<dyn StepBackend>) -> Self {
         let mut warnings = scene.warnings;
         warnings.extend(small_sphere_warnings(&scene.effects, &scene.model));
+        let offset = scene.params.contact.offset;
+        warnings.extend(obstacle_overlap_warnings(
+            &scene.effects,
+            &scene.model,
+            &scene.initial.pos,
+            offset,
+        ));
         Self {
             file: scene.file,
             scenario: scene.scenario,

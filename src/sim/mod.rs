@@ -29,7 +29,8 @@ pub use diagnosis::{Cause, Vibration, stiffest_vibration};
 pub use effects::{
     AirDamping, BendingModel, ClothBox, ClothSprings, DEFAULT_DIHEDRAL_STIFFNESS, Effect, Gravity,
     Handle, Obstacle, ObstacleError, Plane, SelfCollision, Sphere, TooThick, Wind, air_damping_of,
-    gravity_of, min_surface_distance, shortest_edge, small_sphere_warnings, thickness_fits,
+    gravity_of, min_surface_distance, obstacle_overlap_warnings, shortest_edge,
+    small_sphere_warnings, thickness_fits,
 };
 pub use forces::{Force, ForceSet, ForceTerm, JacobianMode, SystemMatrix};
 pub use guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check};

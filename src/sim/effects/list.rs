@@ -50,6 +50,45 @@ pub fn min_surface_distance(effects: &[Effect], pos: &[Vec3]) -> Option<f32> {
         .reduce(f32::min)
 }
 
+/// A warning for each mesh obstacle the cloth at `pos` already meets: particles within its
+/// thickness (`offset` unless it has its own) or cloth edges through it. The first substep
+/// then pushes those particles out, as far as the thickness, wherever they are.
+pub fn obstacle_overlap_warnings(
+    effects: &[Effect],
+    model: &ClothModel,
+    pos: &[Vec3],
+    offset: f32,
+) -> Vec<String> {
+    let obstacles = effects.iter().filter_map(|e| match e {
+        Effect::Obstacle(o) => o.placed().map(|p| (o, p)),
+        _ => None,
+    });
+    let mut out = Vec::new();
+    for (obstacle, placed) in obstacles {
+        let thickness = obstacle.thickness.unwrap_or(offset);
+        let surface = &placed.surface;
+        let near = (pos.iter())
+            .filter(|&&p| surface.nearest(p, thickness).is_some())
+            .count();
+        let (a, b) = (&model.springs.a, &model.springs.b);
+        let through = (a.iter().zip(b))
+            .filter(|(i, j)| {
+                let (p, q) = (pos[**i as usize], pos[**j as usize]);
+                surface.first_crossing(p, q).is_some()
+            })
+            .count();
+        if near + through > 0 {
+            out.push(format!(
+                "the obstacle {} already meets the cloth: {near} particles within its \
+                 thickness ({thickness} m) and {through} springs through it; the first step \
+                 pushes them out",
+                obstacle.obj.display()
+            ));
+        }
+    }
+    out
+}
+
 /// A warning for each sphere smaller than the cloth's particle spacing (its median spring
 /// rest length): collisions are per particle, so such a sphere can pass between particles
 /// and the cloth's triangles over it.

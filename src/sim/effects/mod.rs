@@ -23,7 +23,8 @@ pub use effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 pub use gravity::Gravity;
 pub use handle::Handle;
 pub use list::{
-    air_damping_of, gravity_of, min_surface_distance, small_sphere_warnings, thickness_fits,
+    air_damping_of, gravity_of, min_surface_distance, obstacle_overlap_warnings,
+    small_sphere_warnings, thickness_fits,
 };
 pub use obstacle::{Obstacle, ObstacleError, Placed, Shape};
 pub use plane::Plane;

@@ -79,6 +79,11 @@ impl Surface {
         self.tree.nearest(p, reach)
     }
 
+    /// The first triangle the segment from `a` to `b` crosses, and where along it.
+    pub fn first_crossing(&self, a: Vec3, b: Vec3) -> Option<(u32, f32)> {
+        self.tree.first_crossing(a, b)
+    }
+
     /// Where a particle moving from `from` to `to` ends, if its path crosses the surface or
     /// ends within `thickness` of it: caught at its first crossing, `thickness` off the
     /// surface on the side it came from, with the part of the rest of the move along the
