@@ -40,9 +40,11 @@ pub fn meshes(effects: &[Effect], time: f64) -> Vec<MeshShape<'_>> {
         .map(|placed| {
             let pose = placed.motion.at(time);
             let pivot = placed.pivot;
+            let (vertices, deforms) = placed.vertices_at(time);
             MeshShape {
                 id: std::ptr::from_ref(placed) as usize,
-                vertices: placed.surface.vertices(),
+                vertices,
+                deforms,
                 triangles: placed.surface.triangles(),
                 transform: Mat4::from_translation(pivot + pose.translation)
                     * Mat4::from_quat(pose.rotation)

@@ -77,7 +77,11 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
         err.to_string().contains("wind") || err.to_string().contains("dihedral"),
         "{err}"
     );
-    for (scene, what) in [("tablecloth", "mesh obstacles"), ("twist", "handles")] {
+    for (scene, what) in [
+        ("tablecloth", "mesh obstacles"),
+        ("twist", "handles"),
+        ("arm", "mesh obstacles"),
+    ] {
         let mut scene = Scene::builtin(scene).expect("scene");
         // Without the twist's self-collision, which is refused first.
         scene

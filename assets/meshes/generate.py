@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """Writes the obstacle meshes the built-in scenes use (metres, y up, outward-facing
-triangles): table.obj and turntable.obj. Run from this folder: python3 generate.py"""
+triangles): table.obj, turntable.obj and the arm's frames, arm/arm_0000.obj to
+arm/arm_0015.obj. Run from this folder: python3 generate.py"""
 
 import math
+import os
 
 
 def write(name, vertices, triangles, comment):
@@ -86,6 +88,54 @@ def turntable(radius=0.5, height=0.3, rings=8):
     return vertices, triangles
 
 
+def arm(angle, segments=12, radius=0.05, length=0.9, height=0.8, elbow_width=0.06):
+    """A closed tube along x, `length` long at `height`, its far half (the forearm) bent up
+    by `angle` radians about the elbow at x = 0; near the elbow the bend is shared out
+    smoothly, so the tube bends there rather than breaking. One frame of the sequence."""
+    vertices, triangles = [], []
+    step = 0.05
+    rings = round(length / step) + 1
+
+    def bend(x, y, z):
+        """A point of the straight tube, bent."""
+        s = min(max((x + elbow_width) / (2 * elbow_width), 0.0), 1.0)
+        a = angle * s * s * (3 - 2 * s)
+        dy = y - height
+        return (x * math.cos(a) - dy * math.sin(a), height + x * math.sin(a) + dy * math.cos(a), z)
+
+    for k in range(rings):
+        x = -length / 2 + k * step
+        for i in range(segments):
+            a = 2 * math.pi * i / segments
+            vertices.append(bend(x, height + radius * math.sin(a), radius * math.cos(a)))
+    for k in range(rings - 1):
+        for i in range(segments):
+            a, b = k * segments + i, k * segments + (i + 1) % segments
+            c, d = a + segments, b + segments
+            triangles += [(a, c, d), (a, d, b)]
+    for k, x, out in ((0, -length / 2, False), (rings - 1, length / 2, True)):
+        centre = len(vertices)
+        vertices.append(bend(x, height, 0.0))
+        for i in range(segments):
+            a, b = k * segments + i, k * segments + (i + 1) % segments
+            triangles.append((centre, b, a) if out else (centre, a, b))
+    return vertices, triangles
+
+
+def arm_frames(count=16, swing=math.radians(30.0)):
+    """One swing of the arm, `count` frames: the forearm bends up and down by `swing`
+    about the straight arm (frame k at angle swing * sin(2 pi k / count)); played at
+    8 frames a second and looped, the swing takes 2 s. The frames cover one cycle once,
+    so that frame 0 follows the last."""
+    os.makedirs("arm", exist_ok=True)
+    for k in range(count):
+        angle = swing * math.sin(2 * math.pi * k / count)
+        write(f"arm/arm_{k:04d}.obj", *arm(angle),
+              f"An arm bending at the elbow, frame {k} of {count}: "
+              f"{math.degrees(angle):.1f} degrees.")
+
+
 if __name__ == "__main__":
+    arm_frames()
     write("table.obj", *table(), "A table: a 1.2 m x 0.8 m top 75 cm up on four legs.")
     write("turntable.obj", *turntable(), "A turntable: a cylinder 1 m across, 30 cm high.")

@@ -29,12 +29,13 @@ pub enum Shape {
 }
 
 /// A triangle mesh to draw (an obstacle), flat-shaded in its own colour: `id` names it
-/// while its vertices and triangles stay the same (the renderer keeps its buffers from
-/// frame to frame), `transform` places it.
-#[derive(Clone, Copy, Debug)]
+/// while its triangles stay the same (the renderer keeps its buffers from frame to frame,
+/// and rewrites the vertices only when it `deforms`), `transform` places it.
+#[derive(Clone, Debug)]
 pub struct MeshShape<'a> {
     pub id: usize,
-    pub vertices: &'a [Vec3],
+    pub vertices: std::borrow::Cow<'a, [Vec3]>,
+    pub deforms: bool,
     pub triangles: &'a [[u32; 3]],
     pub transform: Mat4,
 }

@@ -68,7 +68,10 @@ impl StaticMesh {
             })
         };
         Self {
-            vertices: init(bytemuck::cast_slice(&v), wgpu::BufferUsages::VERTEX),
+            vertices: init(
+                bytemuck::cast_slice(&v),
+                wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            ),
             indices: init(bytemuck::cast_slice(&i), wgpu::BufferUsages::INDEX),
             count: i.len() as u32,
         }
@@ -77,7 +80,7 @@ impl StaticMesh {
 
 /// A flat-shaded mesh: each triangle's corners with its normal.
 fn flat_mesh(shape: &MeshShape<'_>) -> (Vec<SolidVertex>, Vec<u32>) {
-    let v = shape.vertices;
+    let v = &shape.vertices;
     let vertices: Vec<SolidVertex> = (shape.triangles.iter())
         .flat_map(|t| {
             let [a, b, c] = t.map(|i| v.get(i as usize).copied().unwrap_or(Vec3::ZERO));
@@ -506,7 +509,14 @@ impl Renderer {
             .retain(|(id, _)| frame.meshes.iter().any(|m| m.id == *id));
         for (k, shape) in frame.meshes.iter().enumerate() {
             let at = match self.meshes.iter().position(|(id, _)| *id == shape.id) {
-                Some(at) => at,
+                Some(at) => {
+                    if shape.deforms {
+                        let (vertices, _) = flat_mesh(shape);
+                        let bytes = bytemuck::cast_slice(&vertices);
+                        queue.write_buffer(&self.meshes[at].1.vertices, 0, bytes);
+                    }
+                    at
+                }
                 None => {
                     let mesh = StaticMesh::new(device, "clothsim obstacle", flat_mesh(shape));
                     self.meshes.push((shape.id, mesh));

@@ -265,6 +265,8 @@ impl Default for MaterialSpec {
 pub struct LoadedSceneFile {
     pub file: SceneFile,
     pub path: PathBuf,
+    /// The file's text, to point into.
+    pub text: String,
 }
 
 /// The path to a key of `[cloth] grid`.
@@ -340,7 +342,16 @@ impl SceneFile {
         Ok(LoadedSceneFile {
             file: Self::parse(&text, path)?,
             path: path.to_path_buf(),
+            text,
         })
+    }
+
+    /// Where in `text` (this file's) the key `key` of effect `effect` (from 0) is.
+    pub(super) fn effect_key_at(text: &str, effect: usize, key: &'static str) -> (usize, usize) {
+        locate(
+            text,
+            &[Step::Key("effects"), Step::At(effect), Step::Key(key)],
+        )
     }
 
     /// The file as TOML text.

@@ -31,11 +31,22 @@ pub static BUILTIN_SCENES: &[(&str, &str)] = &[
         include_str!("../../assets/scenes/carousel.toml"),
     ),
     ("twist", include_str!("../../assets/scenes/twist.toml")),
+    ("arm", include_str!("../../assets/scenes/arm.toml")),
     (
         "hanging-bench",
         include_str!("../../assets/scenes/hanging-bench.toml"),
     ),
 ];
+
+/// One frame of the arm's OBJ sequence, by its number, as a built-in mesh.
+macro_rules! arm_frame {
+    ($number:literal) => {
+        (
+            concat!("arm/arm_", $number, ".obj"),
+            include_str!(concat!("../../assets/meshes/arm/arm_", $number, ".obj")),
+        )
+    };
+}
 
 /// Name and text of every mesh the built-in scenes' obstacles use (`obj = "…"` in a built-in
 /// scene names one of these); written by `assets/meshes/generate.py`.
@@ -45,6 +56,22 @@ pub static BUILTIN_MESHES: &[(&str, &str)] = &[
         "turntable.obj",
         include_str!("../../assets/meshes/turntable.obj"),
     ),
+    arm_frame!("0000"),
+    arm_frame!("0001"),
+    arm_frame!("0002"),
+    arm_frame!("0003"),
+    arm_frame!("0004"),
+    arm_frame!("0005"),
+    arm_frame!("0006"),
+    arm_frame!("0007"),
+    arm_frame!("0008"),
+    arm_frame!("0009"),
+    arm_frame!("0010"),
+    arm_frame!("0011"),
+    arm_frame!("0012"),
+    arm_frame!("0013"),
+    arm_frame!("0014"),
+    arm_frame!("0015"),
 ];
 
 /// The text of a built-in mesh by its name.

@@ -9,7 +9,9 @@ use crate::cloth::{ClothModel, ClothState};
 use crate::mesh::{
     self, ClothMesh, GridOrientation, GridSpec, ImportOptions, MeshBuild, bounds, thinnest_axis,
 };
-use crate::sim::{Effect, Handle, ParamError, RigidMotion, SimParams, Sphere, thickness_fits};
+use crate::sim::{
+    Effect, Handle, ObstacleError, ParamError, RigidMotion, SimParams, Sphere, thickness_fits,
+};
 
 use super::error::{PinError, SceneError};
 use super::file::{Corner, Edge, HandleSpec, LoadedSceneFile, PinSpec, SceneFile};
@@ -42,16 +44,48 @@ pub struct Scene {
 
 /// Reads the mesh of every obstacle `file` lists (`base`: where relative paths start; a
 /// built-in scene, without one, finds its meshes among the built-in ones).
-fn load_obstacles(file: &mut SceneFile, base: Option<&Path>) -> Result<(), SceneError> {
-    for effect in &mut file.effects {
-        if let Effect::Obstacle(obstacle) = effect {
-            match (base, builtin_mesh(&obstacle.obj)) {
-                (None, Some(text)) => obstacle.load_text(text)?,
-                _ => obstacle.load(base)?,
+fn load_obstacles(
+    file: &mut SceneFile,
+    base: Option<&Path>,
+) -> Result<(), (usize, &'static str, ObstacleError)> {
+    for (k, effect) in file.effects.iter_mut().enumerate() {
+        if let Effect::Obstacle(obstacle) = effect
+            && !obstacle.is_loaded()
+        {
+            let key = if obstacle.frames.is_some() {
+                "frames"
+            } else {
+                "obj"
+            };
+            let located = |e| (k, key, e);
+            // A built-in scene's meshes are the program's own.
+            match base {
+                None => obstacle.load_with(None, &builtin_mesh).map_err(located)?,
+                Some(_) => obstacle.load(base).map_err(located)?,
             }
         }
     }
     Ok(())
+}
+
+/// The file of `loaded` with its obstacles read; one that cannot be is pointed at in the
+/// scene file, by the key that names its mesh (or the setting refused).
+fn with_obstacles(loaded: &LoadedSceneFile) -> Result<SceneFile, SceneError> {
+    let mut file = loaded.file.clone();
+    load_obstacles(&mut file, loaded.path.parent()).map_err(|(k, key, error)| {
+        let key = match &error {
+            ObstacleError::Setting { error, .. } => error.name,
+            ObstacleError::Obj(_) => key,
+        };
+        let (line, column) = SceneFile::effect_key_at(&loaded.text, k, key);
+        SceneError::File {
+            path: loaded.path.clone(),
+            line,
+            column,
+            message: format!("obstacle: {error}"),
+        }
+    })?;
+    Ok(file)
 }
 
 impl Scene {
@@ -88,7 +122,7 @@ impl Scene {
         let (file, base) = if what.ends_with(".toml") {
             let loaded = SceneFile::load(Path::new(what))?;
             let base = loaded.path.parent().map(Path::to_path_buf);
-            (loaded.file, base)
+            (with_obstacles(&loaded)?, base)
         } else {
             (lookup(what)?.clone(), None)
         };
@@ -96,7 +130,7 @@ impl Scene {
             Some(path) => {
                 let cloth = mesh::load_obj_with(path, options)?;
                 let mut file = file;
-                load_obstacles(&mut file, base.as_deref())?;
+                load_obstacles(&mut file, base.as_deref()).map_err(|(_, _, e)| e)?;
                 file.cloth.grid = None;
                 file.cloth.obj = Some(path.to_path_buf());
                 Self::with_mesh(file, &cloth, &path.display().to_string())
@@ -110,7 +144,7 @@ impl Scene {
     /// # Errors
     /// The cloth's [`mesh::ObjError`], or [`SceneError::Pins`].
     pub fn from_loaded(loaded: &LoadedSceneFile) -> Result<Scene, SceneError> {
-        Self::from_file(loaded.file.clone(), loaded.path.parent())
+        Self::from_file(with_obstacles(loaded)?, loaded.path.parent())
     }
 
     /// A scene from a parsed file; `base` is where relative paths start.
@@ -118,7 +152,7 @@ impl Scene {
     /// # Errors
     /// The cloth's [`mesh::ObjError`], or [`SceneError::Pins`].
     pub fn from_file(mut file: SceneFile, base: Option<&Path>) -> Result<Scene, SceneError> {
-        load_obstacles(&mut file, base)?;
+        load_obstacles(&mut file, base).map_err(|(_, _, e)| e)?;
         let (cloth, name) = match (&file.cloth.obj, &file.cloth.grid) {
             (Some(obj), _) => {
                 let path = base.map_or_else(|| obj.clone(), |b| b.join(obj));

@@ -328,7 +328,7 @@ impl Simulation {
             {
                 return Err(SceneError::Effect {
                     effect: effect.phase(),
-                    error: ParamError::new("obj", o.obj.display(), "was not read: load it first"),
+                    error: ParamError::new("obj", o.source(), "was not read: load it first"),
                 });
             }
         }

@@ -181,13 +181,7 @@ fn effect_controls(
 
 fn obstacle_controls(ui: &mut egui::Ui, obstacle: &mut Obstacle) -> bool {
     let triangles = obstacle.placed().map_or(0, |p| p.surface.triangles().len());
-    ui.label(
-        RichText::new(format!(
-            "{} ({triangles} triangles)",
-            obstacle.obj.display()
-        ))
-        .weak(),
-    );
+    ui.label(RichText::new(format!("{} ({triangles} triangles)", obstacle.source())).weak());
     let mut changed = ui
         .add(Slider::new(&mut obstacle.friction, 0.0..=2.0).text("friction μ"))
         .changed();

@@ -82,7 +82,7 @@ pub fn obstacle_overlap_warnings(
                 "the obstacle {} already meets the cloth: {near} particles within its \
                  thickness ({thickness} m) and {through} springs through it; the first step \
                  pushes them out",
-                obstacle.obj.display()
+                obstacle.source()
             ));
         }
     }

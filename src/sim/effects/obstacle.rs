@@ -1,6 +1,7 @@
 //! An obstacle of any shape: a triangle mesh from an OBJ file, placed (scale, then rotate,
-//! then translate, about the OBJ's own origin) and optionally moved through keyframes. The
-//! cloth may not pass it; the cloth does not push it.
+//! then translate, about the OBJ's own origin) and optionally moved through keyframes; or
+//! an animated mesh, one OBJ per frame, placed the same way. The cloth may not pass it;
+//! the cloth does not push it.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -11,7 +12,7 @@ use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 use super::solid::{Solid, default_friction, resolve};
 use crate::mesh::{ObjError, PolygonSoup, parse_obj, read_obj};
 use crate::sim::motion::{AxisAngle, Keyframe, Pose, RigidMotion};
-use crate::sim::obstacle::Surface;
+use crate::sim::obstacle::{Moment, Sequence, SharpEdges, Surface};
 use crate::sim::param_error::ParamError;
 use crate::sim::self_contacts::ContactError;
 
@@ -19,8 +20,22 @@ use crate::sim::self_contacts::ContactError;
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Obstacle {
-    /// The OBJ file (relative to the scene file); metres.
+    /// The OBJ file (relative to the scene file); metres. Empty when `frames` gives the
+    /// mesh.
+    #[serde(default, skip_serializing_if = "is_empty_path")]
     pub obj: PathBuf,
+    /// An animated mesh instead of `obj`: one OBJ per frame (relative to the scene file),
+    /// `%d` or `%04d` standing for the frame's number from 0; as many frames as are found,
+    /// all with frame 0's triangles.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frames: Option<String>,
+    /// Frames a second of `frames` (default 30).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fps: Option<f32>,
+    /// After the last of `frames`, on to frame 0 (over one frame's time) and round again;
+    /// otherwise the last frame holds.
+    #[serde(default, rename = "loop", skip_serializing_if = "std::ops::Not::not")]
+    pub looped: bool,
     /// Uniform scale, first (default 1).
     #[serde(default = "unit_scale")]
     pub scale: f32,
@@ -50,6 +65,38 @@ fn unit_scale() -> f32 {
     1.0
 }
 
+fn is_empty_path(path: &Path) -> bool {
+    path.as_os_str().is_empty()
+}
+
+/// Frames a second of an OBJ sequence that gives none.
+pub const DEFAULT_FPS: f32 = 30.0;
+
+/// The most frames an OBJ sequence may have.
+const MAX_FRAMES: usize = 100_000;
+
+/// The file of frame `k` of a sequence named by `pattern` (`%d`, or `%0Nd` for N digits),
+/// or `None` when the pattern has no such place.
+pub fn frame_path(pattern: &str, k: usize) -> Option<String> {
+    let at = pattern.find('%')?;
+    let rest = &pattern[at + 1..];
+    let digits = rest.find('d')?;
+    let width = &rest[..digits];
+    if !width.chars().all(|c| c.is_ascii_digit()) || (width.len() > 1 && !width.starts_with('0')) {
+        return None;
+    }
+    let width: usize = if width.is_empty() {
+        0
+    } else {
+        width.parse().ok()?
+    };
+    Some(format!(
+        "{}{k:0width$}{}",
+        &pattern[..at],
+        &rest[digits + 1..]
+    ))
+}
+
 /// An obstacle's mesh once read: its surface as placed (in the obstacle's own frame, which
 /// its motion then moves) and its motion.
 #[derive(Clone, Debug, Default)]
@@ -66,12 +113,25 @@ impl PartialEq for Shape {
     }
 }
 
-/// The placed surface and its motion about `pivot`.
+/// The placed surface and its motion about `pivot`; for an OBJ sequence, the surface is
+/// frame 0 and `sequence` the frames (its motion then is none).
 #[derive(Debug)]
 pub struct Placed {
     pub surface: Surface,
     pub motion: RigidMotion,
     pub pivot: Vec3,
+    pub sequence: Option<Sequence>,
+}
+
+impl Placed {
+    /// Its vertices at simulated time `time`, in the obstacle's frame (for a sequence, in
+    /// the world), and whether they change from frame to frame.
+    pub fn vertices_at(&self, time: f64) -> (std::borrow::Cow<'_, [Vec3]>, bool) {
+        match &self.sequence {
+            Some(seq) => (seq.vertices_at(time).into(), true),
+            None => (self.surface.vertices().into(), false),
+        }
+    }
 }
 
 /// An obstacle whose mesh could not be read or placed.
@@ -94,7 +154,28 @@ impl Obstacle {
             friction: default_friction(),
             thickness: None,
             keyframes: Vec::new(),
+            frames: None,
+            fps: None,
+            looped: false,
             shape: Shape::default(),
+        }
+    }
+
+    /// An obstacle of the OBJ sequence `pattern` (see [`Obstacle::frames`]) at `fps`.
+    pub fn sequence(pattern: impl Into<String>, fps: f32, looped: bool) -> Self {
+        Self {
+            frames: Some(pattern.into()),
+            fps: Some(fps),
+            looped,
+            ..Self::new(PathBuf::new())
+        }
+    }
+
+    /// What it is read from: its OBJ, or its sequence's pattern.
+    pub fn source(&self) -> String {
+        match &self.frames {
+            Some(pattern) => pattern.clone(),
+            None => self.obj.display().to_string(),
         }
     }
 
@@ -108,55 +189,134 @@ impl Obstacle {
         self.shape.0.as_deref()
     }
 
-    /// Reads its OBJ (`base` is where a relative path starts) and places it.
+    /// Reads its OBJ, or every frame of its sequence (`base` is where a relative path
+    /// starts), and places it.
     ///
     /// # Errors
     /// The OBJ's [`ObjError`] (naming its file and line), or [`ObstacleError::Setting`] for a
-    /// placement or motion that [`EffectKind::check`] refuses.
+    /// placement or motion that [`EffectKind::check`] refuses, a sequence with no frame 0
+    /// or whose frames differ in their triangles.
     pub fn load(&mut self, base: Option<&Path>) -> Result<(), ObstacleError> {
-        let path = base.map_or_else(|| self.obj.clone(), |b| b.join(&self.obj));
-        self.check().map_err(|error| ObstacleError::Setting {
-            path: path.clone(),
-            error,
-        })?;
-        self.place(&read_obj(&path)?, &path)
+        self.load_with(base, &|_| None)
     }
 
-    /// As [`Obstacle::load`], from the text of its OBJ (a built-in mesh).
+    /// As [`Obstacle::load`], taking the text of a file from `builtin` where it has it
+    /// (the program's own meshes, by the name a built-in scene gives them).
     ///
     /// # Errors
     /// As [`Obstacle::load`].
-    pub fn load_text(&mut self, text: &str) -> Result<(), ObstacleError> {
-        let path = self.obj.clone();
-        self.check().map_err(|error| ObstacleError::Setting {
-            path: path.clone(),
+    pub fn load_with(
+        &mut self,
+        base: Option<&Path>,
+        builtin: &dyn Fn(&Path) -> Option<&'static str>,
+    ) -> Result<(), ObstacleError> {
+        let at = |name: &Path| base.map_or_else(|| name.to_path_buf(), |b| b.join(name));
+        let read = |name: &Path| -> Option<Result<PolygonSoup, ObjError>> {
+            if let Some(text) = builtin(name) {
+                return Some(parse_obj(text, name));
+            }
+            let path = at(name);
+            path.is_file().then(|| read_obj(&path))
+        };
+        let first = at(Path::new(&self.source()));
+        let setting = |path: &Path, error| ObstacleError::Setting {
+            path: path.to_path_buf(),
             error,
-        })?;
-        self.place(&parse_obj(text, &path)?, &path)
+        };
+        self.check().map_err(|e| setting(&first, e))?;
+        let Some(pattern) = self.frames.clone() else {
+            let soup = match read(&self.obj) {
+                Some(soup) => soup?,
+                None => read_obj(&first)?,
+            };
+            return self.place(&soup, &first, Vec::new());
+        };
+        let mut frames = Vec::new();
+        for k in 0..MAX_FRAMES {
+            let Some(name) = frame_path(&pattern, k) else {
+                break;
+            };
+            let Some(soup) = read(Path::new(&name)) else {
+                break;
+            };
+            let soup = soup?.triangulated();
+            if let Some(first) = frames.first() {
+                let (first, path): &(PolygonSoup, PathBuf) = first;
+                if soup.face_indices != first.face_indices
+                    || soup.positions.len() != first.positions.len()
+                {
+                    let error = ParamError::new(
+                        "frames",
+                        &pattern,
+                        format!(
+                            "frame {k} ({}) has other triangles than frame 0 ({}): every frame \
+                             needs the same",
+                            at(Path::new(&name)).display(),
+                            path.display()
+                        ),
+                    );
+                    return Err(setting(path, error));
+                }
+            }
+            frames.push((soup, at(Path::new(&name))));
+        }
+        let Some((soup, path)) = frames.first() else {
+            let name = frame_path(&pattern, 0).unwrap_or_default();
+            let error = ParamError::new(
+                "frames",
+                &pattern,
+                format!(
+                    "has no frame 0 ({} not found)",
+                    at(Path::new(&name)).display()
+                ),
+            );
+            return Err(setting(&first, error));
+        };
+        let rest = frames
+            .iter()
+            .map(|(f, _)| self.placed_positions(f))
+            .collect();
+        self.place(&soup.clone(), &path.clone(), rest)
     }
 
-    /// Places `soup` (read from `path`) as the obstacle says.
-    fn place(&mut self, soup: &PolygonSoup, path: &Path) -> Result<(), ObstacleError> {
+    /// Places `soup` (read from `path`) as the obstacle says; `frames`, when not empty, are
+    /// every frame of a sequence, placed.
+    fn place(
+        &mut self,
+        soup: &PolygonSoup,
+        path: &Path,
+        frames: Vec<Vec<Vec3>>,
+    ) -> Result<(), ObstacleError> {
         let setting = |error| ObstacleError::Setting {
             path: path.to_path_buf(),
             error,
         };
         let soup = soup.triangulated();
-        let rotation = self.rotation();
-        let vertices = (soup.positions.iter())
-            .map(|&p| rotation * (p * self.scale) + self.translate)
-            .collect();
+        let vertices = self.placed_positions(&soup);
         let triangles = (soup.face_indices.chunks_exact(3))
             .map(|t| [t[0], t[1], t[2]])
             .collect();
         let motion = RigidMotion::new(&self.keyframes)
             .map_err(|e| setting(ParamError::new("keyframes", e.index, e.to_string())))?;
+        let surface = Surface::new(vertices, triangles);
+        let fps = f64::from(self.fps.unwrap_or(DEFAULT_FPS));
+        let sequence =
+            (!frames.is_empty()).then(|| Sequence::new(surface.clone(), frames, fps, self.looped));
         self.shape = Shape(Some(Arc::new(Placed {
-            surface: Surface::new(vertices, triangles),
+            surface,
             motion,
             pivot: self.translate,
+            sequence,
         })));
         Ok(())
+    }
+
+    /// The positions of `soup` placed: scaled, rotated, translated.
+    fn placed_positions(&self, soup: &PolygonSoup) -> Vec<Vec3> {
+        let rotation = self.rotation();
+        (soup.positions.iter())
+            .map(|&p| rotation * (p * self.scale) + self.translate)
+            .collect()
     }
 
     /// The placement's rotation.
@@ -175,68 +335,156 @@ struct Posed<'a> {
     friction: f32,
 }
 
+/// How a frame of sharp edges lies in the world: `to_local` takes a world point into it,
+/// `to_world` turns a direction of it into the world's, `velocity` is the surface's
+/// velocity (world) at one of its points.
+struct EdgeFrame<L, W, V> {
+    to_local: L,
+    to_world: W,
+    velocity: V,
+}
+
+/// Keeps every cloth edge (its structural and shear springs) `pass.offset` from the sharp
+/// `edges` where it ends the substep: the two particles are moved apart from the edge in
+/// proportion to how near each is to the nearest point, which moves by exactly what was
+/// missing; their velocity towards the edge is removed, with Coulomb friction `mu` along it.
+/// Returns how many cloth edges it moved.
+fn push_edges<L, W, V>(
+    edges: &SharpEdges,
+    frame: &EdgeFrame<L, W, V>,
+    mu: f32,
+    pass: &mut ContactPass<'_>,
+) -> usize
+where
+    L: Fn(Vec3) -> Vec3,
+    W: Fn(Vec3) -> Vec3,
+    V: Fn(Vec3) -> Vec3,
+{
+    if edges.is_empty() {
+        return 0;
+    }
+    let thickness = pass.offset;
+    let (springs, inv_mass) = (&pass.model.springs, &pass.model.inv_mass);
+    let state = &mut *pass.state;
+    let mut moved = 0;
+    for e in 0..pass.model.bend_start() {
+        let (i, j) = (springs.a[e] as usize, springs.b[e] as usize);
+        let free = [inv_mass[i] > 0.0, inv_mass[j] > 0.0].map(f32::from);
+        if free == [0.0, 0.0] {
+            continue;
+        }
+        let local = [state.pos[i], state.pos[j]].map(&frame.to_local);
+        let Some(hit) = edges.nearest(local[0], local[1], thickness) else {
+            continue;
+        };
+        let away = hit.on_segment - hit.on_edge;
+        if hit.distance <= thickness * 1e-3 || hit.distance >= thickness {
+            continue;
+        }
+        let n = (frame.to_world)(away / hit.distance);
+        let share = [1.0 - hit.along, hit.along];
+        let weight = share[0] * share[0] * free[0] + share[1] * share[1] * free[1];
+        if weight <= 0.0 {
+            continue;
+        }
+        let lift = (thickness - hit.distance) / weight;
+        let v_surface = (frame.velocity)(hit.on_edge);
+        for (k, p) in [i, j].into_iter().enumerate() {
+            let part = share[k] * free[k];
+            if part <= 0.0 {
+                continue;
+            }
+            state.pos[p] += n * (lift * part);
+            let v_rel = state.vel[p] - v_surface;
+            let vn = v_rel.dot(n);
+            if vn < 0.0 {
+                let v_t = v_rel - vn * n;
+                let speed = v_t.length();
+                let keep = if speed > 0.0 {
+                    (1.0 - mu * part * (-vn) / speed).max(0.0)
+                } else {
+                    0.0
+                };
+                state.vel[p] = v_surface + (1.0 - part) * vn * n + keep * v_t;
+            }
+        }
+        moved += 1;
+    }
+    moved
+}
+
 impl Posed<'_> {
-    /// Keeps every cloth edge (its structural and shear springs) the thickness from the
-    /// obstacle's sharp edges where it ends the substep: the two particles are moved apart
-    /// from the edge in proportion to how near each is to the nearest point, which moves by
-    /// exactly what was missing; their velocity towards the edge is removed, with Coulomb
-    /// friction along it. Returns how many cloth edges it moved.
+    /// [`push_edges`] against the obstacle's sharp edges where the substep ends.
     fn push_edges(&self, pass: &mut ContactPass<'_>) -> usize {
-        let edges = self.placed.surface.sharp_edges();
-        if edges.is_empty() {
-            return 0;
+        let (pivot, end) = (self.placed.pivot, self.end);
+        let frame = EdgeFrame {
+            to_local: |p| end.unapply(pivot, p),
+            to_world: |n| end.rotation * n,
+            velocity: |q| end.velocity_at(pivot, end.apply(pivot, q)),
+        };
+        push_edges(
+            self.placed.surface.sharp_edges(),
+            &frame,
+            self.friction,
+            pass,
+        )
+    }
+}
+
+/// A deforming obstacle (an OBJ sequence) over one substep: its surface where the substep
+/// ends, with each vertex's move over it.
+struct Deforming<'a> {
+    moment: &'a Moment,
+    friction: f32,
+}
+
+impl Deforming<'_> {
+    /// [`push_edges`] against its sharp edges where the substep ends.
+    fn push_edges(&self, pass: &mut ContactPass<'_>) -> usize {
+        let reach = pass.offset;
+        let frame = EdgeFrame {
+            to_local: |p| p,
+            to_world: |n| n,
+            velocity: |q| self.moment.velocity_near(q, reach),
+        };
+        let edges = self.moment.surface.sharp_edges();
+        push_edges(edges, &frame, self.friction, pass)
+    }
+}
+
+impl Solid for Deforming<'_> {
+    fn surface_at(&self, p: Vec3) -> (f32, Vec3, Vec3) {
+        match self.moment.surface.nearest(p, f32::INFINITY) {
+            Some(near) => {
+                let away = (p - near.point).normalize_or(Vec3::Y);
+                let velocity = self.moment.at(&near, &self.moment.velocity);
+                (near.distance, away, velocity)
+            }
+            None => (f32::INFINITY, Vec3::Y, Vec3::ZERO),
         }
-        let (pivot, thickness, mu) = (self.placed.pivot, pass.offset, self.friction);
-        let (springs, inv_mass) = (&pass.model.springs, &pass.model.inv_mass);
-        let state = &mut *pass.state;
-        let mut moved = 0;
-        for e in 0..pass.model.bend_start() {
-            let (i, j) = (springs.a[e] as usize, springs.b[e] as usize);
-            let free = [inv_mass[i] > 0.0, inv_mass[j] > 0.0].map(f32::from);
-            if free == [0.0, 0.0] {
-                continue;
-            }
-            let (a, b) = (state.pos[i], state.pos[j]);
-            let local = [a, b].map(|p| self.end.unapply(pivot, p));
-            let Some(hit) = edges.nearest(local[0], local[1], thickness) else {
-                continue;
-            };
-            let away = hit.on_segment - hit.on_edge;
-            if hit.distance <= thickness * 1e-3 || hit.distance >= thickness {
-                continue;
-            }
-            let n = self.end.rotation * (away / hit.distance);
-            let share = [1.0 - hit.along, hit.along];
-            let weight = share[0] * share[0] * free[0] + share[1] * share[1] * free[1];
-            if weight <= 0.0 {
-                continue;
-            }
-            let lift = (thickness - hit.distance) / weight;
-            let v_surface = self
-                .end
-                .velocity_at(pivot, self.end.apply(pivot, hit.on_edge));
-            for (k, p) in [i, j].into_iter().enumerate() {
-                let part = share[k] * free[k];
-                if part <= 0.0 {
-                    continue;
-                }
-                state.pos[p] += n * (lift * part);
-                let v_rel = state.vel[p] - v_surface;
-                let vn = v_rel.dot(n);
-                if vn < 0.0 {
-                    let v_t = v_rel - vn * n;
-                    let speed = v_t.length();
-                    let keep = if speed > 0.0 {
-                        (1.0 - mu * part * (-vn) / speed).max(0.0)
-                    } else {
-                        0.0
-                    };
-                    state.vel[p] = v_surface + (1.0 - part) * vn * n + keep * v_t;
-                }
-            }
-            moved += 1;
-        }
-        moved
+    }
+
+    fn catch(&self, from: Vec3, to: Vec3, offset: f32) -> Option<Vec3> {
+        self.contact(from, to, offset).map(|(at, _, _)| at)
+    }
+
+    /// The move seen from the surface: a start near it is carried by the surface's own
+    /// move over the substep (so a particle resting on it stays on its side however the
+    /// surface moves), then caught against the surface where the substep ends.
+    fn contact(&self, from: Vec3, to: Vec3, offset: f32) -> Option<(Vec3, Vec3, Vec3)> {
+        let m = self.moment;
+        let reach = 2.0 * (offset + m.largest_shift);
+        let start = match m.surface.nearest(from, reach) {
+            Some(near) if m.largest_shift > 0.0 => from + m.at(&near, &m.shift),
+            _ => from,
+        };
+        let caught = m.surface.catch(start, to, offset)?;
+        let velocity = m.velocity_near(caught.at, 2.0 * offset.max(1e-6));
+        Some((caught.at, caught.normal, velocity))
+    }
+
+    fn friction(&self) -> f32 {
+        self.friction
     }
 }
 
@@ -281,6 +529,44 @@ impl EffectKind for Obstacle {
     const ADDABLE: bool = false;
 
     fn check(&self) -> Result<(), ParamError> {
+        match &self.frames {
+            None => ParamError::require(
+                !is_empty_path(&self.obj),
+                "obj",
+                "\"\"",
+                "needs an OBJ file (or frames, an OBJ sequence)",
+            )?,
+            Some(pattern) => {
+                ParamError::require(
+                    is_empty_path(&self.obj),
+                    "frames",
+                    pattern,
+                    "give either obj or frames, not both",
+                )?;
+                ParamError::require(
+                    self.keyframes.is_empty(),
+                    "frames",
+                    pattern,
+                    "give either keyframes or frames, not both",
+                )?;
+                ParamError::require(
+                    frame_path(pattern, 0).is_some(),
+                    "frames",
+                    pattern,
+                    "needs %d (or %04d, for four digits) where the frame number goes",
+                )?;
+            }
+        }
+        if let Some(fps) = self.fps {
+            ParamError::require(fps.is_finite() && fps > 0.0, "fps", fps, "must be > 0")?;
+            ParamError::require(self.frames.is_some(), "fps", fps, "is for frames only")?;
+        }
+        ParamError::require(
+            !self.looped || self.frames.is_some(),
+            "loop",
+            self.looped,
+            "is for frames only",
+        )?;
         ParamError::require(
             self.scale.is_finite() && self.scale > 0.0,
             "scale",
@@ -324,16 +610,26 @@ impl EffectKind for Obstacle {
             return Ok(0);
         };
         let end = pass.state.time;
+        let offset = pass.offset;
+        if let Some(thickness) = self.thickness {
+            pass.offset = thickness;
+        }
+        if let Some(sequence) = &placed.sequence {
+            let moment = sequence.moment(end - pass.substep as f64, end);
+            let deforming = Deforming {
+                moment: &moment,
+                friction: self.friction,
+            };
+            let moved = resolve(&deforming, pass) + deforming.push_edges(pass);
+            pass.offset = offset;
+            return Ok(moved);
+        }
         let posed = Posed {
             placed,
             start: placed.motion.at(end - pass.substep as f64),
             end: placed.motion.at(end),
             friction: self.friction,
         };
-        let offset = pass.offset;
-        if let Some(thickness) = self.thickness {
-            pass.offset = thickness;
-        }
         let moved = resolve(&posed, pass) + posed.push_edges(pass);
         pass.offset = offset;
         Ok(moved)
@@ -354,6 +650,13 @@ impl EffectKind for Obstacle {
         let Some(placed) = self.placed() else {
             return GuardShare::default();
         };
+        if let Some(sequence) = &placed.sequence {
+            return GuardShare {
+                floor: sequence.lowest(up),
+                surface_speed: sequence.fastest(),
+                flow_speed: 0.0,
+            };
+        }
         let vertices = placed.surface.vertices();
         let lowest = vertices.iter().map(|v| v.dot(up)).reduce(f32::min);
         if !placed.motion.moves() {

@@ -15,6 +15,8 @@ const CREASE_COS: f32 = 0.985;
 /// The sharp edges of a surface and a tree over them.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SharpEdges {
+    /// Each edge's two vertices.
+    ends: Vec<[u32; 2]>,
     edges: Vec<[Vec3; 2]>,
     tree: TriangleTree,
 }
@@ -48,15 +50,27 @@ impl SharpEdges {
             .map(|(k, _)| *k)
             .collect();
         keys.sort_unstable();
-        let edges: Vec<[Vec3; 2]> = (keys.iter())
-            .map(|&(a, b)| [vertices[a as usize], vertices[b as usize]])
-            .filter(|[a, b]| a != b)
+        let ends: Vec<[u32; 2]> = (keys.iter())
+            .map(|&(a, b)| [a, b])
+            .filter(|[a, b]| vertices[*a as usize] != vertices[*b as usize])
             .collect();
-        let boxes: Vec<[Vec3; 3]> = edges.iter().map(|&[a, b]| [a, b, b]).collect();
+        let edges: Vec<[Vec3; 2]> = ends
+            .iter()
+            .map(|e| e.map(|i| vertices[i as usize]))
+            .collect();
         Self {
-            tree: TriangleTree::new(&boxes),
+            tree: TriangleTree::new(&boxes(&edges)),
+            ends,
             edges,
         }
+    }
+
+    /// The same edges over moved `vertices` (which edges are sharp stays as first found).
+    pub fn refit(&mut self, vertices: &[Vec3]) {
+        for (edge, ends) in self.edges.iter_mut().zip(&self.ends) {
+            *edge = ends.map(|i| vertices[i as usize]);
+        }
+        self.tree.refit(&boxes(&self.edges));
     }
 
     pub fn len(&self) -> usize {
@@ -80,6 +94,11 @@ impl SharpEdges {
         });
         best
     }
+}
+
+/// Each edge as a degenerate triangle, for the tree.
+fn boxes(edges: &[[Vec3; 2]]) -> Vec<[Vec3; 3]> {
+    edges.iter().map(|&[a, b]| [a, b, b]).collect()
 }
 
 /// The nearest points of the segments `a`–`b` and `p`–`q`.

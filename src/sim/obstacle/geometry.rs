@@ -37,6 +37,21 @@ pub fn closest_on_triangle(p: Vec3, [a, b, c]: [Vec3; 3]) -> Vec3 {
     a + ab * (vb * denom) + ac * (vc * denom)
 }
 
+/// The barycentric weights of `p` (a point of the triangle's plane) on `a`, `b`, `c`
+/// (a degenerate triangle: all on `a`).
+pub fn barycentric(p: Vec3, [a, b, c]: [Vec3; 3]) -> [f32; 3] {
+    let (e0, e1, e2) = (b - a, c - a, p - a);
+    let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
+    let (d20, d21) = (e2.dot(e0), e2.dot(e1));
+    let denom = d00 * d11 - d01 * d01;
+    if denom <= f32::EPSILON * d00 * d11 || denom <= 0.0 {
+        return [1.0, 0.0, 0.0];
+    }
+    let v = (d11 * d20 - d01 * d21) / denom;
+    let w = (d00 * d21 - d01 * d20) / denom;
+    [1.0 - v - w, v, w]
+}
+
 /// Where, as a fraction of the way from `from` to `to`, the segment first crosses triangle
 /// `abc` (either side; touching counts), if it does.
 pub fn segment_crosses(from: Vec3, to: Vec3, [a, b, c]: [Vec3; 3]) -> Option<f32> {

@@ -1,11 +1,13 @@
 //! Obstacles of any shape: triangle surfaces the cloth may not pass, with the tree that
-//! finds what a particle's move comes near.
+//! finds what a particle's move comes near, and the frames of one that deforms.
 
 mod edges;
 mod geometry;
+mod sequence;
 mod surface;
 mod tree;
 
 pub use edges::{EdgeHit, SharpEdges};
+pub use sequence::{Moment, Sequence};
 pub use surface::{Caught, Surface};
 pub use tree::{Nearest, TriangleTree};

@@ -56,6 +56,28 @@ impl Surface {
         }
     }
 
+    /// The same triangles over moved `vertices` (as many as before): normals, tree and
+    /// sharp edges refitted, in time linear in the triangles.
+    ///
+    /// # Panics
+    /// When `vertices` is not as long as before.
+    pub fn refit(&mut self, vertices: &[Vec3]) {
+        assert_eq!(
+            vertices.len(),
+            self.vertices.len(),
+            "refit with other vertices"
+        );
+        self.vertices.copy_from_slice(vertices);
+        let corners: Vec<[Vec3; 3]> = (self.triangles.iter())
+            .map(|t| t.map(|i| vertices[i as usize]))
+            .collect();
+        for (n, [a, b, c]) in self.normals.iter_mut().zip(&corners) {
+            *n = (*b - *a).cross(*c - *a).normalize_or_zero();
+        }
+        self.tree.refit(&corners);
+        self.edges.refit(vertices);
+    }
+
     pub fn vertices(&self) -> &[Vec3] {
         &self.vertices
     }

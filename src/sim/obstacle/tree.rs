@@ -61,6 +61,39 @@ impl TriangleTree {
         }
     }
 
+    /// Moves its triangles to `triangles` (the same triangles, numbered as when it was
+    /// built, with new corners) and refits every box around them, keeping the tree's shape:
+    /// linear in the triangles, for a surface that deforms (an OBJ sequence).
+    ///
+    /// # Panics
+    /// When `triangles` is not as long as the tree.
+    pub fn refit(&mut self, triangles: &[[Vec3; 3]]) {
+        assert_eq!(
+            triangles.len(),
+            self.corners.len(),
+            "refit with other triangles"
+        );
+        for (corners, &t) in self.corners.iter_mut().zip(&self.index) {
+            *corners = triangles[t as usize];
+        }
+        // Children come after their parent, so boxes fill in from the last node back.
+        for at in (0..self.nodes.len()).rev() {
+            let node = self.nodes[at];
+            let (lo, hi) = if node.count > 0 {
+                let held = &self.corners[node.first as usize..(node.first + node.count) as usize];
+                held.iter().flatten().fold(
+                    (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                    |(lo, hi), &c| (lo.min(c), hi.max(c)),
+                )
+            } else {
+                let (a, b) = (self.nodes[at + 1], self.nodes[node.first as usize]);
+                (a.lo.min(b.lo), a.hi.max(b.hi))
+            };
+            self.nodes[at].lo = lo;
+            self.nodes[at].hi = hi;
+        }
+    }
+
     /// How many triangles it holds.
     pub fn len(&self) -> usize {
         self.corners.len()
