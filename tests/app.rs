@@ -94,6 +94,9 @@ fn drop_obj(harness: &mut Harness<'static, ClothApp>, name: &str, text: &str) {
         .input_mut()
         .dropped_files
         .push(Arc::new(Dropped(path)));
+    harness.run_steps(2);
+    // An OBJ could be the cloth or an obstacle: the app asks.
+    harness.get_by_label("Replace cloth").click();
     harness.run_steps(1);
     // A drop starts a background import and says so. (A tiny file may already be done
     // within the same UI frame, so "still loading" is not guaranteed.)
@@ -842,4 +845,52 @@ fn a_self_collision_thicker_than_the_cloth_is_refused_and_the_effects_stay() {
         "{error}"
     );
     harness.get_by_label_contains("shortest rest edge");
+}
+
+/// A dropped OBJ can be added as an obstacle instead of replacing the cloth: the cloth
+/// stays, the scene gains a mesh obstacle (shown in the Effects panel with its triangles).
+/// The Effects panel adds one from a typed path; a path that cannot be read is an error
+/// naming it, and the effects stay as they were.
+#[test]
+fn an_obj_can_be_added_as_an_obstacle_by_drop_or_by_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("slab.obj");
+    std::fs::write(
+        &path,
+        "v -1 -2 -1\nv 1 -2 -1\nv 1 -2 1\nv -1 -2 1\nf 1 3 2\nf 1 4 3\n",
+    )
+    .unwrap();
+    let mut harness = harness_sized(1280.0, 1600.0);
+    let particles = harness.state().sim().model().particle_count();
+    let effects = harness.state().sim().effects().len();
+    harness
+        .input_mut()
+        .dropped_files
+        .push(Arc::new(Dropped(path.clone())));
+    harness.run_steps(2);
+    harness.get_by_label("Add as obstacle").click();
+    harness.run_steps(2);
+    let sim = harness.state().sim();
+    assert_eq!(sim.model().particle_count(), particles, "the cloth stays");
+    assert_eq!(sim.effects().len(), effects + 1);
+    assert!(matches!(
+        sim.effects().last(),
+        Some(clothsim::sim::Effect::Obstacle(_))
+    ));
+    assert!(
+        harness.query_by_label("Add as obstacle").is_none(),
+        "asked once"
+    );
+    harness.get_by_label_contains("(2 triangles)");
+
+    harness.state_mut().panels.side.effects.obstacle_path =
+        dir.path().join("missing.obj").display().to_string();
+    harness.get_by_label("Add obstacle").click();
+    harness.run_steps(2);
+    assert!(last_error(&harness).contains("missing.obj"));
+    assert_eq!(harness.state().sim().effects().len(), effects + 1);
+    harness.state_mut().panels.side.effects.obstacle_path = path.display().to_string();
+    harness.get_by_label("Add obstacle").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().sim().effects().len(), effects + 2);
 }

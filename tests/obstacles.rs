@@ -669,3 +669,68 @@ fn a_fast_obj_sequence_does_not_pass_through_the_cloth() {
         );
     }
 }
+
+/// Saved anywhere, a scene names its obstacles' meshes relative to the saved file, so it
+/// opens as saved: an OBJ and an OBJ sequence two folders up; a built-in scene's own meshes
+/// (an OBJ and a sequence) are written beside it, once; a different file in a built-in
+/// mesh's place refuses the save and writes nothing.
+#[test]
+fn a_saved_scene_finds_its_obstacles_from_where_it_is_saved() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("meshes/lift")).unwrap();
+    let (v, t) = cuboid(Vec3::new(-0.3, -0.5, -0.3), Vec3::new(0.3, -0.4, 0.3));
+    write_obj(&dir.path().join("meshes/top.obj"), &v, &t);
+    for k in 0..3 {
+        let (v, t) = plate(-0.2 - 0.1 * k as f32);
+        write_obj(&dir.path().join(format!("meshes/lift/p{k}.obj")), &v, &t);
+    }
+    let sim = Simulation::new(scene(
+        dir.path(),
+        "name = \"saved\"\n[cloth]\ngrid = { quads = 4, size = 0.5 }\n\
+         [[effects]]\ntype = \"obstacle\"\nobj = \"meshes/top.obj\"\n\
+         [[effects]]\ntype = \"obstacle\"\nframes = \"meshes/lift/p%d.obj\"\nfps = 4.0\n",
+    ));
+    let saved = dir.path().join("out/deeper/saved.toml");
+    std::fs::create_dir_all(saved.parent().unwrap()).unwrap();
+    let written = sim.save_scene(&saved).unwrap();
+    assert!(written.meshes.is_empty());
+    let text = std::fs::read_to_string(&saved).unwrap();
+    assert!(text.contains("obj = \"../../meshes/top.obj\""), "{text}");
+    assert!(
+        text.contains("frames = \"../../meshes/lift/p%d.obj\""),
+        "{text}"
+    );
+    let again = Simulation::new(Scene::open(&saved.display().to_string()).unwrap());
+    let shapes = |sim: &Simulation| {
+        (clothsim::view::meshes(sim.effects(), 0.3).iter())
+            .map(|m| (m.vertices.to_vec(), m.triangles.to_vec()))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(shapes(&again), shapes(&sim));
+
+    // Built-in scenes: their meshes are written beside the file, once.
+    let out = tempfile::tempdir().unwrap();
+    for (name, meshes) in [("tablecloth", 1), ("arm", 16)] {
+        let sim = Simulation::new(Scene::builtin(name).unwrap());
+        let path = out.path().join(format!("{name}.toml"));
+        assert_eq!(
+            sim.save_scene(&path).unwrap().meshes.len(),
+            meshes,
+            "{name}"
+        );
+        assert!(sim.save_scene(&path).unwrap().meshes.is_empty(), "{name}");
+        let again = Simulation::new(Scene::open(&path.display().to_string()).unwrap());
+        assert_eq!(shapes(&again), shapes(&sim), "{name}");
+    }
+    assert!(out.path().join("arm/arm_0015.obj").is_file());
+    let clash = tempfile::tempdir().unwrap();
+    std::fs::write(clash.path().join("table.obj"), "v 0 0 0\n").unwrap();
+    let path = clash.path().join("t.toml");
+    let sim = Simulation::new(Scene::builtin("tablecloth").unwrap());
+    let err = sim.save_scene(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("table.obj") && err.contains("another folder"),
+        "{err}"
+    );
+    assert!(!path.exists());
+}

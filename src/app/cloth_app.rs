@@ -78,6 +78,9 @@ pub struct Loading {
     /// A cloth the user opened (unplaced, with its name): a scenario switch places it again.
     /// `None`: each scene brings its own cloth.
     pub(super) custom_cloth: Option<(MeshBuild, String)>,
+    /// An OBJ dropped on the window, waiting for the user to say whether it is the cloth or
+    /// an obstacle.
+    pub(super) dropped_obj: Option<PathBuf>,
 }
 
 /// The window's panels.
@@ -596,6 +599,7 @@ impl ClothApp {
             Action::Open(path) => self.open_path(path),
             Action::UseDefaultCloth => self.use_default_cloth(),
             Action::SaveScene(path) => self.save_scene(&path),
+            Action::AddObstacle(path) => self.add_obstacle(&path),
             Action::ExportObj => self.export_obj(),
             Action::SetPinsEnabled(enabled) => self.set_pins_enabled(enabled),
             Action::SetBackend(backend) => self.set_backend(backend),
@@ -649,7 +653,15 @@ impl ClothApp {
                 .collect()
         });
         if let Some(path) = dropped.into_iter().next() {
-            self.open_path(path);
+            // A scene file replaces the scene; an OBJ could be the cloth or an obstacle.
+            if path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+            {
+                self.open_path(path);
+            } else {
+                self.loading.dropped_obj = Some(path);
+            }
         }
         self.poll_loading();
         self.poll_writes();
@@ -679,6 +691,7 @@ impl ClothApp {
             .show(ui, |ui| self.show_panel(ui, |p| &mut p.side));
         egui::CentralPanel::no_frame().show(ui, |ui| self.viewport_ui(ui));
         self.accuracy_ui(ui.ctx());
+        self.dropped_obj_ui(ui.ctx());
 
         let hovering = ui.input(|i| !i.raw.hovered_files.is_empty());
         if hovering {

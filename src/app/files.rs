@@ -4,10 +4,12 @@
 use std::path::{Path, PathBuf};
 
 use crate::scene::{Scene, Simulation};
+use crate::sim::{Effect, Obstacle};
 
 use super::background::{Load, Loaded};
 use super::cloth_app::{ClothApp, next_free};
 use super::messages::Level;
+use super::panel::Action;
 
 impl ClothApp {
     /// Starts loading `path` in the background: a `.toml` scene file replaces the scene, an
@@ -103,10 +105,70 @@ impl ClothApp {
     /// Writes the current setup (cloth, placement, parameters, effects, pins) as a scene
     /// file; a failure is reported and nothing is left half-written.
     pub fn save_scene(&mut self, path: &Path) {
-        let text = self.sim().scene_file().to_toml();
-        match crate::output::write_bytes(path, text.as_bytes()) {
-            Ok(()) => self.message(Level::Info, format!("saved scene to {}", path.display())),
+        match self.sim().save_scene(path) {
+            Ok(saved) if saved.meshes.is_empty() => {
+                self.message(Level::Info, format!("saved scene to {}", path.display()));
+            }
+            Ok(saved) => {
+                let meshes = saved.meshes.len();
+                let text = format!(
+                    "saved scene to {} with the {meshes} built-in meshes it uses beside it",
+                    path.display()
+                );
+                self.message(Level::Info, text);
+            }
             Err(e) => self.message(Level::Error, e.to_string()),
+        }
+    }
+
+    /// Asks what a dropped OBJ is: the new cloth, or an obstacle added to the scene.
+    pub(super) fn dropped_obj_ui(&mut self, ctx: &egui::Context) {
+        let Some(path) = self.loading.dropped_obj.clone() else {
+            return;
+        };
+        let mut choice = None;
+        egui::Window::new("Dropped an OBJ")
+            .collapsible(false)
+            .resizable(false)
+            .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
+            .show(ctx, |ui| {
+                ui.label(format!("What is {}?", path.display()));
+                ui.horizontal(|ui| {
+                    if ui.button("Replace cloth").clicked() {
+                        choice = Some(Action::Open(path.clone()));
+                    }
+                    if ui.button("Add as obstacle").clicked() {
+                        choice = Some(Action::AddObstacle(path.clone()));
+                    }
+                    if ui.button("Cancel").clicked() {
+                        choice = Some(Action::DismissMessages);
+                    }
+                });
+            });
+        if let Some(action) = choice {
+            self.loading.dropped_obj = None;
+            if action != Action::DismissMessages {
+                self.apply(action);
+            }
+        }
+    }
+
+    /// Reads `path` as an obstacle (placed as the file has it, the default friction, the
+    /// solver's thickness) and adds it to the effects; a file that cannot be read is
+    /// reported and the effects stay as they are.
+    pub fn add_obstacle(&mut self, path: &Path) {
+        let mut obstacle = Obstacle::new(path);
+        if let Err(e) = obstacle.load(None) {
+            return self.message(Level::Error, format!("{e} — the effects are kept"));
+        }
+        let triangles = obstacle.placed().map_or(0, |p| p.surface.triangles().len());
+        let mut effects = self.sim().effects().to_vec();
+        effects.push(Effect::Obstacle(obstacle));
+        let before = self.sim().effects().len();
+        self.apply_effects(effects);
+        if self.sim().effects().len() > before {
+            let text = format!("added obstacle {}: {triangles} triangles", path.display());
+            self.message(Level::Info, text);
         }
     }
 

@@ -40,6 +40,8 @@ pub enum Action {
     Open(PathBuf),
     /// Back to each scene's own cloth.
     UseDefaultCloth,
+    /// Read an OBJ and add it to the scene as an obstacle, where the file has it.
+    AddObstacle(PathBuf),
     /// Write the current setup as a scene file.
     SaveScene(PathBuf),
     /// Write the cloth as it is now as OBJ, into the capture folder.

@@ -5,6 +5,7 @@ mod file;
 mod framing;
 mod locate;
 mod registry;
+mod save;
 #[allow(clippy::module_inception)]
 mod scene;
 mod simulation;
@@ -16,6 +17,7 @@ pub use file::{
     PerKind, PinSpec, Region, SceneFile, SolverSpec,
 };
 pub use registry::{BUILTIN_SCENES, scenario, scenarios};
+pub use save::{SaveError, Saved};
 pub use scene::{DEFAULT_CLOTH_NAME, DEFAULT_CLOTH_OBJ, Scene};
 pub use simulation::{GRAB_WINDOW, Simulation};
 pub use summary::{PhaseSummary, RunSummary};

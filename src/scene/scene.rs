@@ -61,7 +61,16 @@ fn load_obstacles(
             // A built-in scene's meshes are the program's own.
             match base {
                 None => obstacle.load_with(None, &builtin_mesh).map_err(located)?,
-                Some(_) => obstacle.load(base).map_err(located)?,
+                Some(base) => {
+                    obstacle.load(Some(base)).map_err(located)?;
+                    // From here on the paths read from where the program runs (saving
+                    // makes them relative to the saved file again).
+                    if let Some(pattern) = &obstacle.frames {
+                        obstacle.frames = Some(base.join(pattern).display().to_string());
+                    } else {
+                        obstacle.obj = base.join(&obstacle.obj);
+                    }
+                }
             }
         }
     }
@@ -162,10 +171,10 @@ impl Scene {
                         .weld_tolerance
                         .unwrap_or(ImportOptions::default().weld_tolerance),
                 };
-                (
-                    mesh::load_obj_with(&path, &options)?,
-                    path.display().to_string(),
-                )
+                let build = mesh::load_obj_with(&path, &options)?;
+                let name = path.display().to_string();
+                file.cloth.obj = Some(path);
+                (build, name)
             }
             (None, Some(grid)) => {
                 let [qx, qy] = grid.quads.pair();

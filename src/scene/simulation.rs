@@ -257,6 +257,16 @@ impl Simulation {
         )
     }
 
+    /// Writes [`Simulation::scene_file`] to `path`, its paths relative to it and the
+    /// built-in meshes it names beside it.
+    ///
+    /// # Errors
+    /// [`SaveError`]: a file in a built-in mesh's place, or a write that failed (nothing
+    /// is left half-written).
+    pub fn save_scene(&self, path: &std::path::Path) -> Result<super::Saved, super::SaveError> {
+        super::save::save(&self.scene_file(), path)
+    }
+
     /// The cloth as it is now, as OBJ text: current positions, the triangles, the UVs.
     /// Importing it gives back the same particles and triangles.
     pub fn export_obj(&self) -> String {
@@ -336,8 +346,27 @@ impl Simulation {
             cloth: self.cloth_name.clone(),
             error,
         })?;
+        // An obstacle added now that the cloth already meets is warned about (one it had
+        // before may rest on it).
+        let added: Vec<Effect> = (effects.iter())
+            .filter(|e| match e {
+                Effect::Obstacle(new) => !self.effects.iter().any(|old| match old {
+                    Effect::Obstacle(old) => old.shape == new.shape,
+                    _ => false,
+                }),
+                _ => false,
+            })
+            .cloned()
+            .collect();
         self.effects = effects;
-        let warnings = small_sphere_warnings(&self.effects, &self.model);
+        let mut warnings = small_sphere_warnings(&self.effects, &self.model);
+        let offset = self.params.contact.offset;
+        warnings.extend(obstacle_overlap_warnings(
+            &added,
+            &self.model,
+            &self.state.pos,
+            offset,
+        ));
         (self.backend).configure(&self.model, &self.params, &self.effects, Changes::EFFECTS);
         Ok(warnings)
     }

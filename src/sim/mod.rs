@@ -27,10 +27,10 @@ pub use constraints::DistanceConstraints;
 pub use cpu_stepper::CpuStepper;
 pub use diagnosis::{Cause, Vibration, stiffest_vibration};
 pub use effects::{
-    AirDamping, BendingModel, ClothBox, ClothSprings, DEFAULT_DIHEDRAL_STIFFNESS, Effect, Gravity,
-    Handle, Obstacle, ObstacleError, Plane, SelfCollision, Sphere, TooThick, Wind, air_damping_of,
-    gravity_of, min_surface_distance, obstacle_overlap_warnings, shortest_edge,
-    small_sphere_warnings, thickness_fits,
+    AirDamping, BendingModel, ClothBox, ClothSprings, DEFAULT_DIHEDRAL_STIFFNESS, DEFAULT_FPS,
+    Effect, Gravity, Handle, Obstacle, ObstacleError, Plane, SelfCollision, Sphere, TooThick, Wind,
+    air_damping_of, frame_path, gravity_of, min_surface_distance, obstacle_overlap_warnings,
+    shortest_edge, small_sphere_warnings, thickness_fits,
 };
 pub use forces::{Force, ForceSet, ForceTerm, JacobianMode, SystemMatrix};
 pub use guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check};

@@ -15,7 +15,10 @@ use super::sliders::spring_sliders;
 
 /// The Effects section.
 #[derive(Default)]
-pub struct EffectsPanel;
+pub struct EffectsPanel {
+    /// The OBJ path typed for *Add obstacle*.
+    pub obstacle_path: String,
+}
 
 impl Panel for EffectsPanel {
     fn ui(&mut self, ui: &mut egui::Ui, ctx: &mut PanelContext<'_>) {
@@ -65,6 +68,21 @@ impl Panel for EffectsPanel {
             effects.push(effect);
             effects_changed = true;
         }
+        ui.horizontal(|ui| {
+            ui.add(
+                egui::TextEdit::singleline(&mut self.obstacle_path)
+                    .hint_text("mesh.obj")
+                    .desired_width(150.0),
+            );
+            let path = self.obstacle_path.trim();
+            if ui
+                .add_enabled(!path.is_empty(), egui::Button::new("Add obstacle"))
+                .on_hover_text("read this OBJ as a mesh obstacle, placed as the file has it")
+                .clicked()
+            {
+                ctx.ask(Action::AddObstacle(path.into()));
+            }
+        });
         if params_changed {
             ctx.ask(Action::ApplyParams(params));
         }

@@ -26,7 +26,7 @@ pub use list::{
     air_damping_of, gravity_of, min_surface_distance, obstacle_overlap_warnings,
     small_sphere_warnings, thickness_fits,
 };
-pub use obstacle::{Obstacle, ObstacleError, Placed, Shape};
+pub use obstacle::{DEFAULT_FPS, Obstacle, ObstacleError, Placed, Shape, frame_path};
 pub use plane::Plane;
 pub use registry::{Addable, Effect};
 pub use self_collision::{SelfCollision, TooThick, shortest_edge};

@@ -457,7 +457,7 @@ impl Solid for Deforming<'_> {
         match self.moment.surface.nearest(p, f32::INFINITY) {
             Some(near) => {
                 let away = (p - near.point).normalize_or(Vec3::Y);
-                let velocity = self.moment.at(&near, &self.moment.velocity);
+                let velocity = self.moment.at_nearest(&near, &self.moment.velocity);
                 (near.distance, away, velocity)
             }
             None => (f32::INFINITY, Vec3::Y, Vec3::ZERO),
@@ -470,16 +470,20 @@ impl Solid for Deforming<'_> {
 
     /// The move seen from the surface: a start near it is carried by the surface's own
     /// move over the substep (so a particle resting on it stays on its side however the
-    /// surface moves), then caught against the surface where the substep ends.
+    /// surface moves), then caught against the surface where the substep ends. A surface
+    /// that moves less than half the thickness in the substep carries nothing: what rests
+    /// on it is still outside it, and pushed back out to the thickness.
     fn contact(&self, from: Vec3, to: Vec3, offset: f32) -> Option<(Vec3, Vec3, Vec3)> {
         let m = self.moment;
-        let reach = 2.0 * (offset + m.largest_shift);
-        let start = match m.surface.nearest(from, reach) {
-            Some(near) if m.largest_shift > 0.0 => from + m.at(&near, &m.shift),
-            _ => from,
+        let start = if m.largest_shift >= 0.5 * offset {
+            let reach = 2.0 * (offset + m.largest_shift);
+            (m.surface.nearest(from, reach))
+                .map_or(from, |near| from + m.at_nearest(&near, &m.shift))
+        } else {
+            from
         };
         let caught = m.surface.catch(start, to, offset)?;
-        let velocity = m.velocity_near(caught.at, 2.0 * offset.max(1e-6));
+        let velocity = m.at(caught.triangle, caught.on_surface, &m.velocity);
         Some((caught.at, caught.normal, velocity))
     }
 

@@ -3,9 +3,12 @@
 //! then an inelastic velocity response with Coulomb friction against the surface's own
 //! velocity (a spinning sphere drags the cloth).
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use glam::Vec3;
 
 use super::effect_kind::ContactPass;
+use crate::parallel::{each_part, within};
 
 /// Coulomb friction of a solid when a scene file gives none (dimensionless).
 pub(super) const DEFAULT_FRICTION: f32 = 0.5;
@@ -42,12 +45,34 @@ pub(super) trait Solid {
 /// ([`Solid::catch`]), its approaching normal velocity removed (inelastic contact) and
 /// Coulomb friction applied: the tangential velocity relative to the surface shrinks by at
 /// most `friction` × the removed normal speed. Returns how many particles it moved.
-pub(super) fn resolve(solid: &impl Solid, pass: &mut ContactPass<'_>) -> usize {
-    let (mu, offset) = (solid.friction(), pass.offset);
-    let (start, inv_mass) = (pass.start, &pass.model.inv_mass);
-    let mut contacts = 0;
+///
+/// Each particle's contact is its own, so a large cloth's particles are shared out between
+/// the team's members ([`each_part`]); the result is the same however they are cut.
+pub(super) fn resolve(solid: &(impl Solid + Sync), pass: &mut ContactPass<'_>) -> usize {
+    let (start, inv_mass) = (pass.start, &pass.model.inv_mass[..]);
+    let contacts = AtomicUsize::new(0);
     let state = &mut *pass.state;
-    let particles = state.pos.iter_mut().zip(state.vel.iter_mut());
+    let offset = pass.offset;
+    each_part([&mut state.pos, &mut state.vel], |range, [pos, vel]| {
+        let (start, inv_mass) = (within(start, range.clone()), within(inv_mass, range));
+        let found = resolve_part(solid, offset, pos, vel, start, inv_mass);
+        contacts.fetch_add(found, Ordering::Relaxed);
+    });
+    contacts.into_inner()
+}
+
+/// [`resolve`] over one run of particles.
+fn resolve_part(
+    solid: &impl Solid,
+    offset: f32,
+    pos: &mut [Vec3],
+    vel: &mut [Vec3],
+    start: &[Vec3],
+    inv_mass: &[f32],
+) -> usize {
+    let mu = solid.friction();
+    let mut contacts = 0;
+    let particles = pos.iter_mut().zip(vel.iter_mut());
     for (((x, v), &from), &w) in particles.zip(start).zip(inv_mass) {
         if w == 0.0 {
             continue;

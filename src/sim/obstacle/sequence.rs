@@ -37,18 +37,23 @@ pub struct Moment {
 }
 
 impl Moment {
-    /// `field` (one value per vertex) at the point `near` found on the surface.
-    pub fn at(&self, near: &Nearest, field: &[Vec3]) -> Vec3 {
-        let tri = self.surface.triangles()[near.triangle as usize];
+    /// `field` (one value per vertex) at `point` of triangle `triangle`.
+    pub fn at(&self, triangle: u32, point: Vec3, field: &[Vec3]) -> Vec3 {
+        let tri = self.surface.triangles()[triangle as usize];
         let corners = tri.map(|i| self.surface.vertices()[i as usize]);
-        let w = barycentric(near.point, corners);
+        let w = barycentric(point, corners);
         (0..3).map(|k| field[tri[k] as usize] * w[k]).sum()
+    }
+
+    /// `field` at the point `near` found on the surface.
+    pub fn at_nearest(&self, near: &Nearest, field: &[Vec3]) -> Vec3 {
+        self.at(near.triangle, near.point, field)
     }
 
     /// The surface's velocity at the point of it nearest to `p` (zero when none is
     /// within `reach`).
     pub fn velocity_near(&self, p: Vec3, reach: f32) -> Vec3 {
-        (self.surface.nearest(p, reach)).map_or(Vec3::ZERO, |n| self.at(&n, &self.velocity))
+        (self.surface.nearest(p, reach)).map_or(Vec3::ZERO, |n| self.at_nearest(&n, &self.velocity))
     }
 }
 

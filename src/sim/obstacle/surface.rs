@@ -34,6 +34,10 @@ pub struct Surface {
 pub struct Caught {
     pub at: Vec3,
     pub normal: Vec3,
+    /// The triangle that last held it and the point of it that did (where its velocity
+    /// is the surface's, for a surface that deforms).
+    pub triangle: u32,
+    pub on_surface: Vec3,
 }
 
 impl Surface {
@@ -172,6 +176,7 @@ impl Surface {
         };
         let (mut start, mut end) = (from, to);
         let mut normal = None;
+        let mut held = (0, Vec3::ZERO);
         for _ in 0..CROSSINGS {
             let Some((triangle, t)) = first_crossing(start, end) else {
                 break;
@@ -190,6 +195,7 @@ impl Surface {
             start = hit + n * thickness;
             end = start + along;
             normal = Some(n);
+            held = (triangle, hit);
         }
         for _ in 0..PUSHES {
             let Some(near) = nearest(end) else {
@@ -211,8 +217,14 @@ impl Surface {
             };
             end = near.point + n * thickness;
             normal = Some(n);
+            held = (near.triangle, near.point);
         }
-        normal.map(|normal| Caught { at: end, normal })
+        normal.map(|normal| Caught {
+            at: end,
+            normal,
+            triangle: held.0,
+            on_surface: held.1,
+        })
     }
 }
 
