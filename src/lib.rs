@@ -23,6 +23,7 @@
 
 pub mod app;
 pub mod bench;
+pub mod bench_contact;
 pub mod cloth;
 pub mod device;
 pub mod gpu;

@@ -126,6 +126,10 @@ pub enum Command {
         /// cpu, or gpu (semi-implicit Euler on wgpu compute; --threads does not apply).
         #[arg(long, value_enum, default_value_t = Backend::Cpu)]
         backend: Backend,
+        /// Instead: a 64 × 64 cloth resting on a mesh sphere of about 1 000 and 100 000
+        /// triangles, the obstacle phase against the springs' (per --threads).
+        #[arg(long, conflicts_with_all = ["sizes", "integrators", "backend"])]
+        obstacles: bool,
     },
     /// Write a rectangular grid cloth as an OBJ file (quads: diagonals become shear springs).
     Grid {

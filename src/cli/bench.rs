@@ -104,3 +104,63 @@ pub fn bench(
     }
     Ok(())
 }
+
+/// Runs and prints the contact bench: one row per thread count × obstacle size, and the
+/// ratio of the large obstacle's phase to the small one's.
+pub fn contact_bench(threads: &[usize], json: bool) -> Result<()> {
+    use clothsim::bench_contact::{CONTACT_TRIANGLES, contact_one};
+    if let Some(&t) = threads.iter().find(|&&t| !(1..=256).contains(&t)) {
+        bail!("--threads: {t} is outside 1..=256");
+    }
+    if !json {
+        println!(
+            "{:>9} {:>9} {:>7} {:>8} {:>14} {:>13} {:>9} {:>8}",
+            "particles",
+            "triangles",
+            "threads",
+            "substeps",
+            "obstacle µs/ss",
+            "springs µs/ss",
+            "× springs",
+            "resting",
+        );
+    }
+    for &t in threads {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .with_context(|| format!("cannot start {t} threads"))?;
+        let rows = (CONTACT_TRIANGLES.iter())
+            .map(|&n| pool.install(|| contact_one(n)))
+            .collect::<Result<Vec<_>, _>>()?;
+        for row in &rows {
+            if json {
+                println!("{}", serde_json::to_string(row)?);
+            } else {
+                println!(
+                    "{:>9} {:>9} {:>7} {:>8} {:>14.1} {:>13.1} {:>9.1} {:>8}",
+                    row.particles,
+                    row.triangles,
+                    row.threads,
+                    row.substeps,
+                    row.obstacle_us,
+                    row.springs_us,
+                    row.obstacle_us / row.springs_us,
+                    row.resting
+                );
+            }
+        }
+        if let [small, large] = &rows[..]
+            && !json
+        {
+            println!(
+                "  {} threads: the obstacle phase with {} triangles costs {:.2}× the phase with {}",
+                t,
+                large.triangles,
+                large.obstacle_us / small.obstacle_us,
+                small.triangles
+            );
+        }
+    }
+    Ok(())
+}

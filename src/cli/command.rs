@@ -6,7 +6,7 @@ use clothsim::gpu::{Backend, GPU_INTEGRATOR};
 
 use super::accuracy::accuracy;
 use super::args::{Cli, Command};
-use super::bench::bench;
+use super::bench::{bench, contact_bench};
 use super::grid::grid;
 use super::info::info;
 use super::render::{Output, render};
@@ -86,11 +86,18 @@ pub fn run(cli: Cli) -> Result<()> {
             out,
         }) => grid(quads, size, triangles, &out),
         Some(Command::Bench {
+            threads,
+            json,
+            obstacles: true,
+            ..
+        }) => contact_bench(&threads, json),
+        Some(Command::Bench {
             sizes,
             integrators,
             threads,
             json,
             backend,
+            obstacles: false,
         }) => {
             let integrators = integrators.unwrap_or_else(|| match backend {
                 Backend::Cpu => clothsim::bench::BENCH_INTEGRATORS.to_vec(),

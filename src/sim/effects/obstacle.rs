@@ -279,6 +279,20 @@ impl Obstacle {
         self.place(&soup.clone(), &path.clone(), rest)
     }
 
+    /// Places `soup` (a mesh made in code, named by [`Obstacle::obj`]) as the obstacle says,
+    /// as [`Obstacle::load`] places a file's.
+    ///
+    /// # Errors
+    /// As [`Obstacle::load`].
+    pub fn load_mesh(&mut self, soup: &PolygonSoup) -> Result<(), ObstacleError> {
+        let path = self.obj.clone();
+        self.check().map_err(|error| ObstacleError::Setting {
+            path: path.clone(),
+            error,
+        })?;
+        self.place(soup, &path, Vec::new())
+    }
+
     /// Places `soup` (read from `path`) as the obstacle says; `frames`, when not empty, are
     /// every frame of a sequence, placed.
     fn place(

@@ -16,6 +16,19 @@ const PUSHES: usize = 3;
 /// Triangles near one move that a catch holds at once (more: it walks the tree for each
 /// question instead).
 const NEAR: usize = 48;
+/// How far beyond the thickness a short move's end gathers triangles (as a share of the
+/// thickness): pushes that move the end less than this stay among what was gathered.
+const SLACK: f32 = 0.05;
+/// Triangles a short move's end holds at once (more: the general catch).
+const NEAR_END: usize = 24;
+
+/// What [`Surface::catch_short`] can tell.
+enum Short {
+    Clear,
+    Caught(Caught),
+    /// A long move, or one too near the surface or among too many triangles to tell.
+    Unsure,
+}
 
 /// A triangle surface, fixed in its own frame.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -116,6 +129,11 @@ impl Surface {
     /// surface kept (so it slides) and the part into it dropped; then pushed out to
     /// `thickness` from the nearest point. `None`: the move stays clear.
     pub fn catch(&self, from: Vec3, to: Vec3, thickness: f32) -> Option<Caught> {
+        match self.catch_short(from, to, thickness) {
+            Short::Clear => return None,
+            Short::Caught(caught) => return Some(caught),
+            Short::Unsure => {}
+        }
         // One walk of the tree for the triangles near the whole move; the tree is walked
         // again for each question only when they are too many to hold, or the move ends
         // less than the thickness inside the box they were gathered from (triangles
@@ -124,11 +142,13 @@ impl Surface {
         let (lo, hi) = (from.min(to) - pad, from.max(to) + pad);
         let mut found = [0u32; NEAR];
         let mut count = 0;
-        self.tree.overlapping(lo, hi, |t| {
+        // Past NEAR triangles the walk stops: the tree answers each question instead.
+        self.tree.overlapping_while(lo, hi, |t| {
             if let Some(slot) = found.get_mut(count) {
                 *slot = t;
             }
             count += 1;
+            count <= NEAR
         });
         if count == 0 {
             return None;
@@ -142,6 +162,87 @@ impl Surface {
                 self.catch_among(None, from, to, thickness)
             }
             _ => caught,
+        }
+    }
+
+    /// [`Surface::catch`] for a move shorter than the distance from its end to the surface,
+    /// which therefore crossed nothing (a resting or slow particle: nearly all of them), in
+    /// one walk of the tree: the triangles within a little more than the thickness of the
+    /// end are gathered, and the end is pushed out among them alone.
+    fn catch_short(&self, from: Vec3, to: Vec3, thickness: f32) -> Short {
+        let reach = (1.0 + SLACK) * thickness;
+        let moved = from.distance(to);
+        if moved >= reach {
+            return Short::Unsure;
+        }
+        let mut near = [0u32; NEAR_END];
+        let (mut count, mut closest) = (0, f32::INFINITY);
+        self.tree.within(to, reach, |t, _, d| {
+            if let Some(slot) = near.get_mut(count) {
+                *slot = t;
+            }
+            count += 1;
+            closest = closest.min(d);
+            count <= NEAR_END
+        });
+        // The move lies within `moved` of its end: with no surface that near, it crossed
+        // nothing.
+        if count > NEAR_END || moved >= closest {
+            return Short::Unsure;
+        }
+        let corners = |t: u32| self.triangles[t as usize].map(|i| self.vertices[i as usize]);
+        let mut end = to;
+        let mut held = None;
+        for _ in 0..PUSHES {
+            let nearest = (near[..count].iter())
+                .map(|&t| (t, closest_on_triangle(end, corners(t))))
+                .map(|(t, q)| (t, q, end.distance(q)))
+                .min_by(|x, y| x.2.total_cmp(&y.2));
+            let Some((triangle, point, distance)) = nearest else {
+                break;
+            };
+            if distance >= thickness * (1.0 - 1e-4) {
+                break;
+            }
+            let n = self.away(triangle, point, distance, end, from, thickness);
+            end = point + n * thickness;
+            held = Some((n, triangle, point));
+        }
+        // Pushed further than the gathering reached: triangles not gathered could hold it.
+        if end.distance(to) > reach - thickness {
+            return Short::Unsure;
+        }
+        match held {
+            None => Short::Clear,
+            Some((normal, triangle, on_surface)) => Short::Caught(Caught {
+                at: end,
+                normal,
+                triangle,
+                on_surface,
+            }),
+        }
+    }
+
+    /// The way out of the surface for `end`, `distance` from `point` of `triangle`: away
+    /// from the point, or, on the surface, off it on the side of `start`.
+    fn away(
+        &self,
+        triangle: u32,
+        point: Vec3,
+        distance: f32,
+        end: Vec3,
+        start: Vec3,
+        thickness: f32,
+    ) -> Vec3 {
+        if distance > thickness * 1e-3 {
+            (end - point) / distance
+        } else {
+            let face = self.normals[triangle as usize];
+            if (start - point).dot(face) >= 0.0 {
+                face
+            } else {
+                -face
+            }
         }
     }
 
@@ -204,17 +305,14 @@ impl Surface {
             if near.distance >= thickness * (1.0 - 1e-4) {
                 break;
             }
-            let n = if near.distance > thickness * 1e-3 {
-                (end - near.point) / near.distance
-            } else {
-                // On the surface: off it on the side of the start.
-                let face = self.normals[near.triangle as usize];
-                if (start - near.point).dot(face) >= 0.0 {
-                    face
-                } else {
-                    -face
-                }
-            };
+            let n = self.away(
+                near.triangle,
+                near.point,
+                near.distance,
+                end,
+                start,
+                thickness,
+            );
             end = near.point + n * thickness;
             normal = Some(n);
             held = (near.triangle, near.point);
@@ -284,6 +382,63 @@ mod tests {
             .catch(Vec3::new(0.6, 0.0, 0.0), Vec3::new(0.505, 0.0, 0.0), 0.01)
             .expect("caught");
         assert!((c.at - Vec3::new(0.51, 0.0, 0.0)).length() < 1e-6, "{c:?}");
+    }
+
+    /// A short move's one-walk catch ends where the general catch (the tree asked question
+    /// by question) ends, with the same normal, for moves near and into a bumpy surface of
+    /// small triangles: resting, sliding, sinking within the thickness, and beside it.
+    #[test]
+    fn a_short_moves_catch_agrees_with_the_general_catch() {
+        let n = 40;
+        let at = |i: usize, j: usize| {
+            let (x, z) = (i as f32 / n as f32 - 0.5, j as f32 / n as f32 - 0.5);
+            Vec3::new(x, 0.02 * (9.0 * x).sin() * (7.0 * z).cos(), z)
+        };
+        let vertices: Vec<Vec3> = (0..=n)
+            .flat_map(|i| (0..=n).map(move |j| at(i, j)))
+            .collect();
+        let index = |i: usize, j: usize| (i * (n + 1) + j) as u32;
+        let triangles: Vec<[u32; 3]> = (0..n)
+            .flat_map(|i| (0..n).map(move |j| (i, j)))
+            .flat_map(|(i, j)| {
+                let (a, b, c, d) = (
+                    index(i, j),
+                    index(i + 1, j),
+                    index(i + 1, j + 1),
+                    index(i, j + 1),
+                );
+                [[a, c, b], [a, d, c]]
+            })
+            .collect();
+        let s = Surface::new(vertices, triangles);
+        let mut rnd = crate::test_rng::uniform(7);
+        let thickness = 0.01;
+        let (mut short, mut caught, mut crossed) = (0, 0, 0);
+        for _ in 0..4000 {
+            let from = Vec3::new(rnd() - 0.5, (rnd() - 0.3) * 0.05, rnd() - 0.5);
+            let step = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.018;
+            let to = from + step;
+            let general = s.catch_among(None, from, to, thickness);
+            crossed += usize::from(s.first_crossing(from, to).is_some());
+            if !matches!(s.catch_short(from, to, thickness), Short::Unsure) {
+                short += 1;
+            }
+            let got = s.catch(from, to, thickness);
+            caught += usize::from(got.is_some());
+            match (got, general) {
+                (None, None) => {}
+                (Some(a), Some(b)) => {
+                    assert!(a.at.distance(b.at) < 1e-6, "{from} → {to}: {a:?} vs {b:?}");
+                    assert!(a.normal.distance(b.normal) < 1e-5, "{a:?} vs {b:?}");
+                }
+                (a, b) => panic!("{from} → {to}: {a:?} vs {b:?}"),
+            }
+        }
+        // Most moves took the one walk, many were caught, and some crossed the surface.
+        assert!(
+            short > 2000 && caught > 500 && crossed > 100,
+            "{short} short, {caught} caught, {crossed} crossed"
+        );
     }
 
     /// Every query on a random soup of triangles agrees with testing every triangle.

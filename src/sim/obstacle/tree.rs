@@ -159,6 +159,44 @@ impl TriangleTree {
         })
     }
 
+    /// Calls `visit` with every triangle within `reach` of `p` (its number, the point of it
+    /// nearest to `p`, and the distance), in no order, until `visit` returns `false`.
+    pub fn within(&self, p: Vec3, reach: f32, mut visit: impl FnMut(u32, Vec3, f32) -> bool) {
+        let reach2 = reach * reach;
+        let mut stack = [0u32; 64];
+        let mut top = 0;
+        if !self.nodes.is_empty() {
+            stack[0] = 0;
+            top = 1;
+        }
+        while top > 0 {
+            top -= 1;
+            let at = stack[top];
+            let node = self.nodes[at as usize];
+            if box_distance_squared(p, node.lo, node.hi) > reach2 {
+                continue;
+            }
+            if node.count > 0 {
+                for place in node.first as usize..(node.first + node.count) as usize {
+                    // The triangle's own box first: most in a leaf are out of reach.
+                    let [a, b, c] = self.corners[place];
+                    if box_distance_squared(p, a.min(b).min(c), a.max(b).max(c)) > reach2 {
+                        continue;
+                    }
+                    let q = closest_on_triangle(p, [a, b, c]);
+                    let d2 = p.distance_squared(q);
+                    if d2 <= reach2 && !visit(self.index[place], q, d2.sqrt()) {
+                        return;
+                    }
+                }
+                continue;
+            }
+            stack[top] = node.first;
+            stack[top + 1] = at + 1;
+            top += 2;
+        }
+    }
+
     /// The first triangle the segment from `from` to `to` crosses: its number and the
     /// fraction of the way at which it does.
     pub fn first_crossing(&self, from: Vec3, to: Vec3) -> Option<(u32, f32)> {
@@ -199,6 +237,14 @@ impl TriangleTree {
 
     /// Calls `visit` with the number of every triangle whose box meets the box `lo..hi`.
     pub fn overlapping(&self, lo: Vec3, hi: Vec3, mut visit: impl FnMut(u32)) {
+        self.overlapping_while(lo, hi, |t| {
+            visit(t);
+            true
+        });
+    }
+
+    /// As [`TriangleTree::overlapping`], stopping as soon as `visit` returns `false`.
+    pub fn overlapping_while(&self, lo: Vec3, hi: Vec3, mut visit: impl FnMut(u32) -> bool) {
         let meets = |n: &Node| n.lo.cmple(hi).all() && n.hi.cmpge(lo).all();
         let mut stack = [0u32; 64];
         let mut top = 0;
@@ -212,8 +258,11 @@ impl TriangleTree {
             if node.count > 0 {
                 for place in node.first..node.first + node.count {
                     let [a, b, c] = self.corners[place as usize];
-                    if a.min(b).min(c).cmple(hi).all() && a.max(b).max(c).cmpge(lo).all() {
-                        visit(self.index[place as usize]);
+                    if a.min(b).min(c).cmple(hi).all()
+                        && a.max(b).max(c).cmpge(lo).all()
+                        && !visit(self.index[place as usize])
+                    {
+                        return;
                     }
                 }
                 continue;

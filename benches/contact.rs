@@ -1,0 +1,23 @@
+//! Cost of one frame of a 64 × 64 cloth resting on a mesh sphere of about 1 000 and of
+//! about 100 000 triangles (the scene of `clothsim bench --obstacles`, which times the
+//! obstacle phase alone against the springs). The tree over the triangles keeps the larger
+//! obstacle's frame from growing with its triangles.
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+
+use clothsim::bench_contact::{CONTACT_TRIANGLES, contact_scene};
+
+fn resting(c: &mut Criterion) {
+    let mut group = c.benchmark_group("contact/frame");
+    group.sample_size(10);
+    for triangles in CONTACT_TRIANGLES {
+        let mut sim = contact_scene(triangles).expect("the bench scene builds and settles");
+        group.bench_with_input(BenchmarkId::new("sphere", triangles), &triangles, |b, _| {
+            b.iter(|| sim.step_frame().expect("stable"))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, resting);
+criterion_main!(benches);
