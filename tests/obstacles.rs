@@ -595,26 +595,27 @@ fn bad_obj_sequences_name_where() {
             .unwrap_err()
             .to_string()
     };
-    let err = parse("frames = \"f_%d.obj\"\nkeyframes = [ { time = 0.0 } ]\n");
-    assert!(
-        err.contains("scene.toml:8:1:") && err.contains("keyframes or frames"),
-        "{err}"
-    );
-    let err = parse("frames = \"f_%d.obj\"\nfps = 0.0\n");
-    assert!(
-        err.contains("scene.toml:9:1:") && err.contains("`fps`"),
-        "{err}"
-    );
-    let err = parse("obj = \"a.obj\"\nframes = \"f_%d.obj\"\n");
-    assert!(
-        err.contains("scene.toml:9:1:") && err.contains("obj or frames"),
-        "{err}"
-    );
-    let err = parse("frames = \"f.obj\"\n");
-    assert!(
-        err.contains("scene.toml:8:1:") && err.contains("%d"),
-        "{err}"
-    );
+    for (rest, at, says) in [
+        (
+            "frames = \"f_%d.obj\"\nkeyframes = [ { time = 0.0 } ]\n",
+            "scene.toml:8:1:",
+            "keyframes or frames",
+        ),
+        (
+            "frames = \"f_%d.obj\"\nfps = 0.0\n",
+            "scene.toml:9:1:",
+            "`fps`",
+        ),
+        (
+            "obj = \"a.obj\"\nframes = \"f_%d.obj\"\n",
+            "scene.toml:9:1:",
+            "obj or frames",
+        ),
+        ("frames = \"f.obj\"\n", "scene.toml:8:1:", "%d"),
+    ] {
+        let err = parse(rest);
+        assert!(err.contains(at) && err.contains(says), "{err}");
+    }
 
     let open = |rest: &str| {
         std::fs::write(&path, format!("{head}{rest}")).unwrap();

@@ -261,7 +261,7 @@ impl Simulation {
     /// built-in meshes it names beside it.
     ///
     /// # Errors
-    /// [`SaveError`]: a file in a built-in mesh's place, or a write that failed (nothing
+    /// [`SaveError`](super::SaveError): a file in a built-in mesh's place, or a write that failed (nothing
     /// is left half-written).
     pub fn save_scene(&self, path: &std::path::Path) -> Result<super::Saved, super::SaveError> {
         super::save::save(&self.scene_file(), path)

@@ -110,52 +110,25 @@ impl TriangleTree {
 
     /// The point of the surface nearest to `p`, if one is within `reach`.
     pub fn nearest(&self, p: Vec3, reach: f32) -> Option<Nearest> {
-        let mut best: Option<(u32, Vec3)> = None;
-        let mut best_d2 = reach * reach;
-        // Median splits keep the depth at about log₂(n / LEAF): 64 is never reached.
-        let mut stack = [0u32; 64];
-        let mut top = 0;
-        if self.nodes.is_empty()
-            || box_distance_squared(p, self.nodes[0].lo, self.nodes[0].hi) > best_d2
-        {
-            return None;
-        }
-        stack[0] = 0;
-        top += 1;
-        while top > 0 {
-            top -= 1;
-            let at = stack[top];
-            let node = self.nodes[at as usize];
-            if box_distance_squared(p, node.lo, node.hi) > best_d2 {
-                continue;
-            }
-            if node.count > 0 {
-                let places = node.first as usize..(node.first + node.count) as usize;
-                for place in places {
-                    let q = closest_on_triangle(p, self.corners[place]);
-                    let d2 = p.distance_squared(q);
-                    if d2 <= best_d2 {
-                        best_d2 = d2;
-                        best = Some((place as u32, q));
-                    }
+        let mut best: (Option<(usize, Vec3)>, f32) = (None, reach * reach);
+        self.walk(
+            &mut best,
+            Some(p),
+            true,
+            |best, lo, hi| box_distance_squared(p, lo, hi) <= best.1,
+            |best, place| {
+                let q = closest_on_triangle(p, self.corners[place]);
+                let d2 = p.distance_squared(q);
+                if d2 <= best.1 {
+                    *best = (Some((place, q)), d2);
                 }
-                continue;
-            }
-            // The nearer child last, so it is searched first.
-            let (one, two) = (at + 1, node.first);
-            let (first, second) = if self.box_d2(one, p) <= self.box_d2(two, p) {
-                (two, one)
-            } else {
-                (one, two)
-            };
-            stack[top] = first;
-            stack[top + 1] = second;
-            top += 2;
-        }
-        best.map(|(place, point)| Nearest {
-            triangle: self.index[place as usize],
+                true
+            },
+        );
+        best.0.map(|(place, point)| Nearest {
+            triangle: self.index[place],
             point,
-            distance: best_d2.sqrt(),
+            distance: best.1.sqrt(),
         })
     }
 
@@ -163,76 +136,47 @@ impl TriangleTree {
     /// nearest to `p`, and the distance), in no order, until `visit` returns `false`.
     pub fn within(&self, p: Vec3, reach: f32, mut visit: impl FnMut(u32, Vec3, f32) -> bool) {
         let reach2 = reach * reach;
-        let mut stack = [0u32; 64];
-        let mut top = 0;
-        if !self.nodes.is_empty() {
-            stack[0] = 0;
-            top = 1;
-        }
-        while top > 0 {
-            top -= 1;
-            let at = stack[top];
-            let node = self.nodes[at as usize];
-            if box_distance_squared(p, node.lo, node.hi) > reach2 {
-                continue;
-            }
-            if node.count > 0 {
-                for place in node.first as usize..(node.first + node.count) as usize {
-                    // The triangle's own box first: most in a leaf are out of reach.
-                    let [a, b, c] = self.corners[place];
-                    if box_distance_squared(p, a.min(b).min(c), a.max(b).max(c)) > reach2 {
-                        continue;
-                    }
-                    let q = closest_on_triangle(p, [a, b, c]);
-                    let d2 = p.distance_squared(q);
-                    if d2 <= reach2 && !visit(self.index[place], q, d2.sqrt()) {
-                        return;
-                    }
+        self.walk(
+            &mut (),
+            None,
+            false,
+            |_, lo, hi| box_distance_squared(p, lo, hi) <= reach2,
+            |_, place| {
+                // The triangle's own box first: most in a leaf are out of reach.
+                let [a, b, c] = self.corners[place];
+                if box_distance_squared(p, a.min(b).min(c), a.max(b).max(c)) > reach2 {
+                    return true;
                 }
-                continue;
-            }
-            stack[top] = node.first;
-            stack[top + 1] = at + 1;
-            top += 2;
-        }
+                let q = closest_on_triangle(p, [a, b, c]);
+                let d2 = p.distance_squared(q);
+                d2 > reach2 || visit(self.index[place], q, d2.sqrt())
+            },
+        );
     }
 
     /// The first triangle the segment from `from` to `to` crosses: its number and the
     /// fraction of the way at which it does.
     pub fn first_crossing(&self, from: Vec3, to: Vec3) -> Option<(u32, f32)> {
-        let mut best: Option<(u32, f32)> = None;
-        let mut stack = [0u32; 64];
-        let mut top = 0;
-        if self.nodes.is_empty() {
-            return None;
-        }
-        stack[0] = 0;
-        top += 1;
-        while top > 0 {
-            top -= 1;
-            let at = stack[top];
-            let node = self.nodes[at as usize];
+        let mut best: Option<(usize, f32)> = None;
+        self.walk(
+            &mut best,
+            None,
+            true,
             // Only the part of the segment before the best crossing so far matters.
-            let end = best.map_or(to, |(_, t)| from + (to - from) * t);
-            if !segment_meets_box(from, end, node.lo, node.hi) {
-                continue;
-            }
-            if node.count > 0 {
-                let places = node.first as usize..(node.first + node.count) as usize;
-                for place in places {
-                    if let Some(t) = segment_crosses(from, to, self.corners[place])
-                        && best.is_none_or(|(_, b)| t < b)
-                    {
-                        best = Some((place as u32, t));
-                    }
+            |best, lo, hi| {
+                let end = best.map_or(to, |(_, t)| from + (to - from) * t);
+                segment_meets_box(from, end, lo, hi)
+            },
+            |best, place| {
+                if let Some(t) = segment_crosses(from, to, self.corners[place])
+                    && best.is_none_or(|(_, b)| t < b)
+                {
+                    *best = Some((place, t));
                 }
-                continue;
-            }
-            stack[top] = node.first;
-            stack[top + 1] = at + 1;
-            top += 2;
-        }
-        best.map(|(place, t)| (self.index[place as usize], t))
+                true
+            },
+        );
+        best.map(|(place, t)| (self.index[place], t))
     }
 
     /// Calls `visit` with the number of every triangle whose box meets the box `lo..hi`.
@@ -245,30 +189,60 @@ impl TriangleTree {
 
     /// As [`TriangleTree::overlapping`], stopping as soon as `visit` returns `false`.
     pub fn overlapping_while(&self, lo: Vec3, hi: Vec3, mut visit: impl FnMut(u32) -> bool) {
-        let meets = |n: &Node| n.lo.cmple(hi).all() && n.hi.cmpge(lo).all();
+        let meets = move |a: Vec3, b: Vec3| a.cmple(hi).all() && b.cmpge(lo).all();
+        self.walk(
+            &mut (),
+            None,
+            false,
+            |_, a, b| meets(a, b),
+            |_, place| {
+                let [a, b, c] = self.corners[place];
+                !meets(a.min(b).min(c), a.max(b).max(c)) || visit(self.index[place])
+            },
+        );
+    }
+
+    /// Walks the tree depth first from its root: a node is entered where `enter(state, lo,
+    /// hi)` (its box) says so, and each place of an entered leaf goes to `leaf(state,
+    /// place)`, which ends the walk by returning `false`. Towards a point, the child whose
+    /// box is nearer to it is walked first. A node is asked when it is found and, where
+    /// what `enter` accepts `shrinks` as the walk goes, again when its turn comes.
+    #[inline(always)]
+    fn walk<S>(
+        &self,
+        state: &mut S,
+        towards: Option<Vec3>,
+        shrinks: bool,
+        enter: impl Fn(&S, Vec3, Vec3) -> bool,
+        mut leaf: impl FnMut(&mut S, usize) -> bool,
+    ) {
+        // Median splits keep the depth at about log₂(n / LEAF): 64 is never reached.
         let mut stack = [0u32; 64];
-        let mut top = 0;
-        if self.nodes.first().is_some_and(meets) {
-            top = 1;
-        }
+        let mut top = usize::from(self.nodes.first().is_some_and(|n| enter(state, n.lo, n.hi)));
         while top > 0 {
             top -= 1;
             let at = stack[top];
             let node = self.nodes[at as usize];
+            if shrinks && !enter(state, node.lo, node.hi) {
+                continue;
+            }
             if node.count > 0 {
-                for place in node.first..node.first + node.count {
-                    let [a, b, c] = self.corners[place as usize];
-                    if a.min(b).min(c).cmple(hi).all()
-                        && a.max(b).max(c).cmpge(lo).all()
-                        && !visit(self.index[place as usize])
-                    {
+                for place in node.first as usize..(node.first + node.count) as usize {
+                    if !leaf(state, place) {
                         return;
                     }
                 }
                 continue;
             }
-            for child in [node.first, at + 1] {
-                if meets(&self.nodes[child as usize]) {
+            // The child pushed last is walked first.
+            let (one, two) = (at + 1, node.first);
+            let (last, first) = match towards {
+                Some(p) if self.box_d2(one, p) > self.box_d2(two, p) => (one, two),
+                _ => (two, one),
+            };
+            for child in [last, first] {
+                let n = self.nodes[child as usize];
+                if enter(state, n.lo, n.hi) {
                     stack[top] = child;
                     top += 1;
                 }
