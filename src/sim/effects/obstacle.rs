@@ -9,10 +9,10 @@ use std::sync::Arc;
 use glam::{Quat, Vec3};
 
 use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
-use super::solid::{Solid, default_friction, resolve};
+use super::solid::{Solid, default_friction, resolve, resolve_remembering};
 use crate::mesh::{ObjError, PolygonSoup, parse_obj, read_obj};
 use crate::sim::motion::{AxisAngle, Keyframe, Pose, RigidMotion};
-use crate::sim::obstacle::{Moment, Sequence, SharpEdges, Surface};
+use crate::sim::obstacle::{Gathered, Moment, Sequence, SharpEdges, Surface};
 use crate::sim::param_error::ParamError;
 use crate::sim::self_contacts::ContactError;
 
@@ -121,6 +121,9 @@ pub struct Placed {
     pub motion: RigidMotion,
     pub pivot: Vec3,
     pub sequence: Option<Sequence>,
+    /// What each particle's last contact gathered, in the obstacle's frame (a rigid
+    /// obstacle's only: a sequence's surface changes every substep).
+    pub memory: std::sync::Mutex<Vec<Gathered>>,
 }
 
 impl Placed {
@@ -321,6 +324,7 @@ impl Obstacle {
             motion,
             pivot: self.translate,
             sequence,
+            memory: std::sync::Mutex::new(Vec::new()),
         })));
         Ok(())
     }
@@ -524,19 +528,41 @@ impl Solid for Posed<'_> {
         self.contact(from, to, offset).map(|(at, _, _)| at)
     }
 
-    /// The move seen from the obstacle (start and end each in its frame at that time), so
-    /// a moving obstacle sweeps particles along as a still one stops them.
     fn contact(&self, from: Vec3, to: Vec3, offset: f32) -> Option<(Vec3, Vec3, Vec3)> {
-        let pivot = self.placed.pivot;
-        let (a, b) = (self.start.unapply(pivot, from), self.end.unapply(pivot, to));
-        let caught = self.placed.surface.catch(a, b, offset)?;
-        let at = self.end.apply(pivot, caught.at);
-        let normal = self.end.rotation * caught.normal;
-        Some((at, normal, self.end.velocity_at(pivot, at)))
+        self.caught(from, to, offset, None)
+    }
+
+    fn contact_remembering(
+        &self,
+        from: Vec3,
+        to: Vec3,
+        offset: f32,
+        memory: &mut Gathered,
+    ) -> Option<(Vec3, Vec3, Vec3)> {
+        self.caught(from, to, offset, Some(memory))
     }
 
     fn friction(&self) -> f32 {
         self.friction
+    }
+}
+
+impl Posed<'_> {
+    /// The move seen from the obstacle (start and end each in its frame at that time), so
+    /// a moving obstacle sweeps particles along as a still one stops them.
+    fn caught(
+        &self,
+        from: Vec3,
+        to: Vec3,
+        offset: f32,
+        memory: Option<&mut Gathered>,
+    ) -> Option<(Vec3, Vec3, Vec3)> {
+        let pivot = self.placed.pivot;
+        let (a, b) = (self.start.unapply(pivot, from), self.end.unapply(pivot, to));
+        let caught = (self.placed.surface).catch_remembering(a, b, offset, memory)?;
+        let at = self.end.apply(pivot, caught.at);
+        let normal = self.end.rotation * caught.normal;
+        Some((at, normal, self.end.velocity_at(pivot, at)))
     }
 }
 
@@ -648,7 +674,14 @@ impl EffectKind for Obstacle {
             end: placed.motion.at(end),
             friction: self.friction,
         };
-        let moved = resolve(&posed, pass) + posed.push_edges(pass);
+        // Each particle's memory of its last contact, when no other stepping copy of the
+        // simulation holds it now (it only saves walks of the tree: the result is the same).
+        let mut memory = placed.memory.try_lock().ok();
+        let memory = memory.as_deref_mut().map(|m| {
+            m.resize(pass.state.pos.len(), Gathered::NONE);
+            &mut m[..]
+        });
+        let moved = resolve_remembering(&posed, pass, memory) + posed.push_edges(pass);
         pass.offset = offset;
         Ok(moved)
     }

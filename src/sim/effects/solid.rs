@@ -8,7 +8,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use glam::Vec3;
 
 use super::effect_kind::ContactPass;
-use crate::parallel::{each_part, within};
+use crate::parallel::{Disjoint, each_part, within};
+use crate::sim::obstacle::Gathered;
 
 /// Coulomb friction of a solid when a scene file gives none (dimensionless).
 pub(super) const DEFAULT_FRICTION: f32 = 0.5;
@@ -36,6 +37,18 @@ pub(super) trait Solid {
         Some((caught, n, v_surface))
     }
 
+    /// [`Solid::contact`] for a particle whose last contact left `memory` (what a mesh
+    /// gathered near it; other solids need none).
+    fn contact_remembering(
+        &self,
+        from: Vec3,
+        to: Vec3,
+        offset: f32,
+        _memory: &mut Gathered,
+    ) -> Option<(Vec3, Vec3, Vec3)> {
+        self.contact(from, to, offset)
+    }
+
     /// Coulomb friction coefficient (dimensionless, ≥ 0).
     fn friction(&self) -> f32;
 }
@@ -49,13 +62,26 @@ pub(super) trait Solid {
 /// Each particle's contact is its own, so a large cloth's particles are shared out between
 /// the team's members ([`each_part`]); the result is the same however they are cut.
 pub(super) fn resolve(solid: &(impl Solid + Sync), pass: &mut ContactPass<'_>) -> usize {
+    resolve_remembering(solid, pass, None)
+}
+
+/// [`resolve`] with each particle's memory of its last contact (`memory[i]` particle i's,
+/// as long as the cloth has particles).
+pub(super) fn resolve_remembering(
+    solid: &(impl Solid + Sync),
+    pass: &mut ContactPass<'_>,
+    memory: Option<&mut [Gathered]>,
+) -> usize {
     let (start, inv_mass) = (pass.start, &pass.model.inv_mass[..]);
     let contacts = AtomicUsize::new(0);
     let state = &mut *pass.state;
     let offset = pass.offset;
+    let memory = memory.map(Disjoint::new);
     each_part([&mut state.pos, &mut state.vel], |range, [pos, vel]| {
+        // SAFETY: `each_part`'s ranges are disjoint, so are these parts of the memory.
+        let memory = memory.as_ref().map(|m| unsafe { m.part(range.clone()) });
         let (start, inv_mass) = (within(start, range.clone()), within(inv_mass, range));
-        let found = resolve_part(solid, offset, pos, vel, start, inv_mass);
+        let found = resolve_part(solid, offset, pos, vel, start, inv_mass, memory);
         contacts.fetch_add(found, Ordering::Relaxed);
     });
     contacts.into_inner()
@@ -69,15 +95,20 @@ fn resolve_part(
     vel: &mut [Vec3],
     start: &[Vec3],
     inv_mass: &[f32],
+    mut memory: Option<&mut [Gathered]>,
 ) -> usize {
     let mu = solid.friction();
     let mut contacts = 0;
     let particles = pos.iter_mut().zip(vel.iter_mut());
-    for (((x, v), &from), &w) in particles.zip(start).zip(inv_mass) {
+    for (i, (((x, v), &from), &w)) in particles.zip(start).zip(inv_mass).enumerate() {
         if w == 0.0 {
             continue;
         }
-        let Some((caught, n, v_surface)) = solid.contact(from, *x, offset) else {
+        let found = match memory.as_deref_mut().and_then(|m| m.get_mut(i)) {
+            Some(memory) => solid.contact_remembering(from, *x, offset, memory),
+            None => solid.contact(from, *x, offset),
+        };
+        let Some((caught, n, v_surface)) = found else {
             continue;
         };
         contacts += 1;

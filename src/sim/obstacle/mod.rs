@@ -9,5 +9,5 @@ mod tree;
 
 pub use edges::{EdgeHit, SharpEdges};
 pub use sequence::{Moment, Sequence};
-pub use surface::{Caught, Surface};
+pub use surface::{Caught, Gathered, Surface};
 pub use tree::{Nearest, TriangleTree};
