@@ -356,7 +356,9 @@ struct Posed<'a> {
 /// How a frame of sharp edges lies in the world: `to_local` takes a world point into it,
 /// `to_world` turns a direction of it into the world's, `velocity` is the surface's
 /// velocity (world) at one of its points.
-struct EdgeFrame<L, W, V> {
+struct EdgeFrame<S, L, W, V> {
+    /// A world point where the substep began, into the frame as it was then.
+    from_start: S,
     to_local: L,
     to_world: W,
     velocity: V,
@@ -367,13 +369,14 @@ struct EdgeFrame<L, W, V> {
 /// proportion to how near each is to the nearest point, which moves by exactly what was
 /// missing; their velocity towards the edge is removed, with Coulomb friction `mu` along it.
 /// Returns how many cloth edges it moved.
-fn push_edges<L, W, V>(
+fn push_edges<S, L, W, V>(
     edges: &SharpEdges,
-    frame: &EdgeFrame<L, W, V>,
+    frame: &EdgeFrame<S, L, W, V>,
     mu: f32,
     pass: &mut ContactPass<'_>,
 ) -> usize
 where
+    S: Fn(Vec3) -> Vec3,
     L: Fn(Vec3) -> Vec3,
     W: Fn(Vec3) -> Vec3,
     V: Fn(Vec3) -> Vec3,
@@ -385,57 +388,90 @@ where
     let (springs, inv_mass) = (&pass.model.springs, &pass.model.inv_mass);
     let state = &mut *pass.state;
     let mut moved = 0;
-    for e in 0..pass.model.bend_start() {
-        let (i, j) = (springs.a[e] as usize, springs.b[e] as usize);
-        let free = [inv_mass[i] > 0.0, inv_mass[j] > 0.0].map(f32::from);
-        if free == [0.0, 0.0] {
-            continue;
-        }
-        let local = [state.pos[i], state.pos[j]].map(&frame.to_local);
-        let Some(hit) = edges.nearest(local[0], local[1], thickness) else {
-            continue;
-        };
-        let away = hit.on_segment - hit.on_edge;
-        if hit.distance <= thickness * 1e-3 || hit.distance >= thickness {
-            continue;
-        }
-        let n = (frame.to_world)(away / hit.distance);
-        let share = [1.0 - hit.along, hit.along];
-        let weight = share[0] * share[0] * free[0] + share[1] * share[1] * free[1];
-        if weight <= 0.0 {
-            continue;
-        }
-        let lift = (thickness - hit.distance) / weight;
-        let v_surface = (frame.velocity)(hit.on_edge);
-        for (k, p) in [i, j].into_iter().enumerate() {
-            let part = share[k] * free[k];
-            if part <= 0.0 {
+    // A cloth edge put back from a crossing can pull a neighbour across another: the pass
+    // repeats (a few times at most) while it finds crossings.
+    for _ in 0..EDGE_SWEEPS {
+        let mut crossings = 0;
+        for e in 0..pass.model.bend_start() {
+            let (i, j) = (springs.a[e] as usize, springs.b[e] as usize);
+            let free = [inv_mass[i] > 0.0, inv_mass[j] > 0.0].map(f32::from);
+            if free == [0.0, 0.0] {
                 continue;
             }
-            state.pos[p] += n * (lift * part);
-            let v_rel = state.vel[p] - v_surface;
-            let vn = v_rel.dot(n);
-            if vn < 0.0 {
-                let v_t = v_rel - vn * n;
-                let speed = v_t.length();
-                let keep = if speed > 0.0 {
-                    (1.0 - mu * part * (-vn) / speed).max(0.0)
-                } else {
-                    0.0
-                };
-                state.vel[p] = v_surface + (1.0 - part) * vn * n + keep * v_t;
+            let local = [state.pos[i], state.pos[j]].map(&frame.to_local);
+            let before = [pass.start[i], pass.start[j]].map(&frame.from_start);
+            // An edge the cloth edge passed through in the substep puts it back on the side it
+            // came from; else one it ends within the thickness of pushes it out. Every point
+            // of the cloth edge moved at most `travel`: one that passed through a sharp edge
+            // ends within that of it, so an edge with none that near is not asked.
+            let travel = (local[0] - before[0])
+                .length()
+                .max((local[1] - before[1]).length());
+            let Some(near) = edges.nearest(local[0], local[1], thickness.max(travel)) else {
+                continue;
+            };
+            let crossed = (near.distance <= travel)
+                .then(|| edges.crossed(before, local))
+                .flatten();
+            let (hit, side) = match crossed {
+                Some((edge, side)) => {
+                    crossings += 1;
+                    (SharpEdges::between(local[0], local[1], edge), side)
+                }
+                None => {
+                    if near.distance <= thickness * 1e-3 || near.distance >= thickness {
+                        continue;
+                    }
+                    (near, (near.on_segment - near.on_edge) / near.distance)
+                }
+            };
+            // What the nearest point of the cloth edge must move by, in the frame.
+            let gap = side * thickness - (hit.on_segment - hit.on_edge);
+            let n = (frame.to_world)(side);
+            let gap = (frame.to_world)(gap);
+            let share = [1.0 - hit.along, hit.along];
+            let weight = share[0] * share[0] * free[0] + share[1] * share[1] * free[1];
+            if weight <= 0.0 {
+                continue;
             }
+            let v_surface = (frame.velocity)(hit.on_edge);
+            for (k, p) in [i, j].into_iter().enumerate() {
+                let part = share[k] * free[k];
+                if part <= 0.0 {
+                    continue;
+                }
+                state.pos[p] += gap * (part / weight);
+                let v_rel = state.vel[p] - v_surface;
+                let vn = v_rel.dot(n);
+                if vn < 0.0 {
+                    let v_t = v_rel - vn * n;
+                    let speed = v_t.length();
+                    let keep = if speed > 0.0 {
+                        (1.0 - mu * part * (-vn) / speed).max(0.0)
+                    } else {
+                        0.0
+                    };
+                    state.vel[p] = v_surface + (1.0 - part) * vn * n + keep * v_t;
+                }
+            }
+            moved += 1;
         }
-        moved += 1;
+        if crossings == 0 {
+            break;
+        }
     }
     moved
 }
 
+/// How many times at most the edge pass runs in one substep.
+const EDGE_SWEEPS: usize = 4;
+
 impl Posed<'_> {
     /// [`push_edges`] against the obstacle's sharp edges where the substep ends.
     fn push_edges(&self, pass: &mut ContactPass<'_>) -> usize {
-        let (pivot, end) = (self.placed.pivot, self.end);
+        let (pivot, start, end) = (self.placed.pivot, self.start, self.end);
         let frame = EdgeFrame {
+            from_start: |p| start.unapply(pivot, p),
             to_local: |p| end.unapply(pivot, p),
             to_world: |n| end.rotation * n,
             velocity: |q| end.velocity_at(pivot, end.apply(pivot, q)),
@@ -460,7 +496,9 @@ impl Deforming<'_> {
     /// [`push_edges`] against its sharp edges where the substep ends.
     fn push_edges(&self, pass: &mut ContactPass<'_>) -> usize {
         let reach = pass.offset;
+        // (Its edges are taken where the substep ends for the whole substep.)
         let frame = EdgeFrame {
+            from_start: |p| p,
             to_local: |p| p,
             to_world: |n| n,
             velocity: |q| self.moment.velocity_near(q, reach),

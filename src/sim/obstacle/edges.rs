@@ -81,6 +81,35 @@ impl SharpEdges {
         self.edges.is_empty()
     }
 
+    /// Whether a segment moving from `before` to `after` (each end in a straight line) passes
+    /// through a sharp edge on the way: the first such edge, and the unit direction from it
+    /// to the segment where the move began (the side the segment must stay on).
+    pub fn crossed(&self, before: [Vec3; 2], after: [Vec3; 2]) -> Option<([Vec3; 2], Vec3)> {
+        let lo = before[0].min(before[1]).min(after[0]).min(after[1]);
+        let hi = before[0].max(before[1]).max(after[0]).max(after[1]);
+        let mut first: Option<(f32, [Vec3; 2], Vec3)> = None;
+        self.tree.overlapping(lo, hi, |e| {
+            let [p, q] = self.edges[e as usize];
+            let Some(t) = sweep_meets(before, after, p, q) else {
+                return;
+            };
+            if first.is_some_and(|(f, _, _)| f <= t) {
+                return;
+            }
+            let start = closest_between(before[0], before[1], p, q);
+            if start.distance > 0.0 {
+                let side = (start.on_segment - start.on_edge) / start.distance;
+                first = Some((t, [p, q], side));
+            }
+        });
+        first.map(|(_, edge, side)| (edge, side))
+    }
+
+    /// The nearest points of the segment from `a` to `b` and the sharp edge `edge`.
+    pub fn between(a: Vec3, b: Vec3, edge: [Vec3; 2]) -> EdgeHit {
+        closest_between(a, b, edge[0], edge[1])
+    }
+
     /// The sharp edge nearest to the segment from `a` to `b`, if one is within `reach`.
     pub fn nearest(&self, a: Vec3, b: Vec3, reach: f32) -> Option<EdgeHit> {
         let pad = Vec3::splat(reach);
@@ -94,6 +123,41 @@ impl SharpEdges {
         });
         best
     }
+}
+
+/// The first time in `0..=1` at which the segment moving from `before` to `after` meets the
+/// segment `p`–`q`: where the four points are coplanar (a quadratic in time) and the two
+/// segments then touch.
+fn sweep_meets(before: [Vec3; 2], after: [Vec3; 2], p: Vec3, q: Vec3) -> Option<f32> {
+    let u = q - p;
+    let (a, da) = (before[0] - p, after[0] - before[0]);
+    let (c, dc) = (before[1] - before[0], (after[1] - before[1]) - da);
+    // (a + t·da) · ((c + t·dc) × u) = k0 + k1·t + k2·t².
+    let (k0, k1, k2) = (
+        a.dot(c.cross(u)),
+        a.dot(dc.cross(u)) + da.dot(c.cross(u)),
+        da.dot(dc.cross(u)),
+    );
+    let scale = (c.length() + dc.length() + da.length()) * u.length();
+    let mut roots = [f32::NAN; 2];
+    if k2.abs() > 1e-9 * scale * scale.max(1e-12) {
+        let disc = k1 * k1 - 4.0 * k2 * k0;
+        if disc >= 0.0 {
+            let s = disc.sqrt();
+            roots = [(-k1 - s) / (2.0 * k2), (-k1 + s) / (2.0 * k2)];
+        }
+    } else if k1.abs() > 0.0 {
+        roots[0] = -k0 / k1;
+    }
+    roots.sort_by(f32::total_cmp);
+    let touch = 1e-5 * (c.length() + u.length());
+    roots
+        .into_iter()
+        .filter(|t| (0.0..=1.0).contains(t))
+        .find(|&t| {
+            let (x, y) = (before[0] + da * t, before[1] + (after[1] - before[1]) * t);
+            closest_between(x, y, p, q).distance <= touch
+        })
 }
 
 /// Each edge as a degenerate triangle, for the tree.
