@@ -70,7 +70,11 @@ impl SharpEdges {
         for (edge, ends) in self.edges.iter_mut().zip(&self.ends) {
             *edge = ends.map(|i| vertices[i as usize]);
         }
-        self.tree.refit(&boxes(&self.edges));
+        let edges = &self.edges;
+        self.tree.refit(|e| {
+            let [a, b] = edges[e];
+            [a, b, b]
+        });
     }
 
     pub fn len(&self) -> usize {

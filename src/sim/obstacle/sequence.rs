@@ -121,20 +121,36 @@ impl Sequence {
 
     /// Every vertex where the sequence has it at time `t`, seconds.
     pub fn vertices_at(&self, t: f64) -> Vec<Vec3> {
-        let (i, j, s) = self.span(t);
-        let (a, b) = (&self.frames[i], &self.frames[j]);
-        a.iter().zip(b).map(|(a, b)| a.lerp(*b, s)).collect()
+        let mut out = vec![Vec3::ZERO; self.frames[0].len()];
+        self.fill_vertices(t, &mut out);
+        out
     }
 
     /// Every vertex's velocity at time `t` (m/s): constant between two frames.
     pub fn velocities_at(&self, t: f64) -> Vec<Vec3> {
+        let mut out = vec![Vec3::ZERO; self.frames[0].len()];
+        self.fill_velocities(t, &mut out);
+        out
+    }
+
+    /// [`Sequence::vertices_at`] into `out`.
+    fn fill_vertices(&self, t: f64, out: &mut [Vec3]) {
+        let (i, j, s) = self.span(t);
+        let (a, b) = (&self.frames[i], &self.frames[j]);
+        for ((o, a), b) in out.iter_mut().zip(a).zip(b) {
+            *o = a.lerp(*b, s);
+        }
+    }
+
+    /// [`Sequence::velocities_at`] into `out`.
+    fn fill_velocities(&self, t: f64, out: &mut [Vec3]) {
         let (i, j, _) = self.span(t);
         let still = i == j || (t < 0.0);
         let (a, b) = (&self.frames[i], &self.frames[j]);
         let fps = self.fps as f32;
-        (a.iter().zip(b))
-            .map(|(a, b)| if still { Vec3::ZERO } else { (*b - *a) * fps })
-            .collect()
+        for ((o, a), b) in out.iter_mut().zip(a).zip(b) {
+            *o = if still { Vec3::ZERO } else { (*b - *a) * fps };
+        }
     }
 
     /// The lowest any vertex reaches along `up` in any frame.
@@ -164,12 +180,18 @@ impl Sequence {
     pub fn moment(&self, start: f64, end: f64) -> MutexGuard<'_, Moment> {
         let mut moment = self.moment.lock().unwrap_or_else(PoisonError::into_inner);
         if (moment.start, moment.end) != (start, end) {
-            let (from, to) = (self.vertices_at(start), self.vertices_at(end));
-            moment.surface.refit(&to);
-            moment.shift = to.iter().zip(&from).map(|(b, a)| *b - *a).collect();
-            moment.largest_shift = (moment.shift.iter().map(|s| s.length())).fold(0.0, f32::max);
-            moment.velocity = self.velocities_at(end);
-            (moment.start, moment.end) = (start, end);
+            // In place: a substep allocates nothing (the shift holds the start meanwhile,
+            // the velocity the end).
+            let m = &mut *moment;
+            self.fill_vertices(start, &mut m.shift);
+            self.fill_vertices(end, &mut m.velocity);
+            m.surface.refit(&m.velocity);
+            for (shift, to) in m.shift.iter_mut().zip(&m.velocity) {
+                *shift = *to - *shift;
+            }
+            m.largest_shift = (m.shift.iter().map(|s| s.length())).fold(0.0, f32::max);
+            self.fill_velocities(end, &mut m.velocity);
+            (m.start, m.end) = (start, end);
         }
         moment
     }

@@ -61,20 +61,13 @@ impl TriangleTree {
         }
     }
 
-    /// Moves its triangles to `triangles` (the same triangles, numbered as when it was
-    /// built, with new corners) and refits every box around them, keeping the tree's shape:
-    /// linear in the triangles, for a surface that deforms (an OBJ sequence).
-    ///
-    /// # Panics
-    /// When `triangles` is not as long as the tree.
-    pub fn refit(&mut self, triangles: &[[Vec3; 3]]) {
-        assert_eq!(
-            triangles.len(),
-            self.corners.len(),
-            "refit with other triangles"
-        );
+    /// Moves each triangle to `triangle(number)` (the same triangles, numbered as when it
+    /// was built, with new corners) and refits every box around them, keeping the tree's
+    /// shape: linear in the triangles and allocating nothing, for a surface that deforms
+    /// (an OBJ sequence) every substep.
+    pub fn refit(&mut self, triangle: impl Fn(usize) -> [Vec3; 3]) {
         for (corners, &t) in self.corners.iter_mut().zip(&self.index) {
-            *corners = triangles[t as usize];
+            *corners = triangle(t as usize);
         }
         // Children come after their parent, so boxes fill in from the last node back.
         for at in (0..self.nodes.len()).rev() {
