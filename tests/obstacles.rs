@@ -638,7 +638,18 @@ fn bad_obj_sequences_name_where() {
     );
     std::fs::write(dir.path().join("empty.obj"), "# nothing\nv 0 0 0\n").unwrap();
     let err = open("obj = \"empty.obj\"\n");
-    assert!(err.contains("empty.obj"), "{err}");
+    assert!(
+        err.contains("scene.toml:8:1:")
+            && err.contains("empty.obj")
+            && err.contains("no usable triangles"),
+        "{err}"
+    );
+    // A placement turning about no axis.
+    let err = parse("obj = \"a.obj\"\nrotate = { axis = [0.0, 0.0, 0.0], degrees = 30.0 }\n");
+    assert!(
+        err.contains("scene.toml:9:1:") && err.contains("non-zero axis"),
+        "{err}"
+    );
 }
 
 /// A deforming obstacle that moves further in a substep than the thickness (a plate rising

@@ -221,19 +221,21 @@ impl Obstacle {
             let path = at(name);
             path.is_file().then(|| read_obj(&path))
         };
-        let first = at(Path::new(&self.source()));
+        let first_path = at(Path::new(&self.source()));
         let setting = |path: &Path, error| ObstacleError::Setting {
             path: path.to_path_buf(),
             error,
         };
-        self.check().map_err(|e| setting(&first, e))?;
+        self.check().map_err(|e| setting(&first_path, e))?;
         let Some(pattern) = self.frames.clone() else {
             let soup = match read(&self.obj) {
                 Some(soup) => soup?,
-                None => read_obj(&first)?,
+                None => read_obj(&first_path)?,
             };
-            return self.place(&soup, &first, Vec::new());
+            return self.place(&soup, &first_path, Vec::new());
         };
+        // Frame 0 as read (its triangles are every frame's), and every frame placed.
+        let mut first: Option<(PolygonSoup, PathBuf)> = None;
         let mut frames = Vec::new();
         for k in 0..MAX_FRAMES {
             let Some(name) = frame_path(&pattern, k) else {
@@ -243,10 +245,12 @@ impl Obstacle {
                 break;
             };
             let soup = soup?.triangulated();
-            if let Some(first) = frames.first() {
-                let (first, path): &(PolygonSoup, PathBuf) = first;
-                if soup.face_indices != first.face_indices
-                    || soup.positions.len() != first.positions.len()
+            frames.push(self.placed_positions(&soup));
+            match &first {
+                None => first = Some((soup, at(Path::new(&name)))),
+                Some((first, path))
+                    if soup.face_indices != first.face_indices
+                        || soup.positions.len() != first.positions.len() =>
                 {
                     let error = ParamError::new(
                         "frames",
@@ -260,10 +264,10 @@ impl Obstacle {
                     );
                     return Err(setting(path, error));
                 }
+                Some(_) => {}
             }
-            frames.push((soup, at(Path::new(&name))));
         }
-        let Some((soup, path)) = frames.first() else {
+        let Some((soup, path)) = first else {
             let name = frame_path(&pattern, 0).unwrap_or_default();
             let error = ParamError::new(
                 "frames",
@@ -273,13 +277,9 @@ impl Obstacle {
                     at(Path::new(&name)).display()
                 ),
             );
-            return Err(setting(&first, error));
+            return Err(setting(&first_path, error));
         };
-        let rest = frames
-            .iter()
-            .map(|(f, _)| self.placed_positions(f))
-            .collect();
-        self.place(&soup.clone(), &path.clone(), rest)
+        self.place(&soup, &path, frames)
     }
 
     /// Places `soup` (a mesh made in code, named by [`Obstacle::obj`]) as the obstacle says,
