@@ -635,7 +635,12 @@ fn one_pass(
     state: &mut ClothState,
 ) -> Result<usize, ContactError> {
     let start = state.pos.clone();
-    solver.resolve(params.thickness, params.friction, model, &start, state)
+    solver.resolve(
+        [params.thickness, params.friction, 1.0 / 240.0],
+        model,
+        &start,
+        state,
+    )
 }
 
 /// A square cloth of `quads`² quads folded in half: the back half lies over the front half
@@ -653,12 +658,13 @@ fn folded_sheet(quads: u32, thickness: f32) -> (ClothModel, ClothState) {
 
 #[test]
 fn self_collision_work_grows_linearly_with_the_particle_count() {
-    let params = SelfCollision {
-        thickness: 0.004,
-        friction: 0.0,
-    };
     let mut per_particle = Vec::new();
     for quads in [16, 32, 64] {
+        // A quarter of the spacing, as the app suggests.
+        let params = SelfCollision {
+            thickness: 0.25 / quads as f32,
+            friction: 0.0,
+        };
         let (model, mut state) = folded_sheet(quads, params.thickness);
         let mut solver = SelfContacts::default();
         one_pass(&mut solver, &params, &model, &mut state).unwrap();

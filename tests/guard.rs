@@ -257,27 +257,27 @@ fn a_cloth_diverging_with_self_collision_is_rolled_back_not_aborted() {
     assert!(work.binned <= 8 * triangles, "{} entries", work.binned);
 }
 
-/// With the guard off nothing checks the substeps, and the blow-up reaches self-collision,
-/// which refuses it (a non-finite or absurdly spread state) instead of allocating for it:
-/// the frame fails with a message, and the process lives.
+/// With the guard off nothing checks the substeps, and the diverging state reaches
+/// self-contact, which never allocates for it: the table stays bounded every frame, and
+/// the run either ends with contact detection's refusal (a non-finite or absurdly spread
+/// state) or stays finite, its motion cut wherever the cloth would cross itself.
 #[test]
-fn with_the_guard_off_self_collision_refuses_a_blown_up_state() {
+fn with_the_guard_off_self_collision_stays_bounded_on_a_diverging_state() {
     let mut sim = builtin("self-fold", |s| {
         s.params.material.stiffness = s.params.material.stiffness.map(|k| k * 8.0);
         s.params.guard.enabled = false;
     });
     let triangles = sim.model().triangles.len() as u64;
-    let mut failed = None;
-    for _ in 0..10 {
+    for _ in 0..4 {
         if let Err(e) = sim.step_frame() {
-            failed = Some(e);
-            break;
+            let err = e.to_string();
+            assert!(err.contains("contact detection refused"), "{err}");
+            return;
         }
         let work = sim.self_collision_work().unwrap();
         assert!(work.binned <= 8 * triangles, "{} entries", work.binned);
+        assert!(sim.state().is_finite());
     }
-    let err = failed.expect("the blow-up ends in an error").to_string();
-    assert!(err.contains("contact detection refused"), "{err}");
 }
 
 /// A 20 × 20 cloth of 1 m with gravity and nothing else.

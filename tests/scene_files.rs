@@ -36,7 +36,7 @@ fn parse_error(text: &str) -> (usize, usize, String) {
 
 #[test]
 fn every_builtin_scene_file_parses_builds_and_round_trips() {
-    assert_eq!(BUILTIN_SCENES.len(), 10);
+    assert_eq!(BUILTIN_SCENES.len(), 13);
     for file in scenarios() {
         let scene = Scene::builtin(&file.name).expect("builds");
         assert!(scene.model.particle_count() > 100, "{}", file.name);
@@ -57,6 +57,9 @@ fn every_builtin_scene_file_parses_builds_and_round_trips() {
             "carousel",
             "twist",
             "arm",
+            "crumple",
+            "layers",
+            "fast-fold",
             "hanging-bench"
         ]
     );

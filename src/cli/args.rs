@@ -57,6 +57,10 @@ pub enum Command {
         /// numbered as `render --every` numbers its PNGs); must exist.
         #[arg(long)]
         out_dir: Option<PathBuf>,
+        /// After every frame, count the triangle pairs that intersect (the cloth's own, and
+        /// the cloth's against each solid) and report the largest counts.
+        #[arg(long)]
+        check_intersections: bool,
     },
     /// Render the state after --seconds to a PNG, or every K frames to a numbered sequence.
     Render {
@@ -191,6 +195,10 @@ pub struct RunArgs {
     /// Substeps per frame.
     #[arg(long)]
     pub substeps: Option<u32>,
+    /// Resize the scene's grid cloth to N quads along its longer side (its self-collision
+    /// thickness shrinks with the spacing).
+    #[arg(long)]
+    pub quads: Option<u32>,
     /// What steps the cloth: cpu (every integrator and effect) or gpu (wgpu compute:
     /// semi-implicit Euler, springs, gravity, air damping, pins, spheres, planes).
     #[arg(long, value_enum, default_value_t = Backend::Cpu)]
@@ -202,8 +210,9 @@ pub struct RunArgs {
 impl RunArgs {
     /// The simulation the arguments describe, on the backend they ask for.
     pub fn simulation(&self) -> Result<Simulation> {
+        let options = self.import.options()?;
         let mut scene =
-            Scene::open_with_obj(&self.scene, self.obj.as_deref(), &self.import.options()?)?;
+            Scene::open_resized(&self.scene, self.obj.as_deref(), &options, self.quads)?;
         if let Some(k) = self.integrator {
             scene.params.step.integrator = k;
         }

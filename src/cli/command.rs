@@ -32,11 +32,13 @@ pub fn run(cli: Cli) -> Result<()> {
             export_obj,
             every,
             out_dir,
+            check_intersections,
         }) => simulate(
             &run,
             json,
             export_obj.as_deref(),
             out_dir.as_deref().map(|dir| (dir, every.unwrap_or(1))),
+            check_intersections,
         ),
         Some(Command::Render {
             run,

@@ -5,6 +5,7 @@ use std::path::Path;
 use anyhow::{Result, bail};
 use clothsim::mesh::{PolygonSoup, write_obj};
 use clothsim::scene::Simulation;
+use clothsim::sim::Intersections;
 use clothsim::view;
 
 use super::args::RunArgs;
@@ -18,6 +19,7 @@ pub fn simulate(
     json: bool,
     export: Option<&Path>,
     frames: Option<(&Path, u32)>,
+    check_intersections: bool,
 ) -> Result<()> {
     if let Some(path) = export {
         check_directory(path)?;
@@ -29,14 +31,22 @@ pub fn simulate(
     }
     let mut sim = args.simulation()?;
     let mut written = 0u64;
-    let summary = sim.run_observed(args.seconds, |sim, frame| match frames {
-        Some((dir, every)) if frame % every.max(1) as u64 == 0 => {
-            write_frame(sim, dir, written)?;
-            written += 1;
-            anyhow::Ok(())
+    let mut worst: Option<Intersections> = None;
+    let mut summary = sim.run_observed(args.seconds, |sim, frame| {
+        if check_intersections {
+            let now = sim.intersections();
+            worst = Some(worst.as_ref().map_or_else(|| now.clone(), |w| w.max(&now)));
         }
-        _ => Ok(()),
+        match frames {
+            Some((dir, every)) if frame % every.max(1) as u64 == 0 => {
+                write_frame(sim, dir, written)?;
+                written += 1;
+                anyhow::Ok(())
+            }
+            _ => Ok(()),
+        }
     })?;
+    summary.intersections = worst;
     if let Some((dir, _)) = frames
         && !json
     {
@@ -75,6 +85,14 @@ pub fn simulate(
         match summary.min_collider_distance {
             Some(d) => println!("  closest particle to a collider surface: {d:.5} m"),
             None => println!("  no colliders"),
+        }
+        if let Some(found) = &summary.intersections {
+            let solids: Vec<String> = found.obstacles.iter().map(ToString::to_string).collect();
+            println!(
+                "  intersections (most after any frame): self {}, solids [{}]",
+                found.self_pairs,
+                solids.join(", ")
+            );
         }
         for event in &summary.guard_events {
             println!("  stability guard: {event}");

@@ -17,7 +17,7 @@ use super::weld::weld;
 /// Cloth topology in its rest shape. Valid by construction: every particle belongs to at
 /// least one triangle of positive area, indices are in range, edges are unique, and no
 /// particle pair carries two springs.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct ClothMesh {
     /// Rest positions of the particles, metres.
     pub positions: Vec<Vec3>,
@@ -59,6 +59,31 @@ impl From<ClothMesh> for MeshBuild {
 }
 
 impl ClothMesh {
+    /// `layers` copies of the mesh, each `step` (metres) beyond the one before, as one
+    /// cloth of separate pieces (the copies share no particle).
+    pub fn stacked(&self, layers: u32, step: Vec3) -> ClothMesh {
+        let mut out = ClothMesh::default();
+        let n = self.positions.len() as u32;
+        for layer in 0..layers {
+            let shift = step * layer as f32;
+            let at = layer * n;
+            let moved = |x: &[u32; 2]| x.map(|i| i + at);
+            out.positions
+                .extend(self.positions.iter().map(|&p| p + shift));
+            out.uvs.extend_from_slice(&self.uvs);
+            out.triangles
+                .extend(self.triangles.iter().map(|t| t.map(|i| i + at)));
+            out.edges.extend(self.edges.iter().map(moved));
+            out.edge_kinds.extend_from_slice(&self.edge_kinds);
+            out.cross_diagonals
+                .extend(self.cross_diagonals.iter().map(moved));
+            out.bend_pairs.extend(self.bend_pairs.iter().map(moved));
+            out.hinges
+                .extend(self.hinges.iter().map(|h| h.map(|i| i + at)));
+        }
+        out
+    }
+
     /// Number of mesh edges of the given kind.
     pub fn edge_count(&self, kind: SpringKind) -> usize {
         self.edge_kinds.iter().filter(|&&k| k == kind).count()

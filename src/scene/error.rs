@@ -47,6 +47,9 @@ pub enum SceneError {
     /// An obstacle's mesh could not be read or placed.
     #[error(transparent)]
     Obstacle(#[from] crate::sim::ObstacleError),
+    /// `--quads` cannot resize this scene's cloth.
+    #[error("scene `{scene}`: {why}")]
+    Resize { scene: String, why: String },
     /// A scene file built in code names no cloth (`cloth.obj` or `cloth.grid`).
     #[error("the scene `{scene}` has no cloth: give `obj` or `grid` in [cloth]")]
     NoCloth { scene: String },

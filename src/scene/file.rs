@@ -104,6 +104,31 @@ pub struct GridShape {
     /// Which pairs get bend springs (default: across each interior edge).
     #[serde(default, skip_serializing_if = "is_default")]
     pub bend: GridBends,
+    /// Copies of the grid stacked one above another (default 1), `spacing` metres apart.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub layers: u32,
+    /// Metres between stacked layers (with `layers`).
+    #[serde(
+        default = "default_spacing",
+        skip_serializing_if = "is_default_spacing"
+    )]
+    pub spacing: f32,
+}
+
+fn one() -> u32 {
+    1
+}
+
+fn is_one(n: &u32) -> bool {
+    *n == 1
+}
+
+fn default_spacing() -> f32 {
+    0.05
+}
+
+fn is_default_spacing(s: &f32) -> bool {
+    *s == default_spacing()
 }
 
 fn is_default<T: Default + PartialEq>(value: &T) -> bool {
@@ -375,6 +400,17 @@ impl SceneFile {
                 }
                 if !(sx.is_finite() && sy.is_finite() && sx > 0.0 && sy > 0.0) {
                     return bad(grid_key("size"), "must be positive metres");
+                }
+                if !(1..=64).contains(&g.layers) {
+                    return bad(grid_key("layers"), "must be in 1..=64");
+                }
+                let height = g.spacing * (g.layers - 1) as f32;
+                if !(g.spacing.is_finite() && g.spacing > 0.0 && height < sx.min(sy)) {
+                    return bad(
+                        grid_key("spacing"),
+                        "must be positive metres, the stack (spacing × (layers − 1)) less \
+                         than the grid's shorter side",
+                    );
                 }
             }
             (Some(_), None) => {}

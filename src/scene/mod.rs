@@ -5,6 +5,7 @@ mod file;
 mod framing;
 mod locate;
 mod registry;
+mod resize;
 mod save;
 #[allow(clippy::module_inception)]
 mod scene;

@@ -32,6 +32,12 @@ pub static BUILTIN_SCENES: &[(&str, &str)] = &[
     ),
     ("twist", include_str!("../../assets/scenes/twist.toml")),
     ("arm", include_str!("../../assets/scenes/arm.toml")),
+    ("crumple", include_str!("../../assets/scenes/crumple.toml")),
+    ("layers", include_str!("../../assets/scenes/layers.toml")),
+    (
+        "fast-fold",
+        include_str!("../../assets/scenes/fast-fold.toml"),
+    ),
     (
         "hanging-bench",
         include_str!("../../assets/scenes/hanging-bench.toml"),

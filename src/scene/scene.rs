@@ -128,13 +128,36 @@ impl Scene {
         obj: Option<&Path>,
         options: &ImportOptions,
     ) -> Result<Scene, SceneError> {
-        let (file, base) = if what.ends_with(".toml") {
+        Self::open_resized(what, obj, options, None)
+    }
+
+    /// As [`Scene::open_with_obj`], with the grid cloth resized to `quads` quads along its
+    /// longer side when given ([`SceneFile::resize_grid`]).
+    ///
+    /// # Errors
+    /// As [`Scene::open_with_obj`], and [`SceneError::Resize`].
+    pub fn open_resized(
+        what: &str,
+        obj: Option<&Path>,
+        options: &ImportOptions,
+        quads: Option<u32>,
+    ) -> Result<Scene, SceneError> {
+        let (mut file, base) = if what.ends_with(".toml") {
             let loaded = SceneFile::load(Path::new(what))?;
             let base = loaded.path.parent().map(Path::to_path_buf);
             (with_obstacles(&loaded)?, base)
         } else {
             (lookup(what)?.clone(), None)
         };
+        if let Some(quads) = quads {
+            if obj.is_some() {
+                return Err(SceneError::Resize {
+                    scene: file.name.clone(),
+                    why: "--quads resizes a grid cloth; it cannot go with --obj".into(),
+                });
+            }
+            file.resize_grid(quads)?;
+        }
         match obj {
             Some(path) => {
                 let cloth = mesh::load_obj_with(path, options)?;
@@ -187,8 +210,12 @@ impl Scene {
                     orientation: GridOrientation::Horizontal,
                     center: Vec3::ZERO,
                 };
-                let mesh = spec.build_with(grid.bend)?;
-                let name = format!("{qx}×{qy}-quad grid, {sx}×{sy} m");
+                let mut mesh = spec.build_with(grid.bend)?;
+                let mut name = format!("{qx}×{qy}-quad grid, {sx}×{sy} m");
+                if grid.layers > 1 {
+                    mesh = mesh.stacked(grid.layers, Vec3::Y * grid.spacing);
+                    name = format!("{} layers of {name}, {} m apart", grid.layers, grid.spacing);
+                }
                 (MeshBuild::from(mesh), name)
             }
             // `SceneFile::parse` refuses this; a file built in code may still have it.

@@ -5,8 +5,9 @@
 use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{
     Cause, Changes, CpuStepper, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent,
-    IntegratorKind, ParamError, PhaseTimings, SimParams, StepBackend, StepError, StepReport,
-    StepStats, obstacle_overlap_warnings, small_sphere_warnings, thickness_fits,
+    IntegratorKind, Intersections, ParamError, PhaseTimings, SimParams, StepBackend, StepError,
+    StepReport, StepStats, intersections, obstacle_overlap_warnings, small_sphere_warnings,
+    thickness_fits,
 };
 
 use super::error::SceneError;
@@ -95,6 +96,11 @@ impl Simulation {
             &scene.model,
             &scene.initial.pos,
             offset,
+        ));
+        warnings.extend(intersection_warnings(
+            &scene.effects,
+            &scene.model,
+            &scene.initial,
         ));
         Self {
             file: scene.file,
@@ -201,6 +207,17 @@ impl Simulation {
 
     pub fn effects(&self) -> &[Effect] {
         &self.effects
+    }
+
+    /// The triangle pairs that intersect now: the cloth's own, and the cloth's against each
+    /// solid (see [`crate::sim::intersections()`]).
+    pub fn intersections(&self) -> Intersections {
+        intersections(
+            &self.effects,
+            self.state.time,
+            &self.model.triangles,
+            &self.state.pos,
+        )
     }
 
     /// The solids among the effects (spheres, planes): what a particle may not enter.
@@ -584,4 +601,34 @@ impl Simulation {
     pub fn integrator_in_effect(&self) -> IntegratorKind {
         self.backend.integrator()
     }
+}
+
+/// A warning for a cloth that already intersects itself or a solid in `initial`: the
+/// guarantee that contact keeps a cloth free of intersections starts from a free state.
+fn intersection_warnings(
+    effects: &[Effect],
+    model: &ClothModel,
+    initial: &ClothState,
+) -> Vec<String> {
+    let found = intersections(effects, initial.time, &model.triangles, &initial.pos);
+    let mut warnings = Vec::new();
+    if found.self_pairs > 0 {
+        warnings.push(format!(
+            "the cloth intersects itself at the start ({} triangle pairs meet): contact \
+             keeps a cloth free of intersections only from a free start",
+            found.self_pairs
+        ));
+    }
+    let solids = effects.iter().filter(|e| e.is_solid());
+    for (k, (count, solid)) in found.obstacles.iter().zip(solids).enumerate() {
+        if *count > 0 {
+            warnings.push(format!(
+                "the cloth intersects solid {} ({}) at the start: {count} of its triangles \
+                 meet it",
+                k + 1,
+                solid.phase()
+            ));
+        }
+    }
+    warnings
 }

@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use crate::mesh::SpringKind;
-use crate::sim::{FrameOutcome, GuardEvent, min_surface_distance};
+use crate::sim::{FrameOutcome, GuardEvent, Intersections, min_surface_distance};
 
 use super::simulation::Simulation;
 
@@ -50,6 +50,10 @@ pub struct RunSummary {
     /// Linear-solver (conjugate-gradient) iterations per step during the run: 0 for
     /// integrators without a linear solve.
     pub solver_iterations_per_step: f64,
+    /// The largest intersection counts seen after any frame, when asked for (`simulate
+    /// --check-intersections`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub intersections: Option<Intersections>,
     /// Set when the run stopped early because it diverged.
     pub error: Option<String>,
 }
@@ -153,6 +157,7 @@ impl Simulation {
             guard_events: Vec::new(),
             phases: BTreeMap::new(),
             solver_iterations_per_step: 0.0,
+            intersections: None,
             error: None,
         }
     }

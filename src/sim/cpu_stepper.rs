@@ -50,6 +50,8 @@ pub struct CpuStepper {
     substep_start: Vec<glam::Vec3>,
     self_collision: Option<SelfCollision>,
     self_contacts: SelfContacts,
+    /// Positions after self-contact, before the solids act again.
+    after_self: Vec<glam::Vec3>,
     /// Air damping in effect, 1/s (0 without the effect; for the guard's diagnosis).
     air_damping: f32,
 }
@@ -76,6 +78,7 @@ impl CpuStepper {
             substep_start: Vec::new(),
             self_collision: None,
             self_contacts: SelfContacts::default(),
+            after_self: Vec::new(),
             air_damping: 0.0,
         };
         stepper.configure(model, params, effects, Changes::all());
@@ -130,6 +133,23 @@ impl CpuStepper {
         };
         for c in &self.contacts {
             contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
+        }
+        // Self-contact may have pushed cloth into a solid (a stack pressing its lowest
+        // layer): the solids act once more, and the cloth's motion since self-contact is
+        // checked again, cut where a pair of the cloth could meet.
+        if let Some(own) = self.self_collision
+            && self.contacts.len() > 1
+        {
+            self.after_self.clone_from(&pass.state.pos);
+            for c in self.contacts.iter().filter(|c| c.is_solid()) {
+                contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
+            }
+            let (from, h) = (&self.after_self, pass.substep);
+            let settle = || {
+                pass.self_contacts
+                    .settle(own.thickness, h, model, from, pass.state)
+            };
+            self.timings.time("self-recheck", settle)?;
         }
         if contacts > 0 {
             // Contacts changed positions and velocities after the integrator's step.

@@ -110,7 +110,8 @@ impl EffectKind for SelfCollision {
 
     fn resolve(&self, pass: &mut ContactPass<'_>) -> Result<usize, ContactError> {
         let (model, start) = (pass.model, pass.start);
-        (pass.self_contacts).resolve(self.thickness, self.friction, model, start, pass.state)
+        let settings = [self.thickness, self.friction, pass.substep];
+        (pass.self_contacts).resolve(settings, model, start, pass.state)
     }
 
     fn on_gpu(&self) -> Result<(), &'static str> {

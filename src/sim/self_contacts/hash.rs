@@ -1,0 +1,159 @@
+//! The broad phase: a hierarchical spatial hash of the triangles' boxes. Each box goes to
+//! the first level whose cells (the base cell times 2^level) hold it in at most two cells
+//! along each axis, so the table holds at most eight entries a triangle however the cloth
+//! is stretched, and two boxes that overlap share a cell at the coarser one's level.
+
+use glam::Vec3;
+
+use super::error::ContactError;
+
+/// Levels of the hash. A box wider than the base cell times 2^`MAX_LEVEL` (a million times
+/// the cloth's own scale) is a state that has blown up, refused rather than binned.
+const MAX_LEVEL: u32 = 20;
+
+/// Most cells one triangle is binned in: two along each axis.
+pub const CELLS_PER_TRIANGLE: usize = 8;
+
+/// The key of cell `c` at `level`: three coordinates wrapped into 21 bits each, mixed with
+/// the level. Distinct cells rarely share a key, and a shared key only adds entries that
+/// the level and cell checks then skip.
+fn cell_key(c: [i32; 3], level: u32) -> u64 {
+    let w = |x: i32| (x as u64) & 0x1F_FFFF;
+    (w(c[0]) | (w(c[1]) << 21) | (w(c[2]) << 42))
+        ^ (level as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+}
+
+fn cell_of(p: Vec3, size: f32) -> [i32; 3] {
+    // Float-to-int casts saturate: a far-away point lands in an edge cell, which only adds
+    // candidates.
+    // `floor` without a call into libm: truncate, then step down below zero.
+    (p / size).to_array().map(|x| {
+        let i = x as i32;
+        if (i as f32) > x { i - 1 } else { i }
+    })
+}
+
+/// The first level at which the box `lo..hi` lies in at most two cells along each axis;
+/// `None` past [`MAX_LEVEL`].
+fn level_of(lo: Vec3, hi: Vec3, cell: f32) -> Option<u32> {
+    let extent = (hi - lo).max_element();
+    (0..=MAX_LEVEL).find(|&level| {
+        let size = cell * (1u32 << level) as f32;
+        let (first, last) = (cell_of(lo, size), cell_of(hi, size));
+        extent <= size && (0..3).all(|i| i64::from(last[i]) - i64::from(first[i]) <= 1)
+    })
+}
+
+/// Calls `visit` with each cell of the box `lo..hi` at cell `size`.
+fn each_cell(lo: Vec3, hi: Vec3, size: f32, mut visit: impl FnMut([i32; 3])) {
+    let (first, last) = (cell_of(lo, size), cell_of(hi, size));
+    for x in first[0]..=last[0] {
+        for y in first[1]..=last[1] {
+            for z in first[2]..=last[2] {
+                visit([x, y, z]);
+            }
+        }
+    }
+}
+
+/// The table, kept between substeps (its buffers are reused).
+#[derive(Clone, Debug, Default)]
+pub struct BoxHash {
+    /// (cell key, box), sorted by key.
+    bins: Vec<(u64, u32)>,
+    /// Each box's level.
+    level: Vec<u8>,
+    /// Bit `l` is set when some box is at level `l`.
+    levels: u32,
+    cell: f32,
+}
+
+impl BoxHash {
+    /// Entries in the table now: at most [`CELLS_PER_TRIANGLE`] per box.
+    pub fn len(&self) -> usize {
+        self.bins.len()
+    }
+
+    /// Bins the boxes (`lo[i]..hi[i]`) with a base cell of `cell` metres.
+    ///
+    /// # Errors
+    /// [`ContactError::Extent`] for a box a million base cells wide (nothing is binned).
+    pub fn bin(&mut self, lo: &[Vec3], hi: &[Vec3], cell: f32) -> Result<(), ContactError> {
+        self.bins.clear();
+        self.level.clear();
+        self.levels = 0;
+        self.cell = cell;
+        for (t, (&lo, &hi)) in lo.iter().zip(hi).enumerate() {
+            let Some(level) = level_of(lo, hi, cell) else {
+                self.bins.clear();
+                return Err(ContactError::Extent {
+                    triangle: t,
+                    extent: (hi - lo).max_element(),
+                    cell,
+                });
+            };
+            self.levels |= 1 << level;
+            self.level.push(level as u8);
+            let size = cell * (1u32 << level) as f32;
+            each_cell(lo, hi, size, |c| {
+                self.bins.push((cell_key(c, level), t as u32))
+            });
+        }
+        self.bins.sort_unstable();
+        Ok(())
+    }
+
+    /// Calls `pair(a, b)` once for every pair of boxes that overlap: pairs at one level
+    /// from the runs of the table's cells (in the table's order), each in the one cell
+    /// that holds the overlap's lowest corner; then each box against the coarser levels'
+    /// cells it touches.
+    pub fn overlapping_pairs(&self, lo: &[Vec3], hi: &[Vec3], mut pair: impl FnMut(u32, u32)) {
+        let mut overlap = |a: usize, b: usize, level: u32, key: u64| {
+            let (l, h) = (lo[a].max(lo[b]), hi[a].min(hi[b]));
+            let size = self.cell * (1u32 << level) as f32;
+            if l.cmple(h).all() && cell_key(cell_of(l, size), level) == key {
+                pair(a as u32, b as u32);
+            }
+        };
+        let mut run = 0;
+        while run < self.bins.len() {
+            let key = self.bins[run].0;
+            let end = run + self.bins[run..].partition_point(|&(k, _)| k == key);
+            let cell = &self.bins[run..end];
+            for (i, &(_, a)) in cell.iter().enumerate() {
+                let level = u32::from(self.level[a as usize]);
+                for &(_, b) in &cell[i + 1..] {
+                    // A shared key from another level is not a shared cell.
+                    if u32::from(self.level[b as usize]) == level {
+                        overlap(a as usize, b as usize, level, key);
+                    }
+                }
+            }
+            run = end;
+        }
+        if self.levels.count_ones() < 2 {
+            return;
+        }
+        for a in 0..lo.len() {
+            let own = u32::from(self.level[a]);
+            let mut levels = self.levels >> (own + 1) << (own + 1);
+            while levels != 0 {
+                let level = levels.trailing_zeros();
+                levels &= levels - 1;
+                let size = self.cell * (1u32 << level) as f32;
+                each_cell(lo[a], hi[a], size, |c| {
+                    let key = cell_key(c, level);
+                    let first = self.bins.partition_point(|&(k, _)| k < key);
+                    for &(k, b) in &self.bins[first..] {
+                        if k != key {
+                            break;
+                        }
+                        if u32::from(self.level[b as usize]) == level {
+                            overlap(a, b as usize, level, key);
+                        }
+                    }
+                });
+            }
+        }
+    }
+}

@@ -1,0 +1,21 @@
+//! Self-contact: the cloth kept off itself. Two kinds of pair — a vertex against a triangle
+//! it is not a corner of, an edge against an edge it shares no particle with — are found
+//! by a hierarchical spatial hash of the triangles' boxes over the substep's motion
+//! ([`hash`]), pushed a thickness apart at the substep's end with friction, and then
+//! checked along the whole motion by conservative continuous collision detection
+//! ([`ccd`]): a pair whose sides could meet has its free particles' motion cut short where
+//! they are still apart, round after round, until no pair can meet (after a few rounds
+//! the cut is to the substep's start, where the cloth was free of intersections, so the
+//! rounds end). A cloth that starts free of intersections so never gets one; only motion
+//! that is prescribed (pins, handles) can force a pair through, and such pairs are
+//! counted ([`SelfWork::forced`]).
+
+mod ccd;
+mod error;
+mod hash;
+mod primitives;
+mod solver;
+
+pub use error::ContactError;
+pub use hash::CELLS_PER_TRIANGLE;
+pub use solver::{SelfContacts, SelfWork};

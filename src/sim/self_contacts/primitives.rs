@@ -1,0 +1,216 @@
+//! The two kinds of contact between a cloth and itself — a vertex against a triangle, an
+//! edge against an edge — their closest points, and the push that keeps one a thickness
+//! from the other.
+
+use glam::{DVec3, Vec3};
+
+use crate::cloth::{ClothModel, ClothState};
+
+/// A pair that may come into contact: vertex `v[0]` against triangle `v[1..4]`, or (with
+/// `edges`) edge `v[0..2]` against edge `v[2..4]`. The four particles are distinct.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Pair {
+    pub v: [u32; 4],
+    pub edges: bool,
+}
+
+impl Pair {
+    /// The weights that make the pair's two closest points from its four particles: the
+    /// first point is Σ `w[i]` x_i over the first side, the second over the other (both
+    /// sides' weights sum to one).
+    pub fn weights(&self, x: [Vec3; 4]) -> [f32; 4] {
+        if self.edges {
+            let (s, t) = segments_closest(x[0], x[1], x[2], x[3]);
+            [1.0 - s, s, 1.0 - t, t]
+        } else {
+            let b = triangle_closest(x[0], x[1], x[2], x[3]);
+            [1.0, b[0], b[1], b[2]]
+        }
+    }
+
+    /// How many of the four particles belong to the first side.
+    pub fn first_side(&self) -> usize {
+        if self.edges { 2 } else { 1 }
+    }
+}
+
+/// Barycentric weights of the point of triangle (a, b, c) closest to `p`.
+pub fn triangle_closest(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
+    // Ericson, Real-Time Collision Detection, 5.1.5: regions by barycentric signs.
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return [1.0, 0.0, 0.0];
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return [0.0, 1.0, 0.0];
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return [1.0 - v, v, 0.0];
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return [0.0, 0.0, 1.0];
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return [1.0 - w, 0.0, w];
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return [0.0, 1.0 - w, w];
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    [1.0 - v - w, v, w]
+}
+
+/// Parameters (s, t) in [0, 1] of the closest points of segments (p0, p1) and (q0, q1).
+pub fn segments_closest(p0: Vec3, p1: Vec3, q0: Vec3, q1: Vec3) -> (f32, f32) {
+    let (s, t) = segments_closest_f64(p0.as_dvec3(), p1.as_dvec3(), q0.as_dvec3(), q1.as_dvec3());
+    (s as f32, t as f32)
+}
+
+fn segments_closest_f64(p0: DVec3, p1: DVec3, q0: DVec3, q1: DVec3) -> (f64, f64) {
+    // Ericson 5.1.9, with the degenerate cases.
+    let (d1, d2, r) = (p1 - p0, q1 - q0, p0 - q0);
+    let (a, e, f) = (d1.length_squared(), d2.length_squared(), d2.dot(r));
+    if a <= f64::EPSILON && e <= f64::EPSILON {
+        return (0.0, 0.0);
+    }
+    if a <= f64::EPSILON {
+        return (0.0, (f / e).clamp(0.0, 1.0));
+    }
+    let c = d1.dot(r);
+    if e <= f64::EPSILON {
+        return ((-c / a).clamp(0.0, 1.0), 0.0);
+    }
+    let b = d1.dot(d2);
+    let denom = a * e - b * b;
+    let mut s = if denom > 0.0 {
+        ((b * f - c * e) / denom).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let mut t = (b * s + f) / e;
+    if t < 0.0 {
+        t = 0.0;
+        s = (-c / a).clamp(0.0, 1.0);
+    } else if t > 1.0 {
+        t = 1.0;
+        s = ((b - c) / a).clamp(0.0, 1.0);
+    }
+    (s, t)
+}
+
+/// The distance between the pair's two sides with its particles at `x`, in f64.
+pub fn distance(pair: &Pair, x: [DVec3; 4]) -> f64 {
+    if pair.edges {
+        let (s, t) = segments_closest_f64(x[0], x[1], x[2], x[3]);
+        (x[0] + s * (x[1] - x[0])).distance(x[2] + t * (x[3] - x[2]))
+    } else {
+        point_triangle_distance(x[0], [x[1], x[2], x[3]])
+    }
+}
+
+/// The distance from `p` to triangle (a, b, c), in f64.
+pub fn point_triangle_distance(p: DVec3, [a, b, c]: [DVec3; 3]) -> f64 {
+    let n = (b - a).cross(c - a);
+    let inside = [(a, b), (b, c), (c, a)]
+        .iter()
+        .all(|&(u, v)| (v - u).cross(p - u).dot(n) >= 0.0);
+    if inside && n != DVec3::ZERO {
+        return (p - a).dot(n).abs() / n.length();
+    }
+    let to_segment = |u: DVec3, v: DVec3| {
+        let d = v - u;
+        let s = if d == DVec3::ZERO {
+            0.0
+        } else {
+            ((p - u).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+        };
+        p.distance(u + s * d)
+    };
+    to_segment(a, b).min(to_segment(b, c)).min(to_segment(c, a))
+}
+
+/// Keeps the pair's sides `thickness` apart, on the side they were on at the substep's
+/// start (`start`): each particle moves by its share of the push (its weight times its
+/// inverse mass); the approaching relative velocity is removed and Coulomb `friction`
+/// applied to the sliding part. Returns whether it pushed.
+pub fn push_apart(
+    pair: &Pair,
+    [thickness, friction]: [f32; 2],
+    model: &ClothModel,
+    start: &[Vec3],
+    state: &mut ClothState,
+) -> bool {
+    let ids = pair.v.map(|i| i as usize);
+    let x = ids.map(|i| state.pos[i]);
+    let k = pair.first_side();
+    // Sides whose boxes are a thickness apart are not in contact.
+    let side_box = |r: std::ops::Range<usize>| {
+        r.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), i| {
+            (lo.min(x[i]), hi.max(x[i]))
+        })
+    };
+    let ((alo, ahi), (blo, bhi)) = (side_box(0..k), side_box(k..4));
+    if (blo - ahi).max(alo - bhi).max_element() >= thickness {
+        return false;
+    }
+    let w = pair.weights(x);
+    // Signed weights: the first side counts positively, the other negatively.
+    let sign = |i: usize| if i < k { 1.0 } else { -1.0 };
+    let gap: Vec3 = (0..4).map(|i| sign(i) * w[i] * x[i]).sum();
+    let dist = gap.length();
+    if dist >= thickness {
+        return false;
+    }
+    // Which side: the sides' offset at the start, at the same weights.
+    let before: Vec3 = (0..4).map(|i| sign(i) * w[i] * start[ids[i]]).sum();
+    let direction = if before.length_squared() > 0.0 && gap.dot(before) > 0.0 && dist > 1e-9 {
+        gap / dist
+    } else if let Some(n) = before.try_normalize() {
+        n
+    } else if let Some(n) = gap.try_normalize() {
+        n
+    } else {
+        return false;
+    };
+    let depth = thickness - gap.dot(direction);
+    if depth <= 0.0 {
+        return false;
+    }
+    let inv = &model.inv_mass;
+    let weight: f32 = (0..4).map(|i| w[i] * w[i] * inv[ids[i]]).sum();
+    if weight <= 0.0 {
+        return false;
+    }
+    let lambda = depth / weight;
+    for i in 0..4 {
+        state.pos[ids[i]] += (sign(i) * w[i] * inv[ids[i]] * lambda) * direction;
+    }
+    let relative: Vec3 = (0..4).map(|i| sign(i) * w[i] * state.vel[ids[i]]).sum();
+    let approach = relative.dot(direction);
+    if approach < 0.0 {
+        let sliding = relative - approach * direction;
+        let speed = sliding.length();
+        let friction = if speed > 0.0 {
+            (friction * -approach / speed).min(1.0)
+        } else {
+            0.0
+        };
+        let impulse = (-approach * direction - friction * sliding) / weight;
+        for i in 0..4 {
+            state.vel[ids[i]] += (sign(i) * w[i] * inv[ids[i]]) * impulse;
+        }
+    }
+    true
+}

@@ -1,0 +1,405 @@
+//! The self-contact solver: finds the pairs, pushes them apart, and cuts motion that
+//! could make a pair meet (see the module's notes).
+
+use glam::Vec3;
+use rustc_hash::FxHashMap;
+
+use crate::cloth::{ClothModel, ClothState};
+
+use super::ccd::safe_fraction;
+use super::error::ContactError;
+use super::hash::BoxHash;
+use super::primitives::{Pair, distance, push_apart};
+
+/// Work done by the last resolve: for cost checks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct SelfWork {
+    /// Vertex–triangle and edge–edge pairs whose boxes over the substep overlap.
+    pub candidates: u64,
+    /// Pushes that kept a pair a thickness apart at the substep's end.
+    pub contacts: u64,
+    /// Entries in the spatial hash's table (at most [`CELLS_PER_TRIANGLE`](super::CELLS_PER_TRIANGLE) per triangle).
+    pub binned: u64,
+    /// Searches of the hash (0 when the pairs found before still held).
+    pub searches: u64,
+    /// Pairs whose motion was cut short because their sides could otherwise have met.
+    pub impacts: u64,
+    /// Pairs that prescribed motion (pins, handles) drove together, so no cut could keep
+    /// them apart.
+    pub forced: u64,
+}
+
+/// The separation the continuous check keeps, as a share of the thickness (pairs that
+/// start closer keep half of what they start at).
+const KEEP: f64 = 0.1;
+
+/// Gauss–Seidel sweeps of the pushes over the pairs.
+const PUSH_SWEEPS: usize = 2;
+
+/// Rounds of cuts by the safe fraction; after them, a pair that can still meet has its
+/// free particles sent back to the substep's start.
+const SCALED_ROUNDS: usize = 4;
+
+/// Which vertices and edges each triangle owns: each vertex and each edge belongs to the
+/// first triangle that has it, so a pair of triangles yields each vertex–triangle and
+/// edge–edge pair of theirs once.
+#[derive(Clone, Debug, Default)]
+struct Owners {
+    /// What it was built for: triangle count, particle count and a hash of the triangles.
+    key: (usize, usize, u64),
+    vertices: Vec<[u32; 3]>,
+    edges: Vec<[[u32; 2]; 3]>,
+}
+
+const NONE: u32 = u32::MAX;
+
+impl Owners {
+    fn key(model: &ClothModel) -> (usize, usize, u64) {
+        use std::hash::{Hash, Hasher};
+        let mut h = rustc_hash::FxHasher::default();
+        model.triangles.hash(&mut h);
+        (model.triangles.len(), model.particle_count(), h.finish())
+    }
+
+    fn build(model: &ClothModel) -> Owners {
+        let mut seen = vec![false; model.particle_count()];
+        let mut edges: FxHashMap<[u32; 2], ()> = FxHashMap::default();
+        let mut owners = Owners {
+            key: Self::key(model),
+            vertices: Vec::with_capacity(model.triangles.len()),
+            edges: Vec::with_capacity(model.triangles.len()),
+        };
+        for t in &model.triangles {
+            let mut v = [NONE; 3];
+            let mut e = [[NONE; 2]; 3];
+            for k in 0..3 {
+                let i = t[k] as usize;
+                if !seen[i] {
+                    seen[i] = true;
+                    v[k] = t[k];
+                }
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let edge = [a.min(b), a.max(b)];
+                if edges.insert(edge, ()).is_none() {
+                    e[k] = edge;
+                }
+            }
+            owners.vertices.push(v);
+            owners.edges.push(e);
+        }
+        owners
+    }
+}
+
+/// Reusable buffers of self-contact: nothing is allocated per substep once warm.
+#[derive(Clone, Debug, Default)]
+pub struct SelfContacts {
+    hash: BoxHash,
+    owners: Owners,
+    /// Each particle's box when the pairs were found: its motion grown by half the
+    /// thickness and a margin.
+    vertex_lo: Vec<Vec3>,
+    vertex_hi: Vec<Vec3>,
+    /// The substep's start and end in the frame that moves with the cloth, and how far
+    /// that frame has moved.
+    from: Vec<Vec3>,
+    to: Vec<Vec3>,
+    shift: Vec3,
+    /// How far each particle can be from where it was when the pairs were found, while
+    /// in its box.
+    reach: Vec<f64>,
+    /// Each triangle's box: its corners' boxes together.
+    lo: Vec<Vec3>,
+    hi: Vec<Vec3>,
+    pairs: Vec<Pair>,
+    /// The thickness the pairs were found for (`None`: none found, or a failed search).
+    found_for: Option<f32>,
+    /// How much of its motion each particle keeps, and whether that changed last round.
+    scale: Vec<f64>,
+    cut: Vec<f64>,
+    changed: Vec<bool>,
+    pub work: SelfWork,
+    /// Pairs prescribed motion forced together since the solver was made.
+    pub forced_total: u64,
+}
+
+/// Whether boxes `a` and `b` overlap.
+fn meet((alo, ahi): (Vec3, Vec3), (blo, bhi): (Vec3, Vec3)) -> bool {
+    alo.cmple(bhi).all() && blo.cmple(ahi).all()
+}
+
+impl SelfContacts {
+    /// Keeps the cloth off itself after a substep of `substep` seconds that moved it from
+    /// `start` to `state`: pairs closer than `thickness` (m) are pushed apart on the side
+    /// they started on, with Coulomb `friction`; then no pair's sides may meet anywhere along
+    /// the substep's straight-line motion. Returns the pushes.
+    ///
+    /// # Errors
+    /// [`ContactError`] for a state that has blown up (a non-finite position, or a triangle
+    /// a million times wider than the cloth's scale); nothing is moved then.
+    pub fn resolve(
+        &mut self,
+        [thickness, friction, substep]: [f32; 3],
+        model: &ClothModel,
+        start: &[Vec3],
+        state: &mut ClothState,
+    ) -> Result<usize, ContactError> {
+        if thickness <= 0.0 || model.triangles.is_empty() {
+            return Ok(0);
+        }
+        if let Some(particle) = state.pos.iter().position(|p| !p.is_finite()) {
+            return Err(ContactError::NonFinite { particle });
+        }
+        if self.owners.key != Owners::key(model) {
+            self.owners = Owners::build(model);
+        }
+        self.work = SelfWork::default();
+        // Pairs are found, and kept while they hold, in a frame that moves with the
+        // cloth's mean motion (it changes no distance): a cloth falling as a whole moves
+        // little in it.
+        let n = start.len() as f64;
+        let mean = (start.iter().zip(&state.pos))
+            .fold(glam::DVec3::ZERO, |m, (s, p)| m + (*p - *s).as_dvec3())
+            / n;
+        let mean = mean.as_vec3();
+        self.relative(start, &state.pos, mean);
+        if !self.holds(thickness) {
+            self.find_pairs(model, thickness)?;
+        }
+        self.work.candidates = self.pairs.len() as u64;
+        self.work.binned = self.hash.len() as u64;
+        let mut contacts = 0;
+        for _ in 0..PUSH_SWEEPS {
+            for pair in &self.pairs {
+                contacts +=
+                    usize::from(push_apart(pair, [thickness, friction], model, start, state));
+            }
+        }
+        self.work.contacts = contacts as u64;
+        // The pushes may have taken a particle out of the box its pairs were found in.
+        self.relative(start, &state.pos, mean);
+        if !self.holds(thickness) {
+            self.find_pairs(model, thickness)?;
+        }
+        self.shift += mean;
+        self.keep_apart(model, start, state, thickness, substep);
+        self.forced_total += self.work.forced;
+        Ok(contacts)
+    }
+
+    /// Checks a motion after [`SelfContacts::resolve`] (from `from`, free of
+    /// intersections, to `state`) along its whole length, cutting it where a pair could
+    /// meet, as `resolve` does but without pushes. Returns the pairs cut.
+    ///
+    /// # Errors
+    /// As [`SelfContacts::resolve`].
+    pub fn settle(
+        &mut self,
+        thickness: f32,
+        substep: f32,
+        model: &ClothModel,
+        from: &[Vec3],
+        state: &mut ClothState,
+    ) -> Result<usize, ContactError> {
+        if thickness <= 0.0 || model.triangles.is_empty() {
+            return Ok(0);
+        }
+        self.relative(from, &state.pos, Vec3::ZERO);
+        if !self.holds(thickness) {
+            self.find_pairs(model, thickness)?;
+        }
+        let (impacts, forced) = (self.work.impacts, self.work.forced);
+        self.keep_apart(model, from, state, thickness, substep);
+        self.forced_total += self.work.forced - forced;
+        Ok((self.work.impacts - impacts) as usize)
+    }
+
+    /// Entries in the hash's table now: at most [`CELLS_PER_TRIANGLE`](super::CELLS_PER_TRIANGLE) per triangle,
+    /// whatever the positions.
+    pub fn table_len(&self) -> usize {
+        self.hash.len()
+    }
+
+    /// Fills the substep's start and end in the moving frame: less the shift so far, and
+    /// the end less this substep's `mean` motion too.
+    fn relative(&mut self, start: &[Vec3], pos: &[Vec3], mean: Vec3) {
+        let shift = self.shift;
+        self.from.clear();
+        self.from.extend(start.iter().map(|&s| s - shift));
+        self.to.clear();
+        self.to.extend(pos.iter().map(|&p| p - shift - mean));
+    }
+
+    /// Whether the pairs found last still hold every pair that can matter for the motion
+    /// from `from` to `to`: found for this thickness, and every particle's motion within
+    /// its box less half the thickness.
+    fn holds(&self, thickness: f32) -> bool {
+        let g = Vec3::splat(0.5 * thickness);
+        self.found_for == Some(thickness)
+            && self.vertex_lo.len() == self.to.len()
+            && (self.from.iter().zip(&self.to))
+                .zip(self.vertex_lo.iter().zip(&self.vertex_hi))
+                .all(|((s, p), (lo, hi))| {
+                    (s.min(*p) - g).cmpge(*lo).all() && (s.max(*p) + g).cmple(*hi).all()
+                })
+    }
+
+    /// The pairs whose boxes overlap: each particle's box holds its motion from `from` to
+    /// `to` grown by a margin (three quarters of the thickness and a quarter of the
+    /// motion), so the pairs hold for the substeps after as long as the motion stays in it
+    /// less half the thickness.
+    fn find_pairs(&mut self, model: &ClothModel, thickness: f32) -> Result<(), ContactError> {
+        let (start, pos) = (&self.from, &self.to);
+        self.found_for = None;
+        self.vertex_lo.clear();
+        self.vertex_hi.clear();
+        self.reach.clear();
+        for (s, p) in start.iter().zip(pos) {
+            let moved = s.distance(*p);
+            let grow = 0.75 * thickness + 0.25 * moved;
+            self.vertex_lo.push(s.min(*p) - Vec3::splat(grow));
+            self.vertex_hi.push(s.max(*p) + Vec3::splat(grow));
+            // The farthest a particle can be from where it is now while in its box.
+            self.reach.push(f64::from(moved + 3f32.sqrt() * grow));
+        }
+        let (vlo, vhi) = (&self.vertex_lo, &self.vertex_hi);
+        self.lo.clear();
+        self.hi.clear();
+        for t in &model.triangles {
+            let [a, b, c] = t.map(|i| i as usize);
+            self.lo.push(vlo[a].min(vlo[b]).min(vlo[c]));
+            self.hi.push(vhi[a].max(vhi[b]).max(vhi[c]));
+        }
+        let longest = model.springs.rest[..model.mesh_edges.min(model.springs.len())]
+            .iter()
+            .fold(0.0f32, |m, &r| m.max(r));
+        let cell = (2.0 * longest).max(2.0 * thickness).max(1e-6);
+        self.hash.bin(&self.lo, &self.hi, cell)?;
+        self.pairs.clear();
+        let (owners, tris) = (&self.owners, &model.triangles);
+        let (lo, hi) = (&self.lo, &self.hi);
+        let pairs = &mut self.pairs;
+        let reach = &self.reach;
+        // A pair is kept only if, with each particle anywhere in its box, its sides could
+        // come within the thickness.
+        let mut keep = |pair: Pair| {
+            let x = pair.v.map(|i| pos[i as usize].as_dvec3());
+            let k = pair.first_side();
+            let most = |r: std::ops::Range<usize>| {
+                r.map(|i| reach[pair.v[i] as usize]).fold(0.0f64, f64::max)
+            };
+            if distance(&pair, x) - most(0..k) - most(k..4) < f64::from(thickness) {
+                pairs.push(pair);
+            }
+        };
+        let vbox = |v: u32| (vlo[v as usize], vhi[v as usize]);
+        let ebox = |[a, b]: [u32; 2]| {
+            let (a, b) = (a as usize, b as usize);
+            (vlo[a].min(vlo[b]), vhi[a].max(vhi[b]))
+        };
+        self.hash.overlapping_pairs(lo, hi, |a, b| {
+            let (a, b) = (a as usize, b as usize);
+            for (own, other) in [(a, b), (b, a)] {
+                let tri = tris[other];
+                for &v in &owners.vertices[own] {
+                    if v != NONE && !tri.contains(&v) && meet(vbox(v), (lo[other], hi[other])) {
+                        keep(Pair {
+                            v: [v, tri[0], tri[1], tri[2]],
+                            edges: false,
+                        });
+                    }
+                }
+            }
+            for &e in &owners.edges[a] {
+                for &f in &owners.edges[b] {
+                    if e[0] != NONE
+                        && f[0] != NONE
+                        && !e.iter().any(|i| f.contains(i))
+                        && meet(ebox(e), ebox(f))
+                    {
+                        keep(Pair {
+                            v: [e[0], e[1], f[0], f[1]],
+                            edges: true,
+                        });
+                    }
+                }
+            }
+        });
+        self.work.searches += 1;
+        self.found_for = Some(thickness);
+        Ok(())
+    }
+
+    /// Cuts the free particles' motion short until no pair's sides can meet along the
+    /// substep (see the module's notes); cut particles move at their remaining motion's
+    /// average velocity.
+    fn keep_apart(
+        &mut self,
+        model: &ClothModel,
+        start: &[Vec3],
+        state: &mut ClothState,
+        thickness: f32,
+        substep: f32,
+    ) {
+        let n = state.pos.len();
+        let keep = KEEP * f64::from(thickness);
+        let free = |i: usize| model.inv_mass[i] > 0.0;
+        self.scale.clear();
+        self.scale.resize(n, 1.0);
+        self.changed.clear();
+        self.changed.resize(n, true);
+        for round in 0.. {
+            self.cut.clone_from(&self.scale);
+            let mut any = false;
+            for pair in &self.pairs {
+                let ids = pair.v.map(|i| i as usize);
+                if !ids.iter().any(|&i| self.changed[i]) {
+                    continue;
+                }
+                let from = ids.map(|i| start[i].as_dvec3());
+                let moves =
+                    ids.map(|i| self.scale[i] * (state.pos[i].as_dvec3() - start[i].as_dvec3()));
+                let t = safe_fraction(pair, from, moves, keep);
+                if t >= 1.0 {
+                    continue;
+                }
+                self.work.impacts += 1;
+                let mut cut_any = false;
+                for &i in &ids {
+                    if free(i) && self.scale[i] > 0.0 {
+                        let to = if round < SCALED_ROUNDS {
+                            self.scale[i] * t
+                        } else {
+                            0.0
+                        };
+                        if to < self.cut[i] {
+                            self.cut[i] = to;
+                        }
+                        cut_any = true;
+                    }
+                }
+                if cut_any {
+                    any = true;
+                } else {
+                    self.work.forced += 1;
+                }
+            }
+            if !any {
+                break;
+            }
+            for ((changed, cut), scale) in self.changed.iter_mut().zip(&self.cut).zip(&self.scale) {
+                *changed = cut != scale;
+            }
+            std::mem::swap(&mut self.scale, &mut self.cut);
+        }
+        let moved = (self.scale.iter().zip(start)).zip(state.pos.iter_mut().zip(&mut state.vel));
+        for ((&s, from), (pos, vel)) in moved {
+            if s < 1.0 {
+                let from = from.as_dvec3();
+                let to = from + s * (pos.as_dvec3() - from);
+                *pos = to.as_vec3();
+                *vel = ((to - from) / f64::from(substep)).as_vec3();
+            }
+        }
+    }
+}

@@ -1,0 +1,296 @@
+//! Cloth that never passes through itself: the exact intersection check, the edge–edge
+//! pairs, the continuous check's guarantee on the stress scenes under every integrator
+//! that keeps it, and friction between layers against Coulomb's law.
+
+use clothsim::cloth::{ClothModel, ClothState};
+use clothsim::mesh::{ImportOptions, build_mesh};
+use clothsim::scene::{Scene, SceneFile, Simulation};
+use clothsim::sim::intersections::{self_intersections, triangles_meet};
+use clothsim::sim::{GuardAction, IntegratorKind, SelfContacts};
+use glam::{DVec3, Vec3};
+
+fn d(x: f64, y: f64, z: f64) -> DVec3 {
+    DVec3::new(x, y, z)
+}
+
+#[test]
+fn the_check_tells_crossing_touching_and_apart_triangles() {
+    let flat = [d(0.0, 0.0, 0.0), d(1.0, 0.0, 0.0), d(0.0, 0.0, 1.0)];
+    // A vertical triangle through the middle of the flat one.
+    let through = [d(0.2, -0.5, 0.2), d(0.2, 0.5, 0.2), d(0.3, 0.5, 0.3)];
+    assert!(triangles_meet(flat, through));
+    // The same, lifted clear of it.
+    let above = through.map(|p| p + d(0.0, 0.6, 0.0));
+    assert!(!triangles_meet(flat, above));
+    // Touching at one point (a corner on the face) meets; a hair above does not.
+    let touching = [d(0.2, 0.0, 0.2), d(0.2, 0.5, 0.2), d(0.3, 0.5, 0.3)];
+    assert!(triangles_meet(flat, touching));
+    let hair = touching.map(|p| p + d(0.0, 1e-12, 0.0));
+    assert!(!triangles_meet(flat, hair));
+    // Coplanar: overlapping meets, side by side does not.
+    let overlapping = flat.map(|p| p + d(0.3, 0.0, 0.3));
+    assert!(triangles_meet(flat, overlapping));
+    let beside = flat.map(|p| p + d(2.0, 0.0, 0.0));
+    assert!(!triangles_meet(flat, beside));
+}
+
+/// Two triangles sharing vertex 0: (0, 1, 2) flat and (0, 3, 4), whose far edge (3, 4)
+/// is at height `y` and crosses over the first.
+fn hinge(y: f32) -> Vec<Vec3> {
+    vec![
+        Vec3::ZERO,
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::new(0.6, y, -0.2),
+        Vec3::new(-0.2, y, 0.6),
+    ]
+}
+
+#[test]
+fn triangles_sharing_a_vertex_meet_only_where_an_opposite_edge_passes_through() {
+    let tris = [[0, 1, 2], [0, 3, 4]];
+    // Far edge above: they touch only at the shared vertex.
+    assert_eq!(self_intersections(&tris, &hinge(0.3)), 0);
+    // Far edge pushed down through the first triangle.
+    assert_eq!(
+        self_intersections(&tris, &hinge(-0.3)),
+        0,
+        "not through: it starts beside"
+    );
+    let mut through = hinge(-0.3);
+    through[3] = Vec3::new(0.3, 0.3, 0.3);
+    through[4] = Vec3::new(0.3, -0.3, 0.3);
+    assert_eq!(self_intersections(&tris, &through), 1);
+    // Sharing an edge, even folded through one another, is never counted.
+    let folded = [
+        Vec3::ZERO,
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::new(0.5, -0.1, 0.5),
+    ];
+    assert_eq!(self_intersections(&[[0, 1, 2], [0, 1, 3]], &folded), 0);
+}
+
+/// Story: in plain f64 the check counted intersections in a flat cloth falling straight
+/// down (coplanar neighbours whose volumes rounding gave signs); exact predicates count
+/// none.
+#[test]
+fn a_flat_cloth_at_any_height_has_no_intersection() {
+    let mut sim = builtin("layers", Some(12));
+    for _ in 0..12 {
+        sim.step_frame().expect("falls");
+        assert_eq!(sim.intersections().self_pairs, 0);
+    }
+}
+
+/// A strip along x pinned at height 0 and one along z `gap` above it, each one quad 1 m long
+/// and 2 cm wide, crossing at their middles: no vertex of either is over the other's face,
+/// so only their edges can meet.
+fn crossed_strips(gap: f32) -> (ClothModel, ClothState) {
+    let strip = |along_x: bool, y: f32| -> Vec<Vec3> {
+        let (l, w) = (0.5, 0.01);
+        let c = [(-l, -w), (l, -w), (l, w), (-l, w)];
+        c.iter()
+            .map(|&(a, b)| {
+                if along_x {
+                    Vec3::new(a, y, b)
+                } else {
+                    Vec3::new(b, y, a)
+                }
+            })
+            .collect()
+    };
+    let mut positions = strip(true, 0.0);
+    positions.extend(strip(false, gap));
+    let soup = clothsim::mesh::PolygonSoup {
+        positions,
+        uvs: None,
+        face_indices: vec![0, 1, 2, 3, 4, 5, 6, 7],
+        face_arities: vec![4, 4],
+    };
+    let mesh = build_mesh(&soup, std::path::Path::new("strips"))
+        .unwrap()
+        .mesh;
+    let model = ClothModel::new(&mesh, 0.2, &[0, 1, 2, 3]);
+    let state = ClothState::at_rest(&model);
+    (model, state)
+}
+
+#[test]
+fn edges_that_cross_without_a_vertex_near_a_face_are_caught() {
+    let (model, mut state) = crossed_strips(0.05);
+    let start = state.pos.clone();
+    // The upper strip moves 10 cm down in one substep: through the lower one.
+    for p in &mut state.pos[4..] {
+        p.y -= 0.1;
+    }
+    // Unresolved, it would end on the other side.
+    assert!(state.pos[4..].iter().all(|p| p.y < 0.0));
+    let mut solver = SelfContacts::default();
+    solver
+        .resolve([0.005, 0.0, 1.0 / 240.0], &model, &start, &mut state)
+        .unwrap();
+    assert_eq!(self_intersections(&model.triangles, &state.pos), 0);
+    // It stopped above the lower strip, not merely somewhere else.
+    let lowest = state.pos[4..]
+        .iter()
+        .map(|p| p.y)
+        .fold(f32::INFINITY, f32::min);
+    assert!(lowest > 0.0, "upper strip at {lowest} m");
+}
+
+fn builtin(name: &str, quads: Option<u32>) -> Simulation {
+    let scene = Scene::open_resized(name, None, &ImportOptions::default(), quads).unwrap();
+    Simulation::new(scene)
+}
+
+/// Runs `name` (resized to `quads`) for `seconds` under `integrator` at `substeps`,
+/// checking every frame: no intersection of the cloth with itself or a solid, finite, and
+/// no frame the guard gave up on.
+fn never_passes_through(
+    name: &str,
+    quads: Option<u32>,
+    integrator: IntegratorKind,
+    substeps: u32,
+    seconds: f64,
+) {
+    let mut scene = Scene::open_resized(name, None, &ImportOptions::default(), quads).unwrap();
+    scene.params.step.integrator = integrator;
+    scene.params.step.substeps = substeps;
+    let mut sim = Simulation::new(scene);
+    assert_eq!(sim.intersections().total(), 0, "{name} starts free");
+    let frames = (seconds / sim.params().step.dt as f64).round() as usize;
+    for frame in 1..=frames {
+        sim.step_frame()
+            .unwrap_or_else(|e| panic!("{name} {integrator:?} frame {frame}: {e}"));
+        let found = sim.intersections();
+        assert_eq!(
+            found.self_pairs, 0,
+            "{name} {integrator:?}: the cloth crosses itself after frame {frame}"
+        );
+        assert!(sim.state().is_finite());
+        for e in sim.take_guard_events() {
+            assert_ne!(e.action, GuardAction::GaveUp, "{name} {integrator:?}: {e}");
+        }
+    }
+    let work = sim.self_collision_work().unwrap();
+    assert_eq!(
+        work.forced, 0,
+        "{name} {integrator:?}: prescribed motion forced a pair"
+    );
+}
+
+const SEMI_IMPLICIT: IntegratorKind = IntegratorKind::SemiImplicitEuler;
+const IMPLICIT: IntegratorKind = IntegratorKind::ImplicitEuler;
+const XPBD: IntegratorKind = IntegratorKind::Xpbd;
+
+#[test]
+fn crumple_never_passes_through_itself() {
+    never_passes_through("crumple", Some(16), SEMI_IMPLICIT, 24, 1.5);
+    never_passes_through("crumple", Some(16), IMPLICIT, 3, 1.5);
+    never_passes_through("crumple", Some(16), XPBD, 3, 1.5);
+}
+
+#[test]
+fn twist_never_passes_through_itself() {
+    never_passes_through("twist", None, SEMI_IMPLICIT, 64, 2.0);
+    never_passes_through("twist", None, IMPLICIT, 3, 2.0);
+    never_passes_through("twist", None, XPBD, 3, 2.0);
+}
+
+#[test]
+fn layers_never_pass_through_each_other() {
+    never_passes_through("layers", Some(8), SEMI_IMPLICIT, 24, 1.2);
+    never_passes_through("layers", Some(8), IMPLICIT, 3, 1.2);
+    never_passes_through("layers", Some(8), XPBD, 3, 1.2);
+}
+
+#[test]
+fn fast_fold_never_passes_through_itself() {
+    never_passes_through("fast-fold", Some(16), SEMI_IMPLICIT, 24, 0.8);
+    never_passes_through("fast-fold", Some(16), IMPLICIT, 3, 0.8);
+    never_passes_through("fast-fold", Some(16), XPBD, 3, 0.8);
+}
+
+/// Two 8 × 8-quad cloths of 0.5 m, one 1.05 thickness above the other; the lower pinned;
+/// gravity tilted by `degrees` from the normal (an incline); friction `mu` between them.
+fn incline(degrees: f32, mu: f32) -> Simulation {
+    let thickness = 0.01;
+    let text = format!(
+        "name = \"incline\"\n[cloth]\ngrid = {{ quads = 8, size = 0.5, layers = 2, spacing = {} }}\n\
+         [solver]\nintegrator = \"semi-implicit-euler\"\nsubsteps = 16\n\
+         [material]\nstiffness = {{ structural = 400.0, shear = 150.0, bend = 20.0 }}\n\
+         [pins]\nregion = {{ min = [-1.0, -1.0, -1.0], max = [1.0, 0.001, 1.0] }}\n\
+         [[effects]]\ntype = \"gravity\"\nacceleration = [0.0, {}, {}]\n\
+         [[effects]]\ntype = \"self-collision\"\nthickness = {thickness}\nfriction = {mu}\n",
+        1.05 * thickness,
+        -9.81 * degrees.to_radians().cos(),
+        9.81 * degrees.to_radians().sin(),
+    );
+    let file = SceneFile::parse(&text, std::path::Path::new("incline.toml")).unwrap();
+    Simulation::new(Scene::from_file(file, None).unwrap())
+}
+
+/// The upper cloth's mean velocity along the slope (+z).
+fn slope_speed(sim: &Simulation) -> f32 {
+    let n = sim.model().particle_count() / 2;
+    sim.state().vel[n..].iter().map(|v| v.z).sum::<f32>() / n as f32
+}
+
+/// Coulomb's law on an incline: the upper cloth slides with acceleration g (sin θ − μ cos
+/// θ) when tan θ > μ, and stays when tan θ < μ: it does not freeze into the one below, and
+/// friction is not lost.
+#[test]
+fn a_cloth_slides_off_another_as_coulomb_friction_says() {
+    let mu = 0.3f32;
+    for degrees in [30.0f32, 40.0] {
+        let mut sim = incline(degrees, mu);
+        sim.run(0.05);
+        let (t0, v0) = (sim.state().time, slope_speed(&sim));
+        sim.run(0.2);
+        let a = (slope_speed(&sim) - v0) / (sim.state().time - t0) as f32;
+        let th = degrees.to_radians();
+        let expected = 9.81 * (th.sin() - mu * th.cos());
+        assert!(
+            (a - expected).abs() < 0.1 * expected,
+            "{degrees}°: {a} m/s² against Coulomb's {expected}"
+        );
+    }
+    // tan 10° = 0.18 < 0.3: it holds.
+    let mut sim = incline(10.0, mu);
+    sim.run(0.3);
+    assert!(slope_speed(&sim).abs() < 0.01, "{} m/s", slope_speed(&sim));
+}
+
+#[test]
+fn quads_resizes_a_grid_and_its_thickness_with_it() {
+    let sim = builtin("crumple", Some(64));
+    assert_eq!(sim.model().particle_count(), 65 * 65);
+    let thickness = |sim: &Simulation| {
+        sim.effects()
+            .iter()
+            .find_map(|e| match e {
+                clothsim::sim::Effect::SelfCollision(s) => Some(s.thickness),
+                _ => None,
+            })
+            .unwrap()
+    };
+    assert!(
+        (thickness(&sim) - 0.003).abs() < 1e-6,
+        "{}",
+        thickness(&sim)
+    );
+    // Coarser: the thickness stays.
+    assert_eq!(thickness(&builtin("crumple", Some(16))), 0.006);
+    // A strip keeps its proportions.
+    assert_eq!(builtin("twist", Some(64)).model().particle_count(), 65 * 17);
+    // An OBJ cloth cannot be resized.
+    let err = Scene::open_resized(
+        "hanging",
+        Some(std::path::Path::new("assets/cloth.obj")),
+        &ImportOptions::default(),
+        Some(8),
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("--quads"), "{err}");
+}
