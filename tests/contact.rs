@@ -145,8 +145,8 @@ fn builtin(name: &str, quads: Option<u32>) -> Simulation {
 }
 
 /// Runs `name` (resized to `quads`) for `seconds` under `integrator` at `substeps`,
-/// checking every frame: no intersection of the cloth with itself or a solid, finite, and
-/// no frame the guard gave up on.
+/// checking every frame: no intersection of the cloth with itself or a solid, finite, no
+/// frame the guard gave up on, and no pair forced by prescribed motion.
 fn never_passes_through(
     name: &str,
     quads: Option<u32>,
@@ -167,6 +167,11 @@ fn never_passes_through(
         assert_eq!(
             found.self_pairs, 0,
             "{name} {integrator:?}: the cloth crosses itself after frame {frame}"
+        );
+        assert_eq!(
+            found.total(),
+            0,
+            "{name} {integrator:?}: the cloth meets a solid after frame {frame}: {found:?}"
         );
         assert!(sim.state().is_finite());
         for e in sim.take_guard_events() {

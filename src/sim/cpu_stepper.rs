@@ -22,6 +22,10 @@ use super::self_contacts::{SelfContacts, SelfWork};
 use super::stats::StepStats;
 use super::timings::PhaseTimings;
 
+/// Rounds of solids then the self-contact check after self-contact, at most: another
+/// round only follows one whose check had to cut.
+const RECHECKS: usize = 3;
+
 /// Advances a cloth on the CPU. Built from a scene's effect list: absent effects are not in
 /// it and cost nothing.
 pub struct CpuStepper {
@@ -130,8 +134,18 @@ impl CpuStepper {
             state,
             offset: self.offset,
             self_contacts: &mut self.self_contacts,
+            faces: self.self_collision.is_some(),
         };
+        if self.self_collision.is_some() {
+            self.after_self.clone_from(&pass.state.pos);
+        }
         for c in &self.contacts {
+            if matches!(c, Effect::SelfCollision(_)) {
+                // What the solids moved rests on them.
+                let held = &mut pass.self_contacts.held;
+                held.clear();
+                held.extend((self.after_self.iter().zip(&pass.state.pos)).map(|(a, b)| a != b));
+            }
             contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
         }
         // Self-contact may have pushed cloth into a solid (a stack pressing its lowest
@@ -140,16 +154,20 @@ impl CpuStepper {
         if let Some(own) = self.self_collision
             && self.contacts.len() > 1
         {
-            self.after_self.clone_from(&pass.state.pos);
-            for c in self.contacts.iter().filter(|c| c.is_solid()) {
-                contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
+            for _ in 0..RECHECKS {
+                self.after_self.clone_from(&pass.state.pos);
+                for c in self.contacts.iter().filter(|c| c.is_solid()) {
+                    contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
+                }
+                let (from, h) = (&self.after_self, pass.substep);
+                let settle = || {
+                    pass.self_contacts
+                        .settle(own.thickness, h, model, from, pass.state)
+                };
+                if self.timings.time("self-recheck", settle)? == 0 {
+                    break;
+                }
             }
-            let (from, h) = (&self.after_self, pass.substep);
-            let settle = || {
-                pass.self_contacts
-                    .settle(own.thickness, h, model, from, pass.state)
-            };
-            self.timings.time("self-recheck", settle)?;
         }
         if contacts > 0 {
             // Contacts changed positions and velocities after the integrator's step.

@@ -12,6 +12,7 @@ use glam::{DVec3, Vec3};
 
 use super::effects::Effect;
 use super::obstacle::TriangleTree;
+use super::self_contacts::point_triangle_distance;
 
 /// How many triangle pairs meet, for the cloth against itself and against each obstacle.
 #[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -234,27 +235,6 @@ pub fn intersections_between(triangles: &[[u32; 3]], pos: &[Vec3], other: &[[Vec
     count
 }
 
-/// The distance from `p` to triangle `t`, in f64.
-fn distance_to_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> f64 {
-    let n = (b - a).cross(c - a);
-    let inside = [(a, b), (b, c), (c, a)]
-        .iter()
-        .all(|&(u, v)| (v - u).cross(p - u).dot(n) >= 0.0);
-    if inside && n != DVec3::ZERO {
-        return (p - a).dot(n).abs() / n.length();
-    }
-    let to_segment = |u: DVec3, v: DVec3| {
-        let d = v - u;
-        let s = if d == DVec3::ZERO {
-            0.0
-        } else {
-            ((p - u).dot(d) / d.length_squared()).clamp(0.0, 1.0)
-        };
-        p.distance(u + s * d)
-    };
-    to_segment(a, b).min(to_segment(b, c)).min(to_segment(c, a))
-}
-
 /// The cloth (`triangles` at `pos`) against every solid among `effects` at simulated time
 /// `time`, and against itself.
 pub fn intersections(
@@ -290,7 +270,7 @@ pub fn intersections(
                 let centre = wide(s.center);
                 let inside = (triangles.iter())
                     .filter(|t| {
-                        distance_to_triangle(centre, t.map(|i| wide(pos[i as usize])))
+                        point_triangle_distance(centre, t.map(|i| wide(pos[i as usize])))
                             < f64::from(s.radius)
                     })
                     .count();

@@ -22,6 +22,9 @@ pub struct ContactPass<'a> {
     pub offset: f32,
     /// Self-collision's buffers, kept between substeps.
     pub self_contacts: &'a mut SelfContacts,
+    /// Whether solids keep the cloth's triangles out too, not only its particles (with
+    /// self-contact, whose guarantee covers the surface).
+    pub faces: bool,
 }
 
 /// What an effect adds to the stability guard's limits.

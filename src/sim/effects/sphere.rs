@@ -5,7 +5,7 @@ use glam::Vec3;
 use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 use super::solid::{Solid, default_friction, resolve};
 use crate::sim::param_error::ParamError;
-use crate::sim::self_contacts::ContactError;
+use crate::sim::self_contacts::{ContactError, triangle_closest};
 
 /// A sphere spinning with angular velocity `spin` (zero for a still one).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -64,6 +64,56 @@ impl Solid for Sphere {
     }
 }
 
+impl Sphere {
+    /// Keeps each triangle's interior out of the sphere too (with self-contact, whose
+    /// guarantee covers the surface): a flat triangle over a small sphere dips in between
+    /// its corners however far out they are. A triangle whose point
+    /// nearest the centre is within the radius and half the offset is pushed out along the
+    /// line from the centre, its corners by their weights and inverse masses, and their
+    /// velocities lose what points in. Returns the triangles pushed.
+    fn keep_faces_out(&self, pass: &mut ContactPass<'_>) -> usize {
+        let reach = self.radius + pass.offset;
+        let (model, state) = (pass.model, &mut *pass.state);
+        let inv = &model.inv_mass;
+        let mut pushed = 0;
+        for t in &model.triangles {
+            let ids = t.map(|i| i as usize);
+            let x = ids.map(|i| state.pos[i]);
+            let near = x
+                .iter()
+                .map(|p| p.distance(self.center))
+                .fold(f32::INFINITY, f32::min);
+            let longest = x[0]
+                .distance(x[1])
+                .max(x[1].distance(x[2]))
+                .max(x[2].distance(x[0]));
+            if near > reach + longest {
+                continue;
+            }
+            let w = triangle_closest(self.center, x[0], x[1], x[2]);
+            let q = w[0] * x[0] + w[1] * x[1] + w[2] * x[2];
+            let gap = q - self.center;
+            let d = gap.length();
+            let weight: f32 = (0..3).map(|k| w[k] * w[k] * inv[ids[k]]).sum();
+            if d >= reach || d < 1e-9 || weight <= 0.0 {
+                continue;
+            }
+            let n = gap / d;
+            let lambda = (reach - d) / weight;
+            for k in 0..3 {
+                let i = ids[k];
+                state.pos[i] += (w[k] * inv[i] * lambda) * n;
+                let inward = state.vel[i].dot(n);
+                if w[k] > 0.0 && inward < 0.0 {
+                    state.vel[i] -= inward * n;
+                }
+            }
+            pushed += 1;
+        }
+        pushed
+    }
+}
+
 /// The first point (relative to the sphere's centre) where the segment `a → b` enters the
 /// sphere of radius `r`, if `a` is outside it and the segment reaches it.
 #[inline]
@@ -109,7 +159,13 @@ impl EffectKind for Sphere {
     }
 
     fn resolve(&self, pass: &mut ContactPass<'_>) -> Result<usize, ContactError> {
-        Ok(resolve(self, pass))
+        let particles = resolve(self, pass);
+        let faces = if pass.faces {
+            self.keep_faces_out(pass)
+        } else {
+            0
+        };
+        Ok(particles + faces)
     }
 
     fn surface(&self, p: Vec3) -> Option<(f32, Vec3, Vec3)> {

@@ -61,6 +61,8 @@ fn each_cell(lo: Vec3, hi: Vec3, size: f32, mut visit: impl FnMut([i32; 3])) {
 pub struct BoxHash {
     /// (cell key, box), sorted by key.
     bins: Vec<(u64, u32)>,
+    /// Where each run of entries with one key starts.
+    runs: Vec<u32>,
     /// Each box's level.
     level: Vec<u8>,
     /// Bit `l` is set when some box is at level `l`.
@@ -100,14 +102,38 @@ impl BoxHash {
             });
         }
         self.bins.sort_unstable();
+        self.runs.clear();
+        for (i, w) in self.bins.iter().enumerate() {
+            if i == 0 || self.bins[i - 1].0 != w.0 {
+                self.runs.push(i as u32);
+            }
+        }
         Ok(())
     }
 
-    /// Calls `pair(a, b)` once for every pair of boxes that overlap: pairs at one level
-    /// from the runs of the table's cells (in the table's order), each in the one cell
-    /// that holds the overlap's lowest corner; then each box against the coarser levels'
-    /// cells it touches.
-    pub fn overlapping_pairs(&self, lo: &[Vec3], hi: &[Vec3], mut pair: impl FnMut(u32, u32)) {
+    /// Pieces the search for overlapping pairs is cut into, for a team to share: runs of
+    /// the table's cells, then (with boxes at more than one level) ranges of boxes looked
+    /// up at the coarser levels.
+    pub fn pieces(&self) -> usize {
+        let cross = if self.levels.count_ones() > 1 {
+            self.level.len().div_ceil(BOXES_PER_PIECE)
+        } else {
+            0
+        };
+        self.runs.len().div_ceil(RUNS_PER_PIECE) + cross
+    }
+
+    /// Calls `pair(a, b)` for the pairs of overlapping boxes that piece `piece` finds: pairs
+    /// at one level from a run of cells, each in the one cell that holds the overlap's
+    /// lowest corner; or a range of boxes against the coarser levels' cells they touch.
+    /// Every overlapping pair is found by exactly one piece, once.
+    pub fn piece_pairs(
+        &self,
+        piece: usize,
+        lo: &[Vec3],
+        hi: &[Vec3],
+        mut pair: impl FnMut(u32, u32),
+    ) {
         let mut overlap = |a: usize, b: usize, level: u32, key: u64| {
             let (l, h) = (lo[a].max(lo[b]), hi[a].min(hi[b]));
             let size = self.cell * (1u32 << level) as f32;
@@ -115,26 +141,32 @@ impl BoxHash {
                 pair(a as u32, b as u32);
             }
         };
-        let mut run = 0;
-        while run < self.bins.len() {
-            let key = self.bins[run].0;
-            let end = run + self.bins[run..].partition_point(|&(k, _)| k == key);
-            let cell = &self.bins[run..end];
-            for (i, &(_, a)) in cell.iter().enumerate() {
-                let level = u32::from(self.level[a as usize]);
-                for &(_, b) in &cell[i + 1..] {
-                    // A shared key from another level is not a shared cell.
-                    if u32::from(self.level[b as usize]) == level {
-                        overlap(a as usize, b as usize, level, key);
+        let run_pieces = self.runs.len().div_ceil(RUNS_PER_PIECE);
+        if piece < run_pieces {
+            let first = piece * RUNS_PER_PIECE;
+            let last = (first + RUNS_PER_PIECE).min(self.runs.len());
+            for r in first..last {
+                let start = self.runs[r] as usize;
+                let end = self
+                    .runs
+                    .get(r + 1)
+                    .map_or(self.bins.len(), |&e| e as usize);
+                let cell = &self.bins[start..end];
+                let key = cell[0].0;
+                for (i, &(_, a)) in cell.iter().enumerate() {
+                    let level = u32::from(self.level[a as usize]);
+                    for &(_, b) in &cell[i + 1..] {
+                        // A shared key from another level is not a shared cell.
+                        if u32::from(self.level[b as usize]) == level {
+                            overlap(a as usize, b as usize, level, key);
+                        }
                     }
                 }
             }
-            run = end;
-        }
-        if self.levels.count_ones() < 2 {
             return;
         }
-        for a in 0..lo.len() {
+        let first = (piece - run_pieces) * BOXES_PER_PIECE;
+        for a in first..(first + BOXES_PER_PIECE).min(lo.len()) {
             let own = u32::from(self.level[a]);
             let mut levels = self.levels >> (own + 1) << (own + 1);
             while levels != 0 {
@@ -143,8 +175,8 @@ impl BoxHash {
                 let size = self.cell * (1u32 << level) as f32;
                 each_cell(lo[a], hi[a], size, |c| {
                     let key = cell_key(c, level);
-                    let first = self.bins.partition_point(|&(k, _)| k < key);
-                    for &(k, b) in &self.bins[first..] {
+                    let start = self.bins.partition_point(|&(k, _)| k < key);
+                    for &(k, b) in &self.bins[start..] {
                         if k != key {
                             break;
                         }
@@ -157,3 +189,9 @@ impl BoxHash {
         }
     }
 }
+
+/// Cell runs in one piece of the search.
+const RUNS_PER_PIECE: usize = 256;
+
+/// Boxes in one piece of the search across levels.
+const BOXES_PER_PIECE: usize = 2048;

@@ -144,13 +144,15 @@ pub fn point_triangle_distance(p: DVec3, [a, b, c]: [DVec3; 3]) -> f64 {
 /// Keeps the pair's sides `thickness` apart, on the side they were on at the substep's
 /// start (`start`): each particle moves by its share of the push (its weight times its
 /// inverse mass); the approaching relative velocity is removed and Coulomb `friction`
-/// applied to the sliding part. Returns whether it pushed.
+/// applied to the sliding part. Particles `held` (resting on a solid) move only where
+/// nothing else in the pair can. Returns whether it pushed.
 pub fn push_apart(
     pair: &Pair,
     [thickness, friction]: [f32; 2],
     model: &ClothModel,
     start: &[Vec3],
     state: &mut ClothState,
+    held: &[bool],
 ) -> bool {
     let ids = pair.v.map(|i| i as usize);
     let x = ids.map(|i| state.pos[i]);
@@ -188,14 +190,19 @@ pub fn push_apart(
     if depth <= 0.0 {
         return false;
     }
-    let inv = &model.inv_mass;
-    let weight: f32 = (0..4).map(|i| w[i] * w[i] * inv[ids[i]]).sum();
+    let held = |i: usize| held.get(i).copied().unwrap_or(false);
+    let mut inv = ids.map(|i| if held(i) { 0.0 } else { model.inv_mass[i] });
+    let mut weight: f32 = (0..4).map(|i| w[i] * w[i] * inv[i]).sum();
+    if weight <= 0.0 {
+        inv = ids.map(|i| model.inv_mass[i]);
+        weight = (0..4).map(|i| w[i] * w[i] * inv[i]).sum();
+    }
     if weight <= 0.0 {
         return false;
     }
     let lambda = depth / weight;
     for i in 0..4 {
-        state.pos[ids[i]] += (sign(i) * w[i] * inv[ids[i]] * lambda) * direction;
+        state.pos[ids[i]] += (sign(i) * w[i] * inv[i] * lambda) * direction;
     }
     let relative: Vec3 = (0..4).map(|i| sign(i) * w[i] * state.vel[ids[i]]).sum();
     let approach = relative.dot(direction);
@@ -209,7 +216,7 @@ pub fn push_apart(
         };
         let impulse = (-approach * direction - friction * sliding) / weight;
         for i in 0..4 {
-            state.vel[ids[i]] += (sign(i) * w[i] * inv[ids[i]]) * impulse;
+            state.vel[ids[i]] += (sign(i) * w[i] * inv[i]) * impulse;
         }
     }
     true

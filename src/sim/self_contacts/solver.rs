@@ -5,6 +5,7 @@ use glam::Vec3;
 use rustc_hash::FxHashMap;
 
 use crate::cloth::{ClothModel, ClothState};
+use crate::parallel::{Disjoint, Team};
 
 use super::ccd::safe_fraction;
 use super::error::ContactError;
@@ -34,7 +35,7 @@ pub struct SelfWork {
 const KEEP: f64 = 0.1;
 
 /// Gauss–Seidel sweeps of the pushes over the pairs.
-const PUSH_SWEEPS: usize = 2;
+const PUSH_SWEEPS: usize = 4;
 
 /// Rounds of cuts by the safe fraction; after them, a pair that can still meet has its
 /// free particles sent back to the substep's start.
@@ -111,7 +112,18 @@ pub struct SelfContacts {
     /// Each triangle's box: its corners' boxes together.
     lo: Vec<Vec3>,
     hi: Vec<Vec3>,
-    pairs: Vec<Pair>,
+    /// The pairs, as each member of the team found them, and where each piece of the
+    /// search put its own (`pieces` of them in use): read in the pieces' order, they are
+    /// the same however the pieces were shared out.
+    found: Vec<Vec<Pair>>,
+    segments: Vec<Segment>,
+    pieces: usize,
+    /// Particles resting on a solid this substep (set by the stepper before
+    /// [`SelfContacts::resolve`]): pushes move them only where nothing else can.
+    pub held: Vec<bool>,
+    /// Particles the cuts leave alone besides the pinned (those the solids moved, in
+    /// [`SelfContacts::settle`]); empty: none.
+    fixed: Vec<bool>,
     /// The thickness the pairs were found for (`None`: none found, or a failed search).
     found_for: Option<f32>,
     /// How much of its motion each particle keeps, and whether that changed last round.
@@ -121,6 +133,96 @@ pub struct SelfContacts {
     pub work: SelfWork,
     /// Pairs prescribed motion forced together since the solver was made.
     pub forced_total: u64,
+}
+
+/// Where one piece of the search put its pairs: `found[member][start..end]`.
+#[derive(Clone, Copy, Debug, Default)]
+struct Segment {
+    member: u32,
+    start: u32,
+    end: u32,
+}
+
+/// The pairs of `segments`, in order.
+fn pairs_in<'a>(found: &'a [Vec<Pair>], segments: &'a [Segment]) -> impl Iterator<Item = &'a Pair> {
+    segments
+        .iter()
+        .flat_map(|s| &found[s.member as usize][s.start as usize..s.end as usize])
+}
+
+/// Triangles from which the search shares its work out between the team's members.
+const PARALLEL_TRIANGLES: usize = 2048;
+
+/// What a search for pairs reads.
+struct Search<'a> {
+    owners: &'a Owners,
+    triangles: &'a [[u32; 3]],
+    vertex_lo: &'a [Vec3],
+    vertex_hi: &'a [Vec3],
+    lo: &'a [Vec3],
+    hi: &'a [Vec3],
+    reach: &'a [f64],
+    pos: &'a [Vec3],
+    thickness: f32,
+}
+
+impl Search<'_> {
+    /// Adds to `out` the vertex–triangle and edge–edge pairs that triangles `a` and `b`
+    /// (whose boxes overlap) own and that could come within the thickness.
+    fn pairs_of(&self, a: usize, b: usize, out: &mut Vec<Pair>) {
+        let vbox = |v: u32| (self.vertex_lo[v as usize], self.vertex_hi[v as usize]);
+        let ebox = |[a, b]: [u32; 2]| {
+            let (a, b) = (a as usize, b as usize);
+            (
+                self.vertex_lo[a].min(self.vertex_lo[b]),
+                self.vertex_hi[a].max(self.vertex_hi[b]),
+            )
+        };
+        for (own, other) in [(a, b), (b, a)] {
+            let tri = self.triangles[other];
+            for &v in &self.owners.vertices[own] {
+                if v != NONE && !tri.contains(&v) && meet(vbox(v), (self.lo[other], self.hi[other]))
+                {
+                    self.keep(
+                        Pair {
+                            v: [v, tri[0], tri[1], tri[2]],
+                            edges: false,
+                        },
+                        out,
+                    );
+                }
+            }
+        }
+        for &e in &self.owners.edges[a] {
+            for &f in &self.owners.edges[b] {
+                if e[0] != NONE
+                    && f[0] != NONE
+                    && !e.iter().any(|i| f.contains(i))
+                    && meet(ebox(e), ebox(f))
+                {
+                    let pair = Pair {
+                        v: [e[0], e[1], f[0], f[1]],
+                        edges: true,
+                    };
+                    self.keep(pair, out);
+                }
+            }
+        }
+    }
+
+    /// Keeps `pair` if, with each particle anywhere in its box, its sides could come within
+    /// the thickness.
+    fn keep(&self, pair: Pair, out: &mut Vec<Pair>) {
+        let x = pair.v.map(|i| self.pos[i as usize].as_dvec3());
+        let k = pair.first_side();
+        let most = |r: std::ops::Range<usize>| {
+            r.map(|i| self.reach[pair.v[i] as usize])
+                .fold(0.0f64, f64::max)
+        };
+        if distance(&pair, x) - most(0..k) - most(k..4) < f64::from(self.thickness) {
+            out.push(pair);
+        }
+    }
 }
 
 /// Whether boxes `a` and `b` overlap.
@@ -166,13 +268,19 @@ impl SelfContacts {
         if !self.holds(thickness) {
             self.find_pairs(model, thickness)?;
         }
-        self.work.candidates = self.pairs.len() as u64;
+        self.work.candidates = self.pairs().count() as u64;
         self.work.binned = self.hash.len() as u64;
         let mut contacts = 0;
         for _ in 0..PUSH_SWEEPS {
-            for pair in &self.pairs {
-                contacts +=
-                    usize::from(push_apart(pair, [thickness, friction], model, start, state));
+            for pair in pairs_in(&self.found, &self.segments[..self.pieces]) {
+                contacts += usize::from(push_apart(
+                    pair,
+                    [thickness, friction],
+                    model,
+                    start,
+                    state,
+                    &self.held,
+                ));
             }
         }
         self.work.contacts = contacts as u64;
@@ -182,6 +290,7 @@ impl SelfContacts {
             self.find_pairs(model, thickness)?;
         }
         self.shift += mean;
+        self.fixed.clear();
         self.keep_apart(model, start, state, thickness, substep);
         self.forced_total += self.work.forced;
         Ok(contacts)
@@ -209,9 +318,17 @@ impl SelfContacts {
             self.find_pairs(model, thickness)?;
         }
         let (impacts, forced) = (self.work.impacts, self.work.forced);
+        // What the solids just moved stays where they put it: the cut falls on the rest.
+        self.fixed.clear();
+        (self.fixed).extend(from.iter().zip(&state.pos).map(|(a, b)| a != b));
         self.keep_apart(model, from, state, thickness, substep);
         self.forced_total += self.work.forced - forced;
         Ok((self.work.impacts - impacts) as usize)
+    }
+
+    /// The pairs found last.
+    fn pairs(&self) -> impl Iterator<Item = &Pair> {
+        pairs_in(&self.found, &self.segments[..self.pieces])
     }
 
     /// Entries in the hash's table now: at most [`CELLS_PER_TRIANGLE`](super::CELLS_PER_TRIANGLE) per triangle,
@@ -249,14 +366,13 @@ impl SelfContacts {
     /// motion), so the pairs hold for the substeps after as long as the motion stays in it
     /// less half the thickness.
     fn find_pairs(&mut self, model: &ClothModel, thickness: f32) -> Result<(), ContactError> {
-        let (start, pos) = (&self.from, &self.to);
         self.found_for = None;
         self.vertex_lo.clear();
         self.vertex_hi.clear();
         self.reach.clear();
-        for (s, p) in start.iter().zip(pos) {
+        for (s, p) in self.from.iter().zip(&self.to) {
             let moved = s.distance(*p);
-            let grow = 0.75 * thickness + 0.25 * moved;
+            let grow = 0.75 * thickness;
             self.vertex_lo.push(s.min(*p) - Vec3::splat(grow));
             self.vertex_hi.push(s.max(*p) + Vec3::splat(grow));
             // The farthest a particle can be from where it is now while in its box.
@@ -275,56 +391,52 @@ impl SelfContacts {
             .fold(0.0f32, |m, &r| m.max(r));
         let cell = (2.0 * longest).max(2.0 * thickness).max(1e-6);
         self.hash.bin(&self.lo, &self.hi, cell)?;
-        self.pairs.clear();
-        let (owners, tris) = (&self.owners, &model.triangles);
-        let (lo, hi) = (&self.lo, &self.hi);
-        let pairs = &mut self.pairs;
-        let reach = &self.reach;
-        // A pair is kept only if, with each particle anywhere in its box, its sides could
-        // come within the thickness.
-        let mut keep = |pair: Pair| {
-            let x = pair.v.map(|i| pos[i as usize].as_dvec3());
-            let k = pair.first_side();
-            let most = |r: std::ops::Range<usize>| {
-                r.map(|i| reach[pair.v[i] as usize]).fold(0.0f64, f64::max)
+        let pieces = self.hash.pieces();
+        self.pieces = 0;
+        let team = Team::current();
+        self.found.resize_with(team.members().max(1), Vec::new);
+        for buffer in &mut self.found {
+            buffer.clear();
+        }
+        self.segments.resize(pieces, Segment::default());
+        let search = Search {
+            owners: &self.owners,
+            triangles: &model.triangles,
+            vertex_lo: &self.vertex_lo,
+            vertex_hi: &self.vertex_hi,
+            lo: &self.lo,
+            hi: &self.hi,
+            reach: &self.reach,
+            pos: &self.to,
+            thickness,
+        };
+        let (found, segments) = (
+            Disjoint::new(&mut self.found),
+            Disjoint::new(&mut self.segments),
+        );
+        let hash = &self.hash;
+        let work = |member: usize, piece: usize| {
+            // SAFETY: a member takes only its own buffer, and each piece is run once and
+            // writes only its own segment.
+            let (out, segment) = unsafe {
+                (
+                    &mut found.part(member..member + 1)[0],
+                    &mut segments.part(piece..piece + 1)[0],
+                )
             };
-            if distance(&pair, x) - most(0..k) - most(k..4) < f64::from(thickness) {
-                pairs.push(pair);
-            }
+            let start = out.len();
+            hash.piece_pairs(piece, &self.lo, &self.hi, |a, b| {
+                search.pairs_of(a as usize, b as usize, out);
+            });
+            *segment = Segment {
+                member: member as u32,
+                start: start as u32,
+                end: out.len() as u32,
+            };
         };
-        let vbox = |v: u32| (vlo[v as usize], vhi[v as usize]);
-        let ebox = |[a, b]: [u32; 2]| {
-            let (a, b) = (a as usize, b as usize);
-            (vlo[a].min(vlo[b]), vhi[a].max(vhi[b]))
-        };
-        self.hash.overlapping_pairs(lo, hi, |a, b| {
-            let (a, b) = (a as usize, b as usize);
-            for (own, other) in [(a, b), (b, a)] {
-                let tri = tris[other];
-                for &v in &owners.vertices[own] {
-                    if v != NONE && !tri.contains(&v) && meet(vbox(v), (lo[other], hi[other])) {
-                        keep(Pair {
-                            v: [v, tri[0], tri[1], tri[2]],
-                            edges: false,
-                        });
-                    }
-                }
-            }
-            for &e in &owners.edges[a] {
-                for &f in &owners.edges[b] {
-                    if e[0] != NONE
-                        && f[0] != NONE
-                        && !e.iter().any(|i| f.contains(i))
-                        && meet(ebox(e), ebox(f))
-                    {
-                        keep(Pair {
-                            v: [e[0], e[1], f[0], f[1]],
-                            edges: true,
-                        });
-                    }
-                }
-            }
-        });
+        let parallel = model.triangles.len() >= PARALLEL_TRIANGLES;
+        team.run_pieces_if(parallel, pieces, &work);
+        self.pieces = pieces;
         self.work.searches += 1;
         self.found_for = Some(thickness);
         Ok(())
@@ -343,7 +455,9 @@ impl SelfContacts {
     ) {
         let n = state.pos.len();
         let keep = KEEP * f64::from(thickness);
-        let free = |i: usize| model.inv_mass[i] > 0.0;
+        let fixed = &self.fixed;
+        let pinned_free = |i: usize| model.inv_mass[i] > 0.0;
+        let free = |i: usize| pinned_free(i) && !fixed.get(i).copied().unwrap_or(false);
         self.scale.clear();
         self.scale.resize(n, 1.0);
         self.changed.clear();
@@ -351,7 +465,7 @@ impl SelfContacts {
         for round in 0.. {
             self.cut.clone_from(&self.scale);
             let mut any = false;
-            for pair in &self.pairs {
+            for pair in pairs_in(&self.found, &self.segments[..self.pieces]) {
                 let ids = pair.v.map(|i| i as usize);
                 if !ids.iter().any(|&i| self.changed[i]) {
                     continue;
@@ -364,9 +478,15 @@ impl SelfContacts {
                     continue;
                 }
                 self.work.impacts += 1;
+                // Particles a solid placed are cut only where nothing else in the pair can be:
+                // the cloth's own guarantee comes first.
+                let only_placed = !ids.iter().any(|&i| free(i) && self.scale[i] > 0.0);
+                let movable = |i: usize| {
+                    self.scale[i] > 0.0 && if only_placed { pinned_free(i) } else { free(i) }
+                };
                 let mut cut_any = false;
                 for &i in &ids {
-                    if free(i) && self.scale[i] > 0.0 {
+                    if movable(i) {
                         let to = if round < SCALED_ROUNDS {
                             self.scale[i] * t
                         } else {
