@@ -24,6 +24,7 @@
 pub mod app;
 pub mod bench;
 pub mod bench_contact;
+pub mod bench_crumple;
 pub mod cloth;
 pub mod device;
 pub mod gpu;

@@ -134,6 +134,19 @@ pub enum Command {
         /// triangles, the obstacle phase against the springs' (per --threads).
         #[arg(long, conflicts_with_all = ["sizes", "integrators", "backend"])]
         obstacles: bool,
+        /// Instead: the `crumple` scene's first simulated second at --quads (its own
+        /// integrator, or the first of --integrators), the contact phases per substep
+        /// against the springs' and the pairs per particle (per --threads).
+        #[arg(long, conflicts_with_all = ["sizes", "backend", "obstacles"])]
+        crumple: bool,
+        /// Comma-separated grid sizes (quads a side) for --crumple.
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "64",
+            requires = "crumple"
+        )]
+        quads: Vec<u32>,
     },
     /// Write a rectangular grid cloth as an OBJ file (quads: diagonals become shear springs).
     Grid {

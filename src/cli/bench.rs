@@ -164,3 +164,60 @@ pub fn contact_bench(threads: &[usize], json: bool) -> Result<()> {
     }
     Ok(())
 }
+
+/// Runs and prints the crumple bench: one row per thread count × grid size.
+pub fn crumple_bench(
+    quads: &[u32],
+    integrator: Option<IntegratorKind>,
+    threads: &[usize],
+    json: bool,
+) -> Result<()> {
+    use clothsim::bench_crumple::crumple_one;
+    if let Some(&t) = threads.iter().find(|&&t| !(1..=256).contains(&t)) {
+        bail!("--threads: {t} is outside 1..=256");
+    }
+    if !json {
+        println!(
+            "{:>6} {:>9} {:<16} {:>7} {:>8} {:>11} {:>13} {:>13} {:>9} {:>11} {:>9}",
+            "quads",
+            "particles",
+            "integrator",
+            "threads",
+            "substeps",
+            "wall/sim s",
+            "contact µs/ss",
+            "springs µs/ss",
+            "× springs",
+            "pairs/part.",
+            "searches",
+        );
+    }
+    for &t in threads {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .with_context(|| format!("cannot start {t} threads"))?;
+        for &q in quads {
+            let row = pool.install(|| crumple_one(q, integrator))?;
+            if json {
+                println!("{}", serde_json::to_string(&row)?);
+            } else {
+                println!(
+                    "{:>6} {:>9} {:<16} {:>7} {:>8} {:>11.2} {:>13.1} {:>13.1} {:>9.1} {:>11.1} {:>9.2}",
+                    row.quads,
+                    row.particles,
+                    row.integrator,
+                    row.threads,
+                    row.substeps,
+                    row.wall_per_second,
+                    row.contact_us,
+                    row.springs_us,
+                    row.contact_us / row.springs_us,
+                    row.pairs_per_particle,
+                    row.searches_per_substep,
+                );
+            }
+        }
+    }
+    Ok(())
+}

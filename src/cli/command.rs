@@ -6,7 +6,7 @@ use clothsim::gpu::{Backend, GPU_INTEGRATOR};
 
 use super::accuracy::accuracy;
 use super::args::{Cli, Command};
-use super::bench::{bench, contact_bench};
+use super::bench::{bench, contact_bench, crumple_bench};
 use super::grid::grid;
 use super::info::info;
 use super::render::{Output, render};
@@ -94,12 +94,27 @@ pub fn run(cli: Cli) -> Result<()> {
             ..
         }) => contact_bench(&threads, json),
         Some(Command::Bench {
+            threads,
+            json,
+            crumple: true,
+            quads,
+            integrators,
+            ..
+        }) => crumple_bench(
+            &quads,
+            integrators.and_then(|k| k.first().copied()),
+            &threads,
+            json,
+        ),
+        Some(Command::Bench {
             sizes,
             integrators,
             threads,
             json,
             backend,
             obstacles: false,
+            crumple: false,
+            ..
         }) => {
             let integrators = integrators.unwrap_or_else(|| match backend {
                 Backend::Cpu => clothsim::bench::BENCH_INTEGRATORS.to_vec(),

@@ -159,10 +159,10 @@ impl CpuStepper {
                 for c in self.contacts.iter().filter(|c| c.is_solid()) {
                     contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
                 }
-                let (from, h) = (&self.after_self, pass.substep);
+                let (placed, h) = (&self.after_self, pass.substep);
                 let settle = || {
-                    pass.self_contacts
-                        .settle(own.thickness, h, model, from, pass.state)
+                    let motion = [pass.start, &placed[..]];
+                    (pass.self_contacts).settle(own.thickness, h, model, motion, pass.state)
                 };
                 if self.timings.time("self-recheck", settle)? == 0 {
                     break;

@@ -200,7 +200,11 @@ pub fn push_apart(
     if weight <= 0.0 {
         return false;
     }
-    let lambda = depth / weight;
+    // No particle moves farther than the depth: a pair whose only free particle barely
+    // weighs in its side (a small weight) is pushed partly, not flung.
+    let most = (0..4).map(|i| w[i] * inv[i]).fold(0.0f32, f32::max);
+    let share = (weight / most).min(1.0);
+    let lambda = share * depth / weight;
     for i in 0..4 {
         state.pos[ids[i]] += (sign(i) * w[i] * inv[i] * lambda) * direction;
     }
@@ -214,7 +218,7 @@ pub fn push_apart(
         } else {
             0.0
         };
-        let impulse = (-approach * direction - friction * sliding) / weight;
+        let impulse = share * (-approach * direction - friction * sliding) / weight;
         for i in 0..4 {
             state.vel[ids[i]] += (sign(i) * w[i] * inv[i]) * impulse;
         }

@@ -28,11 +28,17 @@ pub struct SelfWork {
     /// Pairs that prescribed motion (pins, handles) drove together, so no cut could keep
     /// them apart.
     pub forced: u64,
+    /// [`SelfWork::forced`] added up since the solver was made.
+    pub forced_total: u64,
 }
 
 /// The separation the continuous check keeps, as a share of the thickness (pairs that
 /// start closer keep half of what they start at).
 const KEEP: f64 = 0.1;
+
+/// The pairs found are kept for later substeps (their boxes given room) only while no
+/// particle moves more than this share of the thickness in a substep.
+const REUSE_BELOW: f32 = 0.5;
 
 /// Gauss–Seidel sweeps of the pushes over the pairs.
 const PUSH_SWEEPS: usize = 4;
@@ -106,6 +112,8 @@ pub struct SelfContacts {
     from: Vec<Vec3>,
     to: Vec<Vec3>,
     shift: Vec3,
+    /// The cloth's mean motion in the last substep resolved.
+    mean: Vec3,
     /// How far each particle can be from where it was when the pairs were found, while
     /// in its box.
     reach: Vec<f64>,
@@ -132,7 +140,7 @@ pub struct SelfContacts {
     changed: Vec<bool>,
     pub work: SelfWork,
     /// Pairs prescribed motion forced together since the solver was made.
-    pub forced_total: u64,
+    forced_total: u64,
 }
 
 /// Where one piece of the search put its pairs: `found[member][start..end]`.
@@ -290,15 +298,19 @@ impl SelfContacts {
             self.find_pairs(model, thickness)?;
         }
         self.shift += mean;
+        self.mean = mean;
         self.fixed.clear();
         self.keep_apart(model, start, state, thickness, substep);
         self.forced_total += self.work.forced;
+        self.work.forced_total = self.forced_total;
         Ok(contacts)
     }
 
-    /// Checks a motion after [`SelfContacts::resolve`] (from `from`, free of
-    /// intersections, to `state`) along its whole length, cutting it where a pair could
-    /// meet, as `resolve` does but without pushes. Returns the pairs cut.
+    /// Checks the substep's motion again after [`SelfContacts::resolve`] and a move of the
+    /// solids (from `start`, the substep's, free of intersections, to `state`; `placed`:
+    /// the positions before the solids moved them) along its whole length, cutting it where
+    /// a pair could meet, as `resolve` does but without pushes; what the solids moved is cut
+    /// only where nothing else can be. Returns the pairs cut.
     ///
     /// # Errors
     /// As [`SelfContacts::resolve`].
@@ -307,22 +319,27 @@ impl SelfContacts {
         thickness: f32,
         substep: f32,
         model: &ClothModel,
-        from: &[Vec3],
+        [start, placed]: [&[Vec3]; 2],
         state: &mut ClothState,
     ) -> Result<usize, ContactError> {
         if thickness <= 0.0 || model.triangles.is_empty() {
             return Ok(0);
         }
-        self.relative(from, &state.pos, Vec3::ZERO);
+        // The substep's start in the frame it was resolved in.
+        let mean = self.mean;
+        self.shift -= mean;
+        self.relative(start, &state.pos, mean);
+        self.shift += mean;
         if !self.holds(thickness) {
             self.find_pairs(model, thickness)?;
         }
         let (impacts, forced) = (self.work.impacts, self.work.forced);
         // What the solids just moved stays where they put it: the cut falls on the rest.
         self.fixed.clear();
-        (self.fixed).extend(from.iter().zip(&state.pos).map(|(a, b)| a != b));
-        self.keep_apart(model, from, state, thickness, substep);
+        (self.fixed).extend(placed.iter().zip(&state.pos).map(|(a, b)| a != b));
+        self.keep_apart(model, start, state, thickness, substep);
         self.forced_total += self.work.forced - forced;
+        self.work.forced_total = self.forced_total;
         Ok((self.work.impacts - impacts) as usize)
     }
 
@@ -362,17 +379,27 @@ impl SelfContacts {
     }
 
     /// The pairs whose boxes overlap: each particle's box holds its motion from `from` to
-    /// `to` grown by a margin (three quarters of the thickness and a quarter of the
-    /// motion), so the pairs hold for the substeps after as long as the motion stays in it
-    /// less half the thickness.
+    /// `to` grown by half the thickness, or (where the cloth moves slowly) three quarters of
+    /// it, so the pairs hold for the substeps after as long as the motion stays in it less
+    /// half the thickness.
     fn find_pairs(&mut self, model: &ClothModel, thickness: f32) -> Result<(), ContactError> {
         self.found_for = None;
         self.vertex_lo.clear();
         self.vertex_hi.clear();
         self.reach.clear();
+        // Room to reuse the pairs only where the cloth moves slowly in the moving frame; a
+        // fast substep would leave its boxes at once, and the room would only add pairs.
+        let fastest = (self.from.iter().zip(&self.to))
+            .map(|(s, p)| s.distance_squared(*p))
+            .fold(0.0f32, f32::max)
+            .sqrt();
+        let grow = if fastest < REUSE_BELOW * thickness {
+            0.75 * thickness
+        } else {
+            0.5 * thickness
+        };
         for (s, p) in self.from.iter().zip(&self.to) {
             let moved = s.distance(*p);
-            let grow = 0.75 * thickness;
             self.vertex_lo.push(s.min(*p) - Vec3::splat(grow));
             self.vertex_hi.push(s.max(*p) + Vec3::splat(grow));
             // The farthest a particle can be from where it is now while in its box.
