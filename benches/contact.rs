@@ -1,7 +1,8 @@
 //! Cost of one frame of a 64 × 64 cloth resting on a mesh sphere of about 1 000 and of
 //! about 100 000 triangles (the scene of `clothsim bench --obstacles`, which times the
 //! obstacle phase alone against the springs). The tree over the triangles keeps the larger
-//! obstacle's frame from growing with its triangles.
+//! obstacle's frame from growing with its triangles. And one frame of `crumple` folding onto
+//! itself (the scene of `clothsim bench --crumple`).
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 
@@ -19,5 +20,25 @@ fn resting(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, resting);
+/// One frame of `crumple` at 32 × 32 quads as it lands in folds (after 40 frames): the
+/// self-contact pass, its recheck and the solids against the rest of the step.
+fn crumpling(c: &mut Criterion) {
+    let mut group = c.benchmark_group("contact/crumple");
+    group.sample_size(10);
+    let scene = clothsim::scene::Scene::open_resized(
+        "crumple",
+        None,
+        &clothsim::mesh::ImportOptions::default(),
+        Some(32),
+    )
+    .expect("the built-in scene builds");
+    let mut sim = clothsim::scene::Simulation::new(scene);
+    for _ in 0..40 {
+        sim.step_frame().expect("stable");
+    }
+    group.bench_function("frame-32", |b| b.iter(|| sim.step_frame().expect("stable")));
+    group.finish();
+}
+
+criterion_group!(benches, resting, crumpling);
 criterion_main!(benches);
