@@ -6,20 +6,46 @@ use glam::{DVec3, Vec3};
 
 use crate::cloth::{ClothModel, ClothState};
 
-/// A pair that may come into contact: vertex `v[0]` against triangle `v[1..4]`, or (with
-/// `edges`) edge `v[0..2]` against edge `v[2..4]`. The four particles are distinct.
+/// A pair that may come into contact: vertex 0 against triangle (1, 2, 3), or edge (0, 1)
+/// against edge (2, 3); the four particles are distinct. Sixteen bytes: which kind rides in
+/// the top bit of the first particle's number (a cloth has fewer than 2³¹ particles).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Pair {
-    pub v: [u32; 4],
-    pub edges: bool,
-}
+pub struct Pair([u32; 4]);
+
+/// The bit that marks an edge–edge pair.
+const EDGES: u32 = 1 << 31;
 
 impl Pair {
+    /// Vertex `v` against triangle `t`.
+    pub fn vertex_triangle(v: u32, t: [u32; 3]) -> Pair {
+        Pair([v, t[0], t[1], t[2]])
+    }
+
+    /// Edge `e` against edge `f`.
+    pub fn edge_edge(e: [u32; 2], f: [u32; 2]) -> Pair {
+        Pair([e[0] | EDGES, e[1], f[0], f[1]])
+    }
+
+    /// Whether it is an edge–edge pair.
+    pub fn edges(&self) -> bool {
+        self.0[0] & EDGES != 0
+    }
+
+    /// Its four particles.
+    pub fn ids(&self) -> [usize; 4] {
+        [
+            (self.0[0] & !EDGES) as usize,
+            self.0[1] as usize,
+            self.0[2] as usize,
+            self.0[3] as usize,
+        ]
+    }
+
     /// The weights that make the pair's two closest points from its four particles: the
     /// first point is Σ `w[i]` x_i over the first side, the second over the other (both
     /// sides' weights sum to one).
     pub fn weights(&self, x: [Vec3; 4]) -> [f32; 4] {
-        if self.edges {
+        if self.edges() {
             let (s, t) = segments_closest(x[0], x[1], x[2], x[3]);
             [1.0 - s, s, 1.0 - t, t]
         } else {
@@ -30,7 +56,7 @@ impl Pair {
 
     /// How many of the four particles belong to the first side.
     pub fn first_side(&self) -> usize {
-        if self.edges { 2 } else { 1 }
+        if self.edges() { 2 } else { 1 }
     }
 }
 
@@ -112,7 +138,7 @@ fn segments_closest_f64(p0: DVec3, p1: DVec3, q0: DVec3, q1: DVec3) -> (f64, f64
 
 /// The distance between the pair's two sides with its particles at `x`, in f64.
 pub fn distance(pair: &Pair, x: [DVec3; 4]) -> f64 {
-    if pair.edges {
+    if pair.edges() {
         let (s, t) = segments_closest_f64(x[0], x[1], x[2], x[3]);
         (x[0] + s * (x[1] - x[0])).distance(x[2] + t * (x[3] - x[2]))
     } else {
@@ -154,7 +180,7 @@ pub fn push_apart(
     state: &mut ClothState,
     held: &[bool],
 ) -> bool {
-    let ids = pair.v.map(|i| i as usize);
+    let ids = pair.ids();
     let x = ids.map(|i| state.pos[i]);
     let k = pair.first_side();
     // Sides whose boxes are a thickness apart are not in contact.

@@ -191,13 +191,7 @@ impl Search<'_> {
             for &v in &self.owners.vertices[own] {
                 if v != NONE && !tri.contains(&v) && meet(vbox(v), (self.lo[other], self.hi[other]))
                 {
-                    self.keep(
-                        Pair {
-                            v: [v, tri[0], tri[1], tri[2]],
-                            edges: false,
-                        },
-                        out,
-                    );
+                    self.keep(Pair::vertex_triangle(v, tri), out);
                 }
             }
         }
@@ -208,11 +202,7 @@ impl Search<'_> {
                     && !e.iter().any(|i| f.contains(i))
                     && meet(ebox(e), ebox(f))
                 {
-                    let pair = Pair {
-                        v: [e[0], e[1], f[0], f[1]],
-                        edges: true,
-                    };
-                    self.keep(pair, out);
+                    self.keep(Pair::edge_edge(e, f), out);
                 }
             }
         }
@@ -221,12 +211,10 @@ impl Search<'_> {
     /// Keeps `pair` if, with each particle anywhere in its box, its sides could come within
     /// the thickness.
     fn keep(&self, pair: Pair, out: &mut Vec<Pair>) {
-        let x = pair.v.map(|i| self.pos[i as usize].as_dvec3());
+        let ids = pair.ids();
+        let x = ids.map(|i| self.pos[i].as_dvec3());
         let k = pair.first_side();
-        let most = |r: std::ops::Range<usize>| {
-            r.map(|i| self.reach[pair.v[i] as usize])
-                .fold(0.0f64, f64::max)
-        };
+        let most = |r: std::ops::Range<usize>| r.map(|i| self.reach[ids[i]]).fold(0.0f64, f64::max);
         if distance(&pair, x) - most(0..k) - most(k..4) < f64::from(self.thickness) {
             out.push(pair);
         }
@@ -493,7 +481,7 @@ impl SelfContacts {
             self.cut.clone_from(&self.scale);
             let mut any = false;
             for pair in pairs_in(&self.found, &self.segments[..self.pieces]) {
-                let ids = pair.v.map(|i| i as usize);
+                let ids = pair.ids();
                 if !ids.iter().any(|&i| self.changed[i]) {
                     continue;
                 }
