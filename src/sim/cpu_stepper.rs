@@ -159,6 +159,10 @@ impl CpuStepper {
                 for c in self.contacts.iter().filter(|c| c.is_solid()) {
                     contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
                 }
+                // Nothing moved since self-contact: nothing to check.
+                if self.after_self == pass.state.pos {
+                    break;
+                }
                 let (placed, h) = (&self.after_self, pass.substep);
                 let settle = || {
                     let motion = [pass.start, &placed[..]];
