@@ -25,11 +25,15 @@ fn cell_key(c: [i32; 3], level: u32) -> u64 {
 
 fn cell_of(p: Vec3, size: f32) -> [i32; 3] {
     // Float-to-int casts saturate: a far-away point lands in an edge cell, which only adds
-    // candidates.
-    // `floor` without a call into libm: truncate, then step down below zero.
+    // candidates. `floor` without a call into libm: truncate, then step down below zero
+    // (saturating too: past i32::MIN the truncation already is the edge cell).
     (p / size).to_array().map(|x| {
         let i = x as i32;
-        if (i as f32) > x { i - 1 } else { i }
+        if (i as f32) > x {
+            i.saturating_sub(1)
+        } else {
+            i
+        }
     })
 }
 
@@ -195,3 +199,20 @@ const RUNS_PER_PIECE: usize = 256;
 
 /// Boxes in one piece of the search across levels.
 const BOXES_PER_PIECE: usize = 2048;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cell of a point is the floor of its coordinates over the size, and a point past
+    /// what an `i32` holds lands in the edge cell (the truncation saturates; stepping down
+    /// from it once overflowed).
+    #[test]
+    fn cells_floor_and_saturate() {
+        let c = cell_of(Vec3::new(-0.5, 0.0, 2.5), 1.0);
+        assert_eq!(c, [-1, 0, 2]);
+        assert_eq!(cell_of(Vec3::new(-1.0, 1.0, -2.0), 1.0), [-1, 1, -2]);
+        let far = cell_of(Vec3::new(-1e12, 1e12, -3.5e9), 1.0);
+        assert_eq!(far, [i32::MIN, i32::MAX, i32::MIN]);
+    }
+}
