@@ -176,13 +176,13 @@ fn wide(p: Vec3) -> DVec3 {
 /// Whether two triangles of one mesh (corner numbers `s`, `t`, at `pos`) intersect: not at
 /// all when they share an edge; on the edge opposite a shared vertex; else anywhere.
 pub fn mesh_triangles_intersect(s: [u32; 3], t: [u32; 3], pos: &[Vec3]) -> bool {
-    let shared: Vec<u32> = s.iter().copied().filter(|i| t.contains(i)).collect();
     let corners = |x: [u32; 3]| x.map(|i| wide(pos[i as usize]));
-    match shared.as_slice() {
-        [] => triangles_meet(corners(s), corners(t)),
-        [v] => {
+    let mut shared = s.iter().filter(|i| t.contains(i));
+    match (shared.next(), shared.next()) {
+        (None, _) => triangles_meet(corners(s), corners(t)),
+        (Some(&v), None) => {
             let opposite = |x: [u32; 3]| {
-                let k = x.iter().position(|i| i == v).unwrap_or(0);
+                let k = x.iter().position(|&i| i == v).unwrap_or(0);
                 (
                     wide(pos[x[(k + 1) % 3] as usize]),
                     wide(pos[x[(k + 2) % 3] as usize]),
