@@ -319,3 +319,63 @@ fn self_contact_gives_the_same_bits_on_two_threads_as_on_one() {
     assert!(work.candidates > 100, "{work:?}");
     assert!(one.pos == two.pos && one.vel == two.vel);
 }
+
+fn parsed(text: &str) -> Scene {
+    let file = SceneFile::parse(text, std::path::Path::new("start.toml")).unwrap();
+    Scene::from_file(file, None).unwrap()
+}
+
+/// A cloth that starts through a solid, or through itself, is warned about with the count
+/// the check finds; a mesh obstacle through it is counted too.
+#[test]
+fn a_cloth_that_starts_intersecting_is_warned_with_the_count() {
+    // A ground tilted through the middle of a flat 8 × 8 cloth.
+    let grid = "name = \"start\"\n[cloth]\ngrid = { quads = 8, size = 1.0 }\n";
+    let sim = Simulation::new(parsed(&format!(
+        "{grid}[[effects]]\ntype = \"plane\"\nnormal = [0.0, 1.0, 0.3]\n"
+    )));
+    let found = sim.intersections();
+    let below = found.obstacles[0];
+    assert!(
+        below > 8 && below < 128,
+        "{below} of 128 triangles below the ground"
+    );
+    let warned = sim.warnings().join("\n");
+    assert!(
+        warned.contains(&format!("{below} of its triangles")) && warned.contains("plane"),
+        "{warned}"
+    );
+    // The back half folded over the front one, tilted so that it passes through it.
+    let mut scene = parsed(grid);
+    for p in &mut scene.initial.pos {
+        if p.z < 0.0 {
+            *p = Vec3::new(p.x, 0.3 * -p.z - 0.1, -p.z);
+        }
+    }
+    let pos = scene.initial.pos.clone();
+    let pairs = self_intersections(&scene.model.triangles, &pos);
+    assert!(pairs > 0);
+    let sim = Simulation::new(scene);
+    let warned = sim.warnings().join("\n");
+    assert!(
+        warned.contains(&format!(
+            "intersects itself at the start ({pairs} triangle pairs"
+        )),
+        "{warned}"
+    );
+    // A mesh sphere through the flat cloth meets it; lifted clear, it does not.
+    let sim = Simulation::new(parsed(grid));
+    let through = |lift: f32| {
+        let mut sphere = clothsim::sim::Obstacle::new("ball.obj");
+        let mut soup = clothsim::bench_contact::cube_sphere(0.3, 1000);
+        for p in &mut soup.positions {
+            p.y += lift;
+        }
+        sphere.load_mesh(&soup).unwrap();
+        let effects = [clothsim::sim::Effect::Obstacle(sphere)];
+        let model = sim.model();
+        clothsim::sim::intersections(&effects, 0.0, &model.triangles, &sim.state().pos).obstacles[0]
+    };
+    assert!(through(0.0) > 0);
+    assert_eq!(through(0.5), 0);
+}
