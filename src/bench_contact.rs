@@ -160,11 +160,7 @@ pub fn contact_one(triangles: usize) -> Result<ContactRow, ContactBenchError> {
         sim.step_frame()?;
     }
     let timings = sim.take_timings();
-    let phase = |name| {
-        timings
-            .get(name)
-            .map_or((Duration::ZERO, 0), |p| (p.time, p.calls))
-    };
+    let phase = |name| timings.totals(name);
     let (obstacle, substeps) = phase("obstacle");
     let (springs, _) = phase("springs");
     let per = |t: Duration| t.as_secs_f64() * 1e6 / substeps.max(1) as f64;

@@ -77,11 +77,7 @@ pub fn crumple_one(
     }
     let wall = start.elapsed().as_secs_f64();
     let timings = sim.take_timings();
-    let phase = |name| {
-        timings
-            .get(name)
-            .map_or((Duration::ZERO, 0), |p| (p.time, p.calls))
-    };
+    let phase = |name| timings.totals(name);
     let (springs, substeps) = phase("springs");
     let contact: Duration = ["self-collision", "self-recheck", "sphere", "plane"]
         .iter()

@@ -16,9 +16,7 @@ pub fn bench(
     if let Some(&n) = sizes.iter().find(|&&n| !(3..=2048).contains(&n)) {
         bail!("--sizes: {n} particles per side is outside 3..=2048");
     }
-    if let Some(&t) = threads.iter().find(|&&t| !(1..=256).contains(&t)) {
-        bail!("--threads: {t} is outside 1..=256");
-    }
+    check_threads(threads)?;
     if backend == Backend::Gpu
         && let Some(k) = integrators.iter().find(|&&k| k != GPU_INTEGRATOR)
     {
@@ -109,9 +107,7 @@ pub fn bench(
 /// ratio of the large obstacle's phase to the small one's.
 pub fn contact_bench(threads: &[usize], json: bool) -> Result<()> {
     use clothsim::bench_contact::{CONTACT_TRIANGLES, contact_one};
-    if let Some(&t) = threads.iter().find(|&&t| !(1..=256).contains(&t)) {
-        bail!("--threads: {t} is outside 1..=256");
-    }
+    check_threads(threads)?;
     if !json {
         println!(
             "{:>9} {:>9} {:>7} {:>8} {:>14} {:>13} {:>9} {:>8}",
@@ -173,9 +169,7 @@ pub fn crumple_bench(
     json: bool,
 ) -> Result<()> {
     use clothsim::bench_crumple::crumple_one;
-    if let Some(&t) = threads.iter().find(|&&t| !(1..=256).contains(&t)) {
-        bail!("--threads: {t} is outside 1..=256");
-    }
+    check_threads(threads)?;
     if !json {
         println!(
             "{:>6} {:>9} {:<16} {:>7} {:>8} {:>11} {:>13} {:>13} {:>9} {:>11} {:>9}",
@@ -218,6 +212,14 @@ pub fn crumple_bench(
                 );
             }
         }
+    }
+    Ok(())
+}
+
+/// Refuses a thread count outside 1..=256.
+fn check_threads(threads: &[usize]) -> Result<()> {
+    if let Some(&t) = threads.iter().find(|&&t| !(1..=256).contains(&t)) {
+        bail!("--threads: {t} is outside 1..=256");
     }
     Ok(())
 }

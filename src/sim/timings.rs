@@ -55,6 +55,12 @@ impl PhaseTimings {
         self.entries.iter().find(|p| p.name == name)
     }
 
+    /// A phase's total time and calls (nothing for a phase that did not run).
+    pub fn totals(&self, name: &str) -> (std::time::Duration, u64) {
+        self.get(name)
+            .map_or((std::time::Duration::ZERO, 0), |p| (p.time, p.calls))
+    }
+
     /// Adds another set of timings to this one.
     pub fn merge(&mut self, other: &PhaseTimings) {
         for p in &other.entries {

@@ -139,8 +139,6 @@ pub struct SelfContacts {
     cut: Vec<f64>,
     changed: Vec<bool>,
     pub work: SelfWork,
-    /// Pairs prescribed motion forced together since the solver was made.
-    forced_total: u64,
 }
 
 /// Where one piece of the search put its pairs: `found[member][start..end]`.
@@ -251,7 +249,11 @@ impl SelfContacts {
         if self.owners.key != Owners::key(model) {
             self.owners = Owners::build(model);
         }
-        self.work = SelfWork::default();
+        // Only the running total outlives a resolve.
+        self.work = SelfWork {
+            forced_total: self.work.forced_total,
+            ..SelfWork::default()
+        };
         // Pairs are found, and kept while they hold, in a frame that moves with the
         // cloth's mean motion (it changes no distance): a cloth falling as a whole moves
         // little in it.
@@ -289,8 +291,7 @@ impl SelfContacts {
         self.mean = mean;
         self.fixed.clear();
         self.keep_apart(model, start, state, thickness, substep);
-        self.forced_total += self.work.forced;
-        self.work.forced_total = self.forced_total;
+        self.work.forced_total += self.work.forced;
         Ok(contacts)
     }
 
@@ -326,8 +327,7 @@ impl SelfContacts {
         self.fixed.clear();
         (self.fixed).extend(placed.iter().zip(&state.pos).map(|(a, b)| a != b));
         self.keep_apart(model, start, state, thickness, substep);
-        self.forced_total += self.work.forced - forced;
-        self.work.forced_total = self.forced_total;
+        self.work.forced_total += self.work.forced - forced;
         Ok((self.work.impacts - impacts) as usize)
     }
 
