@@ -40,6 +40,11 @@ const KEEP: f64 = 0.1;
 /// particle moves more than this share of the thickness in a substep.
 const REUSE_BELOW: f32 = 0.5;
 
+/// The distance, as a share of the thickness, within which the continuous check needs
+/// its pairs: twice what it keeps, for margin (pairs farther apart along the whole motion
+/// cannot come within [`KEEP`]). The pushes need the whole thickness.
+const CHECKED: f32 = 2.0 * KEEP as f32;
+
 /// Gauss–Seidel sweeps of the pushes over the pairs.
 const PUSH_SWEEPS: usize = 4;
 
@@ -263,7 +268,7 @@ impl SelfContacts {
             / n;
         let mean = mean.as_vec3();
         self.relative(start, &state.pos, mean);
-        if !self.holds(thickness) {
+        if !self.holds(thickness, thickness) {
             self.find_pairs(model, thickness)?;
         }
         self.work.candidates = self.pairs().count() as u64;
@@ -282,9 +287,10 @@ impl SelfContacts {
             }
         }
         self.work.contacts = contacts as u64;
-        // The pushes may have taken a particle out of the box its pairs were found in.
+        // The pushes may have taken a particle out of the box its pairs were found in; the
+        // check needs only the pairs that can come within what it keeps.
         self.relative(start, &state.pos, mean);
-        if !self.holds(thickness) {
+        if !self.holds(thickness, CHECKED * thickness) {
             self.find_pairs(model, thickness)?;
         }
         self.shift += mean;
@@ -319,7 +325,7 @@ impl SelfContacts {
         self.shift -= mean;
         self.relative(start, &state.pos, mean);
         self.shift += mean;
-        if !self.holds(thickness) {
+        if !self.holds(thickness, CHECKED * thickness) {
             self.find_pairs(model, thickness)?;
         }
         let (impacts, forced) = (self.work.impacts, self.work.forced);
@@ -352,11 +358,12 @@ impl SelfContacts {
         self.to.extend(pos.iter().map(|&p| p - shift - mean));
     }
 
-    /// Whether the pairs found last still hold every pair that can matter for the motion
-    /// from `from` to `to`: found for this thickness, and every particle's motion within
-    /// its box less half the thickness.
-    fn holds(&self, thickness: f32) -> bool {
-        let g = Vec3::splat(0.5 * thickness);
+    /// Whether the pairs found last hold every pair that can come within `within` along the
+    /// motion from `from` to `to`: found for this thickness, and every particle's motion
+    /// within its box less half of `within` (two boxes that far apart keep their particles
+    /// `within` apart).
+    fn holds(&self, thickness: f32, within: f32) -> bool {
+        let g = Vec3::splat(0.5 * within);
         self.found_for == Some(thickness)
             && self.vertex_lo.len() == self.to.len()
             && (self.from.iter().zip(&self.to))
