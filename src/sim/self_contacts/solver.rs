@@ -119,8 +119,9 @@ pub struct SelfContacts {
     shift: Vec3,
     /// The cloth's mean motion in the last substep resolved.
     mean: Vec3,
-    /// How far each particle can be from where it was when the pairs were found, while
-    /// in its box.
+    /// The centre of each particle's box, and how far a particle in its box can be from
+    /// it.
+    center: Vec<Vec3>,
     reach: Vec<f64>,
     /// Each triangle's box: its corners' boxes together.
     lo: Vec<Vec3>,
@@ -173,7 +174,7 @@ struct Search<'a> {
     lo: &'a [Vec3],
     hi: &'a [Vec3],
     reach: &'a [f64],
-    pos: &'a [Vec3],
+    center: &'a [Vec3],
     thickness: f32,
 }
 
@@ -215,7 +216,7 @@ impl Search<'_> {
     /// the thickness.
     fn keep(&self, pair: Pair, out: &mut Vec<Pair>) {
         let ids = pair.ids();
-        let x = ids.map(|i| self.pos[i].as_dvec3());
+        let x = ids.map(|i| self.center[i].as_dvec3());
         let k = pair.first_side();
         let most = |r: std::ops::Range<usize>| r.map(|i| self.reach[ids[i]]).fold(0.0f64, f64::max);
         if distance(&pair, x) - most(0..k) - most(k..4) < f64::from(self.thickness) {
@@ -393,12 +394,15 @@ impl SelfContacts {
         } else {
             0.5 * thickness
         };
+        self.center.clear();
         for (s, p) in self.from.iter().zip(&self.to) {
-            let moved = s.distance(*p);
-            self.vertex_lo.push(s.min(*p) - Vec3::splat(grow));
-            self.vertex_hi.push(s.max(*p) + Vec3::splat(grow));
-            // The farthest a particle can be from where it is now while in its box.
-            self.reach.push(f64::from(moved + 3f32.sqrt() * grow));
+            let (lo, hi) = (s.min(*p) - Vec3::splat(grow), s.max(*p) + Vec3::splat(grow));
+            self.vertex_lo.push(lo);
+            self.vertex_hi.push(hi);
+            // The smallest ball around the box: a particle in its box is at most half the
+            // box's diagonal from its centre.
+            self.center.push(0.5 * (lo + hi));
+            self.reach.push(0.5 * f64::from((hi - lo).length()));
         }
         let (vlo, vhi) = (&self.vertex_lo, &self.vertex_hi);
         self.lo.clear();
@@ -429,7 +433,7 @@ impl SelfContacts {
             lo: &self.lo,
             hi: &self.hi,
             reach: &self.reach,
-            pos: &self.to,
+            center: &self.center,
             thickness,
         };
         let (found, segments) = (
