@@ -195,7 +195,7 @@ impl BoxHash {
 }
 
 /// Cell runs in one piece of the search.
-const RUNS_PER_PIECE: usize = 256;
+const RUNS_PER_PIECE: usize = 64;
 
 /// Boxes in one piece of the search across levels.
 const BOXES_PER_PIECE: usize = 2048;
