@@ -10,7 +10,7 @@ use crate::parallel::{Disjoint, Team};
 use super::ccd::safe_fraction;
 use super::error::ContactError;
 use super::hash::BoxHash;
-use super::primitives::{Pair, distance, push_apart};
+use super::primitives::{Pair, StoredPair, distance, push_apart};
 
 /// Work done by the last resolve: for cost checks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -129,7 +129,7 @@ pub struct SelfContacts {
     /// The pairs, as each member of the team found them, and where each piece of the
     /// search put its own (`pieces` of them in use): read in the pieces' order, they are
     /// the same however the pieces were shared out.
-    found: Vec<Vec<Pair>>,
+    found: Vec<Vec<StoredPair>>,
     segments: Vec<Segment>,
     pieces: usize,
     /// Particles resting on a solid this substep (set by the stepper before
@@ -155,11 +155,18 @@ struct Segment {
     end: u32,
 }
 
-/// The pairs of `segments`, in order.
-fn pairs_in<'a>(found: &'a [Vec<Pair>], segments: &'a [Segment]) -> impl Iterator<Item = &'a Pair> {
+/// The pairs of `segments`, in order, expanded with the cloth's `triangles` and the owned
+/// `edges`.
+fn pairs_in<'a>(
+    found: &'a [Vec<StoredPair>],
+    segments: &'a [Segment],
+    triangles: &'a [[u32; 3]],
+    edges: &'a [[[u32; 2]; 3]],
+) -> impl Iterator<Item = Pair> + 'a {
     segments
         .iter()
         .flat_map(|s| &found[s.member as usize][s.start as usize..s.end as usize])
+        .map(|p| p.expand(triangles, edges))
 }
 
 /// Triangles from which the search shares its work out between the team's members.
@@ -181,7 +188,7 @@ struct Search<'a> {
 impl Search<'_> {
     /// Adds to `out` the vertex–triangle and edge–edge pairs that triangles `a` and `b`
     /// (whose boxes overlap) own and that could come within the thickness.
-    fn pairs_of(&self, a: usize, b: usize, out: &mut Vec<Pair>) {
+    fn pairs_of(&self, a: usize, b: usize, out: &mut Vec<StoredPair>) {
         let vbox = |v: u32| (self.vertex_lo[v as usize], self.vertex_hi[v as usize]);
         let ebox = |[a, b]: [u32; 2]| {
             let (a, b) = (a as usize, b as usize);
@@ -195,32 +202,34 @@ impl Search<'_> {
             for &v in &self.owners.vertices[own] {
                 if v != NONE && !tri.contains(&v) && meet(vbox(v), (self.lo[other], self.hi[other]))
                 {
-                    self.keep(Pair::vertex_triangle(v, tri), out);
+                    let stored = StoredPair::vertex_triangle(v, other as u32);
+                    self.keep(Pair::vertex_triangle(v, tri), stored, out);
                 }
             }
         }
-        for &e in &self.owners.edges[a] {
-            for &f in &self.owners.edges[b] {
+        for (j, &e) in self.owners.edges[a].iter().enumerate() {
+            for (k, &f) in self.owners.edges[b].iter().enumerate() {
                 if e[0] != NONE
                     && f[0] != NONE
                     && !e.iter().any(|i| f.contains(i))
                     && meet(ebox(e), ebox(f))
                 {
-                    self.keep(Pair::edge_edge(e, f), out);
+                    let stored = StoredPair::edge_edge((3 * a + j) as u32, (3 * b + k) as u32);
+                    self.keep(Pair::edge_edge(e, f), stored, out);
                 }
             }
         }
     }
 
-    /// Keeps `pair` if, with each particle anywhere in its box, its sides could come within
-    /// the thickness.
-    fn keep(&self, pair: Pair, out: &mut Vec<Pair>) {
+    /// Keeps `pair` (as `stored`) if, with each particle anywhere in its box, its sides
+    /// could come within the thickness.
+    fn keep(&self, pair: Pair, stored: StoredPair, out: &mut Vec<StoredPair>) {
         let ids = pair.ids();
         let x = ids.map(|i| self.center[i].as_dvec3());
         let k = pair.first_side();
         let most = |r: std::ops::Range<usize>| r.map(|i| self.reach[ids[i]]).fold(0.0f64, f64::max);
         if distance(&pair, x) - most(0..k) - most(k..4) < f64::from(self.thickness) {
-            out.push(pair);
+            out.push(stored);
         }
     }
 }
@@ -276,9 +285,15 @@ impl SelfContacts {
         self.work.binned = self.hash.len() as u64;
         let mut contacts = 0;
         for _ in 0..PUSH_SWEEPS {
-            for pair in pairs_in(&self.found, &self.segments[..self.pieces]) {
+            let pairs = pairs_in(
+                &self.found,
+                &self.segments[..self.pieces],
+                &model.triangles,
+                &self.owners.edges,
+            );
+            for pair in pairs {
                 contacts += usize::from(push_apart(
-                    pair,
+                    &pair,
                     [thickness, friction],
                     model,
                     start,
@@ -339,8 +354,10 @@ impl SelfContacts {
     }
 
     /// The pairs found last.
-    fn pairs(&self) -> impl Iterator<Item = &Pair> {
-        pairs_in(&self.found, &self.segments[..self.pieces])
+    fn pairs(&self) -> impl Iterator<Item = &StoredPair> {
+        (self.segments[..self.pieces])
+            .iter()
+            .flat_map(|s| &self.found[s.member as usize][s.start as usize..s.end as usize])
     }
 
     /// Entries in the hash's table now: at most [`CELLS_PER_TRIANGLE`](super::CELLS_PER_TRIANGLE) per triangle,
@@ -491,7 +508,13 @@ impl SelfContacts {
         for round in 0.. {
             self.cut.clone_from(&self.scale);
             let mut any = false;
-            for pair in pairs_in(&self.found, &self.segments[..self.pieces]) {
+            let pairs = pairs_in(
+                &self.found,
+                &self.segments[..self.pieces],
+                &model.triangles,
+                &self.owners.edges,
+            );
+            for pair in pairs {
                 let ids = pair.ids();
                 if !ids.iter().any(|&i| self.changed[i]) {
                     continue;
@@ -499,7 +522,7 @@ impl SelfContacts {
                 let from = ids.map(|i| start[i].as_dvec3());
                 let moves =
                     ids.map(|i| self.scale[i] * (state.pos[i].as_dvec3() - start[i].as_dvec3()));
-                let t = safe_fraction(pair, from, moves, keep);
+                let t = safe_fraction(&pair, from, moves, keep);
                 if t >= 1.0 {
                     continue;
                 }
