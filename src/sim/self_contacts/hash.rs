@@ -100,6 +100,22 @@ impl BoxHash {
             };
             self.levels |= 1 << level;
             self.level.push(level as u8);
+        }
+        // The entries counted first, so the table grows to what it holds, not to the next
+        // power of two (where a cloth lands fast that is megabytes).
+        let cells = |(&lo, &hi): (&Vec3, &Vec3), level: u8| {
+            let size = cell * (1u32 << level) as f32;
+            let (first, last) = (cell_of(lo, size), cell_of(hi, size));
+            (0..3)
+                .map(|i| (last[i] - first[i] + 1) as usize)
+                .product::<usize>()
+        };
+        let entries = (lo.iter().zip(hi).zip(&self.level))
+            .map(|(b, &level)| cells(b, level))
+            .sum();
+        self.bins.reserve_exact(entries);
+        for (t, ((&lo, &hi), &level)) in lo.iter().zip(hi).zip(&self.level).enumerate() {
+            let level = u32::from(level);
             let size = cell * (1u32 << level) as f32;
             each_cell(lo, hi, size, |c| {
                 self.bins.push((cell_key(c, level), t as u32))

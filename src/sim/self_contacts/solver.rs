@@ -126,12 +126,8 @@ pub struct SelfContacts {
     /// Each triangle's box: its corners' boxes together.
     lo: Vec<Vec3>,
     hi: Vec<Vec3>,
-    /// The pairs, as each member of the team found them, and where each piece of the
-    /// search put its own (`pieces` of them in use): read in the pieces' order, they are
-    /// the same however the pieces were shared out.
-    found: Vec<Vec<StoredPair>>,
-    segments: Vec<Segment>,
-    pieces: usize,
+    /// The pairs found last.
+    found: Found,
     /// Particles resting on a solid this substep (set by the stepper before
     /// [`SelfContacts::resolve`]): pushes move them only where nothing else can.
     pub held: Vec<bool>,
@@ -147,7 +143,7 @@ pub struct SelfContacts {
     pub work: SelfWork,
 }
 
-/// Where one piece of the search put its pairs: `found[member][start..end]`.
+/// Where one piece of the search put its pairs: `members[member][start..end]`.
 #[derive(Clone, Copy, Debug, Default)]
 struct Segment {
     member: u32,
@@ -155,18 +151,32 @@ struct Segment {
     end: u32,
 }
 
-/// The pairs of `segments`, in order, expanded with the cloth's `triangles` and the owned
-/// `edges`.
-fn pairs_in<'a>(
-    found: &'a [Vec<StoredPair>],
-    segments: &'a [Segment],
-    triangles: &'a [[u32; 3]],
-    edges: &'a [[[u32; 2]; 3]],
-) -> impl Iterator<Item = Pair> + 'a {
-    segments
-        .iter()
-        .flat_map(|s| &found[s.member as usize][s.start as usize..s.end as usize])
-        .map(|p| p.expand(triangles, edges))
+/// The pairs, as each member of the team found them, and where each piece of the search
+/// put its own (`pieces` of them in use): read in the pieces' order, they are the same
+/// however the pieces were shared out.
+#[derive(Clone, Debug, Default)]
+struct Found {
+    members: Vec<Vec<StoredPair>>,
+    segments: Vec<Segment>,
+    pieces: usize,
+}
+
+impl Found {
+    /// The pairs as stored, in order.
+    fn stored(&self) -> impl Iterator<Item = &StoredPair> {
+        (self.segments[..self.pieces])
+            .iter()
+            .flat_map(|s| &self.members[s.member as usize][s.start as usize..s.end as usize])
+    }
+
+    /// The pairs, expanded with the cloth's `triangles` and the owned `edges`.
+    fn pairs<'a>(
+        &'a self,
+        triangles: &'a [[u32; 3]],
+        owners: &'a Owners,
+    ) -> impl Iterator<Item = Pair> + 'a {
+        self.stored().map(|p| p.expand(triangles, &owners.edges))
+    }
 }
 
 /// Triangles from which the search shares its work out between the team's members.
@@ -229,6 +239,11 @@ impl Search<'_> {
         let k = pair.first_side();
         let most = |r: std::ops::Range<usize>| r.map(|i| self.reach[ids[i]]).fold(0.0f64, f64::max);
         if distance(&pair, x) - most(0..k) - most(k..4) < f64::from(self.thickness) {
+            // Grown by half, not doubled: where a cloth lands fast the pairs run to
+            // millions, and a doubled buffer can hold as much again unused.
+            if out.len() == out.capacity() {
+                out.reserve_exact((out.capacity() / 2).max(1024));
+            }
             out.push(stored);
         }
     }
@@ -281,17 +296,11 @@ impl SelfContacts {
         if !self.holds(thickness, thickness) {
             self.find_pairs(model, thickness)?;
         }
-        self.work.candidates = self.pairs().count() as u64;
+        self.work.candidates = self.found.stored().count() as u64;
         self.work.binned = self.hash.len() as u64;
         let mut contacts = 0;
         for _ in 0..PUSH_SWEEPS {
-            let pairs = pairs_in(
-                &self.found,
-                &self.segments[..self.pieces],
-                &model.triangles,
-                &self.owners.edges,
-            );
-            for pair in pairs {
+            for pair in self.found.pairs(&model.triangles, &self.owners) {
                 contacts += usize::from(push_apart(
                     &pair,
                     [thickness, friction],
@@ -351,13 +360,6 @@ impl SelfContacts {
         self.keep_apart(model, start, state, thickness, substep);
         self.work.forced_total += self.work.forced - forced;
         Ok((self.work.impacts - impacts) as usize)
-    }
-
-    /// The pairs found last.
-    fn pairs(&self) -> impl Iterator<Item = &StoredPair> {
-        (self.segments[..self.pieces])
-            .iter()
-            .flat_map(|s| &self.found[s.member as usize][s.start as usize..s.end as usize])
     }
 
     /// Entries in the hash's table now: at most [`CELLS_PER_TRIANGLE`](super::CELLS_PER_TRIANGLE) per triangle,
@@ -435,13 +437,13 @@ impl SelfContacts {
         let cell = (2.0 * longest).max(2.0 * thickness).max(1e-6);
         self.hash.bin(&self.lo, &self.hi, cell)?;
         let pieces = self.hash.pieces();
-        self.pieces = 0;
+        self.found.pieces = 0;
         let team = Team::current();
-        self.found.resize_with(team.members().max(1), Vec::new);
-        for buffer in &mut self.found {
+        (self.found.members).resize_with(team.members().max(1), Vec::new);
+        for buffer in &mut self.found.members {
             buffer.clear();
         }
-        self.segments.resize(pieces, Segment::default());
+        (self.found.segments).resize(pieces, Segment::default());
         let search = Search {
             owners: &self.owners,
             triangles: &model.triangles,
@@ -454,8 +456,8 @@ impl SelfContacts {
             thickness,
         };
         let (found, segments) = (
-            Disjoint::new(&mut self.found),
-            Disjoint::new(&mut self.segments),
+            Disjoint::new(&mut self.found.members),
+            Disjoint::new(&mut self.found.segments),
         );
         let hash = &self.hash;
         let work = |member: usize, piece: usize| {
@@ -479,7 +481,7 @@ impl SelfContacts {
         };
         let parallel = model.triangles.len() >= PARALLEL_TRIANGLES;
         team.run_pieces_if(parallel, pieces, &work);
-        self.pieces = pieces;
+        self.found.pieces = pieces;
         self.work.searches += 1;
         self.found_for = Some(thickness);
         Ok(())
@@ -508,13 +510,7 @@ impl SelfContacts {
         for round in 0.. {
             self.cut.clone_from(&self.scale);
             let mut any = false;
-            let pairs = pairs_in(
-                &self.found,
-                &self.segments[..self.pieces],
-                &model.triangles,
-                &self.owners.edges,
-            );
-            for pair in pairs {
+            for pair in self.found.pairs(&model.triangles, &self.owners) {
                 let ids = pair.ids();
                 if !ids.iter().any(|&i| self.changed[i]) {
                     continue;
