@@ -4,8 +4,9 @@ use glam::Vec3;
 
 use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 use super::solid::{Solid, default_friction, resolve};
+use crate::sim::obstacle::closest_weights;
 use crate::sim::param_error::ParamError;
-use crate::sim::self_contacts::{ContactError, triangle_closest};
+use crate::sim::self_contacts::ContactError;
 
 /// A sphere spinning with angular velocity `spin` (zero for a still one).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -90,7 +91,7 @@ impl Sphere {
             if near > reach + longest {
                 continue;
             }
-            let w = triangle_closest(self.center, x[0], x[1], x[2]);
+            let w = closest_weights(self.center, x);
             let q = w[0] * x[0] + w[1] * x[1] + w[2] * x[2];
             let gap = q - self.center;
             let d = gap.length();

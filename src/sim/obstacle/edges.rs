@@ -5,6 +5,7 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 
+use super::geometry::segments_closest;
 use super::tree::TriangleTree;
 
 /// Two faces meeting at less than this cosine between their normals (about 10°) make a
@@ -171,36 +172,10 @@ fn boxes(edges: &[[Vec3; 2]]) -> Vec<[Vec3; 3]> {
 
 /// The nearest points of the segments `a`–`b` and `p`–`q`.
 fn closest_between(a: Vec3, b: Vec3, p: Vec3, q: Vec3) -> EdgeHit {
-    let (d1, d2, r) = (b - a, q - p, a - p);
-    let (l1, l2, f) = (d1.dot(d1), d2.dot(d2), d2.dot(r));
-    let (s, t) = if l1 <= f32::EPSILON && l2 <= f32::EPSILON {
-        (0.0, 0.0)
-    } else if l1 <= f32::EPSILON {
-        (0.0, (f / l2).clamp(0.0, 1.0))
-    } else {
-        let c = d1.dot(r);
-        if l2 <= f32::EPSILON {
-            ((-c / l1).clamp(0.0, 1.0), 0.0)
-        } else {
-            let bb = d1.dot(d2);
-            let denom = l1 * l2 - bb * bb;
-            let mut s = if denom > f32::EPSILON * l1 * l2 {
-                ((bb * f - c * l2) / denom).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let mut t = (bb * s + f) / l2;
-            if t < 0.0 {
-                t = 0.0;
-                s = (-c / l1).clamp(0.0, 1.0);
-            } else if t > 1.0 {
-                t = 1.0;
-                s = ((bb - c) / l1).clamp(0.0, 1.0);
-            }
-            (s, t)
-        }
-    };
-    let (on_segment, on_edge) = (a + d1 * s, p + d2 * t);
+    let [a64, b64, p64, q64] = [a, b, p, q].map(|v| v.as_dvec3());
+    let (s, t) = segments_closest(a64, b64, p64, q64);
+    let (s, t) = (s as f32, t as f32);
+    let (on_segment, on_edge) = (a + (b - a) * s, p + (q - p) * t);
     EdgeHit {
         along: s,
         on_segment,

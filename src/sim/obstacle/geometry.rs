@@ -1,40 +1,85 @@
 //! Points, segments and triangles: the closest point of a triangle to a point, and where a
 //! segment crosses a triangle.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 /// The point of triangle `abc` closest to `p` (its inside, an edge or a corner).
-pub fn closest_on_triangle(p: Vec3, [a, b, c]: [Vec3; 3]) -> Vec3 {
-    // The Voronoi regions of the corners, then of the edges, then the inside.
+pub fn closest_on_triangle(p: Vec3, t: [Vec3; 3]) -> Vec3 {
+    let w = closest_weights(p, t);
+    w[0] * t[0] + w[1] * t[1] + w[2] * t[2]
+}
+
+/// The barycentric weights on `a`, `b`, `c` of the point of triangle `abc` closest to `p`.
+pub fn closest_weights(p: Vec3, [a, b, c]: [Vec3; 3]) -> [f32; 3] {
+    // Ericson, Real-Time Collision Detection, 5.1.5: the Voronoi regions of the corners,
+    // then of the edges, then the inside.
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
     if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
+        return [1.0, 0.0, 0.0];
     }
     let bp = p - b;
     let (d3, d4) = (ab.dot(bp), ac.dot(bp));
     if d3 >= 0.0 && d4 <= d3 {
-        return b;
+        return [0.0, 1.0, 0.0];
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
+        let v = d1 / (d1 - d3);
+        return [1.0 - v, v, 0.0];
     }
     let cp = p - c;
     let (d5, d6) = (ab.dot(cp), ac.dot(cp));
     if d6 >= 0.0 && d5 <= d6 {
-        return c;
+        return [0.0, 0.0, 1.0];
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
+        let w = d2 / (d2 - d6);
+        return [1.0 - w, 0.0, w];
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return [0.0, 1.0 - w, w];
     }
     let denom = 1.0 / (va + vb + vc);
-    a + ab * (vb * denom) + ac * (vc * denom)
+    let (v, w) = (vb * denom, vc * denom);
+    [1.0 - v - w, v, w]
+}
+
+/// Where along segments `p0`–`p1` and `q0`–`q1` (0 at the first end, 1 at the second) their
+/// nearest points lie, in f64. Ericson 5.1.9, with a point for a segment and parallel
+/// segments (any nearest pair then).
+pub fn segments_closest(p0: DVec3, p1: DVec3, q0: DVec3, q1: DVec3) -> (f64, f64) {
+    let (d1, d2, r) = (p1 - p0, q1 - q0, p0 - q0);
+    let (a, e, f) = (d1.length_squared(), d2.length_squared(), d2.dot(r));
+    if a <= f64::EPSILON && e <= f64::EPSILON {
+        return (0.0, 0.0);
+    }
+    if a <= f64::EPSILON {
+        return (0.0, (f / e).clamp(0.0, 1.0));
+    }
+    let c = d1.dot(r);
+    if e <= f64::EPSILON {
+        return ((-c / a).clamp(0.0, 1.0), 0.0);
+    }
+    let b = d1.dot(d2);
+    let denom = a * e - b * b;
+    let mut s = if denom > 0.0 {
+        ((b * f - c * e) / denom).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let mut t = (b * s + f) / e;
+    if t < 0.0 {
+        t = 0.0;
+        s = (-c / a).clamp(0.0, 1.0);
+    } else if t > 1.0 {
+        t = 1.0;
+        s = ((b - c) / a).clamp(0.0, 1.0);
+    }
+    (s, t)
 }
 
 /// The barycentric weights of `p` (a point of the triangle's plane) on `a`, `b`, `c`

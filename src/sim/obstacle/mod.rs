@@ -8,6 +8,7 @@ mod surface;
 mod tree;
 
 pub use edges::{EdgeHit, SharpEdges};
+pub(crate) use geometry::{closest_weights, segments_closest};
 pub use sequence::{Moment, Sequence};
 pub use surface::{Caught, Gathered, Surface};
 pub use tree::{Nearest, TriangleTree};

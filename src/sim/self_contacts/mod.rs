@@ -18,5 +18,5 @@ mod solver;
 
 pub use error::ContactError;
 pub use hash::CELLS_PER_TRIANGLE;
-pub(crate) use primitives::{point_triangle_distance, triangle_closest};
+pub(crate) use primitives::point_triangle_distance;
 pub use solver::{SelfContacts, SelfWork};

@@ -5,6 +5,7 @@
 use glam::{DVec3, Vec3};
 
 use crate::cloth::{ClothModel, ClothState};
+use crate::sim::obstacle::{closest_weights, segments_closest};
 
 /// A pair that may come into contact: vertex 0 against triangle (1, 2, 3), or edge (0, 1)
 /// against edge (2, 3); the four particles are distinct. Sixteen bytes: which kind rides in
@@ -76,10 +77,11 @@ impl Pair {
     /// sides' weights sum to one).
     pub fn weights(&self, x: [Vec3; 4]) -> [f32; 4] {
         if self.edges() {
-            let (s, t) = segments_closest(x[0], x[1], x[2], x[3]);
-            [1.0 - s, s, 1.0 - t, t]
+            let [p0, p1, q0, q1] = x.map(|v| v.as_dvec3());
+            let (s, t) = segments_closest(p0, p1, q0, q1);
+            [1.0 - s as f32, s as f32, 1.0 - t as f32, t as f32]
         } else {
-            let b = triangle_closest(x[0], x[1], x[2], x[3]);
+            let b = closest_weights(x[0], [x[1], x[2], x[3]]);
             [1.0, b[0], b[1], b[2]]
         }
     }
@@ -90,86 +92,10 @@ impl Pair {
     }
 }
 
-/// Barycentric weights of the point of triangle (a, b, c) closest to `p`.
-pub fn triangle_closest(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> [f32; 3] {
-    // Ericson, Real-Time Collision Detection, 5.1.5: regions by barycentric signs.
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return [1.0, 0.0, 0.0];
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return [0.0, 1.0, 0.0];
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return [1.0 - v, v, 0.0];
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return [0.0, 0.0, 1.0];
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return [1.0 - w, 0.0, w];
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return [0.0, 1.0 - w, w];
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let (v, w) = (vb * denom, vc * denom);
-    [1.0 - v - w, v, w]
-}
-
-/// Parameters (s, t) in [0, 1] of the closest points of segments (p0, p1) and (q0, q1).
-pub fn segments_closest(p0: Vec3, p1: Vec3, q0: Vec3, q1: Vec3) -> (f32, f32) {
-    let (s, t) = segments_closest_f64(p0.as_dvec3(), p1.as_dvec3(), q0.as_dvec3(), q1.as_dvec3());
-    (s as f32, t as f32)
-}
-
-fn segments_closest_f64(p0: DVec3, p1: DVec3, q0: DVec3, q1: DVec3) -> (f64, f64) {
-    // Ericson 5.1.9, with the degenerate cases.
-    let (d1, d2, r) = (p1 - p0, q1 - q0, p0 - q0);
-    let (a, e, f) = (d1.length_squared(), d2.length_squared(), d2.dot(r));
-    if a <= f64::EPSILON && e <= f64::EPSILON {
-        return (0.0, 0.0);
-    }
-    if a <= f64::EPSILON {
-        return (0.0, (f / e).clamp(0.0, 1.0));
-    }
-    let c = d1.dot(r);
-    if e <= f64::EPSILON {
-        return ((-c / a).clamp(0.0, 1.0), 0.0);
-    }
-    let b = d1.dot(d2);
-    let denom = a * e - b * b;
-    let mut s = if denom > 0.0 {
-        ((b * f - c * e) / denom).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let mut t = (b * s + f) / e;
-    if t < 0.0 {
-        t = 0.0;
-        s = (-c / a).clamp(0.0, 1.0);
-    } else if t > 1.0 {
-        t = 1.0;
-        s = ((b - c) / a).clamp(0.0, 1.0);
-    }
-    (s, t)
-}
-
 /// The distance between the pair's two sides with its particles at `x`, in f64.
 pub fn distance(pair: &Pair, x: [DVec3; 4]) -> f64 {
     if pair.edges() {
-        let (s, t) = segments_closest_f64(x[0], x[1], x[2], x[3]);
+        let (s, t) = segments_closest(x[0], x[1], x[2], x[3]);
         (x[0] + s * (x[1] - x[0])).distance(x[2] + t * (x[3] - x[2]))
     } else {
         point_triangle_distance(x[0], [x[1], x[2], x[3]])
