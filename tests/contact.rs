@@ -370,9 +370,19 @@ fn a_cloth_that_starts_intersecting_is_warned_with_the_count() {
         "{warned}"
     );
     // A mesh sphere through the flat cloth meets it; lifted clear, it does not.
+    // Moved by keyframes, it is counted where its motion has it at the time asked.
     let sim = Simulation::new(parsed(grid));
-    let through = |lift: f32| {
+    let through = |lift: f32, moves: Option<Vec3>, time: f64| {
         let mut sphere = clothsim::sim::Obstacle::new("ball.obj");
+        if let Some(by) = moves {
+            let key = |time, translate| clothsim::sim::Keyframe {
+                time,
+                translate,
+                rotate: None,
+                ease: clothsim::sim::Ease::Linear,
+            };
+            sphere.keyframes = vec![key(0.0, None), key(1.0, Some(by))];
+        }
         let mut soup = clothsim::bench_contact::cube_sphere(0.3, 1000);
         for p in &mut soup.positions {
             p.y += lift;
@@ -380,8 +390,12 @@ fn a_cloth_that_starts_intersecting_is_warned_with_the_count() {
         sphere.load_mesh(&soup).unwrap();
         let effects = [clothsim::sim::Effect::Obstacle(sphere)];
         let model = sim.model();
-        clothsim::sim::intersections(&effects, 0.0, &model.triangles, &sim.state().pos).obstacles[0]
+        let pos = &sim.state().pos;
+        clothsim::sim::intersections(&effects, time, &model.triangles, pos).obstacles[0]
     };
-    assert!(through(0.0) > 0);
-    assert_eq!(through(0.5), 0);
+    assert!(through(0.0, None, 0.0) > 0);
+    assert_eq!(through(0.5, None, 0.0), 0);
+    let down = Some(Vec3::new(0.0, -0.5, 0.0));
+    assert_eq!(through(0.5, down, 0.0), 0);
+    assert!(through(0.5, down, 1.0) > 0);
 }

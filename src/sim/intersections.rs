@@ -251,18 +251,7 @@ pub fn intersections(
                     obstacles.push(0);
                     continue;
                 };
-                let (vertices, _) = placed.vertices_at(time);
-                let world: Vec<Vec3> = match &placed.sequence {
-                    Some(_) => vertices.into_owned(),
-                    None => {
-                        let pose = placed.motion.at(time);
-                        (vertices.iter())
-                            .map(|&v| {
-                                placed.pivot + pose.translation + pose.rotation * (v - placed.pivot)
-                            })
-                            .collect()
-                    }
-                };
+                let world = placed.world_vertices(time);
                 let other = corners_of(placed.surface.triangles(), &world);
                 obstacles.push(intersections_between(triangles, pos, &other));
             }

@@ -135,6 +135,21 @@ impl Placed {
             None => (self.surface.vertices().into(), false),
         }
     }
+
+    /// Its vertices at simulated time `time` in the world: moved by its motion about the
+    /// pivot, or a sequence's frame as it is.
+    pub fn world_vertices(&self, time: f64) -> Vec<Vec3> {
+        let (vertices, _) = self.vertices_at(time);
+        match &self.sequence {
+            Some(_) => vertices.into_owned(),
+            None => {
+                let pose = self.motion.at(time);
+                (vertices.iter())
+                    .map(|&v| pose.apply(self.pivot, v))
+                    .collect()
+            }
+        }
+    }
 }
 
 /// An obstacle whose mesh could not be read or placed.
