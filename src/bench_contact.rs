@@ -12,7 +12,7 @@ use crate::mesh::PolygonSoup;
 use crate::scene::{Scene, SceneError, SceneFile, Simulation};
 use crate::sim::{Diverged, Effect, Obstacle};
 
-/// Why the contact bench could not run.
+/// Why a contact bench (`bench --obstacles`, `bench --crumple`) could not run.
 #[derive(Debug, thiserror::Error)]
 pub enum ContactBenchError {
     #[error(transparent)]

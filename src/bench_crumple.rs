@@ -8,9 +8,10 @@ use std::time::Duration;
 
 use serde::Serialize;
 
+use crate::bench_contact::ContactBenchError;
 use crate::mesh::ImportOptions;
-use crate::scene::{Scene, SceneError, Simulation};
-use crate::sim::{Diverged, IntegratorKind};
+use crate::scene::{Scene, Simulation};
+use crate::sim::IntegratorKind;
 
 /// The simulated seconds timed.
 pub const CRUMPLE_SECONDS: f64 = 1.0;
@@ -40,15 +41,6 @@ pub struct CrumpleRow {
     pub forced: u64,
 }
 
-/// Why the crumple bench could not run.
-#[derive(Debug, thiserror::Error)]
-pub enum CrumpleBenchError {
-    #[error(transparent)]
-    Scene(#[from] SceneError),
-    #[error(transparent)]
-    Diverged(#[from] Diverged),
-}
-
 /// Runs `crumple` at `quads` quads a side under `integrator` (the scene's own with `None`)
 /// for [`CRUMPLE_SECONDS`] on the current thread pool, and times it.
 ///
@@ -57,7 +49,7 @@ pub enum CrumpleBenchError {
 pub fn crumple_one(
     quads: u32,
     integrator: Option<IntegratorKind>,
-) -> Result<CrumpleRow, CrumpleBenchError> {
+) -> Result<CrumpleRow, ContactBenchError> {
     let mut scene = Scene::open_resized("crumple", None, &ImportOptions::default(), Some(quads))?;
     if let Some(k) = integrator {
         scene.params.step.integrator = k;

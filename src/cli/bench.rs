@@ -48,10 +48,7 @@ pub fn bench(
         threads
     };
     for &t in threads {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build()
-            .with_context(|| format!("cannot start {t} threads"))?;
+        let pool = pool(t)?;
         for &n in sizes {
             for &k in integrators {
                 let row = match backend {
@@ -122,10 +119,7 @@ pub fn contact_bench(threads: &[usize], json: bool) -> Result<()> {
         );
     }
     for &t in threads {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build()
-            .with_context(|| format!("cannot start {t} threads"))?;
+        let pool = pool(t)?;
         let rows = (CONTACT_TRIANGLES.iter())
             .map(|&n| pool.install(|| contact_one(n)))
             .collect::<Result<Vec<_>, _>>()?;
@@ -187,10 +181,7 @@ pub fn crumple_bench(
         );
     }
     for &t in threads {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build()
-            .with_context(|| format!("cannot start {t} threads"))?;
+        let pool = pool(t)?;
         for &q in quads {
             let row = pool.install(|| crumple_one(q, integrator))?;
             if json {
@@ -217,6 +208,14 @@ pub fn crumple_bench(
 }
 
 /// Refuses a thread count outside 1..=256.
+/// A pool of `t` threads for one bench row's runs.
+fn pool(t: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(t)
+        .build()
+        .with_context(|| format!("cannot start {t} threads"))
+}
+
 fn check_threads(threads: &[usize]) -> Result<()> {
     if let Some(&t) = threads.iter().find(|&&t| !(1..=256).contains(&t)) {
         bail!("--threads: {t} is outside 1..=256");
