@@ -54,8 +54,9 @@ pub struct CpuStepper {
     substep_start: Vec<glam::Vec3>,
     self_collision: Option<SelfCollision>,
     self_contacts: SelfContacts,
-    /// Positions after self-contact, before the solids act again.
-    after_self: Vec<glam::Vec3>,
+    /// Positions before the solids act (first, and again after self-contact): what they
+    /// moved is what changed since.
+    before_solids: Vec<glam::Vec3>,
     /// Air damping in effect, 1/s (0 without the effect; for the guard's diagnosis).
     air_damping: f32,
 }
@@ -82,7 +83,7 @@ impl CpuStepper {
             substep_start: Vec::new(),
             self_collision: None,
             self_contacts: SelfContacts::default(),
-            after_self: Vec::new(),
+            before_solids: Vec::new(),
             air_damping: 0.0,
         };
         stepper.configure(model, params, effects, Changes::all());
@@ -137,14 +138,14 @@ impl CpuStepper {
             faces: self.self_collision.is_some(),
         };
         if self.self_collision.is_some() {
-            self.after_self.clone_from(&pass.state.pos);
+            self.before_solids.clone_from(&pass.state.pos);
         }
         for c in &self.contacts {
             if matches!(c, Effect::SelfCollision(_)) {
                 // What the solids moved rests on them.
                 let held = &mut pass.self_contacts.held;
                 held.clear();
-                held.extend((self.after_self.iter().zip(&pass.state.pos)).map(|(a, b)| a != b));
+                held.extend((self.before_solids.iter().zip(&pass.state.pos)).map(|(a, b)| a != b));
             }
             contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
         }
@@ -155,15 +156,15 @@ impl CpuStepper {
             && self.contacts.len() > 1
         {
             for _ in 0..RECHECKS {
-                self.after_self.clone_from(&pass.state.pos);
+                self.before_solids.clone_from(&pass.state.pos);
                 for c in self.contacts.iter().filter(|c| c.is_solid()) {
                     contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
                 }
                 // Nothing moved since self-contact: nothing to check.
-                if self.after_self == pass.state.pos {
+                if self.before_solids == pass.state.pos {
                     break;
                 }
-                let (placed, h) = (&self.after_self, pass.substep);
+                let (placed, h) = (&self.before_solids, pass.substep);
                 let settle = || {
                     let motion = [pass.start, &placed[..]];
                     (pass.self_contacts).settle(own.thickness, h, model, motion, pass.state)
