@@ -60,7 +60,7 @@ impl SharpEdges {
             .map(|e| e.map(|i| vertices[i as usize]))
             .collect();
         Self {
-            tree: TriangleTree::new(&boxes(&edges)),
+            tree: TriangleTree::new(&edges.iter().map(|&e| as_triangle(e)).collect::<Vec<_>>()),
             ends,
             edges,
         }
@@ -72,10 +72,7 @@ impl SharpEdges {
             *edge = ends.map(|i| vertices[i as usize]);
         }
         let edges = &self.edges;
-        self.tree.refit(|e| {
-            let [a, b] = edges[e];
-            [a, b, b]
-        });
+        self.tree.refit(|e| as_triangle(edges[e]));
     }
 
     pub fn len(&self) -> usize {
@@ -165,9 +162,9 @@ fn sweep_meets(before: [Vec3; 2], after: [Vec3; 2], p: Vec3, q: Vec3) -> Option<
         })
 }
 
-/// Each edge as a degenerate triangle, for the tree.
-fn boxes(edges: &[[Vec3; 2]]) -> Vec<[Vec3; 3]> {
-    edges.iter().map(|&[a, b]| [a, b, b]).collect()
+/// An edge as a degenerate triangle, for the tree.
+fn as_triangle([a, b]: [Vec3; 2]) -> [Vec3; 3] {
+    [a, b, b]
 }
 
 /// The nearest points of the segments `a`–`b` and `p`–`q`.

@@ -569,6 +569,17 @@ mod tests {
         assert!(walks * 4 < moves, "{walks} walks in {moves} moves");
     }
 
+    /// `n` random triangles of sides up to 0.3 m in a cube of side `size` (`v`: a random
+    /// point of the unit cube).
+    fn soup(v: &mut impl FnMut() -> Vec3, n: usize, size: f32) -> Vec<[Vec3; 3]> {
+        (0..n)
+            .map(|_| {
+                let c = v() * size;
+                [c, c + v() * 0.3, c + v() * 0.3]
+            })
+            .collect()
+    }
+
     /// A tree refitted to moved triangles answers as a search of every moved triangle
     /// does: every corner moved by up to a third of the soup's size, so boxes left where
     /// the triangles were would miss.
@@ -577,12 +588,7 @@ mod tests {
         use super::super::geometry::closest_on_triangle;
         let mut rnd = crate::test_rng::uniform(5);
         let mut v = || Vec3::new(rnd(), rnd(), rnd());
-        let first: Vec<[Vec3; 3]> = (0..400)
-            .map(|_| {
-                let c = v() * 3.0;
-                [c, c + v() * 0.3, c + v() * 0.3]
-            })
-            .collect();
+        let first = soup(&mut v, 400, 3.0);
         let moved: Vec<[Vec3; 3]> = (first.iter())
             .map(|t| t.map(|c| c + (v() - 0.5) * 2.0))
             .collect();
@@ -605,12 +611,7 @@ mod tests {
         use super::super::geometry::{closest_on_triangle, segment_crosses};
         let mut rnd = crate::test_rng::uniform(4);
         let mut v = || Vec3::new(rnd(), rnd(), rnd());
-        let corners: Vec<[Vec3; 3]> = (0..500)
-            .map(|_| {
-                let c = v() * 4.0;
-                [c, c + v() * 0.3, c + v() * 0.3]
-            })
-            .collect();
+        let corners = soup(&mut v, 500, 4.0);
         let tree = TriangleTree::new(&corners);
         for _ in 0..300 {
             let p = v() * 4.5 - 0.25;
