@@ -300,6 +300,17 @@ fn quads_resizes_a_grid_and_its_thickness_with_it() {
     )
     .unwrap_err();
     assert!(err.to_string().contains("--quads"), "{err}");
+    // Nor can a scene file's OBJ cloth, and 0 quads or more than 2048 are refused.
+    let text = "name = \"o\"\n[cloth]\nobj = \"cloth.obj\"\n";
+    let mut file = SceneFile::parse(text, std::path::Path::new("o.toml")).unwrap();
+    let err = file.resize_grid(8).unwrap_err().to_string();
+    assert!(err.contains("OBJ") && err.contains("--quads"), "{err}");
+    for quads in [0, 2049] {
+        let err = Scene::open_resized("crumple", None, &ImportOptions::default(), Some(quads))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("1..=2048"), "{quads}: {err}");
+    }
 }
 
 /// The search for pairs is shared out between the team (from 2 048 triangles on): its

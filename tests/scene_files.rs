@@ -155,6 +155,23 @@ fn out_of_range_values_name_the_key_and_its_line() {
     // The cloth needs exactly one source.
     let (_, _, message) = parse_error("name = \"x\"\n[cloth]\norientation = \"vertical\"\n");
     assert!(message.contains("`obj` or `grid`"), "{message}");
+    // Stacked grids: 1 to 64 layers, a positive spacing, the stack lower than the grid is
+    // wide (the key named on the grid's line).
+    for (grid, key) in [
+        ("layers = 0", "`layers`"),
+        ("layers = 65", "`layers`"),
+        ("layers = 2, spacing = 0.0", "`spacing`"),
+        ("layers = 2, spacing = -0.1", "`spacing`"),
+        ("layers = 5, spacing = 0.25", "`spacing`"),
+    ] {
+        let text = format!("name = \"x\"\n[cloth]\ngrid = {{ quads = 4, size = 1.0, {grid} }}\n");
+        let (line, _, message) = parse_error(&text);
+        assert!(message.contains(key), "{grid}: {message}");
+        assert_eq!(line, 3, "{grid}: {message}");
+    }
+    let text =
+        "name = \"x\"\n[cloth]\ngrid = { quads = 4, size = 1.0, layers = 5, spacing = 0.2 }\n";
+    SceneFile::parse(text, Path::new("t.toml")).expect("a stack of 0.8 m under a 1 m grid");
 }
 
 #[test]
