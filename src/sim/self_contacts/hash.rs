@@ -37,14 +37,16 @@ fn cell_of(p: Vec3, size: f32) -> [i32; 3] {
     })
 }
 
-/// The first level at which the box `lo..hi` lies in at most two cells along each axis;
-/// `None` past [`MAX_LEVEL`].
-fn level_of(lo: Vec3, hi: Vec3, cell: f32) -> Option<u32> {
+/// The first level at which the box `lo..hi` lies in at most two cells along each axis,
+/// and how many cells it lies in there; `None` past [`MAX_LEVEL`].
+fn level_of(lo: Vec3, hi: Vec3, cell: f32) -> Option<(u32, usize)> {
     let extent = (hi - lo).max_element();
-    (0..=MAX_LEVEL).find(|&level| {
+    (0..=MAX_LEVEL).find_map(|level| {
         let size = cell * (1u32 << level) as f32;
         let (first, last) = (cell_of(lo, size), cell_of(hi, size));
-        extent <= size && (0..3).all(|i| i64::from(last[i]) - i64::from(first[i]) <= 1)
+        let spans = [0, 1, 2].map(|i| i64::from(last[i]) - i64::from(first[i]));
+        (extent <= size && spans.iter().all(|&d| d <= 1))
+            .then(|| (level, spans.iter().map(|&d| d as usize + 1).product()))
     })
 }
 
@@ -89,8 +91,11 @@ impl BoxHash {
         self.level.clear();
         self.levels = 0;
         self.cell = cell;
+        // The entries counted first, so the table grows to what it holds, not to the next
+        // power of two (where a cloth lands fast that is megabytes).
+        let mut entries = 0;
         for (t, (&lo, &hi)) in lo.iter().zip(hi).enumerate() {
-            let Some(level) = level_of(lo, hi, cell) else {
+            let Some((level, cells)) = level_of(lo, hi, cell) else {
                 self.bins.clear();
                 return Err(ContactError::Extent {
                     triangle: t,
@@ -100,19 +105,8 @@ impl BoxHash {
             };
             self.levels |= 1 << level;
             self.level.push(level as u8);
+            entries += cells;
         }
-        // The entries counted first, so the table grows to what it holds, not to the next
-        // power of two (where a cloth lands fast that is megabytes).
-        let cells = |(&lo, &hi): (&Vec3, &Vec3), level: u8| {
-            let size = cell * (1u32 << level) as f32;
-            let (first, last) = (cell_of(lo, size), cell_of(hi, size));
-            (0..3)
-                .map(|i| (last[i] - first[i] + 1) as usize)
-                .product::<usize>()
-        };
-        let entries = (lo.iter().zip(hi).zip(&self.level))
-            .map(|(b, &level)| cells(b, level))
-            .sum();
         self.bins.reserve_exact(entries);
         for (t, ((&lo, &hi), &level)) in lo.iter().zip(hi).zip(&self.level).enumerate() {
             let level = u32::from(level);
