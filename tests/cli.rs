@@ -645,6 +645,17 @@ fn simulate_counts_intersections_and_resizes_a_grid() {
     assert_eq!(v["intersections"]["self"], 0);
     // The sphere and the ground, in the scene's order.
     assert_eq!(v["intersections"]["obstacles"], serde_json::json!([0, 0]));
+    // Nothing prescribed forced a pair; a scene without self-collision has no count.
+    assert_eq!(v["forced_pairs"], 0);
+    let out = clothsim(&[
+        "simulate",
+        "--scene",
+        "hanging",
+        "--seconds",
+        "0.1",
+        "--json",
+    ]);
+    assert!(json(&out).get("forced_pairs").is_none());
     // Without the switch there is no count.
     let out = clothsim(&[
         "simulate",

@@ -86,7 +86,7 @@ fn a_flat_cloth_at_any_height_has_no_intersection() {
 /// A strip along x pinned at height 0 and one along z `gap` above it, each one quad 1 m long
 /// and 2 cm wide, crossing at their middles: no vertex of either is over the other's face,
 /// so only their edges can meet.
-fn crossed_strips(gap: f32) -> (ClothModel, ClothState) {
+fn crossed_strips(gap: f32, pinned: &[u32]) -> (ClothModel, ClothState) {
     let strip = |along_x: bool, y: f32| -> Vec<Vec3> {
         let (l, w) = (0.5, 0.01);
         let c = [(-l, -w), (l, -w), (l, w), (-l, w)];
@@ -111,14 +111,14 @@ fn crossed_strips(gap: f32) -> (ClothModel, ClothState) {
     let mesh = build_mesh(&soup, std::path::Path::new("strips"))
         .unwrap()
         .mesh;
-    let model = ClothModel::new(&mesh, 0.2, &[0, 1, 2, 3]);
+    let model = ClothModel::new(&mesh, 0.2, pinned);
     let state = ClothState::at_rest(&model);
     (model, state)
 }
 
 #[test]
 fn edges_that_cross_without_a_vertex_near_a_face_are_caught() {
-    let (model, mut state) = crossed_strips(0.05);
+    let (model, mut state) = crossed_strips(0.05, &[0, 1, 2, 3]);
     let start = state.pos.clone();
     // The upper strip moves 10 cm down in one substep: through the lower one.
     for p in &mut state.pos[4..] {
@@ -134,6 +134,26 @@ fn edges_that_cross_without_a_vertex_near_a_face_are_caught() {
     // It stopped above the lower strip, not merely somewhere else.
     let lowest = clothsim::mesh::bounds(&state.pos[4..]).0.y;
     assert!(lowest > 0.0, "upper strip at {lowest} m");
+}
+
+/// Where prescribed motion drives the cloth through itself, no cut can stop it: the pairs
+/// are counted, not hidden.
+#[test]
+fn prescribed_motion_through_the_cloth_is_counted() {
+    // Both strips pinned: the upper one is moved through the lower one as a handle would.
+    let (model, mut state) = crossed_strips(0.05, &[0, 1, 2, 3, 4, 5, 6, 7]);
+    let start = state.pos.clone();
+    for p in &mut state.pos[4..] {
+        p.y -= 0.1;
+    }
+    let mut solver = SelfContacts::default();
+    solver
+        .resolve([0.005, 0.0, 1.0 / 240.0], &model, &start, &mut state)
+        .unwrap();
+    assert!(solver.work.forced > 0, "{:?}", solver.work);
+    assert_eq!(solver.work.forced_total, solver.work.forced);
+    // The pins' motion stands: the upper strip went through, below the lower one.
+    assert!(state.pos[4..].iter().all(|p| p.y < 0.0));
 }
 
 fn builtin(name: &str, quads: Option<u32>) -> Simulation {

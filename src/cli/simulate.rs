@@ -94,6 +94,12 @@ pub fn simulate(
                 solids.join(", ")
             );
         }
+        if let Some(forced) = summary.forced_pairs.filter(|&n| n > 0) {
+            println!(
+                "  self-contact: prescribed motion (pins, handles) forced {forced} pairs of the \
+                 cloth together"
+            );
+        }
         for event in &summary.guard_events {
             println!("  stability guard: {event}");
         }

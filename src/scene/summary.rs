@@ -54,6 +54,11 @@ pub struct RunSummary {
     /// --check-intersections`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub intersections: Option<Intersections>,
+    /// With self-collision: the pairs of the cloth that prescribed motion (pins, handles)
+    /// drove together where no cut could keep them apart, since the simulation began
+    /// (substeps a rollback redid counted again); 0 when the guarantee held everywhere.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub forced_pairs: Option<u64>,
     /// Set when the run stopped early because it diverged.
     pub error: Option<String>,
 }
@@ -158,6 +163,7 @@ impl Simulation {
             phases: BTreeMap::new(),
             solver_iterations_per_step: 0.0,
             intersections: None,
+            forced_pairs: self.self_collision_work().map(|w| w.forced_total),
             error: None,
         }
     }

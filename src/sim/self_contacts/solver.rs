@@ -292,7 +292,7 @@ impl SelfContacts {
             .fold(glam::DVec3::ZERO, |m, (s, p)| m + (*p - *s).as_dvec3())
             / n;
         let mean = mean.as_vec3();
-        self.relative(start, &state.pos, mean);
+        self.relative(start, &state.pos, self.shift, mean);
         if !self.holds(thickness, thickness) {
             self.find_pairs(model, thickness)?;
         }
@@ -314,7 +314,7 @@ impl SelfContacts {
         self.work.contacts = contacts as u64;
         // The pushes may have taken a particle out of the box its pairs were found in; the
         // check needs only the pairs that can come within what it keeps.
-        self.relative(start, &state.pos, mean);
+        self.relative(start, &state.pos, self.shift, mean);
         if !self.holds(thickness, CHECKED * thickness) {
             self.find_pairs(model, thickness)?;
         }
@@ -322,7 +322,6 @@ impl SelfContacts {
         self.mean = mean;
         self.fixed.clear();
         self.keep_apart(model, start, state, thickness, substep);
-        self.work.forced_total += self.work.forced;
         Ok(contacts)
     }
 
@@ -345,20 +344,16 @@ impl SelfContacts {
         if thickness <= 0.0 || model.triangles.is_empty() {
             return Ok(0);
         }
-        // The substep's start in the frame it was resolved in.
-        let mean = self.mean;
-        self.shift -= mean;
-        self.relative(start, &state.pos, mean);
-        self.shift += mean;
+        // The substep in the frame it was resolved in (whose shift already has its mean).
+        self.relative(start, &state.pos, self.shift - self.mean, self.mean);
         if !self.holds(thickness, CHECKED * thickness) {
             self.find_pairs(model, thickness)?;
         }
-        let (impacts, forced) = (self.work.impacts, self.work.forced);
+        let impacts = self.work.impacts;
         // What the solids just moved stays where they put it: the cut falls on the rest.
         self.fixed.clear();
         (self.fixed).extend(placed.iter().zip(&state.pos).map(|(a, b)| a != b));
         self.keep_apart(model, start, state, thickness, substep);
-        self.work.forced_total += self.work.forced - forced;
         Ok((self.work.impacts - impacts) as usize)
     }
 
@@ -368,10 +363,10 @@ impl SelfContacts {
         self.hash.len()
     }
 
-    /// Fills the substep's start and end in the moving frame: less the shift so far, and
-    /// the end less this substep's `mean` motion too.
-    fn relative(&mut self, start: &[Vec3], pos: &[Vec3], mean: Vec3) {
-        let shift = self.shift;
+    /// Fills the substep's start and end in the moving frame: less `shift`, how far the
+    /// frame had moved by the substep's start, and the end less the substep's `mean` motion
+    /// too.
+    fn relative(&mut self, start: &[Vec3], pos: &[Vec3], shift: Vec3, mean: Vec3) {
         self.from.clear();
         self.from.extend(start.iter().map(|&s| s - shift));
         self.to.clear();
@@ -547,6 +542,7 @@ impl SelfContacts {
                     any = true;
                 } else {
                     self.work.forced += 1;
+                    self.work.forced_total += 1;
                 }
             }
             if !any {
