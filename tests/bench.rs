@@ -205,6 +205,55 @@ fn bench_cli_prints_one_json_row_per_size_and_thread_count() {
     assert!(err.contains("--sizes") && err.contains("3..=2048"), "{err}");
 }
 
+/// `bench --crumple`: a row per grid size × integrator, each substep counted (XPBD has no
+/// spring-force phase to count them by, and no spring cost to compare with).
+#[test]
+fn crumple_bench_prints_a_row_per_size_and_integrator() {
+    let out = Command::new(env!("CARGO_BIN_EXE_clothsim"))
+        .args([
+            "bench",
+            "--crumple",
+            "--quads",
+            "6,8",
+            "--integrators",
+            "xpbd,implicit-euler",
+            "--threads",
+            "1",
+            "--json",
+        ])
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("one JSON object per line"))
+        .collect();
+    let shape: Vec<_> = (rows.iter())
+        .map(|r| (r["quads"].as_u64(), r["integrator"].as_str()))
+        .collect();
+    assert_eq!(
+        shape,
+        [
+            (Some(6), Some("xpbd")),
+            (Some(6), Some("implicit-euler")),
+            (Some(8), Some("xpbd")),
+            (Some(8), Some("implicit-euler")),
+        ]
+    );
+    for row in &rows {
+        // 60 frames of the scene's 4 substeps.
+        assert_eq!(row["substeps"], 240, "{row}");
+        assert!(row["contact_us"].as_f64().unwrap() > 0.0, "{row}");
+        assert_eq!(row["forced"], 0, "{row}");
+    }
+    assert_eq!(rows[0]["springs_us"], 0.0);
+    assert!(rows[1]["springs_us"].as_f64().unwrap() > 0.0);
+}
+
 #[test]
 fn bench_cli_refuses_bad_thread_counts_and_gpu_integrators_in_one_line() {
     let run = |args: &[&str]| {
@@ -219,6 +268,8 @@ fn bench_cli_refuses_bad_thread_counts_and_gpu_integrators_in_one_line() {
         assert_eq!(err.trim().lines().count(), 1, "{err}");
         err
     };
+    let err = run(&["bench", "--crumple", "--quads", "0"]);
+    assert!(err.contains("--quads") && err.contains("1..=2048"), "{err}");
     let err = run(&["bench", "--sizes", "8", "--threads", "0"]);
     assert!(
         err.contains("--threads") && err.contains("1..=256"),

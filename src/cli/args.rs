@@ -135,7 +135,7 @@ pub enum Command {
         #[arg(long, conflicts_with_all = ["sizes", "integrators", "backend"])]
         obstacles: bool,
         /// Instead: the `crumple` scene's first simulated second at --quads (its own
-        /// integrator, or the first of --integrators), the contact phases per substep
+        /// integrator, or each of --integrators), the contact phases per substep
         /// against the springs' and the pairs per particle (per --threads).
         #[arg(long, conflicts_with_all = ["sizes", "backend", "obstacles"])]
         crumple: bool,

@@ -155,18 +155,24 @@ pub fn contact_bench(threads: &[usize], json: bool) -> Result<()> {
     Ok(())
 }
 
-/// Runs and prints the crumple bench: one row per thread count × grid size.
+/// Runs and prints the crumple bench: one row per thread count × grid size × integrator.
 pub fn crumple_bench(
     quads: &[u32],
-    integrator: Option<IntegratorKind>,
+    integrators: Option<&[IntegratorKind]>,
     threads: &[usize],
     json: bool,
 ) -> Result<()> {
     use clothsim::bench_crumple::crumple_one;
     check_threads(threads)?;
+    if let Some(&q) = quads.iter().find(|&&q| !(1..=2048).contains(&q)) {
+        bail!("--quads: {q} is outside 1..=2048");
+    }
+    // The scene's own integrator (`None`), or each asked for.
+    let integrators: Vec<Option<IntegratorKind>> =
+        integrators.map_or(vec![None], |ks| ks.iter().copied().map(Some).collect());
     if !json {
         println!(
-            "{:>6} {:>9} {:<16} {:>7} {:>8} {:>11} {:>13} {:>13} {:>9} {:>11} {:>9}",
+            "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11} {:>13} {:>13} {:>9} {:>11} {:>9}",
             "quads",
             "particles",
             "integrator",
@@ -182,13 +188,16 @@ pub fn crumple_bench(
     }
     for &t in threads {
         let pool = pool(t)?;
-        for &q in quads {
-            let row = pool.install(|| crumple_one(q, integrator))?;
+        for (&q, &k) in quads
+            .iter()
+            .flat_map(|q| integrators.iter().map(move |k| (q, k)))
+        {
+            let row = pool.install(|| crumple_one(q, k))?;
             if json {
                 println!("{}", serde_json::to_string(&row)?);
             } else {
                 println!(
-                    "{:>6} {:>9} {:<16} {:>7} {:>8} {:>11.2} {:>13.1} {:>13.1} {:>9.1} {:>11.1} {:>9.2}",
+                    "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11.2} {:>13.1} {:>13.1} {:>9} {:>11.1} {:>9.2}",
                     row.quads,
                     row.particles,
                     row.integrator,
@@ -197,7 +206,7 @@ pub fn crumple_bench(
                     row.wall_per_second,
                     row.contact_us,
                     row.springs_us,
-                    row.contact_us / row.springs_us,
+                    ratio(row.contact_us, row.springs_us),
                     row.pairs_per_particle,
                     row.searches_per_substep,
                 );
@@ -207,7 +216,15 @@ pub fn crumple_bench(
     Ok(())
 }
 
-/// Refuses a thread count outside 1..=256.
+/// `a / b` to one decimal, or "-" without a `b` to compare with.
+fn ratio(a: f64, b: f64) -> String {
+    if b > 0.0 {
+        format!("{:.1}", a / b)
+    } else {
+        "-".to_string()
+    }
+}
+
 /// A pool of `t` threads for one bench row's runs.
 fn pool(t: usize) -> Result<rayon::ThreadPool> {
     rayon::ThreadPoolBuilder::new()
@@ -216,6 +233,7 @@ fn pool(t: usize) -> Result<rayon::ThreadPool> {
         .with_context(|| format!("cannot start {t} threads"))
 }
 
+/// Refuses a thread count outside 1..=256.
 fn check_threads(threads: &[usize]) -> Result<()> {
     if let Some(&t) = threads.iter().find(|&&t| !(1..=256).contains(&t)) {
         bail!("--threads: {t} is outside 1..=256");

@@ -100,12 +100,7 @@ pub fn run(cli: Cli) -> Result<()> {
             quads,
             integrators,
             ..
-        }) => crumple_bench(
-            &quads,
-            integrators.and_then(|k| k.first().copied()),
-            &threads,
-            json,
-        ),
+        }) => crumple_bench(&quads, integrators.as_deref(), &threads, json),
         Some(Command::Bench {
             sizes,
             integrators,
