@@ -9,7 +9,7 @@ use std::sync::Arc;
 use glam::{Quat, Vec3};
 
 use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
-use super::solid::{Solid, default_friction, resolve, resolve_remembering};
+use super::solid::{Solid, default_friction, resolve, resolve_remembering, touching};
 use crate::mesh::{ObjError, PolygonSoup, parse_obj, read_obj};
 use crate::sim::motion::{AxisAngle, Keyframe, Pose, RigidMotion};
 use crate::sim::obstacle::{Gathered, Moment, Sequence, SharpEdges, Surface};
@@ -456,18 +456,7 @@ where
                     continue;
                 }
                 state.pos[p] += gap * (part / weight);
-                let v_rel = state.vel[p] - v_surface;
-                let vn = v_rel.dot(n);
-                if vn < 0.0 {
-                    let v_t = v_rel - vn * n;
-                    let speed = v_t.length();
-                    let keep = if speed > 0.0 {
-                        (1.0 - mu * part * (-vn) / speed).max(0.0)
-                    } else {
-                        0.0
-                    };
-                    state.vel[p] = v_surface + (1.0 - part) * vn * n + keep * v_t;
-                }
+                state.vel[p] = touching(state.vel[p], v_surface, n, mu, part);
             }
             moved += 1;
         }

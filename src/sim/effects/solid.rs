@@ -113,18 +113,27 @@ fn resolve_part(
         };
         contacts += 1;
         *x = caught;
-        let v_rel = *v - v_surface;
-        let vn = v_rel.dot(n);
-        if vn < 0.0 {
-            let v_t = v_rel - vn * n;
-            let t_speed = v_t.length();
-            let keep = if t_speed > 0.0 {
-                (1.0 - mu * (-vn) / t_speed).max(0.0)
-            } else {
-                0.0
-            };
-            *v = v_surface + keep * v_t;
-        }
+        *v = touching(*v, v_surface, n, mu, 1.0);
     }
     contacts
+}
+
+/// The velocity `v` of a particle that touches a surface moving at `v_surface` (unit
+/// normal `n`), where `part` of it (1: all) bears on the contact: that part of its
+/// approach along `n` is removed, and its sliding slowed by Coulomb friction `mu` in
+/// proportion. Unchanged where it moves away.
+pub(super) fn touching(v: Vec3, v_surface: Vec3, n: Vec3, mu: f32, part: f32) -> Vec3 {
+    let v_rel = v - v_surface;
+    let vn = v_rel.dot(n);
+    if vn >= 0.0 {
+        return v;
+    }
+    let v_t = v_rel - vn * n;
+    let speed = v_t.length();
+    let keep = if speed > 0.0 {
+        (1.0 - mu * part * (-vn) / speed).max(0.0)
+    } else {
+        0.0
+    };
+    v_surface + (1.0 - part) * vn * n + keep * v_t
 }
