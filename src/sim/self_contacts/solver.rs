@@ -119,10 +119,6 @@ pub struct SelfContacts {
     shift: Vec3,
     /// The cloth's mean motion in the last substep resolved.
     mean: Vec3,
-    /// The centre of each particle's box, and how far a particle in its box can be from
-    /// it.
-    center: Vec<Vec3>,
-    reach: Vec<f64>,
     /// Each triangle's box: its corners' boxes together.
     lo: Vec<Vec3>,
     hi: Vec<Vec3>,
@@ -190,8 +186,6 @@ struct Search<'a> {
     vertex_hi: &'a [Vec3],
     lo: &'a [Vec3],
     hi: &'a [Vec3],
-    reach: &'a [f64],
-    center: &'a [Vec3],
     thickness: f32,
 }
 
@@ -235,9 +229,16 @@ impl Search<'_> {
     /// could come within the thickness.
     fn keep(&self, pair: Pair, stored: StoredPair, out: &mut Vec<StoredPair>) {
         let ids = pair.ids();
-        let x = ids.map(|i| self.center[i].as_dvec3());
+        // The smallest ball around each particle's box: in its box, a particle is at most
+        // half the box's diagonal from the box's centre.
+        let (lo, hi) = (
+            ids.map(|i| self.vertex_lo[i]),
+            ids.map(|i| self.vertex_hi[i]),
+        );
+        let x = std::array::from_fn(|j| (0.5 * (lo[j] + hi[j])).as_dvec3());
+        let radius = |j: usize| 0.5 * f64::from((hi[j] - lo[j]).length());
+        let most = |r: std::ops::Range<usize>| r.map(radius).fold(0.0f64, f64::max);
         let k = pair.first_side();
-        let most = |r: std::ops::Range<usize>| r.map(|i| self.reach[ids[i]]).fold(0.0f64, f64::max);
         if distance(&pair, x) - most(0..k) - most(k..4) < f64::from(self.thickness) {
             // Grown by half, not doubled: where a cloth lands fast the pairs run to
             // millions, and a doubled buffer can hold as much again unused.
@@ -396,7 +397,6 @@ impl SelfContacts {
         self.found_for = None;
         self.vertex_lo.clear();
         self.vertex_hi.clear();
-        self.reach.clear();
         // Room to reuse the pairs only where the cloth moves slowly in the moving frame; a
         // fast substep would leave its boxes at once, and the room would only add pairs.
         let fastest = (self.from.iter().zip(&self.to))
@@ -408,15 +408,9 @@ impl SelfContacts {
         } else {
             0.5 * thickness
         };
-        self.center.clear();
         for (s, p) in self.from.iter().zip(&self.to) {
-            let (lo, hi) = (s.min(*p) - Vec3::splat(grow), s.max(*p) + Vec3::splat(grow));
-            self.vertex_lo.push(lo);
-            self.vertex_hi.push(hi);
-            // The smallest ball around the box: a particle in its box is at most half the
-            // box's diagonal from its centre.
-            self.center.push(0.5 * (lo + hi));
-            self.reach.push(0.5 * f64::from((hi - lo).length()));
+            self.vertex_lo.push(s.min(*p) - Vec3::splat(grow));
+            self.vertex_hi.push(s.max(*p) + Vec3::splat(grow));
         }
         let (vlo, vhi) = (&self.vertex_lo, &self.vertex_hi);
         self.lo.clear();
@@ -446,8 +440,6 @@ impl SelfContacts {
             vertex_hi: &self.vertex_hi,
             lo: &self.lo,
             hi: &self.hi,
-            reach: &self.reach,
-            center: &self.center,
             thickness,
         };
         let (found, segments) = (
