@@ -146,19 +146,11 @@ fn bench_rows_name_the_teams_threads_not_a_larger_pools() {
     assert_eq!(threads_in(17), 16);
 }
 
-#[test]
-fn bench_cli_prints_one_json_row_per_size_and_thread_count() {
+/// Runs `clothsim` with `args` (a `--json` bench), which must succeed, and reads one JSON
+/// row per line of its output.
+fn json_rows(args: &[&str]) -> Vec<serde_json::Value> {
     let out = Command::new(env!("CARGO_BIN_EXE_clothsim"))
-        .args([
-            "bench",
-            "--sizes",
-            "8,12",
-            "--integrators",
-            "semi-implicit-euler",
-            "--threads",
-            "1,2",
-            "--json",
-        ])
+        .args(args)
         .output()
         .expect("runs");
     assert!(
@@ -166,11 +158,24 @@ fn bench_cli_prints_one_json_row_per_size_and_thread_count() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let text = String::from_utf8_lossy(&out.stdout);
-    let rows: Vec<serde_json::Value> = text
+    String::from_utf8_lossy(&out.stdout)
         .lines()
         .map(|l| serde_json::from_str(l).expect("one JSON object per line"))
-        .collect();
+        .collect()
+}
+
+#[test]
+fn bench_cli_prints_one_json_row_per_size_and_thread_count() {
+    let rows = json_rows(&[
+        "bench",
+        "--sizes",
+        "8,12",
+        "--integrators",
+        "semi-implicit-euler",
+        "--threads",
+        "1,2",
+        "--json",
+    ]);
     assert_eq!(rows.len(), 4);
     for row in &rows {
         for key in [
@@ -209,29 +214,17 @@ fn bench_cli_prints_one_json_row_per_size_and_thread_count() {
 /// spring-force phase to count them by, and no spring cost to compare with).
 #[test]
 fn crumple_bench_prints_a_row_per_size_and_integrator() {
-    let out = Command::new(env!("CARGO_BIN_EXE_clothsim"))
-        .args([
-            "bench",
-            "--crumple",
-            "--quads",
-            "6,8",
-            "--integrators",
-            "xpbd,implicit-euler",
-            "--threads",
-            "1",
-            "--json",
-        ])
-        .output()
-        .expect("runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let rows: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("one JSON object per line"))
-        .collect();
+    let rows = json_rows(&[
+        "bench",
+        "--crumple",
+        "--quads",
+        "6,8",
+        "--integrators",
+        "xpbd,implicit-euler",
+        "--threads",
+        "1",
+        "--json",
+    ]);
     let shape: Vec<_> = (rows.iter())
         .map(|r| (r["quads"].as_u64(), r["integrator"].as_str()))
         .collect();

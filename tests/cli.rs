@@ -624,60 +624,25 @@ fn simulate_writes_the_cloth_and_its_obstacles_every_k_frames() {
 
 #[test]
 fn simulate_counts_intersections_and_resizes_a_grid() {
-    let out = clothsim(&[
-        "simulate",
-        "--scene",
-        "crumple",
-        "--quads",
-        "8",
-        "--seconds",
-        "0.5",
-        "--check-intersections",
-        "--json",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v = json(&out);
+    let simulate = |line: &str| clothsim(&line.split_whitespace().collect::<Vec<_>>());
+    let v = json(&simulate(
+        "simulate --scene crumple --quads 8 --seconds 0.5 --check-intersections --json",
+    ));
     assert_eq!(v["particles"], 81);
     assert_eq!(v["intersections"]["self"], 0);
     // The sphere and the ground, in the scene's order.
     assert_eq!(v["intersections"]["obstacles"], serde_json::json!([0, 0]));
     // Nothing prescribed forced a pair; a scene without self-collision has no count.
     assert_eq!(v["forced_pairs"], 0);
-    let out = clothsim(&[
-        "simulate",
-        "--scene",
-        "hanging",
-        "--seconds",
-        "0.1",
-        "--json",
-    ]);
-    assert!(json(&out).get("forced_pairs").is_none());
+    let v = json(&simulate("simulate --scene hanging --seconds 0.1 --json"));
+    assert!(v.get("forced_pairs").is_none());
     // Without the switch there is no count.
-    let out = clothsim(&[
-        "simulate",
-        "--scene",
-        "crumple",
-        "--quads",
-        "8",
-        "--seconds",
-        "0.1",
-        "--json",
-    ]);
-    assert!(json(&out).get("intersections").is_none());
+    let v = json(&simulate(
+        "simulate --scene crumple --quads 8 --seconds 0.1 --json",
+    ));
+    assert!(v.get("intersections").is_none());
     // An OBJ cloth cannot be resized.
-    let out = clothsim(&[
-        "simulate",
-        "--obj",
-        "assets/cloth.obj",
-        "--quads",
-        "8",
-        "--seconds",
-        "0.1",
-    ]);
+    let out = simulate("simulate --obj assets/cloth.obj --quads 8 --seconds 0.1");
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--quads"));
 }
