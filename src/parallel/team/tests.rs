@@ -180,3 +180,32 @@ fn a_team_that_goes_alone_gives_its_helpers_no_share_and_times_every_section() {
     assert_eq!(ran.into_inner().unwrap(), want);
     assert_eq!(team.busy.lock().unwrap().sections, 5, "five sections timed");
 }
+
+/// Large pieces are handed to the helpers even while the pace runs the caller alone (the
+/// section's epoch is bumped, which only a shared section does), each piece runs once, and
+/// the pace does not time them.
+#[test]
+fn large_pieces_are_shared_whatever_the_pace_and_not_timed() {
+    let team = Team::new(2);
+    team.busy.lock().unwrap().alone = true;
+    let runs: Vec<AtomicUsize> = (0..40).map(|_| AtomicUsize::new(0)).collect();
+    let before = team.shared.epoch.load(Ordering::SeqCst);
+    team.run_large_pieces(runs.len(), &|_, piece| {
+        runs[piece].fetch_add(1, Ordering::SeqCst);
+    });
+    assert_eq!(
+        team.shared.epoch.load(Ordering::SeqCst),
+        before + 1,
+        "handed over"
+    );
+    assert!(runs.iter().all(|r| r.load(Ordering::SeqCst) == 1));
+    assert_eq!(team.busy.lock().unwrap().sections, 0, "not timed");
+    // A paced section still runs alone and is timed.
+    team.run_pieces(4, &|_, _| {});
+    assert_eq!(
+        team.shared.epoch.load(Ordering::SeqCst),
+        before + 1,
+        "run alone"
+    );
+    assert_eq!(team.busy.lock().unwrap().sections, 1);
+}

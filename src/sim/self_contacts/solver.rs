@@ -466,8 +466,11 @@ impl SelfContacts {
                 end: out.len() as u32,
             };
         };
-        let parallel = model.triangles.len() >= PARALLEL_TRIANGLES;
-        team.run_pieces_if(parallel, pieces, &work);
+        if model.triangles.len() >= PARALLEL_TRIANGLES {
+            team.run_large_pieces(pieces, &work);
+        } else {
+            (0..pieces).for_each(|piece| work(0, piece));
+        }
         self.found.pieces = pieces;
         self.work.searches += 1;
         self.found_for = Some(thickness);
