@@ -172,7 +172,7 @@ pub fn crumple_bench(
         integrators.map_or(vec![None], |ks| ks.iter().copied().map(Some).collect());
     if !json {
         println!(
-            "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11} {:>13} {:>13} {:>9} {:>11} {:>9}",
+            "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11} {:>13} {:>13} {:>9} {:>11} {:>9} {:>9}",
             "quads",
             "particles",
             "integrator",
@@ -184,6 +184,7 @@ pub fn crumple_bench(
             "× springs",
             "pairs/part.",
             "searches",
+            "refreshes",
         );
     }
     for &t in threads {
@@ -197,7 +198,7 @@ pub fn crumple_bench(
                 println!("{}", serde_json::to_string(&row)?);
             } else {
                 println!(
-                    "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11.2} {:>13.1} {:>13.1} {:>9} {:>11.1} {:>9.2}",
+                    "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11.2} {:>13.1} {:>13.1} {:>9} {:>11.1} {:>9.2} {:>9.2}",
                     row.quads,
                     row.particles,
                     row.integrator,
@@ -209,6 +210,7 @@ pub fn crumple_bench(
                     ratio(row.contact_us, row.springs_us),
                     row.pairs_per_particle,
                     row.searches_per_substep,
+                    row.refreshes_per_substep,
                 );
             }
         }

@@ -204,6 +204,48 @@ impl BoxHash {
     }
 }
 
+impl BoxHash {
+    /// The base cell the boxes were binned with, m.
+    pub fn cell(&self) -> f32 {
+        self.cell
+    }
+
+    /// How many levels finer than box `a`'s the finest binned box is: looking up `a` at
+    /// that level visits up to (2^levels + 1)³ cells.
+    pub fn levels_below(&self, a: usize) -> u32 {
+        u32::from(self.level[a]).saturating_sub(self.levels.trailing_zeros())
+    }
+
+    /// Calls `visit(b)` once for each binned box `b` other than `a` (binned too) that
+    /// overlaps `a`: at each level, `a`'s cells are looked up, and `b` is taken in the one
+    /// that holds the overlap's lowest corner.
+    pub fn overlapping(&self, a: usize, lo: &[Vec3], hi: &[Vec3], mut visit: impl FnMut(u32)) {
+        let mut levels = self.levels;
+        while levels != 0 {
+            let level = levels.trailing_zeros();
+            levels &= levels - 1;
+            let size = self.cell * (1u32 << level) as f32;
+            each_cell(lo[a], hi[a], size, |c| {
+                let key = cell_key(c, level);
+                let start = self.bins.partition_point(|&(k, _)| k < key);
+                for &(k, b) in &self.bins[start..] {
+                    if k != key {
+                        break;
+                    }
+                    let bi = b as usize;
+                    if bi == a || u32::from(self.level[bi]) != level {
+                        continue;
+                    }
+                    let (l, h) = (lo[a].max(lo[bi]), hi[a].min(hi[bi]));
+                    if l.cmple(h).all() && cell_of(l, size) == c {
+                        visit(b);
+                    }
+                }
+            });
+        }
+    }
+}
+
 /// Cell runs in one piece of the search.
 const RUNS_PER_PIECE: usize = 64;
 

@@ -12,6 +12,7 @@
 
 mod ccd;
 mod error;
+mod found;
 mod hash;
 mod primitives;
 mod solver;

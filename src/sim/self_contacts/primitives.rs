@@ -20,7 +20,7 @@ const EDGES: u32 = 1 << 31;
 /// `1`, or the edges numbered `0` and `1` (an edge's number is three times its triangle's
 /// plus its side in it), the kind in the top bit of the first. Half a [`Pair`]'s size:
 /// where a cloth lands fast its pairs are counted in millions.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub struct StoredPair([u32; 2]);
 
 impl StoredPair {
@@ -42,6 +42,32 @@ impl StoredPair {
         } else {
             let edge = |n: u32| edges[n as usize / 3][n as usize % 3];
             Pair::edge_edge(edge(a & !EDGES), edge(b))
+        }
+    }
+}
+
+impl StoredPair {
+    /// The same pair with an edge–edge pair's edges in order of their numbers (which comes
+    /// first depends on which triangle a search started from).
+    #[cfg(test)]
+    pub fn canonical(self) -> StoredPair {
+        let [a, b] = self.0;
+        if a & EDGES == 0 {
+            self
+        } else {
+            let (e, f) = (a & !EDGES, b);
+            StoredPair::edge_edge(e.min(f), e.max(f))
+        }
+    }
+
+    /// The two triangles whose search found it: the owner of the vertex (`vertex_owner`:
+    /// each vertex's owning triangle) and the triangle, or the edges' triangles.
+    pub fn triangles(self, vertex_owner: &[u32]) -> [u32; 2] {
+        let [a, b] = self.0;
+        if a & EDGES == 0 {
+            [vertex_owner[a as usize], b]
+        } else {
+            [(a & !EDGES) / 3, b / 3]
         }
     }
 }

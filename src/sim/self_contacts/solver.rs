@@ -5,10 +5,10 @@ use glam::Vec3;
 use rustc_hash::FxHashMap;
 
 use crate::cloth::{ClothModel, ClothState};
-use crate::parallel::{Disjoint, Team};
 
 use super::ccd::safe_fraction;
 use super::error::ContactError;
+use super::found::Found;
 use super::hash::BoxHash;
 use super::primitives::{Pair, StoredPair, distance, push_apart};
 
@@ -21,8 +21,13 @@ pub struct SelfWork {
     pub contacts: u64,
     /// Entries in the spatial hash's table (at most [`CELLS_PER_TRIANGLE`](super::CELLS_PER_TRIANGLE) per triangle).
     pub binned: u64,
-    /// Searches of the hash (0 when the pairs found before still held).
+    /// Searches of the whole hash (0 when the pairs found before still held, or only
+    /// some triangles were searched again).
     pub searches: u64,
+    /// Searches of only the triangles whose particles left their boxes.
+    pub refreshes: u64,
+    /// Triangles those searched again.
+    pub refreshed: u64,
     /// Pairs whose motion was cut short because their sides could otherwise have met.
     pub impacts: u64,
     /// Pairs that prescribed motion (pins, handles) drove together, so no cut could keep
@@ -36,9 +41,22 @@ pub struct SelfWork {
 /// start closer keep half of what they start at).
 const KEEP: f64 = 0.1;
 
-/// The pairs found are kept for later substeps (their boxes given room) only while no
-/// particle moves more than this share of the thickness in a substep.
+/// The particles' boxes are given room for later substeps only while none moves more
+/// than this share of the thickness in a substep in the moving frame. Room for the slow
+/// particles alone was tried: where `crumple` piles up, it kept 15 000–20 000 pairs at
+/// 64² against a few hundred, and cost more than the searches it saved.
 const REUSE_BELOW: f32 = 0.5;
+
+/// Only the triangles whose particles left their boxes are searched again while those
+/// particles are fewer than one in this many; more, and the whole hash is.
+const REFRESH_BELOW: usize = 4;
+
+/// Triangles searched again in one piece of a refresh.
+const REFRESHED_PER_PIECE: usize = 64;
+
+/// A refresh looks a triangle up at every level of the hash: where the finest is more than
+/// this many levels below the triangle's, the whole hash is searched instead.
+const REFRESH_LEVELS: u32 = 2;
 
 /// The distance, as a share of the thickness, within which the continuous check needs
 /// its pairs: twice what it keeps, for margin (pairs farther apart along the whole motion
@@ -61,6 +79,8 @@ struct Owners {
     key: (usize, usize, u64),
     vertices: Vec<[u32; 3]>,
     edges: Vec<[[u32; 2]; 3]>,
+    /// Each particle's owning triangle ([`NONE`] for a particle in none).
+    vertex_owner: Vec<u32>,
 }
 
 const NONE: u32 = u32::MAX;
@@ -80,8 +100,9 @@ impl Owners {
             key: Self::key(model),
             vertices: Vec::with_capacity(model.triangles.len()),
             edges: Vec::with_capacity(model.triangles.len()),
+            vertex_owner: vec![NONE; model.particle_count()],
         };
-        for t in &model.triangles {
+        for (n, t) in model.triangles.iter().enumerate() {
             let mut v = [NONE; 3];
             let mut e = [[NONE; 2]; 3];
             for k in 0..3 {
@@ -89,6 +110,7 @@ impl Owners {
                 if !seen[i] {
                     seen[i] = true;
                     v[k] = t[k];
+                    owners.vertex_owner[i] = n as u32;
                 }
                 let (a, b) = (t[k], t[(k + 1) % 3]);
                 let edge = [a.min(b), a.max(b)];
@@ -122,8 +144,16 @@ pub struct SelfContacts {
     /// Each triangle's box: its corners' boxes together.
     lo: Vec<Vec3>,
     hi: Vec<Vec3>,
-    /// The pairs found last.
+    /// The pairs found: for every two triangles whose boxes overlap, their pairs whose
+    /// particles' boxes could come within the thickness.
     found: Found,
+    /// Particles whose motion left their boxes, and the triangles they are corners of
+    /// (as flags and as a list), for a refresh.
+    left: Vec<bool>,
+    dirty: Vec<bool>,
+    dirty_list: Vec<u32>,
+    /// How much the boxes were grown by around each particle's motion.
+    grow: f32,
     /// Particles resting on a solid this substep (set by the stepper before
     /// [`SelfContacts::resolve`]): pushes move them only where nothing else can.
     pub held: Vec<bool>,
@@ -137,42 +167,6 @@ pub struct SelfContacts {
     cut: Vec<f64>,
     changed: Vec<bool>,
     pub work: SelfWork,
-}
-
-/// Where one piece of the search put its pairs: `members[member][start..end]`.
-#[derive(Clone, Copy, Debug, Default)]
-struct Segment {
-    member: u32,
-    start: u32,
-    end: u32,
-}
-
-/// The pairs, as each member of the team found them, and where each piece of the search
-/// put its own (`pieces` of them in use): read in the pieces' order, they are the same
-/// however the pieces were shared out.
-#[derive(Clone, Debug, Default)]
-struct Found {
-    members: Vec<Vec<StoredPair>>,
-    segments: Vec<Segment>,
-    pieces: usize,
-}
-
-impl Found {
-    /// The pairs as stored, in order.
-    fn stored(&self) -> impl Iterator<Item = &StoredPair> {
-        (self.segments[..self.pieces])
-            .iter()
-            .flat_map(|s| &self.members[s.member as usize][s.start as usize..s.end as usize])
-    }
-
-    /// The pairs, expanded with the cloth's `triangles` and the owned `edges`.
-    fn pairs<'a>(
-        &'a self,
-        triangles: &'a [[u32; 3]],
-        owners: &'a Owners,
-    ) -> impl Iterator<Item = Pair> + 'a {
-        self.stored().map(|p| p.expand(triangles, &owners.edges))
-    }
 }
 
 /// Triangles from which the search shares its work out between the team's members.
@@ -250,6 +244,15 @@ impl Search<'_> {
     }
 }
 
+/// The pairs `found`, expanded with the cloth's `triangles` and the owned edges.
+fn pairs<'a>(
+    found: &'a Found,
+    triangles: &'a [[u32; 3]],
+    owners: &'a Owners,
+) -> impl Iterator<Item = Pair> + 'a {
+    found.stored().map(|p| p.expand(triangles, &owners.edges))
+}
+
 /// Whether boxes `a` and `b` overlap.
 fn meet((alo, ahi): (Vec3, Vec3), (blo, bhi): (Vec3, Vec3)) -> bool {
     alo.cmple(bhi).all() && blo.cmple(ahi).all()
@@ -294,14 +297,12 @@ impl SelfContacts {
             / n;
         let mean = mean.as_vec3();
         self.relative(start, &state.pos, self.shift, mean);
-        if !self.holds(thickness, thickness) {
-            self.find_pairs(model, thickness)?;
-        }
+        self.update_pairs(model, thickness, thickness)?;
         self.work.candidates = self.found.stored().count() as u64;
         self.work.binned = self.hash.len() as u64;
         let mut contacts = 0;
         for _ in 0..PUSH_SWEEPS {
-            for pair in self.found.pairs(&model.triangles, &self.owners) {
+            for pair in pairs(&self.found, &model.triangles, &self.owners) {
                 contacts += usize::from(push_apart(
                     &pair,
                     [thickness, friction],
@@ -316,9 +317,7 @@ impl SelfContacts {
         // The pushes may have taken a particle out of the box its pairs were found in; the
         // check needs only the pairs that can come within what it keeps.
         self.relative(start, &state.pos, self.shift, mean);
-        if !self.holds(thickness, CHECKED * thickness) {
-            self.find_pairs(model, thickness)?;
-        }
+        self.update_pairs(model, thickness, CHECKED * thickness)?;
         self.shift += mean;
         self.mean = mean;
         self.fixed.clear();
@@ -347,9 +346,7 @@ impl SelfContacts {
         }
         // The substep in the frame it was resolved in (whose shift already has its mean).
         self.relative(start, &state.pos, self.shift - self.mean, self.mean);
-        if !self.holds(thickness, CHECKED * thickness) {
-            self.find_pairs(model, thickness)?;
-        }
+        self.update_pairs(model, thickness, CHECKED * thickness)?;
         let impacts = self.work.impacts;
         // What the solids just moved stays where they put it: the cut falls on the rest.
         self.fixed.clear();
@@ -374,25 +371,119 @@ impl SelfContacts {
         self.to.extend(pos.iter().map(|&p| p - shift - mean));
     }
 
-    /// Whether the pairs found last hold every pair that can come within `within` along the
-    /// motion from `from` to `to`: found for this thickness, and every particle's motion
-    /// within its box less half of `within` (two boxes that far apart keep their particles
-    /// `within` apart).
-    fn holds(&self, thickness: f32, within: f32) -> bool {
+    /// Makes the pairs hold every pair that can come within `within` along the motion from
+    /// `from` to `to`: they do while they were found for this thickness and every
+    /// particle's motion lies in its box less half of `within` (two boxes that far apart
+    /// keep their particles `within` apart). Particles whose motion left theirs get new
+    /// boxes, and their triangles are searched again ([`SelfContacts::refresh`]); where
+    /// many left, the whole hash is ([`SelfContacts::find_pairs`]).
+    fn update_pairs(
+        &mut self,
+        model: &ClothModel,
+        thickness: f32,
+        within: f32,
+    ) -> Result<(), ContactError> {
+        if self.found_for != Some(thickness) || self.vertex_lo.len() != self.to.len() {
+            return self.find_pairs(model, thickness);
+        }
         let g = Vec3::splat(0.5 * within);
-        self.found_for == Some(thickness)
-            && self.vertex_lo.len() == self.to.len()
-            && (self.from.iter().zip(&self.to))
+        self.left.clear();
+        self.left.extend(
+            (self.from.iter().zip(&self.to))
                 .zip(self.vertex_lo.iter().zip(&self.vertex_hi))
-                .all(|((s, p), (lo, hi))| {
-                    (s.min(*p) - g).cmpge(*lo).all() && (s.max(*p) + g).cmple(*hi).all()
-                })
+                .map(|((s, p), (lo, hi))| {
+                    !((s.min(*p) - g).cmpge(*lo).all() && (s.max(*p) + g).cmple(*hi).all())
+                }),
+        );
+        let left = self.left.iter().filter(|&&l| l).count();
+        if left == 0 {
+            return Ok(());
+        }
+        if left * REFRESH_BELOW < self.left.len() && self.refresh(model, thickness)? {
+            return Ok(());
+        }
+        self.find_pairs(model, thickness)
     }
 
-    /// The pairs whose boxes overlap: each particle's box holds its motion from `from` to
-    /// `to` grown by half the thickness, or (where the cloth moves slowly) three quarters of
-    /// it, so the pairs hold for the substeps after as long as the motion stays in it less
-    /// half the thickness.
+    /// The box that holds a particle's motion from `s` to `p`, grown by `grow` each way.
+    fn vertex_box(s: Vec3, p: Vec3, grow: f32) -> (Vec3, Vec3) {
+        (s.min(p) - Vec3::splat(grow), s.max(p) + Vec3::splat(grow))
+    }
+
+    /// Triangle `t`'s box: its corners' boxes together.
+    fn triangle_box(&self, t: [u32; 3]) -> (Vec3, Vec3) {
+        let [a, b, c] = t.map(|i| i as usize);
+        let (lo, hi) = (&self.vertex_lo, &self.vertex_hi);
+        (lo[a].min(lo[b]).min(lo[c]), hi[a].max(hi[b]).max(hi[c]))
+    }
+
+    /// The particles that [`SelfContacts::update_pairs`] found out of their boxes get new
+    /// ones; the pairs of every triangle they are corners of are dropped and searched
+    /// again against the whole hash, binned anew. The pairs of two triangles neither of
+    /// which moved out stand: their boxes are the same. Returns false, having changed no
+    /// pair, where a triangle would be looked up too many levels down (a search of the
+    /// whole hash then follows).
+    fn refresh(&mut self, model: &ClothModel, thickness: f32) -> Result<bool, ContactError> {
+        // Until the pairs are whole again (an error on the way leaves them not).
+        self.found_for = None;
+        for (i, _) in self.left.iter().enumerate().filter(|(_, l)| **l) {
+            (self.vertex_lo[i], self.vertex_hi[i]) =
+                Self::vertex_box(self.from[i], self.to[i], self.grow);
+        }
+        self.dirty.clear();
+        self.dirty_list.clear();
+        for (n, &t) in model.triangles.iter().enumerate() {
+            let dirty = t.iter().any(|&i| self.left[i as usize]);
+            self.dirty.push(dirty);
+            if dirty {
+                self.dirty_list.push(n as u32);
+                (self.lo[n], self.hi[n]) = self.triangle_box(t);
+            }
+        }
+        self.hash.bin(&self.lo, &self.hi, self.hash.cell())?;
+        let hash = &self.hash;
+        if (self.dirty_list.iter()).any(|&a| hash.levels_below(a as usize) > REFRESH_LEVELS) {
+            return Ok(false);
+        }
+        let (dirty, owner) = (&self.dirty, &self.owners.vertex_owner);
+        (self.found).retain(|p| p.triangles(owner).iter().all(|&t| !dirty[t as usize]));
+        let search = Search {
+            owners: &self.owners,
+            triangles: &model.triangles,
+            vertex_lo: &self.vertex_lo,
+            vertex_hi: &self.vertex_hi,
+            lo: &self.lo,
+            hi: &self.hi,
+            thickness,
+        };
+        let list = &self.dirty_list;
+        let pieces = list.len().div_ceil(REFRESHED_PER_PIECE);
+        let work = |piece: usize, out: &mut Vec<StoredPair>| {
+            let first = piece * REFRESHED_PER_PIECE;
+            for &a in &list[first..(first + REFRESHED_PER_PIECE).min(list.len())] {
+                let a = a as usize;
+                hash.overlapping(a, search.lo, search.hi, |b| {
+                    // Two triangles moved out: their pairs are searched from the first.
+                    let b = b as usize;
+                    if !dirty[b] || a < b {
+                        search.pairs_of(a, b, out);
+                    }
+                });
+            }
+        };
+        // A triangle looked up costs about what one searched with the whole hash does.
+        let parallel = list.len() >= PARALLEL_TRIANGLES / 4;
+        self.found.extend(pieces, parallel, &work);
+        self.work.refreshes += 1;
+        self.work.refreshed += list.len() as u64;
+        self.found_for = Some(thickness);
+        Ok(true)
+    }
+
+    /// The pairs of every two triangles whose boxes overlap, each particle's box its
+    /// motion grown by half the thickness, or (where the whole cloth moves slowly in the
+    /// moving frame) three quarters of it, so that the pairs hold for the substeps after
+    /// while each particle's motion stays in its box less half the thickness.
     fn find_pairs(&mut self, model: &ClothModel, thickness: f32) -> Result<(), ContactError> {
         self.found_for = None;
         self.vertex_lo.clear();
@@ -403,36 +494,36 @@ impl SelfContacts {
             .map(|(s, p)| s.distance_squared(*p))
             .fold(0.0f32, f32::max)
             .sqrt();
-        let grow = if fastest < REUSE_BELOW * thickness {
+        self.grow = if fastest < REUSE_BELOW * thickness {
             0.75 * thickness
         } else {
             0.5 * thickness
         };
         for (s, p) in self.from.iter().zip(&self.to) {
-            self.vertex_lo.push(s.min(*p) - Vec3::splat(grow));
-            self.vertex_hi.push(s.max(*p) + Vec3::splat(grow));
+            let (lo, hi) = Self::vertex_box(*s, *p, self.grow);
+            self.vertex_lo.push(lo);
+            self.vertex_hi.push(hi);
         }
-        let (vlo, vhi) = (&self.vertex_lo, &self.vertex_hi);
+        self.search_all(model, thickness)
+    }
+
+    /// The pairs of every two triangles whose boxes overlap, from the particles' boxes as
+    /// they are.
+    fn search_all(&mut self, model: &ClothModel, thickness: f32) -> Result<(), ContactError> {
+        self.found_for = None;
         self.lo.clear();
         self.hi.clear();
-        for t in &model.triangles {
-            let [a, b, c] = t.map(|i| i as usize);
-            self.lo.push(vlo[a].min(vlo[b]).min(vlo[c]));
-            self.hi.push(vhi[a].max(vhi[b]).max(vhi[c]));
+        for &t in &model.triangles {
+            let (lo, hi) = self.triangle_box(t);
+            self.lo.push(lo);
+            self.hi.push(hi);
         }
         let longest = model.springs.rest[..model.mesh_edges.min(model.springs.len())]
             .iter()
             .fold(0.0f32, |m, &r| m.max(r));
         let cell = (2.0 * longest).max(2.0 * thickness).max(1e-6);
         self.hash.bin(&self.lo, &self.hi, cell)?;
-        let pieces = self.hash.pieces();
-        self.found.pieces = 0;
-        let team = Team::current();
-        (self.found.members).resize_with(team.members().max(1), Vec::new);
-        for buffer in &mut self.found.members {
-            buffer.clear();
-        }
-        (self.found.segments).resize(pieces, Segment::default());
+        self.found.clear();
         let search = Search {
             owners: &self.owners,
             triangles: &model.triangles,
@@ -442,36 +533,14 @@ impl SelfContacts {
             hi: &self.hi,
             thickness,
         };
-        let (found, segments) = (
-            Disjoint::new(&mut self.found.members),
-            Disjoint::new(&mut self.found.segments),
-        );
         let hash = &self.hash;
-        let work = |member: usize, piece: usize| {
-            // SAFETY: a member takes only its own buffer, and each piece is run once and
-            // writes only its own segment.
-            let (out, segment) = unsafe {
-                (
-                    &mut found.part(member..member + 1)[0],
-                    &mut segments.part(piece..piece + 1)[0],
-                )
-            };
-            let start = out.len();
-            hash.piece_pairs(piece, &self.lo, &self.hi, |a, b| {
+        let work = |piece: usize, out: &mut Vec<StoredPair>| {
+            hash.piece_pairs(piece, search.lo, search.hi, |a, b| {
                 search.pairs_of(a as usize, b as usize, out);
             });
-            *segment = Segment {
-                member: member as u32,
-                start: start as u32,
-                end: out.len() as u32,
-            };
         };
-        if model.triangles.len() >= PARALLEL_TRIANGLES {
-            team.run_large_pieces(pieces, &work);
-        } else {
-            (0..pieces).for_each(|piece| work(0, piece));
-        }
-        self.found.pieces = pieces;
+        let parallel = model.triangles.len() >= PARALLEL_TRIANGLES;
+        self.found.extend(hash.pieces(), parallel, &work);
         self.work.searches += 1;
         self.found_for = Some(thickness);
         Ok(())
@@ -500,7 +569,7 @@ impl SelfContacts {
         for round in 0.. {
             self.cut.clone_from(&self.scale);
             let mut any = false;
-            for pair in self.found.pairs(&model.triangles, &self.owners) {
+            for pair in pairs(&self.found, &model.triangles, &self.owners) {
                 let ids = pair.ids();
                 if !ids.iter().any(|&i| self.changed[i]) {
                     continue;
@@ -559,3 +628,6 @@ impl SelfContacts {
         }
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,119 @@
+//! The refresh: searching again only the triangles whose particles left their boxes gives
+//! the pairs a search of the whole hash gives with the same boxes, in an order that does
+//! not depend on the team's size.
+
+use glam::Vec3;
+
+use super::*;
+use crate::mesh::{GridOrientation, GridSpec};
+
+const THICKNESS: f32 = 0.01;
+
+/// A 48 × 48-quad cloth (4 608 triangles, so the search is shared out) 1 m wide, crumpled
+/// by random offsets of up to 1.5 cm, so that its particles have many pairs.
+fn crumpled() -> (ClothModel, Vec<Vec3>) {
+    let mesh = GridSpec::square(48, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
+        .build()
+        .unwrap();
+    let model = ClothModel::new(&mesh, 0.2, &[]);
+    let mut rnd = crate::test_rng::uniform(5);
+    let mut jitter = || Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.03;
+    let pos = mesh.positions.iter().map(|&p| p + jitter()).collect();
+    (model, pos)
+}
+
+/// Pairs found from `start` to `end` (no motion: a search of the whole hash), then the
+/// particles in the band `x < band` moved by `shift`, which takes them out of their boxes,
+/// and the pairs brought up to date. Returns the solver and the pairs before and after.
+fn refreshed(band: f32, shift: Vec3) -> (SelfContacts, Vec<StoredPair>, Vec<StoredPair>) {
+    let (model, start) = crumpled();
+    let mut contacts = SelfContacts {
+        owners: Owners::build(&model),
+        ..SelfContacts::default()
+    };
+    contacts.relative(&start, &start, Vec3::ZERO, Vec3::ZERO);
+    contacts.update_pairs(&model, THICKNESS, THICKNESS).unwrap();
+    assert_eq!(contacts.work.searches, 1);
+    let before: Vec<StoredPair> = contacts.found.stored().copied().collect();
+    let end: Vec<Vec3> = (start.iter())
+        .map(|&p| if p.x < band { p + shift } else { p })
+        .collect();
+    contacts.relative(&start, &end, Vec3::ZERO, Vec3::ZERO);
+    contacts.update_pairs(&model, THICKNESS, THICKNESS).unwrap();
+    let after = contacts.found.stored().copied().collect();
+    (contacts, before, after)
+}
+
+/// The pairs as a set: sorted, each edge–edge pair's edges in order.
+fn sorted(pairs: Vec<StoredPair>) -> Vec<StoredPair> {
+    let mut pairs: Vec<StoredPair> = pairs.into_iter().map(StoredPair::canonical).collect();
+    pairs.sort_unstable();
+    pairs
+}
+
+/// A band of a fifth of the cloth moved 4 cm sideways: only its triangles are searched
+/// again (one refresh, no second search of the whole hash), and the pairs are exactly
+/// those a search of the whole hash finds with the boxes as they now are — the band's
+/// new pairs found, its old ones gone, the rest kept.
+#[test]
+fn a_refresh_finds_what_a_whole_search_finds() {
+    let (mut contacts, before, after) = refreshed(-0.3, Vec3::new(0.0, 0.0, 0.04));
+    let model = crumpled().0;
+    assert_eq!((contacts.work.searches, contacts.work.refreshes), (1, 1));
+    let refreshed = contacts.work.refreshed as usize;
+    assert!(
+        refreshed > 500 && refreshed < model.triangles.len() / 3,
+        "{refreshed}"
+    );
+    assert_ne!(
+        sorted(before.clone()),
+        sorted(after.clone()),
+        "the band moved"
+    );
+    let kept = before.iter().filter(|p| after.contains(p)).count();
+    assert!(kept > before.len() / 2, "{kept} of {}", before.len());
+    contacts.search_all(&model, THICKNESS).unwrap();
+    let whole: Vec<StoredPair> = contacts.found.stored().copied().collect();
+    assert!(whole.len() > 10_000, "{}", whole.len());
+    let (after, whole) = (sorted(after), sorted(whole));
+    let extra: Vec<_> = after
+        .iter()
+        .filter(|p| whole.binary_search(p).is_err())
+        .collect();
+    let missing: Vec<_> = whole
+        .iter()
+        .filter(|p| after.binary_search(p).is_err())
+        .collect();
+    assert!(
+        extra.is_empty() && missing.is_empty() && after.len() == whole.len(),
+        "{} pairs not in the whole search's {}, {} of its missing: {:?} {:?}",
+        extra.len(),
+        whole.len(),
+        missing.len(),
+        &extra[..extra.len().min(5)],
+        &missing[..missing.len().min(5)]
+    );
+}
+
+/// Where a quarter or more of the particles left their boxes, the whole hash is searched.
+#[test]
+fn many_particles_out_of_their_boxes_search_the_whole_hash() {
+    let (contacts, _, _) = refreshed(0.1, Vec3::new(0.0, 0.0, 0.04));
+    assert_eq!((contacts.work.searches, contacts.work.refreshes), (2, 0));
+}
+
+/// A refresh shared out between two threads stores its pairs in the same order as on one.
+#[test]
+fn a_refresh_stores_the_same_order_on_two_threads_as_on_one() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| refreshed(-0.3, Vec3::new(0.0, 0.0, 0.04)))
+    };
+    let ((one, _, a), (two, _, b)) = (run(1), run(2));
+    assert!(one.work.refreshed as usize >= PARALLEL_TRIANGLES / 4);
+    assert_eq!(two.work.refreshes, 1);
+    assert_eq!(a, b);
+}
