@@ -71,6 +71,9 @@ pub struct BoxHash {
     runs: Vec<u32>,
     /// Each box's level.
     level: Vec<u8>,
+    /// The cell of each box's lowest corner at its level: the cell of two boxes' overlap's
+    /// lowest corner is theirs taken axis by axis at the larger (a floor keeps order).
+    first: Vec<[i32; 3]>,
     /// Bit `l` is set when some box is at level `l`.
     levels: u32,
     cell: f32,
@@ -89,6 +92,7 @@ impl BoxHash {
     pub fn bin(&mut self, lo: &[Vec3], hi: &[Vec3], cell: f32) -> Result<(), ContactError> {
         self.bins.clear();
         self.level.clear();
+        self.first.clear();
         self.levels = 0;
         self.cell = cell;
         // The entries counted first, so the table grows to what it holds, not to the next
@@ -105,6 +109,7 @@ impl BoxHash {
             };
             self.levels |= 1 << level;
             self.level.push(level as u8);
+            self.first.push(cell_of(lo, cell * (1u32 << level) as f32));
             entries += cells;
         }
         self.bins.reserve_exact(entries);
@@ -168,11 +173,19 @@ impl BoxHash {
                 let cell = &self.bins[start..end];
                 let key = cell[0].0;
                 for (i, &(_, a)) in cell.iter().enumerate() {
-                    let level = u32::from(self.level[a as usize]);
+                    let a = a as usize;
+                    let (level, first) = (self.level[a], self.first[a]);
                     for &(_, b) in &cell[i + 1..] {
-                        // A shared key from another level is not a shared cell.
-                        if u32::from(self.level[b as usize]) == level {
-                            overlap(a as usize, b as usize, level, key);
+                        let b = b as usize;
+                        // A shared key from another level is not a shared cell; the pair is
+                        // taken in the cell of its overlap's lowest corner, which is this
+                        // one when the larger of the boxes' first cells has its key.
+                        let lowest = std::array::from_fn(|k| first[k].max(self.first[b][k]));
+                        if self.level[b] == level
+                            && cell_key(lowest, u32::from(level)) == key
+                            && lo[a].max(lo[b]).cmple(hi[a].min(hi[b])).all()
+                        {
+                            pair(a as u32, b as u32);
                         }
                     }
                 }
