@@ -74,6 +74,28 @@ impl Found {
         self.segments.retain(|s| s.start != s.end);
     }
 
+    /// How many pairs there are.
+    pub(super) fn len(&self) -> usize {
+        self.segments
+            .iter()
+            .map(|s| (s.end - s.start) as usize)
+            .sum()
+    }
+
+    /// Calls `visit` with each piece's pairs, shared with the team's helpers when
+    /// `parallel` (in no set order then: for work whose result does not depend on it).
+    pub(super) fn share(&self, parallel: bool, visit: &(dyn Fn(&[StoredPair]) + Sync)) {
+        let piece = |piece: usize| {
+            let s = self.segments[piece];
+            visit(&self.members[s.member as usize][s.start as usize..s.end as usize]);
+        };
+        if parallel {
+            Team::current().run_large_pieces(self.segments.len(), &|_, p| piece(p));
+        } else {
+            (0..self.segments.len()).for_each(piece);
+        }
+    }
+
     /// Keeps only the pairs for which `keep` is true, in their order.
     pub(super) fn retain(&mut self, keep: impl Fn(StoredPair) -> bool) {
         self.order.clear();

@@ -1,6 +1,8 @@
 //! The self-contact solver: finds the pairs, pushes them apart, and cuts motion that
 //! could make a pair meet (see the module's notes).
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use glam::Vec3;
 use rustc_hash::FxHashMap;
 
@@ -66,9 +68,23 @@ const CHECKED: f32 = 2.0 * KEEP as f32;
 /// Gauss–Seidel sweeps of the pushes over the pairs.
 const PUSH_SWEEPS: usize = 4;
 
+/// Pairs from which the continuous check's rounds are shared with the team.
+const PARALLEL_PAIRS: usize = 16_384;
+
 /// Rounds of cuts by the safe fraction; after them, a pair that can still meet has its
 /// free particles sent back to the substep's start.
 const SCALED_ROUNDS: usize = 4;
+
+/// The continuous check's cuts in a round, as atomics the team's members lower together.
+/// Scratch: a clone starts empty.
+#[derive(Debug, Default)]
+struct Cuts(Vec<AtomicU64>);
+
+impl Clone for Cuts {
+    fn clone(&self) -> Self {
+        Cuts::default()
+    }
+}
 
 /// Which vertices and edges each triangle owns: each vertex and each edge belongs to the
 /// first triangle that has it, so a pair of triangles yields each vertex–triangle and
@@ -164,7 +180,8 @@ pub struct SelfContacts {
     found_for: Option<f32>,
     /// How much of its motion each particle keeps, and whether that changed last round.
     scale: Vec<f64>,
-    cut: Vec<f64>,
+    /// This round's cuts: each particle's smallest scale yet, as the bits of an `f64`.
+    cut: Cuts,
     changed: Vec<bool>,
     pub work: SelfWork,
 }
@@ -298,7 +315,7 @@ impl SelfContacts {
         let mean = mean.as_vec3();
         self.relative(start, &state.pos, self.shift, mean);
         self.update_pairs(model, thickness, thickness)?;
-        self.work.candidates = self.found.stored().count() as u64;
+        self.work.candidates = self.found.len() as u64;
         self.work.binned = self.hash.len() as u64;
         let mut contacts = 0;
         for _ in 0..PUSH_SWEEPS {
@@ -566,56 +583,68 @@ impl SelfContacts {
         self.scale.resize(n, 1.0);
         self.changed.clear();
         self.changed.resize(n, true);
+        // A round's cuts depend only on the last round's scales, and each particle keeps the
+        // smallest: the pairs can be shared out in any order and give the same bits.
+        let parallel = self.work.candidates as usize >= PARALLEL_PAIRS;
         for round in 0.. {
-            self.cut.clone_from(&self.scale);
-            let mut any = false;
-            for pair in pairs(&self.found, &model.triangles, &self.owners) {
-                let ids = pair.ids();
-                if !ids.iter().any(|&i| self.changed[i]) {
-                    continue;
-                }
-                let from = ids.map(|i| start[i].as_dvec3());
-                let moves =
-                    ids.map(|i| self.scale[i] * (state.pos[i].as_dvec3() - start[i].as_dvec3()));
-                let t = safe_fraction(&pair, from, moves, keep);
-                if t >= 1.0 {
-                    continue;
-                }
-                self.work.impacts += 1;
-                // Particles a solid placed are cut only where nothing else in the pair can be:
-                // the cloth's own guarantee comes first.
-                let only_placed = !ids.iter().any(|&i| free(i) && self.scale[i] > 0.0);
-                let movable = |i: usize| {
-                    self.scale[i] > 0.0 && if only_placed { pinned_free(i) } else { free(i) }
-                };
-                let mut cut_any = false;
-                for &i in &ids {
-                    if movable(i) {
-                        let to = if round < SCALED_ROUNDS {
-                            self.scale[i] * t
-                        } else {
-                            0.0
-                        };
-                        if to < self.cut[i] {
-                            self.cut[i] = to;
-                        }
-                        cut_any = true;
+            self.cut.0.clear();
+            (self.cut.0).extend(self.scale.iter().map(|s| AtomicU64::new(s.to_bits())));
+            let (impacts, forced) = (AtomicU64::new(0), AtomicU64::new(0));
+            let (scale, changed, cut) = (&self.scale, &self.changed, &self.cut.0);
+            let (triangles, edges) = (&model.triangles, &self.owners.edges);
+            self.found.share(parallel, &|stored| {
+                let (mut impacted, mut stuck) = (0, 0);
+                for pair in stored.iter().map(|p| p.expand(triangles, edges)) {
+                    let ids = pair.ids();
+                    if !ids.iter().any(|&i| changed[i]) {
+                        continue;
                     }
+                    let from = ids.map(|i| start[i].as_dvec3());
+                    let moves =
+                        ids.map(|i| scale[i] * (state.pos[i].as_dvec3() - start[i].as_dvec3()));
+                    let t = safe_fraction(&pair, from, moves, keep);
+                    if t >= 1.0 {
+                        continue;
+                    }
+                    impacted += 1;
+                    // Particles a solid placed are cut only where nothing else in the pair
+                    // can be: the cloth's own guarantee comes first.
+                    let only_placed = !ids.iter().any(|&i| free(i) && scale[i] > 0.0);
+                    let movable = |i: usize| {
+                        scale[i] > 0.0 && if only_placed { pinned_free(i) } else { free(i) }
+                    };
+                    let mut cut_any = false;
+                    for &i in &ids {
+                        if movable(i) {
+                            let to = if round < SCALED_ROUNDS {
+                                scale[i] * t
+                            } else {
+                                0.0
+                            };
+                            // Non-negative floats order as their bits do.
+                            cut[i].fetch_min(to.to_bits(), Ordering::Relaxed);
+                            cut_any = true;
+                        }
+                    }
+                    stuck += u64::from(!cut_any);
                 }
-                if cut_any {
-                    any = true;
-                } else {
-                    self.work.forced += 1;
-                    self.work.forced_total += 1;
-                }
-            }
-            if !any {
+                impacts.fetch_add(impacted, Ordering::Relaxed);
+                forced.fetch_add(stuck, Ordering::Relaxed);
+            });
+            let (impacted, stuck) = (impacts.into_inner(), forced.into_inner());
+            self.work.impacts += impacted;
+            self.work.forced += stuck;
+            self.work.forced_total += stuck;
+            // Every impact cut something, or was forced.
+            if impacted == stuck {
                 break;
             }
-            for ((changed, cut), scale) in self.changed.iter_mut().zip(&self.cut).zip(&self.scale) {
-                *changed = cut != scale;
+            let rounds = (self.changed.iter_mut()).zip(self.scale.iter_mut().zip(&self.cut.0));
+            for (changed, (scale, cut)) in rounds {
+                let cut = f64::from_bits(cut.load(Ordering::Relaxed));
+                *changed = cut != *scale;
+                *scale = cut;
             }
-            std::mem::swap(&mut self.scale, &mut self.cut);
         }
         let moved = (self.scale.iter().zip(start)).zip(state.pos.iter_mut().zip(&mut state.vel));
         for ((&s, from), (pos, vel)) in moved {

@@ -117,3 +117,30 @@ fn a_refresh_stores_the_same_order_on_two_threads_as_on_one() {
     assert_eq!(two.work.refreshes, 1);
     assert_eq!(a, b);
 }
+
+/// The continuous check's rounds, shared out between two threads, cut the motion to the
+/// same bits as on one: each particle keeps its smallest cut, whichever thread found it.
+#[test]
+fn the_checks_cut_the_same_bits_on_two_threads_as_on_one() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let (model, start) = crumpled();
+            let mut rnd = crate::test_rng::uniform(9);
+            let mut state = ClothState::at_rest(&model);
+            for (p, s) in state.pos.iter_mut().zip(&start) {
+                *p = *s + Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.04;
+            }
+            let mut contacts = SelfContacts::default();
+            (contacts.resolve([THICKNESS, 0.3, 0.01], &model, &start, &mut state)).unwrap();
+            (state, contacts.work)
+        })
+    };
+    let ((one, work), (two, _)) = (run(1), run(2));
+    assert!(work.candidates as usize >= PARALLEL_PAIRS, "{work:?}");
+    assert!(work.impacts > 500, "{work:?}");
+    assert!(one.pos == two.pos && one.vel == two.vel);
+}
