@@ -80,14 +80,15 @@ impl Sphere {
         for t in &model.triangles {
             let ids = t.map(|i| i as usize);
             let x = ids.map(|i| state.pos[i]);
-            let near = x
-                .iter()
-                .map(|p| p.distance(self.center))
-                .fold(f32::INFINITY, f32::min);
-            let longest = x[0]
-                .distance(x[1])
-                .max(x[1].distance(x[2]))
-                .max(x[2].distance(x[0]));
+            // One root each: the root of the least square is the least root.
+            let near = (x.iter())
+                .map(|p| p.distance_squared(self.center))
+                .fold(f32::INFINITY, f32::min)
+                .sqrt();
+            let longest = (x[0].distance_squared(x[1]))
+                .max(x[1].distance_squared(x[2]))
+                .max(x[2].distance_squared(x[0]))
+                .sqrt();
             if near > reach + longest {
                 continue;
             }
