@@ -82,6 +82,22 @@ impl Found {
             .sum()
     }
 
+    /// Makes `out` the pairs for which `keep` is true, in their order: a piece per segment,
+    /// shared with the team's helpers when `parallel`.
+    pub(super) fn select_into(
+        &self,
+        out: &mut Found,
+        parallel: bool,
+        keep: &(dyn Fn(StoredPair) -> bool + Sync),
+    ) {
+        out.clear();
+        out.extend(self.segments.len(), parallel, &|piece, buffer| {
+            let s = self.segments[piece];
+            let pairs = &self.members[s.member as usize][s.start as usize..s.end as usize];
+            buffer.extend(pairs.iter().copied().filter(|&p| keep(p)));
+        });
+    }
+
     /// Calls `visit` with each piece's pairs, shared with the team's helpers when
     /// `parallel` (in no set order then: for work whose result does not depend on it).
     pub(super) fn share(&self, parallel: bool, visit: &(dyn Fn(&[StoredPair]) + Sync)) {

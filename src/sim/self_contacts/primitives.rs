@@ -149,6 +149,28 @@ pub fn point_triangle_distance(p: DVec3, [a, b, c]: [DVec3; 3]) -> f64 {
     to_segment(a, b).min(to_segment(b, c)).min(to_segment(c, a))
 }
 
+/// Whether the pair's sides are closer than `d` with its particles at `pos`: then the
+/// weights of their closest points ([`Pair::weights`]) and the offset between them (first
+/// side less the other).
+pub fn closer_than(pair: &Pair, pos: &[Vec3], d: f32) -> Option<([f32; 4], Vec3)> {
+    let x = pair.ids().map(|i| pos[i]);
+    let k = pair.first_side();
+    // Sides whose boxes are `d` apart are not closer.
+    let side_box = |r: std::ops::Range<usize>| {
+        r.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), i| {
+            (lo.min(x[i]), hi.max(x[i]))
+        })
+    };
+    let ((alo, ahi), (blo, bhi)) = (side_box(0..k), side_box(k..4));
+    if (blo - ahi).max(alo - bhi).max_element() >= d {
+        return None;
+    }
+    let w = pair.weights(x);
+    let sign = |i: usize| if i < k { 1.0 } else { -1.0 };
+    let gap: Vec3 = (0..4).map(|i| sign(i) * w[i] * x[i]).sum();
+    (gap.length() < d).then_some((w, gap))
+}
+
 /// Keeps the pair's sides `thickness` apart, on the side they were on at the substep's
 /// start (`start`): each particle moves by its share of the push (its weight times its
 /// inverse mass); the approaching relative velocity is removed and Coulomb `friction`
@@ -163,26 +185,13 @@ pub fn push_apart(
     held: &[bool],
 ) -> bool {
     let ids = pair.ids();
-    let x = ids.map(|i| state.pos[i]);
     let k = pair.first_side();
-    // Sides whose boxes are a thickness apart are not in contact.
-    let side_box = |r: std::ops::Range<usize>| {
-        r.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), i| {
-            (lo.min(x[i]), hi.max(x[i]))
-        })
-    };
-    let ((alo, ahi), (blo, bhi)) = (side_box(0..k), side_box(k..4));
-    if (blo - ahi).max(alo - bhi).max_element() >= thickness {
+    let Some((w, gap)) = closer_than(pair, &state.pos, thickness) else {
         return false;
-    }
-    let w = pair.weights(x);
+    };
+    let dist = gap.length();
     // Signed weights: the first side counts positively, the other negatively.
     let sign = |i: usize| if i < k { 1.0 } else { -1.0 };
-    let gap: Vec3 = (0..4).map(|i| sign(i) * w[i] * x[i]).sum();
-    let dist = gap.length();
-    if dist >= thickness {
-        return false;
-    }
     // Which side: the sides' offset at the start, at the same weights.
     let before: Vec3 = (0..4).map(|i| sign(i) * w[i] * start[ids[i]]).sum();
     let direction = if before.length_squared() > 0.0 && gap.dot(before) > 0.0 && dist > 1e-9 {

@@ -12,7 +12,7 @@ use super::ccd::safe_fraction;
 use super::error::ContactError;
 use super::found::Found;
 use super::hash::BoxHash;
-use super::primitives::{Pair, StoredPair, distance, push_apart};
+use super::primitives::{Pair, StoredPair, closer_than, distance, push_apart};
 
 /// Work done by the last resolve: for cost checks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -68,7 +68,14 @@ const CHECKED: f32 = 2.0 * KEEP as f32;
 /// Gauss–Seidel sweeps of the pushes over the pairs.
 const PUSH_SWEEPS: usize = 4;
 
-/// Pairs from which the continuous check's rounds are shared with the team.
+/// The pushes go through only the pairs whose sides are closer than this many
+/// thicknesses before their first sweep: one farther apart comes into contact within the
+/// sweeps only where pushes elsewhere move its particles a thickness (the next substep
+/// pushes it then; the continuous check, not the pushes, keeps the guarantee).
+const NEAR: f32 = 2.0;
+
+/// Pairs from which picking out the near ones, and the continuous check's rounds, are
+/// shared with the team.
 const PARALLEL_PAIRS: usize = 16_384;
 
 /// Rounds of cuts by the safe fraction; after them, a pair that can still meet has its
@@ -180,6 +187,8 @@ pub struct SelfContacts {
     found_for: Option<f32>,
     /// How much of its motion each particle keeps, and whether that changed last round.
     scale: Vec<f64>,
+    /// The pairs the pushes go through.
+    near: Found,
     /// This round's cuts: each particle's smallest scale yet, as the bits of an `f64`.
     cut: Cuts,
     changed: Vec<bool>,
@@ -317,9 +326,17 @@ impl SelfContacts {
         self.update_pairs(model, thickness, thickness)?;
         self.work.candidates = self.found.len() as u64;
         self.work.binned = self.hash.len() as u64;
+        // The sweeps go through the pairs whose sides are near enough to come into
+        // contact, picked out first (by the team, where they are many).
+        let (triangles, edges, pos) = (&model.triangles, &self.owners.edges, &state.pos);
+        let near = |p: StoredPair| {
+            closer_than(&p.expand(triangles, edges), pos, NEAR * thickness).is_some()
+        };
+        let parallel = self.work.candidates as usize >= PARALLEL_PAIRS;
+        self.found.select_into(&mut self.near, parallel, &near);
         let mut contacts = 0;
         for _ in 0..PUSH_SWEEPS {
-            for pair in pairs(&self.found, &model.triangles, &self.owners) {
+            for pair in pairs(&self.near, &model.triangles, &self.owners) {
                 contacts += usize::from(push_apart(
                     &pair,
                     [thickness, friction],
