@@ -14,13 +14,35 @@ const MAX_LEVEL: u32 = 20;
 /// Most cells one triangle is binned in: two along each axis.
 pub const CELLS_PER_TRIANGLE: usize = 8;
 
-/// The key of cell `c` at `level`: three coordinates wrapped into 21 bits each, mixed with
-/// the level. Distinct cells rarely share a key, and a shared key only adds entries that
-/// the level and cell checks then skip.
+/// The key of cell `c` at `level`, in [`KEY_BITS`] bits: three coordinates wrapped into
+/// 21 bits each, mixed with the level, then hashed (the top bits of an odd multiple).
+/// Distinct cells rarely share a key, and a shared key only adds entries that the level,
+/// overlap and cell checks then skip.
 fn cell_key(c: [i32; 3], level: u32) -> u64 {
     let w = |x: i32| (x as u64) & 0x1F_FFFF;
-    (w(c[0]) | (w(c[1]) << 21) | (w(c[2]) << 42))
-        ^ (level as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+    let cell = (w(c[0]) | (w(c[1]) << 21) | (w(c[2]) << 42))
+        ^ (level as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    cell.wrapping_mul(0xD6E8_FEB8_6659_FD93) >> (64 - KEY_BITS)
+}
+
+/// Bits of a table entry that number its box; the key takes the rest.
+const BOX_BITS: u32 = 24;
+const KEY_BITS: u32 = 64 - BOX_BITS;
+
+/// An entry of the table: the cell's key above the box's number, so that entries sort by
+/// key in eight bytes. A cloth has at most 8 388 608 triangles (the importer's and the
+/// grid's limits), under 2^24.
+fn entry(key: u64, b: usize) -> u64 {
+    debug_assert!(b < 1 << BOX_BITS);
+    (key << BOX_BITS) | b as u64
+}
+
+fn entry_key(e: u64) -> u64 {
+    e >> BOX_BITS
+}
+
+fn entry_box(e: u64) -> usize {
+    (e & ((1 << BOX_BITS) - 1)) as usize
 }
 
 fn cell_of(p: Vec3, size: f32) -> [i32; 3] {
@@ -65,8 +87,8 @@ fn each_cell(lo: Vec3, hi: Vec3, size: f32, mut visit: impl FnMut([i32; 3])) {
 /// The table, kept between substeps (its buffers are reused).
 #[derive(Clone, Debug, Default)]
 pub struct BoxHash {
-    /// (cell key, box), sorted by key.
-    bins: Vec<(u64, u32)>,
+    /// Entries ([`entry`]: cell key and box), sorted.
+    bins: Vec<u64>,
     /// Where each run of entries with one key starts.
     runs: Vec<u32>,
     /// Each box's level.
@@ -117,13 +139,13 @@ impl BoxHash {
             let level = u32::from(level);
             let size = cell * (1u32 << level) as f32;
             each_cell(lo, hi, size, |c| {
-                self.bins.push((cell_key(c, level), t as u32))
+                self.bins.push(entry(cell_key(c, level), t))
             });
         }
         self.bins.sort_unstable();
         self.runs.clear();
         for (i, w) in self.bins.iter().enumerate() {
-            if i == 0 || self.bins[i - 1].0 != w.0 {
+            if i == 0 || entry_key(self.bins[i - 1]) != entry_key(*w) {
                 self.runs.push(i as u32);
             }
         }
@@ -171,12 +193,12 @@ impl BoxHash {
                     .get(r + 1)
                     .map_or(self.bins.len(), |&e| e as usize);
                 let cell = &self.bins[start..end];
-                let key = cell[0].0;
-                for (i, &(_, a)) in cell.iter().enumerate() {
-                    let a = a as usize;
+                let key = entry_key(cell[0]);
+                for (i, &a) in cell.iter().enumerate() {
+                    let a = entry_box(a);
                     let (level, first) = (self.level[a], self.first[a]);
-                    for &(_, b) in &cell[i + 1..] {
-                        let b = b as usize;
+                    for &b in &cell[i + 1..] {
+                        let b = entry_box(b);
                         // A shared key from another level is not a shared cell; the pair is
                         // taken in the cell of its overlap's lowest corner, which is this
                         // one when the larger of the boxes' first cells has its key.
@@ -201,15 +223,8 @@ impl BoxHash {
                 levels &= levels - 1;
                 let size = self.cell * (1u32 << level) as f32;
                 each_cell(lo[a], hi[a], size, |c| {
-                    let key = cell_key(c, level);
-                    let start = self.bins.partition_point(|&(k, _)| k < key);
-                    for &(k, b) in &self.bins[start..] {
-                        if k != key {
-                            break;
-                        }
-                        if u32::from(self.level[b as usize]) == level {
-                            overlap(a, b as usize, level, key);
-                        }
+                    for b in self.binned_in(c, level) {
+                        overlap(a, b as usize, level, cell_key(c, level));
                     }
                 });
             }
@@ -221,6 +236,17 @@ impl BoxHash {
     /// The base cell the boxes were binned with, m.
     pub fn cell(&self) -> f32 {
         self.cell
+    }
+
+    /// The boxes binned at `level` in its cell `c` (looked up by the cell's key; a box of
+    /// another level under the same key is not in this cell).
+    fn binned_in(&self, c: [i32; 3], level: u32) -> impl Iterator<Item = u32> + '_ {
+        let key = cell_key(c, level);
+        let start = self.bins.partition_point(|&e| entry_key(e) < key);
+        (self.bins[start..].iter())
+            .take_while(move |&&e| entry_key(e) == key)
+            .map(|&e| entry_box(e) as u32)
+            .filter(move |&b| u32::from(self.level[b as usize]) == level)
     }
 
     /// How many levels finer than box `a`'s the finest binned box is: looking up `a` at
@@ -239,14 +265,9 @@ impl BoxHash {
             levels &= levels - 1;
             let size = self.cell * (1u32 << level) as f32;
             each_cell(lo[a], hi[a], size, |c| {
-                let key = cell_key(c, level);
-                let start = self.bins.partition_point(|&(k, _)| k < key);
-                for &(k, b) in &self.bins[start..] {
-                    if k != key {
-                        break;
-                    }
+                for b in self.binned_in(c, level) {
                     let bi = b as usize;
-                    if bi == a || u32::from(self.level[bi]) != level {
+                    if bi == a {
                         continue;
                     }
                     let (l, h) = (lo[a].max(lo[bi]), hi[a].min(hi[bi]));

@@ -153,10 +153,8 @@ impl Owners {
 pub struct SelfContacts {
     hash: BoxHash,
     owners: Owners,
-    /// Each particle's box when the pairs were found: its motion grown by half the
-    /// thickness and a margin.
-    vertex_lo: Vec<Vec3>,
-    vertex_hi: Vec<Vec3>,
+    /// The particles' and triangles' boxes the pairs were found with.
+    boxes: Boxes,
     /// The substep's start and end in the frame that moves with the cloth, and how far
     /// that frame has moved.
     from: Vec<Vec3>,
@@ -164,9 +162,6 @@ pub struct SelfContacts {
     shift: Vec3,
     /// The cloth's mean motion in the last substep resolved.
     mean: Vec3,
-    /// Each triangle's box: its corners' boxes together.
-    lo: Vec<Vec3>,
-    hi: Vec<Vec3>,
     /// The pairs found: for every two triangles whose boxes overlap, their pairs whose
     /// particles' boxes could come within the thickness.
     found: Found,
@@ -198,14 +193,22 @@ pub struct SelfContacts {
 /// Triangles from which the search shares its work out between the team's members.
 const PARALLEL_TRIANGLES: usize = 2048;
 
+/// The boxes a search bins and reads.
+#[derive(Clone, Debug, Default)]
+struct Boxes {
+    /// Each particle's: its motion grown by half the thickness or more.
+    vertex_lo: Vec<Vec3>,
+    vertex_hi: Vec<Vec3>,
+    /// Each triangle's: its corners' boxes together.
+    lo: Vec<Vec3>,
+    hi: Vec<Vec3>,
+}
+
 /// What a search for pairs reads.
 struct Search<'a> {
     owners: &'a Owners,
     triangles: &'a [[u32; 3]],
-    vertex_lo: &'a [Vec3],
-    vertex_hi: &'a [Vec3],
-    lo: &'a [Vec3],
-    hi: &'a [Vec3],
+    boxes: &'a Boxes,
     thickness: f32,
 }
 
@@ -213,18 +216,25 @@ impl Search<'_> {
     /// Adds to `out` the vertex–triangle and edge–edge pairs that triangles `a` and `b`
     /// (whose boxes overlap) own and that could come within the thickness.
     fn pairs_of(&self, a: usize, b: usize, out: &mut Vec<StoredPair>) {
-        let vbox = |v: u32| (self.vertex_lo[v as usize], self.vertex_hi[v as usize]);
+        let vbox = |v: u32| {
+            (
+                self.boxes.vertex_lo[v as usize],
+                self.boxes.vertex_hi[v as usize],
+            )
+        };
         let ebox = |[a, b]: [u32; 2]| {
             let (a, b) = (a as usize, b as usize);
             (
-                self.vertex_lo[a].min(self.vertex_lo[b]),
-                self.vertex_hi[a].max(self.vertex_hi[b]),
+                self.boxes.vertex_lo[a].min(self.boxes.vertex_lo[b]),
+                self.boxes.vertex_hi[a].max(self.boxes.vertex_hi[b]),
             )
         };
         for (own, other) in [(a, b), (b, a)] {
             let tri = self.triangles[other];
             for &v in &self.owners.vertices[own] {
-                if v != NONE && !tri.contains(&v) && meet(vbox(v), (self.lo[other], self.hi[other]))
+                if v != NONE
+                    && !tri.contains(&v)
+                    && meet(vbox(v), (self.boxes.lo[other], self.boxes.hi[other]))
                 {
                     let stored = StoredPair::vertex_triangle(v, other as u32);
                     self.keep(Pair::vertex_triangle(v, tri), stored, out);
@@ -252,18 +262,19 @@ impl Search<'_> {
         // The smallest ball around each particle's box: in its box, a particle is at most
         // half the box's diagonal from the box's centre.
         let (lo, hi) = (
-            ids.map(|i| self.vertex_lo[i]),
-            ids.map(|i| self.vertex_hi[i]),
+            ids.map(|i| self.boxes.vertex_lo[i]),
+            ids.map(|i| self.boxes.vertex_hi[i]),
         );
         let x = std::array::from_fn(|j| (0.5 * (lo[j] + hi[j])).as_dvec3());
         let radius = |j: usize| 0.5 * f64::from((hi[j] - lo[j]).length());
         let most = |r: std::ops::Range<usize>| r.map(radius).fold(0.0f64, f64::max);
         let k = pair.first_side();
         if distance(&pair, x) - most(0..k) - most(k..4) < f64::from(self.thickness) {
-            // Grown by half, not doubled: where a cloth lands fast the pairs run to
-            // millions, and a doubled buffer can hold as much again unused.
+            // Grown by a quarter, not doubled: where a cloth lands fast the pairs run to
+            // millions, and a doubled buffer can hold as much again unused (a large
+            // buffer grows in place: the allocator remaps its pages).
             if out.len() == out.capacity() {
-                out.reserve_exact((out.capacity() / 2).max(1024));
+                out.reserve_exact((out.capacity() / 4).max(1024));
             }
             out.push(stored);
         }
@@ -417,14 +428,14 @@ impl SelfContacts {
         thickness: f32,
         within: f32,
     ) -> Result<(), ContactError> {
-        if self.found_for != Some(thickness) || self.vertex_lo.len() != self.to.len() {
+        if self.found_for != Some(thickness) || self.boxes.vertex_lo.len() != self.to.len() {
             return self.find_pairs(model, thickness);
         }
         let g = Vec3::splat(0.5 * within);
         self.left.clear();
         self.left.extend(
             (self.from.iter().zip(&self.to))
-                .zip(self.vertex_lo.iter().zip(&self.vertex_hi))
+                .zip(self.boxes.vertex_lo.iter().zip(&self.boxes.vertex_hi))
                 .map(|((s, p), (lo, hi))| {
                     !((s.min(*p) - g).cmpge(*lo).all() && (s.max(*p) + g).cmple(*hi).all())
                 }),
@@ -447,7 +458,7 @@ impl SelfContacts {
     /// Triangle `t`'s box: its corners' boxes together.
     fn triangle_box(&self, t: [u32; 3]) -> (Vec3, Vec3) {
         let [a, b, c] = t.map(|i| i as usize);
-        let (lo, hi) = (&self.vertex_lo, &self.vertex_hi);
+        let (lo, hi) = (&self.boxes.vertex_lo, &self.boxes.vertex_hi);
         (lo[a].min(lo[b]).min(lo[c]), hi[a].max(hi[b]).max(hi[c]))
     }
 
@@ -461,7 +472,7 @@ impl SelfContacts {
         // Until the pairs are whole again (an error on the way leaves them not).
         self.found_for = None;
         for (i, _) in self.left.iter().enumerate().filter(|(_, l)| **l) {
-            (self.vertex_lo[i], self.vertex_hi[i]) =
+            (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) =
                 Self::vertex_box(self.from[i], self.to[i], self.grow);
         }
         self.dirty.clear();
@@ -471,10 +482,11 @@ impl SelfContacts {
             self.dirty.push(dirty);
             if dirty {
                 self.dirty_list.push(n as u32);
-                (self.lo[n], self.hi[n]) = self.triangle_box(t);
+                (self.boxes.lo[n], self.boxes.hi[n]) = self.triangle_box(t);
             }
         }
-        self.hash.bin(&self.lo, &self.hi, self.hash.cell())?;
+        self.hash
+            .bin(&self.boxes.lo, &self.boxes.hi, self.hash.cell())?;
         let hash = &self.hash;
         if (self.dirty_list.iter()).any(|&a| hash.levels_below(a as usize) > REFRESH_LEVELS) {
             return Ok(false);
@@ -484,10 +496,7 @@ impl SelfContacts {
         let search = Search {
             owners: &self.owners,
             triangles: &model.triangles,
-            vertex_lo: &self.vertex_lo,
-            vertex_hi: &self.vertex_hi,
-            lo: &self.lo,
-            hi: &self.hi,
+            boxes: &self.boxes,
             thickness,
         };
         let list = &self.dirty_list;
@@ -496,7 +505,7 @@ impl SelfContacts {
             let first = piece * REFRESHED_PER_PIECE;
             for &a in &list[first..(first + REFRESHED_PER_PIECE).min(list.len())] {
                 let a = a as usize;
-                hash.overlapping(a, search.lo, search.hi, |b| {
+                hash.overlapping(a, &search.boxes.lo, &search.boxes.hi, |b| {
                     // Two triangles moved out: their pairs are searched from the first.
                     let b = b as usize;
                     if !dirty[b] || a < b {
@@ -520,8 +529,8 @@ impl SelfContacts {
     /// while each particle's motion stays in its box less half the thickness.
     fn find_pairs(&mut self, model: &ClothModel, thickness: f32) -> Result<(), ContactError> {
         self.found_for = None;
-        self.vertex_lo.clear();
-        self.vertex_hi.clear();
+        self.boxes.vertex_lo.clear();
+        self.boxes.vertex_hi.clear();
         // Room to reuse the pairs only where the cloth moves slowly in the moving frame; a
         // fast substep would leave its boxes at once, and the room would only add pairs.
         let fastest = (self.from.iter().zip(&self.to))
@@ -535,8 +544,8 @@ impl SelfContacts {
         };
         for (s, p) in self.from.iter().zip(&self.to) {
             let (lo, hi) = Self::vertex_box(*s, *p, self.grow);
-            self.vertex_lo.push(lo);
-            self.vertex_hi.push(hi);
+            self.boxes.vertex_lo.push(lo);
+            self.boxes.vertex_hi.push(hi);
         }
         self.search_all(model, thickness)
     }
@@ -545,31 +554,28 @@ impl SelfContacts {
     /// they are.
     fn search_all(&mut self, model: &ClothModel, thickness: f32) -> Result<(), ContactError> {
         self.found_for = None;
-        self.lo.clear();
-        self.hi.clear();
+        self.boxes.lo.clear();
+        self.boxes.hi.clear();
         for &t in &model.triangles {
             let (lo, hi) = self.triangle_box(t);
-            self.lo.push(lo);
-            self.hi.push(hi);
+            self.boxes.lo.push(lo);
+            self.boxes.hi.push(hi);
         }
         let longest = model.springs.rest[..model.mesh_edges.min(model.springs.len())]
             .iter()
             .fold(0.0f32, |m, &r| m.max(r));
         let cell = (2.0 * longest).max(2.0 * thickness).max(1e-6);
-        self.hash.bin(&self.lo, &self.hi, cell)?;
+        self.hash.bin(&self.boxes.lo, &self.boxes.hi, cell)?;
         self.found.clear();
         let search = Search {
             owners: &self.owners,
             triangles: &model.triangles,
-            vertex_lo: &self.vertex_lo,
-            vertex_hi: &self.vertex_hi,
-            lo: &self.lo,
-            hi: &self.hi,
+            boxes: &self.boxes,
             thickness,
         };
         let hash = &self.hash;
         let work = |piece: usize, out: &mut Vec<StoredPair>| {
-            hash.piece_pairs(piece, search.lo, search.hi, |a, b| {
+            hash.piece_pairs(piece, &search.boxes.lo, &search.boxes.hi, |a, b| {
                 search.pairs_of(a as usize, b as usize, out);
             });
         };
