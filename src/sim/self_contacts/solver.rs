@@ -202,6 +202,12 @@ struct Boxes {
     /// Each triangle's: its corners' boxes together.
     lo: Vec<Vec3>,
     hi: Vec<Vec3>,
+    /// Whether the pairs were also judged by each particle's motion, from `from` to `to`
+    /// (in the moving frame): where the cloth moves fast, and the boxes have no room to
+    /// reuse them in later substeps anyway.
+    swept: bool,
+    from: Vec<Vec3>,
+    to: Vec<Vec3>,
 }
 
 /// What a search for pairs reads.
@@ -269,7 +275,10 @@ impl Search<'_> {
         let radius = |j: usize| 0.5 * f64::from((hi[j] - lo[j]).length());
         let most = |r: std::ops::Range<usize>| r.map(radius).fold(0.0f64, f64::max);
         let k = pair.first_side();
-        if distance(&pair, x) - most(0..k) - most(k..4) < f64::from(self.thickness) {
+        let thickness = f64::from(self.thickness);
+        if distance(&pair, x) - most(0..k) - most(k..4) < thickness
+            && (!self.boxes.swept || self.swept_apart(&pair) < thickness)
+        {
             // Grown by a quarter, not doubled: where a cloth lands fast the pairs run to
             // millions, and a doubled buffer can hold as much again unused (a large
             // buffer grows in place: the allocator remaps its pages).
@@ -278,6 +287,26 @@ impl Search<'_> {
             }
             out.push(stored);
         }
+    }
+}
+
+impl Search<'_> {
+    /// A lower bound on how close the pair's sides come along the particles' straight
+    /// motion the boxes were made for: its distance changes along the motion no faster
+    /// than the sides' largest displacements relative to the pair's mean motion add up to
+    /// (`L`), so it stays above both `d₀ − τL` and `d₁ − (1 − τ)L`, whose larger is least,
+    /// `(d₀ + d₁ − L)/2`, where they cross.
+    fn swept_apart(&self, pair: &Pair) -> f64 {
+        let ids = pair.ids();
+        let (from, to) = (&self.boxes.from, &self.boxes.to);
+        let x0 = ids.map(|i| from[i].as_dvec3());
+        let x1 = ids.map(|i| to[i].as_dvec3());
+        let moves: [glam::DVec3; 4] = std::array::from_fn(|j| x1[j] - x0[j]);
+        let mean = moves.iter().copied().sum::<glam::DVec3>() / 4.0;
+        let reach =
+            |r: std::ops::Range<usize>| r.map(|j| (moves[j] - mean).length()).fold(0.0, f64::max);
+        let k = pair.first_side();
+        0.5 * (distance(pair, x0) + distance(pair, x1) - reach(0..k) - reach(k..4))
     }
 }
 
@@ -366,7 +395,7 @@ impl SelfContacts {
         self.shift += mean;
         self.mean = mean;
         self.fixed.clear();
-        self.keep_apart(model, start, state, thickness, substep);
+        self.keep_apart(model, start, state, thickness, substep)?;
         Ok(contacts)
     }
 
@@ -396,7 +425,7 @@ impl SelfContacts {
         // What the solids just moved stays where they put it: the cut falls on the rest.
         self.fixed.clear();
         (self.fixed).extend(placed.iter().zip(&state.pos).map(|(a, b)| a != b));
-        self.keep_apart(model, start, state, thickness, substep);
+        self.keep_apart(model, start, state, thickness, substep)?;
         Ok((self.work.impacts - impacts) as usize)
     }
 
@@ -432,12 +461,19 @@ impl SelfContacts {
             return self.find_pairs(model, thickness);
         }
         let g = Vec3::splat(0.5 * within);
+        // Pairs judged by the motion hold while each particle starts where it did and ends
+        // within half of what `within` leaves of the thickness from where it did: a pair
+        // that stayed a thickness apart then stays `within` apart.
+        let (swept, slack) = (self.boxes.swept, 0.5 * (thickness - within));
+        let boxes = &self.boxes;
         self.left.clear();
         self.left.extend(
             (self.from.iter().zip(&self.to))
-                .zip(self.boxes.vertex_lo.iter().zip(&self.boxes.vertex_hi))
-                .map(|((s, p), (lo, hi))| {
-                    !((s.min(*p) - g).cmpge(*lo).all() && (s.max(*p) + g).cmple(*hi).all())
+                .enumerate()
+                .map(|(i, (s, p))| {
+                    let (lo, hi) = (boxes.vertex_lo[i], boxes.vertex_hi[i]);
+                    !((s.min(*p) - g).cmpge(lo).all() && (s.max(*p) + g).cmple(hi).all())
+                        || swept && (*s != boxes.from[i] || p.distance(boxes.to[i]) > slack)
                 }),
         );
         let left = self.left.iter().filter(|&&l| l).count();
@@ -474,6 +510,9 @@ impl SelfContacts {
         for (i, _) in self.left.iter().enumerate().filter(|(_, l)| **l) {
             (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) =
                 Self::vertex_box(self.from[i], self.to[i], self.grow);
+            if self.boxes.swept {
+                (self.boxes.from[i], self.boxes.to[i]) = (self.from[i], self.to[i]);
+            }
         }
         self.dirty.clear();
         self.dirty_list.clear();
@@ -537,15 +576,18 @@ impl SelfContacts {
             .map(|(s, p)| s.distance_squared(*p))
             .fold(0.0f32, f32::max)
             .sqrt();
-        self.grow = if fastest < REUSE_BELOW * thickness {
-            0.75 * thickness
-        } else {
-            0.5 * thickness
-        };
+        let slow = fastest < REUSE_BELOW * thickness;
+        self.grow = if slow { 0.75 } else { 0.5 } * thickness;
         for (s, p) in self.from.iter().zip(&self.to) {
             let (lo, hi) = Self::vertex_box(*s, *p, self.grow);
             self.boxes.vertex_lo.push(lo);
             self.boxes.vertex_hi.push(hi);
+        }
+        // Fast, the pairs are judged by this motion too (see `Boxes::swept`).
+        self.boxes.swept = !slow;
+        if self.boxes.swept {
+            self.boxes.from.clone_from(&self.from);
+            self.boxes.to.clone_from(&self.to);
         }
         self.search_all(model, thickness)
     }
@@ -596,20 +638,20 @@ impl SelfContacts {
         state: &mut ClothState,
         thickness: f32,
         substep: f32,
-    ) {
+    ) -> Result<(), ContactError> {
         let n = state.pos.len();
         let keep = KEEP * f64::from(thickness);
-        let fixed = &self.fixed;
         let pinned_free = |i: usize| model.inv_mass[i] > 0.0;
-        let free = |i: usize| pinned_free(i) && !fixed.get(i).copied().unwrap_or(false);
         self.scale.clear();
         self.scale.resize(n, 1.0);
         self.changed.clear();
         self.changed.resize(n, true);
-        // A round's cuts depend only on the last round's scales, and each particle keeps the
-        // smallest: the pairs can be shared out in any order and give the same bits.
-        let parallel = self.work.candidates as usize >= PARALLEL_PAIRS;
         for round in 0.. {
+            let fixed = &self.fixed;
+            let free = |i: usize| pinned_free(i) && !fixed.get(i).copied().unwrap_or(false);
+            // A round's cuts depend only on the last round's scales, and each particle keeps
+            // the smallest: the pairs can be shared out in any order and give the same bits.
+            let parallel = self.found.len() >= PARALLEL_PAIRS;
             self.cut.0.clear();
             (self.cut.0).extend(self.scale.iter().map(|s| AtomicU64::new(s.to_bits())));
             let (impacts, forced) = (AtomicU64::new(0), AtomicU64::new(0));
@@ -668,6 +710,23 @@ impl SelfContacts {
                 *changed = cut != *scale;
                 *scale = cut;
             }
+            if self.boxes.swept {
+                // Pairs judged by the motion hold for the motion as cut only while the cut
+                // particles end within the slack of where they did: the others' pairs are
+                // searched again, and the next round checks every pair.
+                let cuts = (self.to.iter_mut().zip(&self.scale)).zip(start.iter().zip(&state.pos));
+                for ((to, &s), (&a, &b)) in cuts {
+                    if s < 1.0 {
+                        let end = a.as_dvec3() + s * (b.as_dvec3() - a.as_dvec3());
+                        *to = end.as_vec3() - self.shift;
+                    }
+                }
+                let searches = self.work.searches + self.work.refreshes;
+                self.update_pairs(model, thickness, CHECKED * thickness)?;
+                if self.work.searches + self.work.refreshes != searches {
+                    self.changed.iter_mut().for_each(|c| *c = true);
+                }
+            }
         }
         let moved = (self.scale.iter().zip(start)).zip(state.pos.iter_mut().zip(&mut state.vel));
         for ((&s, from), (pos, vel)) in moved {
@@ -678,6 +737,7 @@ impl SelfContacts {
                 *vel = ((to - from) / f64::from(substep)).as_vec3();
             }
         }
+        Ok(())
     }
 }
 

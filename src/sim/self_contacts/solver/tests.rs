@@ -22,27 +22,41 @@ fn crumpled() -> (ClothModel, Vec<Vec3>) {
     (model, pos)
 }
 
-/// Pairs found from `start` to `end` (no motion: a search of the whole hash), then the
-/// particles in the band `x < band` moved by `shift`, which takes them out of their boxes,
-/// and the pairs brought up to date. Returns the solver and the pairs before and after.
-fn refreshed(band: f32, shift: Vec3) -> (SelfContacts, Vec<StoredPair>, Vec<StoredPair>) {
+/// Pairs found for every particle moving by `motion` (none: the boxes get room, and the
+/// pairs are judged by them alone; a fast one: by the motion too), then the particles in
+/// the band `x < band` moved by `shift` more, which takes them out of their boxes, and the
+/// pairs brought up to date for what `within` needs. Returns the solver and the pairs
+/// before and after.
+fn refreshed(
+    motion: Vec3,
+    (band, shift): (f32, Vec3),
+    within: f32,
+) -> (SelfContacts, Vec<StoredPair>, Vec<StoredPair>) {
     let (model, start) = crumpled();
     let mut contacts = SelfContacts {
         owners: Owners::build(&model),
         ..SelfContacts::default()
     };
-    contacts.relative(&start, &start, Vec3::ZERO, Vec3::ZERO);
-    contacts.update_pairs(&model, THICKNESS, THICKNESS).unwrap();
-    assert_eq!(contacts.work.searches, 1);
-    let before: Vec<StoredPair> = contacts.found.stored().copied().collect();
-    let end: Vec<Vec3> = (start.iter())
-        .map(|&p| if p.x < band { p + shift } else { p })
-        .collect();
+    let end: Vec<Vec3> = start.iter().map(|&p| p + motion).collect();
     contacts.relative(&start, &end, Vec3::ZERO, Vec3::ZERO);
     contacts.update_pairs(&model, THICKNESS, THICKNESS).unwrap();
+    assert_eq!(contacts.work.searches, 1);
+    assert_eq!(contacts.boxes.swept, motion != Vec3::ZERO);
+    let before: Vec<StoredPair> = contacts.found.stored().copied().collect();
+    let end: Vec<Vec3> = (end.iter().zip(&start))
+        .map(|(&p, s)| if s.x < band { p + shift } else { p })
+        .collect();
+    contacts.relative(&start, &end, Vec3::ZERO, Vec3::ZERO);
+    contacts.update_pairs(&model, THICKNESS, within).unwrap();
     let after = contacts.found.stored().copied().collect();
     (contacts, before, after)
 }
+
+/// A fast motion for [`refreshed`]: more than half the thickness a substep.
+const FAST: Vec3 = Vec3::new(0.0, 0.0, 0.6 * THICKNESS);
+
+/// The band [`refreshed`] moves: a fifth of the cloth, 4 cm sideways.
+const BAND: (f32, Vec3) = (-0.3, Vec3::new(0.0, 0.0, 0.04));
 
 /// The pairs as a set: sorted, each edge–edge pair's edges in order.
 fn sorted(pairs: Vec<StoredPair>) -> Vec<StoredPair> {
@@ -54,51 +68,74 @@ fn sorted(pairs: Vec<StoredPair>) -> Vec<StoredPair> {
 /// A band of a fifth of the cloth moved 4 cm sideways: only its triangles are searched
 /// again (one refresh, no second search of the whole hash), and the pairs are exactly
 /// those a search of the whole hash finds with the boxes as they now are — the band's
-/// new pairs found, its old ones gone, the rest kept.
+/// new pairs found, its old ones gone, the rest kept — whether the pairs were judged by
+/// their boxes (the cloth still) or by the motion too (the cloth moving fast).
 #[test]
 fn a_refresh_finds_what_a_whole_search_finds() {
-    let (mut contacts, before, after) = refreshed(-0.3, Vec3::new(0.0, 0.0, 0.04));
     let model = crumpled().0;
-    assert_eq!((contacts.work.searches, contacts.work.refreshes), (1, 1));
-    let refreshed = contacts.work.refreshed as usize;
-    assert!(
-        refreshed > 500 && refreshed < model.triangles.len() / 3,
-        "{refreshed}"
-    );
-    assert_ne!(
-        sorted(before.clone()),
-        sorted(after.clone()),
-        "the band moved"
-    );
-    let kept = before.iter().filter(|p| after.contains(p)).count();
-    assert!(kept > before.len() / 2, "{kept} of {}", before.len());
-    contacts.search_all(&model, THICKNESS).unwrap();
-    let whole: Vec<StoredPair> = contacts.found.stored().copied().collect();
-    assert!(whole.len() > 10_000, "{}", whole.len());
-    let (after, whole) = (sorted(after), sorted(whole));
-    let extra: Vec<_> = after
-        .iter()
-        .filter(|p| whole.binary_search(p).is_err())
-        .collect();
-    let missing: Vec<_> = whole
-        .iter()
-        .filter(|p| after.binary_search(p).is_err())
-        .collect();
-    assert!(
-        extra.is_empty() && missing.is_empty() && after.len() == whole.len(),
-        "{} pairs not in the whole search's {}, {} of its missing: {:?} {:?}",
-        extra.len(),
-        whole.len(),
-        missing.len(),
-        &extra[..extra.len().min(5)],
-        &missing[..missing.len().min(5)]
-    );
+    for (motion, within, least) in [
+        (Vec3::ZERO, THICKNESS, 10_000),
+        (FAST, CHECKED * THICKNESS, 1000),
+    ] {
+        let (mut contacts, before, after) = refreshed(motion, BAND, within);
+        assert_eq!((contacts.work.searches, contacts.work.refreshes), (1, 1));
+        let refreshed = contacts.work.refreshed as usize;
+        assert!(
+            refreshed > 500 && refreshed < model.triangles.len() / 3,
+            "{refreshed}"
+        );
+        assert_ne!(
+            sorted(before.clone()),
+            sorted(after.clone()),
+            "the band moved"
+        );
+        let kept = before.iter().filter(|p| after.contains(p)).count();
+        assert!(kept > before.len() / 2, "{kept} of {}", before.len());
+        contacts.search_all(&model, THICKNESS).unwrap();
+        let whole: Vec<StoredPair> = contacts.found.stored().copied().collect();
+        assert!(whole.len() > least, "{}", whole.len());
+        let (after, whole) = (sorted(after), sorted(whole));
+        let extra: Vec<_> = (after.iter())
+            .filter(|p| whole.binary_search(p).is_err())
+            .collect();
+        let missing: Vec<_> = (whole.iter())
+            .filter(|p| after.binary_search(p).is_err())
+            .collect();
+        assert!(
+            extra.is_empty() && missing.is_empty() && after.len() == whole.len(),
+            "{} pairs not in the whole search's {}, {} of its missing: {:?} {:?}",
+            extra.len(),
+            whole.len(),
+            missing.len(),
+            &extra[..extra.len().min(5)],
+            &missing[..missing.len().min(5)]
+        );
+    }
+}
+
+/// Where the cloth moves fast the pairs are judged by the motion too, and then hold only
+/// while every particle ends within the slack of where it did (half of what `within`
+/// leaves of the thickness): a particle moved 0.45 of the thickness (0.26 along each axis,
+/// inside its box) is searched again for the checks (0.2 × thickness), one moved 0.35 is
+/// not; judged by the boxes alone, neither is.
+#[test]
+fn pairs_judged_by_the_motion_hold_within_the_slack() {
+    let nudge = |by: f32| (-0.49, Vec3::splat(by * THICKNESS / 3f32.sqrt()));
+    for (motion, by, searched) in [(FAST, 0.45, 1), (FAST, 0.35, 0), (Vec3::ZERO, 0.45, 0)] {
+        let (contacts, _, _) = refreshed(motion, nudge(by), CHECKED * THICKNESS);
+        let work = contacts.work;
+        assert_eq!(
+            work.searches + work.refreshes,
+            1 + searched,
+            "{motion} {by}"
+        );
+    }
 }
 
 /// Where a quarter or more of the particles left their boxes, the whole hash is searched.
 #[test]
 fn many_particles_out_of_their_boxes_search_the_whole_hash() {
-    let (contacts, _, _) = refreshed(0.1, Vec3::new(0.0, 0.0, 0.04));
+    let (contacts, _, _) = refreshed(Vec3::ZERO, (0.1, BAND.1), THICKNESS);
     assert_eq!((contacts.work.searches, contacts.work.refreshes), (2, 0));
 }
 
@@ -110,7 +147,7 @@ fn a_refresh_stores_the_same_order_on_two_threads_as_on_one() {
             .num_threads(threads)
             .build()
             .unwrap();
-        pool.install(|| refreshed(-0.3, Vec3::new(0.0, 0.0, 0.04)))
+        pool.install(|| refreshed(Vec3::ZERO, BAND, THICKNESS))
     };
     let ((one, _, a), (two, _, b)) = (run(1), run(2));
     assert!(one.work.refreshed as usize >= PARALLEL_TRIANGLES / 4);
