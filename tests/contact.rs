@@ -234,6 +234,15 @@ fn layers_never_pass_through_each_other() {
     never_passes_through_under_each("layers", Some(8), 24, 1.2);
 }
 
+/// Five 32 × 32 cloths stacked on a sphere at one implicit substep a frame: the sphere
+/// presses the lowest layers into those above every substep, and pairs come within what
+/// `f32` can tell apart (5·10⁻⁸ m); the cut positions, rounded to `f32`, are checked
+/// again, so none crosses.
+#[test]
+fn layers_pressed_by_a_solid_never_pass_through_at_one_substep() {
+    never_passes_through("layers", Some(32), IntegratorKind::ImplicitEuler, 1, 2.0);
+}
+
 #[test]
 fn fast_fold_never_passes_through_itself() {
     never_passes_through_under_each("fast-fold", Some(16), 24, 0.8);
