@@ -217,17 +217,12 @@ impl BoxHash {
         let first = (piece - run_pieces) * BOXES_PER_PIECE;
         for a in first..(first + BOXES_PER_PIECE).min(lo.len()) {
             let own = u32::from(self.level[a]);
-            let mut levels = self.levels >> (own + 1) << (own + 1);
-            while levels != 0 {
-                let level = levels.trailing_zeros();
-                levels &= levels - 1;
-                let size = self.cell * (1u32 << level) as f32;
-                each_cell(lo[a], hi[a], size, |c| {
-                    for b in self.binned_in(c, level) {
-                        overlap(a, b as usize, level, cell_key(c, level));
-                    }
-                });
-            }
+            let coarser = self.levels >> (own + 1) << (own + 1);
+            self.each_cell_at(coarser, lo[a], hi[a], |level, c| {
+                for b in self.binned_in(c, level) {
+                    overlap(a, b as usize, level, cell_key(c, level));
+                }
+            });
         }
     }
 }
@@ -259,22 +254,30 @@ impl BoxHash {
     /// overlaps `a`: at each level, `a`'s cells are looked up, and `b` is taken in the one
     /// that holds the overlap's lowest corner.
     pub fn overlapping(&self, a: usize, lo: &[Vec3], hi: &[Vec3], mut visit: impl FnMut(u32)) {
-        let mut levels = self.levels;
+        self.each_cell_at(self.levels, lo[a], hi[a], |level, c| {
+            let size = self.cell * (1u32 << level) as f32;
+            for b in self.binned_in(c, level) {
+                let bi = b as usize;
+                if bi == a {
+                    continue;
+                }
+                let (l, h) = (lo[a].max(lo[bi]), hi[a].min(hi[bi]));
+                if l.cmple(h).all() && cell_of(l, size) == c {
+                    visit(b);
+                }
+            }
+        });
+    }
+
+    /// Calls `visit(level, c)` for each cell `c` of the box `lo..hi` at each level whose
+    /// bit is set in `levels`.
+    fn each_cell_at(&self, levels: u32, lo: Vec3, hi: Vec3, mut visit: impl FnMut(u32, [i32; 3])) {
+        let mut levels = levels;
         while levels != 0 {
             let level = levels.trailing_zeros();
             levels &= levels - 1;
-            let size = self.cell * (1u32 << level) as f32;
-            each_cell(lo[a], hi[a], size, |c| {
-                for b in self.binned_in(c, level) {
-                    let bi = b as usize;
-                    if bi == a {
-                        continue;
-                    }
-                    let (l, h) = (lo[a].max(lo[bi]), hi[a].min(hi[bi]));
-                    if l.cmple(h).all() && cell_of(l, size) == c {
-                        visit(b);
-                    }
-                }
+            each_cell(lo, hi, self.cell * (1u32 << level) as f32, |c| {
+                visit(level, c)
             });
         }
     }

@@ -58,6 +58,12 @@ const FAST: Vec3 = Vec3::new(0.0, 0.0, 0.6 * THICKNESS);
 /// The band [`refreshed`] moves: a fifth of the cloth, 4 cm sideways.
 const BAND: (f32, Vec3) = (-0.3, Vec3::new(0.0, 0.0, 0.04));
 
+/// `f`'s result on a pool of `threads` threads (and the team of as many).
+fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build();
+    pool.unwrap().install(f)
+}
+
 /// The pairs as a set: sorted, each edge–edge pair's edges in order.
 fn sorted(pairs: Vec<StoredPair>) -> Vec<StoredPair> {
     let mut pairs: Vec<StoredPair> = pairs.into_iter().map(StoredPair::canonical).collect();
@@ -142,13 +148,7 @@ fn many_particles_out_of_their_boxes_search_the_whole_hash() {
 /// A refresh shared out between two threads stores its pairs in the same order as on one.
 #[test]
 fn a_refresh_stores_the_same_order_on_two_threads_as_on_one() {
-    let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| refreshed(Vec3::ZERO, BAND, THICKNESS))
-    };
+    let run = |threads: usize| on_threads(threads, || refreshed(Vec3::ZERO, BAND, THICKNESS));
     let ((one, _, a), (two, _, b)) = (run(1), run(2));
     assert!(one.work.refreshed as usize >= PARALLEL_TRIANGLES / 4);
     assert_eq!(two.work.refreshes, 1);
@@ -160,11 +160,7 @@ fn a_refresh_stores_the_same_order_on_two_threads_as_on_one() {
 #[test]
 fn the_checks_cut_the_same_bits_on_two_threads_as_on_one() {
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        on_threads(threads, || {
             let (model, start) = crumpled();
             let mut rnd = crate::test_rng::uniform(9);
             let mut state = ClothState::at_rest(&model);
