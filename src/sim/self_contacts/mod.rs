@@ -1,7 +1,8 @@
 //! Self-contact: the cloth kept off itself. Two kinds of pair — a vertex against a triangle
 //! it is not a corner of, an edge against an edge it shares no particle with — are found
 //! by a hierarchical spatial hash of the triangles' boxes over the substep's motion
-//! ([`hash`]), pushed a thickness apart at the substep's end with friction, and then
+//! ([`hash`]; which pairs of two overlapping triangles are kept, [`search`]; where they are
+//! kept, [`found`]), pushed a thickness apart at the substep's end with friction, and then
 //! checked along the whole motion by conservative continuous collision detection
 //! ([`ccd`]): a pair whose sides could meet has its free particles' motion cut short where
 //! they are still apart, round after round, until no pair can meet (after a few rounds
@@ -15,6 +16,7 @@ mod error;
 mod found;
 mod hash;
 mod primitives;
+mod search;
 mod solver;
 
 pub use error::ContactError;

@@ -4,7 +4,6 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::Vec3;
-use rustc_hash::FxHashMap;
 
 use crate::cloth::{ClothModel, ClothState};
 
@@ -12,7 +11,8 @@ use super::ccd::safe_fraction;
 use super::error::ContactError;
 use super::found::Found;
 use super::hash::BoxHash;
-use super::primitives::{Pair, StoredPair, closer_than, distance, push_apart};
+use super::primitives::{StoredPair, closer_than, push_apart};
+use super::search::{Boxes, Owners, Search, pairs};
 
 /// Work done by the last resolve: for cost checks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -93,61 +93,6 @@ impl Clone for Cuts {
     }
 }
 
-/// Which vertices and edges each triangle owns: each vertex and each edge belongs to the
-/// first triangle that has it, so a pair of triangles yields each vertex–triangle and
-/// edge–edge pair of theirs once.
-#[derive(Clone, Debug, Default)]
-struct Owners {
-    /// What it was built for: triangle count, particle count and a hash of the triangles.
-    key: (usize, usize, u64),
-    vertices: Vec<[u32; 3]>,
-    edges: Vec<[[u32; 2]; 3]>,
-    /// Each particle's owning triangle ([`NONE`] for a particle in none).
-    vertex_owner: Vec<u32>,
-}
-
-const NONE: u32 = u32::MAX;
-
-impl Owners {
-    fn key(model: &ClothModel) -> (usize, usize, u64) {
-        use std::hash::{Hash, Hasher};
-        let mut h = rustc_hash::FxHasher::default();
-        model.triangles.hash(&mut h);
-        (model.triangles.len(), model.particle_count(), h.finish())
-    }
-
-    fn build(model: &ClothModel) -> Owners {
-        let mut seen = vec![false; model.particle_count()];
-        let mut edges: FxHashMap<[u32; 2], ()> = FxHashMap::default();
-        let mut owners = Owners {
-            key: Self::key(model),
-            vertices: Vec::with_capacity(model.triangles.len()),
-            edges: Vec::with_capacity(model.triangles.len()),
-            vertex_owner: vec![NONE; model.particle_count()],
-        };
-        for (n, t) in model.triangles.iter().enumerate() {
-            let mut v = [NONE; 3];
-            let mut e = [[NONE; 2]; 3];
-            for k in 0..3 {
-                let i = t[k] as usize;
-                if !seen[i] {
-                    seen[i] = true;
-                    v[k] = t[k];
-                    owners.vertex_owner[i] = n as u32;
-                }
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                let edge = [a.min(b), a.max(b)];
-                if edges.insert(edge, ()).is_none() {
-                    e[k] = edge;
-                }
-            }
-            owners.vertices.push(v);
-            owners.edges.push(e);
-        }
-        owners
-    }
-}
-
 /// Reusable buffers of self-contact: nothing is allocated per substep once warm.
 #[derive(Clone, Debug, Default)]
 pub struct SelfContacts {
@@ -192,137 +137,6 @@ pub struct SelfContacts {
 
 /// Triangles from which the search shares its work out between the team's members.
 const PARALLEL_TRIANGLES: usize = 2048;
-
-/// The boxes a search bins and reads.
-#[derive(Clone, Debug, Default)]
-struct Boxes {
-    /// Each particle's: its motion grown by half the thickness or more.
-    vertex_lo: Vec<Vec3>,
-    vertex_hi: Vec<Vec3>,
-    /// Each triangle's: its corners' boxes together.
-    lo: Vec<Vec3>,
-    hi: Vec<Vec3>,
-    /// Whether the pairs were also judged by each particle's motion, from `from` to `to`
-    /// (in the moving frame): where the cloth moves fast, and the boxes have no room to
-    /// reuse them in later substeps anyway.
-    swept: bool,
-    from: Vec<Vec3>,
-    to: Vec<Vec3>,
-}
-
-/// What a search for pairs reads.
-struct Search<'a> {
-    owners: &'a Owners,
-    triangles: &'a [[u32; 3]],
-    boxes: &'a Boxes,
-    thickness: f32,
-}
-
-impl Search<'_> {
-    /// Adds to `out` the vertex–triangle and edge–edge pairs that triangles `a` and `b`
-    /// (whose boxes overlap) own and that could come within the thickness.
-    fn pairs_of(&self, a: usize, b: usize, out: &mut Vec<StoredPair>) {
-        let vbox = |v: u32| {
-            (
-                self.boxes.vertex_lo[v as usize],
-                self.boxes.vertex_hi[v as usize],
-            )
-        };
-        let ebox = |[a, b]: [u32; 2]| {
-            let (a, b) = (a as usize, b as usize);
-            (
-                self.boxes.vertex_lo[a].min(self.boxes.vertex_lo[b]),
-                self.boxes.vertex_hi[a].max(self.boxes.vertex_hi[b]),
-            )
-        };
-        for (own, other) in [(a, b), (b, a)] {
-            let tri = self.triangles[other];
-            for &v in &self.owners.vertices[own] {
-                if v != NONE
-                    && !tri.contains(&v)
-                    && meet(vbox(v), (self.boxes.lo[other], self.boxes.hi[other]))
-                {
-                    let stored = StoredPair::vertex_triangle(v, other as u32);
-                    self.keep(Pair::vertex_triangle(v, tri), stored, out);
-                }
-            }
-        }
-        for (j, &e) in self.owners.edges[a].iter().enumerate() {
-            for (k, &f) in self.owners.edges[b].iter().enumerate() {
-                if e[0] != NONE
-                    && f[0] != NONE
-                    && !e.iter().any(|i| f.contains(i))
-                    && meet(ebox(e), ebox(f))
-                {
-                    let stored = StoredPair::edge_edge((3 * a + j) as u32, (3 * b + k) as u32);
-                    self.keep(Pair::edge_edge(e, f), stored, out);
-                }
-            }
-        }
-    }
-
-    /// Keeps `pair` (as `stored`) if, with each particle anywhere in its box, its sides
-    /// could come within the thickness.
-    fn keep(&self, pair: Pair, stored: StoredPair, out: &mut Vec<StoredPair>) {
-        let ids = pair.ids();
-        // The smallest ball around each particle's box: in its box, a particle is at most
-        // half the box's diagonal from the box's centre.
-        let (lo, hi) = (
-            ids.map(|i| self.boxes.vertex_lo[i]),
-            ids.map(|i| self.boxes.vertex_hi[i]),
-        );
-        let x = std::array::from_fn(|j| (0.5 * (lo[j] + hi[j])).as_dvec3());
-        let radius = |j: usize| 0.5 * f64::from((hi[j] - lo[j]).length());
-        let most = |r: std::ops::Range<usize>| r.map(radius).fold(0.0f64, f64::max);
-        let k = pair.first_side();
-        let thickness = f64::from(self.thickness);
-        if distance(&pair, x) - most(0..k) - most(k..4) < thickness
-            && (!self.boxes.swept || self.swept_apart(&pair) < thickness)
-        {
-            // Grown by a quarter, not doubled: where a cloth lands fast the pairs run to
-            // millions, and a doubled buffer can hold as much again unused (a large
-            // buffer grows in place: the allocator remaps its pages).
-            if out.len() == out.capacity() {
-                out.reserve_exact((out.capacity() / 4).max(1024));
-            }
-            out.push(stored);
-        }
-    }
-}
-
-impl Search<'_> {
-    /// A lower bound on how close the pair's sides come along the particles' straight
-    /// motion the boxes were made for: its distance changes along the motion no faster
-    /// than the sides' largest displacements relative to the pair's mean motion add up to
-    /// (`L`), so it stays above both `d₀ − τL` and `d₁ − (1 − τ)L`, whose larger is least,
-    /// `(d₀ + d₁ − L)/2`, where they cross.
-    fn swept_apart(&self, pair: &Pair) -> f64 {
-        let ids = pair.ids();
-        let (from, to) = (&self.boxes.from, &self.boxes.to);
-        let x0 = ids.map(|i| from[i].as_dvec3());
-        let x1 = ids.map(|i| to[i].as_dvec3());
-        let moves: [glam::DVec3; 4] = std::array::from_fn(|j| x1[j] - x0[j]);
-        let mean = moves.iter().copied().sum::<glam::DVec3>() / 4.0;
-        let reach =
-            |r: std::ops::Range<usize>| r.map(|j| (moves[j] - mean).length()).fold(0.0, f64::max);
-        let k = pair.first_side();
-        0.5 * (distance(pair, x0) + distance(pair, x1) - reach(0..k) - reach(k..4))
-    }
-}
-
-/// The pairs `found`, expanded with the cloth's `triangles` and the owned edges.
-fn pairs<'a>(
-    found: &'a Found,
-    triangles: &'a [[u32; 3]],
-    owners: &'a Owners,
-) -> impl Iterator<Item = Pair> + 'a {
-    found.stored().map(|p| p.expand(triangles, &owners.edges))
-}
-
-/// Whether boxes `a` and `b` overlap.
-fn meet((alo, ahi): (Vec3, Vec3), (blo, bhi): (Vec3, Vec3)) -> bool {
-    alo.cmple(bhi).all() && blo.cmple(ahi).all()
-}
 
 impl SelfContacts {
     /// Keeps the cloth off itself after a substep of `substep` seconds that moved it from
