@@ -160,8 +160,8 @@ impl SelfContacts {
         if let Some(particle) = state.pos.iter().position(|p| !p.is_finite()) {
             return Err(ContactError::NonFinite { particle });
         }
-        if self.owners.key != Owners::key(model) {
-            self.owners = Owners::build(model);
+        if self.owners.update(model) {
+            self.found_for = None;
         }
         // Only the running total outlives a resolve.
         self.work = SelfWork {
@@ -417,10 +417,7 @@ impl SelfContacts {
             self.boxes.lo.push(lo);
             self.boxes.hi.push(hi);
         }
-        let longest = model.springs.rest[..model.mesh_edges.min(model.springs.len())]
-            .iter()
-            .fold(0.0f32, |m, &r| m.max(r));
-        let cell = (2.0 * longest).max(2.0 * thickness).max(1e-6);
+        let cell = (2.0 * self.owners.longest).max(2.0 * thickness).max(1e-6);
         self.hash.bin(&self.boxes.lo, &self.boxes.hi, cell)?;
         self.found.clear();
         let search = Search {
