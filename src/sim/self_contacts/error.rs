@@ -14,4 +14,6 @@ pub enum ContactError {
         extent: f32,
         cell: f32,
     },
+    #[error("self-collision handles at most {most} triangles; this cloth has {triangles}")]
+    TooMany { triangles: usize, most: usize },
 }

@@ -30,8 +30,8 @@ const BOX_BITS: u32 = 24;
 const KEY_BITS: u32 = 64 - BOX_BITS;
 
 /// An entry of the table: the cell's key above the box's number, so that entries sort by
-/// key in eight bytes. A cloth has at most 8 388 608 triangles (the importer's and the
-/// grid's limits), under 2^24.
+/// key in eight bytes (a cloth of more than 2^24 triangles is refused: see
+/// [`BoxHash::bin`]).
 fn entry(key: u64, b: usize) -> u64 {
     debug_assert!(b < 1 << BOX_BITS);
     (key << BOX_BITS) | b as u64
@@ -110,8 +110,15 @@ impl BoxHash {
     /// Bins the boxes (`lo[i]..hi[i]`) with a base cell of `cell` metres.
     ///
     /// # Errors
-    /// [`ContactError::Extent`] for a box a million base cells wide (nothing is binned).
+    /// [`ContactError::Extent`] for a box a million base cells wide, [`ContactError::TooMany`]
+    /// for more boxes than an entry can number (nothing is binned).
     pub fn bin(&mut self, lo: &[Vec3], hi: &[Vec3], cell: f32) -> Result<(), ContactError> {
+        if lo.len() > 1 << BOX_BITS {
+            return Err(ContactError::TooMany {
+                triangles: lo.len(),
+                most: 1 << BOX_BITS,
+            });
+        }
         self.bins.clear();
         self.level.clear();
         self.first.clear();
@@ -131,14 +138,13 @@ impl BoxHash {
             };
             self.levels |= 1 << level;
             self.level.push(level as u8);
-            self.first.push(cell_of(lo, cell * (1u32 << level) as f32));
+            self.first.push(cell_of(lo, self.size(level)));
             entries += cells;
         }
         self.bins.reserve_exact(entries);
         for (t, ((&lo, &hi), &level)) in lo.iter().zip(hi).zip(&self.level).enumerate() {
             let level = u32::from(level);
-            let size = cell * (1u32 << level) as f32;
-            each_cell(lo, hi, size, |c| {
+            each_cell(lo, hi, self.size(level), |c| {
                 self.bins.push(entry(cell_key(c, level), t))
             });
         }
@@ -177,7 +183,7 @@ impl BoxHash {
     ) {
         let mut overlap = |a: usize, b: usize, level: u32, key: u64| {
             let (l, h) = (lo[a].max(lo[b]), hi[a].min(hi[b]));
-            let size = self.cell * (1u32 << level) as f32;
+            let size = self.size(level);
             if l.cmple(h).all() && cell_key(cell_of(l, size), level) == key {
                 pair(a as u32, b as u32);
             }
@@ -225,12 +231,15 @@ impl BoxHash {
             });
         }
     }
-}
 
-impl BoxHash {
     /// The base cell the boxes were binned with, m.
     pub fn cell(&self) -> f32 {
         self.cell
+    }
+
+    /// The cells' size at `level`, m.
+    fn size(&self, level: u32) -> f32 {
+        self.cell * (1u32 << level) as f32
     }
 
     /// The boxes binned at `level` in its cell `c` (looked up by the cell's key; a box of
@@ -255,7 +264,7 @@ impl BoxHash {
     /// that holds the overlap's lowest corner.
     pub fn overlapping(&self, a: usize, lo: &[Vec3], hi: &[Vec3], mut visit: impl FnMut(u32)) {
         self.each_cell_at(self.levels, lo[a], hi[a], |level, c| {
-            let size = self.cell * (1u32 << level) as f32;
+            let size = self.size(level);
             for b in self.binned_in(c, level) {
                 let bi = b as usize;
                 if bi == a {
@@ -276,9 +285,7 @@ impl BoxHash {
         while levels != 0 {
             let level = levels.trailing_zeros();
             levels &= levels - 1;
-            each_cell(lo, hi, self.cell * (1u32 << level) as f32, |c| {
-                visit(level, c)
-            });
+            each_cell(lo, hi, self.size(level), |c| visit(level, c));
         }
     }
 }
