@@ -38,11 +38,7 @@ pub fn safe_fraction(pair: &Pair, from: [DVec3; 4], moves: [DVec3; 4], keep: f64
     if (blo - ahi).max(alo - bhi).max_element() > keep {
         return 1.0;
     }
-    // Only relative motion matters: take out the mean.
-    let mean = moves.iter().copied().sum::<DVec3>() / 4.0;
-    let reach =
-        |r: std::ops::Range<usize>| r.map(|i| (moves[i] - mean).length()).fold(0.0f64, f64::max);
-    let speed = reach(0..k) + reach(k..4);
+    let speed = closing_bound(pair, moves);
     if speed == 0.0 {
         return 1.0;
     }
@@ -68,4 +64,15 @@ pub fn safe_fraction(pair: &Pair, from: [DVec3; 4], moves: [DVec3; 4], keep: f64
         }
     }
     t
+}
+
+/// How far the pair's sides can close on each other over the motion `moves` (the pair's
+/// four particles) at most: only relative motion matters, so the mean is taken out, and
+/// no point of a side moves farther than the side's farthest particle.
+pub fn closing_bound(pair: &Pair, moves: [DVec3; 4]) -> f64 {
+    let k = pair.first_side();
+    let mean = moves.iter().copied().sum::<DVec3>() / 4.0;
+    let reach =
+        |r: std::ops::Range<usize>| r.map(|i| (moves[i] - mean).length()).fold(0.0f64, f64::max);
+    reach(0..k) + reach(k..4)
 }

@@ -27,8 +27,12 @@ pub(super) struct Found {
 impl Found {
     /// The pairs as stored, in order.
     pub(super) fn stored(&self) -> impl Iterator<Item = &StoredPair> {
-        (self.segments.iter())
-            .flat_map(|s| &self.members[s.member as usize][s.start as usize..s.end as usize])
+        self.segments.iter().flat_map(|&s| self.segment(s))
+    }
+
+    /// The pairs of segment `s`.
+    fn segment(&self, s: Segment) -> &[StoredPair] {
+        &self.members[s.member as usize][s.start as usize..s.end as usize]
     }
 
     /// Forgets every pair (the buffers are kept).
@@ -92,8 +96,7 @@ impl Found {
     ) {
         out.clear();
         out.extend(self.segments.len(), parallel, &|piece, buffer| {
-            let s = self.segments[piece];
-            let pairs = &self.members[s.member as usize][s.start as usize..s.end as usize];
+            let pairs = self.segment(self.segments[piece]);
             buffer.extend(pairs.iter().copied().filter(|&p| keep(p)));
         });
     }
@@ -101,10 +104,7 @@ impl Found {
     /// Calls `visit` with each piece's pairs, shared with the team's helpers when
     /// `parallel` (in no set order then: for work whose result does not depend on it).
     pub(super) fn share(&self, parallel: bool, visit: &(dyn Fn(&[StoredPair]) + Sync)) {
-        let piece = |piece: usize| {
-            let s = self.segments[piece];
-            visit(&self.members[s.member as usize][s.start as usize..s.end as usize]);
-        };
+        let piece = |piece: usize| visit(self.segment(self.segments[piece]));
         if parallel {
             Team::current().run_large_pieces(self.segments.len(), &|_, p| piece(p));
         } else {

@@ -44,9 +44,7 @@ impl StoredPair {
             Pair::edge_edge(edge(a & !EDGES), edge(b))
         }
     }
-}
 
-impl StoredPair {
     /// The same pair with an edge–edge pair's edges in order of their numbers (which comes
     /// first depends on which triangle a search started from).
     #[cfg(test)]

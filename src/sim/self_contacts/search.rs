@@ -5,6 +5,7 @@
 use glam::Vec3;
 use rustc_hash::FxHashMap;
 
+use super::ccd::closing_bound;
 use super::found::Found;
 use super::primitives::{Pair, StoredPair, distance};
 use crate::cloth::ClothModel;
@@ -163,7 +164,8 @@ impl Search<'_> {
     }
 
     /// Keeps `pair` (as `stored`) if, with each particle anywhere in its box, its sides
-    /// could come within the thickness.
+    /// could come within the thickness, and (where the boxes are `swept`) if they could
+    /// along the motion the boxes were made for.
     fn keep(&self, pair: Pair, stored: StoredPair, out: &mut Vec<StoredPair>) {
         let ids = pair.ids();
         // The smallest ball around each particle's box: in its box, a particle is at most
@@ -189,9 +191,7 @@ impl Search<'_> {
             out.push(stored);
         }
     }
-}
 
-impl Search<'_> {
     /// A lower bound on how close the pair's sides come along the particles' straight
     /// motion the boxes were made for: its distance changes along the motion no faster
     /// than the sides' largest displacements relative to the pair's mean motion add up to
@@ -202,12 +202,8 @@ impl Search<'_> {
         let (from, to) = (&self.boxes.from, &self.boxes.to);
         let x0 = ids.map(|i| from[i].as_dvec3());
         let x1 = ids.map(|i| to[i].as_dvec3());
-        let moves: [glam::DVec3; 4] = std::array::from_fn(|j| x1[j] - x0[j]);
-        let mean = moves.iter().copied().sum::<glam::DVec3>() / 4.0;
-        let reach =
-            |r: std::ops::Range<usize>| r.map(|j| (moves[j] - mean).length()).fold(0.0, f64::max);
-        let k = pair.first_side();
-        0.5 * (distance(pair, x0) + distance(pair, x1) - reach(0..k) - reach(k..4))
+        let moves = std::array::from_fn(|j| x1[j] - x0[j]);
+        0.5 * (distance(pair, x0) + distance(pair, x1) - closing_bound(pair, moves))
     }
 }
 
