@@ -455,25 +455,35 @@ impl SelfContacts {
         // can undo a cut's last fraction where the pair has come close (`crumple`-like
         // stacks pressed by a solid every substep: a VT pair at 5·10⁻⁸ m crossed so), so
         // they are checked again as rounded, and cut again where they fail.
+        // A pass whose cuts move nothing (a particle already held at its start against
+        // prescribed motion is cut again to where it is) ends them; its forced pairs are
+        // the substep's, counted once however many passes saw them.
         let mut round = 0;
-        while self.cut_rounds(model, [start, &state.pos], keep, &mut round, thickness)? {
-            let moved =
-                (self.scale.iter().zip(start)).zip(state.pos.iter_mut().zip(&mut state.vel));
-            for ((&s, from), (pos, vel)) in moved {
+        loop {
+            let forced =
+                self.cut_rounds(model, [start, &state.pos], keep, &mut round, thickness)?;
+            let mut moved = false;
+            let cuts = (self.scale.iter().zip(start)).zip(state.pos.iter_mut().zip(&mut state.vel));
+            for ((&s, from), (pos, vel)) in cuts {
                 if s < 1.0 {
                     let from = from.as_dvec3();
                     let to = from + s * (pos.as_dvec3() - from);
+                    moved |= to.as_vec3() != *pos;
                     *pos = to.as_vec3();
                     *vel = ((to - from) / f64::from(substep)).as_vec3();
                 }
             }
+            if !moved {
+                self.work.forced += forced;
+                self.work.forced_total += forced;
+                return Ok(());
+            }
         }
-        Ok(())
     }
 
     /// Rounds of cuts of the motion from `start` to `end`, counted on from `round`, until one
     /// cuts nothing; leaves each particle's share of its motion in `scale`, and returns
-    /// whether any was cut.
+    /// how many pairs were forced (no particle of theirs could be cut).
     fn cut_rounds(
         &mut self,
         model: &ClothModel,
@@ -481,14 +491,14 @@ impl SelfContacts {
         keep: f64,
         round: &mut usize,
         thickness: f32,
-    ) -> Result<bool, ContactError> {
+    ) -> Result<u64, ContactError> {
         let n = end.len();
         let pinned_free = |i: usize| model.inv_mass[i] > 0.0;
         self.scale.clear();
         self.scale.resize(n, 1.0);
         self.changed.clear();
         self.changed.resize(n, true);
-        let mut any_cut = false;
+        let mut forced_here = 0;
         loop {
             let round_now = *round;
             *round += 1;
@@ -542,13 +552,11 @@ impl SelfContacts {
             });
             let (impacted, stuck) = (impacts.into_inner(), forced.into_inner());
             self.work.impacts += impacted;
-            self.work.forced += stuck;
-            self.work.forced_total += stuck;
+            forced_here += stuck;
             // Every impact cut something, or was forced.
             if impacted == stuck {
-                return Ok(any_cut);
+                return Ok(forced_here);
             }
-            any_cut = true;
             let rounds = (self.changed.iter_mut()).zip(self.scale.iter_mut().zip(&self.cut.0));
             for (changed, (scale, cut)) in rounds {
                 let cut = f64::from_bits(cut.load(Ordering::Relaxed));
