@@ -121,6 +121,11 @@ impl ClothModel {
         self.rest_positions.len()
     }
 
+    /// The mesh edges' rest lengths, metres (the first springs).
+    pub fn edge_rest_lengths(&self) -> &[f32] {
+        &self.springs.rest[..self.mesh_edges.min(self.springs.len())]
+    }
+
     /// The index of the first bend spring (the bend springs are the last ones).
     pub fn bend_start(&self) -> usize {
         self.springs.len() - self.bend_springs

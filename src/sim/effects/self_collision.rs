@@ -69,9 +69,7 @@ impl SelfCollision {
 
 /// The shortest rest length among the cloth's mesh edges, metres (infinite without edges).
 pub fn shortest_edge(model: &ClothModel) -> f32 {
-    model.springs.rest[..model.mesh_edges.min(model.springs.len())]
-        .iter()
-        .fold(f32::INFINITY, |m, &r| m.min(r))
+    (model.edge_rest_lengths().iter()).fold(f32::INFINITY, |m, &r| m.min(r))
 }
 
 impl Default for SelfCollision {

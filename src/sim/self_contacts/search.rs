@@ -66,8 +66,7 @@ impl Owners {
         let mut owners = Owners {
             identity: (0, 0, 0),
             key: Self::key(model),
-            longest: (model.springs.rest[..model.mesh_edges.min(model.springs.len())].iter())
-                .fold(0.0f32, |m, &r| m.max(r)),
+            longest: (model.edge_rest_lengths().iter()).fold(0.0f32, |m, &r| m.max(r)),
             vertices: Vec::with_capacity(model.triangles.len()),
             edges: Vec::with_capacity(model.triangles.len()),
             vertex_owner: vec![NONE; model.particle_count()],
