@@ -34,7 +34,10 @@ impl Owners {
     /// Brings the owners up to `model`: built anew when its triangles differ from those
     /// they were built for (hashed only when the model is another in memory, not every
     /// substep: hashing 8 192 triangles took 18 µs, half a spring pass at 64²). Returns
-    /// whether they were, so that pairs found for the old triangles are dropped.
+    /// whether they were, so that pairs found for the old triangles are dropped. A solver
+    /// serves one model: another of the same size rebuilt at the same address after the
+    /// first was freed would not be told apart (a `Simulation` makes a new solver with
+    /// each model).
     pub(super) fn update(&mut self, model: &ClothModel) -> bool {
         let identity = (
             model.triangles.as_ptr() as usize,
