@@ -14,6 +14,7 @@ fn matrix(c: &mut Criterion) {
         ("sie", IntegratorKind::SemiImplicitEuler),
         ("implicit", IntegratorKind::ImplicitEuler),
         ("xpbd", IntegratorKind::Xpbd),
+        ("vbd", IntegratorKind::Vbd),
     ];
     for threads in [1usize, 2] {
         let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(threads).build() else {

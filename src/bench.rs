@@ -28,28 +28,32 @@ pub const REFERENCE_SAG: [(u32, f64); 6] = [
     (700, 0.015759),
 ];
 
-/// How close the sag must be for a speed to count: 1 %, 5 % for implicit Euler and XPBD
+/// How close the sag must be for a speed to count: 1 %, 5 % for implicit Euler, XPBD and VBD
 /// (which trade accuracy for their large steps).
 pub fn sag_tolerance(integrator: IntegratorKind) -> f64 {
     match integrator {
-        IntegratorKind::ImplicitEuler | IntegratorKind::Xpbd => 0.05,
+        IntegratorKind::ImplicitEuler | IntegratorKind::Xpbd | IntegratorKind::Vbd => 0.05,
         _ => 0.01,
     }
 }
 
 /// The integrators `clothsim bench` runs on the CPU unless told which: one explicit, one
-/// implicit, one constraint solver (the three targets).
-pub const BENCH_INTEGRATORS: [IntegratorKind; 3] = [
+/// implicit, and the two that solve implicit steps iteratively (XPBD's constraints, VBD's
+/// particles).
+pub const BENCH_INTEGRATORS: [IntegratorKind; 4] = [
     IntegratorKind::SemiImplicitEuler,
     IntegratorKind::ImplicitEuler,
     IntegratorKind::Xpbd,
+    IntegratorKind::Vbd,
 ];
 
 /// Substeps per 1/60 s frame the bench gives each integrator: N (so `dt = 1/(60 N)`, the
-/// scene's definition), five large steps for implicit Euler.
+/// scene's definition), five large steps for implicit Euler, N/2 for VBD (one sweep each:
+/// small steps; docs/performance.md has the other settings measured).
 pub fn bench_substeps(integrator: IntegratorKind, n: u32) -> u32 {
     match integrator {
         IntegratorKind::ImplicitEuler => 5,
+        IntegratorKind::Vbd => (n / 2).max(1),
         _ => n,
     }
 }

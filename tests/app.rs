@@ -631,7 +631,7 @@ fn dragging_the_cloth_pulls_a_particle_and_ctrl_click_pins_it_under_every_integr
             IntegratorKind::ExplicitEuler => 2400,
             IntegratorKind::Rk2 => 150,
             IntegratorKind::ImplicitEuler => 4,
-            IntegratorKind::Xpbd => 10,
+            IntegratorKind::Xpbd | IntegratorKind::Vbd => 10,
             _ => 48,
         };
         harness.state_mut().reset();

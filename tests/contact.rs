@@ -244,6 +244,7 @@ fn never_passes_through_under_each(
         (IntegratorKind::SemiImplicitEuler, explicit_substeps),
         (IntegratorKind::ImplicitEuler, 3),
         (IntegratorKind::Xpbd, 3),
+        (IntegratorKind::Vbd, 3),
     ] {
         never_passes_through(name, quads, integrator, substeps, seconds);
     }

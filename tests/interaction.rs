@@ -29,7 +29,7 @@ fn hanging(kind: IntegratorKind) -> Simulation {
         IntegratorKind::ExplicitEuler => 1500,
         IntegratorKind::Rk2 => 120,
         IntegratorKind::ImplicitEuler => 4,
-        IntegratorKind::Xpbd => 10,
+        IntegratorKind::Xpbd | IntegratorKind::Vbd => 10,
         _ => 40,
     };
     let mut sim = Simulation::new(scene);

@@ -37,7 +37,7 @@ fn stable_substeps(kind: IntegratorKind) -> u32 {
     match kind {
         IntegratorKind::ExplicitEuler => 1500,
         IntegratorKind::Rk2 => 200,
-        IntegratorKind::ImplicitEuler | IntegratorKind::Xpbd => 4,
+        IntegratorKind::ImplicitEuler | IntegratorKind::Xpbd | IntegratorKind::Vbd => 4,
         _ => 64,
     }
 }

@@ -117,7 +117,7 @@ pub enum Command {
         /// Comma-separated particles per side.
         #[arg(long, value_delimiter = ',', default_value = "32,64,128,256")]
         sizes: Vec<u32>,
-        /// Comma-separated integrators [default: semi-implicit-euler,implicit-euler,xpbd;
+        /// Comma-separated integrators [default: semi-implicit-euler,implicit-euler,xpbd,vbd;
         /// with --backend gpu, semi-implicit-euler, the one it runs].
         #[arg(long, value_delimiter = ',')]
         integrators: Option<Vec<IntegratorKind>>,
@@ -196,7 +196,8 @@ pub struct RunArgs {
     /// Use this OBJ cloth instead of the scene's own.
     #[arg(long)]
     pub obj: Option<PathBuf>,
-    /// Integrator: explicit-euler, semi-implicit-euler, verlet, rk2, rk4, implicit-euler, xpbd.
+    /// Integrator: explicit-euler, semi-implicit-euler, verlet, rk2, rk4, implicit-euler, xpbd,
+    /// vbd.
     #[arg(long)]
     pub integrator: Option<IntegratorKind>,
     /// Simulated seconds.
@@ -208,6 +209,9 @@ pub struct RunArgs {
     /// Substeps per frame.
     #[arg(long)]
     pub substeps: Option<u32>,
+    /// Sweeps per substep of XPBD (constraint projections) and VBD (descent sweeps).
+    #[arg(long)]
+    pub iterations: Option<u32>,
     /// Resize the scene's grid cloth to N quads along its longer side (its self-collision
     /// thickness shrinks with the spacing).
     #[arg(long)]
@@ -234,6 +238,10 @@ impl RunArgs {
         }
         if let Some(s) = self.substeps {
             scene.params.step.substeps = s;
+        }
+        if let Some(n) = self.iterations {
+            scene.params.solver.xpbd_iterations = n;
+            scene.params.solver.vbd_iterations = n;
         }
         scene.params.validate().map_err(anyhow::Error::msg)?;
         if !(self.seconds.is_finite() && self.seconds >= 0.0) {

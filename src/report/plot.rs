@@ -10,7 +10,7 @@ pub const PLOT_SIZE: (u32, u32) = (1200, 800);
 
 /// A colour per integrator, in `IntegratorKind::ALL` order.
 pub fn integrator_color(kind: IntegratorKind) -> (u8, u8, u8) {
-    const COLORS: [(u8, u8, u8); 7] = [
+    const COLORS: [(u8, u8, u8); 8] = [
         (214, 39, 40),
         (31, 119, 180),
         (44, 160, 44),
@@ -18,6 +18,7 @@ pub fn integrator_color(kind: IntegratorKind) -> (u8, u8, u8) {
         (148, 103, 189),
         (140, 86, 75),
         (23, 190, 207),
+        (188, 189, 34),
     ];
     let i = IntegratorKind::ALL
         .iter()

@@ -212,6 +212,7 @@ pub struct SolverSpec {
     pub newton_iterations: u32,
     pub newton_tolerance: f32,
     pub xpbd_iterations: u32,
+    pub vbd_iterations: u32,
     pub guard: GuardPolicy,
 }
 
@@ -228,6 +229,7 @@ impl Default for SolverSpec {
             newton_iterations: p.solver.newton_iterations,
             newton_tolerance: p.solver.newton_tolerance,
             xpbd_iterations: p.solver.xpbd_iterations,
+            vbd_iterations: p.solver.vbd_iterations,
             guard: p.guard,
         }
     }
@@ -501,6 +503,7 @@ impl SceneFile {
                 newton_iterations: s.newton_iterations,
                 newton_tolerance: s.newton_tolerance,
                 xpbd_iterations: s.xpbd_iterations,
+                vbd_iterations: s.vbd_iterations,
             },
         }
     }
@@ -531,6 +534,7 @@ impl SceneFile {
             newton_iterations: params.solver.newton_iterations,
             newton_tolerance: params.solver.newton_tolerance,
             xpbd_iterations: params.solver.xpbd_iterations,
+            vbd_iterations: params.solver.vbd_iterations,
             guard: params.guard.clone(),
         };
         file.material = MaterialSpec {

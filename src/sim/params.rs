@@ -157,6 +157,8 @@ pub struct SolverConfig {
     pub newton_tolerance: f32,
     /// Constraint sweeps per XPBD substep (default 1: small steps, one iteration).
     pub xpbd_iterations: u32,
+    /// Descent sweeps per VBD substep (default 1: small steps, one iteration).
+    pub vbd_iterations: u32,
 }
 
 impl Default for SolverConfig {
@@ -167,6 +169,7 @@ impl Default for SolverConfig {
             newton_iterations: 1,
             newton_tolerance: 1e-3,
             xpbd_iterations: 1,
+            vbd_iterations: 1,
         }
     }
 }
@@ -230,6 +233,7 @@ impl SimParams {
             ("solver.max_iterations", solver.max_iterations),
             ("solver.newton_iterations", solver.newton_iterations),
             ("solver.xpbd_iterations", solver.xpbd_iterations),
+            ("solver.vbd_iterations", solver.vbd_iterations),
         ] {
             ParamError::require(
                 (1..=10_000).contains(&value),
@@ -289,7 +293,7 @@ mod tests {
     #[test]
     fn a_change_names_its_concern() {
         type Edit = fn(&mut SimParams);
-        let cases: [(Changes, Edit); 10] = [
+        let cases: [(Changes, Edit); 11] = [
             (Changes::DT, |p| p.step.dt *= 2.0),
             (Changes::SUBSTEPS, |p| p.step.substeps += 1),
             (Changes::INTEGRATOR, |p| {
@@ -302,6 +306,7 @@ mod tests {
             (Changes::GUARD, |p| p.guard.enabled = !p.guard.enabled),
             (Changes::SOLVER, |p| p.solver.tolerance *= 0.5),
             (Changes::SOLVER, |p| p.solver.xpbd_iterations += 1),
+            (Changes::SOLVER, |p| p.solver.vbd_iterations += 1),
         ];
         let before = SimParams::default();
         assert_eq!(before.changes_to(&before.clone()), Changes::empty());

@@ -70,6 +70,24 @@ impl Panel for SolverPanel {
                 }
             });
             ui.end_row();
+            let sweeps = match params.step.integrator {
+                IntegratorKind::Xpbd => Some(&mut params.solver.xpbd_iterations),
+                IntegratorKind::Vbd => Some(&mut params.solver.vbd_iterations),
+                _ => None,
+            };
+            if let Some(sweeps) = sweeps {
+                let label = ui.label("Sweeps");
+                changed |= ui
+                    .add(egui::DragValue::new(sweeps).range(1..=100))
+                    .on_hover_text(
+                        "iterations per substep: more move the step towards the implicit one \
+                         (stiffer, less damped); more substeps of one sweep each usually buy \
+                         more accuracy for the same time",
+                    )
+                    .labelled_by(label.id)
+                    .changed();
+                ui.end_row();
+            }
             ui.label("Substep");
             ui.label(format!("{:.3} ms", 1e3 * in_effect.substep_length));
             ui.end_row();

@@ -7,6 +7,7 @@ use super::rk2::Rk2;
 use super::rk4::Rk4;
 use super::semi_implicit_euler::SemiImplicitEuler;
 use super::step::Integrator;
+use super::vbd::Vbd;
 use super::velocity_verlet::VelocityVerlet;
 use super::xpbd::Xpbd;
 
@@ -21,6 +22,7 @@ impl IntegratorKind {
             IntegratorKind::Rk4 => Box::new(Rk4::default()),
             IntegratorKind::ImplicitEuler => Box::new(ImplicitEuler::default()),
             IntegratorKind::Xpbd => Box::new(Xpbd::default()),
+            IntegratorKind::Vbd => Box::new(Vbd::default()),
         }
     }
 }

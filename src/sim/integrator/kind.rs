@@ -22,10 +22,13 @@ pub enum IntegratorKind {
     ImplicitEuler,
     /// Extended position-based dynamics: springs as compliant distance constraints.
     Xpbd,
+    /// Vertex block descent: implicit Euler's step as a minimisation, one particle at a
+    /// time by a 3 × 3 Newton step, colour by colour.
+    Vbd,
 }
 
 impl IntegratorKind {
-    pub const ALL: [IntegratorKind; 7] = [
+    pub const ALL: [IntegratorKind; 8] = [
         IntegratorKind::ExplicitEuler,
         IntegratorKind::SemiImplicitEuler,
         IntegratorKind::Verlet,
@@ -33,6 +36,7 @@ impl IntegratorKind {
         IntegratorKind::Rk4,
         IntegratorKind::ImplicitEuler,
         IntegratorKind::Xpbd,
+        IntegratorKind::Vbd,
     ];
 
     /// The name the CLI accepts and JSON prints.
@@ -45,6 +49,7 @@ impl IntegratorKind {
             IntegratorKind::Rk4 => "rk4",
             IntegratorKind::ImplicitEuler => "implicit-euler",
             IntegratorKind::Xpbd => "xpbd",
+            IntegratorKind::Vbd => "vbd",
         }
     }
 
@@ -58,6 +63,7 @@ impl IntegratorKind {
             IntegratorKind::Rk4 => "RK4",
             IntegratorKind::ImplicitEuler => "Implicit Euler (CG)",
             IntegratorKind::Xpbd => "XPBD",
+            IntegratorKind::Vbd => "VBD (vertex block descent)",
         }
     }
 
@@ -67,7 +73,8 @@ impl IntegratorKind {
             IntegratorKind::ExplicitEuler
             | IntegratorKind::SemiImplicitEuler
             | IntegratorKind::ImplicitEuler
-            | IntegratorKind::Xpbd => 1,
+            | IntegratorKind::Xpbd
+            | IntegratorKind::Vbd => 1,
             IntegratorKind::Verlet | IntegratorKind::Rk2 => 2,
             IntegratorKind::Rk4 => 4,
         }

@@ -13,6 +13,7 @@ mod rk4;
 mod semi_implicit_euler;
 mod stability;
 mod step;
+mod vbd;
 mod velocity_verlet;
 mod xpbd;
 
@@ -25,5 +26,6 @@ pub use rk2::Rk2;
 pub use rk4::Rk4;
 pub use semi_implicit_euler::SemiImplicitEuler;
 pub use step::Integrator;
+pub use vbd::Vbd;
 pub use velocity_verlet::VelocityVerlet;
 pub use xpbd::Xpbd;

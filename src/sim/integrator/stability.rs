@@ -10,11 +10,13 @@ const TOLERATED_GROWTH: f64 = 0.01;
 
 impl IntegratorKind {
     /// The longest stable substep (s) for a vibration of angular frequency `omega` (rad/s)
-    /// damped at rate `gamma` (1/s); `None` where every step is stable (implicit Euler, XPBD),
+    /// damped at rate `gamma` (1/s); `None` where every step is stable (implicit Euler, XPBD, VBD),
     /// `Some(0.0)` where no step is (explicit Euler on an undamped spring).
     pub fn stable_substep(self, omega: f64, gamma: f64) -> Option<f64> {
         match self {
-            IntegratorKind::ImplicitEuler | IntegratorKind::Xpbd => return None,
+            IntegratorKind::ImplicitEuler | IntegratorKind::Xpbd | IntegratorKind::Vbd => {
+                return None;
+            }
             IntegratorKind::ExplicitEuler
             | IntegratorKind::SemiImplicitEuler
             | IntegratorKind::Verlet
@@ -92,7 +94,7 @@ impl IntegratorKind {
                 )
             }
             // Stable at any step; never asked (see `stable_substep`).
-            IntegratorKind::ImplicitEuler | IntegratorKind::Xpbd => (x, v),
+            IntegratorKind::ImplicitEuler | IntegratorKind::Xpbd | IntegratorKind::Vbd => (x, v),
         }
     }
 }

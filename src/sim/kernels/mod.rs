@@ -3,10 +3,14 @@
 //! threads.
 
 mod components;
+#[cfg(target_arch = "x86_64")]
+mod lanes;
 mod real;
 mod run_pass;
 mod spring_runs;
 mod two_passes;
+mod vbd_lanes;
+mod vbd_stencil;
 mod xpbd_lanes;
 
 pub use components::{
@@ -16,4 +20,6 @@ pub use real::Real;
 pub use run_pass::Projectors;
 pub use spring_runs::SpringRuns;
 pub use two_passes::{BlockPass, TwoPasses};
+pub use vbd_lanes::{Particle, StepLength, descend_range};
+pub use vbd_stencil::Stencil;
 pub use xpbd_lanes::{Moved, Scaled, project_range};

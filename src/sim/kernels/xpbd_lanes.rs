@@ -9,6 +9,9 @@ use glam::Vec3;
 use crate::parallel::Disjoint;
 use crate::sim::constraints::DistanceConstraints;
 
+#[cfg(target_arch = "x86_64")]
+use super::lanes::{LANES, Row, V3, add, dot, load_rows, scale, store_rows, sub};
+
 /// A particle's predicted position and its displacement this step, and its inverse mass:
 /// eight f32 in this order (the AVX2 sweep loads and stores a particle as one 32-byte row).
 #[derive(Clone, Copy, Debug)]
@@ -91,7 +94,6 @@ unsafe fn project_eights_avx2(
     moved: &Disjoint<'_, Moved>,
     lambda: &Disjoint<'_, f32>,
 ) -> Range<usize> {
-    use lanes::*;
     use std::arch::x86_64::*;
     let end = (range.end.min(c.len()).min(lambda.len()))
         .min(s.alpha.len())
@@ -167,150 +169,50 @@ unsafe fn project_eights_avx2(
     k..range.end
 }
 
-/// Eight 3-vectors in AVX2 registers, one per lane (`[x, y, z]`), and the few operations
-/// the XPBD sweep does on them, each the same IEEE operations as glam's `Vec3`.
+/// Eight particles' rows of [`Moved`] as columns: one register per quantity, one lane per
+/// particle.
 #[cfg(target_arch = "x86_64")]
-mod lanes {
-    use std::arch::x86_64::*;
+#[derive(Clone, Copy)]
+struct Columns {
+    predicted: V3,
+    displacement: V3,
+    inv_mass: std::arch::x86_64::__m256,
+    pad: std::arch::x86_64::__m256,
+}
 
-    use super::Moved;
-    use crate::parallel::Disjoint;
+// SAFETY: `Moved` is eight f32, `repr(C, align(32))`.
+#[cfg(target_arch = "x86_64")]
+unsafe impl Row for Moved {}
 
-    pub const LANES: usize = 8;
-
-    pub type V3 = [__m256; 3];
-
-    #[target_feature(enable = "avx2")]
-    #[inline]
-    pub fn sub(x: V3, y: V3) -> V3 {
-        [
-            _mm256_sub_ps(x[0], y[0]),
-            _mm256_sub_ps(x[1], y[1]),
-            _mm256_sub_ps(x[2], y[2]),
-        ]
+/// The rows of `moved` at `ends` as columns.
+///
+/// # Safety
+/// As [`load_rows`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn load_columns(moved: &Disjoint<'_, Moved>, ends: &[u32]) -> Columns {
+    // SAFETY: the caller's contract.
+    let [x, y, z, dx, dy, dz, inv_mass, pad] = unsafe { load_rows(moved, ends) };
+    Columns {
+        predicted: [x, y, z],
+        displacement: [dx, dy, dz],
+        inv_mass,
+        pad,
     }
+}
 
-    #[target_feature(enable = "avx2")]
-    #[inline]
-    pub fn add(x: V3, y: V3) -> V3 {
-        [
-            _mm256_add_ps(x[0], y[0]),
-            _mm256_add_ps(x[1], y[1]),
-            _mm256_add_ps(x[2], y[2]),
-        ]
-    }
-
-    /// `s · x`, lane by lane.
-    #[target_feature(enable = "avx2")]
-    #[inline]
-    pub fn scale(s: __m256, x: V3) -> V3 {
-        [
-            _mm256_mul_ps(s, x[0]),
-            _mm256_mul_ps(s, x[1]),
-            _mm256_mul_ps(s, x[2]),
-        ]
-    }
-
-    /// `(x₀y₀ + x₁y₁) + x₂y₂`, glam's order.
-    #[target_feature(enable = "avx2")]
-    #[inline]
-    pub fn dot(x: V3, y: V3) -> __m256 {
-        let xy = _mm256_add_ps(_mm256_mul_ps(x[0], y[0]), _mm256_mul_ps(x[1], y[1]));
-        _mm256_add_ps(xy, _mm256_mul_ps(x[2], y[2]))
-    }
-
-    /// Eight particles' rows of `Moved` as columns: one register per quantity, one lane
-    /// per particle.
-    #[derive(Clone, Copy)]
-    pub struct Columns {
-        pub predicted: V3,
-        pub displacement: V3,
-        pub inv_mass: __m256,
-        pub pad: __m256,
-    }
-
-    /// The rows of `moved` at `ends` as columns. Each half row is loaded whole, row `i`
-    /// beside row `i + 4`, then transposed four by four within the halves of the registers.
-    ///
-    /// # Safety
-    /// Every index is in bounds, and no other thread writes those rows meanwhile.
-    #[target_feature(enable = "avx2")]
-    #[inline]
-    pub(super) unsafe fn load_columns(moved: &Disjoint<'_, Moved>, ends: &[u32]) -> Columns {
-        let base = moved.as_ptr() as *const f32;
-        let mut halves = [[_mm256_setzero_ps(); 4]; 2];
-        for (i, &end) in ends[..4].iter().enumerate() {
-            let (row, other) = (8 * end as usize, 8 * ends[i + 4] as usize);
-            for (h, half) in halves.iter_mut().enumerate() {
-                // SAFETY: `Moved` is eight f32, 32-byte aligned; the rest is the caller's
-                // contract.
-                half[i] = unsafe {
-                    let low = _mm256_castps128_ps256(_mm_load_ps(base.add(row + 4 * h)));
-                    _mm256_insertf128_ps::<1>(low, _mm_load_ps(base.add(other + 4 * h)))
-                };
-            }
-        }
-        let ([x, y, z, dx], [dy, dz, inv_mass, pad]) =
-            (transpose4(halves[0]), transpose4(halves[1]));
-        Columns {
-            predicted: [x, y, z],
-            displacement: [dx, dy, dz],
-            inv_mass,
-            pad,
-        }
-    }
-
-    /// Stores columns as [`load_columns`] makes them back into the rows of `moved` at
-    /// `ends`, row by row in order.
-    ///
-    /// # Safety
-    /// Every index is in bounds, and no other thread uses those rows meanwhile.
-    #[target_feature(enable = "avx2")]
-    #[inline]
-    pub(super) unsafe fn store_columns(moved: &Disjoint<'_, Moved>, ends: &[u32], c: Columns) {
-        let base = moved.as_ptr() as *mut f32;
-        let ([x, y, z], [dx, dy, dz]) = (c.predicted, c.displacement);
-        let low = transpose4([x, y, z, dx]);
-        let high = transpose4([dy, dz, c.inv_mass, c.pad]);
-        for (i, &end) in ends[..LANES].iter().enumerate() {
-            let (half, row) = (i % 4, 8 * end as usize);
-            // SAFETY: as `load_columns`.
-            unsafe {
-                let (l, h) = if i < 4 {
-                    (
-                        _mm256_castps256_ps128(low[half]),
-                        _mm256_castps256_ps128(high[half]),
-                    )
-                } else {
-                    (
-                        _mm256_extractf128_ps::<1>(low[half]),
-                        _mm256_extractf128_ps::<1>(high[half]),
-                    )
-                };
-                _mm_store_ps(base.add(row), l);
-                _mm_store_ps(base.add(row + 4), h);
-            }
-        }
-    }
-
-    /// The 4 × 4 transpose within each 128-bit half: element `j` of register `i` becomes
-    /// element `i` of register `j`, for the low halves and for the high halves.
-    #[target_feature(enable = "avx2")]
-    #[inline]
-    fn transpose4(r: [__m256; 4]) -> [__m256; 4] {
-        let t = [
-            _mm256_unpacklo_ps(r[0], r[1]),
-            _mm256_unpackhi_ps(r[0], r[1]),
-            _mm256_unpacklo_ps(r[2], r[3]),
-            _mm256_unpackhi_ps(r[2], r[3]),
-        ];
-        [
-            _mm256_shuffle_ps::<0x44>(t[0], t[2]),
-            _mm256_shuffle_ps::<0xEE>(t[0], t[2]),
-            _mm256_shuffle_ps::<0x44>(t[1], t[3]),
-            _mm256_shuffle_ps::<0xEE>(t[1], t[3]),
-        ]
-    }
+/// Stores columns as [`load_columns`] makes them back into the rows at `ends`.
+///
+/// # Safety
+/// As [`store_rows`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn store_columns(moved: &Disjoint<'_, Moved>, ends: &[u32], c: Columns) {
+    let ([x, y, z], [dx, dy, dz]) = (c.predicted, c.displacement);
+    // SAFETY: the caller's contract.
+    unsafe { store_rows(moved, ends, [x, y, z, dx, dy, dz, c.inv_mass, c.pad]) };
 }
 
 /// Projects constraint `k` (XPBD with constraint damping), moving its particles' predicted

@@ -1,0 +1,179 @@
+//! Vertex block descent (VBD; Chen, Macklin, Kim et al., SIGGRAPH 2024).
+
+use glam::Vec3;
+
+use super::context::StepContext;
+use super::kind::IntegratorKind;
+use super::report::{StepError, StepReport};
+use super::step::Integrator;
+use crate::cloth::ClothState;
+use crate::parallel::{Disjoint, Team};
+use crate::sim::forces::Force;
+use crate::sim::kernels::{Particle, Stencil, StepLength, descend_range};
+
+/// Backward Euler's step written as a minimisation, solved one particle at a time.
+///
+/// Each substep moves every particle by the displacement `d` that minimises
+/// `G(d) = Σᵢ ½ mᵢ |dᵢ − ŷᵢ|² + h²·E(x + d)`, with `ŷᵢ = h·vᵢ + h²·fᵢ/mᵢ` the inertial
+/// prediction (`f`: every force but the springs, at the start of the step: gravity, air
+/// damping, wind, bending, as XPBD takes them) and `E` the springs' energy; the springs'
+/// dashpots act on the new velocity `d/h` (Rayleigh-free, as implicit Euler's do). Its
+/// minimum is implicit Euler's step for the springs. The descent starts from `ŷ` and makes
+/// `vbd_iterations` sweeps; in each, a particle takes one Newton step on `G` with the others
+/// held: `Hᵢ·Δdᵢ = −∇ᵢG`, where `Hᵢ = mᵢ·I + Σ (h²·(k·n nᵀ + k·max(0, 1 − L/l)·(I − n nᵀ))
+/// + h·c·n nᵀ)` over its springs is the 3 × 3 block of the Hessian kept positive definite (a
+/// compressed spring's negative transverse term left out). Particles are visited colour by
+/// colour ([`Stencil`]): no two of a colour share a spring, so a colour's particles move at
+/// the same time on the team's threads, and the result does not depend on how many there
+/// are. Finally `v = d/h`, `x += d`.
+///
+/// At one sweep it is a Gauss–Seidel Newton iteration started from the inertial guess; as
+/// the sweeps grow it converges to the implicit step (each sweep of two particles on a
+/// spring shrinks the distance to it by about `(h²k/(m + h²k))²`). First order in the step,
+/// stable at any stiffness: every particle's move lowers `G`.
+///
+/// The displacement is kept as such, not recovered as a difference of two positions (see
+/// [`super::Xpbd`] for why that matters in f32 at small steps).
+#[derive(Default)]
+pub struct Vbd {
+    stencil: Stencil,
+    built: bool,
+    force: Vec<Vec3>,
+    /// The inertial displacement `ŷ` per particle, metres.
+    inertial: Vec<Vec3>,
+    /// Per particle its start position, its displacement `d` this step (metres) and its
+    /// masses, side by side: the descent reads them from one 32-byte row.
+    particles: Vec<Particle>,
+    /// The velocities before the last step and its length, from which the next step's
+    /// first guess takes each particle's last acceleration; `None` when the state changed
+    /// outside since (or there was no step yet).
+    previous: Option<(Vec<Vec3>, f32)>,
+}
+
+/// Colours from this many particles are shared out between the team's threads.
+const PARALLEL_COLOUR: usize = 1024;
+/// Particles per piece of a colour (a multiple of the groups of eight).
+const PIECE: usize = 256;
+
+impl Vbd {
+    /// The descent's starting point (the adaptive start of Chen et al.): `d = h·v + h²·ã`,
+    /// where `ã` is the part of the external acceleration `a = f/m` that the particle
+    /// showed in its last step, `â·clamp(a_last·â, 0, |a|)`: a cloth hanging at rest starts
+    /// where it is (its weight held by the springs), a falling one where it falls to. With
+    /// no last step, `ã = a` (the inertial prediction). Pinned particles stay.
+    fn first_guess(&self, v: Vec3, f: Vec3, w: f32, p: usize, h: f32) -> Vec3 {
+        if w == 0.0 {
+            return Vec3::ZERO;
+        }
+        let a = f * w;
+        let taken = match &self.previous {
+            Some((last, last_h)) if p < last.len() => {
+                let a_last = (v - last[p]) / *last_h;
+                let size = a.length();
+                if size > 0.0 {
+                    let along = a / size;
+                    along * a_last.dot(along).clamp(0.0, size)
+                } else {
+                    Vec3::ZERO
+                }
+            }
+            _ => a,
+        };
+        (v + taken * h) * h
+    }
+
+    /// One sweep: every free particle, colour by colour, takes its Newton step; a large
+    /// colour in pieces shared between the team's threads.
+    fn sweep(&mut self, h: f32) {
+        let stencil = &self.stencil;
+        let inertial = &self.inertial;
+        let n = self.particles.len();
+        assert!(stencil.spans.len() == n && inertial.len() == n);
+        let particles = Disjoint::new(&mut self.particles);
+        let team = Team::current();
+        let step = StepLength::new(h);
+        for colour in &stencil.colours {
+            let pieces = colour.len().div_ceil(PIECE);
+            let parallel = colour.len() >= PARALLEL_COLOUR;
+            team.run_pieces_if(parallel, pieces, &|_, piece| {
+                let start = colour.start + piece * PIECE;
+                let range = start..(start + PIECE).min(colour.end);
+                // SAFETY: a colour's particles share no spring, so while this piece moves
+                // its particles no other thread writes them or any particle they read; the
+                // stencil was built for these particles (lengths checked above).
+                unsafe { descend_range(stencil, &particles, inertial, range, step, true) };
+            });
+        }
+    }
+}
+
+impl Integrator for Vbd {
+    fn kind(&self) -> IntegratorKind {
+        IntegratorKind::Vbd
+    }
+
+    fn step(
+        &mut self,
+        ctx: &mut StepContext<'_>,
+        state: &mut ClothState,
+        h: f32,
+    ) -> Result<StepReport, StepError> {
+        let model = ctx.model;
+        if !self.built || self.stencil.spans.len() != model.particle_count() {
+            let springs = ctx.forces.constraints(model);
+            self.stencil = Stencil::new(&springs, model.particle_count());
+            self.built = true;
+        }
+        let not_springs = |t: &Force| t.springs().is_none();
+        ctx.forces_where(&state.pos, &state.vel, not_springs, &mut self.force);
+        let w = &model.inv_mass;
+        self.inertial.clear();
+        let particles = state.vel.iter().zip(&self.force).zip(w);
+        self.inertial
+            .extend(particles.map(|((&v, &f), &w)| (v + f * w * h) * h));
+        let mut rows = std::mem::take(&mut self.particles);
+        rows.clear();
+        for (p, (&pos, &v)) in state.pos.iter().zip(&state.vel).enumerate() {
+            rows.push(Particle {
+                pos,
+                disp: self.first_guess(v, self.force[p], w[p], p, h),
+                inv_mass: w[p],
+                mass: model.mass[p],
+            });
+        }
+        self.particles = rows;
+        let sweeps = ctx.config.vbd_iterations;
+        ctx.solve(|| {
+            for _ in 0..sweeps {
+                self.sweep(h);
+            }
+            ((), sweeps, None, true)
+        });
+        if !self.particles.iter().all(|p| p.disp.is_finite()) {
+            return Err(StepError::NonFinite { iterations: sweeps });
+        }
+        let mut previous = self.previous.take().map(|p| p.0).unwrap_or_default();
+        previous.clone_from(&state.vel);
+        self.previous = Some((previous, h));
+        let inv_h = 1.0 / h;
+        let states = state.pos.iter_mut().zip(state.vel.iter_mut());
+        for ((x, v), row) in states.zip(&self.particles) {
+            if row.inv_mass != 0.0 {
+                *v = row.disp * inv_h;
+                *x += row.disp;
+            }
+        }
+        state.time += h as f64;
+        Ok(ctx.report())
+    }
+
+    fn invalidate(&mut self) {
+        self.previous = None;
+    }
+
+    /// The stencil keeps the springs' strengths: new strengths make it stale.
+    fn forces_changed(&mut self) {
+        self.built = false;
+        self.invalidate();
+    }
+}
