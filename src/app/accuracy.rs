@@ -219,7 +219,7 @@ fn plot(ui: &mut egui::Ui, report: &AccuracyReport, tolerance: f64) {
                 .iter()
                 .map(|&i| {
                     [
-                        log(report.points[i].wall_s_per_sim_s),
+                        log(report.points[i].work_per_sim_s),
                         log(report.points[i].max_error),
                     ]
                 })
@@ -236,7 +236,7 @@ fn plot(ui: &mut egui::Ui, report: &AccuracyReport, tolerance: f64) {
                     .points
                     .iter()
                     .filter(|p| p.integrator == kind && p.stable)
-                    .map(|p| [log(p.wall_s_per_sim_s), log(p.max_error)])
+                    .map(|p| [log(p.work_per_sim_s), log(p.max_error)])
                     .collect();
                 mine.sort_by(|a, b| a[0].total_cmp(&b[0]));
                 if !mine.is_empty() {
@@ -267,9 +267,11 @@ fn table(ui: &mut egui::Ui, report: &AccuracyReport) {
                         "dt (s)",
                         "max error",
                         "stable",
-                        "cost (s/s)",
+                        "work (evals/s)",
+                        "wall (s/s)",
                         "evals/step",
-                        "iters/step",
+                        "CG iters/step",
+                        "sweeps/step",
                     ] {
                         ui.label(RichText::new(head).strong());
                     }
@@ -283,9 +285,11 @@ fn table(ui: &mut egui::Ui, report: &AccuracyReport) {
                             "—".into()
                         });
                         ui.label(if p.stable { "yes" } else { "no" });
+                        ui.label(format!("{:.3e}", p.work_per_sim_s));
                         ui.label(format!("{:.2e}", p.wall_s_per_sim_s));
                         ui.label(format!("{:.1}", p.force_evals_per_step));
-                        ui.label(format!("{:.1}", p.solver_iterations_per_step));
+                        ui.label(format!("{:.1}", p.linear_iterations_per_step));
+                        ui.label(format!("{:.1}", p.sweeps_per_step));
                         ui.end_row();
                     }
                 });

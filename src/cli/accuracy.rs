@@ -41,3 +41,34 @@ pub fn accuracy(
     }
     Ok(())
 }
+
+/// Measures the unit costs on `scene` on this machine and prints them beside the built-in
+/// ones.
+pub fn calibrate(scene: &str, obj: Option<&std::path::Path>) -> Result<()> {
+    let scene = Scene::open_with_obj(scene, obj, &mesh::ImportOptions::default())?;
+    eprintln!("timing each kind of work on `{}`…", scene.scenario);
+    let measured = clothsim::report::calibrate(&scene);
+    let built_in = clothsim::report::UnitCosts::default();
+    println!("unit costs, in force evaluations of the cloth (one semi-implicit Euler substep):");
+    println!("{:<34} {:>10} {:>10}", "", "measured", "built in");
+    let rows = [
+        (
+            "implicit Euler's assembly",
+            measured.assembly,
+            built_in.assembly,
+        ),
+        (
+            "a conjugate-gradient iteration",
+            measured.linear_iteration,
+            built_in.linear_iteration,
+        ),
+        ("an XPBD sweep", measured.xpbd_sweep, built_in.xpbd_sweep),
+        ("a VBD sweep", measured.vbd_sweep, built_in.vbd_sweep),
+    ];
+    for (what, m, b) in rows {
+        println!("{what:<34} {m:>10.2} {b:>10.2}");
+    }
+    println!("measured: {}", measured.source);
+    println!("built in: {}", built_in.source);
+    Ok(())
+}

@@ -94,7 +94,7 @@ pub enum Command {
         /// Use this OBJ cloth instead of the scene's own.
         #[arg(long)]
         obj: Option<PathBuf>,
-        /// Comma-separated integrators (default: all seven).
+        /// Comma-separated integrators (default: all eight).
         #[arg(long, value_delimiter = ',')]
         integrators: Option<Vec<IntegratorKind>>,
         /// Comma-separated step sizes in seconds (default: 1/60 s over 3, 6, … 384 substeps).
@@ -107,8 +107,13 @@ pub enum Command {
         #[arg(long, default_value_t = clothsim::report::DEFAULT_TOLERANCE, allow_negative_numbers = true)]
         tolerance: f64,
         /// Output directory (created if missing).
+        #[arg(long, required_unless_present = "calibrate")]
+        out: Option<PathBuf>,
+        /// Instead: measure on this machine what each kind of work costs on the scene (the
+        /// unit costs the choice weighs counted work by) and print them beside the built-in
+        /// ones the report uses.
         #[arg(long)]
-        out: PathBuf,
+        calibrate: bool,
     },
     /// Speed on the `hanging-bench` scene: µs per substep and the sag after 2 s for each
     /// size × integrator × thread count (the scene the peer frameworks run too). µs per

@@ -67,7 +67,14 @@ pub fn run(cli: Cli) -> Result<()> {
             seconds,
             tolerance,
             out,
+            calibrate,
         }) => {
+            if calibrate {
+                return super::accuracy::calibrate(&scene, obj.as_deref());
+            }
+            let Some(out) = out else {
+                anyhow::bail!("--out is needed (or --calibrate)");
+            };
             let mut config = clothsim::report::SweepConfig {
                 seconds,
                 tolerance,

@@ -1,6 +1,7 @@
 //! What accuracy costs in time: sweeps of every integrator over step sizes against a
 //! reference, their tables (CSV, Markdown) and plot (PNG).
 
+mod cost;
 mod error;
 mod files;
 mod frontier;
@@ -10,9 +11,10 @@ mod point;
 mod sweep;
 mod table;
 
+pub use cost::{UnitCosts, Work, calibrate};
 pub use error::ReportError;
 pub use files::write_report;
-pub use frontier::{frontier, recommend};
+pub use frontier::{COST_RESOLUTION, frontier, recommend};
 pub use measure::{BLOW_UP_SPEED, Record, Trajectory, position_error, run, undamped};
 pub use plot::{PLOT_SIZE, draw, integrator_color};
 pub use point::Point;

@@ -68,7 +68,7 @@ fn chart(
     let costs: Vec<f64> = report
         .points
         .iter()
-        .map(|p| p.wall_s_per_sim_s)
+        .map(|p| p.work_per_sim_s)
         .filter(|&c| finite(c))
         .collect();
     let floor = report.reference.check_max;
@@ -97,7 +97,7 @@ fn chart(
         .map_err(err)?;
     chart
         .configure_mesh()
-        .x_desc("cost: wall-clock seconds per simulated second")
+        .x_desc("cost: work per simulated second, in force evaluations of this cloth")
         .y_desc("max position error / cloth size")
         .x_label_formatter(&|x| format!("{x:.0e}"))
         .y_label_formatter(&|y| format!("{y:.0e}"))
@@ -135,12 +135,7 @@ fn chart(
     let frontier: Vec<(f64, f64)> = report
         .frontier
         .iter()
-        .map(|&i| {
-            (
-                report.points[i].wall_s_per_sim_s,
-                report.points[i].max_error,
-            )
-        })
+        .map(|&i| (report.points[i].work_per_sim_s, report.points[i].max_error))
         .collect();
     let shade = BLACK.mix(0.3);
     chart
@@ -151,14 +146,14 @@ fn chart(
     for kind in IntegratorKind::ALL {
         let mine = |stable: bool| {
             report.points.iter().filter(move |p| {
-                p.integrator == kind && p.stable == stable && finite(p.wall_s_per_sim_s)
+                p.integrator == kind && p.stable == stable && finite(p.work_per_sim_s)
             })
         };
         let mut line: Vec<(f64, f64)> = mine(true)
             .filter(|p| finite(p.max_error))
-            .map(|p| (p.wall_s_per_sim_s, p.max_error))
+            .map(|p| (p.work_per_sim_s, p.max_error))
             .collect();
-        let unstable: Vec<f64> = mine(false).map(|p| p.wall_s_per_sim_s).collect();
+        let unstable: Vec<f64> = mine(false).map(|p| p.work_per_sim_s).collect();
         if line.is_empty() && unstable.is_empty() {
             continue;
         }
@@ -211,6 +206,7 @@ fn range(values: &[f64], below: f64, above: f64) -> (f64, f64) {
 
 #[cfg(test)]
 mod tests {
+    use super::super::UnitCosts;
     use super::*;
     use crate::report::point::Point;
     use crate::report::sweep::Reference;
@@ -238,7 +234,7 @@ mod tests {
         }
         let mut unstable = points[6].clone();
         unstable.stable = false;
-        unstable.wall_s_per_sim_s = 0.5;
+        unstable.work_per_sim_s = 0.5;
         points.push(unstable);
         AccuracyReport {
             scene: "test".into(),
@@ -257,6 +253,7 @@ mod tests {
             limits: Vec::new(),
             frontier: Vec::new(),
             recommendation: None,
+            unit_costs: UnitCosts::default(),
         }
     }
 

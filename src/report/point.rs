@@ -23,15 +23,22 @@ pub struct Point {
     /// Finite throughout, with energy bounded (it never gained more than the reference's
     /// peak kinetic energy) and error below the cloth's size.
     pub stable: bool,
-    /// Wall-clock seconds per simulated second.
+    /// Wall-clock seconds per simulated second (measured; varies from run to run).
     pub wall_s_per_sim_s: f64,
+    /// The counted work per simulated second, in force evaluations of this cloth (see
+    /// [`super::UnitCosts`]): the cost the choice is made by, the same on every run.
+    pub work_per_sim_s: f64,
     pub force_evals_per_step: f64,
-    pub solver_iterations_per_step: f64,
+    /// Conjugate-gradient iterations per step (implicit Euler).
+    pub linear_iterations_per_step: f64,
+    /// Constraint (XPBD) or descent (VBD) sweeps per step.
+    pub sweeps_per_step: f64,
 }
 
 #[cfg(test)]
 impl Point {
-    /// An RK4 point of this cost and error (tests: the rest are placeholders).
+    /// An RK4 point of this counted cost and error (tests: the rest are placeholders; its
+    /// wall time runs against its cost, so a choice by wall time would differ).
     pub(crate) fn at(cost: f64, error: f64, stable: bool) -> Self {
         Self {
             integrator: IntegratorKind::Rk4,
@@ -42,9 +49,11 @@ impl Point {
             max_error: error,
             energy_drift: 0.0,
             stable,
-            wall_s_per_sim_s: cost,
+            wall_s_per_sim_s: 1.0 / cost,
+            work_per_sim_s: cost,
             force_evals_per_step: 1.0,
-            solver_iterations_per_step: 0.0,
+            linear_iterations_per_step: 0.0,
+            sweeps_per_step: 0.0,
         }
     }
 }

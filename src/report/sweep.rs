@@ -5,6 +5,7 @@ use crate::mesh::bbox_diagonal;
 use crate::scene::Scene;
 use crate::sim::IntegratorKind;
 
+use super::cost::{UnitCosts, Work};
 use super::error::ReportError;
 use super::frontier::{frontier, recommend};
 use super::measure::{Record, Trajectory, position_error, run, undamped};
@@ -26,6 +27,8 @@ pub struct SweepConfig {
     pub bisection_steps: u32,
     /// Run the two reference trajectories side by side on two threads.
     pub parallel_reference: bool,
+    /// What each kind of work costs: the choice is made by counted work weighed by these.
+    pub unit_costs: UnitCosts,
 }
 
 /// The default sweep: a 1/60 s frame divided into 3 … 384 substeps (2.1 decades of step).
@@ -52,6 +55,7 @@ impl Default for SweepConfig {
             tolerance: DEFAULT_TOLERANCE,
             bisection_steps: 6,
             parallel_reference: true,
+            unit_costs: UnitCosts::default(),
         }
     }
 }
@@ -138,6 +142,8 @@ pub struct AccuracyReport {
     pub frontier: Vec<usize>,
     /// Index into `points` of the cheapest one within the tolerance.
     pub recommendation: Option<usize>,
+    /// The unit costs the counted work was weighed by.
+    pub unit_costs: UnitCosts,
 }
 
 impl AccuracyReport {
@@ -218,6 +224,8 @@ pub fn measure(
     let energy_drift = energy.energy_deviation() / scale;
     let bounded = energy.energy_growth() <= scale;
     let (rms_error, max_error) = (rms / size, max / size);
+    let work = Work::per_step(integrator, &damped.stats);
+    let steps_per_sim_s = 1.0 / damped.h;
     Point {
         integrator,
         dt: damped.h,
@@ -228,8 +236,10 @@ pub fn measure(
         energy_drift,
         stable: damped.finite && energy.finite && bounded && max_error < 1.0,
         wall_s_per_sim_s: damped.wall / config.seconds,
-        force_evals_per_step: damped.stats.force_evals_per_step(),
-        solver_iterations_per_step: damped.stats.solver_iterations_per_step(),
+        work_per_sim_s: steps_per_sim_s * config.unit_costs.step(integrator, &work),
+        force_evals_per_step: work.force_evals,
+        linear_iterations_per_step: work.linear_iterations,
+        sweeps_per_step: work.sweeps,
     }
 }
 
@@ -450,5 +460,6 @@ pub fn sweep(
         limits,
         frontier,
         recommendation,
+        unit_costs: config.unit_costs.clone(),
     })
 }

@@ -6,7 +6,7 @@ use super::point::Point;
 use super::sweep::AccuracyReport;
 
 /// CSV columns, in order.
-pub const CSV_COLUMNS: [&str; 12] = [
+pub const CSV_COLUMNS: [&str; 14] = [
     "integrator",
     "dt",
     "steps",
@@ -14,9 +14,11 @@ pub const CSV_COLUMNS: [&str; 12] = [
     "max_error",
     "energy_drift",
     "stable",
+    "work_per_sim_s",
     "wall_s_per_sim_s",
     "force_evals_per_step",
-    "solver_iterations_per_step",
+    "linear_iterations_per_step",
+    "sweeps_per_step",
     "substeps_per_frame",
     "on_frontier",
 ];
@@ -35,7 +37,7 @@ pub fn csv(report: &AccuracyReport) -> String {
     for (i, p) in report.points.iter().enumerate() {
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{},{:.3},{:.3},{:.2},{}",
+            "{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{:.2},{}",
             p.integrator,
             sci(p.dt),
             p.steps,
@@ -43,9 +45,11 @@ pub fn csv(report: &AccuracyReport) -> String {
             sci(p.max_error),
             sci(p.energy_drift),
             p.stable,
+            sci(p.work_per_sim_s),
             sci(p.wall_s_per_sim_s),
             p.force_evals_per_step,
-            p.solver_iterations_per_step,
+            p.linear_iterations_per_step,
+            p.sweeps_per_step,
             p.substeps_per_frame,
             report.frontier.contains(&i),
         );
@@ -68,11 +72,13 @@ pub fn choice_sentence(report: &AccuracyReport) -> String {
     match report.recommended() {
         Some(p) => format!(
             "{} at dt = {:.3e} s ({:.0} substeps per 1/60 s frame): max error {} of the cloth's \
-             size at {:.3} s of wall time per simulated second",
+             size for {:.3e} force evaluations' work per simulated second ({:.3} s of wall \
+             time per simulated second here)",
             p.integrator,
             p.dt,
             p.substeps_per_frame,
             percent(p.max_error),
+            p.work_per_sim_s,
             p.wall_s_per_sim_s
         ),
         None => format!(
@@ -85,7 +91,7 @@ pub fn choice_sentence(report: &AccuracyReport) -> String {
 fn point_row(out: &mut String, p: &Point, frontier: bool) {
     let _ = writeln!(
         out,
-        "| {} | {:.3e} | {:.0} | {} | {} | {} | {} | {:.3e} | {:.1} | {:.1} |",
+        "| {} | {:.3e} | {:.0} | {} | {} | {} | {} | {:.3e} | {:.3e} | {:.1} | {:.1} | {:.1} |",
         if frontier {
             format!("**{}**", p.integrator)
         } else {
@@ -101,9 +107,11 @@ fn point_row(out: &mut String, p: &Point, frontier: bool) {
             "—".into()
         },
         if p.stable { "yes" } else { "**no**" },
+        p.work_per_sim_s,
         p.wall_s_per_sim_s,
         p.force_evals_per_step,
-        p.solver_iterations_per_step,
+        p.linear_iterations_per_step,
+        p.sweeps_per_step,
     );
 }
 
@@ -117,8 +125,19 @@ pub fn markdown(report: &AccuracyReport) -> String {
         out,
         "{} particles, cloth size {:.3} m (bounding-box diagonal), {} s simulated. Errors are \
          the largest deviation from the reference along the trajectory, as a fraction of the \
-         cloth's size; cost is wall-clock seconds per simulated second on this machine.\n",
+         cloth's size. Cost is the work counted per simulated second (force evaluations, \
+         conjugate-gradient iterations, constraint and descent sweeps) weighed by fixed unit \
+         costs, in force evaluations of this cloth, so the choice is the same on every run; \
+         wall-clock seconds per simulated second on this machine are reported beside it.\n",
         report.particles, report.size, report.seconds
+    );
+    let u = &report.unit_costs;
+    let _ = writeln!(
+        out,
+        "Unit costs ({}): a force evaluation 1, implicit Euler's assembly {:.2} per \
+         evaluation, a conjugate-gradient iteration {:.2}, an XPBD sweep {:.2}, a VBD sweep \
+         {:.2}; `clothsim accuracy --calibrate` measures them on this machine.\n",
+        u.source, u.assembly, u.linear_iteration, u.xpbd_sweep, u.vbd_sweep
     );
     let _ = writeln!(out, "## The choice\n");
     let _ = writeln!(
@@ -170,9 +189,9 @@ pub fn markdown(report: &AccuracyReport) -> String {
     );
     let _ = writeln!(
         out,
-        "| integrator | dt (s) | substeps/frame | RMS error | max error | energy drift | stable | wall s / sim s | force evals / step | solver iterations / step |"
+        "| integrator | dt (s) | substeps/frame | RMS error | max error | energy drift | stable | work / sim s | wall s / sim s | force evals / step | CG iterations / step | sweeps / step |"
     );
-    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (i, p) in report.points.iter().enumerate() {
         point_row(&mut out, p, report.frontier.contains(&i));
     }
@@ -181,10 +200,12 @@ pub fn markdown(report: &AccuracyReport) -> String {
         let p = &report.points[i];
         let _ = writeln!(
             out,
-            "- {} at dt = {:.3e} s: max error {}, {:.3e} s per simulated second",
+            "- {} at dt = {:.3e} s: max error {}, {:.3e} force evaluations' work ({:.3e} s) per \
+             simulated second",
             p.integrator,
             p.dt,
             percent(p.max_error),
+            p.work_per_sim_s,
             p.wall_s_per_sim_s
         );
     }
