@@ -88,8 +88,9 @@ pub enum Command {
     /// What accuracy costs in time: every integrator × step size against a reference;
     /// writes accuracy.csv, accuracy.md and accuracy.png.
     Accuracy {
-        /// A built-in scene (see `clothsim scenes`) or a scene file (.toml).
-        #[arg(long, default_value = "hanging")]
+        /// A built-in scene (see `clothsim scenes`) or a scene file (.toml); `orders`, where
+        /// every method's order of accuracy shows, unless told another.
+        #[arg(long, default_value = clothsim::report::ORDERS_SCENE)]
         scene: String,
         /// Use this OBJ cloth instead of the scene's own.
         #[arg(long)]
@@ -97,12 +98,13 @@ pub enum Command {
         /// Comma-separated integrators (default: all eight).
         #[arg(long, value_delimiter = ',')]
         integrators: Option<Vec<IntegratorKind>>,
-        /// Comma-separated step sizes in seconds (default: 1/60 s over 3, 6, … 384 substeps).
+        /// Comma-separated step sizes in seconds (default: on `orders` 1/60 s over 1, √2, 2,
+        /// 2√2, 4, 8, … 1 024 substeps; on any other scene over 3, 6, … 384).
         #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
         dts: Option<Vec<f64>>,
-        /// Simulated seconds of each run.
-        #[arg(long, default_value_t = 0.25, allow_negative_numbers = true)]
-        seconds: f64,
+        /// Simulated seconds of each run (default: 1 on `orders`, 0.25 on any other scene).
+        #[arg(long, allow_negative_numbers = true)]
+        seconds: Option<f64>,
         /// Largest acceptable max position error, as a fraction of the cloth's size.
         #[arg(long, default_value_t = clothsim::report::DEFAULT_TOLERANCE, allow_negative_numbers = true)]
         tolerance: f64,

@@ -76,10 +76,12 @@ pub fn run(cli: Cli) -> Result<()> {
                 anyhow::bail!("--out is needed (or --calibrate)");
             };
             let mut config = clothsim::report::SweepConfig {
-                seconds,
                 tolerance,
-                ..Default::default()
+                ..clothsim::report::SweepConfig::for_scene(&scene)
             };
+            if let Some(seconds) = seconds {
+                config.seconds = seconds;
+            }
             if let Some(list) = integrators {
                 config.integrators = list;
             }

@@ -2,12 +2,15 @@
 
 use super::point::Point;
 
-/// Indices of the stable points on the Pareto frontier, cheapest first: each is more
-/// accurate (smaller maximum error) than every cheaper stable point. Cheaper by counted
+/// Indices of the stable, resolved points on the Pareto frontier, cheapest first: each is
+/// more accurate (smaller maximum error) than every cheaper one. An unresolved error (near
+/// the reference's uncertainty or the run's rounding) cannot rank a point. Cheaper by counted
 /// work ([`Point::work_per_sim_s`]), never by wall time: the same points give the same
 /// frontier on every run.
 pub fn frontier(points: &[Point]) -> Vec<usize> {
-    let mut stable: Vec<usize> = (0..points.len()).filter(|&i| points[i].stable).collect();
+    let mut stable: Vec<usize> = (0..points.len())
+        .filter(|&i| points[i].stable && points[i].resolved)
+        .collect();
     stable.sort_by(|&a, &b| {
         let (pa, pb) = (&points[a], &points[b]);
         pa.work_per_sim_s
@@ -55,6 +58,10 @@ mod tests {
             Point::at(3.0, 0.01, true),
             Point::at(0.5, 1e-9, false), // cheap and exact, but unstable
             Point::at(4.0, 0.001, true),
+            Point {
+                resolved: false, // its error is within the reference's uncertainty
+                ..Point::at(5.0, 1e-7, true)
+            },
         ];
         assert_eq!(frontier(&points), vec![0, 2, 4]);
     }

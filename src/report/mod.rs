@@ -6,8 +6,10 @@ mod error;
 mod files;
 mod frontier;
 mod measure;
+mod order;
 mod plot;
 mod point;
+mod reference;
 mod sweep;
 mod table;
 
@@ -16,10 +18,12 @@ pub use error::ReportError;
 pub use files::write_report;
 pub use frontier::{COST_RESOLUTION, frontier, recommend};
 pub use measure::{BLOW_UP_SPEED, Record, Trajectory, position_error, run, undamped};
+pub use order::{ASYMPTOTIC_ERROR, ObservedOrder, RESOLVED, observed_order};
 pub use plot::{PLOT_SIZE, draw, integrator_color};
 pub use point::Point;
+pub use reference::{REFERENCE_REFINEMENT, Reference};
 pub use sweep::{
-    AccuracyReport, DEFAULT_SUBSTEPS, DEFAULT_TOLERANCE, Progress, REFERENCE_REFINEMENT, Reference,
+    AccuracyReport, DEFAULT_SUBSTEPS, DEFAULT_TOLERANCE, ORDERS_SCENE, ORDERS_SUBSTEPS, Progress,
     StableLimit, SweepConfig, measure, sweep,
 };
 pub use table::{CSV_COLUMNS, choice_sentence, csv, markdown};

@@ -81,7 +81,8 @@ fn chart(
         .filter(|&e| finite(e))
         .collect();
     let (x_lo, x_hi) = range(&costs, 0.5, 2.0);
-    let (y_lo, y_hi) = range(&errors, 0.3, 20.0);
+    // Room above the data for the legend, in the upper right.
+    let (y_lo, y_hi) = range(&errors, 0.3, 300.0);
     let mut chart = ChartBuilder::on(root)
         .caption(
             format!(
@@ -128,7 +129,7 @@ fn chart(
                 gray.stroke_width(2),
             ))
             .map_err(err)?
-            .label("reference uncertainty (errors below are not resolved)")
+            .label("reference uncertainty (hollow: not resolved)")
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], gray.stroke_width(2)));
     }
     // The frontier, under the integrators' lines.
@@ -141,7 +142,7 @@ fn chart(
     chart
         .draw_series(LineSeries::new(frontier, shade.stroke_width(10)))
         .map_err(err)?
-        .label("frontier (cheapest for its accuracy)")
+        .label("frontier")
         .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], shade.stroke_width(10)));
     for kind in IntegratorKind::ALL {
         let mine = |stable: bool| {
@@ -165,8 +166,22 @@ fn chart(
             .map_err(err)?
             .label(kind.name())
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(3)));
+        // Resolved errors filled, unresolved ones (within ten times the floor) hollow.
+        let resolved: Vec<bool> = {
+            let mut mine: Vec<&crate::report::Point> =
+                mine(true).filter(|p| finite(p.max_error)).collect();
+            mine.sort_by(|a, b| a.work_per_sim_s.total_cmp(&b.work_per_sim_s));
+            mine.iter().map(|p| p.resolved).collect()
+        };
         chart
-            .draw_series(line.iter().map(|&p| Circle::new(p, 6, color.filled())))
+            .draw_series(line.iter().zip(&resolved).map(|(&p, &filled)| {
+                let style = if filled {
+                    color.filled()
+                } else {
+                    color.stroke_width(2)
+                };
+                Circle::new(p, 6, style)
+            }))
             .map_err(err)?;
         // Unstable runs have no meaningful error: a cross along the top edge, at their cost.
         chart
@@ -180,14 +195,14 @@ fn chart(
     chart
         .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
         .map_err(err)?
-        .label("× along the top: an unstable run, at its cost")
+        .label("× unstable, at its cost")
         .legend(|(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.9))
         .border_style(BLACK)
         .label_font(("sans-serif", 20))
-        .position(SeriesLabelPosition::LowerLeft)
+        .position(SeriesLabelPosition::UpperRight)
         .draw()
         .map_err(err)?;
     Ok(())
@@ -208,8 +223,8 @@ fn range(values: &[f64], below: f64, above: f64) -> (f64, f64) {
 mod tests {
     use super::super::UnitCosts;
     use super::*;
+    use crate::report::Reference;
     use crate::report::point::Point;
-    use crate::report::sweep::Reference;
 
     fn pixels_of(buffer: &[u8], kind: IntegratorKind) -> usize {
         let (r, g, b) = integrator_color(kind);
@@ -248,6 +263,8 @@ mod tests {
                 check_rms: 1e-10,
                 check_max: 1e-10,
                 peak_kinetic: 1.0,
+                ladder: Vec::new(),
+                rounding: Vec::new(),
             },
             points,
             limits: Vec::new(),

@@ -23,6 +23,9 @@ pub struct Point {
     /// Finite throughout, with energy bounded (it never gained more than the reference's
     /// peak kinetic energy) and error below the cloth's size.
     pub stable: bool,
+    /// The error is at least ten times the reference's uncertainty; below, it measures the
+    /// reference as much as the run.
+    pub resolved: bool,
     /// Wall-clock seconds per simulated second (measured; varies from run to run).
     pub wall_s_per_sim_s: f64,
     /// The counted work per simulated second, in force evaluations of this cloth (see
@@ -49,6 +52,7 @@ impl Point {
             max_error: error,
             energy_drift: 0.0,
             stable,
+            resolved: true,
             wall_s_per_sim_s: 1.0 / cost,
             work_per_sim_s: cost,
             force_evals_per_step: 1.0,

@@ -1,15 +1,16 @@
 //! The accuracy-versus-cost sweep: every integrator at every step size against a reference
 //! trajectory, the largest stable step of each, and the cheapest choice within a tolerance.
 
-use crate::mesh::bbox_diagonal;
 use crate::scene::Scene;
 use crate::sim::IntegratorKind;
 
 use super::cost::{UnitCosts, Work};
 use super::error::ReportError;
 use super::frontier::{frontier, recommend};
-use super::measure::{Record, Trajectory, position_error, run, undamped};
+use super::measure::{Record, Trajectory, position_error, run};
+use super::order::{ObservedOrder, RESOLVED, observed_order};
 use super::point::Point;
+use super::reference::{Reference, reference, scene_size};
 
 /// What to sweep.
 #[derive(Clone, Debug, PartialEq)]
@@ -35,8 +36,6 @@ pub struct SweepConfig {
 pub const DEFAULT_SUBSTEPS: [u32; 8] = [3, 6, 12, 24, 48, 96, 192, 384];
 /// The default tolerance: every particle within 1 % of the cloth's size of the reference.
 pub const DEFAULT_TOLERANCE: f64 = 0.01;
-/// The reference takes RK4 at this fraction of the smallest swept step.
-pub const REFERENCE_REFINEMENT: f64 = 4.0;
 
 impl Default for SweepConfig {
     fn default() -> Self {
@@ -60,7 +59,45 @@ impl Default for SweepConfig {
     }
 }
 
+/// The scene the report runs unless told another: every integrator's order shows on it.
+pub const ORDERS_SCENE: &str = "orders";
+
+/// The `orders` sweep's substeps per 1/60 s frame: 1 to 4 in steps of √2 (where RK4's error
+/// falls through its resolved range), then doubling to 1 024 (where the first-order methods'
+/// does).
+pub const ORDERS_SUBSTEPS: [f64; 13] = [
+    1.0,
+    std::f64::consts::SQRT_2,
+    2.0,
+    2.0 * std::f64::consts::SQRT_2,
+    4.0,
+    8.0,
+    16.0,
+    32.0,
+    64.0,
+    128.0,
+    256.0,
+    512.0,
+    1024.0,
+];
+
 impl SweepConfig {
+    /// The sweep for the scene called `name`: on [`ORDERS_SCENE`] one second at
+    /// [`ORDERS_SUBSTEPS`] (smooth for a second, and the orders need the span), one sample
+    /// every 1/30 s; on any other the default, a quarter second at [`DEFAULT_SUBSTEPS`]
+    /// (before a folding cloth turns chaotic).
+    pub fn for_scene(name: &str) -> Self {
+        if name != ORDERS_SCENE {
+            return Self::default();
+        }
+        Self {
+            dts: ORDERS_SUBSTEPS.iter().map(|n| 1.0 / (60.0 * n)).collect(),
+            seconds: 1.0,
+            samples: 30,
+            ..Self::default()
+        }
+    }
+
     /// Checks that the sweep can run.
     ///
     /// # Errors
@@ -99,20 +136,6 @@ impl SweepConfig {
     }
 }
 
-/// The reference trajectory and how well it is converged.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct Reference {
-    pub integrator: IntegratorKind,
-    /// Its step, seconds.
-    pub dt: f64,
-    /// RMS and maximum difference (fractions of the cloth's size) between the reference and
-    /// the same method at half its step.
-    pub check_rms: f64,
-    pub check_max: f64,
-    /// Peak kinetic energy of the undamped scene, joules: the scale of energy drift.
-    pub peak_kinetic: f64,
-}
-
 /// The largest step at which an integrator stayed stable.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct StableLimit {
@@ -121,9 +144,8 @@ pub struct StableLimit {
     pub dt: Option<f64>,
     /// True when the search stopped at its upper bound (a sample interval) still stable.
     pub at_upper_bound: bool,
-    /// Observed order: the slope of log error over log step between its two smallest stable
-    /// steps (where the error is above the reference's own).
-    pub observed_order: Option<f64>,
+    /// The order its stable runs showed (see [`observed_order`]).
+    pub observed_order: Option<ObservedOrder>,
 }
 
 /// Everything the sweep measured.
@@ -212,7 +234,7 @@ pub fn measure(
         Record::Positions,
     );
     let energy = run(
-        &undamped(scene),
+        &super::measure::undamped(scene),
         integrator,
         dt,
         config.seconds,
@@ -235,60 +257,13 @@ pub fn measure(
         max_error,
         energy_drift,
         stable: damped.finite && energy.finite && bounded && max_error < 1.0,
+        resolved: max_error >= RESOLVED * reference.1.floor(damped.h),
         wall_s_per_sim_s: damped.wall / config.seconds,
         work_per_sim_s: steps_per_sim_s * config.unit_costs.step(integrator, &work),
         force_evals_per_step: work.force_evals,
         linear_iterations_per_step: work.linear_iterations,
         sweeps_per_step: work.sweeps,
     }
-}
-
-fn scene_size(scene: &Scene) -> f64 {
-    (bbox_diagonal(&scene.initial.pos) as f64).max(1e-9)
-}
-
-/// Runs the reference (RK4 at a quarter of the smallest swept step), its check at half
-/// that step, and the undamped run (RK4 at the smallest swept step) whose peak kinetic
-/// energy sets the scale of energy drift.
-fn reference(scene: &Scene, config: &SweepConfig) -> (Trajectory, Reference) {
-    let smallest = config.dts.iter().copied().fold(f64::INFINITY, f64::min);
-    let h = smallest / REFERENCE_REFINEMENT;
-    let (seconds, samples) = (config.seconds, config.samples);
-    let rk4 = IntegratorKind::Rk4;
-    let main = || run(scene, rk4, h, seconds, samples, Record::Positions);
-    let check = || run(scene, rk4, h / 2.0, seconds, samples, Record::Positions);
-    let (main, check) = if config.parallel_reference {
-        std::thread::scope(|s| {
-            let other = s.spawn(check);
-            let main = main();
-            (
-                main,
-                other
-                    .join()
-                    .unwrap_or_else(|e| std::panic::resume_unwind(e)),
-            )
-        })
-    } else {
-        (main(), check())
-    };
-    let energy = run(
-        &undamped(scene),
-        rk4,
-        smallest,
-        seconds,
-        samples * 2,
-        Record::Energy,
-    );
-    let size = scene_size(scene);
-    let (rms, max) = position_error(&check, &main);
-    let info = Reference {
-        integrator: rk4,
-        dt: main.h,
-        check_rms: rms / size,
-        check_max: max / size,
-        peak_kinetic: energy.peak_kinetic(),
-    };
-    (main, info)
 }
 
 /// Whether `integrator` stays stable (finite, energy bounded) on the undamped scene at `dt`.
@@ -321,7 +296,7 @@ fn stable_limit(
     tracker: &mut Tracker<'_>,
 ) -> Result<StableLimit, ReportError> {
     let upper_bound = config.seconds / config.samples as f64;
-    let undamped = undamped(scene);
+    let undamped = super::measure::undamped(scene);
     let probe = |dt: f64, tracker: &mut Tracker<'_>| -> Result<bool, ReportError> {
         tracker.begin(format!("{integrator}: stability at {dt:.2e} s"))?;
         let ok = stable_at(&undamped, config, peak_kinetic, integrator, dt);
@@ -385,19 +360,6 @@ fn stable_limit(
     })
 }
 
-/// Slope of log error over log step between the two smallest stable steps whose error is
-/// well above the reference check (otherwise the reference's own error would be measured).
-fn observed_order(points: &[&Point], reference: &Reference) -> Option<f64> {
-    let floor = 10.0 * reference.check_max;
-    let mut usable: Vec<&&Point> = points
-        .iter()
-        .filter(|p| p.stable && p.max_error > floor)
-        .collect();
-    usable.sort_by(|a, b| a.dt.total_cmp(&b.dt));
-    let (a, b) = (usable.first()?, usable.get(1)?);
-    Some((b.max_error / a.max_error).ln() / (b.dt / a.dt).ln())
-}
-
 /// Runs the whole sweep on `scene`, calling `progress` after every unit of work; it
 /// returns `false` to cancel.
 ///
@@ -444,7 +406,11 @@ pub fn sweep(
             &mine,
             &mut tracker,
         )?;
-        limit.observed_order = observed_order(&mine, &reference);
+        let runs: Vec<(f64, f64)> = (mine.iter())
+            .filter(|p| p.stable && p.resolved)
+            .map(|p| (p.dt, p.max_error))
+            .collect();
+        limit.observed_order = observed_order(&runs);
         limits.push(limit);
     }
     let frontier = frontier(&points);

@@ -6,7 +6,7 @@ use super::point::Point;
 use super::sweep::AccuracyReport;
 
 /// CSV columns, in order.
-pub const CSV_COLUMNS: [&str; 14] = [
+pub const CSV_COLUMNS: [&str; 15] = [
     "integrator",
     "dt",
     "steps",
@@ -14,6 +14,7 @@ pub const CSV_COLUMNS: [&str; 14] = [
     "max_error",
     "energy_drift",
     "stable",
+    "resolved",
     "work_per_sim_s",
     "wall_s_per_sim_s",
     "force_evals_per_step",
@@ -37,7 +38,7 @@ pub fn csv(report: &AccuracyReport) -> String {
     for (i, p) in report.points.iter().enumerate() {
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{:.2},{}",
+            "{},{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{:.2},{}",
             p.integrator,
             sci(p.dt),
             p.steps,
@@ -45,6 +46,7 @@ pub fn csv(report: &AccuracyReport) -> String {
             sci(p.max_error),
             sci(p.energy_drift),
             p.stable,
+            p.resolved,
             sci(p.work_per_sim_s),
             sci(p.wall_s_per_sim_s),
             p.force_evals_per_step,
@@ -100,7 +102,11 @@ fn point_row(out: &mut String, p: &Point, frontier: bool) {
         p.dt,
         p.substeps_per_frame,
         percent(p.rms_error),
-        percent(p.max_error),
+        if p.resolved || !p.max_error.is_finite() {
+            percent(p.max_error)
+        } else {
+            format!("({})", percent(p.max_error))
+        },
         if p.energy_drift.is_finite() {
             format!("{:.2e}", p.energy_drift)
         } else {
@@ -149,22 +155,37 @@ pub fn markdown(report: &AccuracyReport) -> String {
     let _ = writeln!(out, "## Reference\n");
     let _ = writeln!(
         out,
-        "{} at dt = {:.3e} s. Halving its step changes it by {} (RMS) / {} (max) of the \
-         cloth's size, {:.0}× below the tolerance.\n",
+        "{} at dt = {:.3e} s: of RK4 at steps doubling from a quarter of the smallest swept \
+         one, the one that differs least from the run at twice its step (in f32 a smaller \
+         step is not always surer: rounding grows with the steps taken). That difference, {} \
+         (RMS) / {} (max) of the cloth's size, is its uncertainty, {:.0}× below the \
+         tolerance. A run's error counts as resolved from ten times the larger of it and \
+         the rounding RK4 itself shows at that step (for steps finer than the reference's: \
+         {}); unresolved errors are in parentheses, and hollow in the plot.\n",
         r.integrator,
         r.dt,
         percent(r.check_rms),
         percent(r.check_max),
-        report.tolerance / r.check_max.max(1e-300)
+        report.tolerance / r.check_max.max(1e-300),
+        if r.rounding.is_empty() {
+            "none".to_string()
+        } else {
+            (r.rounding.iter())
+                .map(|(h, e)| format!("{} at {h:.2e} s", percent(*e)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        }
     );
     let _ = writeln!(out, "## Largest stable step\n");
     let _ = writeln!(
         out,
         "Stable: finite; on the undamped scene the energy never gains more than the \
          reference's peak kinetic energy (losing it, as the damping methods do, is no \
-         instability); error below the cloth's size. Observed order: the slope between the \
-         two smallest steps whose error is at least ten times the reference's uncertainty \
-         (— where fewer qualify).\n"
+         instability); error below the cloth's size. Observed order: the least-squares slope \
+         of log error over log step through the stable runs whose error is resolved and at \
+         most 10 % of the cloth's size (beyond, a method is not yet in its asymptotic range), \
+         with how many steps and decades of error it spans (— where fewer than two \
+         qualify).\n"
     );
     let _ = writeln!(
         out,
@@ -179,7 +200,12 @@ pub fn markdown(report: &AccuracyReport) -> String {
             ),
             None => ("none found".into(), "—".into()),
         };
-        let order = l.observed_order.map_or("—".into(), |o| format!("{o:.2}"));
+        let order = l.observed_order.map_or("—".into(), |o| {
+            format!(
+                "{:.2} ({} steps, {:.1} decades)",
+                o.order, o.points, o.decades
+            )
+        });
         let _ = writeln!(out, "| {} | {dt} | {substeps} | {order} |", l.integrator);
     }
     let _ = writeln!(out, "\n## Every run\n");

@@ -42,6 +42,7 @@ pub static BUILTIN_SCENES: &[(&str, &str)] = &[
         "hanging-bench",
         include_str!("../../assets/scenes/hanging-bench.toml"),
     ),
+    ("orders", include_str!("../../assets/scenes/orders.toml")),
 ];
 
 /// One frame of the arm's OBJ sequence, by its number, as a built-in mesh.
