@@ -1,6 +1,7 @@
 //! What accuracy costs in time: sweeps of every integrator over step sizes against a
 //! reference, their tables (CSV, Markdown) and plot (PNG).
 
+mod config;
 mod cost;
 mod error;
 mod files;
@@ -13,6 +14,7 @@ mod reference;
 mod sweep;
 mod table;
 
+pub use config::{DEFAULT_SUBSTEPS, DEFAULT_TOLERANCE, ORDERS_SCENE, ORDERS_SUBSTEPS, SweepConfig};
 pub use cost::{UnitCosts, Work, calibrate};
 pub use error::ReportError;
 pub use files::write_report;
@@ -22,8 +24,5 @@ pub use order::{ASYMPTOTIC_ERROR, ObservedOrder, RESOLVED, observed_order};
 pub use plot::{PLOT_SIZE, draw, integrator_color};
 pub use point::Point;
 pub use reference::{REFERENCE_REFINEMENT, Reference};
-pub use sweep::{
-    AccuracyReport, DEFAULT_SUBSTEPS, DEFAULT_TOLERANCE, ORDERS_SCENE, ORDERS_SUBSTEPS, Progress,
-    StableLimit, SweepConfig, measure, sweep,
-};
+pub use sweep::{AccuracyReport, Progress, StableLimit, measure, sweep};
 pub use table::{CSV_COLUMNS, choice_sentence, csv, markdown};

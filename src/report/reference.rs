@@ -5,8 +5,8 @@ use crate::mesh::bbox_diagonal;
 use crate::scene::Scene;
 use crate::sim::IntegratorKind;
 
+use super::config::SweepConfig;
 use super::measure::{Record, Trajectory, position_error, run, undamped};
-use super::sweep::SweepConfig;
 
 /// The reference's finest candidate step is this many times below the smallest swept step.
 pub const REFERENCE_REFINEMENT: f64 = 4.0;
