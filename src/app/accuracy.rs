@@ -60,9 +60,19 @@ impl AccuracyWindow {
         }));
         let cancel = Arc::new(AtomicBool::new(false));
         let (tx, rx) = channel();
+        // Left as it came, the sweep is the scene's own (the `orders` scene's spans the steps
+        // its orders need).
+        let base = if self.config == Self::default().config {
+            SweepConfig {
+                parallel_reference: false,
+                ..SweepConfig::for_scene(&scene.scenario)
+            }
+        } else {
+            self.config.clone()
+        };
         let config = SweepConfig {
             tolerance: self.tolerance,
-            ..self.config.clone()
+            ..base
         };
         let (p, c) = (progress.clone(), cancel.clone());
         std::thread::spawn(move || {
@@ -119,7 +129,7 @@ impl AccuracyWindow {
     /// The cheapest measured point within the typed tolerance.
     pub fn choice(&self) -> Option<&crate::report::Point> {
         let report = self.report.as_ref()?;
-        recommend(&report.points, &report.frontier, self.tolerance).map(|i| &report.points[i])
+        recommend(&report.points, self.tolerance).map(|i| &report.points[i])
     }
 
     /// `params` with the chosen integrator and the substeps that give its step at `params.step.dt`.
@@ -142,7 +152,7 @@ impl AccuracyWindow {
             .open(&mut open)
             .default_size([720.0, 560.0])
             .show(ctx, |ui| {
-                ui.label("Error against a reference trajectory (RK4 at a very small step) and wall-clock cost, for every integrator and step size, on the current scene.");
+                ui.label("Error against a reference trajectory (RK4 at the step it is surest at) and counted work (force evaluations, CG iterations, sweeps), for every integrator and step size, on the current scene. The `orders` scene shows every method's order of accuracy.");
                 ui.horizontal(|ui| {
                     if let Some(job) = &self.job {
                         let p = job.progress.lock().map(|p| p.clone()).unwrap_or(Progress { done: 0, total: 1, what: String::new() });
@@ -181,6 +191,7 @@ impl AccuracyWindow {
                 });
                 if let Some(report) = &self.report {
                     plot(ui, report, self.tolerance);
+                    orders(ui, report);
                     table(ui, report);
                 }
             });
@@ -194,7 +205,7 @@ fn plot(ui: &mut egui::Ui, report: &AccuracyReport, tolerance: f64) {
     Plot::new("accuracy plot")
         .height(300.0)
         .legend(Legend::default())
-        .x_axis_label("log10 of cost (wall s per simulated s)")
+        .x_axis_label("log10 of cost (work per simulated s, in force evaluations)")
         .y_axis_label("log10 of max error / cloth size")
         .x_axis_formatter(|m, _| format!("1e{:.0}", m.value))
         .y_axis_formatter(|m, _| format!("1e{:.0}", m.value))
@@ -232,26 +243,68 @@ fn plot(ui: &mut egui::Ui, report: &AccuracyReport, tolerance: f64) {
             for kind in IntegratorKind::ALL {
                 let (r, g, b) = integrator_color(kind);
                 let color = Color32::from_rgb(r, g, b);
-                let mut mine: Vec<[f64; 2]> = report
+                let mut mine: Vec<(bool, [f64; 2])> = report
                     .points
                     .iter()
-                    .filter(|p| p.integrator == kind && p.stable)
-                    .map(|p| [log(p.work_per_sim_s), log(p.max_error)])
+                    // An error of exactly zero is the reference's own run: no point on a
+                    // log scale.
+                    .filter(|p| p.integrator == kind && p.stable && p.max_error > 0.0)
+                    .map(|p| (p.resolved, [log(p.work_per_sim_s), log(p.max_error)]))
                     .collect();
-                mine.sort_by(|a, b| a[0].total_cmp(&b[0]));
+                mine.sort_by(|a, b| a.1[0].total_cmp(&b.1[0]));
                 if !mine.is_empty() {
+                    let line: Vec<[f64; 2]> = mine.iter().map(|m| m.1).collect();
                     plot_ui.line(
-                        Line::new(kind.name(), PlotPoints::from(mine.clone()))
+                        Line::new(kind.name(), PlotPoints::from(line))
                             .color(color)
                             .width(2.0),
                     );
-                    plot_ui.points(
-                        Points::new(kind.name(), PlotPoints::from(mine))
-                            .color(color)
-                            .radius(3.0),
-                    );
+                    // Resolved errors filled, those lost in the floor hollow.
+                    for resolved in [true, false] {
+                        let some: Vec<[f64; 2]> = (mine.iter())
+                            .filter(|m| m.0 == resolved)
+                            .map(|m| m.1)
+                            .collect();
+                        plot_ui.points(
+                            Points::new(kind.name(), PlotPoints::from(some))
+                                .color(color)
+                                .filled(resolved)
+                                .radius(3.0),
+                        );
+                    }
                 }
             }
+        });
+}
+
+/// Each integrator's observed order of accuracy, beside the order its method has.
+fn orders(ui: &mut egui::Ui, report: &AccuracyReport) {
+    egui::CollapsingHeader::new("Orders of accuracy")
+        .default_open(true)
+        .show(ui, |ui| {
+            egui::Grid::new("accuracy orders")
+                .striped(true)
+                .show(ui, |ui| {
+                    for head in ["integrator", "order", "observed", "over"] {
+                        ui.label(RichText::new(head).strong());
+                    }
+                    ui.end_row();
+                    for limit in &report.limits {
+                        ui.label(limit.integrator.label());
+                        ui.label(limit.integrator.order().to_string());
+                        match limit.observed_order {
+                            Some(o) => {
+                                ui.label(format!("{:.2}", o.order));
+                                ui.label(format!("{} steps, {:.1} decades", o.points, o.decades));
+                            }
+                            None => {
+                                ui.label("—");
+                                ui.label("too few resolved errors");
+                            }
+                        }
+                        ui.end_row();
+                    }
+                });
         });
 }
 

@@ -23,9 +23,12 @@ pub struct Point {
     /// Finite throughout, with energy bounded (it never gained more than the reference's
     /// peak kinetic energy) and error below the cloth's size.
     pub stable: bool,
-    /// The error is at least ten times the reference's uncertainty; below, it measures the
-    /// reference as much as the run.
+    /// The error is at least ten times `floor`; below, it measures the reference or the
+    /// run's rounding as much as its method.
     pub resolved: bool,
+    /// The larger of the reference's uncertainty and the rounding RK4 shows at this step
+    /// (fraction of the cloth's size; see [`super::Reference::floor`]).
+    pub floor: f64,
     /// Wall-clock seconds per simulated second (measured; varies from run to run).
     pub wall_s_per_sim_s: f64,
     /// The counted work per simulated second, in force evaluations of this cloth (see
@@ -36,6 +39,23 @@ pub struct Point {
     pub linear_iterations_per_step: f64,
     /// Constraint (XPBD) or descent (VBD) sweeps per step.
     pub sweeps_per_step: f64,
+}
+
+impl Point {
+    /// The substeps per frame as a whole number, where the frame holds this step a whole
+    /// number of times (to the f32 rounding of the frame's length); `None` for steps such
+    /// as √2 substeps a frame.
+    pub fn whole_substeps(&self) -> Option<u32> {
+        let n = self.substeps_per_frame;
+        let whole = n >= 0.5 && (n - n.round()).abs() <= 1e-4 * n;
+        whole.then(|| n.round() as u32)
+    }
+
+    /// What the error is known to be below: the error where resolved, else ten times the
+    /// floor it is lost in. The frontier and the choice rank points by it.
+    pub fn error_bound(&self) -> f64 {
+        self.max_error.max(super::RESOLVED * self.floor)
+    }
 }
 
 #[cfg(test)]
@@ -53,6 +73,7 @@ impl Point {
             energy_drift: 0.0,
             stable,
             resolved: true,
+            floor: 0.0,
             wall_s_per_sim_s: 1.0 / cost,
             work_per_sim_s: cost,
             force_evals_per_step: 1.0,

@@ -135,6 +135,7 @@ pub fn measure(
         energy_drift,
         stable: damped.finite && energy.finite && bounded && max_error < 1.0,
         resolved: max_error >= RESOLVED * reference.1.floor(damped.h),
+        floor: reference.1.floor(damped.h),
         wall_s_per_sim_s: damped.wall / config.seconds,
         work_per_sim_s: steps_per_sim_s * config.unit_costs.step(integrator, &work),
         force_evals_per_step: work.force_evals,
@@ -291,7 +292,7 @@ pub fn sweep(
         limits.push(limit);
     }
     let frontier = frontier(&points);
-    let recommendation = recommend(&points, &frontier, config.tolerance);
+    let recommendation = recommend(&points, config.tolerance);
     Ok(AccuracyReport {
         scene: scene.scenario.clone(),
         particles: scene.model.particle_count(),

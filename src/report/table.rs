@@ -74,7 +74,7 @@ pub fn choice_sentence(report: &AccuracyReport) -> String {
     match report.recommended() {
         Some(p) => format!(
             "{} at dt = {:.3e} s ({:.0} substeps per 1/60 s frame): max error {} of the cloth's \
-             size for {:.3e} force evaluations' work per simulated second ({:.3} s of wall \
+             size for {:.3e} force evaluations' work per simulated second ({:.2e} s of wall \
              time per simulated second here)",
             p.integrator,
             p.dt,
@@ -90,17 +90,25 @@ pub fn choice_sentence(report: &AccuracyReport) -> String {
     }
 }
 
+/// Substeps per frame: whole, or to two decimals (√2).
+fn substeps(p: &Point) -> String {
+    match p.whole_substeps() {
+        Some(n) => n.to_string(),
+        None => format!("{:.2}", p.substeps_per_frame),
+    }
+}
+
 fn point_row(out: &mut String, p: &Point, frontier: bool) {
     let _ = writeln!(
         out,
-        "| {} | {:.3e} | {:.0} | {} | {} | {} | {} | {:.3e} | {:.3e} | {:.1} | {:.1} | {:.1} |",
+        "| {} | {:.3e} | {} | {} | {} | {} | {} | {:.3e} | {:.3e} | {:.1} | {:.1} | {:.1} |",
         if frontier {
             format!("**{}**", p.integrator)
         } else {
             p.integrator.to_string()
         },
         p.dt,
-        p.substeps_per_frame,
+        substeps(p),
         percent(p.rms_error),
         if p.resolved || !p.max_error.is_finite() {
             percent(p.max_error)
