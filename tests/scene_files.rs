@@ -61,7 +61,8 @@ fn every_builtin_scene_file_parses_builds_and_round_trips() {
             "crumple",
             "layers",
             "fast-fold",
-            "hanging-bench"
+            "hanging-bench",
+            "orders",
         ]
     );
 }
