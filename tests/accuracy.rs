@@ -281,3 +281,80 @@ fn the_bare_report_shows_every_integrators_order_within_its_band() {
         assert!(!finest(kind).resolved, "{kind} at its finest step");
     }
 }
+
+/// Story: a user about to simulate a stiffer fabric asks how small a step each method
+/// needs. The map's limits follow each method's stability law: symplectic Euler is held by
+/// `ωh < 2`, and `ω ∝ √k`, so its largest stable step falls as `k^(−½)`; explicit Euler
+/// survives only where damping outweighs its energy gain, `h ≲ γ/ω²`, so as `k⁻¹`; implicit
+/// Euler is stable at every step probed. Measured 2026-11-26 from 10 to 100 times the
+/// `orders` scene's stiffness: slopes −0.48 and −1.09.
+#[test]
+fn the_stability_map_follows_each_methods_stability_law() {
+    let scene = Scene::builtin(report::ORDERS_SCENE).unwrap();
+    let config = SweepConfig {
+        integrators: vec![
+            IntegratorKind::ExplicitEuler,
+            IntegratorKind::SemiImplicitEuler,
+            IntegratorKind::ImplicitEuler,
+        ],
+        ..SweepConfig::for_scene(report::ORDERS_SCENE)
+    };
+    let map =
+        report::stability_map(&scene, &config, &[10.0, 31.6, 100.0], &mut |_, _| true).unwrap();
+    assert_eq!(map.points.len(), 9);
+    let slope = |kind| {
+        map.slope(kind)
+            .unwrap_or_else(|| panic!("{kind}: no slope"))
+    };
+    let symplectic = slope(IntegratorKind::SemiImplicitEuler);
+    assert!(
+        (symplectic + 0.5).abs() < 0.1,
+        "symplectic Euler: {symplectic:.2}"
+    );
+    let explicit = slope(IntegratorKind::ExplicitEuler);
+    assert!(
+        (explicit + 1.0).abs() < 0.2,
+        "explicit Euler: {explicit:.2}"
+    );
+    for p in map
+        .points
+        .iter()
+        .filter(|p| p.integrator == IntegratorKind::ImplicitEuler)
+    {
+        assert!(p.at_upper_bound, "{p:?}");
+    }
+    let md = map.markdown();
+    assert!(md.contains("| 100 | 800.000 |"), "{md}");
+}
+
+/// Story: should XPBD or VBD spend a frame's sweeps on substeps or on iterations? Macklin et
+/// al.'s answer (SCA 2019) holds here: n substeps of one sweep make the error fall at first
+/// order, while one substep of n sweeps converges to that substep's implicit step and its
+/// error stops falling, so the small steps win at every budget.
+#[test]
+fn small_steps_beat_iterations_at_every_budget_and_iterations_plateau() {
+    let scene = Scene::builtin(report::ORDERS_SCENE).unwrap();
+    let config = SweepConfig::for_scene(report::ORDERS_SCENE);
+    let grid = report::small_steps(&scene, &config, &mut |_, _| true).unwrap();
+    let duels = grid.duels();
+    assert_eq!(duels.len(), 10);
+    for d in &duels {
+        assert!(d.small_steps_win(), "{d:?}");
+    }
+    for kind in [IntegratorKind::Xpbd, IntegratorKind::Vbd] {
+        let mine: Vec<&report::Duel> = duels.iter().filter(|d| d.integrator == kind).collect();
+        // n × 1: halving the step halves the error, near enough (first order).
+        for pair in mine.windows(2) {
+            let ratio = pair[0].small_steps / pair[1].small_steps;
+            assert!((1.5..2.3).contains(&ratio), "{kind}: {ratio:.2} ({pair:?})");
+        }
+        // 1 × n: 16 and 32 sweeps give the same step to within 1 %.
+        let (a, b) = (mine[3].many_iterations, mine[4].many_iterations);
+        assert!((a / b - 1.0).abs() < 0.01, "{kind}: {a} then {b}");
+    }
+    assert!(
+        grid.verdict()
+            .iter()
+            .all(|v| v.contains("small steps win at every budget"))
+    );
+}

@@ -898,3 +898,31 @@ fn an_obj_can_be_added_as_an_obstacle_by_drop_or_by_path() {
     harness.run_steps(2);
     assert_eq!(harness.state().sim().effects().len(), effects + 2);
 }
+
+/// Story: in the Accuracy window a user asks for the stability map and for small steps on
+/// the `orders` scene; each runs in the background and its answer appears in the window.
+#[test]
+fn the_accuracy_window_answers_the_stability_map_and_small_steps() {
+    let mut harness = harness();
+    harness.state_mut().set_scenario("orders");
+    harness.run_steps(2);
+    harness.get_by_label("Accuracy").click();
+    harness.run_steps(2);
+    harness.get_by_label("Small steps").click();
+    harness.run_steps(1);
+    assert!(harness.state().accuracy.is_running());
+    harness.state_mut().accuracy.wait();
+    harness.run_steps(2);
+    let grid = harness.state().accuracy.extras.small_steps.clone();
+    let grid = grid.expect("small steps answered");
+    assert_eq!(grid.scene, "orders");
+    harness.get_by_label_contains("XPBD: small steps win");
+    harness.get_by_label("Stability map").click();
+    harness.run_steps(1);
+    harness.state_mut().accuracy.wait();
+    harness.run_steps(2);
+    let map = harness.state().accuracy.extras.map.clone().expect("a map");
+    let kinds = clothsim::sim::IntegratorKind::ALL.len();
+    assert_eq!(map.points.len(), kinds * clothsim::report::MAP_SCALES.len());
+    harness.get_by_label_contains("Stability map (fewest stable substeps");
+}

@@ -9,11 +9,19 @@ use std::sync::{Arc, Mutex};
 use egui::{Color32, RichText};
 use egui_plot::{HLine, Legend, Line, LineStyle, Plot, PlotPoints, Points};
 
+use super::accuracy_extras::{Extras, Question};
 use crate::report::{
     AccuracyReport, Progress, ReportError, SweepConfig, integrator_color, recommend, sweep,
 };
 use crate::scene::Scene;
 use crate::sim::{IntegratorKind, SimParams};
+
+/// What the window asks to start.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Start {
+    Sweep,
+    Question(Question),
+}
 
 /// A sweep running on its own thread.
 struct Job {
@@ -28,6 +36,8 @@ pub struct AccuracyWindow {
     /// The sweep the window runs (the CLI's defaults, on one thread).
     pub config: SweepConfig,
     job: Option<Job>,
+    /// The stability map and small steps, when asked.
+    pub extras: Extras,
     pub report: Option<AccuracyReport>,
     /// Tolerance the user typed, as a fraction of the cloth's size.
     pub tolerance: f64,
@@ -43,6 +53,7 @@ impl Default for AccuracyWindow {
                 ..SweepConfig::default()
             },
             job: None,
+            extras: Extras::default(),
             report: None,
             tolerance: crate::report::DEFAULT_TOLERANCE,
             error: None,
@@ -51,6 +62,29 @@ impl Default for AccuracyWindow {
 }
 
 impl AccuracyWindow {
+    /// The sweep's configuration for `scene`: the window's, or, left as it came, the scene's
+    /// own (the `orders` scene's spans the steps its orders need); one thread.
+    fn config_for(&self, scene: &Scene) -> SweepConfig {
+        let base = if self.config == Self::default().config {
+            SweepConfig {
+                parallel_reference: false,
+                ..SweepConfig::for_scene(&scene.scenario)
+            }
+        } else {
+            self.config.clone()
+        };
+        SweepConfig {
+            tolerance: self.tolerance,
+            ..base
+        }
+    }
+
+    /// Asks the stability map or small steps about `scene` in the background.
+    pub fn ask(&mut self, question: Question, scene: Scene) {
+        let config = self.config_for(&scene);
+        self.extras.start(question, scene, config);
+    }
+
     /// Starts a sweep of `scene` in the background (one thread, so the viewport keeps a core).
     pub fn start(&mut self, scene: Scene) {
         let progress = Arc::new(Mutex::new(Progress {
@@ -60,20 +94,7 @@ impl AccuracyWindow {
         }));
         let cancel = Arc::new(AtomicBool::new(false));
         let (tx, rx) = channel();
-        // Left as it came, the sweep is the scene's own (the `orders` scene's spans the steps
-        // its orders need).
-        let base = if self.config == Self::default().config {
-            SweepConfig {
-                parallel_reference: false,
-                ..SweepConfig::for_scene(&scene.scenario)
-            }
-        } else {
-            self.config.clone()
-        };
-        let config = SweepConfig {
-            tolerance: self.tolerance,
-            ..base
-        };
+        let config = self.config_for(&scene);
         let (p, c) = (progress.clone(), cancel.clone());
         std::thread::spawn(move || {
             let result = sweep(&scene, &config, &mut |now| {
@@ -93,7 +114,7 @@ impl AccuracyWindow {
     }
 
     pub fn is_running(&self) -> bool {
-        self.job.is_some()
+        self.job.is_some() || self.extras.is_running()
     }
 
     /// Asks a running sweep to stop.
@@ -103,8 +124,9 @@ impl AccuracyWindow {
         }
     }
 
-    /// Collects a finished sweep.
+    /// Collects a finished sweep or question.
     pub fn poll(&mut self) {
+        self.extras.poll();
         let Some(job) = &self.job else { return };
         if let Ok(result) = job.result.try_recv() {
             match result {
@@ -115,8 +137,9 @@ impl AccuracyWindow {
         }
     }
 
-    /// Waits for a running sweep (tests).
+    /// Waits for a running sweep and question (tests).
     pub fn wait(&mut self) {
+        self.extras.wait();
         if let Some(job) = self.job.take() {
             match job.result.recv() {
                 Ok(Ok(report)) => self.report = Some(report),
@@ -144,9 +167,13 @@ impl AccuracyWindow {
 
     /// Draws the window; returns parameters to apply when the user asked for it, and
     /// whether a sweep should start.
-    pub fn ui(&mut self, ctx: &egui::Context, params: &SimParams) -> (Option<SimParams>, bool) {
+    pub fn ui(
+        &mut self,
+        ctx: &egui::Context,
+        params: &SimParams,
+    ) -> (Option<SimParams>, Option<Start>) {
         let mut apply = None;
-        let mut start = false;
+        let mut start = None;
         let mut open = self.open;
         egui::Window::new("Accuracy")
             .open(&mut open)
@@ -161,7 +188,7 @@ impl AccuracyWindow {
                             self.cancel();
                         }
                     } else if ui.button("Run sweep").clicked() {
-                        start = true;
+                        start = Some(Start::Sweep);
                     }
                 });
                 if let Some(e) = &self.error {
@@ -189,6 +216,9 @@ impl AccuracyWindow {
                         None => {}
                     }
                 });
+                if let Some(question) = self.extras.ui(ui) {
+                    start = Some(Start::Question(question));
+                }
                 if let Some(report) = &self.report {
                     plot(ui, report, self.tolerance);
                     orders(ui, report);

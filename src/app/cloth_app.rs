@@ -9,7 +9,7 @@ use crate::scene::{Scene, Simulation};
 use crate::sim::{Effect, GuardAction, PhaseTimings, SimParams};
 use crate::view;
 
-use super::accuracy::AccuracyWindow;
+use super::accuracy::{AccuracyWindow, Start};
 use super::background::{Load, PngWriter};
 use super::messages::{Level, Message};
 use super::panel::{Action, Panel, PanelContext, Status};
@@ -714,8 +714,10 @@ impl ClothApp {
             return;
         }
         let (apply, start) = self.accuracy.ui(ctx, self.sim.params());
-        if start {
-            self.accuracy.start(self.sim.to_scene());
+        match start {
+            Some(Start::Sweep) => self.accuracy.start(self.sim.to_scene()),
+            Some(Start::Question(q)) => self.accuracy.ask(q, self.sim.to_scene()),
+            None => {}
         }
         if let Some(params) = apply {
             let text = format!(

@@ -2,6 +2,7 @@
 //! drives the library and never re-implements it.
 
 mod accuracy;
+mod accuracy_extras;
 mod background;
 mod cloth_app;
 mod files;

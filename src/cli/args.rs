@@ -116,6 +116,14 @@ pub enum Command {
         /// ones the report uses.
         #[arg(long)]
         calibrate: bool,
+        /// Also: each integrator's largest stable step against the springs' stiffness, a
+        /// tenth to a hundred times the scene's (stability-map.csv, .md, .png).
+        #[arg(long)]
+        map: bool,
+        /// Also: XPBD and VBD over substeps × sweeps per substep, and n substeps of one
+        /// sweep against one substep of n sweeps (small-steps.csv, .md).
+        #[arg(long)]
+        small_steps: bool,
     },
     /// Speed on the `hanging-bench` scene: µs per substep and the sag after 2 s for each
     /// size × integrator × thread count (the scene the peer frameworks run too). µs per

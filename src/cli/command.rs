@@ -68,6 +68,8 @@ pub fn run(cli: Cli) -> Result<()> {
             tolerance,
             out,
             calibrate,
+            map,
+            small_steps,
         }) => {
             if calibrate {
                 return super::accuracy::calibrate(&scene, obj.as_deref());
@@ -88,7 +90,8 @@ pub fn run(cli: Cli) -> Result<()> {
             if let Some(list) = dts {
                 config.dts = list;
             }
-            accuracy(&scene, obj.as_deref(), &config, &out)
+            let extras = super::accuracy::Extras { map, small_steps };
+            accuracy(&scene, obj.as_deref(), &config, extras, &out)
         }
         Some(Command::Grid {
             quads,

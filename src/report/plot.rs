@@ -27,7 +27,8 @@ pub fn integrator_color(kind: IntegratorKind) -> (u8, u8, u8) {
     COLORS[i % COLORS.len()]
 }
 
-fn register_font() {
+/// Registers the font the plots' text uses (once).
+pub(super) fn register_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         // The font egui ships with: no system font lookup, the same text on every machine.
@@ -209,7 +210,8 @@ fn chart(
 }
 
 /// `(min · below, max · above)` of positive values, or a unit decade without any.
-fn range(values: &[f64], below: f64, above: f64) -> (f64, f64) {
+/// The positive values' range, widened by `below` and `above` (factors).
+pub(super) fn range(values: &[f64], below: f64, above: f64) -> (f64, f64) {
     let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = values.iter().copied().fold(0.0, f64::max);
     if lo.is_finite() && hi > 0.0 {
