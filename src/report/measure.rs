@@ -5,7 +5,7 @@ use std::time::Instant;
 use glam::Vec3;
 
 use crate::scene::{Scene, Simulation};
-use crate::sim::{Effect, IntegratorKind, StepStats};
+use crate::sim::{Effect, IntegratorKind, StepStats, intersections, min_surface_distance};
 
 /// Speed (m/s) past which a run is stopped and counted as unstable: a hundred times any
 /// speed in the scenes, so only a blow-up gets there.
@@ -18,6 +18,40 @@ pub enum Record {
     Positions,
     /// Total mechanical energy and kinetic energy (for drift and stability).
     Energy,
+}
+
+/// What a run's contacts let through.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ContactMeasures {
+    /// Deepest penetration of a particle into a sphere or plane, metres (0: none).
+    pub deepest_penetration: f64,
+    /// Most intersecting triangle pairs (the cloth's own, and against each solid) at one
+    /// sample time.
+    pub intersections: usize,
+}
+
+impl ContactMeasures {
+    /// The measures of the cloth at `pos` among `effects` at time `t`, or `None` when the
+    /// scene has nothing to pass through (no solid, no self-collision).
+    pub fn of(effects: &[Effect], triangles: &[[u32; 3]], pos: &[Vec3], t: f64) -> Option<Self> {
+        let contact = |e: &Effect| e.is_solid() || matches!(e, Effect::SelfCollision(_));
+        if !effects.iter().any(contact) {
+            return None;
+        }
+        let inside = min_surface_distance(effects, pos).map_or(0.0, |d| (-d).max(0.0));
+        Some(Self {
+            deepest_penetration: inside as f64,
+            intersections: intersections(effects, t, triangles, pos).total(),
+        })
+    }
+
+    /// The worse of two.
+    fn worst(self, other: Self) -> Self {
+        Self {
+            deepest_penetration: self.deepest_penetration.max(other.deepest_penetration),
+            intersections: self.intersections.max(other.intersections),
+        }
+    }
 }
 
 /// A run of `seconds` split into equal sample intervals, each of whole steps.
@@ -39,6 +73,10 @@ pub struct Trajectory {
     pub kinetic: Vec<f64>,
     /// False when the state went non-finite, a solve failed, or it blew up.
     pub finite: bool,
+    /// On a scene with solids or self-collision (with [`Record::Positions`]): the deepest
+    /// any particle was inside a sphere or plane at a sample time (metres, 0 when none was),
+    /// and the most intersecting triangle pairs at one ([`crate::sim::intersections()`]).
+    pub contact: Option<ContactMeasures>,
     /// Wall time of the stepping alone, seconds.
     pub wall: f64,
     pub stats: StepStats,
@@ -113,6 +151,7 @@ pub fn run(
         energy: Vec::new(),
         kinetic: Vec::new(),
         finite: true,
+        contact: None,
         wall: 0.0,
         stats: StepStats::default(),
     };
@@ -135,7 +174,19 @@ pub fn run(
             break 'samples;
         }
         match record {
-            Record::Positions => out.positions.push(state.pos.clone()),
+            Record::Positions => {
+                let now = ContactMeasures::of(
+                    sim.effects(),
+                    &sim.model().triangles,
+                    &state.pos,
+                    state.time,
+                );
+                out.contact = match (out.contact, now) {
+                    (Some(a), Some(b)) => Some(a.worst(b)),
+                    (a, b) => a.or(b),
+                };
+                out.positions.push(state.pos.clone());
+            }
             Record::Energy => {
                 out.energy.push(sim.energy());
                 out.kinetic.push(state.kinetic_energy(sim.model()));

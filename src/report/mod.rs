@@ -24,7 +24,9 @@ pub use files::{write_map, write_report, write_small_steps};
 pub use frontier::{COST_RESOLUTION, frontier, recommend};
 pub use map::{MAP_SCALES, MapPoint, StabilityMap, stability_map};
 pub use map_plot::draw_map;
-pub use measure::{BLOW_UP_SPEED, Record, Trajectory, position_error, run, undamped};
+pub use measure::{
+    BLOW_UP_SPEED, ContactMeasures, Record, Trajectory, position_error, run, undamped,
+};
 pub use order::{ASYMPTOTIC_ERROR, ObservedOrder, RESOLVED, observed_order};
 pub use plot::{PLOT_SIZE, draw, integrator_color};
 pub use point::Point;

@@ -39,6 +39,9 @@ pub struct Point {
     pub linear_iterations_per_step: f64,
     /// Constraint (XPBD) or descent (VBD) sweeps per step.
     pub sweeps_per_step: f64,
+    /// On a scene with solids or self-collision: the deepest penetration and the most
+    /// intersections at a sample time.
+    pub contact: Option<super::ContactMeasures>,
 }
 
 impl Point {
@@ -79,6 +82,7 @@ impl Point {
             force_evals_per_step: 1.0,
             linear_iterations_per_step: 0.0,
             sweeps_per_step: 0.0,
+            contact: None,
         }
     }
 }

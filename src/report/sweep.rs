@@ -141,6 +141,7 @@ pub fn measure(
         force_evals_per_step: work.force_evals,
         linear_iterations_per_step: work.linear_iterations,
         sweeps_per_step: work.sweeps,
+        contact: damped.contact,
     }
 }
 

@@ -6,7 +6,7 @@ use super::point::Point;
 use super::sweep::AccuracyReport;
 
 /// CSV columns, in order.
-pub const CSV_COLUMNS: [&str; 15] = [
+pub const CSV_COLUMNS: [&str; 17] = [
     "integrator",
     "dt",
     "steps",
@@ -22,6 +22,8 @@ pub const CSV_COLUMNS: [&str; 15] = [
     "sweeps_per_step",
     "substeps_per_frame",
     "on_frontier",
+    "deepest_penetration_m",
+    "intersections",
 ];
 
 fn sci(x: f64) -> String {
@@ -38,7 +40,7 @@ pub fn csv(report: &AccuracyReport) -> String {
     for (i, p) in report.points.iter().enumerate() {
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{:.2},{}",
+            "{},{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{:.2},{},{},{}",
             p.integrator,
             sci(p.dt),
             p.steps,
@@ -54,6 +56,10 @@ pub fn csv(report: &AccuracyReport) -> String {
             p.sweeps_per_step,
             p.substeps_per_frame,
             report.frontier.contains(&i),
+            p.contact
+                .map_or("n/a".into(), |c| sci(c.deepest_penetration)),
+            p.contact
+                .map_or("n/a".into(), |c| c.intersections.to_string()),
         );
     }
     out
@@ -98,7 +104,7 @@ fn substeps(p: &Point) -> String {
     }
 }
 
-fn point_row(out: &mut String, p: &Point, frontier: bool) {
+fn point_row(out: &mut String, p: &Point, frontier: bool, contact: bool) {
     let _ = writeln!(
         out,
         "| {} | {:.3e} | {} | {} | {} | {} | {} | {:.3e} | {:.3e} | {:.1} | {:.1} | {:.1} |",
@@ -127,6 +133,18 @@ fn point_row(out: &mut String, p: &Point, frontier: bool) {
         p.linear_iterations_per_step,
         p.sweeps_per_step,
     );
+    if contact {
+        // The row's last cell is written above; the contact cells go before its newline.
+        out.pop();
+        let _ = writeln!(
+            out,
+            " {} | {} |",
+            p.contact
+                .map_or("—".into(), |c| format!("{:.1e}", c.deepest_penetration)),
+            p.contact
+                .map_or("—".into(), |c| c.intersections.to_string())
+        );
+    }
 }
 
 /// Readable tables: the choice, the reference, the largest stable steps, every run and the
@@ -221,13 +239,31 @@ pub fn markdown(report: &AccuracyReport) -> String {
         out,
         "Frontier points (no other run is both cheaper and more accurate) in bold.\n"
     );
+    let contact = report.points.iter().any(|p| p.contact.is_some());
+    if contact {
+        let _ = writeln!(
+            out,
+            "On this scene's solids and self-contact each run also reports the deepest any \
+             particle got inside a sphere or plane (m) and the most intersecting triangle \
+             pairs at a sample time.\n"
+        );
+    }
     let _ = writeln!(
         out,
-        "| integrator | dt (s) | substeps/frame | RMS error | max error | energy drift | stable | work / sim s | wall s / sim s | force evals / step | CG iterations / step | sweeps / step |"
+        "| integrator | dt (s) | substeps/frame | RMS error | max error | energy drift | stable | work / sim s | wall s / sim s | force evals / step | CG iterations / step | sweeps / step |{}",
+        if contact {
+            " deepest penetration (m) | intersections |"
+        } else {
+            ""
+        }
     );
-    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(
+        out,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|{}",
+        if contact { "---|---|" } else { "" }
+    );
     for (i, p) in report.points.iter().enumerate() {
-        point_row(&mut out, p, report.frontier.contains(&i));
+        point_row(&mut out, p, report.frontier.contains(&i), contact);
     }
     let _ = writeln!(out, "\n## Frontier, cheapest first\n");
     for &i in &report.frontier {
