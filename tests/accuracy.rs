@@ -240,6 +240,7 @@ fn the_bare_report_shows_every_integrators_order_within_its_band() {
         ..SweepConfig::for_scene(report::ORDERS_SCENE)
     };
     let report = report::sweep(&scene, &config, &mut |_| true).unwrap();
+    assert_eq!(report.reference.judged, report::Judged::Trajectory);
     for limit in &report.limits {
         let kind = limit.integrator;
         let fit = limit
@@ -407,4 +408,46 @@ fn on_a_scene_with_a_collider_each_run_reports_what_it_let_through() {
     let orders = Scene::builtin(report::ORDERS_SCENE).unwrap();
     let none = report::ContactMeasures::of(&orders.effects, &orders.model.triangles, &pos, 0.0);
     assert_eq!(none, None);
+}
+
+/// Story: a user sweeps a scene whose folds turn chaotic within the horizon (`hanging` over
+/// 1.5 s, on a coarser cloth): the reference cannot agree with itself about where the
+/// particles are, so position errors would measure nothing. The report says so, judges runs
+/// by the shape in aggregate (centre of mass and spread against the reference's), and that
+/// measure still converges: implicit Euler's shape error falls as its step shrinks.
+#[test]
+fn a_chaotic_scene_is_judged_by_its_shape_and_says_so() {
+    let mesh = GridSpec::square(12, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
+        .build()
+        .unwrap();
+    let scene = Scene::with_cloth("hanging", &MeshBuild::from(mesh), "grid").unwrap();
+    let config = SweepConfig {
+        integrators: vec![IntegratorKind::ImplicitEuler],
+        dts: [6.0, 12.0, 24.0, 48.0]
+            .iter()
+            .map(|n| 1.0 / (60.0 * n))
+            .collect(),
+        seconds: 1.5,
+        samples: 15,
+        bisection_steps: 0,
+        ..SweepConfig::default()
+    };
+    let report = report::sweep(&scene, &config, &mut |_| true).unwrap();
+    let r = &report.reference;
+    assert_eq!(r.judged, report::Judged::Shape, "{r:?}");
+    assert!(10.0 * r.check_max > config.tolerance);
+    assert!(
+        r.check_shape < 0.1 * r.check_max,
+        "the shape is surer: {r:?}"
+    );
+    let shape: Vec<f64> = report.points.iter().map(|p| p.shape_error).collect();
+    for pair in shape.windows(2) {
+        assert!(pair[1] < 0.8 * pair[0], "shape errors {shape:?}");
+    }
+    let md = report::markdown(&report);
+    assert!(md.contains("Judged by shape"));
+    // The choice is by the shape error, within the tolerance.
+    if let Some(p) = report.recommended() {
+        assert!(p.error_bound() <= config.tolerance && p.shape_error <= config.tolerance);
+    }
 }

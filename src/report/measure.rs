@@ -83,6 +83,23 @@ pub struct Trajectory {
 }
 
 impl Trajectory {
+    /// A run of `integrator` that has not started: no steps, no samples, finite.
+    pub fn empty(integrator: IntegratorKind) -> Self {
+        Self {
+            integrator,
+            h: 0.0,
+            steps_per_sample: 0,
+            steps: 0,
+            positions: Vec::new(),
+            energy: Vec::new(),
+            kinetic: Vec::new(),
+            finite: true,
+            contact: None,
+            wall: 0.0,
+            stats: StepStats::default(),
+        }
+    }
+
     /// Largest deviation of the total energy from its start, joules (infinite if the run
     /// did not stay finite).
     pub fn energy_deviation(&self) -> f64 {
@@ -143,17 +160,9 @@ pub fn run(
     scene.params.step.substeps = steps_per_sample;
     let mut sim = Simulation::new(scene);
     let mut out = Trajectory {
-        integrator,
         h: interval / steps_per_sample as f64,
         steps_per_sample,
-        steps: 0,
-        positions: Vec::new(),
-        energy: Vec::new(),
-        kinetic: Vec::new(),
-        finite: true,
-        contact: None,
-        wall: 0.0,
-        stats: StepStats::default(),
+        ..Trajectory::empty(integrator)
     };
     if record == Record::Energy {
         out.energy.push(sim.energy());

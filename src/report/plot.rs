@@ -72,12 +72,15 @@ fn chart(
         .map(|p| p.work_per_sim_s)
         .filter(|&c| finite(c))
         .collect();
-    let floor = report.reference.check_max;
+    let floor = match report.reference.judged {
+        crate::report::Judged::Trajectory => report.reference.check_max,
+        crate::report::Judged::Shape => report.reference.check_shape,
+    };
     let errors: Vec<f64> = report
         .points
         .iter()
         .filter(|p| p.stable)
-        .map(|p| p.max_error)
+        .map(|p| p.judged_error().0)
         .chain([report.tolerance, floor])
         .filter(|&e| finite(e))
         .collect();
@@ -100,7 +103,10 @@ fn chart(
     chart
         .configure_mesh()
         .x_desc("cost: work per simulated second, in force evaluations of this cloth")
-        .y_desc("max position error / cloth size")
+        .y_desc(match report.reference.judged {
+            crate::report::Judged::Trajectory => "max position error / cloth size",
+            crate::report::Judged::Shape => "shape error (centre of mass, spread) / cloth size",
+        })
         .x_label_formatter(&|x| format!("{x:.0e}"))
         .y_label_formatter(&|y| format!("{y:.0e}"))
         .label_style(("sans-serif", 18))
@@ -137,7 +143,12 @@ fn chart(
     let frontier: Vec<(f64, f64)> = report
         .frontier
         .iter()
-        .map(|&i| (report.points[i].work_per_sim_s, report.points[i].max_error))
+        .map(|&i| {
+            (
+                report.points[i].work_per_sim_s,
+                report.points[i].judged_error().0,
+            )
+        })
         .collect();
     let shade = BLACK.mix(0.3);
     chart
@@ -152,8 +163,8 @@ fn chart(
             })
         };
         let mut line: Vec<(f64, f64)> = mine(true)
-            .filter(|p| finite(p.max_error))
-            .map(|p| (p.work_per_sim_s, p.max_error))
+            .filter(|p| finite(p.judged_error().0))
+            .map(|p| (p.work_per_sim_s, p.judged_error().0))
             .collect();
         let unstable: Vec<f64> = mine(false).map(|p| p.work_per_sim_s).collect();
         if line.is_empty() && unstable.is_empty() {
@@ -170,7 +181,7 @@ fn chart(
         // Resolved errors filled, unresolved ones (within ten times the floor) hollow.
         let resolved: Vec<bool> = {
             let mut mine: Vec<&crate::report::Point> =
-                mine(true).filter(|p| finite(p.max_error)).collect();
+                mine(true).filter(|p| finite(p.judged_error().0)).collect();
             mine.sort_by(|a, b| a.work_per_sim_s.total_cmp(&b.work_per_sim_s));
             mine.iter().map(|p| p.resolved).collect()
         };
@@ -264,6 +275,8 @@ mod tests {
                 dt: 1e-5,
                 check_rms: 1e-10,
                 check_max: 1e-10,
+                check_shape: 1e-10,
+                judged: crate::report::Judged::Trajectory,
                 peak_kinetic: 1.0,
                 ladder: Vec::new(),
                 rounding: Vec::new(),

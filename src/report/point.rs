@@ -29,6 +29,16 @@ pub struct Point {
     /// The larger of the reference's uncertainty and the rounding RK4 shows at this step
     /// (fraction of the cloth's size; see [`super::Reference::floor`]).
     pub floor: f64,
+    /// How far the shape in aggregate strays from the reference's (centre of mass and
+    /// spread, fraction of the cloth's size; see [`super::shape_error`]), and the mean
+    /// structural strain's largest difference.
+    pub shape_error: f64,
+    pub strain_error: f64,
+    /// The reference's own uncertainty in shape.
+    pub shape_floor: f64,
+    /// What the report judges this run by: its position error, or (on a scene chaotic over
+    /// the horizon) its shape error.
+    pub judged: super::Judged,
     /// Wall-clock seconds per simulated second (measured; varies from run to run).
     pub wall_s_per_sim_s: f64,
     /// The counted work per simulated second, in force evaluations of this cloth (see
@@ -54,10 +64,19 @@ impl Point {
         whole.then(|| n.round() as u32)
     }
 
-    /// What the error is known to be below: the error where resolved, else ten times the
-    /// floor it is lost in. The frontier and the choice rank points by it.
+    /// The error the run is judged by ([`Point::judged`]) and the floor it may be lost in.
+    pub fn judged_error(&self) -> (f64, f64) {
+        match self.judged {
+            super::Judged::Trajectory => (self.max_error, self.floor),
+            super::Judged::Shape => (self.shape_error, self.shape_floor),
+        }
+    }
+
+    /// What the judged error is known to be below: the error where resolved, else ten
+    /// times the floor it is lost in. The frontier and the choice rank points by it.
     pub fn error_bound(&self) -> f64 {
-        self.max_error.max(super::RESOLVED * self.floor)
+        let (error, floor) = self.judged_error();
+        error.max(super::RESOLVED * floor)
     }
 }
 
@@ -77,6 +96,10 @@ impl Point {
             stable,
             resolved: true,
             floor: 0.0,
+            shape_error: error,
+            strain_error: 0.0,
+            shape_floor: 0.0,
+            judged: super::Judged::Trajectory,
             wall_s_per_sim_s: 1.0 / cost,
             work_per_sim_s: cost,
             force_evals_per_step: 1.0,

@@ -7,6 +7,8 @@ use crate::sim::IntegratorKind;
 
 use super::config::SweepConfig;
 use super::measure::{Record, Trajectory, position_error, run, undamped};
+use super::order::RESOLVED;
+use super::shape::{Judged, shape_error};
 
 /// The reference's finest candidate step is this many times below the smallest swept step.
 pub const REFERENCE_REFINEMENT: f64 = 4.0;
@@ -21,6 +23,11 @@ pub struct Reference {
     /// the same method at twice its step: its uncertainty.
     pub check_rms: f64,
     pub check_max: f64,
+    /// The same pair's difference in shape ([`super::shape_error`]: fraction of the cloth's
+    /// size), the uncertainty of shape errors.
+    pub check_shape: f64,
+    /// What runs are judged by (see [`Reference::judge`]).
+    pub judged: Judged,
     /// Peak kinetic energy of the undamped scene, joules: the scale of energy drift.
     pub peak_kinetic: f64,
     /// Every candidate step but the finest (seconds), and how far its run is from the run at
@@ -33,6 +40,18 @@ pub struct Reference {
 }
 
 impl Reference {
+    /// Decides what runs are judged by for `tolerance`: their trajectories, unless the
+    /// reference is too unsure of its own to resolve an error at the tolerance (ten times
+    /// its uncertainty above it): then the trajectory is chaotic over the horizon, and runs
+    /// are judged by the shape in aggregate.
+    pub fn judge(&mut self, tolerance: f64) {
+        self.judged = if RESOLVED * self.check_max > tolerance {
+            Judged::Shape
+        } else {
+            Judged::Trajectory
+        };
+    }
+
     /// Below this error (a fraction of the cloth's size) a run at step `dt` measures the
     /// reference's uncertainty or its own rounding as much as its method: the larger of the
     /// reference's uncertainty and the rounding at the candidate step nearest `dt` (for
@@ -125,6 +144,10 @@ pub fn reference(scene: &Scene, config: &SweepConfig) -> (Trajectory, Reference)
     let ladder = (1..runs.len())
         .map(|j| (runs[j].h, differences[j - 1].1))
         .collect();
+    let check_shape = match best {
+        Some(j) => shape_error(&scene.model, &runs[j + 1], &runs[j], size).0,
+        None => f64::INFINITY,
+    };
     let rounding = (0..chosen)
         .map(|j| (runs[j].h, position_error(&runs[j], &runs[chosen]).1 / size))
         .collect();
@@ -135,6 +158,8 @@ pub fn reference(scene: &Scene, config: &SweepConfig) -> (Trajectory, Reference)
         dt: main.h,
         check_rms,
         check_max,
+        check_shape,
+        judged: Judged::Trajectory,
         peak_kinetic: energy.peak_kinetic(),
         ladder,
         rounding,
@@ -156,6 +181,8 @@ mod tests {
             dt: 1e-3,
             check_rms: 1e-7,
             check_max: 2e-7,
+            check_shape: 1e-7,
+            judged: Judged::Trajectory,
             peak_kinetic: 1.0,
             ladder: Vec::new(),
             rounding: vec![(1.25e-4, 3e-6), (2.5e-4, 1e-6), (5e-4, 1e-7)],

@@ -54,7 +54,8 @@ pub fn small_steps(
         ..config.clone()
     };
     config.validate()?;
-    let (trajectory, info) = reference(scene, &config);
+    let (trajectory, mut info) = reference(scene, &config);
+    info.judge(config.tolerance);
     let kinds = [IntegratorKind::Xpbd, IntegratorKind::Vbd];
     let total = kinds.len() * SMALL_STEPS_AXIS.len() * SMALL_STEPS_AXIS.len();
     let mut runs = Vec::with_capacity(total);

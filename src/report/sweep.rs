@@ -12,6 +12,7 @@ use super::measure::{Record, Trajectory, position_error, run};
 use super::order::{ObservedOrder, RESOLVED, observed_order};
 use super::point::Point;
 use super::reference::{Reference, reference, scene_size};
+use super::shape::{Judged, shape_error};
 
 /// The largest step at which an integrator stayed stable.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -119,6 +120,8 @@ pub fn measure(
         Record::Energy,
     );
     let (rms, max) = position_error(&damped, reference.0);
+    let info = reference.1;
+    let (shape_error, strain_error) = shape_error(&scene.model, &damped, reference.0, size);
     let scale = reference.1.peak_kinetic.max(1e-12);
     let energy_drift = energy.energy_deviation() / scale;
     let bounded = energy.energy_growth() <= scale;
@@ -134,8 +137,15 @@ pub fn measure(
         max_error,
         energy_drift,
         stable: damped.finite && energy.finite && bounded && max_error < 1.0,
-        resolved: max_error >= RESOLVED * reference.1.floor(damped.h),
-        floor: reference.1.floor(damped.h),
+        resolved: match info.judged {
+            Judged::Trajectory => max_error >= RESOLVED * info.floor(damped.h),
+            Judged::Shape => shape_error >= RESOLVED * info.check_shape,
+        },
+        floor: info.floor(damped.h),
+        shape_error,
+        strain_error,
+        shape_floor: info.check_shape,
+        judged: info.judged,
         wall_s_per_sim_s: damped.wall / config.seconds,
         work_per_sim_s: steps_per_sim_s * config.unit_costs.step(integrator, &work),
         force_evals_per_step: work.force_evals,
@@ -256,7 +266,8 @@ pub fn sweep(
         total: 1 + config.integrators.len() * per_integrator,
         callback: progress,
     };
-    let (reference_run, reference) = reference(scene, config);
+    let (reference_run, mut reference) = reference(scene, config);
+    reference.judge(config.tolerance);
     tracker.step(format!("reference: RK4 at {:.2e} s", reference.dt))?;
     let mut points = Vec::new();
     for &integrator in &config.integrators {
@@ -287,7 +298,7 @@ pub fn sweep(
         )?;
         let runs: Vec<(f64, f64)> = (mine.iter())
             .filter(|p| p.stable && p.resolved)
-            .map(|p| (p.dt, p.max_error))
+            .map(|p| (p.dt, p.judged_error().0))
             .collect();
         limit.observed_order = observed_order(&runs);
         limits.push(limit);
