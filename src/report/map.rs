@@ -9,6 +9,8 @@ use crate::sim::IntegratorKind;
 use super::config::SweepConfig;
 use super::error::ReportError;
 use super::measure::{Record, run, undamped};
+use super::order::slope;
+use super::sweep::stable_at;
 
 /// The default stiffness scales: the scene's springs from a tenth to a hundred times as
 /// stiff, three decades in steps of about √10.
@@ -54,17 +56,7 @@ fn largest_stable_step(
     scale: f64,
     upper_bound: f64,
 ) -> (Option<f64>, bool) {
-    let stable = |dt: f64| {
-        let energy = run(
-            scene,
-            integrator,
-            dt,
-            config.seconds,
-            config.samples * 2,
-            Record::Energy,
-        );
-        energy.finite && energy.energy_growth() <= scale
-    };
+    let stable = |dt: f64| stable_at(scene, config, scale, integrator, dt);
     if stable(upper_bound) {
         return (Some(upper_bound), true);
     }
@@ -219,16 +211,6 @@ impl StabilityMap {
             .filter(|p| p.integrator == integrator && !p.at_upper_bound)
             .filter_map(|p| p.dt.map(|dt| (p.stiffness.ln(), dt.ln())))
             .collect();
-        let n = pts.len() as f64;
-        if pts.len() < 2 {
-            return None;
-        }
-        let (mx, my) = (
-            pts.iter().map(|p| p.0).sum::<f64>() / n,
-            pts.iter().map(|p| p.1).sum::<f64>() / n,
-        );
-        let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-        let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-        (sxx > 0.0).then(|| sxy / sxx)
+        slope(&pts)
     }
 }

@@ -29,27 +29,31 @@ pub fn observed_order(runs: &[(f64, f64)]) -> Option<ObservedOrder> {
         .filter(|(_, e)| *e > 0.0 && *e <= ASYMPTOTIC_ERROR)
         .map(|&(dt, e)| (dt.ln(), e.ln()))
         .collect();
-    let n = fitted.len();
-    if n < 2 {
-        return None;
-    }
-    let mean = |f: fn(&(f64, f64)) -> f64| fitted.iter().map(f).sum::<f64>() / n as f64;
-    let (mx, my) = (mean(|p| p.0), mean(|p| p.1));
-    let sxx: f64 = fitted.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = fitted.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    if sxx <= 0.0 {
-        return None;
-    }
+    let order = slope(&fitted)?;
     let (lo, hi) = fitted
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
             (lo.min(p.1), hi.max(p.1))
         });
     Some(ObservedOrder {
-        order: sxy / sxx,
+        order,
         decades: (hi - lo) / std::f64::consts::LN_10,
-        points: n,
+        points: fitted.len(),
     })
+}
+
+/// The least-squares slope of `y` over `x` through `points`; `None` with fewer than two
+/// distinct `x`.
+pub fn slope(points: &[(f64, f64)]) -> Option<f64> {
+    let n = points.len() as f64;
+    if points.len() < 2 {
+        return None;
+    }
+    let mean = |f: fn(&(f64, f64)) -> f64| points.iter().map(f).sum::<f64>() / n;
+    let (mx, my) = (mean(|p| p.0), mean(|p| p.1));
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
 }
 
 #[cfg(test)]

@@ -155,8 +155,9 @@ pub fn measure(
     }
 }
 
-/// Whether `integrator` stays stable (finite, energy bounded) on the undamped scene at `dt`.
-fn stable_at(
+/// Whether `integrator` keeps `scene` (the undamped one) stable at `dt`: finite, and its
+/// energy never gaining more than `peak_kinetic` (joules).
+pub(super) fn stable_at(
     scene: &Scene,
     config: &SweepConfig,
     peak_kinetic: f64,
