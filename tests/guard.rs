@@ -117,6 +117,27 @@ fn the_fallback_integrator_saves_what_refinement_cannot() {
     );
 }
 
+/// VBD, stable at any step for the springs too, serves as the fallback when asked for
+/// (`[solver.guard] fallback = "vbd"`): the same stiff frame is saved by it.
+#[test]
+fn vbd_as_the_fallback_saves_the_same_frame() {
+    let mut sim = hanging(|s| {
+        s.params.material.stiffness = s.params.material.stiffness.map(|k| k * 100.0);
+        s.params.guard.max_refinements = 1;
+        s.params.guard.fallback = Some(IntegratorKind::Vbd);
+    });
+    let summary = sim.run(1.0);
+    assert!(
+        summary.finite && summary.error.is_none(),
+        "{:?}",
+        summary.error
+    );
+    assert_eq!(summary.integrator_in_effect, "vbd");
+    assert!(
+        (summary.guard_events.iter()).any(|e| matches!(e.action, GuardAction::FellBack { .. }))
+    );
+}
+
 /// Story: substeps the guard raised used to stay for the rest of the run, so one bad frame
 /// made everything after it 2–8× slower. Once the trouble has passed they come back down.
 #[test]
