@@ -15,11 +15,12 @@ pub struct SweepConfig {
     pub seconds: f64,
     /// Times along the trajectory at which positions are compared.
     pub samples: u32,
-    /// Largest acceptable maximum position error, as a fraction of the cloth's size.
+    /// Largest acceptable error (position, or shape on a chaotic scene), as a fraction of
+    /// the cloth's size.
     pub tolerance: f64,
     /// Bisection steps when searching each integrator's largest stable step (0: none).
     pub bisection_steps: u32,
-    /// Run the two reference trajectories side by side on two threads.
+    /// Run the reference's candidate steps on two threads.
     pub parallel_reference: bool,
     /// What each kind of work costs: the choice is made by counted work weighed by these.
     pub unit_costs: UnitCosts,
@@ -38,9 +39,9 @@ impl Default for SweepConfig {
                 .iter()
                 .map(|&n| 1.0 / (60.0 * n as f64))
                 .collect(),
-            // Long enough for the cloth to swing well down; short enough that the folding
-            // cloth has not yet turned chaotic (by 0.5 s halving the reference's own step
-            // moves it by 0.15 % of its size, the floor every method converges to).
+            // Long enough for a cloth to swing well down; short enough that a folding one
+            // (`hanging`) has not yet turned chaotic (over 1.5 s its reference is unsure of
+            // its positions by 2 % of its size).
             seconds: 0.25,
             // One comparison per 1/60 s frame.
             samples: 15,
