@@ -20,8 +20,7 @@ use crate::sim::kernels::{Particle, Stencil, StepLength, descend_range};
 /// dashpots act on the new velocity `d/h` (Rayleigh-free, as implicit Euler's do). Its
 /// minimum is implicit Euler's step for the springs. The descent starts from an adaptive
 /// guess (each particle's last acceleration along the external one) and makes
-/// `vbd_iterations` sweeps; in each, a particle takes
-/// one Newton step on `G` with the others
+/// `vbd_iterations` sweeps; in each, a particle takes one Newton step on `G` with the others
 /// held: `Hᵢ·Δdᵢ = −∇ᵢG`, where `Hᵢ = mᵢ·I + Σ (h²·(k·n nᵀ + k·max(0, 1 − L/l)·(I − n nᵀ))
 /// + h·c·n nᵀ)` over its springs is the 3 × 3 block of the Hessian kept positive definite (a
 /// compressed spring's negative transverse term left out). Particles are visited colour by
