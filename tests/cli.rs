@@ -159,6 +159,10 @@ fn bad_arguments_fail_with_a_reason() {
             "unknown integrator",
         ),
         (
+            &["simulate", "--integrator", "vbd", "--iterations", "0"][..],
+            "--iterations must be in 1..=10000, got 0",
+        ),
+        (
             &["render", "--out", "/no/such/dir/x.png", "--seconds", "0"][..],
             "does not exist",
         ),
@@ -645,4 +649,72 @@ fn simulate_counts_intersections_and_resizes_a_grid() {
     let out = simulate("simulate --obj assets/cloth.obj --quads 8 --seconds 0.1");
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--quads"));
+}
+
+/// `--iterations` sets XPBD's and VBD's sweeps per substep: VBD reports three a step.
+#[test]
+fn iterations_set_the_sweeps_per_substep() {
+    let out = clothsim(&[
+        "simulate",
+        "--integrator",
+        "vbd",
+        "--iterations",
+        "3",
+        "--seconds",
+        "0.05",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(json(&out)["solver_iterations_per_step"], 3.0);
+}
+
+/// `--map` and `--small-steps` write their files beside the report and say how long they
+/// took; `--calibrate` prints the unit costs beside the built-in ones, and needs no `--out`.
+#[test]
+fn accuracy_answers_the_map_and_small_steps_and_calibrates() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = clothsim(&[
+        "accuracy",
+        "--integrators",
+        "semi-implicit-euler,implicit-euler",
+        "--map",
+        "--small-steps",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("stability map: "), "{stdout}");
+    assert!(stdout.contains("small steps: "), "{stdout}");
+    assert!(stdout.contains("XPBD: "), "{stdout}");
+    for name in [
+        "stability-map.csv",
+        "stability-map.md",
+        "stability-map.png",
+        "small-steps.csv",
+        "small-steps.md",
+    ] {
+        assert!(dir.path().join(name).is_file(), "{name} missing");
+    }
+    let map = std::fs::read_to_string(dir.path().join("stability-map.csv")).unwrap();
+    assert_eq!(map.lines().count(), 1 + 2 * 7, "{map}");
+    let out = clothsim(&["accuracy", "--calibrate"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("a VBD sweep") && stdout.contains("built in"),
+        "{stdout}"
+    );
 }

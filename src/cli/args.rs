@@ -255,6 +255,9 @@ impl RunArgs {
             scene.params.step.substeps = s;
         }
         if let Some(n) = self.iterations {
+            if !(1..=10_000).contains(&n) {
+                bail!("--iterations must be in 1..=10000, got {n}");
+            }
             scene.params.solver.xpbd_iterations = n;
             scene.params.solver.vbd_iterations = n;
         }
