@@ -18,7 +18,15 @@ impl Adjacency {
     /// Builds the adjacency of `springs` over `particles` particles; each particle's list
     /// is in spring order, so gathers are deterministic.
     pub fn new(particles: usize, springs: &Springs) -> Self {
-        let (a, b) = (&springs.a, &springs.b);
+        Self::of_pairs(particles, &springs.a, &springs.b)
+    }
+
+    /// The adjacency of the pairs `(a[e], b[e])` (springs, constraints) over `particles`
+    /// particles, as [`Adjacency::new`].
+    ///
+    /// # Panics
+    /// If a pair names a particle `≥ particles`.
+    pub fn of_pairs(particles: usize, a: &[u32], b: &[u32]) -> Self {
         let mut count = vec![0u32; particles + 1];
         for (&a, &b) in a.iter().zip(b) {
             count[a as usize + 1] += 1;

@@ -3,6 +3,7 @@
 
 use std::ops::Range;
 
+use crate::cloth::Adjacency;
 use crate::sim::constraints::DistanceConstraints;
 
 /// One spring seen from one of its ends (while the stencil is built).
@@ -66,31 +67,20 @@ impl Stencil {
                 0.0
             }
         };
-        // Each particle's links, by particle number.
-        let mut start = vec![0usize; particles + 1];
-        for (&a, &b) in springs.a.iter().zip(&springs.b) {
-            start[a as usize + 1] += 1;
-            start[b as usize + 1] += 1;
-        }
-        for p in 0..particles {
-            start[p + 1] += start[p];
-        }
-        let mut next = start.clone();
-        let mut by_particle = vec![Link::default(); start[particles]];
-        for e in 0..springs.len() {
-            let (a, b) = (springs.a[e], springs.b[e]);
-            for (p, other) in [(a, b), (b, a)] {
-                let slot = &mut next[p as usize];
-                by_particle[*slot] = Link {
-                    other,
+        // Each particle's links, by particle number, in the springs' order.
+        let adjacency = Adjacency::of_pairs(particles, &springs.a, &springs.b);
+        let by_particle: Vec<Link> = (0..adjacency.spring.len())
+            .map(|slot| {
+                let e = adjacency.spring[slot] as usize;
+                Link {
+                    other: adjacency.other[slot],
                     rest: springs.rest[e],
                     k: stiffness(e),
                     c: springs.damping[e],
-                };
-                *slot += 1;
-            }
-        }
-        let links_of = |p: u32| &by_particle[start[p as usize]..start[p as usize + 1]];
+                }
+            })
+            .collect();
+        let links_of = |p: u32| &by_particle[adjacency.range(p as usize)];
         let mut colour = vec![u32::MAX; particles];
         let mut taken = Vec::new();
         for p in 0..particles {
