@@ -39,8 +39,8 @@ use crate::sim::kernels::{Particle, Stencil, StepLength, descend_range};
 /// [`super::Xpbd`] for why that matters in f32 at small steps).
 #[derive(Default)]
 pub struct Vbd {
-    stencil: Stencil,
-    built: bool,
+    /// Built from the springs' strengths at the first step after they change.
+    stencil: Option<Stencil>,
     force: Vec<Vec3>,
     /// The inertial displacement `ŷ` per particle, metres.
     inertial: Vec<Vec3>,
@@ -87,8 +87,7 @@ impl Vbd {
 
     /// One sweep: every free particle, colour by colour, takes its Newton step; a large
     /// colour in pieces shared between the team's threads.
-    fn sweep(&mut self, h: f32) {
-        let stencil = &self.stencil;
+    fn sweep(&mut self, stencil: &Stencil, h: f32) {
         let inertial = &self.inertial;
         let n = self.particles.len();
         assert!(stencil.spans.len() == n && inertial.len() == n);
@@ -122,36 +121,39 @@ impl Integrator for Vbd {
         h: f32,
     ) -> Result<StepReport, StepError> {
         let model = ctx.model;
-        if !self.built || self.stencil.spans.len() != model.particle_count() {
-            let springs = ctx.forces.constraints(model);
-            self.stencil = Stencil::new(&springs, model.particle_count());
-            self.built = true;
-        }
+        let n = model.particle_count();
+        let stencil = match self.stencil.take() {
+            Some(s) if s.spans.len() == n => s,
+            _ => Stencil::new(&ctx.forces.constraints(model), n),
+        };
         let not_springs = |t: &Force| t.springs().is_none();
         ctx.forces_where(&state.pos, &state.vel, not_springs, &mut self.force);
         let w = &model.inv_mass;
-        self.inertial.clear();
-        let particles = state.vel.iter().zip(&self.force).zip(w);
-        self.inertial
-            .extend(particles.map(|((&v, &f), &w)| (v + f * w * h) * h));
-        let mut rows = std::mem::take(&mut self.particles);
+        let (mut inertial, mut rows) = (
+            std::mem::take(&mut self.inertial),
+            std::mem::take(&mut self.particles),
+        );
+        inertial.clear();
         rows.clear();
         for (p, (&pos, &v)) in state.pos.iter().zip(&state.vel).enumerate() {
+            let f = self.force[p];
+            inertial.push((v + f * w[p] * h) * h);
             rows.push(Particle {
                 pos,
-                disp: self.first_guess(v, self.force[p], w[p], p, h),
+                disp: self.first_guess(v, f, w[p], p, h),
                 inv_mass: w[p],
                 mass: model.mass[p],
             });
         }
-        self.particles = rows;
+        (self.inertial, self.particles) = (inertial, rows);
         let sweeps = ctx.config.vbd_iterations;
         ctx.solve(|| {
             for _ in 0..sweeps {
-                self.sweep(h);
+                self.sweep(&stencil, h);
             }
             ((), sweeps, None, true)
         });
+        self.stencil = Some(stencil);
         if !self.particles.iter().all(|p| p.disp.is_finite()) {
             return Err(StepError::NonFinite { iterations: sweeps });
         }
@@ -176,7 +178,7 @@ impl Integrator for Vbd {
 
     /// The stencil keeps the springs' strengths: new strengths make it stale.
     fn forces_changed(&mut self) {
-        self.built = false;
+        self.stencil = None;
         self.invalidate();
     }
 }
