@@ -279,7 +279,12 @@ fn plot(ui: &mut egui::Ui, report: &AccuracyReport, tolerance: f64) {
                     // An error of exactly zero is the reference's own run: no point on a
                     // log scale.
                     .filter(|p| p.integrator == kind && p.stable && p.judged_error().0 > 0.0)
-                    .map(|p| (p.resolved, [log(p.work_per_sim_s), log(p.judged_error().0)]))
+                    .map(|p| {
+                        (
+                            p.resolved(),
+                            [log(p.work_per_sim_s), log(p.judged_error().0)],
+                        )
+                    })
                     .collect();
                 mine.sort_by(|a, b| a.1[0].total_cmp(&b.1[0]));
                 if !mine.is_empty() {

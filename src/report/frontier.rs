@@ -68,7 +68,6 @@ mod tests {
             Point::at(4.0, 0.001, true),
             Point {
                 // Its error is lost in a floor of 1e-4: known only to be below 1e-3.
-                resolved: false,
                 floor: 1e-4,
                 ..Point::at(5.0, 1e-7, true)
             },
@@ -93,7 +92,6 @@ mod tests {
     #[test]
     fn an_unresolved_error_counts_as_ten_times_its_floor() {
         let points = [Point {
-            resolved: false,
             floor: 1e-5,
             ..Point::at(1.0, 1e-6, true)
         }];

@@ -183,7 +183,7 @@ fn chart(
             let mut mine: Vec<&crate::report::Point> =
                 mine(true).filter(|p| finite(p.judged_error().0)).collect();
             mine.sort_by(|a, b| a.work_per_sim_s.total_cmp(&b.work_per_sim_s));
-            mine.iter().map(|p| p.resolved).collect()
+            mine.iter().map(|p| p.resolved()).collect()
         };
         chart
             .draw_series(line.iter().zip(&resolved).map(|(&p, &filled)| {

@@ -23,9 +23,6 @@ pub struct Point {
     /// Finite throughout, with energy bounded (it never gained more than the reference's
     /// peak kinetic energy) and error below the cloth's size.
     pub stable: bool,
-    /// The error is at least ten times `floor`; below, it measures the reference or the
-    /// run's rounding as much as its method.
-    pub resolved: bool,
     /// The larger of the reference's uncertainty and the rounding RK4 shows at this step
     /// (fraction of the cloth's size; see [`super::Reference::floor`]).
     pub floor: f64,
@@ -72,6 +69,13 @@ impl Point {
         }
     }
 
+    /// Whether the judged error is at least ten times its floor; below, it measures the
+    /// reference or the run's rounding as much as the method.
+    pub fn resolved(&self) -> bool {
+        let (error, floor) = self.judged_error();
+        error >= super::RESOLVED * floor
+    }
+
     /// What the judged error is known to be below: the error where resolved, else ten
     /// times the floor it is lost in. The frontier and the choice rank points by it.
     pub fn error_bound(&self) -> f64 {
@@ -94,7 +98,6 @@ impl Point {
             max_error: error,
             energy_drift: 0.0,
             stable,
-            resolved: true,
             floor: 0.0,
             shape_error: error,
             strain_error: 0.0,

@@ -9,10 +9,10 @@ use super::cost::{UnitCosts, Work};
 use super::error::ReportError;
 use super::frontier::{frontier, recommend};
 use super::measure::{Record, Trajectory, position_error, run};
-use super::order::{ObservedOrder, RESOLVED, observed_order};
+use super::order::{ObservedOrder, observed_order};
 use super::point::Point;
 use super::reference::{Reference, reference, scene_size};
-use super::shape::{Judged, shape_error};
+use super::shape::shape_error;
 
 /// The largest step at which an integrator stayed stable.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -137,10 +137,6 @@ pub fn measure(
         max_error,
         energy_drift,
         stable: damped.finite && energy.finite && bounded && max_error < 1.0,
-        resolved: match info.judged {
-            Judged::Trajectory => max_error >= RESOLVED * info.floor(damped.h),
-            Judged::Shape => shape_error >= RESOLVED * info.check_shape,
-        },
         floor: info.floor(damped.h),
         shape_error,
         strain_error,
@@ -298,7 +294,7 @@ pub fn sweep(
             &mut tracker,
         )?;
         let runs: Vec<(f64, f64)> = (mine.iter())
-            .filter(|p| p.stable && p.resolved)
+            .filter(|p| p.stable && p.resolved())
             .map(|p| (p.dt, p.judged_error().0))
             .collect();
         limit.observed_order = observed_order(&runs);

@@ -52,7 +52,7 @@ pub fn csv(report: &AccuracyReport) -> String {
             sci(p.max_error),
             sci(p.energy_drift),
             p.stable,
-            p.resolved,
+            p.resolved(),
             sci(p.work_per_sim_s),
             sci(p.wall_s_per_sim_s),
             p.force_evals_per_step,
@@ -108,7 +108,7 @@ pub fn choice_sentence(report: &AccuracyReport) -> String {
 
 /// An error as a percentage, in parentheses where it is the one judged and unresolved.
 fn judged(p: &Point, by: Judged, error: f64) -> String {
-    if p.judged == by && !p.resolved && error.is_finite() {
+    if p.judged == by && !p.resolved() && error.is_finite() {
         format!("({})", percent(error))
     } else {
         percent(error)
