@@ -124,7 +124,7 @@ fn substeps(p: &Point) -> String {
 }
 
 fn point_row(out: &mut String, p: &Point, frontier: bool, contact: bool) {
-    let _ = writeln!(
+    let _ = write!(
         out,
         "| {} | {:.3e} | {} | {} | {} | {} | {} | {} | {} | {:.3e} | {:.3e} | {:.1} | {:.1} | {:.1} |",
         if frontier {
@@ -155,9 +155,7 @@ fn point_row(out: &mut String, p: &Point, frontier: bool, contact: bool) {
         p.sweeps_per_step,
     );
     if contact {
-        // The row's last cell is written above; the contact cells go before its newline.
-        out.pop();
-        let _ = writeln!(
+        let _ = write!(
             out,
             " {} | {} |",
             p.contact
@@ -166,6 +164,7 @@ fn point_row(out: &mut String, p: &Point, frontier: bool, contact: bool) {
                 .map_or("—".into(), |c| c.intersections.to_string())
         );
     }
+    out.push('\n');
 }
 
 /// Readable tables: the choice, the reference, the largest stable steps, every run and the
