@@ -3,89 +3,82 @@
 use plotters::prelude::*;
 
 use super::map::StabilityMap;
-use super::plot::{PLOT_SIZE, integrator_color, range, register_font};
+use super::plot::{Area, err, integrator_color, range, render};
 use crate::sim::IntegratorKind;
 
-/// Draws the map into an RGB buffer of [`PLOT_SIZE`]: one line per integrator of its
+/// Draws the map into an RGB buffer of [`PLOT_SIZE`](super::PLOT_SIZE): one line per integrator of its
 /// largest stable step (as substeps per 1/60 s frame) against the structural springs'
 /// stiffness; a method stable at every step probed sits on the dashed upper bound.
 ///
 /// # Errors
 /// A message from plotters.
 pub fn draw_map(map: &StabilityMap) -> Result<Vec<u8>, String> {
-    register_font();
-    let err = |e: &dyn std::fmt::Display| e.to_string();
-    let (w, h) = PLOT_SIZE;
-    let mut buffer = vec![255u8; (w * h * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| err(&e))?;
-        let substeps = |dt: f64| 1.0 / (60.0 * dt);
-        let ks: Vec<f64> = map.points.iter().map(|p| p.stiffness).collect();
-        let ns: Vec<f64> = (map.points.iter())
-            .filter_map(|p| p.dt.map(substeps))
+    render(|root| chart(root, map))
+}
+
+fn chart(root: &Area<'_>, map: &StabilityMap) -> Result<(), String> {
+    let substeps = |dt: f64| 1.0 / (60.0 * dt);
+    let ks: Vec<f64> = map.points.iter().map(|p| p.stiffness).collect();
+    let ns: Vec<f64> = (map.points.iter())
+        .filter_map(|p| p.dt.map(substeps))
+        .collect();
+    let (x_lo, x_hi) = range(&ks, 0.7, 1.4);
+    let (y_lo, y_hi) = range(&ns, 0.5, 4.0);
+    let mut chart = ChartBuilder::on(root)
+        .caption(format!("Stability map — {}", map.scene), ("sans-serif", 30))
+        .margin(20)
+        .x_label_area_size(60)
+        .y_label_area_size(90)
+        .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("structural spring stiffness, N/m (shear and bend scaled alike)")
+        .y_desc("fewest stable substeps per 1/60 s frame")
+        .x_label_formatter(&|x| format!("{x:.0e}"))
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .label_style(("sans-serif", 18))
+        .axis_desc_style(("sans-serif", 22))
+        .draw()
+        .map_err(err)?;
+    let bound = substeps(map.upper_bound);
+    let gray = RGBColor(90, 90, 90);
+    chart
+        .draw_series(DashedLineSeries::new(
+            [(x_lo, bound), (x_hi, bound)],
+            4,
+            6,
+            gray.stroke_width(2),
+        ))
+        .map_err(err)?
+        .label("largest step probed (stable at every step)")
+        .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], gray.stroke_width(2)));
+    for kind in IntegratorKind::ALL {
+        let line: Vec<(f64, f64)> = (map.points.iter())
+            .filter(|p| p.integrator == kind)
+            .filter_map(|p| p.dt.map(|dt| (p.stiffness, substeps(dt))))
             .collect();
-        let (x_lo, x_hi) = range(&ks, 0.7, 1.4);
-        let (y_lo, y_hi) = range(&ns, 0.5, 4.0);
-        let mut chart = ChartBuilder::on(&root)
-            .caption(format!("Stability map — {}", map.scene), ("sans-serif", 30))
-            .margin(20)
-            .x_label_area_size(60)
-            .y_label_area_size(90)
-            .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())
-            .map_err(|e| err(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("structural spring stiffness, N/m (shear and bend scaled alike)")
-            .y_desc("fewest stable substeps per 1/60 s frame")
-            .x_label_formatter(&|x| format!("{x:.0e}"))
-            .y_label_formatter(&|y| format!("{y:.0e}"))
-            .label_style(("sans-serif", 18))
-            .axis_desc_style(("sans-serif", 22))
-            .draw()
-            .map_err(|e| err(&e))?;
-        let bound = substeps(map.upper_bound);
-        let gray = RGBColor(90, 90, 90);
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(x_lo, bound), (x_hi, bound)],
-                4,
-                6,
-                gray.stroke_width(2),
-            ))
-            .map_err(|e| err(&e))?
-            .label("largest step probed (stable at every step)")
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], gray.stroke_width(2)));
-        for kind in IntegratorKind::ALL {
-            let line: Vec<(f64, f64)> = (map.points.iter())
-                .filter(|p| p.integrator == kind)
-                .filter_map(|p| p.dt.map(|dt| (p.stiffness, substeps(dt))))
-                .collect();
-            if line.is_empty() {
-                continue;
-            }
-            let (r, g, b) = integrator_color(kind);
-            let color = RGBColor(r, g, b);
-            chart
-                .draw_series(LineSeries::new(line.clone(), color.stroke_width(3)))
-                .map_err(|e| err(&e))?
-                .label(kind.name())
-                .legend(move |(x, y)| {
-                    PathElement::new([(x, y), (x + 20, y)], color.stroke_width(3))
-                });
-            chart
-                .draw_series(line.iter().map(|&p| Circle::new(p, 6, color.filled())))
-                .map_err(|e| err(&e))?;
+        if line.is_empty() {
+            continue;
         }
+        let (r, g, b) = integrator_color(kind);
+        let color = RGBColor(r, g, b);
         chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 20))
-            .position(SeriesLabelPosition::UpperLeft)
-            .draw()
-            .map_err(|e| err(&e))?;
-        root.present().map_err(|e| err(&e))?;
+            .draw_series(LineSeries::new(line.clone(), color.stroke_width(3)))
+            .map_err(err)?
+            .label(kind.name())
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(3)));
+        chart
+            .draw_series(line.iter().map(|&p| Circle::new(p, 6, color.filled())))
+            .map_err(err)?;
     }
-    Ok(buffer)
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 20))
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()
+        .map_err(err)?;
+    Ok(())
 }

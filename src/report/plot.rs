@@ -28,7 +28,7 @@ pub fn integrator_color(kind: IntegratorKind) -> (u8, u8, u8) {
 }
 
 /// Registers the font the plots' text uses (once).
-pub(super) fn register_font() {
+fn register_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         // The font egui ships with: no system font lookup, the same text on every machine.
@@ -45,26 +45,33 @@ pub(super) fn register_font() {
 /// # Errors
 /// A message from plotters.
 pub fn draw(report: &AccuracyReport) -> Result<Vec<u8>, String> {
+    render(|root| chart(root, report))
+}
+
+/// The area a plot draws its chart on.
+pub(super) type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+
+/// An RGB buffer of [`PLOT_SIZE`], white, with what `chart` draws on it.
+pub(super) fn render(
+    chart: impl FnOnce(&Area<'_>) -> Result<(), String>,
+) -> Result<Vec<u8>, String> {
     register_font();
     let (w, h) = PLOT_SIZE;
     let mut buffer = vec![255u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        chart(&root, report)?;
-        root.present().map_err(|e| e.to_string())?;
+        root.fill(&WHITE).map_err(err)?;
+        chart(&root)?;
+        root.present().map_err(err)?;
     }
     Ok(buffer)
 }
 
-fn err(e: impl std::fmt::Display) -> String {
+pub(super) fn err(e: impl std::fmt::Display) -> String {
     e.to_string()
 }
 
-fn chart(
-    root: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
-    report: &AccuracyReport,
-) -> Result<(), String> {
+fn chart(root: &Area<'_>, report: &AccuracyReport) -> Result<(), String> {
     let finite = |x: f64| x.is_finite() && x > 0.0;
     let costs: Vec<f64> = report
         .points
