@@ -12,7 +12,6 @@ use crate::report::{
     MAP_SCALES, ReportError, SmallSteps, StabilityMap, SweepConfig, small_steps, stability_map,
 };
 use crate::scene::Scene;
-use crate::sim::IntegratorKind;
 
 /// What a finished question answered.
 enum Answer {
@@ -171,34 +170,22 @@ impl Extras {
 
 /// The map as a grid: a row per stiffness, a column per integrator.
 fn map_grid(ui: &mut egui::Ui, map: &StabilityMap) {
-    let mut kinds: Vec<IntegratorKind> = Vec::new();
-    for p in &map.points {
-        if !kinds.contains(&p.integrator) {
-            kinds.push(p.integrator);
-        }
-    }
     egui::Grid::new("stability map")
         .striped(true)
         .show(ui, |ui| {
             ui.label(RichText::new("k (N/m)").strong());
-            for k in &kinds {
-                ui.label(RichText::new(k.name()).strong());
+            for p in map.rows().first().copied().unwrap_or_default() {
+                ui.label(RichText::new(p.integrator.name()).strong());
             }
             ui.end_row();
-            let mut scales: Vec<f64> = map.points.iter().map(|p| p.scale).collect();
-            scales.dedup();
-            for scale in scales {
-                let row: Vec<_> = map.points.iter().filter(|p| p.scale == scale).collect();
+            for row in map.rows() {
                 ui.label(format!("{:.3}", row[0].stiffness));
-                for k in &kinds {
-                    let cell = match row.iter().find(|p| p.integrator == *k) {
-                        Some(p) if p.at_upper_bound => "any".to_string(),
-                        Some(p) => {
-                            p.dt.map_or("none".into(), |dt| format!("{:.1}", 1.0 / (60.0 * dt)))
-                        }
-                        None => "—".into(),
-                    };
-                    ui.label(cell);
+                for p in row {
+                    ui.label(match p.substeps() {
+                        _ if p.at_upper_bound => "any".to_string(),
+                        Some(n) => format!("{n:.1}"),
+                        None => "none".into(),
+                    });
                 }
                 ui.end_row();
             }

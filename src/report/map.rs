@@ -34,6 +34,13 @@ pub struct MapPoint {
     pub at_upper_bound: bool,
 }
 
+impl MapPoint {
+    /// The largest stable step as substeps per 1/60 s frame.
+    pub fn substeps(&self) -> Option<f64> {
+        self.dt.map(|dt| 1.0 / (60.0 * dt))
+    }
+}
+
 /// The whole map.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct StabilityMap {
@@ -152,12 +159,6 @@ impl StabilityMap {
     /// largest stable step in substeps per 1/60 s frame.
     pub fn markdown(&self) -> String {
         use std::fmt::Write;
-        let mut kinds: Vec<IntegratorKind> = Vec::new();
-        for p in &self.points {
-            if !kinds.contains(&p.integrator) {
-                kinds.push(p.integrator);
-            }
-        }
         let mut out = format!(
             "# Stability map — scene `{}`\n\nThe largest stable step of each integrator \
              against the springs' stiffness (all kinds scaled together), as the fewest \
@@ -169,38 +170,32 @@ impl StabilityMap {
             self.seconds_taken
         );
         let _ = write!(out, "| stiffness × | structural k (N/m) |");
-        for k in &kinds {
-            let _ = write!(out, " {} |", k.name());
+        for p in self.rows().first().copied().unwrap_or_default() {
+            let _ = write!(out, " {} |", p.integrator.name());
         }
         let _ = write!(out, "\n|---|---|");
-        for _ in &kinds {
+        for _ in self.rows().first().copied().unwrap_or_default() {
             out.push_str("---|");
         }
         out.push('\n');
-        let mut scales: Vec<f64> = self.points.iter().map(|p| p.scale).collect();
-        scales.dedup();
-        for scale in scales {
-            let row: Vec<&MapPoint> = self.points.iter().filter(|p| p.scale == scale).collect();
-            let _ = write!(out, "| {scale} | {:.3} |", row[0].stiffness);
-            for k in &kinds {
-                let cell = match row.iter().find(|p| p.integrator == *k) {
-                    Some(MapPoint {
-                        dt: Some(dt),
-                        at_upper_bound,
-                        ..
-                    }) => format!(
-                        "{}{:.1}",
-                        if *at_upper_bound { "≤ " } else { "" },
-                        1.0 / (60.0 * dt)
-                    ),
-                    Some(_) => "none found".into(),
-                    None => "—".into(),
+        for row in self.rows() {
+            let _ = write!(out, "| {} | {:.3} |", row[0].scale, row[0].stiffness);
+            for p in row {
+                let cell = match p.substeps() {
+                    Some(n) if p.at_upper_bound => format!("≤ {n:.1}"),
+                    Some(n) => format!("{n:.1}"),
+                    None => "none found".into(),
                 };
                 let _ = write!(out, " {cell} |");
             }
             out.push('\n');
         }
         out
+    }
+
+    /// The points a row per stiffness, each in the integrators' order (as they were mapped).
+    pub fn rows(&self) -> Vec<&[MapPoint]> {
+        self.points.chunk_by(|a, b| a.scale == b.scale).collect()
     }
 
     /// The slope of log largest-stable-step over log stiffness for `integrator`, over the
