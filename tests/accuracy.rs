@@ -349,8 +349,18 @@ fn small_steps_beat_iterations_at_every_budget_and_iterations_plateau() {
             let ratio = pair[0].small_steps / pair[1].small_steps;
             assert!((1.5..2.3).contains(&ratio), "{kind}: {ratio:.2} ({pair:?})");
         }
-        // 1 × n: 16 and 32 sweeps give the same step to within 1 %.
+        // 1 × n: the sweeps do move the step (32 of them leave at least a fifth less error
+        // than one: measured 0.26 against 0.40 of the cloth's size), then 16 and 32 give the
+        // same step to within 1 %.
+        let one_sweep = (grid.runs.iter())
+            .find(|r| r.point.integrator == kind && r.substeps == 1 && r.iterations == 1)
+            .map(|r| r.point.max_error)
+            .unwrap();
         let (a, b) = (mine[3].many_iterations, mine[4].many_iterations);
+        assert!(
+            b < 0.8 * one_sweep,
+            "{kind}: {one_sweep} with one sweep, {b} with 32"
+        );
         assert!((a / b - 1.0).abs() < 0.01, "{kind}: {a} then {b}");
     }
     assert!(
