@@ -241,6 +241,13 @@ fn the_bare_report_shows_every_integrators_order_within_its_band() {
     };
     let report = report::sweep(&scene, &config, &mut |_| true).unwrap();
     assert_eq!(report.reference.judged, report::Judged::Trajectory);
+    // The reference is not RK4 at its finest candidate step: there f32 rounding over the
+    // many steps leaves the two finest candidates more than ten times further apart than
+    // the pair the reference comes from (measured 2.2e-4 of the size against 1.5e-6).
+    let r = &report.reference;
+    let (finest_pair, finest_gap) = r.ladder[0];
+    assert!(r.dt > finest_pair, "{r:?}");
+    assert!(finest_gap > 10.0 * r.check_max, "{r:?}");
     for limit in &report.limits {
         let kind = limit.integrator;
         let fit = limit
