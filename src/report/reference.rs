@@ -95,28 +95,29 @@ pub fn reference(scene: &Scene, config: &SweepConfig) -> (Trajectory, Reference)
     let (seconds, samples) = (config.seconds, config.samples);
     let rk4 = IntegratorKind::Rk4;
     let one = |h: f64| run(scene, rk4, h, seconds, samples, Record::Positions);
-    let mut runs: Vec<Option<Trajectory>> = vec![None; steps.len()];
-    if config.parallel_reference && steps.len() > 1 {
-        // The odd steps on a second thread; the finest (the dearest) alone on this one.
-        let (evens, odds): (Vec<_>, Vec<_>) = (0..steps.len()).partition(|i| i % 2 == 0);
-        let odd_runs = std::thread::scope(|s| {
-            let other = s.spawn(|| odds.iter().map(|&i| (i, one(steps[i]))).collect::<Vec<_>>());
-            for &i in &evens {
-                runs[i] = Some(one(steps[i]));
-            }
-            other
-                .join()
-                .unwrap_or_else(|e| std::panic::resume_unwind(e))
+    let runs: Vec<Trajectory> = if config.parallel_reference && steps.len() > 1 {
+        // The odd steps on a second thread, the even ones (the finest, the dearest, among
+        // them) on this one; then put back in order.
+        let (evens, odds) = std::thread::scope(|s| {
+            let other = s.spawn(|| {
+                let odds = steps.iter().skip(1).step_by(2);
+                odds.map(|&h| one(h)).collect::<Vec<Trajectory>>()
+            });
+            let other = || {
+                other
+                    .join()
+                    .unwrap_or_else(|e| std::panic::resume_unwind(e))
+            };
+            let evens: Vec<Trajectory> = steps.iter().step_by(2).map(|&h| one(h)).collect();
+            (evens, other())
         });
-        for (i, r) in odd_runs {
-            runs[i] = Some(r);
-        }
+        let mut odds = odds.into_iter();
+        (evens.into_iter())
+            .flat_map(|even| std::iter::once(even).chain(odds.next()))
+            .collect()
     } else {
-        for (i, &h) in steps.iter().enumerate() {
-            runs[i] = Some(one(h));
-        }
-    }
-    let runs: Vec<Trajectory> = runs.into_iter().flatten().collect();
+        steps.iter().map(|&h| one(h)).collect()
+    };
     let size = scene_size(scene);
     let differences: Vec<(f64, f64)> = (1..runs.len())
         .map(|j| {
