@@ -3,7 +3,7 @@
 use plotters::prelude::*;
 
 use super::map::StabilityMap;
-use super::plot::{Area, err, integrator_color, range, render};
+use super::plot::{Area, dashed_level, err, integrator_color, label_axes, legend, range, render};
 use crate::sim::IntegratorKind;
 
 /// Draws the map into an RGB buffer of [`PLOT_SIZE`](super::PLOT_SIZE): one line per integrator of its
@@ -31,28 +31,21 @@ fn chart(root: &Area<'_>, map: &StabilityMap) -> Result<(), String> {
         .y_label_area_size(90)
         .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("structural spring stiffness, N/m (shear and bend scaled alike)")
-        .y_desc("fewest stable substeps per 1/60 s frame")
-        .x_label_formatter(&|x| format!("{x:.0e}"))
-        .y_label_formatter(&|y| format!("{y:.0e}"))
-        .label_style(("sans-serif", 18))
-        .axis_desc_style(("sans-serif", 22))
-        .draw()
-        .map_err(err)?;
+    label_axes(
+        &mut chart,
+        "structural spring stiffness, N/m (shear and bend scaled alike)",
+        "fewest stable substeps per 1/60 s frame",
+    )?;
     let bound = substeps(map.upper_bound);
-    let gray = RGBColor(90, 90, 90);
-    chart
-        .draw_series(DashedLineSeries::new(
-            [(x_lo, bound), (x_hi, bound)],
-            4,
-            6,
-            gray.stroke_width(2),
-        ))
-        .map_err(err)?
-        .label("largest step probed (stable at every step)")
-        .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], gray.stroke_width(2)));
+    let label = "largest step probed (stable at every step)";
+    dashed_level(
+        &mut chart,
+        (x_lo, x_hi),
+        bound,
+        (4, 6),
+        RGBColor(90, 90, 90),
+        label,
+    )?;
     for kind in IntegratorKind::ALL {
         let line: Vec<(f64, f64)> = (map.points.iter())
             .filter(|p| p.integrator == kind)
@@ -72,13 +65,6 @@ fn chart(root: &Area<'_>, map: &StabilityMap) -> Result<(), String> {
             .draw_series(line.iter().map(|&p| Circle::new(p, 6, color.filled())))
             .map_err(err)?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 20))
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     Ok(())
 }

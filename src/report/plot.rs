@@ -71,6 +71,62 @@ pub(super) fn err(e: impl std::fmt::Display) -> String {
     e.to_string()
 }
 
+/// A chart on log–log axes, as both plots draw.
+pub(super) type LogChart<'a, 'b> =
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+
+/// The axes' descriptions, in both plots' label style.
+pub(super) fn label_axes(chart: &mut LogChart<'_, '_>, x: &str, y: &str) -> Result<(), String> {
+    chart
+        .configure_mesh()
+        .x_desc(x)
+        .y_desc(y)
+        .x_label_formatter(&|x| format!("{x:.0e}"))
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .label_style(("sans-serif", 18))
+        .axis_desc_style(("sans-serif", 22))
+        .draw()
+        .map_err(err)
+}
+
+/// A dashed level across the chart at `y` (from `x.0` to `x.1`), `dash` and `gap` pixels,
+/// in the legend as `label`.
+pub(super) fn dashed_level(
+    chart: &mut LogChart<'_, '_>,
+    x: (f64, f64),
+    y: f64,
+    (dash, gap): (u32, u32),
+    color: RGBColor,
+    label: &str,
+) -> Result<(), String> {
+    chart
+        .draw_series(DashedLineSeries::new(
+            [(x.0, y), (x.1, y)],
+            dash,
+            gap,
+            color.stroke_width(2),
+        ))
+        .map_err(err)?
+        .label(label)
+        .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
+    Ok(())
+}
+
+/// The legend, at `position`.
+pub(super) fn legend<'a, 'b: 'a>(
+    chart: &mut LogChart<'a, 'b>,
+    position: SeriesLabelPosition,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 20))
+        .position(position)
+        .draw()
+        .map_err(err)
+}
+
 fn chart(root: &Area<'_>, report: &AccuracyReport) -> Result<(), String> {
     let finite = |x: f64| x.is_finite() && x > 0.0;
     let costs: Vec<f64> = report
@@ -107,44 +163,27 @@ fn chart(root: &Area<'_>, report: &AccuracyReport) -> Result<(), String> {
         .y_label_area_size(90)
         .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("cost: work per simulated second, in force evaluations of this cloth")
-        .y_desc(match report.reference.judged {
-            crate::report::Judged::Trajectory => "max position error / cloth size",
-            crate::report::Judged::Shape => "shape error (centre of mass, spread) / cloth size",
-        })
-        .x_label_formatter(&|x| format!("{x:.0e}"))
-        .y_label_formatter(&|y| format!("{y:.0e}"))
-        .label_style(("sans-serif", 18))
-        .axis_desc_style(("sans-serif", 22))
-        .draw()
-        .map_err(err)?;
+    let y_desc = match report.reference.judged {
+        crate::report::Judged::Trajectory => "max position error / cloth size",
+        crate::report::Judged::Shape => "shape error (centre of mass, spread) / cloth size",
+    };
+    let x_desc = "cost: work per simulated second, in force evaluations of this cloth";
+    label_axes(&mut chart, x_desc, y_desc)?;
     // The tolerance, and the reference's own uncertainty: errors below it are not resolved.
     let tolerance = report.tolerance;
-    let dark_red = RGBColor(170, 20, 20);
-    chart
-        .draw_series(DashedLineSeries::new(
-            [(x_lo, tolerance), (x_hi, tolerance)],
-            14,
-            8,
-            dark_red.stroke_width(2),
-        ))
-        .map_err(err)?
-        .label(format!("tolerance {tolerance:.1e}"))
-        .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], dark_red.stroke_width(2)));
+    let x = (x_lo, x_hi);
+    let label = format!("tolerance {tolerance:.1e}");
+    dashed_level(
+        &mut chart,
+        x,
+        tolerance,
+        (14, 8),
+        RGBColor(170, 20, 20),
+        &label,
+    )?;
     if finite(floor) {
-        let gray = RGBColor(90, 90, 90);
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(x_lo, floor), (x_hi, floor)],
-                4,
-                6,
-                gray.stroke_width(2),
-            ))
-            .map_err(err)?
-            .label("reference uncertainty (hollow: not resolved)")
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], gray.stroke_width(2)));
+        let label = "reference uncertainty (hollow: not resolved)";
+        dashed_level(&mut chart, x, floor, (4, 6), RGBColor(90, 90, 90), label)?;
     }
     // The frontier, under the integrators' lines.
     let frontier: Vec<(f64, f64)> = report
@@ -216,14 +255,7 @@ fn chart(root: &Area<'_>, report: &AccuracyReport) -> Result<(), String> {
         .map_err(err)?
         .label("× unstable, at its cost")
         .legend(|(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 20))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
 }
 
