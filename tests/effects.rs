@@ -39,7 +39,7 @@ fn grid_model(quads: u32, size: f32) -> ClothModel {
 
 fn forces_of(b: &DihedralBending, model: &ClothModel, pos: &[Vec3]) -> Vec<Vec3> {
     let mut f = vec![Vec3::ZERO; pos.len()];
-    b.add_forces(model, pos, &mut f);
+    b.add_forces::<f32>(model, pos, &mut f);
     f
 }
 
@@ -58,14 +58,14 @@ fn the_hinge_angle_gradient_matches_finite_differences() {
         let fold = Quat::from_rotation_x(2.5 * rng.next());
         let b = fold * Vec3::new(0.6, 0.0, -0.8) + 0.2 * rng.vec();
         let mut p = [x0, x1, a, b];
-        let (_, grad) = hinge_angle(p[0], p[1], p[2], p[3]).unwrap();
+        let (_, grad) = hinge_angle::<f32>(p[0], p[1], p[2], p[3]).unwrap();
         for i in 0..4 {
             for axis in 0..3 {
                 let keep = p[i];
                 p[i][axis] = keep[axis] + eps;
-                let up = hinge_angle(p[0], p[1], p[2], p[3]).unwrap().0;
+                let up = hinge_angle::<f32>(p[0], p[1], p[2], p[3]).unwrap().0;
                 p[i][axis] = keep[axis] - eps;
-                let down = hinge_angle(p[0], p[1], p[2], p[3]).unwrap().0;
+                let down = hinge_angle::<f32>(p[0], p[1], p[2], p[3]).unwrap().0;
                 p[i] = keep;
                 let fd = (up - down) / (2.0 * eps);
                 worst = worst.max((fd - grad[i][axis]).abs() / grad[i].length().max(1.0));
@@ -94,9 +94,9 @@ fn dihedral_forces_are_minus_the_energy_gradient() {
         for axis in 0..3 {
             let keep = pos[i];
             pos[i][axis] = keep[axis] + eps;
-            let up = bending.potential_energy(&model, &pos);
+            let up = bending.potential_energy::<f32>(&model, &pos);
             pos[i][axis] = keep[axis] - eps;
-            let down = bending.potential_energy(&model, &pos);
+            let down = bending.potential_energy::<f32>(&model, &pos);
             pos[i] = keep;
             let fd = -((up - down) / (2.0 * eps as f64)) as f32;
             assert!(
@@ -191,7 +191,7 @@ fn a_flat_sheet_has_no_bending_force_however_it_is_placed() {
         worst < 1e-3 * scale,
         "a flat sheet feels {worst} N ({scale} N per degree)"
     );
-    assert!(bending.potential_energy(&model, &moved) < 1e-9);
+    assert!(bending.potential_energy::<f32>(&model, &moved) < 1e-9);
 }
 
 #[test]
@@ -210,9 +210,9 @@ fn the_bending_force_points_back_towards_the_rest_angle() {
         f[a].dot(f[b]) > 0.0,
         "both wings move the same way relative to the edge"
     );
-    let e0 = bending.potential_energy(&model, &pos);
+    let e0 = bending.potential_energy::<f32>(&model, &pos);
     let step: Vec<Vec3> = pos.iter().zip(&f).map(|(p, f)| *p + 1e-3 * *f).collect();
-    assert!(bending.potential_energy(&model, &step) < e0);
+    assert!(bending.potential_energy::<f32>(&model, &step) < e0);
     // Momentum: the forces are internal.
     let total: Vec3 = f.iter().sum();
     assert!(total.length() < 1e-5 * f[b].length(), "net force {total}");
@@ -305,7 +305,7 @@ fn plate(normal: Vec3, vel: Vec3) -> (ClothModel, Vec<Vec3>, Vec<Vec3>) {
 fn wind_force(wind: &Wind, normal: Vec3, vel: Vec3) -> Vec3 {
     let (model, pos, vel) = plate(normal, vel);
     let mut f = vec![Vec3::ZERO; pos.len()];
-    wind.add_forces(&model, &pos, &vel, 0.0, &mut f);
+    ForceTerm::<f32>::add_forces(wind, &model, &pos, &vel, 0.0, &mut f);
     f.iter().sum()
 }
 
@@ -367,7 +367,7 @@ fn a_tilted_plate_gets_lift_across_the_flow() {
 #[test]
 fn gusts_vary_the_wind_in_time_and_travel_with_it() {
     let wind = Wind::default();
-    let at = |x: f32, t: f64| wind.air_velocity(Vec3::new(x, 0.0, 0.0), t);
+    let at = |x: f32, t: f64| wind.air_velocity::<f32>(Vec3::new(x, 0.0, 0.0), t);
     let samples: Vec<f32> = (0..100)
         .map(|i| at(0.0, i as f64 * 0.05).length())
         .collect();

@@ -2,10 +2,12 @@
 
 mod adjacency;
 mod model;
+mod real;
 mod springs;
 mod state;
 
 pub use adjacency::Adjacency;
 pub use model::{ClothModel, MASS_FLOOR, MassDistribution};
+pub use real::{Matrix, Real, Vector};
 pub use springs::Springs;
 pub use state::ClothState;

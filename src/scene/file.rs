@@ -10,7 +10,7 @@ use crate::cloth::MassDistribution;
 use crate::mesh::{GridBends, GridOrientation};
 use crate::sim::{
     ClothSprings, ContactConfig, Effect, GuardPolicy, IntegratorKind, Keyframe, Material,
-    RigidMotion, SimParams, SolverConfig, StepConfig,
+    Precision, RigidMotion, SimParams, SolverConfig, StepConfig,
 };
 
 use super::error::SceneError;
@@ -213,6 +213,8 @@ pub struct SolverSpec {
     pub newton_tolerance: f32,
     pub xpbd_iterations: u32,
     pub vbd_iterations: u32,
+    /// What the state, forces and integrators compute in: `"f32"` or `"f64"`.
+    pub precision: Precision,
     pub guard: GuardPolicy,
 }
 
@@ -230,6 +232,7 @@ impl Default for SolverSpec {
             newton_tolerance: p.solver.newton_tolerance,
             xpbd_iterations: p.solver.xpbd_iterations,
             vbd_iterations: p.solver.vbd_iterations,
+            precision: p.solver.precision,
             guard: p.guard,
         }
     }
@@ -504,6 +507,7 @@ impl SceneFile {
                 newton_tolerance: s.newton_tolerance,
                 xpbd_iterations: s.xpbd_iterations,
                 vbd_iterations: s.vbd_iterations,
+                precision: s.precision,
             },
         }
     }
@@ -535,6 +539,7 @@ impl SceneFile {
             newton_tolerance: params.solver.newton_tolerance,
             xpbd_iterations: params.solver.xpbd_iterations,
             vbd_iterations: params.solver.vbd_iterations,
+            precision: params.solver.precision,
             guard: params.guard.clone(),
         };
         file.material = MaterialSpec {

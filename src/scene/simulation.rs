@@ -4,9 +4,9 @@
 
 use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{
-    Cause, Changes, CpuStepper, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent,
-    IntegratorKind, Intersections, ParamError, PhaseTimings, SimParams, StepBackend, StepError,
-    StepReport, StepStats, intersections, obstacle_overlap_warnings, small_sphere_warnings,
+    Cause, Changes, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent, IntegratorKind,
+    Intersections, ParamError, PhaseTimings, SimParams, StepBackend, StepError, StepReport,
+    StepStats, cpu_backend, intersections, obstacle_overlap_warnings, small_sphere_warnings,
     thickness_fits,
 };
 
@@ -76,7 +76,7 @@ impl Simulation {
     /// Starts the scene from its initial state on the CPU backend.
     pub fn new(scene: Scene) -> Self {
         // A new CPU stepper is configured for the scene already.
-        let backend = Box::new(CpuStepper::new(&scene.model, &scene.params, &scene.effects));
+        let backend = cpu_backend(&scene.model, &scene.params, &scene.effects);
         Self::assemble(scene, backend)
     }
 
@@ -138,7 +138,7 @@ impl Simulation {
     /// count, parameters, effects and pins. What only a backend knows (substeps the guard
     /// raised, a multi-step integrator's history, timings) starts anew.
     pub fn fork(&self) -> Simulation {
-        let backend = Box::new(CpuStepper::new(&self.model, &self.params, &self.effects));
+        let backend = cpu_backend(&self.model, &self.params, &self.effects);
         Simulation {
             file: self.file.clone(),
             scenario: self.scenario.clone(),
@@ -171,8 +171,8 @@ impl Simulation {
     /// # Errors
     /// As [`Simulation::set_backend`].
     pub fn use_cpu(&mut self) -> Result<(), StepError> {
-        let cpu = CpuStepper::new(&self.model, &self.params, &self.effects);
-        self.set_backend(Box::new(cpu))
+        let cpu = cpu_backend(&self.model, &self.params, &self.effects);
+        self.set_backend(cpu)
     }
 
     pub fn scenario(&self) -> &str {
@@ -305,7 +305,7 @@ impl Simulation {
     /// joules.
     pub fn energy(&self) -> f64 {
         self.state.kinetic_energy(&self.model)
-            + ForceSet::new(&self.model, &self.params.material, &self.effects)
+            + ForceSet::<f32>::new(&self.model, &self.params.material, &self.effects)
                 .potential_energy(&self.model, &self.state.pos)
     }
 
@@ -332,6 +332,12 @@ impl Simulation {
             self.backend.invalidate();
         }
         self.params = params;
+        if changes.contains(Changes::PRECISION) && self.backend.name() == "cpu" {
+            // Another precision is another stepper; it starts from the current state.
+            self.backend = cpu_backend(&self.model, &self.params, &self.effects);
+            self.backend.invalidate();
+            return Ok(());
+        }
         (self.backend).configure(&self.model, &self.params, &self.effects, changes);
         Ok(())
     }

@@ -1,9 +1,7 @@
 //! Preconditioned conjugate gradients on the implicit system, with pinned particles
 //! filtered out of the solve (their unknowns stay zero) and a block-Jacobi preconditioner.
 
-use glam::{Mat3, Vec3};
-
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, Matrix, Real, Vector};
 
 use super::forces::{SystemMatrix, SystemProduct};
 use super::integrator::StepError;
@@ -22,32 +20,32 @@ pub struct CgOutcome {
 /// Scratch vectors of a solve, kept between steps (no allocation once sized). The vectors
 /// are stored one array per component, so every update is a vector loop.
 #[derive(Clone, Debug, Default)]
-pub struct ConjugateGradient {
-    x: Components,
-    r: Components,
-    z: Components,
-    p: Components,
-    q: Components,
+pub struct ConjugateGradient<R: Real = f32> {
+    x: Components<R>,
+    r: Components<R>,
+    z: Components<R>,
+    p: Components<R>,
+    q: Components<R>,
     /// The preconditioner's 3×3 blocks, one array per entry (column-major).
-    precond: Blocks,
+    precond: Blocks<R>,
     free: Vec<bool>,
-    product: SystemProduct,
+    product: SystemProduct<R>,
 }
 
 /// `Σ a_i·b_i`: eight f32 lanes sum a block of 64 particles (eight each, side by side in
 /// the vector units), and the blocks' sums add up in f64. (One f64 running sum was a chain
 /// of dependent additions, an eighth of an implicit step's time.)
-fn dot(a: &Components, b: &Components) -> f64 {
+fn dot<R: Real>(a: &Components<R>, b: &Components<R>) -> f64 {
     const LANES: usize = 8;
     const BLOCK: usize = 8 * LANES;
-    type Lanes = [f32; LANES];
+    let zero = [R::ZERO; LANES];
     let n = a[0].len().min(b[0].len());
-    let lanes_of = |v: &[f32]| -> Lanes { v.try_into().unwrap_or([0.0; LANES]) };
+    let lanes_of = |v: &[R]| -> [R; LANES] { v.try_into().unwrap_or(zero) };
     let mut total = 0.0f64;
     for start in (0..n).step_by(BLOCK) {
         let end = (start + BLOCK).min(n);
         let whole = start + (end - start) / LANES * LANES;
-        let mut sum: Lanes = [0.0; LANES];
+        let mut sum = zero;
         for k in (start..whole).step_by(LANES) {
             for c in 0..3 {
                 let (u, v) = (lanes_of(&a[c][k..k + LANES]), lanes_of(&b[c][k..k + LANES]));
@@ -59,12 +57,12 @@ fn dot(a: &Components, b: &Components) -> f64 {
         for i in whole..end {
             sum[0] += a[0][i] * b[0][i] + a[1][i] * b[1][i] + a[2][i] * b[2][i];
         }
-        total += sum.iter().map(|&s| s as f64).sum::<f64>();
+        total += sum.iter().map(|s| s.to_f64()).sum::<f64>();
     }
     total
 }
 
-impl ConjugateGradient {
+impl<R: Real> ConjugateGradient<R> {
     /// Solves `A·x = b` for the free particles (inverse mass > 0); pinned rows are held
     /// at zero. `x` is the starting guess when it has one entry per particle (a warm start
     /// from the last step's solution), else zero. Stops when `‖r‖ ≤ tolerance·‖b‖` or after
@@ -76,9 +74,9 @@ impl ConjugateGradient {
     pub fn solve(
         &mut self,
         model: &ClothModel,
-        sys: &SystemMatrix,
-        b: &[Vec3],
-        x: &mut Vec<Vec3>,
+        sys: &SystemMatrix<R>,
+        b: &[R::V3],
+        x: &mut Vec<R::V3>,
         tolerance: f32,
         max_iterations: u32,
     ) -> Result<CgOutcome, StepError> {
@@ -88,27 +86,27 @@ impl ConjugateGradient {
         let free = &self.free;
         if x.len() != n {
             x.clear();
-            x.resize(n, Vec3::ZERO);
+            x.resize(n, R::V3::ZERO);
         }
         for (i, xi) in x.iter_mut().enumerate() {
             if !free[i] || !xi.is_finite() {
-                *xi = Vec3::ZERO;
+                *xi = R::V3::ZERO;
             }
         }
         let b_norm = (0..n)
             .filter(|&i| free[i])
-            .map(|i| b[i].length_squared() as f64)
+            .map(|i| b[i].length_squared().to_f64())
             .sum::<f64>()
             .sqrt();
         if b_norm == 0.0 {
-            x.iter_mut().for_each(|xi| *xi = Vec3::ZERO);
+            x.iter_mut().for_each(|xi| *xi = R::V3::ZERO);
             return Ok(CgOutcome {
                 iterations: 0,
                 residual: 0.0,
                 converged: true,
             });
         }
-        let inverse = |(d, &free): (&Mat3, &bool)| if free { d.inverse() } else { Mat3::ZERO };
+        let inverse = |(d, &free): (&R::M3, &bool)| if free { d.inverse() } else { R::M3::ZERO };
         split_blocks(sys.diag.iter().zip(free).map(inverse), &mut self.precond);
         for v in [&mut self.r, &mut self.z, &mut self.p, &mut self.q] {
             zeroed(v, n);
@@ -119,7 +117,11 @@ impl ConjugateGradient {
         self.product.apply_components(&self.x, &mut self.q);
         for (c, r) in self.r.iter_mut().enumerate() {
             for (i, r) in r.iter_mut().enumerate() {
-                *r = if free[i] { b[i][c] - self.q[c][i] } else { 0.0 };
+                *r = if free[i] {
+                    b[i].to_array()[c] - self.q[c][i]
+                } else {
+                    R::ZERO
+                };
             }
         }
         blocks_times(&self.precond, &self.r, &mut self.z, |z, _| z);
@@ -133,7 +135,7 @@ impl ConjugateGradient {
             self.product.apply_components(&self.p, &mut self.q);
             for q in &mut self.q {
                 for (q, &free) in q.iter_mut().zip(free) {
-                    *q = if free { *q } else { 0.0 };
+                    *q = if free { *q } else { R::ZERO };
                 }
             }
             let curvature = dot(&self.p, &self.q);
@@ -143,25 +145,25 @@ impl ConjugateGradient {
             if curvature <= 0.0 {
                 return Err(StepError::Breakdown { iterations });
             }
-            let alpha = (rz / curvature) as f32;
+            let alpha = R::of_f64(rz / curvature);
             for (x, p) in self.x.iter_mut().zip(&self.p) {
-                x.iter_mut().zip(p).for_each(|(x, &p)| *x += alpha * p);
+                x.iter_mut().zip(p).for_each(|(x, &p)| *x += p * alpha);
             }
             for (r, q) in self.r.iter_mut().zip(&self.q) {
-                r.iter_mut().zip(q).for_each(|(r, &q)| *r -= alpha * q);
+                r.iter_mut().zip(q).for_each(|(r, &q)| *r -= q * alpha);
             }
             blocks_times(&self.precond, &self.r, &mut self.z, |z, _| z);
             residual = dot(&self.r, &self.r).sqrt();
             let rz_next = dot(&self.r, &self.z);
-            let beta = (rz_next / rz) as f32;
+            let beta = R::of_f64(rz_next / rz);
             rz = rz_next;
             for (p, z) in self.p.iter_mut().zip(&self.z) {
-                p.iter_mut().zip(z).for_each(|(p, &z)| *p = z + beta * *p);
+                p.iter_mut().zip(z).for_each(|(p, &z)| *p = z + *p * beta);
             }
         }
         let [x0, x1, x2] = &self.x;
         for (i, xi) in x.iter_mut().enumerate() {
-            *xi = Vec3::new(x0[i], x1[i], x2[i]);
+            *xi = R::V3::new(x0[i], x1[i], x2[i]);
         }
         if !residual.is_finite() {
             return Err(StepError::NonFinite { iterations });

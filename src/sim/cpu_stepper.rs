@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-use crate::cloth::{ClothModel, ClothState};
+use crate::cloth::{ClothModel, ClothState, Real};
 
 use super::backend::StepBackend;
 use super::diagnosis::Cause;
@@ -18,6 +18,8 @@ use super::integrator::{
     Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport,
 };
 use super::params::{Changes, SimParams, SolverConfig};
+use super::precise_state::{PreciseState, as_f32, f32_view};
+use super::precision::Precision;
 use super::self_contacts::{SelfContacts, SelfWork};
 use super::stats::StepStats;
 use super::timings::PhaseTimings;
@@ -26,11 +28,12 @@ use super::timings::PhaseTimings;
 /// round only follows one whose check had to cut.
 const RECHECKS: usize = 3;
 
-/// Advances a cloth on the CPU. Built from a scene's effect list: absent effects are not in
-/// it and cost nothing.
-pub struct CpuStepper {
-    integrator: Box<dyn Integrator>,
-    forces: ForceSet,
+/// Advances a cloth on the CPU, its forces and integrator computing in precision `R`
+/// (`f32`, or `f64` on a state of its own whose rounding the caller sees). Built from a
+/// scene's effect list: absent effects are not in it and cost nothing.
+pub struct CpuStepper<R: Real = f32> {
+    integrator: Box<dyn Integrator<R>>,
+    forces: ForceSet<R>,
     /// The effects that act after each substep: solids in the scene's order, then
     /// self-collision.
     contacts: Vec<Effect>,
@@ -44,12 +47,12 @@ pub struct CpuStepper {
     /// Substeps per frame in effect (the guard may have raised them).
     substeps: u32,
     offset: f32,
-    guard: GuardState,
+    guard: GuardState<R>,
     timings: PhaseTimings,
     stats: StepStats,
     meter: StepMeter,
     /// The frame's start state, restored when nothing saves a frame.
-    frame_start: ClothState,
+    frame_start: ClothState<R>,
     /// Positions at the start of the current substep: the paths colliders sweep.
     substep_start: Vec<glam::Vec3>,
     self_collision: Option<SelfCollision>,
@@ -59,11 +62,36 @@ pub struct CpuStepper {
     before_solids: Vec<glam::Vec3>,
     /// Air damping in effect, 1/s (0 without the effect; for the guard's diagnosis).
     air_damping: f32,
+    /// The state stepped, in a precision other than `f32`.
+    precise: PreciseState<R>,
+    /// The state rounded to `f32`, for the guard and the contacts, in a precision other
+    /// than `f32`.
+    view: ClothState,
+}
+
+/// The CPU stepper for `effects` with `params`, in the precision they ask for.
+pub fn cpu_backend(
+    model: &ClothModel,
+    params: &SimParams,
+    effects: &[Effect],
+) -> Box<dyn StepBackend> {
+    match params.solver.precision {
+        Precision::F32 => Box::new(CpuStepper::<f32>::build(model, params, effects)),
+        Precision::F64 => Box::new(CpuStepper::<f64>::build(model, params, effects)),
+    }
 }
 
 impl CpuStepper {
-    /// A stepper for `effects` with the strengths in `params`.
+    /// A stepper in `f32` for `effects` with the strengths in `params` (whatever precision
+    /// they ask for: [`cpu_backend`] heeds it).
     pub fn new(model: &ClothModel, params: &SimParams, effects: &[Effect]) -> Self {
+        Self::build(model, params, effects)
+    }
+}
+
+impl<R: Real> CpuStepper<R> {
+    /// A stepper in precision `R` for `effects` with the strengths in `params`.
+    pub fn build(model: &ClothModel, params: &SimParams, effects: &[Effect]) -> Self {
         let mut stepper = Self {
             integrator: params.step.integrator.build(),
             forces: ForceSet::default(),
@@ -85,6 +113,8 @@ impl CpuStepper {
             self_contacts: SelfContacts::default(),
             before_solids: Vec::new(),
             air_damping: 0.0,
+            precise: PreciseState::default(),
+            view: ClothState::default(),
         };
         stepper.configure(model, params, effects, Changes::all());
         stepper
@@ -100,11 +130,20 @@ impl CpuStepper {
     fn advance(
         &mut self,
         model: &ClothModel,
-        state: &mut ClothState,
+        state: &mut ClothState<R>,
     ) -> Result<StepReport, StepError> {
-        let h = self.substep_length();
+        let h = self.step_length();
         if self.contacts_exist() {
-            self.substep_start.clone_from(&state.pos);
+            match R::f32_slice(&state.pos) {
+                Some(pos) => {
+                    self.substep_start.clear();
+                    self.substep_start.extend_from_slice(pos);
+                }
+                None => {
+                    self.substep_start.clear();
+                    (self.substep_start).extend(state.pos.iter().map(|p| R::v3_f32(*p)));
+                }
+            }
         }
         self.forces.set_time(state.time);
         let report = self.integrate_with(model, state, |integrator, ctx, state| {
@@ -122,11 +161,25 @@ impl CpuStepper {
     fn resolve_contacts(
         &mut self,
         model: &ClothModel,
-        state: &mut ClothState,
+        state: &mut ClothState<R>,
     ) -> Result<(), StepError> {
         if !self.contacts_exist() {
             return Ok(());
         }
+        let mut view = std::mem::take(&mut self.view);
+        let resolved = as_f32(state, &mut view, |state| {
+            self.resolve_contacts_f32(model, state)
+        });
+        self.view = view;
+        resolved
+    }
+
+    /// [`CpuStepper::resolve_contacts`] on the state in `f32`.
+    fn resolve_contacts_f32(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+    ) -> Result<(), StepError> {
         let mut contacts = 0;
         let mut pass = ContactPass {
             model,
@@ -204,12 +257,12 @@ impl CpuStepper {
     }
 
     /// Runs `steps` (the integrator's work) on `state` and charges its phases.
-    fn integrate_with<R>(
+    fn integrate_with<T>(
         &mut self,
         model: &ClothModel,
-        state: &mut ClothState,
-        steps: impl FnOnce(&mut dyn Integrator, &mut StepContext<'_>, &mut ClothState) -> R,
-    ) -> R {
+        state: &mut ClothState<R>,
+        steps: impl FnOnce(&mut dyn Integrator<R>, &mut StepContext<'_, R>, &mut ClothState<R>) -> T,
+    ) -> T {
         let start = Instant::now();
         let result = {
             let mut ctx = StepContext::new(model, &self.forces, &self.solver, &mut self.meter);
@@ -241,12 +294,12 @@ impl CpuStepper {
     fn frame_substeps(
         &mut self,
         model: &ClothModel,
-        state: &mut ClothState,
+        state: &mut ClothState<R>,
         checked: bool,
     ) -> Result<(), Trouble> {
         let count = self.substeps;
         if count > 1 && !self.contacts_exist() {
-            let h = self.substep_length();
+            let h = self.step_length();
             self.forces.set_time(state.time);
             let together = self.integrate_with(model, state, |integrator, ctx, state| {
                 integrator.steps(ctx, state, h, count)
@@ -257,10 +310,13 @@ impl CpuStepper {
             }
         }
         let limits = self.guard.limits.filter(|_| checked);
-        let depth = limits.map_or(0.0, |l| l.depth_of(state));
+        let depth = limits.map_or(0.0, |l| l.depth_of(f32_view(state, &mut self.view)));
         for _ in 0..count {
             self.advance(model, state)?;
-            if let Some(trouble) = limits.and_then(|l| l.check_substep(model, state, depth)) {
+            if let Some(l) = limits
+                && let Some(trouble) =
+                    l.check_substep(model, f32_view(state, &mut self.view), depth)
+            {
                 return Err(trouble);
             }
             self.resolve_contacts(model, state)?;
@@ -273,14 +329,14 @@ impl CpuStepper {
     fn try_frame(
         &mut self,
         model: &ClothModel,
-        state: &mut ClothState,
+        state: &mut ClothState<R>,
         end: f64,
     ) -> Result<(), Trouble> {
         self.frame_substeps(model, state, true)?;
         // Whole frames end on the frame clock, however the substeps' lengths rounded.
         state.time = end;
         let limits = self.guard.limits.as_ref().ok_or(Trouble::NonFinite)?;
-        match check(model, state, limits) {
+        match check(model, f32_view(state, &mut self.view), limits) {
             Some(trouble) => Err(trouble),
             None => Ok(()),
         }
@@ -290,7 +346,7 @@ impl CpuStepper {
     fn replay(
         &mut self,
         model: &ClothModel,
-        state: &mut ClothState,
+        state: &mut ClothState<R>,
         end: f64,
     ) -> Result<(), Trouble> {
         let from = self
@@ -327,7 +383,7 @@ impl CpuStepper {
     fn rescue(
         &mut self,
         model: &ClothModel,
-        state: &mut ClothState,
+        state: &mut ClothState<R>,
         end: f64,
         trouble: Trouble,
     ) -> Result<FrameOutcome, Diverged> {
@@ -380,7 +436,10 @@ impl CpuStepper {
             reason: last.to_string(),
             substeps: tried,
             fallback,
-            cause: self.diagnose(model, &state.pos, tried),
+            cause: {
+                let pos = f32_view(state, &mut self.view).pos.clone();
+                self.diagnose(model, &pos, tried)
+            },
         })
     }
 
@@ -401,7 +460,77 @@ impl CpuStepper {
     }
 }
 
-impl StepBackend for CpuStepper {
+impl<R: Real> CpuStepper<R> {
+    /// The substep's length in the stepper's precision, seconds.
+    fn step_length(&self) -> R {
+        R::of_f32(self.dt) / R::of_f32(self.substeps as f32)
+    }
+
+    /// Runs `f` on the state this stepper steps: `state` itself in `f32`; else its own,
+    /// taken from `state` when that changed and rounded into it afterwards.
+    fn on_state<T>(
+        &mut self,
+        state: &mut ClothState,
+        f: impl FnOnce(&mut Self, &mut ClothState<R>) -> T,
+    ) -> T {
+        if let Some(same) = (state as &mut dyn std::any::Any).downcast_mut::<ClothState<R>>() {
+            return f(self, same);
+        }
+        let mut precise = std::mem::take(&mut self.precise);
+        precise.load(state);
+        let out = f(self, &mut precise.state);
+        precise.store(state);
+        self.precise = precise;
+        out
+    }
+
+    /// One frame under the guard, on the state stepped (see [`StepBackend::frame`]).
+    fn guarded_frame(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState<R>,
+    ) -> Result<FrameOutcome, Diverged> {
+        let end = state.time + self.dt as f64;
+        if !self.guard.policy.enabled {
+            // With the guard off a failed step is all there is to report.
+            self.frame_start.clone_from(state);
+            if let Err(trouble) = self.frame_substeps(model, state, false) {
+                let pos = f32_view(&self.frame_start, &mut self.view).pos.clone();
+                return Err(Diverged {
+                    time: state.time,
+                    reason: trouble.to_string(),
+                    substeps: self.substeps,
+                    fallback: String::new(),
+                    cause: self.diagnose(model, &pos, self.substeps),
+                });
+            }
+            state.time = end;
+            return Ok(FrameOutcome::Stepped);
+        }
+        if self.guard.limits.is_none() {
+            self.guard.limits = Some(GuardLimits::derive(
+                &self.guard.policy,
+                model,
+                f32_view(state, &mut self.view),
+                self.gravity,
+                &self.forces,
+                &self.effects,
+            ));
+        }
+        self.frame_start.clone_from(state);
+        match self.try_frame(model, state, end) {
+            Ok(()) => {
+                let start = std::mem::take(&mut self.frame_start);
+                self.guard.healthy_frame(&start);
+                self.frame_start = start;
+                Ok(self.maybe_recover(end).unwrap_or(FrameOutcome::Stepped))
+            }
+            Err(trouble) => self.rescue(model, state, end, trouble),
+        }
+    }
+}
+
+impl<R: Real> StepBackend for CpuStepper<R> {
     fn name(&self) -> &'static str {
         "cpu"
     }
@@ -432,7 +561,7 @@ impl StepBackend for CpuStepper {
         }
         if changes.contains(Changes::INTEGRATOR) && self.integrator.kind() != params.step.integrator
         {
-            self.integrator = params.step.integrator.build();
+            self.integrator = params.step.integrator.build::<R>();
         }
         // New forces or strengths make whatever the integrator derived stale (new masses
         // come with `invalidate`).
@@ -457,6 +586,7 @@ impl StepBackend for CpuStepper {
     fn invalidate(&mut self) {
         self.integrator.invalidate();
         self.guard.forget_history();
+        self.precise.forget();
     }
 
     fn substep(
@@ -464,9 +594,11 @@ impl StepBackend for CpuStepper {
         model: &ClothModel,
         state: &mut ClothState,
     ) -> Result<StepReport, StepError> {
-        let report = self.advance(model, state)?;
-        self.resolve_contacts(model, state)?;
-        Ok(report)
+        self.on_state(state, |stepper, state| {
+            let report = stepper.advance(model, state)?;
+            stepper.resolve_contacts(model, state)?;
+            Ok(report)
+        })
     }
 
     /// One frame under the guard: a frame that breaks a limit (non-finite, too fast, a
@@ -479,42 +611,7 @@ impl StepBackend for CpuStepper {
         model: &ClothModel,
         state: &mut ClothState,
     ) -> Result<FrameOutcome, Diverged> {
-        let end = state.time + self.dt as f64;
-        if !self.guard.policy.enabled {
-            // With the guard off a failed step is all there is to report.
-            self.frame_start.clone_from(state);
-            if let Err(trouble) = self.frame_substeps(model, state, false) {
-                return Err(Diverged {
-                    time: state.time,
-                    reason: trouble.to_string(),
-                    substeps: self.substeps,
-                    fallback: String::new(),
-                    cause: self.diagnose(model, &self.frame_start.pos, self.substeps),
-                });
-            }
-            state.time = end;
-            return Ok(FrameOutcome::Stepped);
-        }
-        if self.guard.limits.is_none() {
-            self.guard.limits = Some(GuardLimits::derive(
-                &self.guard.policy,
-                model,
-                state,
-                self.gravity,
-                &self.forces,
-                &self.effects,
-            ));
-        }
-        self.frame_start.clone_from(state);
-        match self.try_frame(model, state, end) {
-            Ok(()) => {
-                let start = std::mem::take(&mut self.frame_start);
-                self.guard.healthy_frame(&start);
-                self.frame_start = start;
-                Ok(self.maybe_recover(end).unwrap_or(FrameOutcome::Stepped))
-            }
-            Err(trouble) => self.rescue(model, state, end, trouble),
-        }
+        self.on_state(state, |stepper, state| stepper.guarded_frame(model, state))
     }
 
     fn substeps(&self) -> u32 {

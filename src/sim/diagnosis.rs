@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, Real};
 
 use super::effects::TooThick;
 use super::forces::ForceSet;
@@ -86,10 +86,10 @@ impl Cause {
     /// [`Cause::Substeps`] when `integrator` at `tried` substeps of a `dt`-second frame is
     /// past its stable step for the stiffest vibration of the spring terms in `forces` about
     /// `pos` (with air damping at `air_damping` 1/s); `None` otherwise.
-    pub fn substeps(
+    pub fn substeps<R: Real>(
         integrator: IntegratorKind,
         model: &ClothModel,
-        forces: &ForceSet,
+        forces: &ForceSet<R>,
         pos: &[Vec3],
         air_damping: f32,
         dt: f32,
@@ -124,9 +124,9 @@ pub struct Vibration {
 /// iteration on `M^-½·K·M^-½`, `K` the springs' stiffness along their current directions
 /// (pinned particles held), with the dashpots' and the air's damping of the mode found.
 /// `None` without springs.
-pub fn stiffest_vibration(
+pub fn stiffest_vibration<R: Real>(
     model: &ClothModel,
-    forces: &ForceSet,
+    forces: &ForceSet<R>,
     pos: &[Vec3],
     air_damping: f32,
 ) -> Option<Vibration> {

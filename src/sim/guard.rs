@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use crate::cloth::{ClothModel, ClothState};
+use crate::cloth::{ClothModel, ClothState, Real};
 use crate::mesh::{SpringKind, bounds};
 
 use super::diagnosis::Cause;
@@ -99,12 +99,12 @@ impl GuardLimits {
     /// dragged or springing back from the stretch it has, and the larger of the stretch of
     /// a structural spring carrying the whole weight and the largest stretch it has, times
     /// the policy's headroom.
-    pub fn derive(
+    pub fn derive<R: Real>(
         policy: &GuardPolicy,
         model: &ClothModel,
         state: &ClothState,
         gravity: Vec3,
-        forces: &ForceSet,
+        forces: &ForceSet<R>,
         effects: &[Effect],
     ) -> Self {
         let g = gravity.length();
@@ -248,16 +248,17 @@ impl GuardLimits {
 
 /// The energy stored in the cloth at `pos`, joules: every conservative term's but gravity's
 /// (the height the cloth can fall accounts for that), so the springs' and the hinges'.
-fn stored_energy(model: &ClothModel, forces: &ForceSet, pos: &[Vec3]) -> f64 {
+fn stored_energy<R: Real>(model: &ClothModel, forces: &ForceSet<R>, pos: &[Vec3]) -> f64 {
+    let pos: Vec<R::V3> = pos.iter().map(|p| R::v3(*p)).collect();
     (forces.terms().iter())
         .filter(|t| t.get::<Gravity>().is_none())
-        .map(|t| t.potential_energy(model, pos))
+        .map(|t| t.potential_energy(model, &pos))
         .sum()
 }
 
 /// Relative stretch of the weakest structural spring (the smallest k·l) pulled by `weight`
 /// newtons; 0 without structural springs of positive stiffness.
-fn weight_strain(model: &ClothModel, forces: &ForceSet, weight: f32) -> f32 {
+fn weight_strain<R: Real>(model: &ClothModel, forces: &ForceSet<R>, weight: f32) -> f32 {
     let s = &model.springs;
     let weakest = (forces.springs().flat_map(|t| t.each()))
         .filter(|&(e, _, _)| s.kind[e] == SpringKind::Structural)

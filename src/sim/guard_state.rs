@@ -1,24 +1,24 @@
 //! The guard's running memory: the limits in force, the rollback point, and the counters
 //! that bring raised substeps back down.
 
-use crate::cloth::ClothState;
+use crate::cloth::{ClothState, Real};
 
 use super::guard::{GuardEvent, GuardLimits};
 use super::guard_policy::GuardPolicy;
 
 /// What the guard keeps between frames.
 #[derive(Clone, Debug)]
-pub struct GuardState {
+pub struct GuardState<R: Real = f32> {
     pub policy: GuardPolicy,
     pub limits: Option<GuardLimits>,
     /// A state that stayed healthy for `checkpoint_frames` frames after it: where a failed
     /// frame rolls back to. `None` until the first frame after a reset or an outside change.
-    pub checkpoint: Option<ClothState>,
+    pub checkpoint: Option<ClothState<R>>,
     /// The next checkpoint, and how many healthy frames it has aged.
-    pub candidate: Option<(ClothState, u32)>,
+    pub candidate: Option<(ClothState<R>, u32)>,
     /// A retired checkpoint's buffers, reused for the next candidate (no allocation per
     /// checkpoint in a long run).
-    spare: Option<ClothState>,
+    spare: Option<ClothState<R>>,
     /// Healthy frames since the substeps last changed.
     pub good_frames: u32,
     /// Healthy frames needed before stepping down (doubles after a step down that failed).
@@ -28,7 +28,7 @@ pub struct GuardState {
     pub events: Vec<GuardEvent>,
 }
 
-impl GuardState {
+impl<R: Real> GuardState<R> {
     pub fn new(policy: GuardPolicy) -> Self {
         Self {
             recover_wait: policy.recover_after,
@@ -51,7 +51,7 @@ impl GuardState {
     }
 
     /// Records a healthy frame that started from `start`: ages the candidate, promotes it.
-    pub fn healthy_frame(&mut self, start: &ClothState) {
+    pub fn healthy_frame(&mut self, start: &ClothState<R>) {
         self.good_frames += 1;
         let age_needed = self.policy.checkpoint_frames;
         match &mut self.candidate {
@@ -68,7 +68,7 @@ impl GuardState {
     }
 
     /// `state` copied into the spare buffers when there are some.
-    fn copy_of(&mut self, state: &ClothState) -> ClothState {
+    fn copy_of(&mut self, state: &ClothState<R>) -> ClothState<R> {
         let mut copy = self.spare.take().unwrap_or_default();
         copy.clone_from(state);
         copy

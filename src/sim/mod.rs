@@ -18,6 +18,8 @@ mod motion;
 pub mod obstacle;
 mod param_error;
 mod params;
+mod precise_state;
+mod precision;
 mod self_contacts;
 mod stats;
 mod timings;
@@ -25,7 +27,7 @@ mod timings;
 pub use backend::StepBackend;
 pub use cg::{CgOutcome, ConjugateGradient};
 pub use constraints::DistanceConstraints;
-pub use cpu_stepper::CpuStepper;
+pub use cpu_stepper::{CpuStepper, cpu_backend};
 pub use diagnosis::{Cause, Vibration, stiffest_vibration};
 pub use effects::{
     AirDamping, BendingModel, ClothBox, ClothSprings, DEFAULT_DIHEDRAL_STIFFNESS, DEFAULT_FPS,
@@ -41,6 +43,7 @@ pub use intersections::{Intersections, intersections};
 pub use motion::{AxisAngle, Ease, Keyframe, MotionError, Pose, RigidMotion};
 pub use param_error::ParamError;
 pub use params::{Changes, ContactConfig, Material, SimParams, SolverConfig, StepConfig};
+pub use precision::Precision;
 pub use self_contacts::{CELLS_PER_TRIANGLE, ContactError, SelfContacts, SelfWork};
 pub use stats::StepStats;
 pub use timings::{Phase, PhaseTimings};

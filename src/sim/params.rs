@@ -3,6 +3,7 @@
 use super::guard_policy::GuardPolicy;
 use super::integrator::IntegratorKind;
 use super::param_error::ParamError;
+use super::precision::Precision;
 
 /// Every tunable number of the solver, by concern: each subsystem takes its own part. Units
 /// are SI; each field says how it affects stability.
@@ -113,6 +114,8 @@ bitflags::bitflags! {
         const SOLVER = 1 << 7;
         /// The effect list (an effect on or off, or its settings).
         const EFFECTS = 1 << 8;
+        /// The precision the stepper computes in (a new stepper).
+        const PRECISION = 1 << 9;
     }
 }
 
@@ -132,7 +135,14 @@ impl SimParams {
             (Changes::DENSITY, a.material.density != b.material.density),
             (Changes::CONTACT, a.contact != b.contact),
             (Changes::GUARD, a.guard != b.guard),
-            (Changes::SOLVER, a.solver != b.solver),
+            (
+                Changes::SOLVER,
+                SolverConfig {
+                    precision: b.solver.precision,
+                    ..a.solver
+                } != b.solver,
+            ),
+            (Changes::PRECISION, a.solver.precision != b.solver.precision),
         ];
         (flags.into_iter())
             .filter(|(_, changed)| *changed)
@@ -159,6 +169,8 @@ pub struct SolverConfig {
     pub xpbd_iterations: u32,
     /// Descent sweeps per VBD substep (default 1: small steps, one iteration).
     pub vbd_iterations: u32,
+    /// What the state, forces and integrators compute in (default `f32`).
+    pub precision: Precision,
 }
 
 impl Default for SolverConfig {
@@ -170,6 +182,7 @@ impl Default for SolverConfig {
             newton_tolerance: 1e-3,
             xpbd_iterations: 1,
             vbd_iterations: 1,
+            precision: Precision::F32,
         }
     }
 }
@@ -293,7 +306,7 @@ mod tests {
     #[test]
     fn a_change_names_its_concern() {
         type Edit = fn(&mut SimParams);
-        let cases: [(Changes, Edit); 11] = [
+        let cases: [(Changes, Edit); 12] = [
             (Changes::DT, |p| p.step.dt *= 2.0),
             (Changes::SUBSTEPS, |p| p.step.substeps += 1),
             (Changes::INTEGRATOR, |p| {
@@ -307,6 +320,7 @@ mod tests {
             (Changes::SOLVER, |p| p.solver.tolerance *= 0.5),
             (Changes::SOLVER, |p| p.solver.xpbd_iterations += 1),
             (Changes::SOLVER, |p| p.solver.vbd_iterations += 1),
+            (Changes::PRECISION, |p| p.solver.precision = Precision::F64),
         ];
         let before = SimParams::default();
         assert_eq!(before.changes_to(&before.clone()), Changes::empty());

@@ -1,9 +1,7 @@
 //! Linear air damping, mass-proportional: `f = −c·m·v`, so every free particle loses
 //! velocity at the same rate `c` (1/s) whatever the mesh resolution.
 
-use glam::Vec3;
-
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, Real};
 use crate::parallel::wide;
 use crate::parallel::{each_part, within};
 use crate::sim::forces::{Force, ForceTerm, Fused, SystemMatrix};
@@ -45,16 +43,23 @@ impl AirDamping {
     }
 }
 
-impl ForceTerm for AirDamping {
+impl<R: Real> ForceTerm<R> for AirDamping {
     /// Adds `−c·m·v` (N).
-    fn add_forces(&self, model: &ClothModel, _pos: &[Vec3], vel: &[Vec3], _t: f64, f: &mut [Vec3]) {
+    fn add_forces(
+        &self,
+        model: &ClothModel,
+        _pos: &[R::V3],
+        vel: &[R::V3],
+        _t: f64,
+        f: &mut [R::V3],
+    ) {
         for ((f, v), &m) in f.iter_mut().zip(vel).zip(&model.mass) {
-            *f -= (self.rate * m) * *v;
+            *f -= *v * R::of_f32(self.rate * m);
         }
     }
 
     fn takes_components(&self) -> bool {
-        true
+        R::VECTORISED
     }
 
     fn add_forces_components(
@@ -83,13 +88,13 @@ impl ForceTerm for AirDamping {
     fn add_df_dv(
         &self,
         model: &ClothModel,
-        _pos: &[Vec3],
-        _vel: &[Vec3],
-        u: &[Vec3],
-        out: &mut [Vec3],
+        _pos: &[R::V3],
+        _vel: &[R::V3],
+        u: &[R::V3],
+        out: &mut [R::V3],
     ) {
         for ((o, u), &m) in out.iter_mut().zip(u).zip(&model.mass) {
-            *o -= (self.rate * m) * *u;
+            *o -= *u * R::of_f32(self.rate * m);
         }
     }
 
@@ -97,12 +102,12 @@ impl ForceTerm for AirDamping {
     fn add_to_system(
         &self,
         model: &ClothModel,
-        _pos: &[Vec3],
-        _vel: &[Vec3],
-        sys: &mut SystemMatrix,
+        _pos: &[R::V3],
+        _vel: &[R::V3],
+        sys: &mut SystemMatrix<R>,
     ) {
         for (p, &m) in model.mass.iter().enumerate() {
-            sys.add_dv_diagonal(p, -self.rate * m);
+            sys.add_dv_diagonal(p, R::of_f32(-self.rate * m));
         }
     }
 }
@@ -122,8 +127,13 @@ impl EffectKind for AirDamping {
         )
     }
 
-    fn force(&self, _model: &ClothModel, _material: &Material, _kept: &[Force]) -> Option<Force> {
-        Some(Force::new(Self::NAME, *self))
+    fn force<R: Real>(
+        &self,
+        _model: &ClothModel,
+        _material: &Material,
+        _kept: &[Force<R>],
+    ) -> Option<Force<R>> {
+        Some(Force::of(Self::NAME, *self))
     }
 
     fn on_gpu(&self) -> Result<(), &'static str> {

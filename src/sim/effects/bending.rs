@@ -1,7 +1,7 @@
 //! How a cloth resists bending: springs between the vertices opposite each interior edge
 //! (the material's bend stiffness), or discrete-shells hinges on the dihedral angle.
 
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, Real};
 use crate::sim::forces::{DihedralBending, Force};
 use crate::sim::param_error::ParamError;
 use crate::sim::params::Material;
@@ -48,11 +48,16 @@ impl EffectKind for BendingModel {
         }
     }
 
-    fn force(&self, model: &ClothModel, material: &Material, kept: &[Force]) -> Option<Force> {
+    fn force<R: Real>(
+        &self,
+        model: &ClothModel,
+        material: &Material,
+        kept: &[Force<R>],
+    ) -> Option<Force<R>> {
         Some(match *self {
             BendingModel::Springs => {
                 let range = model.bend_start()..model.springs.len();
-                Force::new(Self::NAME, spring_term(model, material, kept, range))
+                Force::of(Self::NAME, spring_term(model, material, kept, range))
             }
             BendingModel::Dihedral { stiffness } => {
                 let mut b = (kept.iter())
@@ -60,7 +65,7 @@ impl EffectKind for BendingModel {
                     .cloned()
                     .unwrap_or_else(|| DihedralBending::new(model, stiffness));
                 b.set_stiffness(stiffness);
-                Force::new(Self::NAME, b)
+                Force::of(Self::NAME, b)
             }
         })
     }

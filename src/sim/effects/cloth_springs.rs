@@ -1,7 +1,7 @@
 //! The cloth's structural and shear springs: the cloth itself, in every scene (its
 //! stiffness and damping per kind are the material's).
 
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, Real};
 use crate::sim::forces::{Force, SpringForce};
 use crate::sim::params::Material;
 
@@ -13,10 +13,10 @@ pub struct ClothSprings;
 
 /// The springs of `model` over `range` with the material's strengths, reusing a spring
 /// term among `kept` over the same range (its regrouped runs) when there is one.
-pub(super) fn spring_term(
+pub(super) fn spring_term<R: Real>(
     model: &ClothModel,
     material: &Material,
-    kept: &[Force],
+    kept: &[Force<R>],
     range: std::ops::Range<usize>,
 ) -> SpringForce {
     let (stiffness, damping) = (material.stiffness, material.damping);
@@ -35,9 +35,14 @@ impl EffectKind for ClothSprings {
     const MANY: bool = false;
     const ADDABLE: bool = false;
 
-    fn force(&self, model: &ClothModel, material: &Material, kept: &[Force]) -> Option<Force> {
+    fn force<R: Real>(
+        &self,
+        model: &ClothModel,
+        material: &Material,
+        kept: &[Force<R>],
+    ) -> Option<Force<R>> {
         let range = 0..model.bend_start();
-        Some(Force::new(
+        Some(Force::of(
             Self::NAME,
             spring_term(model, material, kept, range),
         ))

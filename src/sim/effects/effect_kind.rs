@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 
-use crate::cloth::{ClothModel, ClothState};
+use crate::cloth::{ClothModel, ClothState, Real};
 use crate::sim::forces::Force;
 use crate::sim::param_error::ParamError;
 use crate::sim::params::Material;
@@ -69,7 +69,12 @@ pub trait EffectKind: Sized {
 
     /// The force term it adds to a step, built for `model` with the cloth's `material`
     /// (from what `kept`, the terms before, already derived); `None`: no force.
-    fn force(&self, _model: &ClothModel, _material: &Material, _kept: &[Force]) -> Option<Force> {
+    fn force<R: Real>(
+        &self,
+        _model: &ClothModel,
+        _material: &Material,
+        _kept: &[Force<R>],
+    ) -> Option<Force<R>> {
         None
     }
 

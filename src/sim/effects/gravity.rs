@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, Real, Vector};
 use crate::parallel::wide;
 use crate::parallel::{each_part, within};
 use crate::sim::forces::{Force, ForceTerm, Fused};
@@ -45,23 +45,24 @@ impl Gravity {
     }
 }
 
-impl ForceTerm for Gravity {
+impl<R: Real> ForceTerm<R> for Gravity {
     /// Adds `m·g` (N) to every particle's force.
     fn add_forces(
         &self,
         model: &ClothModel,
-        _pos: &[Vec3],
-        _vel: &[Vec3],
+        _pos: &[R::V3],
+        _vel: &[R::V3],
         _t: f64,
-        f: &mut [Vec3],
+        f: &mut [R::V3],
     ) {
+        let g = R::v3(self.acceleration);
         for (f, &m) in f.iter_mut().zip(&model.mass) {
-            *f += m * self.acceleration;
+            *f += g * R::of_f32(m);
         }
     }
 
     fn takes_components(&self) -> bool {
-        true
+        R::VECTORISED
     }
 
     fn add_forces_components(
@@ -86,10 +87,11 @@ impl ForceTerm for Gravity {
     }
 
     /// `−Σ m·g·x`, joules.
-    fn potential_energy(&self, model: &ClothModel, pos: &[Vec3]) -> f64 {
+    fn potential_energy(&self, model: &ClothModel, pos: &[R::V3]) -> f64 {
+        let g = R::v3(self.acceleration);
         -pos.iter()
             .zip(&model.mass)
-            .map(|(p, &m)| m as f64 * self.acceleration.dot(*p) as f64)
+            .map(|(p, &m)| m as f64 * g.dot(*p).to_f64())
             .sum::<f64>()
     }
 }
@@ -109,8 +111,13 @@ impl EffectKind for Gravity {
         )
     }
 
-    fn force(&self, _model: &ClothModel, _material: &Material, _kept: &[Force]) -> Option<Force> {
-        Some(Force::new(Self::NAME, *self))
+    fn force<R: Real>(
+        &self,
+        _model: &ClothModel,
+        _material: &Material,
+        _kept: &[Force<R>],
+    ) -> Option<Force<R>> {
+        Some(Force::of(Self::NAME, *self))
     }
 
     fn on_gpu(&self) -> Result<(), &'static str> {

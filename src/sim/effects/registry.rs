@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, Real};
 use crate::sim::forces::Force;
 use crate::sim::param_error::ParamError;
 use crate::sim::params::Material;
@@ -78,7 +78,7 @@ macro_rules! effects {
             }
 
             /// Its force term, if it adds one ([`EffectKind::force`]).
-            pub fn force(&self, model: &ClothModel, material: &Material, kept: &[Force]) -> Option<Force> {
+            pub fn force<R: Real>(&self, model: &ClothModel, material: &Material, kept: &[Force<R>]) -> Option<Force<R>> {
                 match self { $(Effect::$variant(e) => e.force(model, material, kept),)* }
             }
 

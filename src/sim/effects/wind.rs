@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, Real, Vector};
 use crate::sim::forces::{Force, ForceTerm};
 use crate::sim::param_error::ParamError;
 use crate::sim::params::Material;
@@ -54,58 +54,70 @@ impl Wind {
 
     /// The air's velocity at `x` at time `t`, m/s: the steady wind scaled by a gust factor
     /// that travels with it, and turned a little about the vertical by the same gusts.
-    pub fn air_velocity(&self, x: Vec3, t: f64) -> Vec3 {
+    pub fn air_velocity<R: Real>(&self, x: R::V3, t: f64) -> R::V3 {
         let speed = self.speed();
         if speed == 0.0 || self.gust == 0.0 {
-            return self.velocity;
+            return R::v3(self.velocity);
         }
-        let along = self.velocity / speed;
+        let c = R::of_f32;
+        let along = R::v3(self.velocity / speed);
+        let speed = c(speed);
         // Time at which this bit of air passed the origin: gusts are frozen in the flow.
-        let s = t as f32 - x.dot(along) / speed;
+        let s = R::of_f64(t) - x.dot(along) / speed;
         let p = self.gust_period.max(1e-3);
-        let tau = std::f32::consts::TAU;
+        let tau = c(std::f32::consts::TAU);
         // Three incommensurate tones: no visible period, smooth, in [−1, 1].
-        let strength = (tau * s / p).sin() * 0.5
-            + (tau * s / (0.61 * p) + 1.3).sin() * 0.3
-            + (tau * s / (0.37 * p) + 2.1).sin() * 0.2;
-        let veer = (tau * s / (0.83 * p) + 0.7).sin() * 0.25 * self.gust;
+        let strength = (tau * s / c(p)).sin() * c(0.5)
+            + (tau * s / c(0.61 * p) + c(1.3)).sin() * c(0.3)
+            + (tau * s / c(0.37 * p) + c(2.1)).sin() * c(0.2);
+        let veer = (tau * s / c(0.83 * p) + c(0.7)).sin() * c(0.25) * c(self.gust);
         let (sin, cos) = veer.sin_cos();
-        let turned = Vec3::new(
-            cos * along.x + sin * along.z,
-            along.y,
-            -sin * along.x + cos * along.z,
+        let turned = R::V3::new(
+            cos * along.x() + sin * along.z(),
+            along.y(),
+            -sin * along.x() + cos * along.z(),
         );
-        turned * speed * (1.0 + self.gust * strength)
+        turned * speed * (R::ONE + c(self.gust) * strength)
     }
 }
 
-impl ForceTerm for Wind {
+impl<R: Real> ForceTerm<R> for Wind {
     /// Adds each triangle's drag and lift (N), a third to each corner, at time `t`.
-    fn add_forces(&self, model: &ClothModel, pos: &[Vec3], vel: &[Vec3], t: f64, f: &mut [Vec3]) {
-        let half_rho = 0.5 * self.air_density;
+    fn add_forces(
+        &self,
+        model: &ClothModel,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        t: f64,
+        f: &mut [R::V3],
+    ) {
+        let k = R::of_f32;
+        let half_rho = k(0.5 * self.air_density);
+        let (third, half) = (k(3.0), k(0.5));
         for tri in &model.triangles {
             let [a, b, c] = tri.map(|i| i as usize);
             let normal = (pos[b] - pos[a]).cross(pos[c] - pos[a]);
             let twice_area = normal.length();
-            if twice_area <= 1e-12 {
+            if twice_area <= k(1e-12) {
                 continue;
             }
             let n = normal / twice_area;
-            let centre = (pos[a] + pos[b] + pos[c]) / 3.0;
-            let relative = (vel[a] + vel[b] + vel[c]) / 3.0 - self.air_velocity(centre, t);
+            let centre = (pos[a] + pos[b] + pos[c]) / third;
+            let air = self.air_velocity::<R>(centre, t);
+            let relative = (vel[a] + vel[b] + vel[c]) / third - air;
             let speed = relative.length();
-            if speed <= 1e-6 {
+            if speed <= k(1e-6) {
                 continue;
             }
             let flow = relative / speed;
             let facing = flow.dot(n);
-            let area = 0.5 * twice_area;
+            let area = half * twice_area;
             // Drag: pressure on the face, from the flow's component across it.
-            let drag = (-half_rho * self.drag * area * speed * speed * facing) * n;
+            let drag = n * (-half_rho * k(self.drag) * area * speed * speed * facing);
             // Lift: across the flow, largest at 45°; unchanged if the normal flips.
-            let across = n - facing * flow;
-            let lift = (-half_rho * self.lift * area * speed * speed * facing) * across;
-            let share = (drag + lift) / 3.0;
+            let across = n - flow * facing;
+            let lift = across * (-half_rho * k(self.lift) * area * speed * speed * facing);
+            let share = (drag + lift) / third;
             f[a] += share;
             f[b] += share;
             f[c] += share;
@@ -143,8 +155,13 @@ impl EffectKind for Wind {
         Ok(())
     }
 
-    fn force(&self, _model: &ClothModel, _material: &Material, _kept: &[Force]) -> Option<Force> {
-        Some(Force::new(Self::NAME, *self))
+    fn force<R: Real>(
+        &self,
+        _model: &ClothModel,
+        _material: &Material,
+        _kept: &[Force<R>],
+    ) -> Option<Force<R>> {
+        Some(Force::of(Self::NAME, *self))
     }
 
     fn guard(&self, _up: Vec3) -> GuardShare {

@@ -225,8 +225,8 @@ fn both_forms_agree_for_stretched_springs_at_rest() {
     let pos: Vec<Vec3> = model.rest_positions.iter().map(|&p| p * 1.1).collect();
     let vel = vec![Vec3::new(0.3, -0.2, 0.1); model.particle_count()];
     for e in 0..model.springs.len() {
-        let exact = s.blocks(&model.springs, &pos, &vel, e, JacobianMode::Exact);
-        let definite = s.blocks(&model.springs, &pos, &vel, e, JacobianMode::Definite);
+        let exact = s.blocks::<f32>(&model.springs, &pos, &vel, e, JacobianMode::Exact);
+        let definite = s.blocks::<f32>(&model.springs, &pos, &vel, e, JacobianMode::Definite);
         assert!(exact.dx.abs_diff_eq(definite.dx, 1e-3), "spring {e}");
     }
 }

@@ -3,9 +3,7 @@
 //! weighted by `w = 3|e|²/(A₁ + A₂)` of the rest geometry, so the bending stiffness does not
 //! depend on the mesh's resolution.
 
-use glam::Vec3;
-
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, Real, Vector};
 
 use super::force_term::ForceTerm;
 
@@ -19,14 +17,15 @@ pub struct DihedralBending {
 
 /// The signed dihedral angle of hinge `[x0, x1, a, b]` (radians, 0 when flat) and its
 /// gradient with respect to the four points, or `None` for a degenerate hinge.
-pub fn hinge_angle(x0: Vec3, x1: Vec3, a: Vec3, b: Vec3) -> Option<(f32, [Vec3; 4])> {
+pub fn hinge_angle<R: Real>(x0: R::V3, x1: R::V3, a: R::V3, b: R::V3) -> Option<(R, [R::V3; 4])> {
     let e = x1 - x0;
     let len2 = e.length_squared();
     // Unnormalised normals of (x0, x1, a) and (x1, x0, b): equal when flat.
     let na = e.cross(a - x0);
     let nb = (x0 - x1).cross(b - x1);
     let (na2, nb2) = (na.length_squared(), nb.length_squared());
-    if len2 <= 1e-24 || na2 <= 1e-24 || nb2 <= 1e-24 {
+    let tiny = R::of_f32(1e-24);
+    if len2 <= tiny || na2 <= tiny || nb2 <= tiny {
         return None;
     }
     let len = len2.sqrt();
@@ -39,8 +38,9 @@ pub fn hinge_angle(x0: Vec3, x1: Vec3, a: Vec3, b: Vec3) -> Option<(f32, [Vec3; 
     let gb = -nb * (len / nb2);
     let alpha_a = (a - x0).dot(e) / len2;
     let alpha_b = (b - x0).dot(e) / len2;
-    let g0 = (alpha_a - 1.0) * ga + (alpha_b - 1.0) * gb;
-    let g1 = -alpha_a * ga - alpha_b * gb;
+    let one = R::ONE;
+    let g0 = ga * (alpha_a - one) + gb * (alpha_b - one);
+    let g1 = ga * (-alpha_a) - gb * alpha_b;
     Some((theta, [g0, g1, ga, gb]))
 }
 
@@ -53,19 +53,23 @@ const MIN_WING: f32 = 0.02;
 /// `|e|·10¹²` before [`hinge_angle`] calls the hinge degenerate). Scaling all four points'
 /// parts alike keeps the forces summing to zero and free of torque; the force is then no
 /// longer exactly the energy's gradient, for such slivers only.
-fn wing_limit(edge: Vec3, grad: &[Vec3; 4]) -> f32 {
+fn wing_limit<R: Real>(edge: R::V3, grad: &[R::V3; 4]) -> R {
     let largest = grad[2].length().max(grad[3].length());
-    let cap = 1.0 / (MIN_WING * edge.length());
-    if largest > cap { cap / largest } else { 1.0 }
+    let cap = R::ONE / (R::of_f32(MIN_WING) * edge.length());
+    if largest > cap { cap / largest } else { R::ONE }
 }
 
 /// `theta − rest` wrapped into (−π, π]: a hinge folded through ±π stays continuous.
-fn angle_difference(theta: f32, rest: f32) -> f32 {
-    let mut d = theta - rest;
-    if d > std::f32::consts::PI {
-        d -= std::f32::consts::TAU;
-    } else if d < -std::f32::consts::PI {
-        d += std::f32::consts::TAU;
+fn angle_difference<R: Real>(theta: R, rest: f32) -> R {
+    let (pi, tau) = (
+        R::of_f32(std::f32::consts::PI),
+        R::of_f32(std::f32::consts::TAU),
+    );
+    let mut d = theta - R::of_f32(rest);
+    if d > pi {
+        d -= tau;
+    } else if d < -pi {
+        d += tau;
     }
     d
 }
@@ -80,7 +84,7 @@ impl DihedralBending {
             let [x0, x1, a, b] = h.map(|i| p[i as usize]);
             let e = x1 - x0;
             let areas = 0.5 * (e.cross(a - x0).length() + e.cross(b - x0).length());
-            rest.push(hinge_angle(x0, x1, a, b).map_or(0.0, |(t, _)| t));
+            rest.push(hinge_angle::<f32>(x0, x1, a, b).map_or(0.0, |(t, _)| t));
             weight.push(if areas > 0.0 {
                 3.0 * e.length_squared() / areas
             } else {
@@ -103,15 +107,15 @@ impl DihedralBending {
     }
 
     /// Bending energy `Σ k·w·(θ − θ₀)²`, joules.
-    pub fn potential_energy(&self, model: &ClothModel, pos: &[Vec3]) -> f64 {
+    pub fn potential_energy<R: Real>(&self, model: &ClothModel, pos: &[R::V3]) -> f64 {
         model
             .hinges
             .iter()
             .zip(self.rest.iter().zip(&self.weight))
             .filter_map(|(h, (&rest, &w))| {
                 let [x0, x1, a, b] = h.map(|i| pos[i as usize]);
-                hinge_angle(x0, x1, a, b).map(|(t, _)| {
-                    let d = angle_difference(t, rest) as f64;
+                hinge_angle::<R>(x0, x1, a, b).map(|(t, _)| {
+                    let d = angle_difference(t, rest).to_f64();
                     (self.stiffness * w) as f64 * d * d
                 })
             })
@@ -120,30 +124,35 @@ impl DihedralBending {
 
     /// Adds `−∂E/∂x = −2k·w·(θ − θ₀)·∂θ/∂x` (N) to `f`, limited for a wing nearly collapsed
     /// onto its hinge (see `wing_limit`).
-    pub fn add_forces(&self, model: &ClothModel, pos: &[Vec3], f: &mut [Vec3]) {
+    pub fn add_forces<R: Real>(&self, model: &ClothModel, pos: &[R::V3], f: &mut [R::V3]) {
         for (h, (&rest, &w)) in model.hinges.iter().zip(self.rest.iter().zip(&self.weight)) {
             let [x0, x1, a, b] = h.map(|i| pos[i as usize]);
-            let Some((theta, grad)) = hinge_angle(x0, x1, a, b) else {
+            let Some((theta, grad)) = hinge_angle::<R>(x0, x1, a, b) else {
                 continue;
             };
-            let scale = -2.0
-                * self.stiffness
-                * w
+            let scale = R::of_f32(-2.0 * self.stiffness * w)
                 * angle_difference(theta, rest)
-                * wing_limit(x1 - x0, &grad);
+                * wing_limit::<R>(x1 - x0, &grad);
             for (&i, g) in h.iter().zip(grad) {
-                f[i as usize] += scale * g;
+                f[i as usize] += g * scale;
             }
         }
     }
 }
 
-impl ForceTerm for DihedralBending {
-    fn add_forces(&self, model: &ClothModel, pos: &[Vec3], _vel: &[Vec3], _t: f64, f: &mut [Vec3]) {
-        DihedralBending::add_forces(self, model, pos, f);
+impl<R: Real> ForceTerm<R> for DihedralBending {
+    fn add_forces(
+        &self,
+        model: &ClothModel,
+        pos: &[R::V3],
+        _vel: &[R::V3],
+        _t: f64,
+        f: &mut [R::V3],
+    ) {
+        DihedralBending::add_forces::<R>(self, model, pos, f);
     }
 
-    fn potential_energy(&self, model: &ClothModel, pos: &[Vec3]) -> f64 {
-        DihedralBending::potential_energy(self, model, pos)
+    fn potential_energy(&self, model: &ClothModel, pos: &[R::V3]) -> f64 {
+        DihedralBending::potential_energy::<R>(self, model, pos)
     }
 }

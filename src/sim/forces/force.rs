@@ -2,7 +2,7 @@
 
 use std::any::Any;
 
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, Real};
 use crate::sim::params::Material;
 
 use super::force_term::ForceTerm;
@@ -10,14 +10,21 @@ use super::springs::SpringForce;
 
 /// A force term of a scene, with the phase its time is charged to (its effect's name).
 #[derive(Debug)]
-pub struct Force {
+pub struct Force<R: Real = f32> {
     phase: &'static str,
-    term: Box<dyn ForceTerm>,
+    term: Box<dyn ForceTerm<R>>,
 }
 
 impl Force {
-    /// `term`, its time charged to `phase`.
+    /// `term` in `f32`, its time charged to `phase`.
     pub fn new(phase: &'static str, term: impl ForceTerm) -> Self {
+        Self::of(phase, term)
+    }
+}
+
+impl<R: Real> Force<R> {
+    /// `term`, its time charged to `phase`.
+    pub fn of(phase: &'static str, term: impl ForceTerm<R>) -> Self {
         Self {
             phase,
             term: Box::new(term),
@@ -35,7 +42,7 @@ impl Force {
     }
 
     /// The term as its own type, if it is a `T`.
-    pub fn get<T: ForceTerm>(&self) -> Option<&T> {
+    pub fn get<T: ForceTerm<R>>(&self) -> Option<&T> {
         let any: &dyn Any = &*self.term;
         any.downcast_ref()
     }
@@ -48,8 +55,8 @@ impl Force {
 
 /// A term is used through what it computes: `term.add_forces(…)` calls its
 /// [`ForceTerm`] methods.
-impl std::ops::Deref for Force {
-    type Target = dyn ForceTerm;
+impl<R: Real> std::ops::Deref for Force<R> {
+    type Target = dyn ForceTerm<R>;
 
     fn deref(&self) -> &Self::Target {
         &*self.term

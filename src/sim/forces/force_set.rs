@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, Real, Vector};
 
 use super::super::constraints::DistanceConstraints;
 use super::super::effects::Effect;
@@ -26,9 +26,9 @@ const PIECES_PER_MEMBER: usize = 4;
 const MAX_TERMS: usize = 8;
 
 /// The scene's force terms, built from its effect list: an absent effect has no term.
-#[derive(Debug, Default)]
-pub struct ForceSet {
-    terms: Vec<Force>,
+#[derive(Debug)]
+pub struct ForceSet<R: Real = f32> {
+    terms: Vec<Force<R>>,
     /// Simulated time the forces are evaluated at (the wind's gusts move with it), seconds.
     time: f64,
     /// Positions, velocities and forces one array per component, for
@@ -59,6 +59,16 @@ impl TermTimes {
     }
 }
 
+impl<R: Real> Default for ForceSet<R> {
+    fn default() -> Self {
+        Self {
+            terms: Vec::new(),
+            time: 0.0,
+            scratch: Scratch::default(),
+        }
+    }
+}
+
 impl ForceSet {
     /// The terms `effects` call for, with the cloth's `material`.
     pub fn new(model: &ClothModel, material: &Material, effects: &[Effect]) -> Self {
@@ -74,7 +84,9 @@ impl ForceSet {
             ..Self::default()
         }
     }
+}
 
+impl<R: Real> ForceSet<R> {
     /// Sets the simulated time forces are evaluated at, seconds.
     pub fn set_time(&mut self, time: f64) {
         self.time = time;
@@ -112,7 +124,7 @@ impl ForceSet {
         true
     }
 
-    pub fn terms(&self) -> &[Force] {
+    pub fn terms(&self) -> &[Force<R>] {
         &self.terms
     }
 
@@ -135,10 +147,10 @@ impl ForceSet {
     pub fn forces_where(
         &self,
         model: &ClothModel,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        keep: impl Fn(&Force) -> bool,
-        f: &mut Vec<Vec3>,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        keep: impl Fn(&Force<R>) -> bool,
+        f: &mut Vec<R::V3>,
     ) {
         self.sum_forces(model, pos, vel, keep, f, None);
     }
@@ -147,10 +159,10 @@ impl ForceSet {
     pub fn forces_timed(
         &self,
         model: &ClothModel,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        keep: impl Fn(&Force) -> bool,
-        f: &mut Vec<Vec3>,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        keep: impl Fn(&Force<R>) -> bool,
+        f: &mut Vec<R::V3>,
         times: &mut TermTimes,
     ) {
         self.sum_forces(model, pos, vel, keep, f, Some(times));
@@ -159,14 +171,14 @@ impl ForceSet {
     fn sum_forces(
         &self,
         model: &ClothModel,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        keep: impl Fn(&Force) -> bool,
-        f: &mut Vec<Vec3>,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        keep: impl Fn(&Force<R>) -> bool,
+        f: &mut Vec<R::V3>,
         times: Option<&mut TermTimes>,
     ) {
         f.clear();
-        f.resize(pos.len(), Vec3::ZERO);
+        f.resize(pos.len(), R::V3::ZERO);
         self.each_term(keep, times, |term| {
             term.add_forces(model, pos, vel, self.time, f);
         });
@@ -175,9 +187,9 @@ impl ForceSet {
     /// Calls `eval` on each term `keep` selects, in order, charging its wall time to `times`.
     fn each_term(
         &self,
-        keep: impl Fn(&Force) -> bool,
+        keep: impl Fn(&Force<R>) -> bool,
         mut times: Option<&mut TermTimes>,
-        mut eval: impl FnMut(&Force),
+        mut eval: impl FnMut(&Force<R>),
     ) {
         for (slot, term) in self.terms.iter().enumerate().filter(|(_, t)| keep(t)) {
             match times.as_deref_mut() {
@@ -340,11 +352,16 @@ impl ForceSet {
     pub fn accelerations_components(
         &self,
         model: &ClothModel,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        acc: &mut Vec<Vec3>,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        acc: &mut Vec<R::V3>,
         times: &mut TermTimes,
     ) -> bool {
+        let (Some(pos), Some(vel), Some(acc)) =
+            (R::f32_slice(pos), R::f32_slice(vel), R::f32_vec_mut(acc))
+        else {
+            return false;
+        };
         if !self.takes_components() {
             return false;
         }
@@ -363,7 +380,7 @@ impl ForceSet {
     }
 
     /// Writes the total force at `(pos, vel)` into `f`, newtons.
-    pub fn forces(&self, model: &ClothModel, pos: &[Vec3], vel: &[Vec3], f: &mut Vec<Vec3>) {
+    pub fn forces(&self, model: &ClothModel, pos: &[R::V3], vel: &[R::V3], f: &mut Vec<R::V3>) {
         self.forces_where(model, pos, vel, |_| true, f);
     }
 
@@ -372,17 +389,17 @@ impl ForceSet {
     pub fn accelerations(
         &self,
         model: &ClothModel,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        acc: &mut Vec<Vec3>,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        acc: &mut Vec<R::V3>,
     ) {
         self.forces(model, pos, vel, acc);
-        to_accelerations(&model.inv_mass, acc);
+        to_accelerations::<R>(&model.inv_mass, acc);
     }
 
     /// Potential energy of the conservative terms at `pos`, joules (relative to the rest
     /// length of the springs and `x = 0` for gravity). Dissipative terms have none.
-    pub fn potential_energy(&self, model: &ClothModel, pos: &[Vec3]) -> f64 {
+    pub fn potential_energy(&self, model: &ClothModel, pos: &[R::V3]) -> f64 {
         self.terms
             .iter()
             .map(|t| t.potential_energy(model, pos))
@@ -393,14 +410,14 @@ impl ForceSet {
     pub fn df_dx(
         &self,
         model: &ClothModel,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        u: &[Vec3],
+        pos: &[R::V3],
+        vel: &[R::V3],
+        u: &[R::V3],
         mode: JacobianMode,
-        out: &mut Vec<Vec3>,
+        out: &mut Vec<R::V3>,
     ) {
         out.clear();
-        out.resize(pos.len(), Vec3::ZERO);
+        out.resize(pos.len(), R::V3::ZERO);
         for term in &self.terms {
             term.add_df_dx(model, pos, vel, u, mode, out);
         }
@@ -410,13 +427,13 @@ impl ForceSet {
     pub fn df_dv(
         &self,
         model: &ClothModel,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        u: &[Vec3],
-        out: &mut Vec<Vec3>,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        u: &[R::V3],
+        out: &mut Vec<R::V3>,
     ) {
         out.clear();
-        out.resize(pos.len(), Vec3::ZERO);
+        out.resize(pos.len(), R::V3::ZERO);
         for term in &self.terms {
             term.add_df_dv(model, pos, vel, u, out);
         }
@@ -426,10 +443,10 @@ impl ForceSet {
     pub fn assemble(
         &self,
         model: &ClothModel,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        h: f32,
-        sys: &mut SystemMatrix,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        h: R,
+        sys: &mut SystemMatrix<R>,
     ) {
         sys.begin(model, h);
         for term in &self.terms {
@@ -439,9 +456,9 @@ impl ForceSet {
 }
 
 /// Turns forces into accelerations in place: `a = f / m`, zero for pinned particles.
-pub fn to_accelerations(inv_mass: &[f32], f: &mut [Vec3]) {
+pub fn to_accelerations<R: Real>(inv_mass: &[f32], f: &mut [R::V3]) {
     for (a, &w) in f.iter_mut().zip(inv_mass) {
-        *a *= w;
+        *a *= R::of_f32(w);
     }
 }
 

@@ -2,9 +2,7 @@
 //! gravity, air damping and wind in their effects' files, the springs and the dihedral
 //! hinges in this folder.
 
-use glam::Vec3;
-
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, Real};
 use crate::sim::kernels::{Components, TwoPasses};
 use crate::sim::params::Material;
 
@@ -20,15 +18,17 @@ pub enum Fused<'a> {
     No,
 }
 
-/// What a force term computes. Each yields forces in newtons; a term that gives no
-/// derivatives is treated explicitly by implicit methods.
-pub trait ForceTerm: std::any::Any + Send + Sync + std::fmt::Debug {
+/// What a force term computes, in precision `R` (each term's type implements it for both).
+/// Each yields forces in newtons; a term that gives no derivatives is treated explicitly by
+/// implicit methods.
+pub trait ForceTerm<R: Real = f32>: std::any::Any + Send + Sync + std::fmt::Debug {
     /// Adds its forces at `(pos, vel)` and time `t` to `f`, newtons.
-    fn add_forces(&self, model: &ClothModel, pos: &[Vec3], vel: &[Vec3], t: f64, f: &mut [Vec3]);
+    fn add_forces(&self, model: &ClothModel, pos: &[R::V3], vel: &[R::V3], t: f64, f: &mut [R::V3]);
 
-    /// Whether [`ForceTerm::add_forces_components`] evaluates it. No term that takes
-    /// components may depend on time: semi-implicit Euler takes a frame's substeps together
-    /// on component arrays, with the clock set once per batch.
+    /// Whether [`ForceTerm::add_forces_components`] evaluates it (in `f32` only: the
+    /// component kernels are the vectorised path). No term that takes components may
+    /// depend on time: semi-implicit Euler takes a frame's substeps together on component
+    /// arrays, with the clock set once per batch.
     fn takes_components(&self) -> bool {
         false
     }
@@ -60,7 +60,7 @@ pub trait ForceTerm: std::any::Any + Send + Sync + std::fmt::Debug {
     fn retune(&mut self, _model: &ClothModel, _material: &Material) {}
 
     /// Potential energy at `pos`, joules; zero for dissipative and driving terms.
-    fn potential_energy(&self, _model: &ClothModel, _pos: &[Vec3]) -> f64 {
+    fn potential_energy(&self, _model: &ClothModel, _pos: &[R::V3]) -> f64 {
         0.0
     }
 
@@ -68,11 +68,11 @@ pub trait ForceTerm: std::any::Any + Send + Sync + std::fmt::Debug {
     fn add_df_dx(
         &self,
         _model: &ClothModel,
-        _pos: &[Vec3],
-        _vel: &[Vec3],
-        _u: &[Vec3],
+        _pos: &[R::V3],
+        _vel: &[R::V3],
+        _u: &[R::V3],
         _mode: JacobianMode,
-        _out: &mut [Vec3],
+        _out: &mut [R::V3],
     ) {
     }
 
@@ -80,10 +80,10 @@ pub trait ForceTerm: std::any::Any + Send + Sync + std::fmt::Debug {
     fn add_df_dv(
         &self,
         _model: &ClothModel,
-        _pos: &[Vec3],
-        _vel: &[Vec3],
-        _u: &[Vec3],
-        _out: &mut [Vec3],
+        _pos: &[R::V3],
+        _vel: &[R::V3],
+        _u: &[R::V3],
+        _out: &mut [R::V3],
     ) {
     }
 
@@ -91,9 +91,9 @@ pub trait ForceTerm: std::any::Any + Send + Sync + std::fmt::Debug {
     fn add_to_system(
         &self,
         _model: &ClothModel,
-        _pos: &[Vec3],
-        _vel: &[Vec3],
-        _sys: &mut SystemMatrix,
+        _pos: &[R::V3],
+        _vel: &[R::V3],
+        _sys: &mut SystemMatrix<R>,
     ) {
     }
 }

@@ -1,9 +1,7 @@
 //! Force derivatives assembled into the implicit-Euler system
 //! `A = M − h·∂f/∂v − h²·∂f/∂x`, stored as 3×3 blocks: one per spring and one per particle.
 
-use glam::{Mat3, Vec3};
-
-use crate::cloth::{ClothModel, Springs};
+use crate::cloth::{ClothModel, Matrix, Real, Springs, Vector};
 
 use crate::sim::kernels::{Blocks, Components, Projectors, SpringRuns, blocks_times, split_blocks};
 
@@ -21,28 +19,30 @@ pub enum JacobianMode {
 /// Jacobian takes (see [`super::SpringForce::add_to_system`]). Five numbers instead of
 /// nine, and half the arithmetic in a product.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SpringBlock {
-    pub alpha: f32,
-    pub beta: f32,
-    pub n: Vec3,
+pub struct SpringBlock<R: Real = f32> {
+    pub alpha: R,
+    pub beta: R,
+    pub n: R::V3,
 }
 
-impl SpringBlock {
+impl<R: Real> SpringBlock<R> {
     /// The block as a matrix.
-    pub fn matrix(&self) -> Mat3 {
-        let bn = self.beta * self.n;
-        self.alpha * Mat3::IDENTITY + Mat3::from_cols(bn * self.n.x, bn * self.n.y, bn * self.n.z)
+    pub fn matrix(&self) -> R::M3 {
+        let bn = self.n * self.beta;
+        let n = self.n;
+        R::M3::IDENTITY * self.alpha + R::M3::from_cols(bn * n.x(), bn * n.y(), bn * n.z())
     }
 
     /// `[α, β, n.x, n.y, n.z]`: the numbers `SpringRuns::add_block_products` reads per
     /// spring.
-    pub fn numbers(&self) -> [f32; 5] {
-        [self.alpha, self.beta, self.n.x, self.n.y, self.n.z]
+    pub fn numbers(&self) -> [R; 5] {
+        let n = self.n;
+        [self.alpha, self.beta, n.x(), n.y(), n.z()]
     }
 
     /// `S·u`.
-    pub fn times(&self, u: Vec3) -> Vec3 {
-        self.alpha * u + (self.beta * self.n.dot(u)) * self.n
+    pub fn times(&self, u: R::V3) -> R::V3 {
+        u * self.alpha + self.n * (self.beta * self.n.dot(u))
     }
 }
 
@@ -52,21 +52,32 @@ impl SpringBlock {
 /// A spring `e = (a, b)` with blocks `K_x`, `K_v` contributes `S_e = h·K_v + h²·K_x`: `+S_e`
 /// to the diagonal blocks of `a` and `b` and `−S_e` to the off-diagonal blocks `(a, b)`,
 /// `(b, a)`. Per-particle terms (air damping) add to the diagonal only.
-#[derive(Clone, Debug, Default)]
-pub struct SystemMatrix {
+#[derive(Clone, Debug)]
+pub struct SystemMatrix<R: Real = f32> {
     /// Step length, seconds.
-    pub h: f32,
+    pub h: R,
     /// `S_e` per spring.
-    pub spring: Vec<SpringBlock>,
+    pub spring: Vec<SpringBlock<R>>,
     /// Diagonal block per particle, kg.
-    pub diag: Vec<Mat3>,
+    pub diag: Vec<R::M3>,
     /// `(∂f/∂x)·v` at the state the matrix was built at, N/s.
-    pub dfdx_v: Vec<Vec3>,
+    pub dfdx_v: Vec<R::V3>,
 }
 
-impl SystemMatrix {
+impl<R: Real> Default for SystemMatrix<R> {
+    fn default() -> Self {
+        Self {
+            h: R::ZERO,
+            spring: Vec::new(),
+            diag: Vec::new(),
+            dfdx_v: Vec::new(),
+        }
+    }
+}
+
+impl<R: Real> SystemMatrix<R> {
     /// Starts a new matrix `M` for a step of `h` seconds (no allocation once sized).
-    pub fn begin(&mut self, model: &ClothModel, h: f32) {
+    pub fn begin(&mut self, model: &ClothModel, h: R) {
         let (n, e) = (model.particle_count(), model.springs.len());
         self.h = h;
         self.spring.clear();
@@ -76,16 +87,22 @@ impl SystemMatrix {
             model
                 .mass
                 .iter()
-                .map(|&m| Mat3::from_diagonal(Vec3::splat(m))),
+                .map(|&m| R::M3::from_diagonal(R::V3::splat(R::of_f32(m)))),
         );
         self.dfdx_v.clear();
-        self.dfdx_v.resize(n, Vec3::ZERO);
+        self.dfdx_v.resize(n, R::V3::ZERO);
     }
 
     /// Sets spring `e`'s system block `S_e = h·K_v + h²·K_x` (one force term per spring) and
     /// adds `K_x·(v_b − v_a)`.
     #[inline]
-    pub fn add_spring_block(&mut self, springs: &Springs, e: usize, s: SpringBlock, dfdx_w: Vec3) {
+    pub fn add_spring_block(
+        &mut self,
+        springs: &Springs,
+        e: usize,
+        s: SpringBlock<R>,
+        dfdx_w: R::V3,
+    ) {
         let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
         debug_assert_eq!(
             self.spring[e],
@@ -101,12 +118,12 @@ impl SystemMatrix {
     }
 
     /// Adds a per-particle `∂f_p/∂v_p = d·I` (N·s/m).
-    pub fn add_dv_diagonal(&mut self, p: usize, d: f32) {
-        self.diag[p] -= Mat3::from_diagonal(Vec3::splat(self.h * d));
+    pub fn add_dv_diagonal(&mut self, p: usize, d: R) {
+        self.diag[p] -= R::M3::from_diagonal(R::V3::splat(self.h * d));
     }
 
     /// `out = A·u`, gathered per particle over `model.adjacency`.
-    pub fn apply(&self, model: &ClothModel, u: &[Vec3], out: &mut [Vec3]) {
+    pub fn apply(&self, model: &ClothModel, u: &[R::V3], out: &mut [R::V3]) {
         let adj = &model.adjacency;
         for (p, o) in out.iter_mut().enumerate() {
             let mut sum = self.diag[p] * u[p];
@@ -121,10 +138,10 @@ impl SystemMatrix {
     pub fn dense(&self, springs: &Springs) -> Vec<Vec<f64>> {
         let n = self.diag.len();
         let mut m = vec![vec![0.0f64; 3 * n]; 3 * n];
-        let mut put = |i: usize, j: usize, block: Mat3, sign: f64| {
+        let mut put = |i: usize, j: usize, block: R::M3, sign: f64| {
             for r in 0..3 {
                 for c in 0..3 {
-                    m[3 * i + r][3 * j + c] += sign * block.col(c)[r] as f64;
+                    m[3 * i + r][3 * j + c] += sign * block.col(c).to_array()[r].to_f64();
                 }
             }
         };
@@ -145,23 +162,34 @@ impl SystemMatrix {
 /// number, so each product is the vector loops and threads of the spring forces rather
 /// than a 3×3 product per neighbour. The runs are kept while the model's springs stay the
 /// same.
-#[derive(Clone, Debug, Default)]
-pub struct SystemProduct {
+#[derive(Clone, Debug)]
+pub struct SystemProduct<R: Real = f32> {
     /// The springs the runs were made for.
     ends: (Vec<u32>, Vec<u32>),
-    runs: Option<SpringRuns>,
-    blocks: Projectors,
+    runs: Option<SpringRuns<R>>,
+    blocks: Projectors<R>,
     /// The particles' diagonal blocks, one array per entry (column-major).
-    diag: Blocks,
+    diag: Blocks<R>,
 }
 
-impl SystemProduct {
+impl<R: Real> Default for SystemProduct<R> {
+    fn default() -> Self {
+        Self {
+            ends: Default::default(),
+            runs: None,
+            blocks: Default::default(),
+            diag: Default::default(),
+        }
+    }
+}
+
+impl<R: Real> SystemProduct<R> {
     /// Takes `sys`'s spring blocks (call again when the matrix changes).
-    pub fn load(&mut self, model: &ClothModel, sys: &SystemMatrix) {
+    pub fn load(&mut self, model: &ClothModel, sys: &SystemMatrix<R>) {
         let springs = &model.springs;
         if self.runs.is_none() || self.ends.0 != springs.a || self.ends.1 != springs.b {
             self.ends = (springs.a.clone(), springs.b.clone());
-            let none = vec![0.0; springs.len()];
+            let none = vec![R::ZERO; springs.len()];
             let particles = model.particle_count();
             self.runs = Some(SpringRuns::new(
                 particles, &springs.a, &springs.b, &none, &none, &none,
@@ -176,10 +204,10 @@ impl SystemProduct {
     /// `out = A·u` with the matrix last [loaded](SystemProduct::load), `u` and `out` stored
     /// one array per component (`out` as long as `u`): the same as [`SystemMatrix::apply`] up
     /// to rounding.
-    pub fn apply_components(&self, u: &Components, out: &mut Components) {
+    pub fn apply_components(&self, u: &Components<R>, out: &mut Components<R>) {
         let n = u[0].len().min(self.diag[0].len());
         for o in out.iter_mut() {
-            o[..n].fill(0.0);
+            o[..n].fill(R::ZERO);
         }
         if let Some(runs) = &self.runs {
             runs.add_block_products(&self.blocks, u, out);

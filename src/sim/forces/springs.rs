@@ -8,9 +8,7 @@
 use std::ops::Range;
 use std::sync::OnceLock;
 
-use glam::{Mat3, Vec3};
-
-use crate::cloth::{ClothModel, Springs};
+use crate::cloth::{ClothModel, Matrix, Real, Springs, Vector};
 
 use crate::sim::kernels::{Components, SpringRuns, TwoPasses};
 
@@ -49,16 +47,16 @@ impl PartialEq for LazyRuns {
 
 /// The derivative blocks of one spring.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SpringBlocks {
+pub struct SpringBlocks<R: Real = f32> {
     /// `∂f_a/∂x_b`, N/m.
-    pub dx: Mat3,
+    pub dx: R::M3,
     /// `∂f_a/∂v_b`, N·s/m.
-    pub dv: Mat3,
+    pub dv: R::M3,
 }
 
 /// `u vᵀ`.
-fn outer(u: Vec3, v: Vec3) -> Mat3 {
-    Mat3::from_cols(u * v.x, u * v.y, u * v.z)
+fn outer<R: Real>(u: R::V3, v: R::V3) -> R::M3 {
+    R::M3::from_cols(u * v.x(), u * v.y(), u * v.z())
 }
 
 impl SpringForce {
@@ -137,9 +135,44 @@ impl SpringForce {
     }
 
     /// Adds every spring's force (N) to `f`, in parallel for large cloths, with the same
-    /// result on any number of threads.
-    pub fn add_forces(&self, springs: &Springs, pos: &[Vec3], vel: &[Vec3], f: &mut [Vec3]) {
-        self.runs(springs).add_forces(pos, vel, f);
+    /// result on any number of threads: in `f32` through the vectorised runs, in `f64`
+    /// spring by spring ([`SpringForce::add_forces_plain`]).
+    pub fn add_forces<R: Real>(
+        &self,
+        springs: &Springs,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        f: &mut [R::V3],
+    ) {
+        match (R::f32_slice(pos), R::f32_slice(vel), R::f32_slice_mut(f)) {
+            (Some(pos), Some(vel), Some(f)) => self.runs(springs).add_forces(pos, vel, f),
+            _ => self.add_forces_plain::<R>(springs, pos, vel, f),
+        }
+    }
+
+    /// The forces of [`SpringForce::add_forces`] computed one spring at a time, in any
+    /// precision: `f_a = [k(|d| − l₀) + c·(v_b − v_a)·d̂] d̂`, `f_b = −f_a`.
+    pub fn add_forces_plain<R: Real>(
+        &self,
+        springs: &Springs,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        f: &mut [R::V3],
+    ) {
+        for (e, k, c) in self.each() {
+            let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
+            let d = pos[b] - pos[a];
+            let len = d.length();
+            if len <= R::TINY_LENGTH {
+                continue;
+            }
+            let n = d / len;
+            let stretch = len - R::of_f32(springs.rest[e]);
+            let closing = (vel[b] - vel[a]).dot(n);
+            let pull = n * (R::of_f32(k) * stretch + R::of_f32(c) * closing);
+            f[a] += pull;
+            f[b] -= pull;
+        }
     }
 
     /// As [`SpringForce::add_forces`] with positions, velocities and forces stored one array
@@ -160,11 +193,11 @@ impl SpringForce {
     }
 
     /// `Σ ½k(|d| − l₀)²`, joules.
-    pub fn potential_energy(&self, springs: &Springs, pos: &[Vec3]) -> f64 {
+    pub fn potential_energy<R: Real>(&self, springs: &Springs, pos: &[R::V3]) -> f64 {
         self.each()
             .map(|(e, k, _)| {
                 let d = pos[springs.b[e] as usize].distance(pos[springs.a[e] as usize]);
-                let stretch = (d - springs.rest[e]) as f64;
+                let stretch = (d - R::of_f32(springs.rest[e])).to_f64();
                 0.5 * k as f64 * stretch * stretch
             })
             .sum()
@@ -177,68 +210,69 @@ impl SpringForce {
     /// spring is clamped to zero (it would be negative and make the system indefinite) and
     /// the dashpot's dependence on the spring's direction is dropped, so `dx` is symmetric
     /// positive semi-definite.
-    pub fn blocks(
+    pub fn blocks<R: Real>(
         &self,
         springs: &Springs,
-        pos: &[Vec3],
-        vel: &[Vec3],
+        pos: &[R::V3],
+        vel: &[R::V3],
         e: usize,
         mode: JacobianMode,
-    ) -> SpringBlocks {
+    ) -> SpringBlocks<R> {
         let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
         let d = pos[b] - pos[a];
         let len = d.length();
-        if len <= 1e-9 {
+        if len <= R::TINY_LENGTH {
             return SpringBlocks {
-                dx: Mat3::ZERO,
-                dv: Mat3::ZERO,
+                dx: R::M3::ZERO,
+                dv: R::M3::ZERO,
             };
         }
         let n = d / len;
-        let nn = outer(n, n);
-        let transverse = Mat3::IDENTITY - nn;
+        let nn = outer::<R>(n, n);
+        let transverse = R::M3::IDENTITY - nn;
         let (k, c) = (self.k[e - self.range.start], self.c[e - self.range.start]);
-        let stretch = 1.0 - springs.rest[e] / len;
+        let (k, c) = (R::of_f32(k), R::of_f32(c));
+        let stretch = R::ONE - R::of_f32(springs.rest[e]) / len;
         let dx = match mode {
             JacobianMode::Exact => {
                 let dv = vel[b] - vel[a];
-                let elastic = k * nn + (k * stretch) * transverse;
-                let viscous = (c / len) * (outer(n, transverse * dv) + dv.dot(n) * transverse);
+                let elastic = nn * k + transverse * (k * stretch);
+                let viscous = (outer::<R>(n, transverse * dv) + transverse * dv.dot(n)) * (c / len);
                 elastic + viscous
             }
-            JacobianMode::Definite => k * nn + (k * stretch.max(0.0)) * transverse,
+            JacobianMode::Definite => nn * k + transverse * (k * stretch.max(R::ZERO)),
         };
-        SpringBlocks { dx, dv: c * nn }
+        SpringBlocks { dx, dv: nn * c }
     }
 
     /// Adds `(∂f/∂x)·u` to `out`, with the blocks of `mode`, computed on the fly.
-    pub fn add_df_dx(
+    pub fn add_df_dx<R: Real>(
         &self,
         springs: &Springs,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        u: &[Vec3],
+        pos: &[R::V3],
+        vel: &[R::V3],
+        u: &[R::V3],
         mode: JacobianMode,
-        out: &mut [Vec3],
+        out: &mut [R::V3],
     ) {
         for e in self.range.clone() {
-            let block = self.blocks(springs, pos, vel, e, mode).dx;
-            apply_pair(springs, e, block, u, out);
+            let block = self.blocks::<R>(springs, pos, vel, e, mode).dx;
+            apply_pair::<R>(springs, e, block, u, out);
         }
     }
 
     /// Adds `(∂f/∂v)·u` to `out` (the dashpots; exact in either mode).
-    pub fn add_df_dv(
+    pub fn add_df_dv<R: Real>(
         &self,
         springs: &Springs,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        u: &[Vec3],
-        out: &mut [Vec3],
+        pos: &[R::V3],
+        vel: &[R::V3],
+        u: &[R::V3],
+        out: &mut [R::V3],
     ) {
         for e in self.range.clone() {
-            let block = self.blocks(springs, pos, vel, e, JacobianMode::Definite).dv;
-            apply_pair(springs, e, block, u, out);
+            let block = (self.blocks::<R>(springs, pos, vel, e, JacobianMode::Definite)).dv;
+            apply_pair::<R>(springs, e, block, u, out);
         }
     }
 
@@ -247,30 +281,32 @@ impl SpringForce {
     /// `s = max(0, 1 − l₀/|d|)`) and `K_v = c·n nᵀ`, so the system's block is
     /// `S_e = h·K_v + h²·K_x = α·I + β·n nᵀ` and `K_x·(v_b − v_a) = k·s·w + k(1 − s)(n·w)·n`:
     /// built from those scalars directly, a third of the arithmetic of the 3×3 products.
-    pub fn add_to_system(
+    pub fn add_to_system<R: Real>(
         &self,
         springs: &Springs,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        sys: &mut SystemMatrix,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        sys: &mut SystemMatrix<R>,
     ) {
         let h = sys.h;
+        let one = R::ONE;
         for e in self.range.clone() {
             let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
             let d = pos[b] - pos[a];
             let len = d.length();
-            if len <= 1e-9 {
+            if len <= R::TINY_LENGTH {
                 // No direction: both blocks are zero.
                 continue;
             }
             // One division instead of four (three for `n`, one for `s`).
-            let inv = 1.0 / len;
+            let inv = one / len;
             let n = d * inv;
             let (k, c) = (self.k[e - self.range.start], self.c[e - self.range.start]);
-            let s = (1.0 - springs.rest[e] * inv).max(0.0);
-            let (alpha, beta) = (h * h * (k * s), h * c + h * h * (k * (1.0 - s)));
+            let (k, c) = (R::of_f32(k), R::of_f32(c));
+            let s = (one - R::of_f32(springs.rest[e]) * inv).max(R::ZERO);
+            let (alpha, beta) = (h * h * (k * s), h * c + h * h * (k * (one - s)));
             let w = vel[b] - vel[a];
-            let dfdx_w = (k * s) * w + (k * (1.0 - s) * n.dot(w)) * n;
+            let dfdx_w = w * (k * s) + n * (k * (one - s) * n.dot(w));
             sys.add_spring_block(springs, e, SpringBlock { alpha, beta, n }, dfdx_w);
         }
     }
@@ -297,24 +333,31 @@ impl SpringForce {
 
 /// One spring's share of a Jacobian–vector product: `out_a += B(u_b − u_a)`,
 /// `out_b −= B(u_b − u_a)`.
-fn apply_pair(springs: &Springs, e: usize, block: Mat3, u: &[Vec3], out: &mut [Vec3]) {
+fn apply_pair<R: Real>(springs: &Springs, e: usize, block: R::M3, u: &[R::V3], out: &mut [R::V3]) {
     let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
     let t = block * (u[b] - u[a]);
     out[a] += t;
     out[b] -= t;
 }
 
-impl ForceTerm for SpringForce {
+impl<R: Real> ForceTerm<R> for SpringForce {
     fn retune(&mut self, model: &ClothModel, material: &Material) {
         self.set_strengths(&model.springs, material.stiffness, material.damping);
     }
 
-    fn add_forces(&self, model: &ClothModel, pos: &[Vec3], vel: &[Vec3], _t: f64, f: &mut [Vec3]) {
-        SpringForce::add_forces(self, &model.springs, pos, vel, f);
+    fn add_forces(
+        &self,
+        model: &ClothModel,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        _t: f64,
+        f: &mut [R::V3],
+    ) {
+        SpringForce::add_forces::<R>(self, &model.springs, pos, vel, f);
     }
 
     fn takes_components(&self) -> bool {
-        true
+        R::VECTORISED
     }
 
     fn add_forces_components(
@@ -331,40 +374,40 @@ impl ForceTerm for SpringForce {
         Fused::TwoPasses(self.two_passes(&model.springs))
     }
 
-    fn potential_energy(&self, model: &ClothModel, pos: &[Vec3]) -> f64 {
-        SpringForce::potential_energy(self, &model.springs, pos)
+    fn potential_energy(&self, model: &ClothModel, pos: &[R::V3]) -> f64 {
+        SpringForce::potential_energy::<R>(self, &model.springs, pos)
     }
 
     fn add_df_dx(
         &self,
         model: &ClothModel,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        u: &[Vec3],
+        pos: &[R::V3],
+        vel: &[R::V3],
+        u: &[R::V3],
         mode: JacobianMode,
-        out: &mut [Vec3],
+        out: &mut [R::V3],
     ) {
-        SpringForce::add_df_dx(self, &model.springs, pos, vel, u, mode, out);
+        SpringForce::add_df_dx::<R>(self, &model.springs, pos, vel, u, mode, out);
     }
 
     fn add_df_dv(
         &self,
         model: &ClothModel,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        u: &[Vec3],
-        out: &mut [Vec3],
+        pos: &[R::V3],
+        vel: &[R::V3],
+        u: &[R::V3],
+        out: &mut [R::V3],
     ) {
-        SpringForce::add_df_dv(self, &model.springs, pos, vel, u, out);
+        SpringForce::add_df_dv::<R>(self, &model.springs, pos, vel, u, out);
     }
 
     fn add_to_system(
         &self,
         model: &ClothModel,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        sys: &mut SystemMatrix,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        sys: &mut SystemMatrix<R>,
     ) {
-        SpringForce::add_to_system(self, &model.springs, pos, vel, sys);
+        SpringForce::add_to_system::<R>(self, &model.springs, pos, vel, sys);
     }
 }

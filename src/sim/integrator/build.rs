@@ -1,5 +1,7 @@
 //! Building an integrator from its kind: the one place that names every integrator type.
 
+use crate::cloth::Real;
+
 use super::explicit_euler::ExplicitEuler;
 use super::implicit_euler::ImplicitEuler;
 use super::kind::IntegratorKind;
@@ -12,8 +14,8 @@ use super::velocity_verlet::VelocityVerlet;
 use super::xpbd::Xpbd;
 
 impl IntegratorKind {
-    /// A fresh integrator of this kind.
-    pub fn build(self) -> Box<dyn Integrator> {
+    /// A fresh integrator of this kind, in precision `R`.
+    pub fn build<R: Real>(self) -> Box<dyn Integrator<R>> {
         match self {
             IntegratorKind::ExplicitEuler => Box::new(ExplicitEuler::default()),
             IntegratorKind::SemiImplicitEuler => Box::new(SemiImplicitEuler::default()),

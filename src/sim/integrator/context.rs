@@ -3,9 +3,7 @@
 
 use std::time::{Duration, Instant};
 
-use glam::Vec3;
-
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, Real};
 
 use super::super::forces::{Force, ForceSet, TermTimes};
 use super::super::params::SolverConfig;
@@ -31,18 +29,18 @@ pub struct StepMeter {
 }
 
 /// The model, the forces and the configuration of one step.
-pub struct StepContext<'a> {
+pub struct StepContext<'a, R: Real = f32> {
     pub model: &'a ClothModel,
-    pub forces: &'a ForceSet,
+    pub forces: &'a ForceSet<R>,
     pub config: &'a SolverConfig,
     meter: &'a mut StepMeter,
 }
 
-impl<'a> StepContext<'a> {
+impl<'a, R: Real> StepContext<'a, R> {
     /// A context for one step; the meter starts from zero.
     pub fn new(
         model: &'a ClothModel,
-        forces: &'a ForceSet,
+        forces: &'a ForceSet<R>,
         config: &'a SolverConfig,
         meter: &'a mut StepMeter,
     ) -> Self {
@@ -62,7 +60,7 @@ impl<'a> StepContext<'a> {
     }
 
     /// Accelerations at `(pos, vel)` into `acc` (pinned particles get zero).
-    pub fn accelerations(&mut self, pos: &[Vec3], vel: &[Vec3], acc: &mut Vec<Vec3>) {
+    pub fn accelerations(&mut self, pos: &[R::V3], vel: &[R::V3], acc: &mut Vec<R::V3>) {
         let start = Instant::now();
         let meter = &mut *self.meter;
         if (self.forces).accelerations_components(self.model, pos, vel, acc, &mut meter.terms) {
@@ -71,16 +69,16 @@ impl<'a> StepContext<'a> {
             return;
         }
         self.forces_where(pos, vel, |_| true, acc);
-        super::super::forces::to_accelerations(&self.model.inv_mass, acc);
+        super::super::forces::to_accelerations::<R>(&self.model.inv_mass, acc);
     }
 
     /// Forces (N) at `(pos, vel)` of the terms `keep` selects, into `f`.
     pub fn forces_where(
         &mut self,
-        pos: &[Vec3],
-        vel: &[Vec3],
-        keep: impl Fn(&Force) -> bool,
-        f: &mut Vec<Vec3>,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        keep: impl Fn(&Force<R>) -> bool,
+        f: &mut Vec<R::V3>,
     ) {
         let start = Instant::now();
         let meter = &mut *self.meter;
@@ -134,7 +132,7 @@ impl<'a> StepContext<'a> {
 
     /// Runs a linear solve or projection `f`, charging its time to the solve phase and
     /// recording its iterations and final relative residual.
-    pub fn solve<R>(&mut self, f: impl FnOnce() -> (R, u32, Option<f32>, bool)) -> R {
+    pub fn solve<T>(&mut self, f: impl FnOnce() -> (T, u32, Option<f32>, bool)) -> T {
         let start = Instant::now();
         let (out, iterations, residual, converged) = f();
         self.meter.solve += start.elapsed();
@@ -146,7 +144,7 @@ impl<'a> StepContext<'a> {
 
     /// Counts time spent in `f` as force work without counting an evaluation (assembling
     /// derivatives, say).
-    pub fn derivative_work<R>(&mut self, f: impl FnOnce(&ClothModel, &ForceSet) -> R) -> R {
+    pub fn derivative_work<T>(&mut self, f: impl FnOnce(&ClothModel, &ForceSet<R>) -> T) -> T {
         let start = Instant::now();
         let out = f(self.model, self.forces);
         let took = start.elapsed();

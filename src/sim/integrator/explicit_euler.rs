@@ -1,31 +1,29 @@
 //! Explicit (forward) Euler.
 
-use glam::Vec3;
-
 use super::context::StepContext;
 use super::kind::IntegratorKind;
 use super::report::{StepError, StepReport};
 use super::step::Integrator;
-use crate::cloth::ClothState;
+use crate::cloth::{ClothState, Real};
 
 /// `x ← x + v·h`, `v ← v + a(x, v)·h`, both from the start of the step. First order; its
 /// energy grows by `1 + (ωh)²` per step on an undamped oscillator, so it is unstable for
 /// every step on undamped cloth and needs damping to survive at all.
 #[derive(Default)]
-pub struct ExplicitEuler {
-    acc: Vec<Vec3>,
+pub struct ExplicitEuler<R: Real = f32> {
+    acc: Vec<R::V3>,
 }
 
-impl Integrator for ExplicitEuler {
+impl<R: Real> Integrator<R> for ExplicitEuler<R> {
     fn kind(&self) -> IntegratorKind {
         IntegratorKind::ExplicitEuler
     }
 
     fn step(
         &mut self,
-        ctx: &mut StepContext<'_>,
-        state: &mut ClothState,
-        h: f32,
+        ctx: &mut StepContext<'_, R>,
+        state: &mut ClothState<R>,
+        h: R,
     ) -> Result<StepReport, StepError> {
         ctx.accelerations(&state.pos, &state.vel, &mut self.acc);
         let particles = state.pos.iter_mut().zip(state.vel.iter_mut());
@@ -35,7 +33,7 @@ impl Integrator for ExplicitEuler {
                 *v += *a * h;
             }
         }
-        state.time += h as f64;
+        state.time += h.to_f64();
         Ok(ctx.report())
     }
 }

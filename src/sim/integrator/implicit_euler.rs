@@ -1,14 +1,12 @@
 //! Implicit (backward) Euler in the Baraff–Witkin form.
 
-use glam::Vec3;
-
 use super::super::cg::{CgOutcome, ConjugateGradient};
 use super::super::forces::SystemMatrix;
 use super::context::StepContext;
 use super::kind::IntegratorKind;
 use super::report::{StepError, StepReport};
 use super::step::Integrator;
-use crate::cloth::ClothState;
+use crate::cloth::{ClothState, Real, Vector};
 
 /// One linearised backward-Euler step: solve
 /// `(M − h·∂f/∂v − h²·∂f/∂x)·Δv = h·(f + h·(∂f/∂x)·v)` by preconditioned conjugate
@@ -18,25 +16,25 @@ use crate::cloth::ClothState;
 /// springs (energy of an undamped oscillator shrinks by `1/(1 + (ωh)²)` per step).
 /// Forces without derivatives (none yet) would be treated explicitly.
 #[derive(Default)]
-pub struct ImplicitEuler {
-    force: Vec<Vec3>,
-    sys: SystemMatrix,
-    rhs: Vec<Vec3>,
-    dv: Vec<Vec3>,
-    vel: Vec<Vec3>,
-    pos: Vec<Vec3>,
-    cg: ConjugateGradient,
+pub struct ImplicitEuler<R: Real = f32> {
+    force: Vec<R::V3>,
+    sys: SystemMatrix<R>,
+    rhs: Vec<R::V3>,
+    dv: Vec<R::V3>,
+    vel: Vec<R::V3>,
+    pos: Vec<R::V3>,
+    cg: ConjugateGradient<R>,
     /// The step length at which `dv` (and `previous_dv`, when as long) are the last steps'
     /// solutions, from which a step of that length makes its first guess
     /// ([`ImplicitEuler::guess`]); `None` when there are none.
-    warm: Option<f32>,
+    warm: Option<R>,
     /// The Δv of the step before the last.
-    previous_dv: Vec<Vec3>,
+    previous_dv: Vec<R::V3>,
     /// Starts each solve from the last step's Δv alone (for comparisons).
     last_step_guess: bool,
 }
 
-impl ImplicitEuler {
+impl<R: Real> ImplicitEuler<R> {
     /// One whose solves start from the last step's Δv, not extrapolated (for comparisons).
     pub fn last_step_guess() -> Self {
         Self {
@@ -51,7 +49,7 @@ impl ImplicitEuler {
     /// (no history: a guard that relaxes its substeps changes it). Only a starting
     /// point: the solve still runs to its tolerance, in fewer iterations (on the
     /// bench scene 27 instead of 29 a step).
-    fn guess(&mut self, h: f32) {
+    fn guess(&mut self, h: R) {
         if self.warm != Some(h) {
             self.dv.clear();
             self.previous_dv.clear();
@@ -63,7 +61,7 @@ impl ImplicitEuler {
         if self.previous_dv.len() == self.dv.len() {
             for (d, previous) in self.dv.iter_mut().zip(&mut self.previous_dv) {
                 let last = *d;
-                *d = 2.0 * last - *previous;
+                *d = last * R::of_f32(2.0) - *previous;
                 *previous = last;
             }
         } else {
@@ -72,7 +70,7 @@ impl ImplicitEuler {
     }
 
     /// Solves `sys·dv = rhs` through the context (timed and counted as the solve phase).
-    fn solve(&mut self, ctx: &mut StepContext<'_>) -> Result<(), StepError> {
+    fn solve(&mut self, ctx: &mut StepContext<'_, R>) -> Result<(), StepError> {
         let (model, config) = (ctx.model, *ctx.config);
         let (cg, sys, rhs, dv) = (&mut self.cg, &self.sys, &self.rhs, &mut self.dv);
         let outcome: Result<CgOutcome, StepError> = ctx.solve(|| {
@@ -92,16 +90,16 @@ impl ImplicitEuler {
     }
 }
 
-impl Integrator for ImplicitEuler {
+impl<R: Real> Integrator<R> for ImplicitEuler<R> {
     fn kind(&self) -> IntegratorKind {
         IntegratorKind::ImplicitEuler
     }
 
     fn step(
         &mut self,
-        ctx: &mut StepContext<'_>,
-        state: &mut ClothState,
-        h: f32,
+        ctx: &mut StepContext<'_, R>,
+        state: &mut ClothState<R>,
+        h: R,
     ) -> Result<StepReport, StepError> {
         let model = ctx.model;
         ctx.forces_where(&state.pos, &state.vel, |_| true, &mut self.force);
@@ -112,13 +110,13 @@ impl Integrator for ImplicitEuler {
             self.force
                 .iter()
                 .zip(&self.sys.dfdx_v)
-                .map(|(f, k)| h * (*f + h * *k)),
+                .map(|(f, k)| (*f + *k * h) * h),
         );
         let force_scale = self
             .rhs
             .iter()
             .map(|r| r.length_squared())
-            .sum::<f32>()
+            .sum::<R>()
             .sqrt();
         self.guess(h);
         // Until this step succeeds, `dv` is no solution to start from.
@@ -131,24 +129,24 @@ impl Integrator for ImplicitEuler {
             // Residual of backward Euler at the current velocity guess.
             self.pos.clear();
             self.pos
-                .extend(state.pos.iter().zip(&self.vel).map(|(x, v)| *x + h * *v));
+                .extend(state.pos.iter().zip(&self.vel).map(|(x, v)| *x + *v * h));
             ctx.forces_where(&self.pos, &self.vel, |_| true, &mut self.force);
             self.rhs.clear();
             for i in 0..self.vel.len() {
-                let g = model.mass[i] * (self.vel[i] - state.vel[i]) - h * self.force[i];
+                let g = (self.vel[i] - state.vel[i]) * R::of_f32(model.mass[i]) - self.force[i] * h;
                 self.rhs.push(if model.inv_mass[i] > 0.0 {
                     -g
                 } else {
-                    Vec3::ZERO
+                    R::V3::ZERO
                 });
             }
             let residual = self
                 .rhs
                 .iter()
                 .map(|r| r.length_squared())
-                .sum::<f32>()
+                .sum::<R>()
                 .sqrt();
-            if residual <= ctx.config.newton_tolerance * force_scale {
+            if residual <= R::of_f32(ctx.config.newton_tolerance) * force_scale {
                 break;
             }
             let (pos, vel, sys) = (&self.pos, &self.vel, &mut self.sys);
@@ -168,7 +166,7 @@ impl Integrator for ImplicitEuler {
                 *x += *v * h;
             }
         }
-        state.time += h as f64;
+        state.time += h.to_f64();
         self.warm = Some(h);
         Ok(ctx.report())
     }

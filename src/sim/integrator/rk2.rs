@@ -1,36 +1,34 @@
 //! Second-order Runge–Kutta, midpoint form.
 
-use glam::Vec3;
-
 use super::context::StepContext;
 use super::kind::IntegratorKind;
 use super::report::{StepError, StepReport};
 use super::step::Integrator;
-use crate::cloth::ClothState;
+use crate::cloth::{ClothState, Real};
 
 /// Midpoint rule: a half step of explicit Euler to `(x_m, v_m)`, then the whole step with
 /// the midpoint's slopes: `x ← x + v_m·h`, `v ← v + a(x_m, v_m)·h`. Second order, two
 /// force evaluations.
 #[derive(Default)]
-pub struct Rk2 {
-    acc: Vec<Vec3>,
-    mid_pos: Vec<Vec3>,
-    mid_vel: Vec<Vec3>,
+pub struct Rk2<R: Real = f32> {
+    acc: Vec<R::V3>,
+    mid_pos: Vec<R::V3>,
+    mid_vel: Vec<R::V3>,
 }
 
-impl Integrator for Rk2 {
+impl<R: Real> Integrator<R> for Rk2<R> {
     fn kind(&self) -> IntegratorKind {
         IntegratorKind::Rk2
     }
 
     fn step(
         &mut self,
-        ctx: &mut StepContext<'_>,
-        state: &mut ClothState,
-        h: f32,
+        ctx: &mut StepContext<'_, R>,
+        state: &mut ClothState<R>,
+        h: R,
     ) -> Result<StepReport, StepError> {
         ctx.accelerations(&state.pos, &state.vel, &mut self.acc);
-        let half = 0.5 * h;
+        let half = R::of_f32(0.5) * h;
         self.mid_pos.clear();
         self.mid_vel.clear();
         for ((x, v), a) in state.pos.iter().zip(&state.vel).zip(&self.acc) {
@@ -46,7 +44,7 @@ impl Integrator for Rk2 {
                 *v += *a_mid * h;
             }
         }
-        state.time += h as f64;
+        state.time += h.to_f64();
         Ok(ctx.report())
     }
 }

@@ -1,12 +1,10 @@
 //! Semi-implicit (symplectic) Euler.
 
-use glam::Vec3;
-
 use super::context::StepContext;
 use super::kind::IntegratorKind;
 use super::report::{StepError, StepReport};
 use super::step::Integrator;
-use crate::cloth::ClothState;
+use crate::cloth::{ClothState, Real};
 use crate::parallel::Disjoint;
 use crate::parallel::wide;
 use crate::sim::kernels::{Components, join, split};
@@ -19,8 +17,8 @@ use crate::sim::kernels::{Components, join, split};
 /// the same bits. A frame's substeps taken together ([`Integrator::steps`]) stay in those
 /// arrays from the first to the last, and the state is written once at the end.
 #[derive(Default)]
-pub struct SemiImplicitEuler {
-    acc: Vec<Vec3>,
+pub struct SemiImplicitEuler<R: Real = f32> {
+    acc: Vec<R::V3>,
     pos: Components,
     vel: Components,
     force: Components,
@@ -31,7 +29,7 @@ pub struct SemiImplicitEuler {
     whole_vectors: bool,
 }
 
-impl SemiImplicitEuler {
+impl<R: Real> SemiImplicitEuler<R> {
     /// One that always sums forces per vector (the general path), for comparisons.
     pub fn whole_vectors() -> Self {
         Self {
@@ -41,13 +39,13 @@ impl SemiImplicitEuler {
     }
 
     /// Whether the forces can be summed on component arrays.
-    fn on_components(&self, ctx: &StepContext<'_>) -> bool {
-        !self.whole_vectors && ctx.forces.takes_components()
+    fn on_components(&self, ctx: &StepContext<'_, R>) -> bool {
+        R::VECTORISED && !self.whole_vectors && ctx.forces.takes_components()
     }
 
     /// One step of the component arrays `self.pos`, `self.vel` (not of `state`, but for its
     /// clock). Only when [`SemiImplicitEuler::on_components`]: every term takes the arrays.
-    fn advance(&mut self, ctx: &mut StepContext<'_>, state: &mut ClothState, h: f32) {
+    fn advance(&mut self, ctx: &mut StepContext<'_, R>, h: f32) {
         let inv_mass = &ctx.model.inv_mass;
         // (A state and model of different sizes would step only the particles both have.)
         let n = inv_mass.len().min(self.pos[0].len()).min(self.vel[0].len());
@@ -79,33 +77,19 @@ impl SemiImplicitEuler {
         }
         std::mem::swap(&mut self.pos, &mut self.next_pos);
         std::mem::swap(&mut self.vel, &mut self.next_vel);
-        state.time += h as f64;
-    }
-
-    /// Copies the state into the component arrays.
-    fn load(&mut self, state: &ClothState) {
-        let n = state.pos.len();
-        split(&state.pos, &mut self.pos, n);
-        split(&state.vel, &mut self.vel, n);
-    }
-
-    /// Writes the component arrays back into the state.
-    fn store(&self, state: &mut ClothState) {
-        join(&self.pos, &mut state.pos);
-        join(&self.vel, &mut state.vel);
     }
 }
 
-impl Integrator for SemiImplicitEuler {
+impl<R: Real> Integrator<R> for SemiImplicitEuler<R> {
     fn kind(&self) -> IntegratorKind {
         IntegratorKind::SemiImplicitEuler
     }
 
     fn step(
         &mut self,
-        ctx: &mut StepContext<'_>,
-        state: &mut ClothState,
-        h: f32,
+        ctx: &mut StepContext<'_, R>,
+        state: &mut ClothState<R>,
+        h: R,
     ) -> Result<StepReport, StepError> {
         if let Some(report) = self.steps(ctx, state, h, 1) {
             return report;
@@ -118,7 +102,7 @@ impl Integrator for SemiImplicitEuler {
                 *x += *v * h;
             }
         }
-        state.time += h as f64;
+        state.time += h.to_f64();
         Ok(ctx.report())
     }
 
@@ -126,19 +110,30 @@ impl Integrator for SemiImplicitEuler {
     /// depends on time: [`ForceTerm::takes_components`](crate::sim::forces::ForceTerm::takes_components)).
     fn steps(
         &mut self,
-        ctx: &mut StepContext<'_>,
-        state: &mut ClothState,
-        h: f32,
+        ctx: &mut StepContext<'_, R>,
+        state: &mut ClothState<R>,
+        h: R,
         count: u32,
     ) -> Option<Result<StepReport, StepError>> {
         if !self.on_components(ctx) {
             return None;
         }
-        self.load(state);
+        // The component path computes in `f32` (`on_components` asks for it).
+        let (Some(pos), Some(vel)) = (
+            R::f32_slice_mut(&mut state.pos),
+            R::f32_slice_mut(&mut state.vel),
+        ) else {
+            return None;
+        };
+        let n = pos.len();
+        split(&*pos, &mut self.pos, n);
+        split(&*vel, &mut self.vel, n);
         for _ in 0..count {
-            self.advance(ctx, state, h);
+            self.advance(ctx, h.to_f32());
+            state.time += h.to_f64();
         }
-        self.store(state);
+        join(&self.pos, pos);
+        join(&self.vel, vel);
         Some(Ok(ctx.report()))
     }
 }

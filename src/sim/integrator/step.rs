@@ -1,12 +1,12 @@
 //! The integrator interface: one substep in, a report or a typed failure out.
 
-use crate::cloth::ClothState;
+use crate::cloth::{ClothState, Real};
 
 use super::context::StepContext;
 use super::kind::IntegratorKind;
 use super::report::{StepError, StepReport};
 
-/// Advances a cloth state by one substep of `h` seconds.
+/// Advances a cloth state by one substep of `h` seconds, in precision `R`.
 ///
 /// Contract: afterwards `state.vel` holds the velocities at the new time, `state.time` is
 /// advanced by `h`, and particles with inverse mass 0 have not moved. Whatever an
@@ -14,7 +14,7 @@ use super::report::{StepError, StepReport};
 /// [`Integrator::invalidate`], which the stepper calls whenever the state or the model
 /// change outside the integrator, and by [`Integrator::forces_changed`] when the parameters
 /// do.
-pub trait Integrator: Send {
+pub trait Integrator<R: Real = f32>: Send {
     fn kind(&self) -> IntegratorKind;
 
     /// One step.
@@ -24,9 +24,9 @@ pub trait Integrator: Send {
     /// caller rolls back.
     fn step(
         &mut self,
-        ctx: &mut StepContext<'_>,
-        state: &mut ClothState,
-        h: f32,
+        ctx: &mut StepContext<'_, R>,
+        state: &mut ClothState<R>,
+        h: R,
     ) -> Result<StepReport, StepError>;
 
     /// `count` steps in a row, where this integrator has a faster way to take them than one
@@ -37,9 +37,9 @@ pub trait Integrator: Send {
     /// where the forces depend on time (the stepper sets it before each step only).
     fn steps(
         &mut self,
-        _ctx: &mut StepContext<'_>,
-        _state: &mut ClothState,
-        _h: f32,
+        _ctx: &mut StepContext<'_, R>,
+        _state: &mut ClothState<R>,
+        _h: R,
         _count: u32,
     ) -> Option<Result<StepReport, StepError>> {
         None

@@ -1,15 +1,13 @@
 //! Vertex block descent (VBD; Chen, Macklin, Kim et al., SIGGRAPH 2024).
 
-use glam::Vec3;
-
 use super::context::StepContext;
 use super::kind::IntegratorKind;
 use super::report::{StepError, StepReport};
 use super::step::Integrator;
-use crate::cloth::ClothState;
+use crate::cloth::{ClothState, Real, Vector};
 use crate::parallel::{Disjoint, Team};
 use crate::sim::forces::Force;
-use crate::sim::kernels::{Particle, Stencil, StepLength, descend_range};
+use crate::sim::kernels::{Particle, Stencil, StepLength, descend_range, descend_range_plain};
 
 /// Backward Euler's step written as a minimisation, solved one particle at a time.
 ///
@@ -38,19 +36,19 @@ use crate::sim::kernels::{Particle, Stencil, StepLength, descend_range};
 /// The displacement is kept as such, not recovered as a difference of two positions (see
 /// [`super::Xpbd`] for why that matters in f32 at small steps).
 #[derive(Default)]
-pub struct Vbd {
+pub struct Vbd<R: Real = f32> {
     /// Built from the springs' strengths at the first step after they change.
     stencil: Option<Stencil>,
-    force: Vec<Vec3>,
+    force: Vec<R::V3>,
     /// The inertial displacement `ŷ` per particle, metres.
-    inertial: Vec<Vec3>,
+    inertial: Vec<R::V3>,
     /// Per particle its start position, its displacement `d` this step (metres) and its
     /// masses, side by side: the descent reads them from one 32-byte row.
-    particles: Vec<Particle>,
+    particles: Vec<Particle<R>>,
     /// The velocities before the last step and its length, from which the next step's
     /// first guess takes each particle's last acceleration; `None` when the state changed
     /// outside since (or there was no step yet).
-    previous: Option<(Vec<Vec3>, f32)>,
+    previous: Option<(Vec<R::V3>, R)>,
 }
 
 /// Colours from this many particles are shared out between the team's threads.
@@ -58,26 +56,26 @@ const PARALLEL_COLOUR: usize = 1024;
 /// Particles per piece of a colour (a multiple of the groups of eight).
 const PIECE: usize = 256;
 
-impl Vbd {
+impl<R: Real> Vbd<R> {
     /// The descent's starting point (the adaptive start of Chen et al.): `d = h·v + h²·ã`,
     /// where `ã` is the part of the external acceleration `a = f/m` that the particle
     /// showed in its last step, `â·clamp(a_last·â, 0, |a|)`: a cloth hanging at rest starts
     /// where it is (its weight held by the springs), a falling one where it falls to. With
     /// no last step, `ã = a` (the inertial prediction). Pinned particles stay.
-    fn first_guess(&self, v: Vec3, f: Vec3, w: f32, p: usize, h: f32) -> Vec3 {
+    fn first_guess(&self, v: R::V3, f: R::V3, w: f32, p: usize, h: R) -> R::V3 {
         if w == 0.0 {
-            return Vec3::ZERO;
+            return R::V3::ZERO;
         }
-        let a = f * w;
+        let a = f * R::of_f32(w);
         let taken = match &self.previous {
             Some((last, last_h)) if p < last.len() => {
                 let a_last = (v - last[p]) / *last_h;
                 let size = a.length();
-                if size > 0.0 {
+                if size > R::ZERO {
                     let along = a / size;
-                    along * a_last.dot(along).clamp(0.0, size)
+                    along * a_last.dot(along).max(R::ZERO).min(size)
                 } else {
-                    Vec3::ZERO
+                    R::V3::ZERO
                 }
             }
             _ => a,
@@ -87,38 +85,65 @@ impl Vbd {
 
     /// One sweep: every free particle, colour by colour, takes its Newton step; a large
     /// colour in pieces shared between the team's threads.
-    fn sweep(&mut self, stencil: &Stencil, h: f32) {
+    fn sweep(&mut self, stencil: &Stencil, h: R) {
         let inertial = &self.inertial;
         let n = self.particles.len();
         assert!(stencil.spans.len() == n && inertial.len() == n);
-        let particles = Disjoint::new(&mut self.particles);
-        let team = Team::current();
-        let step = StepLength::new(h);
-        for colour in &stencil.colours {
-            let pieces = colour.len().div_ceil(PIECE);
-            let parallel = colour.len() >= PARALLEL_COLOUR;
-            team.run_pieces_if(parallel, pieces, &|_, piece| {
-                let start = colour.start + piece * PIECE;
-                let range = start..(start + PIECE).min(colour.end);
-                // SAFETY: a colour's particles share no spring, so while this piece moves
-                // its particles no other thread writes them or any particle they read; the
-                // stencil was built for these particles (lengths checked above).
-                unsafe { descend_range(stencil, &particles, inertial, range, step, true) };
+        // In `f32` the descent takes its AVX2 lanes; in any other precision, one particle
+        // at a time.
+        use std::any::Any;
+        let rows = (&mut self.particles as &mut dyn Any).downcast_mut::<Vec<Particle>>();
+        let lanes = (inertial as &dyn Any).downcast_ref::<Vec<glam::Vec3>>();
+        if let (Some(rows), Some(inertial), Some(h)) =
+            (rows, lanes, (&h as &dyn Any).downcast_ref())
+        {
+            let step = StepLength::new(*h);
+            // SAFETY: as below.
+            by_colour(stencil, rows, |particles, range| unsafe {
+                descend_range(stencil, particles, inertial, range, step, true)
             });
+            return;
         }
+        let step = StepLength::new(h);
+        // SAFETY: a colour's particles share no spring, so while a piece moves its
+        // particles no other thread writes them or any particle they read; the stencil was
+        // built for these particles (lengths checked above).
+        by_colour(stencil, &mut self.particles, |particles, range| unsafe {
+            descend_range_plain(stencil, particles, inertial, range, step)
+        });
     }
 }
 
-impl Integrator for Vbd {
+/// `descend(particles, range)` over every colour of `stencil` in order, each colour in
+/// pieces that the team's members take as they come where the colour is large.
+fn by_colour<P: Send>(
+    stencil: &Stencil,
+    particles: &mut [P],
+    descend: impl Fn(&Disjoint<'_, P>, std::ops::Range<usize>) + Sync,
+) {
+    let particles = Disjoint::new(particles);
+    let team = Team::current();
+    for colour in &stencil.colours {
+        let pieces = colour.len().div_ceil(PIECE);
+        let parallel = colour.len() >= PARALLEL_COLOUR;
+        team.run_pieces_if(parallel, pieces, &|_, piece| {
+            let start = colour.start + piece * PIECE;
+            let range = start..(start + PIECE).min(colour.end);
+            descend(&particles, range);
+        });
+    }
+}
+
+impl<R: Real> Integrator<R> for Vbd<R> {
     fn kind(&self) -> IntegratorKind {
         IntegratorKind::Vbd
     }
 
     fn step(
         &mut self,
-        ctx: &mut StepContext<'_>,
-        state: &mut ClothState,
-        h: f32,
+        ctx: &mut StepContext<'_, R>,
+        state: &mut ClothState<R>,
+        h: R,
     ) -> Result<StepReport, StepError> {
         let model = ctx.model;
         let n = model.particle_count();
@@ -126,7 +151,7 @@ impl Integrator for Vbd {
             Some(s) if s.spans.len() == n => s,
             _ => Stencil::new(&ctx.forces.constraints(model), n),
         };
-        let not_springs = |t: &Force| t.springs().is_none();
+        let not_springs = |t: &Force<R>| t.springs().is_none();
         ctx.forces_where(&state.pos, &state.vel, not_springs, &mut self.force);
         let w = &model.inv_mass;
         let (mut inertial, mut rows) = (
@@ -137,12 +162,12 @@ impl Integrator for Vbd {
         rows.clear();
         for (p, (&pos, &v)) in state.pos.iter().zip(&state.vel).enumerate() {
             let f = self.force[p];
-            inertial.push((v + f * w[p] * h) * h);
+            inertial.push((v + f * R::of_f32(w[p]) * h) * h);
             rows.push(Particle {
                 pos,
                 disp: self.first_guess(v, f, w[p], p, h),
-                inv_mass: w[p],
-                mass: model.mass[p],
+                inv_mass: R::of_f32(w[p]),
+                mass: R::of_f32(model.mass[p]),
             });
         }
         (self.inertial, self.particles) = (inertial, rows);
@@ -160,15 +185,15 @@ impl Integrator for Vbd {
         let mut previous = self.previous.take().map(|p| p.0).unwrap_or_default();
         previous.clone_from(&state.vel);
         self.previous = Some((previous, h));
-        let inv_h = 1.0 / h;
+        let inv_h = R::ONE / h;
         let states = state.pos.iter_mut().zip(state.vel.iter_mut());
         for ((x, v), row) in states.zip(&self.particles) {
-            if row.inv_mass != 0.0 {
+            if row.inv_mass != R::ZERO {
                 *v = row.disp * inv_h;
                 *x += row.disp;
             }
         }
-        state.time += h as f64;
+        state.time += h.to_f64();
         Ok(ctx.report())
     }
 

@@ -1,12 +1,10 @@
 //! Velocity Verlet.
 
-use glam::Vec3;
-
 use super::context::StepContext;
 use super::kind::IntegratorKind;
 use super::report::{StepError, StepReport};
 use super::step::Integrator;
-use crate::cloth::ClothState;
+use crate::cloth::{ClothState, Real};
 
 /// `x ← x + v·h + ½a·h²`, `a' = a(x', v + a·h)`, `v ← v + ½(a + a')·h`.
 ///
@@ -15,24 +13,24 @@ use crate::cloth::ClothState;
 /// velocities, a pin or density change, new parameters, a rollback — and then recomputed
 /// from the state as it is.
 #[derive(Default)]
-pub struct VelocityVerlet {
-    acc: Vec<Vec3>,
-    acc_next: Vec<Vec3>,
-    predicted: Vec<Vec3>,
+pub struct VelocityVerlet<R: Real = f32> {
+    acc: Vec<R::V3>,
+    acc_next: Vec<R::V3>,
+    predicted: Vec<R::V3>,
     /// Whether `acc` belongs to the current state.
     kept: bool,
 }
 
-impl Integrator for VelocityVerlet {
+impl<R: Real> Integrator<R> for VelocityVerlet<R> {
     fn kind(&self) -> IntegratorKind {
         IntegratorKind::Verlet
     }
 
     fn step(
         &mut self,
-        ctx: &mut StepContext<'_>,
-        state: &mut ClothState,
-        h: f32,
+        ctx: &mut StepContext<'_, R>,
+        state: &mut ClothState<R>,
+        h: R,
     ) -> Result<StepReport, StepError> {
         if !self.kept || self.acc.len() != state.pos.len() {
             ctx.accelerations(&state.pos, &state.vel, &mut self.acc);
@@ -44,7 +42,7 @@ impl Integrator for VelocityVerlet {
         let kept = self.acc.iter().zip(self.predicted.iter_mut());
         for (((x, v), (a, predicted)), &w) in particles.zip(kept).zip(w) {
             if w != 0.0 {
-                *x += *v * h + *a * (0.5 * h * h);
+                *x += *v * h + *a * (R::of_f32(0.5) * h * h);
                 // Velocity-dependent forces (damping) are evaluated at a first-order prediction.
                 *predicted += *a * h;
             }
@@ -53,12 +51,12 @@ impl Integrator for VelocityVerlet {
         let both = self.acc.iter().zip(&self.acc_next);
         for ((v, (a, a_next)), &w) in state.vel.iter_mut().zip(both).zip(w) {
             if w != 0.0 {
-                *v += (*a + *a_next) * (0.5 * h);
+                *v += (*a + *a_next) * (R::of_f32(0.5) * h);
             }
         }
         std::mem::swap(&mut self.acc, &mut self.acc_next);
         self.kept = true;
-        state.time += h as f64;
+        state.time += h.to_f64();
         Ok(ctx.report())
     }
 

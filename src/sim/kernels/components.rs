@@ -3,34 +3,32 @@
 
 use std::sync::{Mutex, MutexGuard};
 
-use glam::{Mat3, Vec3};
-
 use crate::parallel::each_part;
 
-use super::real::Real;
+use crate::cloth::{Matrix, Real, Vector};
 
 /// x, y and z of a list of vectors, one array each (all the same length), in `f32` unless
 /// said otherwise.
 pub type Components<R = f32> = [Vec<R>; 3];
 
 /// Copies the first `n` vectors of `src` into `out`, one array per component.
-pub fn split(src: &[Vec3], out: &mut Components, n: usize) {
+pub fn split<R: Real>(src: &[R::V3], out: &mut Components<R>, n: usize) {
     for (c, comp) in out.iter_mut().enumerate() {
         comp.clear();
-        comp.extend(src[..n].iter().map(|v| v[c]));
+        comp.extend(src[..n].iter().map(|v| v.to_array()[c]));
     }
 }
 
 /// Writes the vectors of `src` (one array per component) into `out`, as many as both hold:
 /// the inverse of [`split`].
-pub fn join(src: &Components, out: &mut [Vec3]) {
+pub fn join<R: Real>(src: &Components<R>, out: &mut [R::V3]) {
     let [x, y, z] = src;
     for (i, o) in out
         .iter_mut()
         .enumerate()
         .take(x.len().min(y.len()).min(z.len()))
     {
-        *o = Vec3::new(x[i], y[i], z[i]);
+        *o = R::V3::new(x[i], y[i], z[i]);
     }
 }
 
@@ -51,20 +49,20 @@ pub type Blocks<R = f32> = [Vec<R>; 9];
 
 /// Sets `out` to `blocks`, one array per entry (sized first, then written in place: nine
 /// pushes a block, each checking its vector's capacity, cost more than making the blocks).
-pub fn split_blocks(blocks: impl ExactSizeIterator<Item = Mat3>, out: &mut Blocks) {
+pub fn split_blocks<R: Real>(blocks: impl ExactSizeIterator<Item = R::M3>, out: &mut Blocks<R>) {
     let n = blocks.len();
     for entry in out.iter_mut() {
         entry.clear();
-        entry.resize(n, 0.0);
+        entry.resize(n, R::ZERO);
     }
     let [e0, e1, e2, e3, e4, e5, e6, e7, e8] = out;
     let entries = [e0, e1, e2, e3, e4, e5, e6, e7, e8].map(|e| &mut e[..n]);
     let [e0, e1, e2, e3, e4, e5, e6, e7, e8] = entries;
     for (i, m) in blocks.enumerate().take(n) {
-        let v = m.to_cols_array();
-        (e0[i], e1[i], e2[i]) = (v[0], v[1], v[2]);
-        (e3[i], e4[i], e5[i]) = (v[3], v[4], v[5]);
-        (e6[i], e7[i], e8[i]) = (v[6], v[7], v[8]);
+        let [c0, c1, c2] = [0, 1, 2].map(|c| m.col(c).to_array());
+        (e0[i], e1[i], e2[i]) = (c0[0], c0[1], c0[2]);
+        (e3[i], e4[i], e5[i]) = (c1[0], c1[1], c1[2]);
+        (e6[i], e7[i], e8[i]) = (c2[0], c2[1], c2[2]);
     }
 }
 

@@ -5,7 +5,6 @@
 mod components;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
-mod real;
 mod run_pass;
 mod spring_runs;
 mod two_passes;
@@ -13,13 +12,13 @@ mod vbd_lanes;
 mod vbd_stencil;
 mod xpbd_lanes;
 
+pub use crate::cloth::Real;
 pub use components::{
     Blocks, Components, Scratch, blocks_times, join, split, split_blocks, zeroed,
 };
-pub use real::Real;
 pub use run_pass::Projectors;
 pub use spring_runs::SpringRuns;
 pub use two_passes::{BlockPass, TwoPasses};
-pub use vbd_lanes::{Particle, StepLength, descend_range};
+pub use vbd_lanes::{Particle, StepLength, descend_range, descend_range_plain};
 pub use vbd_stencil::Stencil;
-pub use xpbd_lanes::{Moved, Scaled, project_range};
+pub use xpbd_lanes::{Moved, Scaled, project_range, project_range_plain};

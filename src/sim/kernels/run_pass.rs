@@ -5,7 +5,7 @@
 use std::ops::Range;
 
 use super::components::Components;
-use super::real::Real;
+use crate::cloth::Real;
 
 /// Springs' system blocks `α·I + β·n nᵀ` in run order: `[α, β, n.x, n.y, n.z]`
 /// ([`SpringBlock::numbers`](crate::sim::forces::SpringBlock::numbers)), one array each

@@ -21,8 +21,8 @@ use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
 use crate::parallel::{wide, wide_fma};
 
 use super::components::{Components, Scratch, split};
-use super::real::Real;
 use super::run_pass::{ForcePass, ProductPass, Projectors, RunPass, at};
+use crate::cloth::Real;
 
 /// Particles per block (a block is one parallel task).
 const BLOCK: usize = 1024;

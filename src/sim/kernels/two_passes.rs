@@ -6,8 +6,8 @@ use std::ops::Range;
 use crate::parallel::Disjoint;
 
 use super::components::Components;
-use super::real::Real;
 use super::spring_runs::{BlockBuffers, Buffers, SpringRuns};
+use crate::cloth::Real;
 
 /// The spring forces in two passes ([`TwoPasses::of`]): first every block's sums
 /// ([`TwoPasses::blocks`], shared out by blocks), then, per range of particles, their sum

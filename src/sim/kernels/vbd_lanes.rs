@@ -6,6 +6,7 @@ use std::ops::Range;
 
 use glam::Vec3;
 
+use crate::cloth::{Real, Vector};
 use crate::parallel::Disjoint;
 
 #[cfg(target_arch = "x86_64")]
@@ -17,11 +18,11 @@ use super::vbd_stencil::{GROUP, Stencil};
 /// row).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C, align(32))]
-pub struct Particle {
-    pub pos: Vec3,
-    pub disp: Vec3,
-    pub inv_mass: f32,
-    pub mass: f32,
+pub struct Particle<R: Real = f32> {
+    pub pos: R::V3,
+    pub disp: R::V3,
+    pub inv_mass: R,
+    pub mass: R,
 }
 
 // SAFETY: `Particle` is eight f32, `repr(C, align(32))`.
@@ -30,18 +31,18 @@ unsafe impl Row for Particle {}
 
 /// The step's numbers: `h`, `h²` and `1/h`.
 #[derive(Clone, Copy, Debug)]
-pub struct StepLength {
-    pub h: f32,
-    pub h2: f32,
-    pub inv_h: f32,
+pub struct StepLength<R: Real = f32> {
+    pub h: R,
+    pub h2: R,
+    pub inv_h: R,
 }
 
-impl StepLength {
-    pub fn new(h: f32) -> Self {
+impl<R: Real> StepLength<R> {
+    pub fn new(h: R) -> Self {
         Self {
             h,
             h2: h * h,
-            inv_h: 1.0 / h,
+            inv_h: R::ONE / h,
         }
     }
 }
@@ -81,6 +82,24 @@ pub unsafe fn descend_range(
     }
 }
 
+/// As [`descend_range`] one particle at a time, in any precision (the `f64` path; in `f32`
+/// the same bits as [`descend_range`]).
+///
+/// # Safety
+/// As [`descend_range`].
+pub unsafe fn descend_range_plain<R: Real>(
+    stencil: &Stencil,
+    particles: &Disjoint<'_, Particle<R>>,
+    inertial: &[R::V3],
+    range: Range<usize>,
+    step: StepLength<R>,
+) {
+    for i in range {
+        // SAFETY: the caller's contract.
+        unsafe { descend(stencil, particles, inertial, i, step) };
+    }
+}
+
 /// The Newton step of the `i`-th particle `p` in the sweep's order with every other particle
 /// held: `dₚ ← dₚ − Hₚ⁻¹·gₚ`, with the gradient `gₚ = mₚ(dₚ − ŷₚ) − h²·Σ fₛ` and the
 /// Hessian block `Hₚ = mₚ·I + Σ (h²k·(n nᵀ + max(0, 1 − L/l)·(I − n nᵀ)) + h·c·n nᵀ)` over
@@ -90,12 +109,12 @@ pub unsafe fn descend_range(
 /// # Safety
 /// As [`descend_range`].
 #[inline(always)]
-unsafe fn descend(
+unsafe fn descend<R: Real>(
     stencil: &Stencil,
-    particles: &Disjoint<'_, Particle>,
-    inertial: &[Vec3],
+    particles: &Disjoint<'_, Particle<R>>,
+    inertial: &[R::V3],
     i: usize,
-    StepLength { h, h2, inv_h }: StepLength,
+    StepLength { h, h2, inv_h }: StepLength<R>,
 ) {
     let p = stencil.order[i] as usize;
     let read = |q: usize| {
@@ -104,52 +123,55 @@ unsafe fn descend(
         unsafe { *particles.as_ptr().add(q) }
     };
     let me = read(p);
-    if me.inv_mass == 0.0 {
+    if me.inv_mass == R::ZERO {
         return;
     }
     let (x, d) = (me.pos, me.disp);
-    let mut g = me.mass * (d - inertial[p]);
+    let mut g = (d - inertial[p]) * me.mass;
+    let (zero, one, tiny) = (R::ZERO, R::ONE, R::of_f32(TINY));
     // The block's upper triangle: xx, yy, zz, xy, xz, yz.
-    let mut hs = [me.mass, me.mass, me.mass, 0.0, 0.0, 0.0];
+    let mut hs = [me.mass, me.mass, me.mass, zero, zero, zero];
     for l in stencil.links_at(i) {
         let other = read(stencil.other[l] as usize);
         let moved = other.disp - d;
         let u = (other.pos - x) + moved;
         let len = u.length();
-        let live = len > TINY;
-        let len = if live { len } else { TINY };
+        let live = len > tiny;
+        let len = if live { len } else { tiny };
         let (k, c) = if live {
-            (stencil.k[l], stencil.c[l])
+            (R::of_f32(stencil.k[l]), R::of_f32(stencil.c[l]))
         } else {
-            (0.0, 0.0)
+            (zero, zero)
         };
-        let inv_len = 1.0 / len;
-        let n = inv_len * u;
-        let pull = k * (len - stencil.rest[l]) + (c * inv_h) * n.dot(moved);
-        g -= (h2 * pull) * n;
+        let rest = R::of_f32(stencil.rest[l]);
+        let inv_len = one / len;
+        let n = u * inv_len;
+        let pull = k * (len - rest) + (c * inv_h) * n.dot(moved);
+        g -= n * (h2 * pull);
         let hk = h2 * k;
-        let transverse = hk * (1.0 - stencil.rest[l] * inv_len).max(0.0);
+        let transverse = hk * (one - rest * inv_len).max(zero);
         let along = (hk - transverse) + h * c;
-        let an = along * n;
-        hs[0] += transverse + an.x * n.x;
-        hs[1] += transverse + an.y * n.y;
-        hs[2] += transverse + an.z * n.z;
-        hs[3] += an.x * n.y;
-        hs[4] += an.x * n.z;
-        hs[5] += an.y * n.z;
+        let (an, n) = ((n * along).to_array(), n.to_array());
+        hs[0] += transverse + an[0] * n[0];
+        hs[1] += transverse + an[1] * n[1];
+        hs[2] += transverse + an[2] * n[2];
+        hs[3] += an[0] * n[1];
+        hs[4] += an[0] * n[2];
+        hs[5] += an[1] * n[2];
     }
     let [xx, yy, zz, xy, xz, yz] = hs;
     // The inverse by cofactors (the block is symmetric).
     let (c00, c01, c02) = (yy * zz - yz * yz, xz * yz - xy * zz, xy * yz - xz * yy);
     let (c11, c12, c22) = (xx * zz - xz * xz, xy * xz - xx * yz, xx * yy - xy * xy);
     let det = (xx * c00 + xy * c01) + xz * c02;
-    if !(det > 0.0 && det < f32::INFINITY) {
+    if !(det > zero && det < R::of_f32(f32::INFINITY)) {
         return;
     }
-    let s = Vec3::new(
-        (c00 * g.x + c01 * g.y) + c02 * g.z,
-        (c01 * g.x + c11 * g.y) + c12 * g.z,
-        (c02 * g.x + c12 * g.y) + c22 * g.z,
+    let [gx, gy, gz] = g.to_array();
+    let s = R::V3::new(
+        (c00 * gx + c01 * gy) + c02 * gz,
+        (c01 * gx + c11 * gy) + c12 * gz,
+        (c02 * gx + c12 * gy) + c22 * gz,
     );
     // SAFETY: `p` is in bounds (read above) and this thread's alone.
     unsafe { particles.at(p).disp = d - s / det };

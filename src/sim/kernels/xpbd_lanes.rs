@@ -4,8 +4,7 @@
 
 use std::ops::Range;
 
-use glam::Vec3;
-
+use crate::cloth::{Real, Vector};
 use crate::parallel::Disjoint;
 use crate::sim::constraints::DistanceConstraints;
 
@@ -16,32 +15,33 @@ use super::lanes::{LANES, Row, V3, add, dot, load_rows, scale, store_rows, sub};
 /// eight f32 in this order (the AVX2 sweep loads and stores a particle as one 32-byte row).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
-pub struct Moved {
-    pub predicted: Vec3,
-    pub displacement: Vec3,
-    pub inv_mass: f32,
-    pub pad: f32,
+pub struct Moved<R: Real = f32> {
+    pub predicted: R::V3,
+    pub displacement: R::V3,
+    pub inv_mass: R,
+    pub pad: R,
 }
 
 /// Each constraint's compliance and damping as the projection uses them at step `h`:
 /// `α̃ = α/h²` and `γ = α·c/h` (in constraint order; kept while `h` and the constraints
 /// stay).
 #[derive(Default)]
-pub struct Scaled {
-    pub h: Option<f32>,
-    pub alpha: Vec<f32>,
-    pub gamma: Vec<f32>,
+pub struct Scaled<R: Real = f32> {
+    pub h: Option<R>,
+    pub alpha: Vec<R>,
+    pub gamma: Vec<R>,
 }
 
-impl Scaled {
+impl<R: Real> Scaled<R> {
     /// Recomputed for step `h` when it or the constraints changed.
-    pub fn update(&mut self, c: &DistanceConstraints, h: f32) {
+    pub fn update(&mut self, c: &DistanceConstraints, h: R) {
         if self.h == Some(h) && self.alpha.len() == c.len() {
             return;
         }
-        self.alpha = c.compliance.iter().map(|a| a / (h * h)).collect();
+        let of = R::of_f32;
+        self.alpha = c.compliance.iter().map(|&a| of(a) / (h * h)).collect();
         let with_damping = c.compliance.iter().zip(&c.damping);
-        self.gamma = with_damping.map(|(a, damping)| a * damping / h).collect();
+        self.gamma = (with_damping.map(|(&a, &damping)| of(a * damping) / h)).collect();
         self.h = Some(h);
     }
 }
@@ -85,6 +85,24 @@ pub unsafe fn project_range(
 ///
 /// # Safety
 /// As [`project_range`], and the CPU supports AVX2.
+/// As [`project_range`] one constraint at a time, in any precision (the `f64` path; in
+/// `f32` the same bits as [`project_range`]).
+///
+/// # Safety
+/// As [`project_range`].
+pub unsafe fn project_range_plain<R: Real>(
+    c: &DistanceConstraints,
+    s: &Scaled<R>,
+    range: Range<usize>,
+    moved: &Disjoint<'_, Moved<R>>,
+    lambda: &Disjoint<'_, R>,
+) {
+    for k in range {
+        // SAFETY: the caller's contract.
+        unsafe { project(c, s, k, moved, lambda) };
+    }
+}
+
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn project_eights_avx2(
@@ -222,12 +240,12 @@ unsafe fn store_columns(moved: &Disjoint<'_, Moved>, ends: &[u32], c: Columns) {
 /// Constraint `k`'s particles are in `moved`, and no other thread uses them or its
 /// multiplier meanwhile; `lambda` is at least as long as `c`.
 #[inline(always)]
-unsafe fn project(
+unsafe fn project<R: Real>(
     c: &DistanceConstraints,
-    s: &Scaled,
+    s: &Scaled<R>,
     k: usize,
-    moved: &Disjoint<'_, Moved>,
-    lambda: &Disjoint<'_, f32>,
+    moved: &Disjoint<'_, Moved<R>>,
+    lambda: &Disjoint<'_, R>,
 ) {
     let (a, b) = (c.a[k] as usize, c.b[k] as usize);
     // SAFETY: in bounds (`c.a[k]` checked, the rest by the caller's contract); no other
@@ -235,23 +253,24 @@ unsafe fn project(
     // self-constraint (a = b) holds no two borrows.
     let (ma, mb, lambda) = unsafe { (*moved.at(a), *moved.at(b), lambda.at(k)) };
     let (wa, wb) = (ma.inv_mass, mb.inv_mass);
-    if wa + wb == 0.0 {
+    if wa + wb == R::ZERO {
         return;
     }
     let (pa, pb, dxa, dxb) = (ma.predicted, mb.predicted, ma.displacement, mb.displacement);
     let d = pb - pa;
     let len = d.length();
-    if len <= 1e-9 {
+    if len <= R::TINY_LENGTH {
         return;
     }
-    let n = (1.0 / len) * d;
+    let one = R::ONE;
+    let n = d * (one / len);
     let (alpha, gamma) = (s.alpha[k], s.gamma[k]);
     // ∇C · (p − x): how fast the constraint is changing this step.
     let rate = n.dot(dxb - dxa);
-    let constraint = len - c.rest[k];
-    let dl = (-constraint - alpha * *lambda - gamma * rate) / ((1.0 + gamma) * (wa + wb) + alpha);
+    let constraint = len - R::of_f32(c.rest[k]);
+    let dl = (-constraint - alpha * *lambda - gamma * rate) / ((one + gamma) * (wa + wb) + alpha);
     *lambda += dl;
-    let (da, db) = ((wa * dl) * n, (wb * dl) * n);
+    let (da, db) = (n * (wa * dl), n * (wb * dl));
     // SAFETY: as above.
     unsafe {
         *moved.at(a) = Moved {
@@ -270,6 +289,7 @@ unsafe fn project(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
 
     /// 29 constraints on distinct particles (three groups of eight and five left over),
     /// among them the cases a projection leaves alone or passes through: a particle tied
