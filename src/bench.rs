@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use crate::gpu::GpuError;
 use crate::scene::{OneOrTwo, Scene, SceneError, Simulation, scenario};
-use crate::sim::IntegratorKind;
+use crate::sim::{IntegratorKind, Precision};
 
 /// The bench scene's name.
 pub const BENCH_SCENE: &str = "hanging-bench";
@@ -76,6 +76,8 @@ pub struct BenchRow {
     pub integrator: String,
     /// The backend's name ("cpu", "gpu").
     pub backend: String,
+    /// What it computed in ("f32", "f64").
+    pub precision: String,
     /// CPU threads the solver may share a step among: the team's members (the pool's size,
     /// at most 16; a cloth under [`crate::parallel::PARALLEL_ELEMENTS`] particles, 64 × 64,
     /// still steps on one of them, and the team runs on one while the others do not pay),
@@ -158,7 +160,22 @@ fn central(sim: &Simulation) -> Vec<usize> {
 /// # Errors
 /// [`BenchError`] for a bad `n`.
 pub fn bench_one(n: u32, integrator: IntegratorKind) -> Result<BenchRow, BenchError> {
-    bench_with(n, integrator, |scene| Ok(Simulation::new(scene)))
+    bench_in(n, integrator, Precision::F32)
+}
+
+/// As [`bench_one`], computing in `precision`.
+///
+/// # Errors
+/// [`BenchError`] for a bad `n`.
+pub fn bench_in(
+    n: u32,
+    integrator: IntegratorKind,
+    precision: Precision,
+) -> Result<BenchRow, BenchError> {
+    bench_with(n, integrator, |mut scene| {
+        scene.params.solver.precision = precision;
+        Ok(Simulation::new(scene))
+    })
 }
 
 /// As [`bench_one`] on the GPU backend, on a headless device of its own
@@ -232,6 +249,7 @@ pub fn bench_with(
         n,
         integrator: integrator.name().to_string(),
         backend: sim.backend_name().to_string(),
+        precision: sim.params().solver.precision.to_string(),
         threads: sim.cpu_threads(),
         substeps_per_frame: substeps,
         us_per_substep: us,

@@ -4,7 +4,7 @@
 use clothsim::device::{AdapterPreference, HeadlessDevice};
 use clothsim::gpu::{Backend, gpu_simulation, gpu_support};
 use clothsim::scene::{Scene, Simulation};
-use clothsim::sim::{Effect, IntegratorKind};
+use clothsim::sim::{Effect, IntegratorKind, Precision};
 
 /// The largest distance between the same particle in `a` and `b`, metres.
 fn farthest(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
@@ -72,7 +72,8 @@ fn gpu_and_cpu_resolve_the_same_sphere_contacts_at_impact() {
 #[test]
 fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
     let flag = Scene::builtin("flag").expect("scene");
-    let err = gpu_support(&flag.params.step, &flag.effects).expect_err("wind is CPU only");
+    let f32 = Precision::F32;
+    let err = gpu_support(&flag.params.step, f32, &flag.effects).expect_err("wind is CPU only");
     assert!(
         err.to_string().contains("wind") || err.to_string().contains("dihedral"),
         "{err}"
@@ -87,12 +88,12 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
         scene
             .effects
             .retain(|e| !matches!(e, Effect::SelfCollision(_)));
-        let err = gpu_support(&scene.params.step, &scene.effects).expect_err(what);
+        let err = gpu_support(&scene.params.step, f32, &scene.effects).expect_err(what);
         assert!(err.to_string().contains(what), "{err}");
     }
     let mut rk4 = Scene::builtin("hanging").expect("scene");
     rk4.params.step.integrator = IntegratorKind::Rk4;
-    let err = gpu_support(&rk4.params.step, &rk4.effects).expect_err("RK4 is CPU only");
+    let err = gpu_support(&rk4.params.step, f32, &rk4.effects).expect_err("RK4 is CPU only");
     let err = err.to_string();
     assert!(
         err.contains("runs Semi-implicit Euler only, not RK4"),
@@ -114,6 +115,21 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
         "{}",
         err.reason
     );
+    assert_eq!(sim.state().pos, before.pos);
+    // So does f64: refused up front with the reason, and mid-run on the next frame.
+    let mut precise = Scene::builtin("hanging").expect("scene");
+    precise.params.solver.precision = Precision::F64;
+    let err = gpu_simulation(precise, true).err().expect("f64 refused");
+    assert!(err.to_string().contains("f32 only, not f64"), "{err}");
+    let mut params = sim.params().clone();
+    params.step.integrator = IntegratorKind::SemiImplicitEuler;
+    sim.set_params(params.clone()).expect("valid parameters");
+    sim.step_frame().expect("back to what it runs");
+    let before = sim.state().clone();
+    params.solver.precision = Precision::F64;
+    sim.set_params(params).expect("valid parameters");
+    let err = sim.step_frame().expect_err("unsupported");
+    assert!(err.reason.contains("f32 only, not f64"), "{}", err.reason);
     assert_eq!(sim.state().pos, before.pos);
 }
 

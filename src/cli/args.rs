@@ -8,7 +8,7 @@ use clap::{Parser, Subcommand};
 use clothsim::gpu::{Backend, gpu_simulation};
 use clothsim::mesh;
 use clothsim::scene::{Scene, Simulation};
-use clothsim::sim::IntegratorKind;
+use clothsim::sim::{IntegratorKind, Precision};
 
 #[derive(Parser)]
 #[command(
@@ -108,6 +108,10 @@ pub enum Command {
         /// Largest acceptable max position error, as a fraction of the cloth's size.
         #[arg(long, default_value_t = clothsim::report::DEFAULT_TOLERANCE, allow_negative_numbers = true)]
         tolerance: f64,
+        /// What every run of the sweep and its reference computes in: f64 (rounding far below
+        /// the errors measured) or f32 (to see where f32's rounding floors the errors).
+        #[arg(long, default_value_t = Precision::F64)]
+        precision: Precision,
         /// Output directory (created if missing).
         #[arg(long, required_unless_present = "calibrate")]
         out: Option<PathBuf>,
@@ -145,6 +149,9 @@ pub enum Command {
         /// cpu, or gpu (semi-implicit Euler on wgpu compute; --threads does not apply).
         #[arg(long, value_enum, default_value_t = Backend::Cpu)]
         backend: Backend,
+        /// What the CPU computes in: f32 or f64 (the GPU refuses f64).
+        #[arg(long, default_value_t = Precision::F32)]
+        precision: Precision,
         /// Instead: a 64 × 64 cloth resting on a mesh sphere of about 1 000 and 100 000
         /// triangles, the obstacle phase against the springs' (per --threads).
         #[arg(long, conflicts_with_all = ["sizes", "integrators", "backend"])]
@@ -224,6 +231,10 @@ pub struct RunArgs {
     /// Substeps per frame.
     #[arg(long)]
     pub substeps: Option<u32>,
+    /// What the state, forces and integrators compute in: f32 (the scene file's unless it
+    /// says otherwise) or f64 (the CPU backend only; about twice the time).
+    #[arg(long)]
+    pub precision: Option<Precision>,
     /// Sweeps per substep of XPBD (constraint projections) and VBD (descent sweeps).
     #[arg(long)]
     pub iterations: Option<u32>,
@@ -253,6 +264,9 @@ impl RunArgs {
         }
         if let Some(s) = self.substeps {
             scene.params.step.substeps = s;
+        }
+        if let Some(p) = self.precision {
+            scene.params.solver.precision = p;
         }
         if let Some(n) = self.iterations {
             if !(1..=10_000).contains(&n) {

@@ -3,7 +3,7 @@
 use anyhow::{Context, Result, bail};
 
 use clothsim::gpu::{Backend, GPU_INTEGRATOR};
-use clothsim::sim::IntegratorKind;
+use clothsim::sim::{IntegratorKind, Precision};
 
 /// Runs and prints one row per thread count × size × integrator (JSON with `json`).
 pub fn bench(
@@ -12,11 +12,15 @@ pub fn bench(
     threads: &[usize],
     json: bool,
     backend: Backend,
+    precision: Precision,
 ) -> Result<()> {
     if let Some(&n) = sizes.iter().find(|&&n| !(3..=2048).contains(&n)) {
         bail!("--sizes: {n} particles per side is outside 3..=2048");
     }
     check_threads(threads)?;
+    if backend == Backend::Gpu && precision != Precision::F32 {
+        bail!("--backend gpu computes in f32 only, not {precision}");
+    }
     if backend == Backend::Gpu
         && let Some(k) = integrators.iter().find(|&&k| k != GPU_INTEGRATOR)
     {
@@ -52,7 +56,7 @@ pub fn bench(
         for &n in sizes {
             for &k in integrators {
                 let row = match backend {
-                    Backend::Cpu => pool.install(|| clothsim::bench::bench_one(n, k))?,
+                    Backend::Cpu => pool.install(|| clothsim::bench::bench_in(n, k, precision))?,
                     // On this thread, not the pool's: a GL device (llvmpipe through EGL) is
                     // current on the thread that made it, and a pool's thread still tearing
                     // that down while the process exits corrupts the heap (a crash at exit

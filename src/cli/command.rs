@@ -66,6 +66,7 @@ pub fn run(cli: Cli) -> Result<()> {
             dts,
             seconds,
             tolerance,
+            precision,
             out,
             calibrate,
             map,
@@ -79,6 +80,7 @@ pub fn run(cli: Cli) -> Result<()> {
             };
             let mut config = clothsim::report::SweepConfig {
                 tolerance,
+                precision,
                 ..clothsim::report::SweepConfig::for_scene(&scene)
             };
             if let Some(seconds) = seconds {
@@ -119,6 +121,7 @@ pub fn run(cli: Cli) -> Result<()> {
             threads,
             json,
             backend,
+            precision,
             obstacles: false,
             crumple: false,
             ..
@@ -127,7 +130,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 Backend::Cpu => clothsim::bench::BENCH_INTEGRATORS.to_vec(),
                 Backend::Gpu => vec![GPU_INTEGRATOR],
             });
-            bench(&sizes, &integrators, &threads, json, backend)
+            bench(&sizes, &integrators, &threads, json, backend, precision)
         }
     }
 }

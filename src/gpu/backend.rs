@@ -30,7 +30,8 @@ pub fn gpu_simulation(
     scene: Scene,
     read_every_frame: bool,
 ) -> Result<(Simulation, String), GpuError> {
-    gpu_support(&scene.params.step, &scene.effects)?;
+    let params = &scene.params;
+    gpu_support(&params.step, params.solver.precision, &scene.effects)?;
     let gpu = HeadlessDevice::open(AdapterPreference::Any)?;
     let stepper = GpuStepper::new(
         &gpu.device,

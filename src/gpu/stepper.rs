@@ -88,7 +88,7 @@ impl GpuStepper {
         effects: &[Effect],
         read_every_frame: bool,
     ) -> Result<Self, GpuError> {
-        gpu_support(&params.step, effects)?;
+        gpu_support(&params.step, params.solver.precision, effects)?;
         let limits = device.limits();
         let count = model.particle_count() as u32;
         check_device(&limits, count)?;
@@ -360,8 +360,8 @@ impl StepBackend for GpuStepper {
         effects: &[Effect],
         changes: Changes,
     ) {
-        if changes.intersects(Changes::INTEGRATOR | Changes::EFFECTS) {
-            self.unsupported = gpu_support(&params.step, effects)
+        if changes.intersects(Changes::INTEGRATOR | Changes::EFFECTS | Changes::PRECISION) {
+            self.unsupported = gpu_support(&params.step, params.solver.precision, effects)
                 .err()
                 .map(|e| e.to_string());
         }

@@ -1,6 +1,6 @@
 //! What the GPU backend runs, and whether a device can hold a cloth.
 
-use crate::sim::{Effect, IntegratorKind, StepConfig};
+use crate::sim::{Effect, IntegratorKind, Precision, StepConfig};
 
 use super::error::GpuError;
 use super::kernel::WORKGROUP;
@@ -9,10 +9,20 @@ use super::packing::{MAX_COLLIDERS, MAX_PARTICLES, Neighbour, Particle};
 /// The one integrator the GPU backend runs.
 pub const GPU_INTEGRATOR: IntegratorKind = IntegratorKind::SemiImplicitEuler;
 
-/// What of `step` and `effects` the GPU backend cannot run, if anything: it runs
-/// semi-implicit Euler with gravity, springs (and bend springs), air damping, pins and up
-/// to four sphere and plane colliders.
-pub fn gpu_support(step: &StepConfig, effects: &[Effect]) -> Result<(), GpuError> {
+/// What of `step`, `precision` and `effects` the GPU backend cannot run, if anything: it
+/// runs semi-implicit Euler in `f32` with gravity, springs (and bend springs), air damping,
+/// pins and up to four sphere and plane colliders.
+pub fn gpu_support(
+    step: &StepConfig,
+    precision: Precision,
+    effects: &[Effect],
+) -> Result<(), GpuError> {
+    if precision != Precision::F32 {
+        return Err(GpuError::Unsupported(format!(
+            "computes in f32 only, not {precision} (f64 is slow or absent on most GPUs, and \
+             WGSL has no f64); run {precision} on the CPU backend"
+        )));
+    }
     if step.integrator != GPU_INTEGRATOR {
         return Err(GpuError::Unsupported(format!(
             "runs {} only, not {}",

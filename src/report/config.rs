@@ -1,6 +1,7 @@
 //! What a sweep runs: which integrators, at which steps, for how long, judged how.
 
-use crate::sim::IntegratorKind;
+use crate::scene::Scene;
+use crate::sim::{IntegratorKind, Precision};
 
 use super::cost::UnitCosts;
 use super::error::ReportError;
@@ -24,6 +25,9 @@ pub struct SweepConfig {
     pub parallel_reference: bool,
     /// What each kind of work costs: the choice is made by counted work weighed by these.
     pub unit_costs: UnitCosts,
+    /// What every run of the sweep (its reference too) computes in: `f64` unless told
+    /// otherwise, so that rounding stays far below the errors measured.
+    pub precision: Precision,
 }
 
 /// The default sweep: a 1/60 s frame divided into 3 … 384 substeps (2.1 decades of step).
@@ -49,6 +53,7 @@ impl Default for SweepConfig {
             bisection_steps: 6,
             parallel_reference: true,
             unit_costs: UnitCosts::default(),
+            precision: Precision::F64,
         }
     }
 }
@@ -76,6 +81,13 @@ pub const ORDERS_SUBSTEPS: [f64; 13] = [
 ];
 
 impl SweepConfig {
+    /// `scene` set up to run in the sweep's precision.
+    pub fn in_precision(&self, scene: &Scene) -> Scene {
+        let mut scene = scene.clone();
+        scene.params.solver.precision = self.precision;
+        scene
+    }
+
     /// The sweep for the scene called `name`: on [`ORDERS_SCENE`] one second at
     /// [`ORDERS_SUBSTEPS`] (smooth for a second, and the orders need the span), one sample
     /// every 1/30 s; on any other the default, a quarter second at [`DEFAULT_SUBSTEPS`]

@@ -103,6 +103,7 @@ pub fn stability_map(
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<StabilityMap, ReportError> {
     config.validate()?;
+    let scene = &config.in_precision(scene);
     if let Some(s) = scales.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
         return Err(ReportError::Config(format!(
             "stiffness scale {s} must be a positive number"

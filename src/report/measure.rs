@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use crate::scene::{Scene, Simulation};
 use crate::sim::{Effect, IntegratorKind, StepStats, intersections, min_surface_distance};
@@ -65,8 +65,9 @@ pub struct Trajectory {
     pub steps_per_sample: u32,
     /// Steps taken in all.
     pub steps: u64,
-    /// Positions at each sample time (with [`Record::Positions`]).
-    pub positions: Vec<Vec<Vec3>>,
+    /// Positions at each sample time (with [`Record::Positions`]), in the precision the run
+    /// computed in.
+    pub positions: Vec<Vec<DVec3>>,
     /// Total energy at t = 0 and each sample time, joules (with [`Record::Energy`]).
     pub energy: Vec<f64>,
     /// Kinetic energy at each sample time, joules (with [`Record::Energy`]).
@@ -194,7 +195,7 @@ pub fn run(
                     (Some(a), Some(b)) => Some(a.worst(b)),
                     (a, b) => a.or(b),
                 };
-                out.positions.push(state.pos.clone());
+                out.positions.push(sim.positions_f64());
             }
             Record::Energy => {
                 out.energy.push(sim.energy());
@@ -217,7 +218,7 @@ pub fn position_error(run: &Trajectory, reference: &Trajectory) -> (f64, f64) {
     for (x, r) in run.positions.iter().zip(&reference.positions) {
         let mut sum = 0.0f64;
         for (a, b) in x.iter().zip(r) {
-            let d = a.distance(*b) as f64;
+            let d = a.distance(*b);
             sum += d * d;
             max = max.max(d);
         }

@@ -3,7 +3,7 @@
 //! particle is), the report judges runs by the cloth's shape in aggregate instead: where its
 //! mass is, how spread it is, how stretched its springs are.
 
-use glam::Vec3;
+use glam::DVec3;
 
 use crate::cloth::ClothModel;
 use crate::mesh::SpringKind;
@@ -25,16 +25,16 @@ pub enum Judged {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ShapeStats {
     /// Centre of mass, metres.
-    pub centre: Vec3,
+    pub centre: DVec3,
     /// Radius of gyration about it, metres.
-    pub spread: f32,
+    pub spread: f64,
     /// Mean relative extension of the structural springs.
-    pub mean_strain: f32,
+    pub mean_strain: f64,
 }
 
 impl ShapeStats {
     /// The stats of `model`'s cloth at `pos`.
-    pub fn of(model: &ClothModel, pos: &[Vec3]) -> Self {
+    pub fn of(model: &ClothModel, pos: &[DVec3]) -> Self {
         let mass: f64 = model.mass.iter().map(|&m| m as f64).sum::<f64>().max(1e-30);
         let weighted = |f: &dyn Fn(usize) -> f64| {
             (0..pos.len())
@@ -42,21 +42,21 @@ impl ShapeStats {
                 .sum::<f64>()
                 / mass
         };
-        let centre = Vec3::new(
-            weighted(&|i| pos[i].x as f64) as f32,
-            weighted(&|i| pos[i].y as f64) as f32,
-            weighted(&|i| pos[i].z as f64) as f32,
+        let centre = DVec3::new(
+            weighted(&|i| pos[i].x),
+            weighted(&|i| pos[i].y),
+            weighted(&|i| pos[i].z),
         );
-        let spread = weighted(&|i| pos[i].distance_squared(centre) as f64).sqrt() as f32;
+        let spread = weighted(&|i| pos[i].distance_squared(centre)).sqrt();
         let s = &model.springs;
         let structural: Vec<f64> = (0..s.len())
             .filter(|&e| s.kind[e] == SpringKind::Structural && s.rest[e] > 0.0)
-            .map(|e| (pos[s.a[e] as usize].distance(pos[s.b[e] as usize]) / s.rest[e] - 1.0) as f64)
+            .map(|e| pos[s.a[e] as usize].distance(pos[s.b[e] as usize]) / s.rest[e] as f64 - 1.0)
             .collect();
         let mean_strain = if structural.is_empty() {
             0.0
         } else {
-            (structural.iter().sum::<f64>() / structural.len() as f64) as f32
+            structural.iter().sum::<f64>() / structural.len() as f64
         };
         Self {
             centre,
@@ -82,10 +82,10 @@ pub fn shape_error(
     let (mut shape, mut strain) = (0.0f64, 0.0f64);
     for (x, r) in run.positions.iter().zip(&reference.positions) {
         let (a, b) = (ShapeStats::of(model, x), ShapeStats::of(model, r));
-        let moved = a.centre.distance(b.centre) as f64;
-        let spread = (a.spread - b.spread).abs() as f64;
+        let moved = a.centre.distance(b.centre);
+        let spread = (a.spread - b.spread).abs();
         shape = shape.max(moved.max(spread) / size);
-        strain = strain.max((a.mean_strain - b.mean_strain).abs() as f64);
+        strain = strain.max((a.mean_strain - b.mean_strain).abs());
     }
     (shape, strain)
 }
@@ -94,6 +94,7 @@ pub fn shape_error(
 mod tests {
     use super::*;
     use crate::cloth::Springs;
+    use glam::Vec3;
 
     /// Two unit masses 2 m apart on a spring of rest length 1: centre midway, spread 1 m,
     /// strain 1; moved 3 m up as a whole, only the centre moves.
@@ -106,12 +107,13 @@ mod tests {
         springs.kind.push(SpringKind::Structural);
         let pos = vec![Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0)];
         let model = ClothModel::from_springs(pos.clone(), springs, vec![1.0, 1.0], &[]);
-        let stats = ShapeStats::of(&model, &pos);
-        assert_eq!(stats.centre, Vec3::new(1.0, 0.0, 0.0));
+        let wide: Vec<DVec3> = pos.iter().map(|p| p.as_dvec3()).collect();
+        let stats = ShapeStats::of(&model, &wide);
+        assert_eq!(stats.centre, DVec3::new(1.0, 0.0, 0.0));
         assert!((stats.spread - 1.0).abs() < 1e-6);
         assert!((stats.mean_strain - 1.0).abs() < 1e-6);
         let trajectory = |p: Vec<Vec3>| Trajectory {
-            positions: vec![p],
+            positions: vec![p.iter().map(|p| p.as_dvec3()).collect()],
             ..Trajectory::empty(crate::sim::IntegratorKind::Rk4)
         };
         let up: Vec<Vec3> = pos.iter().map(|p| *p + Vec3::Y * 3.0).collect();

@@ -46,6 +46,7 @@ pub fn small_steps(
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<SmallSteps, ReportError> {
     let start = Instant::now();
+    let scene = &config.in_precision(scene);
     let frame = scene.params.step.dt as f64;
     let most = *SMALL_STEPS_AXIS.iter().max().unwrap_or(&1) as f64;
     // The reference's candidates span the grid's steps.

@@ -257,6 +257,7 @@ pub fn sweep(
     progress: &mut dyn FnMut(&Progress) -> bool,
 ) -> Result<AccuracyReport, ReportError> {
     config.validate()?;
+    let scene = &config.in_precision(scene);
     let per_integrator = config.dts.len() + config.bisection_steps as usize;
     let mut tracker = Tracker {
         done: 0,

@@ -196,6 +196,16 @@ impl Simulation {
         &self.state
     }
 
+    /// The positions to every digit the backend computes them in (an `f64` stepper's own,
+    /// not their `f32` rounding in [`Simulation::state`]), as `f64`.
+    pub fn positions_f64(&self) -> Vec<glam::DVec3> {
+        let mut out = Vec::new();
+        if !self.backend.positions_f64(&self.state, &mut out) {
+            out.extend(self.state.pos.iter().map(|p| p.as_dvec3()));
+        }
+        out
+    }
+
     /// The state the simulation started from (and returns to on reset).
     pub fn initial(&self) -> &ClothState {
         &self.initial

@@ -638,6 +638,15 @@ impl<R: Real> StepBackend for CpuStepper<R> {
         self.integrator.kind()
     }
 
+    fn positions_f64(&self, state: &ClothState, out: &mut Vec<glam::DVec3>) -> bool {
+        if R::VECTORISED || !self.precise.holds(state) {
+            return false;
+        }
+        out.clear();
+        out.extend(self.precise.state.pos.iter().map(|p| R::v3_f64(*p)));
+        true
+    }
+
     fn self_collision_work(&self) -> Option<SelfWork> {
         self.self_collision.map(|_| self.self_contacts.work)
     }

@@ -70,6 +70,12 @@ impl<R: Real> PreciseState<R> {
         self.stale = true;
     }
 
+    /// Whether the state stepped is `given` to more digits (nothing changed it since it was
+    /// written).
+    pub fn holds(&self, given: &ClothState) -> bool {
+        !self.stale && *given == self.written
+    }
+
     /// Takes `given` unless it is still what was written to it.
     pub fn load(&mut self, given: &ClothState) {
         if self.stale || *given != self.written {
