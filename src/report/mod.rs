@@ -31,7 +31,7 @@ pub use measure::{
 pub use order::{ASYMPTOTIC_ERROR, ObservedOrder, RESOLVED, observed_order};
 pub use plot::{PLOT_SIZE, draw, integrator_color};
 pub use point::Point;
-pub use reference::{REFERENCE_REFINEMENT, Reference};
+pub use reference::{REFERENCE_REFINEMENT, Reference, reference};
 pub use shape::{Judged, ShapeStats, shape_error};
 pub use small_steps::{Duel, GridRun, SMALL_STEPS_AXIS, SmallSteps, small_steps};
 pub use sweep::{AccuracyReport, Progress, StableLimit, measure, sweep};
