@@ -77,14 +77,6 @@ pub unsafe fn project_range(
     }
 }
 
-/// Projects the whole groups of eight at the start of `range` (no two of whose constraints
-/// share a particle), each in one pass of AVX2 instructions: the particles' rows loaded
-/// and transposed into one register per quantity, the projection of [`project`] lane by
-/// lane, and the columns transposed back and stored (a lane that does not move stores what it
-/// loaded). Returns the constraints left over.
-///
-/// # Safety
-/// As [`project_range`], and the CPU supports AVX2.
 /// As [`project_range`] one constraint at a time, in any precision (the `f64` path; in
 /// `f32` the same bits as [`project_range`]).
 ///
@@ -103,6 +95,14 @@ pub unsafe fn project_range_plain<R: Real>(
     }
 }
 
+/// Projects the whole groups of eight at the start of `range` (no two of whose constraints
+/// share a particle), each in one pass of AVX2 instructions: the particles' rows loaded
+/// and transposed into one register per quantity, the projection of [`project`] lane by
+/// lane, and the columns transposed back and stored (a lane that does not move stores what it
+/// loaded). Returns the constraints left over.
+///
+/// # Safety
+/// As [`project_range`], and the CPU supports AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn project_eights_avx2(
