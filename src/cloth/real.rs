@@ -36,8 +36,6 @@ pub trait Real:
     type V3: Vector<Self>;
     /// A 3×3 block (a force derivative) in this precision.
     type M3: Matrix<Self>;
-    /// `"f32"` or `"f64"`.
-    const NAME: &'static str;
     /// Whether the vectorised kernels (component arrays, SIMD lanes) compute in this
     /// precision: `f32` only; `f64` takes the plain paths.
     const VECTORISED: bool;
@@ -59,8 +57,6 @@ pub trait Real:
     fn to_f32(self) -> f32;
     fn max(self, other: Self) -> Self;
     fn min(self, other: Self) -> Self;
-    fn abs(self) -> Self;
-    fn is_finite(self) -> bool;
     fn sin(self) -> Self;
     fn sin_cos(self) -> (Self, Self);
     fn atan2(self, other: Self) -> Self;
@@ -114,7 +110,6 @@ pub trait Vector<R>:
     fn length_squared(self) -> R;
     fn distance(self, other: Self) -> R;
     fn is_finite(self) -> bool;
-    fn normalize_or_zero(self) -> Self;
 }
 
 /// A 3×3 matrix in precision `R`.
@@ -192,10 +187,6 @@ macro_rules! vector {
             fn is_finite(self) -> bool {
                 <$v>::is_finite(self)
             }
-            #[inline(always)]
-            fn normalize_or_zero(self) -> Self {
-                <$v>::normalize_or_zero(self)
-            }
         }
     };
 }
@@ -235,7 +226,6 @@ macro_rules! real {
         impl Real for $t {
             type V3 = $v;
             type M3 = $m;
-            const NAME: &'static str = stringify!($t);
             const VECTORISED: bool = matches!(stringify!($t).as_bytes(), b"f32");
             const ZERO: Self = 0.0;
             const ONE: Self = 1.0;
@@ -281,15 +271,6 @@ macro_rules! real {
                 <$t>::min(self, other)
             }
 
-            #[inline(always)]
-            fn abs(self) -> Self {
-                <$t>::abs(self)
-            }
-
-            #[inline(always)]
-            fn is_finite(self) -> bool {
-                <$t>::is_finite(self)
-            }
 
             #[inline(always)]
             fn sin(self) -> Self {
