@@ -200,7 +200,7 @@ impl Simulation {
     /// not their `f32` rounding in [`Simulation::state`]), as `f64`.
     pub fn positions_f64(&self) -> Vec<glam::DVec3> {
         let mut out = Vec::new();
-        if !self.backend.positions_f64(&self.state, &mut out) {
+        if !self.backend.positions_f64(&mut out) {
             out.extend(self.state.pos.iter().map(|p| p.as_dvec3()));
         }
         out

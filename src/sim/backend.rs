@@ -89,10 +89,10 @@ pub trait StepBackend: Send {
         Ok(())
     }
 
-    /// The positions of `state` in the precision the backend steps them in, widened to
-    /// `f64`, into `out`; false, with `out` untouched, when `state` holds them all (an `f32`
+    /// The positions in the precision the backend steps them in, widened to `f64`, into
+    /// `out`; false, with `out` untouched, when the caller's state holds them all (an `f32`
     /// backend, or a state changed since the backend stepped it).
-    fn positions_f64(&self, _state: &ClothState, _out: &mut Vec<glam::DVec3>) -> bool {
+    fn positions_f64(&self, _out: &mut Vec<glam::DVec3>) -> bool {
         false
     }
 

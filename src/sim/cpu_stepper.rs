@@ -638,8 +638,8 @@ impl<R: Real> StepBackend for CpuStepper<R> {
         self.integrator.kind()
     }
 
-    fn positions_f64(&self, state: &ClothState, out: &mut Vec<glam::DVec3>) -> bool {
-        if R::VECTORISED || !self.precise.holds(state) {
+    fn positions_f64(&self, out: &mut Vec<glam::DVec3>) -> bool {
+        if R::VECTORISED || !self.precise.holds() {
             return false;
         }
         out.clear();

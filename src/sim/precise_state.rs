@@ -44,13 +44,12 @@ pub fn as_f32<R: Real, T>(
 
 /// The state a stepper in a precision other than `f32` steps, beside the caller's `f32`
 /// state, which after each frame holds its rounding. The caller's state is taken again
-/// when the stepper is told it changed ([`PreciseState::forget`]) or when it no longer holds
-/// what was last written to it (a drag, a reset, an edit).
+/// after the stepper is told it changed ([`PreciseState::forget`], from
+/// [`StepBackend::invalidate`](super::backend::StepBackend::invalidate): a drag, a reset, an
+/// edit), as the GPU backend takes it again into its buffers.
 #[derive(Debug)]
 pub struct PreciseState<R: Real> {
     pub state: ClothState<R>,
-    /// What the caller's state was set to last.
-    written: ClothState,
     stale: bool,
 }
 
@@ -58,7 +57,6 @@ impl<R: Real> Default for PreciseState<R> {
     fn default() -> Self {
         Self {
             state: ClothState::default(),
-            written: ClothState::default(),
             stale: true,
         }
     }
@@ -70,23 +68,22 @@ impl<R: Real> PreciseState<R> {
         self.stale = true;
     }
 
-    /// Whether the state stepped is `given` to more digits (nothing changed it since it was
-    /// written).
-    pub fn holds(&self, given: &ClothState) -> bool {
-        !self.stale && *given == self.written
+    /// Whether the state stepped is the caller's to more digits (nothing changed the
+    /// caller's since it was written).
+    pub fn holds(&self) -> bool {
+        !self.stale
     }
 
-    /// Takes `given` unless it is still what was written to it.
+    /// Takes `given` if the caller's state changed since it was last written.
     pub fn load(&mut self, given: &ClothState) {
-        if self.stale || *given != self.written {
+        if self.stale {
             self.state.take(given);
             self.stale = false;
         }
     }
 
     /// Writes the rounding of the state stepped into `given`.
-    pub fn store(&mut self, given: &mut ClothState) {
+    pub fn store(&self, given: &mut ClothState) {
         given.take(&self.state);
-        self.written.clone_from(given);
     }
 }
