@@ -271,7 +271,6 @@ macro_rules! real {
                 <$t>::min(self, other)
             }
 
-
             #[inline(always)]
             fn sin(self) -> Self {
                 <$t>::sin(self)

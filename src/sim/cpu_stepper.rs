@@ -511,7 +511,7 @@ impl<R: Real> CpuStepper<R> {
             self.guard.limits = Some(GuardLimits::derive(
                 &self.guard.policy,
                 model,
-                f32_view(state, &mut self.view),
+                (f32_view(state, &mut self.view), &state.pos),
                 self.gravity,
                 &self.forces,
                 &self.effects,

@@ -98,11 +98,12 @@ impl GuardLimits {
     /// wind): the speeds and energy the scene can reach by falling, being thrown, being
     /// dragged or springing back from the stretch it has, and the larger of the stretch of
     /// a structural spring carrying the whole weight and the largest stretch it has, times
-    /// the policy's headroom.
+    /// the policy's headroom. `stepped` is `state`'s positions in the precision `forces`
+    /// compute in (the energy stored in the springs is theirs).
     pub fn derive<R: Real>(
         policy: &GuardPolicy,
         model: &ClothModel,
-        state: &ClothState,
+        (state, stepped): (&ClothState, &[R::V3]),
         gravity: Vec3,
         forces: &ForceSet<R>,
         effects: &[Effect],
@@ -131,7 +132,7 @@ impl GuardLimits {
         // loaded), never the integrator's: the springs' stretch and the energy stored in it
         // count as reachable, and a stretched cloth let go can fling its lightest particle
         // at up to the speed that energy gives it.
-        let elastic = stored_energy(model, forces, &state.pos);
+        let elastic = stored_energy(model, forces, stepped);
         let lightest = free().map(|(m, _)| *m).fold(f32::INFINITY, f32::min);
         let flung = if lightest > 0.0 && lightest.is_finite() {
             (2.0 * elastic / lightest as f64).sqrt() as f32
@@ -248,11 +249,10 @@ impl GuardLimits {
 
 /// The energy stored in the cloth at `pos`, joules: every conservative term's but gravity's
 /// (the height the cloth can fall accounts for that), so the springs' and the hinges'.
-fn stored_energy<R: Real>(model: &ClothModel, forces: &ForceSet<R>, pos: &[Vec3]) -> f64 {
-    let pos: Vec<R::V3> = pos.iter().map(|p| R::v3(*p)).collect();
+fn stored_energy<R: Real>(model: &ClothModel, forces: &ForceSet<R>, pos: &[R::V3]) -> f64 {
     (forces.terms().iter())
         .filter(|t| t.get::<Gravity>().is_none())
-        .map(|t| t.potential_energy(model, &pos))
+        .map(|t| t.potential_energy(model, pos))
         .sum()
 }
 

@@ -91,13 +91,10 @@ impl<R: Real> Vbd<R> {
         assert!(stencil.spans.len() == n && inertial.len() == n);
         // In `f32` the descent takes its AVX2 lanes; in any other precision, one particle
         // at a time.
-        use std::any::Any;
-        let rows = (&mut self.particles as &mut dyn Any).downcast_mut::<Vec<Particle>>();
-        let lanes = (inertial as &dyn Any).downcast_ref::<Vec<glam::Vec3>>();
-        if let (Some(rows), Some(inertial), Some(h)) =
-            (rows, lanes, (&h as &dyn Any).downcast_ref())
-        {
-            let step = StepLength::new(*h);
+        let rows = (&mut self.particles as &mut dyn std::any::Any).downcast_mut::<Vec<Particle>>();
+        if let (Some(rows), Some(inertial)) = (rows, R::f32_slice(inertial)) {
+            // `h` is an `f32` here: the conversion is exact.
+            let step = StepLength::new(h.to_f32());
             // SAFETY: as below.
             by_colour(stencil, rows, |particles, range| unsafe {
                 descend_range(stencil, particles, inertial, range, step, true)
