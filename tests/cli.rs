@@ -718,3 +718,53 @@ fn accuracy_answers_the_map_and_small_steps_and_calibrates() {
         "{stdout}"
     );
 }
+
+/// A precision that is neither f32 nor f64 is refused by every command that takes one,
+/// naming the choices, before any work; the GPU's bench refuses f64 with the reason; and
+/// `simulate --precision f64` reports a run that computed in it.
+#[test]
+fn a_bad_precision_is_refused_and_f64_runs() {
+    for command in ["simulate", "render", "accuracy", "bench"] {
+        let out = clothsim(&[command, "--precision", "f16"]);
+        assert!(!out.status.success(), "{command}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            stderr.contains("unknown precision `f16`; choose one of: f32, f64"),
+            "{command}: {stderr}"
+        );
+    }
+    let out = clothsim(&[
+        "bench",
+        "--backend",
+        "gpu",
+        "--precision",
+        "f64",
+        "--sizes",
+        "8",
+    ]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("f32 only, not f64"), "{stderr}");
+    let row = |precision| {
+        let out = clothsim(&[
+            "bench",
+            "--sizes",
+            "8",
+            "--threads",
+            "1",
+            "--json",
+            "--integrators",
+            "rk4",
+            "--precision",
+            precision,
+        ]);
+        json(&out)
+    };
+    let (single, double) = (row("f32"), row("f64"));
+    assert_eq!(double["precision"], "f64");
+    assert_eq!(single["precision"], "f32");
+    // The same sag to f32's rounding, but not the same numbers.
+    let sag = |v: &serde_json::Value| v["sag_m"].as_f64().expect("a sag");
+    let gap = (sag(&single) - sag(&double)).abs();
+    assert!(gap > 0.0 && gap < 1e-5, "{gap}");
+}
