@@ -241,8 +241,9 @@ fn the_bare_report_shows_every_integrators_order_within_its_band() {
     };
     let report = report::sweep(&scene, &config, &mut |_| true).unwrap();
     assert_eq!(report.reference.judged, report::Judged::Trajectory);
-    // In f64 (the sweep's default) the reference is sure to 10⁻¹³ of the cloth's size
-    // (measured 1.8e-14; in f32, 1.5e-6).
+    // In f64 (the sweep's default, and the report says so) the reference is sure to 10⁻¹³
+    // of the cloth's size (measured 1.8e-14; in f32, 1.5e-6).
+    assert!(report::markdown(&report).contains("1 s simulated in f64."));
     assert!(report.reference.check_max < 1e-13, "{:?}", report.reference);
     // In f32 the reference is not RK4 at its finest candidate step: there rounding over the
     // many steps leaves the two finest candidates more than ten times further apart than

@@ -325,6 +325,7 @@ mod tests {
             frontier: Vec::new(),
             recommendation: None,
             unit_costs: UnitCosts::default(),
+            precision: crate::sim::Precision::F64,
         }
     }
 

@@ -2,7 +2,7 @@
 //! trajectory, the largest stable step of each, and the cheapest choice within a tolerance.
 
 use crate::scene::Scene;
-use crate::sim::IntegratorKind;
+use crate::sim::{IntegratorKind, Precision};
 
 use super::config::SweepConfig;
 use super::cost::{UnitCosts, Work};
@@ -44,6 +44,8 @@ pub struct AccuracyReport {
     pub recommendation: Option<usize>,
     /// The unit costs the counted work was weighed by.
     pub unit_costs: UnitCosts,
+    /// What every run computed in.
+    pub precision: Precision,
 }
 
 impl AccuracyReport {
@@ -315,5 +317,6 @@ pub fn sweep(
         frontier,
         recommendation,
         unit_costs: config.unit_costs.clone(),
+        precision: config.precision,
     })
 }

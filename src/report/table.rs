@@ -175,13 +175,13 @@ pub fn markdown(report: &AccuracyReport) -> String {
     let _ = writeln!(out, "# What accuracy costs — scene `{}`\n", report.scene);
     let _ = writeln!(
         out,
-        "{} particles, cloth size {:.3} m (bounding-box diagonal), {} s simulated. Errors are \
+        "{} particles, cloth size {:.3} m (bounding-box diagonal), {} s simulated in {}. Errors are \
          the largest deviation from the reference along the trajectory, as a fraction of the \
          cloth's size. Cost is the work counted per simulated second (force evaluations, \
          conjugate-gradient iterations, constraint and descent sweeps) weighed by fixed unit \
          costs, in force evaluations of this cloth, so the choice is the same on every run; \
          wall-clock seconds per simulated second on this machine are reported beside it.\n",
-        report.particles, report.size, report.seconds
+        report.particles, report.size, report.seconds, report.precision
     );
     let u = &report.unit_costs;
     let _ = writeln!(
@@ -218,8 +218,8 @@ pub fn markdown(report: &AccuracyReport) -> String {
     let _ = writeln!(
         out,
         "{} at dt = {:.3e} s: of RK4 at steps doubling from a quarter of the smallest swept \
-         one, the one that differs least from the run at twice its step (in f32 a smaller \
-         step is not always surer: rounding grows with the steps taken). That difference, {} \
+         one, the one that differs least from the run at twice its step (a smaller step is \
+         not always surer: rounding grows with the steps taken). That difference, {} \
          (RMS) / {} (max) of the cloth's size, is its uncertainty, {:.0}× below the \
          tolerance. A run's error counts as resolved from ten times the larger of it and \
          the rounding RK4 itself shows at that step (for steps finer than the reference's: \
