@@ -325,3 +325,39 @@ fn the_system_matrix_is_mass_minus_h_dfdv_minus_h2_dfdx() {
     set.df_dx(&model, &pos, &vel, &vel, JacobianMode::Definite, &mut jx);
     assert!(difference(&sys.dfdx_v, &jx) <= 1e-5 * norm(&jx));
 }
+
+/// The springs' plain path (the one `f64` takes) gives the vectorised runs' forces: in `f32`
+/// the two agree to rounding (they sum in another order) on a jittered, moving cloth, and
+/// in `f64` the plain path agrees with both to `f32`'s rounding.
+#[test]
+fn the_springs_plain_path_gives_the_runs_forces() {
+    let model = small_cloth();
+    let s = spring_term(&model);
+    let (pos, vel) = random_state(&model, &mut Rng(0x5eed));
+    let n = pos.len();
+    let mut runs = vec![Vec3::ZERO; n];
+    s.add_forces::<f32>(&model.springs, &pos, &vel, &mut runs);
+    let mut plain = vec![Vec3::ZERO; n];
+    s.add_forces_plain::<f32>(&model.springs, &pos, &vel, &mut plain);
+    let wide = |v: &[Vec3]| -> Vec<glam::DVec3> { v.iter().map(|p| p.as_dvec3()).collect() };
+    let mut precise = vec![glam::DVec3::ZERO; n];
+    s.add_forces::<f64>(&model.springs, &wide(&pos), &wide(&vel), &mut precise);
+    let largest = runs.iter().map(|f| f.length()).fold(0.0, f32::max);
+    assert!(largest > 1.0, "a real load: {largest} N");
+    for i in 0..n {
+        let tolerance = 1e-5 * largest;
+        assert!(
+            runs[i].distance(plain[i]) < tolerance,
+            "{i}: {} {}",
+            runs[i],
+            plain[i]
+        );
+        let gap = runs[i].as_dvec3().distance(precise[i]) as f32;
+        assert!(
+            gap < tolerance,
+            "{i}: f64 {} against {}",
+            precise[i],
+            runs[i]
+        );
+    }
+}
