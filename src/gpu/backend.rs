@@ -15,7 +15,7 @@ pub enum Backend {
     #[default]
     Cpu,
     /// wgpu compute: semi-implicit Euler, springs, gravity, air damping, pins, spheres and
-    /// planes.
+    /// planes, with the stability guard.
     Gpu,
 }
 

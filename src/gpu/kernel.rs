@@ -1,5 +1,6 @@
 //! The compute kernel: one semi-implicit Euler substep per dispatch
-//! (`shaders/substep.wgsl`), its bind group layout and pipeline.
+//! (`shaders/substep.wgsl`), its bind group layout and pipeline, and the helpers every
+//! kernel of the backend builds its layout, pipelines and bind groups with.
 
 /// Particles per workgroup (the shader's `@workgroup_size`; a test compares them).
 pub(super) const WORKGROUP: u32 = 64;
@@ -24,66 +25,103 @@ pub(super) struct Bindings<'a> {
     pub(super) classes: &'a wgpu::Buffer,
 }
 
-impl SubstepKernel {
-    pub(super) fn new(device: &wgpu::Device) -> Self {
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("cloth substep"),
-            source: wgpu::ShaderSource::Wgsl(SOURCE.into()),
-        });
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+/// How a compute shader binds a buffer.
+#[derive(Clone, Copy)]
+pub(super) enum Slot {
+    Uniform,
+    Read,
+    Write,
+}
+
+/// A bind group layout for a compute shader whose bindings 0, 1, … are buffers bound as
+/// `slots` says.
+pub(super) fn layout(device: &wgpu::Device, label: &str, slots: &[Slot]) -> wgpu::BindGroupLayout {
+    let entries: Vec<wgpu::BindGroupLayoutEntry> = (0u32..)
+        .zip(slots)
+        .map(|(binding, slot)| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::Buffer {
-                ty,
+                ty: match slot {
+                    Slot::Uniform => wgpu::BufferBindingType::Uniform,
+                    Slot::Read => wgpu::BufferBindingType::Storage { read_only: true },
+                    Slot::Write => wgpu::BufferBindingType::Storage { read_only: false },
+                },
                 has_dynamic_offset: false,
                 min_binding_size: None,
             },
             count: None,
-        };
-        let storage = |read_only| wgpu::BufferBindingType::Storage { read_only };
-        let uniform = wgpu::BufferBindingType::Uniform;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("cloth substep"),
-            entries: &[
-                entry(0, uniform),
-                entry(1, storage(true)),
-                entry(2, storage(false)),
-                entry(3, storage(true)),
-                entry(4, storage(true)),
-                entry(5, uniform),
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("cloth substep"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("cloth substep"),
+        })
+        .collect();
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &entries,
+    })
+}
+
+/// The pipelines of `source`'s `entry_points`, all with `layout`.
+pub(super) fn pipelines<const N: usize>(
+    device: &wgpu::Device,
+    label: &str,
+    source: &str,
+    layout: &wgpu::BindGroupLayout,
+    entry_points: [&str; N],
+) -> [wgpu::ComputePipeline; N] {
+    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    entry_points.map(|entry| {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
             layout: Some(&pipeline_layout),
             module: &shader,
-            entry_point: Some("substep"),
+            entry_point: Some(entry),
             compilation_options: Default::default(),
             cache: None,
-        });
+        })
+    })
+}
+
+/// A bind group of `layout` with `buffers` at bindings 0, 1, ….
+pub(super) fn bind(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry<'_>> = (0u32..)
+        .zip(buffers)
+        .map(|(binding, buffer)| wgpu::BindGroupEntry {
+            binding,
+            resource: buffer.as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
+impl SubstepKernel {
+    pub(super) fn new(device: &wgpu::Device) -> Self {
+        use Slot::{Read, Uniform, Write};
+        let slots = [Uniform, Read, Write, Read, Read, Uniform];
+        let layout = layout(device, "cloth substep", &slots);
+        let [pipeline] = pipelines(device, "cloth substep", SOURCE, &layout, ["substep"]);
         Self { pipeline, layout }
     }
 
     /// The bind group of one dispatch.
     pub(super) fn bind(&self, device: &wgpu::Device, b: &Bindings<'_>) -> wgpu::BindGroup {
         let buffers = [b.params, b.src, b.dst, b.offsets, b.neighbours, b.classes];
-        let entries: Vec<wgpu::BindGroupEntry<'_>> = (0u32..)
-            .zip(buffers)
-            .map(|(binding, buffer)| wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            })
-            .collect();
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("cloth substep"),
-            layout: &self.layout,
-            entries: &entries,
-        })
+        bind(device, "cloth substep", &self.layout, &buffers)
     }
 }
 

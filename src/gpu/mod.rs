@@ -1,14 +1,18 @@
 //! The GPU step backend: semi-implicit Euler for the mass-spring cloth in a wgpu compute
-//! shader. It sits beside the CPU solver (which knows nothing of graphics) and plugs into
-//! [`crate::scene::Simulation`] through the same [`crate::sim::StepBackend`] seam. What it
-//! runs (`support`), how it lays the cloth out (`packing`), its kernel (`kernel`) and the
-//! stepper that drives them (`stepper`) are files of their own; it reaches the device
-//! through [`crate::device`] only.
+//! shader, under the stability guard. It sits beside the CPU solver (which knows nothing of
+//! graphics) and plugs into [`crate::scene::Simulation`] through the same
+//! [`crate::sim::StepBackend`] seam. What it runs (`support`), how it lays the cloth out
+//! (`packing`), its kernels (`kernel`, `health`), the stepper that drives them (`stepper`)
+//! and the guard's frame with its rollback points on the device (`guarded`, `snapshot`) are
+//! files of their own; it reaches the device through [`crate::device`] only.
 
 mod backend;
 mod error;
+mod guarded;
+mod health;
 mod kernel;
 mod packing;
+mod snapshot;
 mod stepper;
 mod support;
 

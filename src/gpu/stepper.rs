@@ -12,15 +12,18 @@ use glam::Vec3;
 use crate::cloth::{ClothModel, ClothState};
 use crate::device::map_read;
 use crate::sim::{
-    Cause, Changes, Diverged, Effect, FrameOutcome, IntegratorKind, Material, PhaseTimings,
-    SimParams, StepBackend, StepError, StepReport, StepStats, air_damping_of, gravity_of,
+    Changes, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent, GuardState, IntegratorKind,
+    Material, PhaseTimings, SimParams, StepBackend, StepError, StepReport, StepStats,
+    air_damping_of, gravity_of,
 };
 
 use super::error::GpuError;
+use super::health::HealthKernel;
 use super::kernel::{Bindings, SubstepKernel, WORKGROUP};
 use super::packing::{
     ClassTable, EndsKey, Neighbour, Params, Particle, classify, pack_solids, pack_springs,
 };
+use super::snapshot::DeviceSnapshot;
 use super::support::{GPU_INTEGRATOR, check_device, fits_buffers, gpu_support};
 
 /// What one GPU substep is: one force evaluation, no solve.
@@ -31,10 +34,27 @@ const SUBSTEP: StepReport = StepReport {
     converged: true,
 };
 
+/// What a submission does beside its substeps, for the guard.
+#[derive(Clone, Copy)]
+pub(super) struct Watch {
+    /// Copy the state the substeps start from into the frame's start snapshot.
+    pub(super) keep_start: bool,
+    /// Measure the state they end at (see [`HealthKernel`]).
+    pub(super) measure: bool,
+}
+
+impl Watch {
+    /// Neither: a frame without the guard, a bare substep.
+    pub(super) const OFF: Self = Self {
+        keep_start: false,
+        measure: false,
+    };
+}
+
 /// Steps a cloth with semi-implicit Euler on a wgpu device (see the module documentation).
 pub struct GpuStepper {
-    device: wgpu::Device,
-    queue: wgpu::Queue,
+    pub(super) device: wgpu::Device,
+    pub(super) queue: wgpu::Queue,
     pipeline: wgpu::ComputePipeline,
     uniform: wgpu::Buffer,
     /// The two particle buffers; `current` holds the latest state.
@@ -44,27 +64,42 @@ pub struct GpuStepper {
     classes: wgpu::Buffer,
     /// `groups[i]` reads `particles[i]` and writes the other.
     groups: [wgpu::BindGroup; 2],
+    /// The guard's measure of a frame.
+    pub(super) health: HealthKernel,
+    /// The guard's memory, with its rollback points on the device.
+    pub(super) guard: GuardState<DeviceSnapshot>,
+    /// The state the frame being stepped started from.
+    pub(super) frame_start: DeviceSnapshot,
+    /// The scene's forces on the CPU, for the guard's limits and diagnosis.
+    pub(super) forces: ForceSet,
+    /// The scene's effects, for the guard's limits.
+    pub(super) effects: Vec<Effect>,
+    /// Gravity (m/s²) and air damping (1/s) in effect.
+    pub(super) gravity: Vec3,
+    pub(super) air_damping: f32,
     readback: wgpu::Buffer,
     /// A copy of the state at the end of the last frame, for a renderer on the same device;
     /// made on the first [`GpuStepper::display_buffer`], then kept current.
     display: Option<wgpu::Buffer>,
-    current: usize,
+    pub(super) current: usize,
     count: u32,
     params: Params,
-    dt: f32,
-    substeps: u32,
+    pub(super) dt: f32,
+    /// Substeps per frame in effect (the guard may have raised them), and as requested.
+    pub(super) substeps: u32,
+    pub(super) requested: u32,
     /// The GPU copy must be replaced by the caller's state before the next step.
-    upload: bool,
+    pub(super) upload: bool,
     /// The GPU copy stepped since the caller's state was last brought up to date.
-    behind: bool,
+    pub(super) behind: bool,
     /// Copy the state back into the caller's after every frame (else only on `sync`).
-    read_every_frame: bool,
+    pub(super) read_every_frame: bool,
     /// Why the current configuration cannot run, if it cannot.
     unsupported: Option<String>,
     /// Why the state could not be read back, if it could not: every later frame fails with
     /// it (the GPU copy and the caller's state can no longer be brought together).
-    lost: Option<String>,
-    timings: PhaseTimings,
+    pub(super) lost: Option<String>,
+    pub(super) timings: PhaseTimings,
     stats: StepStats,
     /// The key the device's spring ends were packed with (`None` before the first
     /// upload), and how many times the ends were sent.
@@ -154,6 +189,8 @@ impl GpuStepper {
             )
         };
         let groups = [group(0), group(1)];
+        let health = HealthKernel::new(device, &particles, (&offsets, &neighbours), count);
+        let frame_start = DeviceSnapshot::new(device, queue, bytes);
         let mut stepper = Self {
             device: device.clone(),
             queue: queue.clone(),
@@ -164,6 +201,13 @@ impl GpuStepper {
             neighbours,
             classes,
             groups,
+            health,
+            guard: GuardState::new(params.guard.clone()),
+            frame_start,
+            forces: ForceSet::default(),
+            effects: Vec::new(),
+            gravity: Vec3::ZERO,
+            air_damping: 0.0,
             readback,
             display: None,
             current: 0,
@@ -171,6 +215,7 @@ impl GpuStepper {
             params: Params::zeroed(),
             dt: params.step.dt,
             substeps: params.step.substeps.max(1),
+            requested: params.step.substeps.max(1),
             upload: true,
             behind: false,
             read_every_frame,
@@ -257,12 +302,13 @@ impl GpuStepper {
         self.behind = false;
     }
 
-    /// Encodes and submits `substeps` substeps.
-    fn run(
+    /// Encodes and submits `substeps` substeps, with what `watch` asks for.
+    pub(super) fn run(
         &mut self,
         model: &ClothModel,
         state: &ClothState,
         substeps: u32,
+        watch: Watch,
     ) -> Result<(), StepError> {
         if let Some(why) = &self.unsupported {
             return Err(StepError::Unsupported(why.clone()));
@@ -278,6 +324,10 @@ impl GpuStepper {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("cloth substeps"),
             });
+        if watch.keep_start {
+            let live = &self.particles[self.current];
+            self.frame_start.take(&mut encoder, live, state.time);
+        }
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("cloth substeps"),
@@ -288,6 +338,13 @@ impl GpuStepper {
                 pass.set_bind_group(0, &self.groups[self.current], &[]);
                 pass.dispatch_workgroups(self.count.div_ceil(WORKGROUP), 1, 1);
                 self.current = 1 - self.current;
+            }
+        }
+        if watch.measure {
+            self.health.encode(&mut encoder, self.current);
+            // Read with the measure if the frame passes: one wait for both.
+            if self.read_every_frame {
+                self.copy_out(&mut encoder);
             }
         }
         if let Some(display) = &self.display {
@@ -301,19 +358,62 @@ impl GpuStepper {
         Ok(())
     }
 
-    /// Copies the latest state back into `state` (waits for the GPU).
-    fn read_back(&mut self, state: &mut ClothState) -> Result<(), GpuError> {
-        let bytes = self.count as u64 * std::mem::size_of::<Particle>() as u64;
-        if bytes == 0 {
-            return Ok(());
+    /// Encodes and submits the copy of `snapshot` into the live particle buffer (and the
+    /// display's); returns the time it holds. The device's copy is then ahead of the
+    /// caller's state.
+    pub(super) fn restore(&mut self, snapshot: &DeviceSnapshot) -> f64 {
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("particles rollback"),
+            });
+        let live = &self.particles[self.current];
+        let time = snapshot.restore(&mut encoder, live);
+        if let Some(display) = &self.display {
+            encoder.copy_buffer_to_buffer(live, 0, display, 0, None);
         }
+        self.queue.submit([encoder.finish()]);
+        self.upload = false;
+        self.behind = true;
+        time
+    }
+
+    /// Makes `substeps` per frame the count in effect.
+    pub(super) fn set_substeps(&mut self, substeps: u32) {
+        self.substeps = substeps;
+        self.params.gravity[3] = self.substep_length();
+        self.queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+    }
+
+    /// Copies the latest state back into `state` (waits for the GPU).
+    pub(super) fn read_back(&mut self, state: &mut ClothState) -> Result<(), GpuError> {
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("particles readback"),
             });
-        encoder.copy_buffer_to_buffer(&self.particles[self.current], 0, &self.readback, 0, bytes);
+        self.copy_out(&mut encoder);
         self.queue.submit([encoder.finish()]);
+        self.read_copied(state)
+    }
+
+    /// Encodes the copy of the latest state where [`GpuStepper::read_copied`] reads it.
+    pub(super) fn copy_out(&self, encoder: &mut wgpu::CommandEncoder) {
+        let bytes = self.count as u64 * std::mem::size_of::<Particle>() as u64;
+        if bytes > 0 {
+            let live = &self.particles[self.current];
+            encoder.copy_buffer_to_buffer(live, 0, &self.readback, 0, bytes);
+        }
+    }
+
+    /// Copies into `state` what the last submitted [`GpuStepper::copy_out`] copied (waits
+    /// for the GPU).
+    pub(super) fn read_copied(&mut self, state: &mut ClothState) -> Result<(), GpuError> {
+        let bytes = self.count as u64 * std::mem::size_of::<Particle>() as u64;
+        if bytes == 0 {
+            return Ok(());
+        }
         let slice = self.readback.slice(..bytes);
         map_read(&self.device, &slice).map_err(|e| GpuError::Readback(e.to_string()))?;
         {
@@ -331,14 +431,14 @@ impl GpuStepper {
         Ok(())
     }
 
-    fn timed_run(
+    pub(super) fn timed_run(
         &mut self,
         model: &ClothModel,
         state: &mut ClothState,
         substeps: u32,
     ) -> Result<(), StepError> {
         let start = Instant::now();
-        self.run(model, state, substeps)?;
+        self.run(model, state, substeps, Watch::OFF)?;
         if self.read_every_frame {
             self.read_back(state)
                 .map_err(|e| StepError::Device(e.to_string()))?;
@@ -367,6 +467,7 @@ impl StepBackend for GpuStepper {
         }
         if changes.intersects(Changes::EFFECTS | Changes::STRENGTHS) && self.unsupported.is_none() {
             self.upload_springs(model, &params.material, effects);
+            (self.forces).apply(model, &params.material, effects, changes);
         }
         if changes.contains(Changes::EFFECTS) {
             let (g, drag) = (gravity_of(effects), air_damping_of(effects));
@@ -375,10 +476,22 @@ impl StepBackend for GpuStepper {
             self.params.drag[0] = drag;
             self.params.counts = [self.count, count, 0, 0];
             self.params.colliders = solids;
+            self.effects = effects.to_vec();
+            (self.gravity, self.air_damping) = (g, drag);
         }
         self.params.drag[1] = params.contact.offset;
         self.dt = params.step.dt;
-        self.substeps = params.step.substeps.max(1);
+        if changes.contains(Changes::GUARD) && self.guard.policy != params.guard {
+            self.guard = GuardState::new(params.guard.clone());
+        }
+        // Limits and rollback points belong to the old parameters.
+        self.guard.forget_history();
+        // Substeps the guard raised stay unless the request changed.
+        let requested = params.step.substeps.max(1);
+        if requested != self.requested {
+            self.requested = requested;
+            self.substeps = requested;
+        }
         self.params.gravity[3] = self.substep_length();
         if changes.intersects(Changes::EFFECTS | Changes::CONTACT | Changes::DT | Changes::SUBSTEPS)
         {
@@ -391,26 +504,19 @@ impl StepBackend for GpuStepper {
 
     fn invalidate(&mut self) {
         self.upload = true;
+        self.guard.forget_history();
     }
 
-    /// One frame of substeps in one submission. The GPU path has no rollback guard (that
-    /// would need a read-back per frame to check); a diverged state shows as non-finite.
+    /// One frame of substeps in one submission, under the stability guard: a reduction on
+    /// the device measures the frame's end and only its 32 bytes come back; a frame that
+    /// breaks a limit rolls back to a checkpoint kept on the device and is redone with
+    /// twice the substeps, as on the CPU (see `guarded`).
     fn frame(
         &mut self,
         model: &ClothModel,
         state: &mut ClothState,
     ) -> Result<FrameOutcome, Diverged> {
-        let end = state.time + self.dt as f64;
-        self.timed_run(model, state, self.substeps)
-            .map_err(|e| Diverged {
-                time: state.time,
-                reason: e.to_string(),
-                substeps: self.substeps,
-                fallback: String::new(),
-                cause: Cause::Backend,
-            })?;
-        state.time = end;
-        Ok(FrameOutcome::Stepped)
+        self.guarded_frame(model, state)
     }
 
     fn substep(
@@ -437,6 +543,10 @@ impl StepBackend for GpuStepper {
 
     fn take_stats(&mut self) -> StepStats {
         std::mem::take(&mut self.stats)
+    }
+
+    fn take_guard_events(&mut self) -> Vec<GuardEvent> {
+        std::mem::take(&mut self.guard.events)
     }
 
     fn integrator(&self) -> IntegratorKind {

@@ -47,7 +47,7 @@ pub struct CpuStepper<R: Real = f32> {
     /// Substeps per frame in effect (the guard may have raised them).
     substeps: u32,
     offset: f32,
-    guard: GuardState<R>,
+    guard: GuardState<ClothState<R>>,
     timings: PhaseTimings,
     stats: StepStats,
     meter: StepMeter,
@@ -369,13 +369,8 @@ impl<R: Real> CpuStepper<R> {
     }
 
     fn record(&mut self, time: f64, reason: Option<&Trouble>, action: GuardAction, before: u32) {
-        self.guard.events.push(GuardEvent {
-            time,
-            reason: reason.map(ToString::to_string),
-            action,
-            substeps_before: before,
-            substeps_after: self.substeps,
-        });
+        let after = self.substeps;
+        self.guard.record(time, reason, action, (before, after));
     }
 
     /// A frame failed with `trouble`: roll back and redo it with more substeps, then with
@@ -445,13 +440,8 @@ impl<R: Real> CpuStepper<R> {
 
     /// After a healthy frame: maybe bring raised substeps back down.
     fn maybe_recover(&mut self, end: f64) -> Option<FrameOutcome> {
-        if self.substeps <= self.requested || self.guard.good_frames < self.guard.recover_wait {
-            return None;
-        }
         let before = self.substeps;
-        self.substeps = (self.substeps / 2).max(self.requested);
-        self.guard.good_frames = 0;
-        self.guard.stepped_down = true;
+        self.substeps = self.guard.step_down(before, self.requested)?;
         self.record(end, None, GuardAction::Recovered, before);
         Some(FrameOutcome::Recovered {
             from: before,

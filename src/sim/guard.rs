@@ -60,19 +60,23 @@ fn largest_magnitude_bits(values: &[f32]) -> u32 {
         .fold(0u32, |m, v| m.max(v.to_bits() & 0x7fff_ffff))
 }
 
-/// One pass over the state: what the checks need.
-struct Motion {
-    finite: bool,
+/// One pass over the state: what the checks need (measured here on the CPU, or by a
+/// reduction on the device for the GPU backend).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Motion {
+    /// Every position and velocity is finite.
+    pub finite: bool,
     /// Fastest particle, m/s.
-    speed: f32,
-    /// Joules.
-    joules: f64,
+    pub speed: f32,
+    /// Kinetic energy, joules.
+    pub joules: f64,
     /// Lowest particle's height along the limits' `up`, m.
-    lowest: f32,
+    pub lowest: f32,
 }
 
 impl Motion {
-    fn of(model: &ClothModel, state: &ClothState, up: Vec3) -> Self {
+    /// Measures `state` of `model`, heights along `up`.
+    pub fn of(model: &ClothModel, state: &ClothState, up: Vec3) -> Self {
         let mut m = Motion {
             finite: true,
             speed: 0.0,
@@ -330,18 +334,27 @@ impl From<StepError> for Trouble {
 
 /// The first limit `state` breaks, if any: non-finite, speed, strain, kinetic energy.
 pub fn check(model: &ClothModel, state: &ClothState, limits: &GuardLimits) -> Option<Trouble> {
-    let motion = Motion::of(model, state, limits.up);
-    if let Some(trouble) = limits.motion_trouble(&motion) {
-        return Some(trouble);
+    limits.judge(&Motion::of(model, state, limits.up), || {
+        max_strain(model, state)
+    })
+}
+
+impl GuardLimits {
+    /// The first limit a state with `motion` and the largest relative spring extension
+    /// `strain` (asked for only once the motion passed) breaks, in [`check`]'s order.
+    pub fn judge(&self, motion: &Motion, strain: impl FnOnce() -> f32) -> Option<Trouble> {
+        if let Some(trouble) = self.motion_trouble(motion) {
+            return Some(trouble);
+        }
+        let strain = strain();
+        if strain > self.strain {
+            return Some(Trouble::Strain {
+                strain,
+                limit: self.strain,
+            });
+        }
+        self.energy_trouble(motion)
     }
-    let strain = max_strain(model, state);
-    if strain > limits.strain {
-        return Some(Trouble::Strain {
-            strain,
-            limit: limits.strain,
-        });
-    }
-    limits.energy_trouble(&motion)
 }
 
 /// What the guard did.

@@ -3,22 +3,35 @@
 
 use crate::cloth::{ClothState, Real};
 
-use super::guard::{GuardEvent, GuardLimits};
+use super::guard::{GuardAction, GuardEvent, GuardLimits, Trouble};
 use super::guard_policy::GuardPolicy;
 
-/// What the guard keeps between frames.
+/// A copy of a cloth's state the guard can roll back to: the state itself on the CPU, a
+/// buffer on the device for the GPU backend.
+pub trait Snapshot: Default {
+    /// Makes `self` a copy of `from`, reusing `self`'s storage.
+    fn copy_from(&mut self, from: &Self);
+}
+
+impl<R: Real> Snapshot for ClothState<R> {
+    fn copy_from(&mut self, from: &Self) {
+        self.clone_from(from);
+    }
+}
+
+/// What the guard keeps between frames, with rollback points of type `S`.
 #[derive(Clone, Debug)]
-pub struct GuardState<R: Real = f32> {
+pub struct GuardState<S = ClothState> {
     pub policy: GuardPolicy,
     pub limits: Option<GuardLimits>,
     /// A state that stayed healthy for `checkpoint_frames` frames after it: where a failed
     /// frame rolls back to. `None` until the first frame after a reset or an outside change.
-    pub checkpoint: Option<ClothState<R>>,
+    pub checkpoint: Option<S>,
     /// The next checkpoint, and how many healthy frames it has aged.
-    pub candidate: Option<(ClothState<R>, u32)>,
+    pub candidate: Option<(S, u32)>,
     /// A retired checkpoint's buffers, reused for the next candidate (no allocation per
     /// checkpoint in a long run).
-    spare: Option<ClothState<R>>,
+    spare: Option<S>,
     /// Healthy frames since the substeps last changed.
     pub good_frames: u32,
     /// Healthy frames needed before stepping down (doubles after a step down that failed).
@@ -28,7 +41,7 @@ pub struct GuardState<R: Real = f32> {
     pub events: Vec<GuardEvent>,
 }
 
-impl<R: Real> GuardState<R> {
+impl<S: Snapshot> GuardState<S> {
     pub fn new(policy: GuardPolicy) -> Self {
         Self {
             recover_wait: policy.recover_after,
@@ -51,7 +64,7 @@ impl<R: Real> GuardState<R> {
     }
 
     /// Records a healthy frame that started from `start`: ages the candidate, promotes it.
-    pub fn healthy_frame(&mut self, start: &ClothState<R>) {
+    pub fn healthy_frame(&mut self, start: &S) {
         self.good_frames += 1;
         let age_needed = self.policy.checkpoint_frames;
         match &mut self.candidate {
@@ -68,10 +81,39 @@ impl<R: Real> GuardState<R> {
     }
 
     /// `state` copied into the spare buffers when there are some.
-    fn copy_of(&mut self, state: &ClothState<R>) -> ClothState<R> {
+    fn copy_of(&mut self, state: &S) -> S {
         let mut copy = self.spare.take().unwrap_or_default();
-        copy.clone_from(state);
+        copy.copy_from(state);
         copy
+    }
+
+    /// After a healthy frame at `substeps` per frame: the count to come back down to, when
+    /// they were raised above `requested` and enough healthy frames have passed since.
+    pub fn step_down(&mut self, substeps: u32, requested: u32) -> Option<u32> {
+        if substeps <= requested || self.good_frames < self.recover_wait {
+            return None;
+        }
+        self.good_frames = 0;
+        self.stepped_down = true;
+        Some((substeps / 2).max(requested))
+    }
+
+    /// Records what the guard did in the frame ending at `time` (seconds), for what reason,
+    /// and the substeps per frame before and after.
+    pub fn record(
+        &mut self,
+        time: f64,
+        reason: Option<&Trouble>,
+        action: GuardAction,
+        (before, after): (u32, u32),
+    ) {
+        self.events.push(GuardEvent {
+            time,
+            reason: reason.map(ToString::to_string),
+            action,
+            substeps_before: before,
+            substeps_after: after,
+        });
     }
 
     /// A frame failed: if it came soon after a step down, wait longer before the next one.

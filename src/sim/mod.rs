@@ -36,8 +36,11 @@ pub use effects::{
     shortest_edge, small_sphere_warnings, thickness_fits,
 };
 pub use forces::{Force, ForceSet, ForceTerm, JacobianMode, SystemMatrix};
-pub use guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check};
+pub use guard::{
+    Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Motion, Trouble, check,
+};
 pub use guard_policy::GuardPolicy;
+pub use guard_state::{GuardState, Snapshot};
 pub use integrator::{Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport};
 pub use intersections::{Intersections, intersections};
 pub use motion::{AxisAngle, Ease, Keyframe, MotionError, Pose, RigidMotion};

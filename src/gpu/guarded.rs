@@ -1,0 +1,318 @@
+//! The stability guard on the GPU: the CPU guard's limits, policy and record
+//! ([`crate::sim::GuardLimits`], [`crate::sim::GuardState`]), with the state measured by a
+//! reduction on the device and rolled back from copies kept there. A frame that breaks a
+//! limit is redone from the last checkpoint with twice the substeps, up to the policy's
+//! refinements; raised substeps come back down after a run of healthy frames. The GPU runs
+//! one integrator, so the policy's fallback integrator is not tried: when every refinement
+//! fails the state is the frame's start and the run stops with the likely cause.
+
+use std::time::Instant;
+
+use crate::cloth::{ClothModel, ClothState};
+use crate::sim::{Cause, Diverged, FrameOutcome, GuardAction, GuardLimits, Trouble};
+
+use super::stepper::{GpuStepper, Watch};
+use super::support::GPU_INTEGRATOR;
+
+/// Why a try at a frame failed.
+enum Failed {
+    /// It broke one of the guard's limits.
+    Limit(Trouble),
+    /// The device failed (said in the text); nothing more can be stepped.
+    Device(String),
+}
+
+/// The frame as stepped, and its end measured.
+const FRAME: Watch = Watch {
+    keep_start: true,
+    measure: true,
+};
+
+/// A frame replayed from a rollback point, its end measured.
+const REPLAY: Watch = Watch {
+    keep_start: false,
+    measure: true,
+};
+
+impl GpuStepper {
+    /// One frame under the guard (see the module documentation).
+    pub(super) fn guarded_frame(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+    ) -> Result<FrameOutcome, Diverged> {
+        let end = state.time + self.dt as f64;
+        if !self.guard.policy.enabled {
+            self.timed_run(model, state, self.substeps)
+                .map_err(|e| self.device_failure(state.time, e.to_string()))?;
+            state.time = end;
+            return Ok(FrameOutcome::Stepped);
+        }
+        let start = Instant::now();
+        let outcome = self.checked_frame(model, state, end);
+        self.timings.add("gpu", start.elapsed());
+        outcome
+    }
+
+    fn checked_frame(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+        end: f64,
+    ) -> Result<FrameOutcome, Diverged> {
+        if self.guard.limits.is_none() {
+            self.derive_limits(model, state)
+                .map_err(|why| self.device_failure(state.time, why))?;
+        }
+        let outcome = match self.try_frame(model, state, FRAME) {
+            Ok(()) => {
+                self.guard.healthy_frame(&self.frame_start);
+                Ok(self.maybe_recover(end).unwrap_or(FrameOutcome::Stepped))
+            }
+            Err(Failed::Limit(trouble)) => self.rescue(model, state, end, trouble),
+            Err(Failed::Device(why)) => Err(self.device_failure(state.time, why)),
+        }?;
+        state.time = end;
+        if self.read_every_frame {
+            // The frame's last submission copied its end out with the measure.
+            self.read_copied(state)
+                .map_err(|e| self.device_failure(state.time, e.to_string()))?;
+        }
+        Ok(outcome)
+    }
+
+    /// The guard's limits from the caller's state, brought up to date first.
+    fn derive_limits(&mut self, model: &ClothModel, state: &mut ClothState) -> Result<(), String> {
+        if !self.upload && self.behind {
+            self.read_back(state).map_err(|e| e.to_string())?;
+        }
+        let limits = GuardLimits::derive(
+            &self.guard.policy,
+            model,
+            (state, &state.pos),
+            self.gravity,
+            &self.forces,
+            &self.effects,
+        );
+        self.health.set_up(&self.queue, limits.up);
+        self.guard.limits = Some(limits);
+        Ok(())
+    }
+
+    /// One frame at the substeps in effect, submitted with what `watch` asks, and its end
+    /// judged against the guard's limits.
+    fn try_frame(
+        &mut self,
+        model: &ClothModel,
+        state: &ClothState,
+        watch: Watch,
+    ) -> Result<(), Failed> {
+        (self.run(model, state, self.substeps, watch))
+            .map_err(|e| Failed::Device(e.to_string()))?;
+        let health = self.health.read(&self.device).map_err(|e| {
+            let why = e.to_string();
+            self.lost = Some(why.clone());
+            Failed::Device(why)
+        })?;
+        let limits = (self.guard.limits.as_ref()).ok_or(Failed::Limit(Trouble::NonFinite))?;
+        match limits.judge(&health.motion, || health.strain) {
+            Some(trouble) => Err(Failed::Limit(trouble)),
+            None => Ok(()),
+        }
+    }
+
+    /// Replays from the rollback point to `end` at the substeps in effect.
+    fn replay(&mut self, model: &ClothModel, state: &ClothState, end: f64) -> Result<(), Failed> {
+        let from = (self.guard.checkpoint.clone()).unwrap_or_else(|| self.frame_start.clone());
+        let time = self.restore(&from);
+        let frames = ((end - time) / self.dt as f64).round().max(1.0) as u32;
+        for _ in 0..frames {
+            self.try_frame(model, state, REPLAY)?;
+        }
+        Ok(())
+    }
+
+    /// A frame failed with `trouble`: roll back and redo it with more substeps; else
+    /// restore the frame's start (read back into `state`) and say why.
+    fn rescue(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+        end: f64,
+        trouble: Trouble,
+    ) -> Result<FrameOutcome, Diverged> {
+        self.guard.failed_frame();
+        let before = self.substeps;
+        let mut last = trouble;
+        for _ in 0..self.guard.policy.max_refinements {
+            self.set_substeps(self.substeps.saturating_mul(2));
+            match self.replay(model, state, end) {
+                Ok(()) => {
+                    let to = self.substeps;
+                    (self.guard).record(end, Some(&last), GuardAction::Refined, (before, to));
+                    return Ok(FrameOutcome::Refined { from: before, to });
+                }
+                Err(Failed::Limit(t)) => last = t,
+                Err(Failed::Device(why)) => return Err(self.device_failure(state.time, why)),
+            }
+        }
+        let tried = self.substeps;
+        let start = self.frame_start.clone();
+        self.restore(&start);
+        self.set_substeps(before);
+        let gave_up = GuardAction::GaveUp;
+        (self.guard).record(state.time, Some(&last), gave_up, (before, before));
+        if let Err(e) = self.read_back(state) {
+            return Err(self.device_failure(state.time, e.to_string()));
+        }
+        let cause = Cause::substeps(
+            GPU_INTEGRATOR,
+            model,
+            &self.forces,
+            &state.pos,
+            self.air_damping,
+            self.dt,
+            tried,
+        );
+        Err(Diverged {
+            time: state.time,
+            reason: last.to_string(),
+            substeps: tried,
+            fallback: String::new(),
+            cause: cause.unwrap_or(Cause::Stiffness),
+        })
+    }
+
+    /// After a healthy frame: maybe bring raised substeps back down.
+    fn maybe_recover(&mut self, end: f64) -> Option<FrameOutcome> {
+        let before = self.substeps;
+        let to = self.guard.step_down(before, self.requested)?;
+        self.set_substeps(to);
+        (self.guard).record(end, None, GuardAction::Recovered, (before, to));
+        Some(FrameOutcome::Recovered { from: before, to })
+    }
+
+    /// The run stops: the device failed at `time` (seconds) for `why`.
+    fn device_failure(&self, time: f64, why: String) -> Diverged {
+        Diverged {
+            time,
+            reason: why,
+            substeps: self.substeps,
+            fallback: String::new(),
+            cause: Cause::Backend,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::super::stepper::{GpuStepper, Watch};
+    use crate::cloth::ClothState;
+    use crate::device::{AdapterPreference, HeadlessDevice};
+    use crate::scene::Scene;
+    use crate::sim::{IntegratorKind, Motion, StepBackend};
+
+    /// The rollback point kept on the device is a state the run passed through, to the
+    /// bit, `checkpoint_frames` healthy frames or more before the latest: restored and read
+    /// back after sixteen frames (by then the second candidate has aged into it), it is
+    /// the state read back after the frame it names.
+    #[test]
+    fn the_devices_checkpoint_is_an_earlier_frames_state_to_the_bit() {
+        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let mut scene =
+            crate::bench::bench_scene(16, IntegratorKind::SemiImplicitEuler).expect("scene");
+        scene.params.guard.enabled = true;
+        let (model, params) = (&scene.model, &scene.params);
+        let mut stepper =
+            GpuStepper::new(&gpu.device, &gpu.queue, model, params, &scene.effects, true)
+                .expect("stepper");
+        let mut state = scene.initial.clone();
+        let mut seen = vec![state.clone()];
+        for _ in 0..16 {
+            stepper.frame(model, &mut state).expect("a healthy frame");
+            seen.push(state.clone());
+        }
+        let checkpoint = stepper.guard.checkpoint.clone().expect("a checkpoint");
+        let frame = (checkpoint.time / params.step.dt as f64).round() as usize;
+        let age = params.guard.checkpoint_frames as usize;
+        assert!(
+            (1..=16 - age).contains(&frame),
+            "checkpoint at frame {frame}"
+        );
+        stepper.restore(&checkpoint);
+        let mut back = state.clone();
+        stepper.read_back(&mut back).expect("read back");
+        assert_eq!(back.pos, seen[frame].pos);
+        assert_eq!(back.vel, seen[frame].vel);
+        assert_ne!(back.pos, state.pos, "the cloth moved since");
+    }
+
+    /// The largest relative extension of a spring of `state` (0 when none is stretched).
+    fn strain(scene: &Scene, state: &ClothState) -> f32 {
+        let s = &scene.model.springs;
+        (0..s.len())
+            .map(|e| {
+                let (a, b) = (s.a[e] as usize, s.b[e] as usize);
+                state.pos[a].distance(state.pos[b]) / s.rest[e] - 1.0
+            })
+            .fold(0.0, f32::max)
+    }
+
+    /// On a jittered, moving cloth the device measures what the CPU guard does: the fastest
+    /// speed, the kinetic energy, the lowest height along a tilted `up` and the largest
+    /// stretch, to f32 rounding; a NaN velocity or an infinite position anywhere is seen.
+    #[test]
+    fn the_devices_measure_of_a_state_is_the_cpus() {
+        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let scene = Scene::builtin("sphere-drop").expect("scene");
+        let (model, params) = (&scene.model, &scene.params);
+        let mut state = scene.initial.clone();
+        let mut rng = crate::test_rng::uniform(7);
+        let mut jitter = |scale: f32| scale * Vec3::new(rng() - 0.5, rng() - 0.5, rng() - 0.5);
+        for (x, v) in state.pos.iter_mut().zip(&mut state.vel) {
+            *x += jitter(0.01);
+            *v = jitter(3.0);
+        }
+        let mut stepper =
+            GpuStepper::new(&gpu.device, &gpu.queue, model, params, &scene.effects, true)
+                .expect("stepper");
+        let up = Vec3::new(0.3, 0.9, -0.2).normalize();
+        stepper.health.set_up(&gpu.queue, up);
+        let measure = Watch {
+            keep_start: false,
+            measure: true,
+        };
+        let mut measured = |state: &ClothState| {
+            stepper.upload = true;
+            stepper.run(model, state, 0, measure).expect("run");
+            stepper.health.read(&gpu.device).expect("read")
+        };
+        let device = measured(&state);
+        let cpu = Motion::of(model, &state, up);
+        let close = |a: f64, b: f64, tol: f64| (a - b).abs() <= tol * b.abs();
+        assert!(device.motion.finite);
+        assert!(close(device.motion.speed as f64, cpu.speed as f64, 1e-6));
+        assert!(
+            close(device.motion.joules, cpu.joules, 1e-5),
+            "{device:?} {cpu:?}"
+        );
+        assert!(close(device.motion.lowest as f64, cpu.lowest as f64, 1e-6));
+        let stretch = strain(&scene, &state);
+        assert!(stretch > 0.01, "the jitter stretches springs");
+        assert!(
+            close(device.strain as f64, stretch as f64, 1e-5),
+            "{device:?} {stretch}"
+        );
+        let last = state.pos.len() - 1;
+        for (which, value) in [(0, f32::NAN), (1, f32::INFINITY)] {
+            let mut bad = state.clone();
+            match which {
+                0 => bad.vel[last].y = value,
+                _ => bad.pos[last / 2].x = value,
+            }
+            assert!(!measured(&bad).motion.finite, "{which}: {value}");
+        }
+    }
+}

@@ -1,0 +1,138 @@
+//! The stability guard on the GPU backend (run here on the software adapter): it catches a
+//! blow-up, rolls back to a checkpoint kept on the device, refines and recovers as the CPU
+//! guard does, and says why when nothing saves a frame.
+
+use clothsim::gpu::gpu_simulation;
+use clothsim::scene::{Scene, Simulation};
+use clothsim::sim::{GuardAction, GuardEvent, GuardPolicy, IntegratorKind};
+
+/// The 16 × 16 bench cloth with semi-implicit Euler at `substeps` a frame, springs 30×
+/// stiffer, under the guard with `policy`.
+fn stiff_cloth(substeps: u32, policy: GuardPolicy) -> Scene {
+    let mut scene =
+        clothsim::bench::bench_scene(16, IntegratorKind::SemiImplicitEuler).expect("scene");
+    let params = &mut scene.params;
+    params.step.substeps = substeps;
+    params.material.stiffness = params.material.stiffness.map(|k| 30.0 * k);
+    params.guard = policy;
+    scene
+}
+
+/// What the guard did, without the numbers in its reasons (the backends round apart).
+fn actions(events: &[GuardEvent]) -> Vec<(String, GuardAction, u32, u32)> {
+    (events.iter())
+        .map(|e| {
+            let time = format!("{:.4}", e.time);
+            (time, e.action.clone(), e.substeps_before, e.substeps_after)
+        })
+        .collect()
+}
+
+/// Runs `frames` frames of `scene` on both backends; both simulations and their events.
+fn both(scene: Scene, frames: usize) -> (Simulation, Simulation, Vec<GuardEvent>, Vec<GuardEvent>) {
+    let mut cpu = Simulation::new(scene.clone());
+    let (mut gpu, _) = gpu_simulation(scene, true).expect("GPU backend on the software adapter");
+    let (mut on_cpu, mut on_gpu) = (Vec::new(), Vec::new());
+    for _ in 0..frames {
+        let (a, b) = (cpu.step_frame(), gpu.step_frame());
+        assert_eq!(a.is_ok(), b.is_ok(), "cpu {a:?}, gpu {b:?}");
+        on_cpu.extend(cpu.take_guard_events());
+        on_gpu.extend(gpu.take_guard_events());
+    }
+    (cpu, gpu, on_cpu, on_gpu)
+}
+
+/// The largest distance between the same particle in `a` and `b`, metres.
+fn farthest(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
+    (a.iter().zip(b))
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0, f32::max)
+}
+
+/// Semi-implicit Euler needs about 52 substeps a frame on the stiff cloth: at 30 the first
+/// frame blows up, is redone at 60, and after 10 healthy frames the substeps come back
+/// down, blow up again, and are redone from the checkpoint six frames back; the second step
+/// down waits twice as long. The GPU does all of it at the same frames as the CPU, and its
+/// cloth ends where the CPU's does.
+#[test]
+fn a_blow_up_on_the_gpu_is_rolled_back_refined_and_recovered_as_on_the_cpu() {
+    let policy = GuardPolicy {
+        recover_after: 10,
+        fallback: None,
+        ..GuardPolicy::default()
+    };
+    let (mut cpu, mut gpu, on_cpu, on_gpu) = both(stiff_cloth(30, policy), 40);
+    let expected = [
+        ("0.0167", GuardAction::Refined, 30, 60),
+        ("0.1833", GuardAction::Recovered, 60, 30),
+        ("0.2000", GuardAction::Refined, 30, 60),
+        ("0.5333", GuardAction::Recovered, 60, 30),
+        ("0.5500", GuardAction::Refined, 30, 60),
+    ]
+    .map(|(t, a, b, c)| (t.to_string(), a, b, c));
+    assert_eq!(actions(&on_cpu), expected);
+    assert_eq!(actions(&on_gpu), expected);
+    // Each blow-up reached a NaN or infinity within its frame, on both.
+    let reasons =
+        |events: &[GuardEvent]| events.iter().map(|e| e.reason.clone()).collect::<Vec<_>>();
+    assert_eq!(reasons(&on_gpu), reasons(&on_cpu));
+    let non_finite = Some("a position or velocity became non-finite".to_string());
+    assert_eq!(on_gpu[0].reason, non_finite);
+    assert_eq!(gpu.substeps(), 60);
+    cpu.sync_state().expect("cpu");
+    gpu.sync_state().expect("read back");
+    let pos = &gpu.state().pos;
+    assert!(pos.iter().all(|p| p.is_finite()));
+    let worst = farthest(&cpu.state().pos, pos);
+    eprintln!("after 40 frames the backends are {worst:e} m apart");
+    assert!(worst < 1e-5, "GPU and CPU differ by {worst} m");
+}
+
+/// With one refinement (16 substeps) where 52 are needed, nothing saves the first frame:
+/// the GPU run stops with the CPU's cause and count, and its state is the frame's start,
+/// to the bit.
+#[test]
+fn a_frame_nothing_saves_on_the_gpu_stops_at_its_start_and_says_why() {
+    let policy = GuardPolicy {
+        max_refinements: 1,
+        fallback: None,
+        ..GuardPolicy::default()
+    };
+    let scene = stiff_cloth(8, policy);
+    let start = scene.initial.pos.clone();
+    let mut cpu = Simulation::new(scene.clone());
+    let (mut gpu, _) = gpu_simulation(scene, false).expect("GPU backend");
+    let on_cpu = cpu.step_frame().expect_err("diverges");
+    let on_gpu = gpu.step_frame().expect_err("diverges");
+    eprintln!("{on_gpu}");
+    assert_eq!(on_gpu.cause, on_cpu.cause);
+    let speed = "a particle reached inf m/s";
+    assert!(on_gpu.reason.starts_with(speed) && on_cpu.reason.starts_with(speed));
+    assert_eq!((on_gpu.substeps, on_gpu.time), (16, 0.0));
+    assert!(on_gpu.to_string().contains("Too few substeps"), "{on_gpu}");
+    let events = gpu.take_guard_events();
+    assert_eq!(actions(&events), actions(&cpu.take_guard_events()));
+    assert_eq!(events.len(), 1);
+    assert_eq!(events[0].action, GuardAction::GaveUp);
+    gpu.sync_state().expect("read back");
+    assert_eq!(gpu.state().pos, start);
+    assert_eq!(gpu.state().time, 0.0);
+    assert_eq!(gpu.substeps(), 8);
+}
+
+/// With the guard off, the same blow-up runs on: the guard, not the shader, caught it.
+#[test]
+fn without_the_guard_the_gpu_cloth_blows_up() {
+    let policy = GuardPolicy {
+        enabled: false,
+        ..GuardPolicy::default()
+    };
+    let (mut gpu, _) = gpu_simulation(stiff_cloth(8, policy), false).expect("GPU backend");
+    for _ in 0..3 {
+        gpu.step_frame().expect("no guard to stop it");
+    }
+    gpu.sync_state().expect("read back");
+    assert!(gpu.take_guard_events().is_empty());
+    let blown = (gpu.state().vel.iter()).filter(|v| !v.is_finite() || v.length() >= 1e6);
+    assert!(blown.count() > 0, "every particle slower than 1 km/s");
+}
