@@ -754,8 +754,8 @@ fn the_gpu_button_moves_the_cloth_to_the_gpu_and_back_keeping_its_state() {
         gpu.pos,
         "the state came back"
     );
-    // A scene the GPU cannot run stays on the CPU and says why.
-    harness.state_mut().set_scenario("flag");
+    // A scene the GPU cannot run (self-collision) stays on the CPU and says why.
+    harness.state_mut().set_scenario("self-fold");
     harness.run_steps(1);
     harness.get_by_label("GPU").click();
     run_settled(&mut harness, 2);

@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result, bail};
 
-use clothsim::gpu::{Backend, GPU_INTEGRATOR};
+use clothsim::gpu::{Backend, GPU_INTEGRATORS};
 use clothsim::sim::{IntegratorKind, Precision};
 
 /// Runs and prints one row per thread count × size × integrator (JSON with `json`).
@@ -22,11 +22,12 @@ pub fn bench(
         bail!("--backend gpu computes in f32 only, not {precision}");
     }
     if backend == Backend::Gpu
-        && let Some(k) = integrators.iter().find(|&&k| k != GPU_INTEGRATOR)
+        && let Some(k) = integrators.iter().find(|k| !GPU_INTEGRATORS.contains(k))
     {
+        let runs: Vec<&str> = GPU_INTEGRATORS.iter().map(|k| k.name()).collect();
         bail!(
             "--backend gpu runs {} only, not {}",
-            GPU_INTEGRATOR.name(),
+            runs.join(" and "),
             k.name()
         );
     }

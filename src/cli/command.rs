@@ -2,7 +2,7 @@
 
 use anyhow::Result;
 
-use clothsim::gpu::{Backend, GPU_INTEGRATOR};
+use clothsim::gpu::{Backend, GPU_INTEGRATORS};
 
 use super::accuracy::accuracy;
 use super::args::{Cli, Command};
@@ -128,7 +128,7 @@ pub fn run(cli: Cli) -> Result<()> {
         }) => {
             let integrators = integrators.unwrap_or_else(|| match backend {
                 Backend::Cpu => clothsim::bench::BENCH_INTEGRATORS.to_vec(),
-                Backend::Gpu => vec![GPU_INTEGRATOR],
+                Backend::Gpu => GPU_INTEGRATORS.to_vec(),
             });
             bench(&sizes, &integrators, &threads, json, backend, precision)
         }

@@ -1,11 +1,19 @@
 //! The limits clothsim asks a device for: storage buffers as large as the adapter has (the
 //! GPU backend's large cloths), compute where the adapter offers it.
 
+/// Storage buffers per shader stage asked for where the adapter has them: wgpu's default,
+/// which every adapter with compute shaders but the most limited offers (OpenGL 4.3
+/// guarantees 8 to compute shaders).
+const STORAGE_BUFFERS: u32 = 8;
+
 /// Limits for a headless device: the downlevel defaults at the adapter's resolution, with
-/// storage buffers and buffers as large as the adapter allows.
+/// up to eight storage buffers per stage, as large as the adapter allows.
 pub fn compute_limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
     let available = adapter.limits();
     let mut limits = wgpu::Limits::downlevel_defaults().using_resolution(available.clone());
+    limits.max_storage_buffers_per_shader_stage = available
+        .max_storage_buffers_per_shader_stage
+        .min(STORAGE_BUFFERS);
     limits.max_storage_buffer_binding_size = available.max_storage_buffer_binding_size;
     limits.max_buffer_size = available.max_buffer_size;
     limits

@@ -14,8 +14,8 @@ pub enum Backend {
     /// The CPU solver: every integrator and effect, with the stability guard.
     #[default]
     Cpu,
-    /// wgpu compute: semi-implicit Euler, springs, gravity, air damping, pins, spheres and
-    /// planes, with the stability guard.
+    /// wgpu compute: semi-implicit Euler and XPBD; springs, gravity, air damping, wind,
+    /// dihedral bending, pins, spheres and planes, with the stability guard.
     Gpu,
 }
 

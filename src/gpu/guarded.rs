@@ -11,8 +11,8 @@ use std::time::Instant;
 use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{Cause, Diverged, FrameOutcome, GuardAction, GuardLimits, Trouble};
 
-use super::stepper::{GpuStepper, Watch};
-use super::support::GPU_INTEGRATOR;
+use super::health::Watch;
+use super::stepper::GpuStepper;
 
 /// Why a try at a frame failed.
 enum Failed {
@@ -64,7 +64,7 @@ impl GpuStepper {
             self.derive_limits(model, state)
                 .map_err(|why| self.device_failure(state.time, why))?;
         }
-        let outcome = match self.try_frame(model, state, FRAME) {
+        let outcome = match self.try_frame(model, state, state.time, FRAME) {
             Ok(()) => {
                 self.guard.healthy_frame(&self.frame_start);
                 Ok(self.maybe_recover(end).unwrap_or(FrameOutcome::Stepped))
@@ -99,15 +99,16 @@ impl GpuStepper {
         Ok(())
     }
 
-    /// One frame at the substeps in effect, submitted with what `watch` asks, and its end
-    /// judged against the guard's limits.
+    /// One frame from `time` (seconds) at the substeps in effect, submitted with what
+    /// `watch` asks, and its end judged against the guard's limits.
     fn try_frame(
         &mut self,
         model: &ClothModel,
         state: &ClothState,
+        time: f64,
         watch: Watch,
     ) -> Result<(), Failed> {
-        (self.run(model, state, self.substeps, watch))
+        (self.run(model, state, (self.substeps, time), watch))
             .map_err(|e| Failed::Device(e.to_string()))?;
         let health = self.health.read(&self.device).map_err(|e| {
             let why = e.to_string();
@@ -126,8 +127,9 @@ impl GpuStepper {
         let from = (self.guard.checkpoint.clone()).unwrap_or_else(|| self.frame_start.clone());
         let time = self.restore(&from);
         let frames = ((end - time) / self.dt as f64).round().max(1.0) as u32;
-        for _ in 0..frames {
-            self.try_frame(model, state, REPLAY)?;
+        for k in 0..frames {
+            let start = time + k as f64 * self.dt as f64;
+            self.try_frame(model, state, start, REPLAY)?;
         }
         Ok(())
     }
@@ -166,7 +168,7 @@ impl GpuStepper {
             return Err(self.device_failure(state.time, e.to_string()));
         }
         let cause = Cause::substeps(
-            GPU_INTEGRATOR,
+            self.integrator,
             model,
             &self.forces,
             &state.pos,
@@ -208,7 +210,8 @@ impl GpuStepper {
 mod tests {
     use glam::Vec3;
 
-    use super::super::stepper::{GpuStepper, Watch};
+    use super::super::health::Watch;
+    use super::super::stepper::GpuStepper;
     use crate::cloth::ClothState;
     use crate::device::{AdapterPreference, HeadlessDevice};
     use crate::scene::Scene;
@@ -286,7 +289,9 @@ mod tests {
         };
         let mut measured = |state: &ClothState| {
             stepper.upload = true;
-            stepper.run(model, state, 0, measure).expect("run");
+            stepper
+                .run(model, state, (0, state.time), measure)
+                .expect("run");
             stepper.health.read(&gpu.device).expect("read")
         };
         let device = measured(&state);

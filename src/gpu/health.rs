@@ -40,6 +40,23 @@ pub struct Health {
     pub strain: f32,
 }
 
+/// What a submission does beside its substeps, for the guard.
+#[derive(Clone, Copy)]
+pub(super) struct Watch {
+    /// Copy the state the substeps start from into the frame's start snapshot.
+    pub(super) keep_start: bool,
+    /// Measure the state they end at (see [`HealthKernel`]).
+    pub(super) measure: bool,
+}
+
+impl Watch {
+    /// Neither: a frame without the guard, a bare substep.
+    pub(super) const OFF: Self = Self {
+        keep_start: false,
+        measure: false,
+    };
+}
+
 /// The reduction's pipelines, buffers and bind groups (one per particle buffer).
 pub(super) struct HealthKernel {
     partial: wgpu::ComputePipeline,
@@ -65,12 +82,12 @@ impl HealthKernel {
     ) -> Self {
         use Slot::{Read, Uniform, Write};
         let layout = layout(device, "cloth health", &[Uniform, Read, Read, Read, Write]);
+        let one: &[&wgpu::BindGroupLayout] = &[&layout];
         let [partial, total] = pipelines(
             device,
             "cloth health",
             SOURCE,
-            &layout,
-            ["partial", "total"],
+            [("partial", one), ("total", one)],
         );
         let first = count.div_ceil(WORKGROUP).max(1);
         let buffer = |label, size, usage| {

@@ -8,14 +8,20 @@ pub(super) const WORKGROUP: u32 = 64;
 /// The substep shader's source.
 pub(super) const SOURCE: &str = include_str!("../../shaders/substep.wgsl");
 
-/// The substep pipeline and the layout of what it binds.
+/// The substep's pipelines (semi-implicit Euler's one, XPBD's three) and the layouts of what
+/// they bind: group 0 for all, and for XPBD's projection group 1, the colour it projects.
 pub(super) struct SubstepKernel {
     pub(super) pipeline: wgpu::ComputePipeline,
+    pub(super) predict: wgpu::ComputePipeline,
+    pub(super) project: wgpu::ComputePipeline,
+    pub(super) finish: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    pub(super) colour_layout: wgpu::BindGroupLayout,
 }
 
 /// What one dispatch binds: the uniform parameters, the state it reads and the one it
-/// writes, the springs' CSR offsets and ends, and the class table.
+/// writes, the springs' CSR offsets and ends, the class table, and the element forces with
+/// each particle's slots among them (see `elements`).
 pub(super) struct Bindings<'a> {
     pub(super) params: &'a wgpu::Buffer,
     pub(super) src: &'a wgpu::Buffer,
@@ -23,12 +29,17 @@ pub(super) struct Bindings<'a> {
     pub(super) offsets: &'a wgpu::Buffer,
     pub(super) neighbours: &'a wgpu::Buffer,
     pub(super) classes: &'a wgpu::Buffer,
+    pub(super) element_forces: &'a wgpu::Buffer,
+    pub(super) incidence: &'a wgpu::Buffer,
+    pub(super) constraints: &'a wgpu::Buffer,
 }
 
 /// How a compute shader binds a buffer.
 #[derive(Clone, Copy)]
 pub(super) enum Slot {
     Uniform,
+    /// A uniform bound at an offset given with each dispatch.
+    Dynamic,
     Read,
     Write,
 }
@@ -43,11 +54,11 @@ pub(super) fn layout(device: &wgpu::Device, label: &str, slots: &[Slot]) -> wgpu
             visibility: wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::Buffer {
                 ty: match slot {
-                    Slot::Uniform => wgpu::BufferBindingType::Uniform,
+                    Slot::Uniform | Slot::Dynamic => wgpu::BufferBindingType::Uniform,
                     Slot::Read => wgpu::BufferBindingType::Storage { read_only: true },
                     Slot::Write => wgpu::BufferBindingType::Storage { read_only: false },
                 },
-                has_dynamic_offset: false,
+                has_dynamic_offset: matches!(slot, Slot::Dynamic),
                 min_binding_size: None,
             },
             count: None,
@@ -59,24 +70,26 @@ pub(super) fn layout(device: &wgpu::Device, label: &str, slots: &[Slot]) -> wgpu
     })
 }
 
-/// The pipelines of `source`'s `entry_points`, all with `layout`.
+/// The pipelines of `source`'s `entry_points`, each with its bind group layouts (group
+/// 0, 1, …).
 pub(super) fn pipelines<const N: usize>(
     device: &wgpu::Device,
     label: &str,
     source: &str,
-    layout: &wgpu::BindGroupLayout,
-    entry_points: [&str; N],
+    entry_points: [(&str, &[&wgpu::BindGroupLayout]); N],
 ) -> [wgpu::ComputePipeline; N] {
     let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(source.into()),
     });
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: &[Some(layout)],
-        immediate_size: 0,
-    });
-    entry_points.map(|entry| {
+    entry_points.map(|(entry, layouts)| {
+        let groups: Vec<Option<&wgpu::BindGroupLayout>> =
+            layouts.iter().copied().map(Some).collect();
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &groups,
+            immediate_size: 0,
+        });
         device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(label),
             layout: Some(&pipeline_layout),
@@ -111,16 +124,74 @@ pub(super) fn bind(
 
 impl SubstepKernel {
     pub(super) fn new(device: &wgpu::Device) -> Self {
-        use Slot::{Read, Uniform, Write};
-        let slots = [Uniform, Read, Write, Read, Read, Uniform];
+        use Slot::{Dynamic, Read, Uniform, Write};
+        let slots = [
+            Uniform, Read, Write, Read, Read, Uniform, Write, Read, Write,
+        ];
         let layout = layout(device, "cloth substep", &slots);
-        let [pipeline] = pipelines(device, "cloth substep", SOURCE, &layout, ["substep"]);
-        Self { pipeline, layout }
+        let colour_layout = self::layout(device, "cloth colour", &[Dynamic]);
+        let one: &[&wgpu::BindGroupLayout] = &[&layout];
+        let two: &[&wgpu::BindGroupLayout] = &[&layout, &colour_layout];
+        let [pipeline, predict, project, finish] = pipelines(
+            device,
+            "cloth substep",
+            SOURCE,
+            [
+                ("substep", one),
+                ("xpbd_predict", one),
+                ("xpbd_project", two),
+                ("xpbd_finish", one),
+            ],
+        );
+        Self {
+            pipeline,
+            predict,
+            project,
+            finish,
+            layout,
+            colour_layout,
+        }
+    }
+
+    /// The substep's bind groups: `[i]` reads particle buffer `i` and writes the other, with
+    /// the `fixed` uniform, spring offsets, spring ends and class table, and the element
+    /// pass's forces and slots and XPBD's constraints.
+    pub(super) fn groups(
+        &self,
+        device: &wgpu::Device,
+        particles: &[wgpu::Buffer; 2],
+        [params, offsets, neighbours, classes]: [&wgpu::Buffer; 4],
+        [element_forces, incidence, constraints]: [&wgpu::Buffer; 3],
+    ) -> [wgpu::BindGroup; 2] {
+        [0, 1].map(|from| {
+            let bindings = Bindings {
+                params,
+                src: &particles[from],
+                dst: &particles[1 - from],
+                offsets,
+                neighbours,
+                classes,
+                element_forces,
+                incidence,
+                constraints,
+            };
+            self.bind(device, &bindings)
+        })
     }
 
     /// The bind group of one dispatch.
     pub(super) fn bind(&self, device: &wgpu::Device, b: &Bindings<'_>) -> wgpu::BindGroup {
-        let buffers = [b.params, b.src, b.dst, b.offsets, b.neighbours, b.classes];
+        let buffers = [
+            b.params,
+            b.src,
+            b.dst,
+            b.offsets,
+            b.neighbours,
+            b.classes,
+            b.element_forces,
+            b.incidence,
+            b.constraints,
+        ];
         bind(device, "cloth substep", &self.layout, &buffers)
     }
 }

@@ -1,12 +1,14 @@
-//! The GPU step backend: semi-implicit Euler for the mass-spring cloth in a wgpu compute
-//! shader, under the stability guard. It sits beside the CPU solver (which knows nothing of
+//! The GPU step backend: semi-implicit Euler and XPBD for the mass-spring cloth in wgpu
+//! compute shaders, under the stability guard. It sits beside the CPU solver (which knows nothing of
 //! graphics) and plugs into [`crate::scene::Simulation`] through the same
 //! [`crate::sim::StepBackend`] seam. What it runs (`support`), how it lays the cloth out
-//! (`packing`), its kernels (`kernel`, `health`), the stepper that drives them (`stepper`)
+//! (`packing`), its kernels (`kernel`, `elements`, `health`, `xpbd`), the stepper that
+//! drives them (`stepper`)
 //! and the guard's frame with its rollback points on the device (`guarded`, `snapshot`) are
 //! files of their own; it reaches the device through [`crate::device`] only.
 
 mod backend;
+mod elements;
 mod error;
 mod guarded;
 mod health;
@@ -15,8 +17,9 @@ mod packing;
 mod snapshot;
 mod stepper;
 mod support;
+mod xpbd;
 
 pub use backend::{Backend, gpu_simulation};
 pub use error::GpuError;
 pub use stepper::GpuStepper;
-pub use support::{GPU_INTEGRATOR, gpu_support};
+pub use support::{GPU_INTEGRATOR, GPU_INTEGRATORS, gpu_support};

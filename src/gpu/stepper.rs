@@ -17,45 +17,41 @@ use crate::sim::{
     air_damping_of, gravity_of,
 };
 
+use super::elements::{ElementKernel, pack_elements};
 use super::error::GpuError;
-use super::health::HealthKernel;
-use super::kernel::{Bindings, SubstepKernel, WORKGROUP};
+use super::health::{HealthKernel, Watch};
+use super::kernel::{SubstepKernel, WORKGROUP};
 use super::packing::{
     ClassTable, EndsKey, Neighbour, Params, Particle, classify, pack_solids, pack_springs,
 };
 use super::snapshot::DeviceSnapshot;
-use super::support::{GPU_INTEGRATOR, check_device, fits_buffers, gpu_support};
+use super::support::{check_device, fits_buffers, fits_elements, gpu_support};
+use super::xpbd::XpbdPass;
 
-/// What one GPU substep is: one force evaluation, no solve.
-const SUBSTEP: StepReport = StepReport {
-    force_evals: 1,
-    solver_iterations: 0,
-    residual: None,
-    converged: true,
-};
-
-/// What a submission does beside its substeps, for the guard.
-#[derive(Clone, Copy)]
-pub(super) struct Watch {
-    /// Copy the state the substeps start from into the frame's start snapshot.
-    pub(super) keep_start: bool,
-    /// Measure the state they end at (see [`HealthKernel`]).
-    pub(super) measure: bool,
-}
-
-impl Watch {
-    /// Neither: a frame without the guard, a bare substep.
-    pub(super) const OFF: Self = Self {
-        keep_start: false,
-        measure: false,
-    };
+/// What one GPU substep is: one force evaluation, and `sweeps` constraint sweeps (XPBD).
+fn substep_report(sweeps: u32) -> StepReport {
+    StepReport {
+        force_evals: 1,
+        solver_iterations: sweeps,
+        residual: None,
+        converged: true,
+    }
 }
 
 /// Steps a cloth with semi-implicit Euler on a wgpu device (see the module documentation).
 pub struct GpuStepper {
     pub(super) device: wgpu::Device,
     pub(super) queue: wgpu::Queue,
-    pipeline: wgpu::ComputePipeline,
+    kernel: SubstepKernel,
+    /// Wind and dihedral bending, computed per element before each substep.
+    elements: ElementKernel,
+    /// The integrator in effect (one of those the GPU runs), and XPBD's sweeps a substep.
+    pub(super) integrator: IntegratorKind,
+    sweeps: u32,
+    /// XPBD's constraints in colour order, and whether they must be built again (from
+    /// the positions of the next step's start, as the CPU builds its own).
+    xpbd: XpbdPass,
+    xpbd_stale: bool,
     uniform: wgpu::Buffer,
     /// The two particle buffers; `current` holds the latest state.
     particles: [wgpu::Buffer; 2],
@@ -175,26 +171,23 @@ impl GpuStepper {
             bytes,
             wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         );
-        let group = |from: usize| {
-            kernel.bind(
-                device,
-                &Bindings {
-                    params: &uniform,
-                    src: &particles[from],
-                    dst: &particles[1 - from],
-                    offsets: &offsets,
-                    neighbours: &neighbours,
-                    classes: &classes,
-                },
-            )
-        };
-        let groups = [group(0), group(1)];
+        let none = pack_elements(model, &ForceSet::default(), false);
+        let elements = ElementKernel::new(device, queue, &particles, &none, &[]);
+        let xpbd = XpbdPass::new(device, queue, &kernel, None);
+        let fixed = [&uniform, &offsets, &neighbours, &classes];
+        let extra = [&elements.forces, &elements.incidence, &xpbd.constraints];
+        let groups = kernel.groups(device, &particles, fixed, extra);
         let health = HealthKernel::new(device, &particles, (&offsets, &neighbours), count);
         let frame_start = DeviceSnapshot::new(device, queue, bytes);
         let mut stepper = Self {
             device: device.clone(),
             queue: queue.clone(),
-            pipeline: kernel.pipeline,
+            kernel,
+            elements,
+            integrator: params.step.integrator,
+            sweeps: params.solver.xpbd_iterations.max(1),
+            xpbd,
+            xpbd_stale: true,
             uniform,
             particles,
             offsets,
@@ -212,7 +205,11 @@ impl GpuStepper {
             display: None,
             current: 0,
             count,
-            params: Params::zeroed(),
+            params: Params {
+                // The particles, and the invocations a particle dispatch has.
+                counts: [count, 0, 0, count.div_ceil(WORKGROUP) * WORKGROUP],
+                ..Params::zeroed()
+            },
             dt: params.step.dt,
             substeps: params.step.substeps.max(1),
             requested: params.step.substeps.max(1),
@@ -303,11 +300,12 @@ impl GpuStepper {
     }
 
     /// Encodes and submits `substeps` substeps, with what `watch` asks for.
+    /// The first substep starts at `time` seconds.
     pub(super) fn run(
         &mut self,
         model: &ClothModel,
         state: &ClothState,
-        substeps: u32,
+        (substeps, time): (u32, f64),
         watch: Watch,
     ) -> Result<(), StepError> {
         if let Some(why) = &self.unsupported {
@@ -319,6 +317,10 @@ impl GpuStepper {
         if self.upload {
             self.upload_state(model, state);
         }
+        let xpbd = self.integrator == IntegratorKind::Xpbd;
+        if xpbd && self.xpbd_stale {
+            self.rebuild_constraints(model, state)?;
+        }
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -326,18 +328,35 @@ impl GpuStepper {
             });
         if watch.keep_start {
             let live = &self.particles[self.current];
-            self.frame_start.take(&mut encoder, live, state.time);
+            self.frame_start.take(&mut encoder, live, time);
         }
+        self.elements.start(&self.queue, time);
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("cloth substeps"),
                 timestamp_writes: None,
             });
-            pass.set_pipeline(&self.pipeline);
+            let groups = self.count.div_ceil(WORKGROUP);
             for _ in 0..substeps {
-                pass.set_bind_group(0, &self.groups[self.current], &[]);
-                pass.dispatch_workgroups(self.count.div_ceil(WORKGROUP), 1, 1);
-                self.current = 1 - self.current;
+                self.elements.dispatch(&mut pass, self.current);
+                let (this, other) = (&self.groups[self.current], &self.groups[1 - self.current]);
+                if xpbd {
+                    // The state stays where it is; the other buffer holds the predictions.
+                    pass.set_pipeline(&self.kernel.predict);
+                    pass.set_bind_group(0, this, &[]);
+                    pass.dispatch_workgroups(groups, 1, 1);
+                    for _ in 0..self.sweeps {
+                        self.xpbd.sweep(&mut pass, &self.kernel, this);
+                    }
+                    pass.set_pipeline(&self.kernel.finish);
+                    pass.set_bind_group(0, other, &[]);
+                    pass.dispatch_workgroups(groups, 1, 1);
+                } else {
+                    pass.set_pipeline(&self.kernel.pipeline);
+                    pass.set_bind_group(0, this, &[]);
+                    pass.dispatch_workgroups(groups, 1, 1);
+                    self.current = 1 - self.current;
+                }
             }
         }
         if watch.measure {
@@ -352,10 +371,71 @@ impl GpuStepper {
         }
         self.queue.submit([encoder.finish()]);
         self.behind = true;
+        let report = substep_report(if xpbd { self.sweeps } else { 0 });
         for _ in 0..substeps {
-            self.stats.record(&SUBSTEP);
+            self.stats.record(&report);
         }
         Ok(())
+    }
+
+    /// XPBD's constraints from the forces' springs, coloured as the CPU colours them from
+    /// the positions the next step starts from (the caller's state, or the device's when
+    /// that is ahead), and the substep's bind groups that read them.
+    fn rebuild_constraints(
+        &mut self,
+        model: &ClothModel,
+        state: &ClothState,
+    ) -> Result<(), StepError> {
+        let positions = if self.behind {
+            let mut latest = state.clone();
+            self.read_back(&mut latest)
+                .map_err(|e| StepError::Device(e.to_string()))?;
+            // The caller's state is still the older one.
+            self.behind = true;
+            latest.pos
+        } else {
+            state.pos.clone()
+        };
+        let halves = self.forces.constraints(model).halves(&positions);
+        self.xpbd = XpbdPass::new(&self.device, &self.queue, &self.kernel, Some(&halves));
+        self.params.counts[2] = self.xpbd.count;
+        self.queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+        self.regroup();
+        self.xpbd_stale = false;
+        Ok(())
+    }
+
+    /// The substep's bind groups for the buffers in place.
+    fn regroup(&mut self) {
+        let fixed = [
+            &self.uniform,
+            &self.offsets,
+            &self.neighbours,
+            &self.classes,
+        ];
+        let extra = [
+            &self.elements.forces,
+            &self.elements.incidence,
+            &self.xpbd.constraints,
+        ];
+        self.groups = self
+            .kernel
+            .groups(&self.device, &self.particles, fixed, extra);
+    }
+
+    /// The element pass for `effects` (the forces' terms already theirs), and the substep's
+    /// bind groups that read its slots.
+    fn rebuild_elements(&mut self, model: &ClothModel, effects: &[Effect]) {
+        let wind = effects.iter().any(|e| matches!(e, Effect::Wind(_)));
+        let packed = pack_elements(model, &self.forces, wind);
+        if let Err(e) = fits_elements(&self.device.limits(), &packed) {
+            self.unsupported = Some(e.to_string());
+            return;
+        }
+        let (device, queue) = (&self.device, &self.queue);
+        self.elements = ElementKernel::new(device, queue, &self.particles, &packed, effects);
+        self.regroup();
     }
 
     /// Encodes and submits the copy of `snapshot` into the live particle buffer (and the
@@ -382,6 +462,7 @@ impl GpuStepper {
     pub(super) fn set_substeps(&mut self, substeps: u32) {
         self.substeps = substeps;
         self.params.gravity[3] = self.substep_length();
+        self.elements.set_step(self.substep_length());
         self.queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
     }
@@ -438,7 +519,7 @@ impl GpuStepper {
         substeps: u32,
     ) -> Result<(), StepError> {
         let start = Instant::now();
-        self.run(model, state, substeps, Watch::OFF)?;
+        self.run(model, state, (substeps, state.time), Watch::OFF)?;
         if self.read_every_frame {
             self.read_back(state)
                 .map_err(|e| StepError::Device(e.to_string()))?;
@@ -469,15 +550,27 @@ impl StepBackend for GpuStepper {
             self.upload_springs(model, &params.material, effects);
             (self.forces).apply(model, &params.material, effects, changes);
         }
+        if self.unsupported.is_none() {
+            self.integrator = params.step.integrator;
+        }
+        self.sweeps = params.solver.xpbd_iterations.max(1);
+        // New springs or strengths, or XPBD newly in effect: its constraints are built
+        // again before the next step, as the CPU's are.
+        if changes.intersects(Changes::INTEGRATOR | Changes::EFFECTS | Changes::STRENGTHS) {
+            self.xpbd_stale = true;
+        }
         if changes.contains(Changes::EFFECTS) {
             let (g, drag) = (gravity_of(effects), air_damping_of(effects));
             let (solids, count) = pack_solids(effects);
             self.params.gravity = [g.x, g.y, g.z, 0.0];
             self.params.drag[0] = drag;
-            self.params.counts = [self.count, count, 0, 0];
+            self.params.counts[1] = count;
             self.params.colliders = solids;
             self.effects = effects.to_vec();
             (self.gravity, self.air_damping) = (g, drag);
+            if self.unsupported.is_none() {
+                self.rebuild_elements(model, effects);
+            }
         }
         self.params.drag[1] = params.contact.offset;
         self.dt = params.step.dt;
@@ -493,11 +586,9 @@ impl StepBackend for GpuStepper {
             self.substeps = requested;
         }
         self.params.gravity[3] = self.substep_length();
-        if changes.intersects(Changes::EFFECTS | Changes::CONTACT | Changes::DT | Changes::SUBSTEPS)
-        {
-            self.queue
-                .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
-        }
+        self.elements.set_step(self.substep_length());
+        self.queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
         // The state on the device stays as it is: masses and pins change through the
         // caller's state, which then calls `invalidate`.
     }
@@ -526,7 +617,8 @@ impl StepBackend for GpuStepper {
     ) -> Result<StepReport, StepError> {
         self.timed_run(model, state, 1)?;
         state.time += self.substep_length() as f64;
-        Ok(SUBSTEP)
+        let xpbd = self.integrator == IntegratorKind::Xpbd;
+        Ok(substep_report(if xpbd { self.sweeps } else { 0 }))
     }
 
     fn substeps(&self) -> u32 {
@@ -550,7 +642,7 @@ impl StepBackend for GpuStepper {
     }
 
     fn integrator(&self) -> IntegratorKind {
-        GPU_INTEGRATOR
+        self.integrator
     }
 
     fn sync(&mut self, model: &ClothModel, state: &mut ClothState) -> Result<(), StepError> {

@@ -2,16 +2,21 @@
 
 use crate::sim::{Effect, IntegratorKind, Precision, StepConfig};
 
+use super::elements::PackedElements;
 use super::error::GpuError;
 use super::kernel::WORKGROUP;
 use super::packing::{MAX_COLLIDERS, MAX_PARTICLES, Neighbour, Particle};
 
-/// The one integrator the GPU backend runs.
+/// The integrator the GPU backend runs unless told otherwise.
 pub const GPU_INTEGRATOR: IntegratorKind = IntegratorKind::SemiImplicitEuler;
 
+/// The integrators the GPU backend runs.
+pub const GPU_INTEGRATORS: [IntegratorKind; 2] =
+    [IntegratorKind::SemiImplicitEuler, IntegratorKind::Xpbd];
+
 /// What of `step`, `precision` and `effects` the GPU backend cannot run, if anything: it
-/// runs semi-implicit Euler in `f32` with gravity, springs (and bend springs), air damping,
-/// pins and up to four sphere and plane colliders.
+/// runs semi-implicit Euler and XPBD in `f32` with gravity, springs (and bend springs), dihedral
+/// bending, wind, air damping, pins and up to four sphere and plane colliders.
 pub fn gpu_support(
     step: &StepConfig,
     precision: Precision,
@@ -23,10 +28,11 @@ pub fn gpu_support(
              WGSL has no f64); run {precision} on the CPU backend"
         )));
     }
-    if step.integrator != GPU_INTEGRATOR {
+    if !GPU_INTEGRATORS.contains(&step.integrator) {
+        let runs: Vec<&str> = GPU_INTEGRATORS.iter().map(|k| k.label()).collect();
         return Err(GpuError::Unsupported(format!(
             "runs {} only, not {}",
-            GPU_INTEGRATOR.label(),
+            runs.join(" and "),
             step.integrator.label()
         )));
     }
@@ -46,13 +52,20 @@ pub fn gpu_support(
     Ok(())
 }
 
-/// Whether a device with `limits` gives the shader what it needs for `count` particles:
-/// four storage buffers in a compute stage, and workgroups of [`WORKGROUP`] enough of them.
+/// Storage buffers the substep binds (the most any of the backend's kernels does): the
+/// state it reads and the one it writes, the spring offsets and ends, the element forces
+/// and each particle's slots among them, and XPBD's constraints.
+pub(super) const STORAGE_BUFFERS: u32 = 7;
+
+/// Whether a device with `limits` gives the shaders what they need for `count` particles:
+/// [`STORAGE_BUFFERS`] storage buffers in a compute stage, and workgroups of [`WORKGROUP`]
+/// enough of them.
 pub(super) fn check_device(limits: &wgpu::Limits, count: u32) -> Result<(), GpuError> {
     let storage = limits.max_storage_buffers_per_shader_stage;
-    if storage < 4 {
+    if storage < STORAGE_BUFFERS {
         return Err(GpuError::Unsupported(format!(
-            "needs 4 storage buffers in a compute shader; this device offers {storage}"
+            "needs {STORAGE_BUFFERS} storage buffers in a compute shader; this device offers \
+             {storage}"
         )));
     }
     let groups = limits.max_compute_workgroups_per_dimension as u64 * WORKGROUP as u64;
@@ -76,9 +89,6 @@ pub(super) fn fits_buffers(
     particles: u64,
     spring_ends: u64,
 ) -> Result<(), GpuError> {
-    let most = limits
-        .max_storage_buffer_binding_size
-        .min(limits.max_buffer_size);
     if particles > MAX_PARTICLES {
         return Err(GpuError::Unsupported(format!(
             "takes at most {MAX_PARTICLES} particles, not {particles}"
@@ -88,12 +98,40 @@ pub(super) fn fits_buffers(
         (particles * size_of::<Particle>() as u64, "particles' state"),
         (spring_ends * size_of::<Neighbour>() as u64, "spring ends"),
     ];
+    let cloth = format!("{particles} particles, {spring_ends} spring ends");
+    fits(limits, &need, &cloth)
+}
+
+/// Whether the element pass's buffers for `packed` fit one binding of a device with
+/// `limits` (see [`fits_buffers`]).
+pub(super) fn fits_elements(
+    limits: &wgpu::Limits,
+    packed: &PackedElements,
+) -> Result<(), GpuError> {
+    let (triangles, hinges) = (packed.triangles as u64, packed.hinges as u64);
+    let need = [
+        ((triangles + 2 * hinges) * 16, "triangles and hinges"),
+        ((1 + triangles + 4 * hinges) * 16, "element forces"),
+        (packed.incidence.len() as u64 * 4, "element slots"),
+    ];
+    fits(
+        limits,
+        &need,
+        &format!("{triangles} triangles, {hinges} hinges"),
+    )
+}
+
+/// The first of `need` (bytes, what) that one storage binding of a device with `limits`
+/// cannot hold, said with `cloth`'s sizes.
+fn fits(limits: &wgpu::Limits, need: &[(u64, &str)], cloth: &str) -> Result<(), GpuError> {
+    let most = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size);
     let mib = |bytes: u64| bytes as f64 / (1u64 << 20) as f64;
-    match need.into_iter().find(|&(bytes, _)| bytes > most) {
-        Some((bytes, what)) => Err(GpuError::Unsupported(format!(
+    match need.iter().find(|&&(bytes, _)| bytes > most) {
+        Some(&(bytes, what)) => Err(GpuError::Unsupported(format!(
             "needs {:.1} MiB ({bytes} bytes) in one storage buffer for this cloth's {what} \
-             ({particles} particles, {spring_ends} spring ends); this device binds at most \
-             {:.1} MiB ({most} bytes)",
+             ({cloth}); this device binds at most {:.1} MiB ({most} bytes)",
             mib(bytes),
             mib(most)
         ))),
@@ -142,5 +180,21 @@ mod tests {
         assert!(fits_buffers(&huge, MAX_PARTICLES, 0).is_ok());
         let err = fits_buffers(&huge, MAX_PARTICLES + 1, 0).expect_err("too many");
         assert!(err.to_string().contains("268435456 particles"), "{err}");
+        // The element pass's buffers: a triangle is one 16-byte row and one slot, a hinge
+        // two rows and four slots.
+        let elements = |triangles, hinges| PackedElements {
+            triangles,
+            hinges,
+            ..PackedElements::default()
+        };
+        let rows = (128u32 << 20) / 16;
+        assert!(fits_elements(&limits, &elements(rows - 1, 0)).is_ok());
+        let err = fits_elements(&limits, &elements(0, rows / 2)).expect_err("too many slots");
+        let text = err.to_string();
+        assert!(
+            text.contains("element forces") && text.contains("4194304 hinges"),
+            "{text}"
+        );
+        assert!(fits_elements(&limits, &elements(0, rows / 4 - 1)).is_ok());
     }
 }

@@ -158,7 +158,7 @@ fn halves_of(c: &DistanceConstraints, positions: &[Vec3]) -> Vec<u8> {
 }
 
 /// Constraints in two halves that share no particle, and the seam between them
-/// ([`DistanceConstraints::halves`]): each part's colours, as in [`Coloured`].
+/// ([`DistanceConstraints::halves`]): each part's colours, as in `Coloured`.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Halves {
     pub constraints: DistanceConstraints,

@@ -26,7 +26,7 @@ mod timings;
 
 pub use backend::StepBackend;
 pub use cg::{CgOutcome, ConjugateGradient};
-pub use constraints::DistanceConstraints;
+pub use constraints::{DistanceConstraints, Halves};
 pub use cpu_stepper::{CpuStepper, cpu_backend};
 pub use diagnosis::{Cause, Vibration, stiffest_vibration};
 pub use effects::{

@@ -72,8 +72,7 @@ impl EffectKind for BendingModel {
 
     fn on_gpu(&self) -> Result<(), &'static str> {
         match self {
-            BendingModel::Springs => Ok(()),
-            BendingModel::Dihedral { .. } => Err("dihedral bending"),
+            BendingModel::Springs | BendingModel::Dihedral { .. } => Ok(()),
         }
     }
 

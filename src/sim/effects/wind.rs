@@ -172,7 +172,7 @@ impl EffectKind for Wind {
     }
 
     fn on_gpu(&self) -> Result<(), &'static str> {
-        Err("wind")
+        Ok(())
     }
 
     fn suggested(_cloth: &ClothBox) -> Self {

@@ -102,6 +102,11 @@ impl DihedralBending {
         self.stiffness
     }
 
+    /// Each hinge's rest angle (radians) and weight `3|e|²/(A₁ + A₂)`, in the model's order.
+    pub fn rest_and_weight(&self) -> (&[f32], &[f32]) {
+        (&self.rest, &self.weight)
+    }
+
     pub fn set_stiffness(&mut self, stiffness: f32) {
         self.stiffness = stiffness;
     }

@@ -1,0 +1,323 @@
+//! Forces on elements rather than springs (`shaders/elements.wgsl`): wind on triangles and
+//! dihedral bending on hinges, computed one invocation per element into slots of their
+//! own, which the substep sums per particle over a CSR list of the slots it is in.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::cloth::ClothModel;
+use crate::sim::forces::DihedralBending;
+use crate::sim::{Effect, Force, ForceSet, Wind};
+
+use super::kernel::{Slot, WORKGROUP, bind, layout, pipelines};
+
+/// The shader's source.
+const SOURCE: &str = include_str!("../../shaders/elements.wgsl");
+
+/// The shader's `Params`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+struct Params {
+    clock: [f32; 4],
+    wind: [f32; 4],
+    air: [f32; 4],
+    counts: [u32; 4],
+}
+
+/// The elements as the shader reads them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(super) struct PackedElements {
+    /// Triangles (corners, 0), then per hinge its points and the bits of its rest angle
+    /// and weight.
+    pub(super) rows: Vec<[u32; 4]>,
+    /// Per particle the range of its slots (the first particles + 1 entries), then the
+    /// slots: a triangle's index, or for corner `k` of hinge `h` triangles + 4h + k.
+    pub(super) incidence: Vec<u32>,
+    pub(super) triangles: u32,
+    pub(super) hinges: u32,
+}
+
+/// The triangles of `model` when `wind` blows and the hinges of its dihedral term in
+/// `forces` when it has one, with each particle's slots.
+pub(super) fn pack_elements(model: &ClothModel, forces: &ForceSet, wind: bool) -> PackedElements {
+    let dihedral = (forces.terms().iter()).find_map(Force::get::<DihedralBending>);
+    let mut packed = PackedElements::default();
+    // (particle, slot) in slot order.
+    let mut touches: Vec<(u32, u32)> = Vec::new();
+    if wind {
+        for (t, tri) in (0u32..).zip(&model.triangles) {
+            packed.rows.push([tri[0], tri[1], tri[2], 0]);
+            touches.extend(tri.iter().map(|&p| (p, t)));
+        }
+        packed.triangles = model.triangles.len() as u32;
+    }
+    if let Some(bending) = dihedral {
+        let (rest, weight) = bending.rest_and_weight();
+        let first = packed.triangles;
+        for (h, (ids, (r, w))) in (0u32..).zip(model.hinges.iter().zip(rest.iter().zip(weight))) {
+            packed.rows.push(*ids);
+            packed.rows.push([r.to_bits(), w.to_bits(), 0, 0]);
+            touches.extend((0u32..).zip(ids).map(|(k, &p)| (p, first + 4 * h + k)));
+        }
+        packed.hinges = model.hinges.len() as u32;
+    }
+    // A counting sort by particle keeps each particle's slots in slot order.
+    let count = model.particle_count();
+    let mut offsets = vec![0u32; count + 1];
+    for &(p, _) in &touches {
+        offsets[p as usize + 1] += 1;
+    }
+    for p in 0..count {
+        offsets[p + 1] += offsets[p];
+    }
+    let mut slots = vec![0u32; touches.len()];
+    let mut next = offsets.clone();
+    for &(p, slot) in &touches {
+        slots[next[p as usize] as usize] = slot;
+        next[p as usize] += 1;
+    }
+    packed.incidence = offsets;
+    packed.incidence.extend(slots);
+    packed
+}
+
+/// The element pass: its pipeline, buffers and bind groups (one per particle buffer).
+pub(super) struct ElementKernel {
+    pipeline: wgpu::ComputePipeline,
+    groups: [wgpu::BindGroup; 2],
+    uniform: wgpu::Buffer,
+    /// The frame's substep count in the first `vec4`, then one `vec4` per slot: the
+    /// substep reads and counts here.
+    pub(super) forces: wgpu::Buffer,
+    /// [`PackedElements::incidence`], for the substep.
+    pub(super) incidence: wgpu::Buffer,
+    params: Params,
+}
+
+impl ElementKernel {
+    /// The pass for `packed` over either of `particles`, with the wind and the dihedral
+    /// stiffness of `effects`.
+    pub(super) fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        particles: &[wgpu::Buffer; 2],
+        packed: &PackedElements,
+        effects: &[Effect],
+    ) -> Self {
+        use Slot::{Read, Uniform, Write};
+        let layout = layout(device, "cloth elements", &[Uniform, Read, Read, Write]);
+        let [pipeline] = pipelines(
+            device,
+            "cloth elements",
+            SOURCE,
+            [("elements_forces", &[&layout])],
+        );
+        let buffer = |label, bytes: usize, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: (bytes as u64).max(16),
+                usage: usage | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        use wgpu::BufferUsages as U;
+        let slots = 1 + packed.triangles as usize + 4 * packed.hinges as usize;
+        let uniform = buffer("cloth elements params", size_of::<Params>(), U::UNIFORM);
+        let rows = buffer("cloth elements", packed.rows.len() * 16, U::STORAGE);
+        let forces = buffer("cloth element forces", slots * 16, U::STORAGE | U::COPY_SRC);
+        let incidence = buffer(
+            "cloth element slots",
+            packed.incidence.len() * 4,
+            U::STORAGE,
+        );
+        if !packed.rows.is_empty() {
+            queue.write_buffer(&rows, 0, bytemuck::cast_slice(&packed.rows));
+        }
+        queue.write_buffer(&incidence, 0, bytemuck::cast_slice(&packed.incidence));
+        let group = |p: &wgpu::Buffer| {
+            bind(
+                device,
+                "cloth elements",
+                &layout,
+                &[&uniform, p, &rows, &forces],
+            )
+        };
+        let groups = [group(&particles[0]), group(&particles[1])];
+        let mut params = Params {
+            counts: [packed.triangles, packed.hinges, 0, 0],
+            ..Params::default()
+        };
+        for effect in effects {
+            match effect {
+                Effect::Wind(w) => {
+                    let Wind {
+                        velocity: v,
+                        gust,
+                        gust_period,
+                        drag,
+                        lift,
+                        air_density,
+                    } = *w;
+                    params.wind = [v.x, v.y, v.z, gust];
+                    params.air = [gust_period, drag, lift, air_density];
+                }
+                Effect::Bending(crate::sim::BendingModel::Dihedral { stiffness }) => {
+                    params.clock[2] = *stiffness;
+                }
+                _ => {}
+            }
+        }
+        Self {
+            pipeline,
+            groups,
+            uniform,
+            forces,
+            incidence,
+            params,
+        }
+    }
+
+    /// Elements the pass computes (0: no pass).
+    fn elements(&self) -> u32 {
+        self.params.counts[0] + self.params.counts[1]
+    }
+
+    /// Sets the substep length, seconds (sent with the next [`ElementKernel::start`]).
+    pub(super) fn set_step(&mut self, h: f32) {
+        self.params.clock[1] = h;
+    }
+
+    /// Before a submission whose first substep starts at `time` seconds: its clock.
+    pub(super) fn start(&mut self, queue: &wgpu::Queue, time: f64) {
+        if self.elements() == 0 {
+            return;
+        }
+        self.params.clock[0] = time as f32;
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+        queue.write_buffer(&self.forces, 0, bytemuck::bytes_of(&[0.0f32; 4]));
+    }
+
+    /// Records the pass over particle buffer `current` (nothing without elements).
+    pub(super) fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>, current: usize) {
+        let count = self.elements();
+        if count > 0 {
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.groups[current], &[]);
+            pass.dispatch_workgroups(count.div_ceil(WORKGROUP), 1, 1);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::super::packing::Particle;
+    use super::*;
+    use crate::device::{AdapterPreference, HeadlessDevice, map_read};
+    use crate::scene::Scene;
+    use crate::sim::{BendingModel, ForceTerm};
+
+    /// The element shader's workgroups are the size the host dispatches for.
+    #[test]
+    fn the_element_shader_and_the_host_agree_on_the_workgroup() {
+        assert!(SOURCE.contains(&format!("@workgroup_size({WORKGROUP})")));
+    }
+
+    /// On a crumpled, moving flag with two hinges' wings pressed almost onto their edges
+    /// (where the force is limited), the element pass summed per particle over its slots
+    /// gives the CPU's wind and dihedral forces on every particle, to f32 rounding.
+    #[test]
+    fn the_element_forces_summed_per_particle_are_the_cpus() {
+        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let scene = Scene::builtin("flag").expect("scene");
+        let model = &scene.model;
+        let mut state = scene.initial.clone();
+        let mut rng = crate::test_rng::uniform(11);
+        let mut jitter = |s: f32| s * Vec3::new(rng() - 0.5, rng() - 0.5, rng() - 0.5);
+        for (x, v) in state.pos.iter_mut().zip(&mut state.vel) {
+            *x += jitter(0.03);
+            *v = jitter(4.0);
+        }
+        for h in [3, 40] {
+            let [x0, x1, a, _] = model.hinges[h].map(|i| i as usize);
+            let (p0, p1) = (state.pos[x0], state.pos[x1]);
+            let along = 0.3 * (p1 - p0);
+            let off = (p1 - p0).any_orthonormal_vector() * 0.005 * p0.distance(p1);
+            state.pos[a] = p0 + along + off;
+        }
+        let forces = ForceSet::new(model, &scene.params.material, &scene.effects);
+        let time = 0.37;
+        let mut cpu = vec![Vec3::ZERO; state.pos.len()];
+        for e in &scene.effects {
+            match e {
+                Effect::Wind(w) => {
+                    ForceTerm::<f32>::add_forces(w, model, &state.pos, &state.vel, time, &mut cpu)
+                }
+                Effect::Bending(BendingModel::Dihedral { .. }) => {
+                    let term = (forces.terms().iter()).find_map(Force::get::<DihedralBending>);
+                    term.expect("a dihedral term")
+                        .add_forces::<f32>(model, &state.pos, &mut cpu);
+                }
+                _ => {}
+            }
+        }
+        let packed = pack_elements(model, &forces, true);
+        assert!(packed.triangles > 0 && packed.hinges > 0);
+        let data: Vec<Particle> = (state.pos.iter().zip(&state.vel))
+            .map(|(x, v)| Particle {
+                x: [x.x, x.y, x.z, 1.0],
+                v: [v.x, v.y, v.z, 0.0],
+            })
+            .collect();
+        let particle_buffer = || {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: None,
+                size: (data.len() * size_of::<Particle>()) as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let particles = [particle_buffer(), particle_buffer()];
+        gpu.queue
+            .write_buffer(&particles[0], 0, bytemuck::cast_slice(&data));
+        let (device, queue) = (&gpu.device, &gpu.queue);
+        let mut kernel = ElementKernel::new(device, queue, &particles, &packed, &scene.effects);
+        kernel.set_step(1e-3);
+        kernel.start(queue, time);
+        let size = kernel.forces.size();
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: None,
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            kernel.dispatch(&mut pass, 0);
+        }
+        encoder.copy_buffer_to_buffer(&kernel.forces, 0, &readback, 0, size);
+        queue.submit([encoder.finish()]);
+        let slice = readback.slice(..);
+        map_read(device, &slice).expect("read");
+        let slots: Vec<[f32; 4]> =
+            bytemuck::cast_slice(&slice.get_mapped_range().expect("map")).to_vec();
+        let n = model.particle_count();
+        let (offsets, list) = packed.incidence.split_at(n + 1);
+        let mut worst = 0.0f32;
+        let largest = cpu.iter().fold(0.0f32, |m, f| m.max(f.length()));
+        for p in 0..n {
+            let range = offsets[p] as usize..offsets[p + 1] as usize;
+            let sum = (list[range].iter()).fold(Vec3::ZERO, |s, &slot| {
+                s + Vec3::from_slice(&slots[1 + slot as usize][..3])
+            });
+            worst = worst.max(sum.distance(cpu[p]));
+        }
+        eprintln!("worst {worst:e} N of {largest} N");
+        assert!(largest > 0.1, "the forces are not small ({largest} N)");
+        assert!(
+            worst < 1e-5 * largest,
+            "GPU and CPU forces differ by {worst} N"
+        );
+    }
+}

@@ -1,0 +1,140 @@
+//! XPBD on the GPU (`xpbd_*` in `shaders/substep.wgsl`): the springs as distance
+//! constraints in the CPU's colour order ([`crate::sim::DistanceConstraints::halves`]: the
+//! two halves' colours, then the seam's), one dispatch per colour, so a sweep is the CPU's
+//! Gauss–Seidel sweep: constraints that run at the same time share no particle.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::sim::Halves;
+
+use super::kernel::{SubstepKernel, WORKGROUP};
+
+/// A constraint as the shader reads it (its `Constraint`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub(super) struct GpuConstraint {
+    a: u32,
+    b: u32,
+    rest: f32,
+    compliance: f32,
+    /// Compliance × dashpot, s (the CPU's product, in f32).
+    damped: f32,
+    lambda: f32,
+}
+
+/// Bytes between colour records: dynamic uniform offsets must be multiples of the device's
+/// alignment, which is at most 256.
+const COLOUR_STRIDE: u64 = 256;
+
+/// Workgroups one dispatch may have along x.
+const MOST_GROUPS: u32 = 65_535;
+
+/// The constraints on the device and the colours to dispatch.
+pub(super) struct XpbdPass {
+    /// Bound in the substep's group 0.
+    pub(super) constraints: wgpu::Buffer,
+    colour_group: wgpu::BindGroup,
+    /// Workgroups per colour, in order.
+    groups: Vec<u32>,
+    pub(super) count: u32,
+}
+
+/// Each colour's record `[first, count, serial, invocations]` in sweep order, and the
+/// constraints of `halves` as the shader reads them.
+pub(super) fn pack_constraints(halves: &Halves) -> (Vec<GpuConstraint>, Vec<[u32; 4]>) {
+    let c = &halves.constraints;
+    let constraints = (0..c.len())
+        .map(|k| GpuConstraint {
+            a: c.a[k],
+            b: c.b[k],
+            rest: c.rest[k],
+            compliance: c.compliance[k],
+            damped: c.compliance[k] * c.damping[k],
+            lambda: 0.0,
+        })
+        .collect();
+    let order = (halves.halves.iter().flatten()).chain(&halves.seam);
+    let colours = order
+        .filter(|(range, _)| !range.is_empty())
+        .map(|(range, independent)| {
+            let count = range.len() as u32;
+            let groups = if *independent {
+                count.div_ceil(WORKGROUP).min(MOST_GROUPS)
+            } else {
+                1
+            };
+            let serial = u32::from(!*independent);
+            [range.start as u32, count, serial, groups * WORKGROUP]
+        })
+        .collect();
+    (constraints, colours)
+}
+
+impl XpbdPass {
+    /// The pass for `halves` (none: nothing to project) on `device`.
+    pub(super) fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        kernel: &SubstepKernel,
+        halves: Option<&Halves>,
+    ) -> Self {
+        let (constraints, colours) = halves.map(pack_constraints).unwrap_or_default();
+        let buffer = |label, size: u64, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: usage | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let bytes = (constraints.len() * size_of::<GpuConstraint>()) as u64;
+        let storage = buffer(
+            "xpbd constraints",
+            bytes.max(32),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let records = (colours.len() as u64).max(1) * COLOUR_STRIDE;
+        let uniform = buffer("xpbd colours", records, wgpu::BufferUsages::UNIFORM);
+        if !constraints.is_empty() {
+            queue.write_buffer(&storage, 0, bytemuck::cast_slice(&constraints));
+        }
+        for (k, record) in colours.iter().enumerate() {
+            let at = k as u64 * COLOUR_STRIDE;
+            queue.write_buffer(&uniform, at, bytemuck::bytes_of(record));
+        }
+        let colour_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("xpbd colour"),
+            layout: &kernel.colour_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &uniform,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(16),
+                }),
+            }],
+        });
+        Self {
+            constraints: storage,
+            colour_group,
+            groups: colours.iter().map(|c| c[3] / WORKGROUP).collect(),
+            count: constraints.len() as u32,
+        }
+    }
+
+    /// Records one Gauss–Seidel sweep: every colour, in order, on the substep's `group`.
+    pub(super) fn sweep(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        kernel: &SubstepKernel,
+        group: &wgpu::BindGroup,
+    ) {
+        pass.set_pipeline(&kernel.project);
+        pass.set_bind_group(0, group, &[]);
+        for (k, &groups) in self.groups.iter().enumerate() {
+            let offset = (k as u64 * COLOUR_STRIDE) as u32;
+            pass.set_bind_group(1, &self.colour_group, &[offset]);
+            pass.dispatch_workgroups(groups, 1, 1);
+        }
+    }
+}
