@@ -90,10 +90,8 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
     rk4.params.step.integrator = IntegratorKind::Rk4;
     let err = gpu_support(&rk4.params.step, f32, &rk4.effects).expect_err("RK4 is CPU only");
     let err = err.to_string();
-    assert!(
-        err.contains("runs Semi-implicit Euler and XPBD only, not RK4"),
-        "{err}"
-    );
+    let runs = "runs Semi-implicit Euler, XPBD, VBD (vertex block descent) only, not RK4";
+    assert!(err.contains(runs), "{err}");
     assert_eq!(Backend::default(), Backend::Cpu);
     // Switching the integrator of a running GPU simulation fails the next frame, with the
     // reason, and keeps the state.
@@ -105,12 +103,7 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
     params.step.integrator = IntegratorKind::Rk4;
     sim.set_params(params).expect("valid parameters");
     let err = sim.step_frame().expect_err("unsupported");
-    assert!(
-        err.reason
-            .contains("Semi-implicit Euler and XPBD only, not RK4"),
-        "{}",
-        err.reason
-    );
+    assert!(err.reason.contains(runs), "{}", err.reason);
     assert_eq!(sim.state().pos, before.pos);
     // So does f64: refused up front with the reason, and mid-run on the next frame.
     let mut precise = Scene::builtin("hanging").expect("scene");
@@ -337,9 +330,15 @@ fn gpu_bench_cli_defaults_to_the_integrators_it_runs() {
         .lines()
         .map(|l| serde_json::from_str(l).expect("one JSON object per line"))
         .collect();
-    assert_eq!(rows.len(), 2, "{rows:?}");
-    assert_eq!(rows[0]["integrator"], "semi-implicit-euler");
-    assert_eq!(rows[1]["integrator"], "xpbd");
+    let integrators: Vec<&str> = rows
+        .iter()
+        .filter_map(|r| r["integrator"].as_str())
+        .collect();
+    assert_eq!(
+        integrators,
+        ["semi-implicit-euler", "xpbd", "vbd"],
+        "{rows:?}"
+    );
     for row in &rows {
         assert_eq!(row["backend"], "gpu");
         assert_eq!(row["finite"], true);

@@ -27,7 +27,7 @@ pub fn bench(
         let runs: Vec<&str> = GPU_INTEGRATORS.iter().map(|k| k.name()).collect();
         bail!(
             "--backend gpu runs {} only, not {}",
-            runs.join(" and "),
+            runs.join(", "),
             k.name()
         );
     }

@@ -186,14 +186,14 @@ impl ElementKernel {
         self.params.clock[1] = h;
     }
 
-    /// Before a submission whose first substep starts at `time` seconds: its clock.
+    /// Before a submission whose first substep starts at `time` seconds: its clock (the
+    /// substeps it has taken, which VBD's first guess reads too, start at none).
     pub(super) fn start(&mut self, queue: &wgpu::Queue, time: f64) {
-        if self.elements() == 0 {
-            return;
-        }
-        self.params.clock[0] = time as f32;
-        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
         queue.write_buffer(&self.forces, 0, bytemuck::bytes_of(&[0.0f32; 4]));
+        if self.elements() > 0 {
+            self.params.clock[0] = time as f32;
+            queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+        }
     }
 
     /// Records the pass over particle buffer `current` (nothing without elements).

@@ -5,16 +5,24 @@
 /// Particles per workgroup (the shader's `@workgroup_size`; a test compares them).
 pub(super) const WORKGROUP: u32 = 64;
 
-/// The substep shader's source.
+/// What the step shaders share: particles, parameters, bindings, element forces, colliders.
+pub(super) const COMMON: &str = include_str!("../../shaders/step_common.wgsl");
+/// Semi-implicit Euler's and XPBD's entry points.
 pub(super) const SOURCE: &str = include_str!("../../shaders/substep.wgsl");
+/// VBD's entry points.
+pub(super) const VBD: &str = include_str!("../../shaders/vbd.wgsl");
 
-/// The substep's pipelines (semi-implicit Euler's one, XPBD's three) and the layouts of what
-/// they bind: group 0 for all, and for XPBD's projection group 1, the colour it projects.
+/// The substep's pipelines (semi-implicit Euler's one, XPBD's three, VBD's three) and the
+/// layouts of what they bind: group 0 for all, and for XPBD's projection and VBD's descent
+/// group 1, the colour they take.
 pub(super) struct SubstepKernel {
     pub(super) pipeline: wgpu::ComputePipeline,
     pub(super) predict: wgpu::ComputePipeline,
     pub(super) project: wgpu::ComputePipeline,
     pub(super) finish: wgpu::ComputePipeline,
+    pub(super) vbd_predict: wgpu::ComputePipeline,
+    pub(super) descend: wgpu::ComputePipeline,
+    pub(super) vbd_finish: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     pub(super) colour_layout: wgpu::BindGroupLayout,
 }
@@ -31,7 +39,8 @@ pub(super) struct Bindings<'a> {
     pub(super) classes: &'a wgpu::Buffer,
     pub(super) element_forces: &'a wgpu::Buffer,
     pub(super) incidence: &'a wgpu::Buffer,
-    pub(super) constraints: &'a wgpu::Buffer,
+    /// XPBD's constraints or VBD's stencil.
+    pub(super) solver: &'a wgpu::Buffer,
 }
 
 /// How a compute shader binds a buffer.
@@ -135,7 +144,7 @@ impl SubstepKernel {
         let [pipeline, predict, project, finish] = pipelines(
             device,
             "cloth substep",
-            SOURCE,
+            &format!("{COMMON}{SOURCE}"),
             [
                 ("substep", one),
                 ("xpbd_predict", one),
@@ -143,11 +152,24 @@ impl SubstepKernel {
                 ("xpbd_finish", one),
             ],
         );
+        let [vbd_predict, descend, vbd_finish] = pipelines(
+            device,
+            "cloth vbd",
+            &format!("{COMMON}{VBD}"),
+            [
+                ("vbd_predict", one),
+                ("vbd_descend", two),
+                ("vbd_finish", one),
+            ],
+        );
         Self {
             pipeline,
             predict,
             project,
             finish,
+            vbd_predict,
+            descend,
+            vbd_finish,
             layout,
             colour_layout,
         }
@@ -161,7 +183,7 @@ impl SubstepKernel {
         device: &wgpu::Device,
         particles: &[wgpu::Buffer; 2],
         [params, offsets, neighbours, classes]: [&wgpu::Buffer; 4],
-        [element_forces, incidence, constraints]: [&wgpu::Buffer; 3],
+        [element_forces, incidence, solver]: [&wgpu::Buffer; 3],
     ) -> [wgpu::BindGroup; 2] {
         [0, 1].map(|from| {
             let bindings = Bindings {
@@ -173,7 +195,7 @@ impl SubstepKernel {
                 classes,
                 element_forces,
                 incidence,
-                constraints,
+                solver,
             };
             self.bind(device, &bindings)
         })
@@ -190,7 +212,7 @@ impl SubstepKernel {
             b.classes,
             b.element_forces,
             b.incidence,
-            b.constraints,
+            b.solver,
         ];
         bind(device, "cloth substep", &self.layout, &buffers)
     }
@@ -203,7 +225,7 @@ mod tests {
 
     /// The value of `const NAME: u32 = …u;` in the shader.
     fn shader_const(name: &str) -> u32 {
-        let line = (SOURCE.lines())
+        let line = (COMMON.lines())
             .find(|l| l.starts_with(&format!("const {name}: u32 = ")))
             .unwrap_or_else(|| panic!("no `const {name}` in the shader"));
         let value = line.split('=').nth(1).unwrap_or_default();
@@ -221,6 +243,13 @@ mod tests {
     fn the_shader_and_the_host_agree_on_their_constants() {
         assert_eq!(shader_const("CLASS_BITS"), CLASS_BITS);
         assert_eq!(shader_const("CLASSES") as usize, MAX_CLASSES);
-        assert!(SOURCE.contains(&format!("@workgroup_size({WORKGROUP})")));
+        for source in [SOURCE, VBD] {
+            let ours = format!("@workgroup_size({WORKGROUP})");
+            assert!(source.contains(&ours));
+            assert_eq!(
+                source.matches("@workgroup_size(").count(),
+                source.matches(&ours).count()
+            );
+        }
     }
 }

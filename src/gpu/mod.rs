@@ -1,8 +1,8 @@
-//! The GPU step backend: semi-implicit Euler and XPBD for the mass-spring cloth in wgpu
-//! compute shaders, under the stability guard. It sits beside the CPU solver (which knows nothing of
+//! The GPU step backend: semi-implicit Euler, XPBD and VBD for the mass-spring cloth in
+//! wgpu compute shaders, under the stability guard. It sits beside the CPU solver (which knows nothing of
 //! graphics) and plugs into [`crate::scene::Simulation`] through the same
 //! [`crate::sim::StepBackend`] seam. What it runs (`support`), how it lays the cloth out
-//! (`packing`), its kernels (`kernel`, `elements`, `health`, `xpbd`), the stepper that
+//! (`packing`), its kernels (`kernel`, `elements`, `health`, `xpbd`, `vbd`), the stepper that
 //! drives them (`stepper`)
 //! and the guard's frame with its rollback points on the device (`guarded`, `snapshot`) are
 //! files of their own; it reaches the device through [`crate::device`] only.
@@ -17,6 +17,7 @@ mod packing;
 mod snapshot;
 mod stepper;
 mod support;
+mod vbd;
 mod xpbd;
 
 pub use backend::{Backend, gpu_simulation};

@@ -148,6 +148,9 @@ pub(super) struct Params {
     pub(super) gravity: [f32; 4],
     pub(super) drag: [f32; 4],
     pub(super) counts: [u32; 4],
+    /// VBD: where its stencil's spans, links and memory start, and 1 when the memory is
+    /// stale.
+    pub(super) solver: [u32; 4],
     pub(super) colliders: [GpuCollider; MAX_COLLIDERS],
 }
 
@@ -183,4 +186,56 @@ pub(super) fn pack_solids(effects: &[Effect]) -> ([GpuCollider; MAX_COLLIDERS], 
         count += 1;
     }
     (out, count)
+}
+
+#[cfg(test)]
+pub(super) mod tests {
+    use super::*;
+
+    /// `effects` without bending.
+    pub(in crate::gpu) fn unbent(effects: &[Effect]) -> Vec<Effect> {
+        (effects.iter())
+            .filter(|e| !matches!(e, Effect::Bending(_)))
+            .cloned()
+            .collect()
+    }
+
+    /// Every spring end the CPU's force set has carries its other particle, its rest length
+    /// and the class whose table entry is that spring's stiffness and damping there, in the
+    /// adjacency's order; with the bend springs switched off, their ends are not sent.
+    #[test]
+    fn each_spring_end_points_at_the_strengths_the_cpu_gives_its_spring() {
+        use crate::sim::ForceSet;
+        let scene = crate::scene::Scene::builtin("sphere-drop").expect("scene");
+        let (model, params) = (&scene.model, &scene.params);
+        let unbent = unbent(&scene.effects);
+        for (effects, classes) in [(&scene.effects, 3), (&unbent, 2)] {
+            let forces = ForceSet::new(model, &params.material, effects);
+            let strengths: std::collections::HashMap<usize, (f32, f32)> = (forces.springs())
+                .flat_map(|t| t.each())
+                .map(|(e, k, c)| (e, (k, c)))
+                .collect();
+            let (key, table) = classify(&params.material, effects);
+            let packed = pack_springs(model, &key);
+            let adj = &model.adjacency;
+            let mut used = std::collections::BTreeSet::new();
+            for p in 0..model.particle_count() {
+                let range = packed.offsets[p] as usize..packed.offsets[p + 1] as usize;
+                let slots: Vec<usize> = (adj.range(p))
+                    .filter(|&slot| strengths.contains_key(&(adj.spring[slot] as usize)))
+                    .collect();
+                assert_eq!(range.len(), slots.len(), "particle {p}");
+                for (end, slot) in packed.ends[range].iter().zip(slots) {
+                    let e = adj.spring[slot] as usize;
+                    let class = (end.other % MAX_CLASSES as u32) as usize;
+                    used.insert(class);
+                    assert_eq!(end.other >> CLASS_BITS, adj.other[slot]);
+                    assert_eq!(end.rest, model.springs.rest[e]);
+                    let [k, c, ..] = table[class];
+                    assert_eq!((k, c), strengths[&e], "spring {e}");
+                }
+            }
+            assert_eq!(used.len(), classes, "one class per kind sent: {used:?}");
+        }
+    }
 }

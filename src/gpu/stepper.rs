@@ -26,9 +26,10 @@ use super::packing::{
 };
 use super::snapshot::DeviceSnapshot;
 use super::support::{check_device, fits_buffers, fits_elements, gpu_support};
+use super::vbd::VbdPass;
 use super::xpbd::XpbdPass;
 
-/// What one GPU substep is: one force evaluation, and `sweeps` constraint sweeps (XPBD).
+/// What one GPU substep is: one force evaluation, and `sweeps` sweeps (XPBD, VBD).
 fn substep_report(sweeps: u32) -> StepReport {
     StepReport {
         force_evals: 1,
@@ -45,13 +46,19 @@ pub struct GpuStepper {
     kernel: SubstepKernel,
     /// Wind and dihedral bending, computed per element before each substep.
     elements: ElementKernel,
-    /// The integrator in effect (one of those the GPU runs), and XPBD's sweeps a substep.
+    /// The integrator in effect (one of those the GPU runs), and its sweeps a substep
+    /// (XPBD's or VBD's).
     pub(super) integrator: IntegratorKind,
     sweeps: u32,
-    /// XPBD's constraints in colour order, and whether they must be built again (from
-    /// the positions of the next step's start, as the CPU builds its own).
+    /// XPBD's constraints in colour order and VBD's stencil, and whether the one in effect
+    /// must be built again (XPBD's from the positions of the next step's start, as the CPU
+    /// builds its own).
     xpbd: XpbdPass,
-    xpbd_stale: bool,
+    vbd: VbdPass,
+    solver_stale: bool,
+    /// VBD's memory of each particle's last acceleration is stale (the state changed
+    /// outside, was rolled back, or VBD has not stepped it yet).
+    vbd_fresh: bool,
     uniform: wgpu::Buffer,
     /// The two particle buffers; `current` holds the latest state.
     particles: [wgpu::Buffer; 2],
@@ -174,6 +181,7 @@ impl GpuStepper {
         let none = pack_elements(model, &ForceSet::default(), false);
         let elements = ElementKernel::new(device, queue, &particles, &none, &[]);
         let xpbd = XpbdPass::new(device, queue, &kernel, None);
+        let vbd = VbdPass::new(device, queue, &kernel, None);
         let fixed = [&uniform, &offsets, &neighbours, &classes];
         let extra = [&elements.forces, &elements.incidence, &xpbd.constraints];
         let groups = kernel.groups(device, &particles, fixed, extra);
@@ -185,9 +193,11 @@ impl GpuStepper {
             kernel,
             elements,
             integrator: params.step.integrator,
-            sweeps: params.solver.xpbd_iterations.max(1),
+            sweeps: 1,
             xpbd,
-            xpbd_stale: true,
+            vbd,
+            solver_stale: true,
+            vbd_fresh: true,
             uniform,
             particles,
             offsets,
@@ -296,6 +306,7 @@ impl GpuStepper {
             }
         }
         self.upload = false;
+        self.vbd_fresh = true;
         self.behind = false;
     }
 
@@ -317,9 +328,20 @@ impl GpuStepper {
         if self.upload {
             self.upload_state(model, state);
         }
-        let xpbd = self.integrator == IntegratorKind::Xpbd;
-        if xpbd && self.xpbd_stale {
-            self.rebuild_constraints(model, state)?;
+        let vbd = self.integrator == IntegratorKind::Vbd;
+        let sweeping = vbd || self.integrator == IntegratorKind::Xpbd;
+        if sweeping && self.solver_stale {
+            self.rebuild_solver(model, state)?;
+        }
+        let solver = match self.integrator {
+            IntegratorKind::Xpbd => Some((&self.kernel.predict, &self.kernel.finish)),
+            IntegratorKind::Vbd => Some((&self.kernel.vbd_predict, &self.kernel.vbd_finish)),
+            _ => None,
+        };
+        if vbd {
+            self.params.solver[3] = u32::from(self.vbd_fresh);
+            self.queue
+                .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
         }
         let mut encoder = self
             .device
@@ -340,15 +362,20 @@ impl GpuStepper {
             for _ in 0..substeps {
                 self.elements.dispatch(&mut pass, self.current);
                 let (this, other) = (&self.groups[self.current], &self.groups[1 - self.current]);
-                if xpbd {
-                    // The state stays where it is; the other buffer holds the predictions.
-                    pass.set_pipeline(&self.kernel.predict);
+                if let Some((predict, finish)) = solver {
+                    // The state stays where it is; the other buffer holds the predictions
+                    // (XPBD) or the displacements (VBD).
+                    pass.set_pipeline(predict);
                     pass.set_bind_group(0, this, &[]);
                     pass.dispatch_workgroups(groups, 1, 1);
                     for _ in 0..self.sweeps {
-                        self.xpbd.sweep(&mut pass, &self.kernel, this);
+                        if vbd {
+                            self.vbd.sweep(&mut pass, &self.kernel, this);
+                        } else {
+                            self.xpbd.sweep(&mut pass, &self.kernel, this);
+                        }
                     }
-                    pass.set_pipeline(&self.kernel.finish);
+                    pass.set_pipeline(finish);
                     pass.set_bind_group(0, other, &[]);
                     pass.dispatch_workgroups(groups, 1, 1);
                 } else {
@@ -371,21 +398,31 @@ impl GpuStepper {
         }
         self.queue.submit([encoder.finish()]);
         self.behind = true;
-        let report = substep_report(if xpbd { self.sweeps } else { 0 });
+        if vbd && substeps > 0 {
+            self.vbd_fresh = false;
+        }
+        let report = substep_report(if solver.is_some() { self.sweeps } else { 0 });
         for _ in 0..substeps {
             self.stats.record(&report);
         }
         Ok(())
     }
 
-    /// XPBD's constraints from the forces' springs, coloured as the CPU colours them from
-    /// the positions the next step starts from (the caller's state, or the device's when
-    /// that is ahead), and the substep's bind groups that read them.
-    fn rebuild_constraints(
-        &mut self,
-        model: &ClothModel,
-        state: &ClothState,
-    ) -> Result<(), StepError> {
+    /// The solver's data from the forces' springs, and the substep's bind groups that read
+    /// it: XPBD's constraints coloured as the CPU colours them from the positions the next
+    /// step starts from (the caller's state, or the device's when that is ahead); VBD's
+    /// stencil, coloured by particle number.
+    fn rebuild_solver(&mut self, model: &ClothModel, state: &ClothState) -> Result<(), StepError> {
+        if self.integrator == IntegratorKind::Vbd {
+            let springs = Some((model, &self.forces));
+            self.vbd = VbdPass::new(&self.device, &self.queue, &self.kernel, springs);
+            let [spans, links, memory] = self.vbd.starts;
+            self.params.solver = [spans, links, memory, 1];
+            self.vbd_fresh = true;
+            self.regroup();
+            self.solver_stale = false;
+            return Ok(());
+        }
         let positions = if self.behind {
             let mut latest = state.clone();
             self.read_back(&mut latest)
@@ -402,7 +439,7 @@ impl GpuStepper {
         self.queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
         self.regroup();
-        self.xpbd_stale = false;
+        self.solver_stale = false;
         Ok(())
     }
 
@@ -417,7 +454,10 @@ impl GpuStepper {
         let extra = [
             &self.elements.forces,
             &self.elements.incidence,
-            &self.xpbd.constraints,
+            match self.integrator {
+                IntegratorKind::Vbd => &self.vbd.stencil,
+                _ => &self.xpbd.constraints,
+            },
         ];
         self.groups = self
             .kernel
@@ -454,6 +494,7 @@ impl GpuStepper {
         }
         self.queue.submit([encoder.finish()]);
         self.upload = false;
+        self.vbd_fresh = true;
         self.behind = true;
         time
     }
@@ -553,11 +594,15 @@ impl StepBackend for GpuStepper {
         if self.unsupported.is_none() {
             self.integrator = params.step.integrator;
         }
-        self.sweeps = params.solver.xpbd_iterations.max(1);
+        self.sweeps = match self.integrator {
+            IntegratorKind::Vbd => params.solver.vbd_iterations,
+            _ => params.solver.xpbd_iterations,
+        }
+        .max(1);
         // New springs or strengths, or XPBD newly in effect: its constraints are built
         // again before the next step, as the CPU's are.
         if changes.intersects(Changes::INTEGRATOR | Changes::EFFECTS | Changes::STRENGTHS) {
-            self.xpbd_stale = true;
+            self.solver_stale = true;
         }
         if changes.contains(Changes::EFFECTS) {
             let (g, drag) = (gravity_of(effects), air_damping_of(effects));
@@ -617,8 +662,11 @@ impl StepBackend for GpuStepper {
     ) -> Result<StepReport, StepError> {
         self.timed_run(model, state, 1)?;
         state.time += self.substep_length() as f64;
-        let xpbd = self.integrator == IntegratorKind::Xpbd;
-        Ok(substep_report(if xpbd { self.sweeps } else { 0 }))
+        let sweeps = match self.integrator {
+            IntegratorKind::Xpbd | IntegratorKind::Vbd => self.sweeps,
+            _ => 0,
+        };
+        Ok(substep_report(sweeps))
     }
 
     fn substeps(&self) -> u32 {
@@ -675,54 +723,7 @@ impl StepBackend for GpuStepper {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gpu::packing::{CLASS_BITS, MAX_CLASSES};
-
-    /// `effects` without bending.
-    fn unbent(effects: &[Effect]) -> Vec<Effect> {
-        (effects.iter())
-            .filter(|e| !matches!(e, Effect::Bending(_)))
-            .cloned()
-            .collect()
-    }
-
-    /// Every spring end the CPU's force set has carries its other particle, its rest length
-    /// and the class whose table entry is that spring's stiffness and damping there, in the
-    /// adjacency's order; with the bend springs switched off, their ends are not sent.
-    #[test]
-    fn each_spring_end_points_at_the_strengths_the_cpu_gives_its_spring() {
-        use crate::sim::ForceSet;
-        let scene = crate::scene::Scene::builtin("sphere-drop").expect("scene");
-        let (model, params) = (&scene.model, &scene.params);
-        let unbent = unbent(&scene.effects);
-        for (effects, classes) in [(&scene.effects, 3), (&unbent, 2)] {
-            let forces = ForceSet::new(model, &params.material, effects);
-            let strengths: std::collections::HashMap<usize, (f32, f32)> = (forces.springs())
-                .flat_map(|t| t.each())
-                .map(|(e, k, c)| (e, (k, c)))
-                .collect();
-            let (key, table) = classify(&params.material, effects);
-            let packed = pack_springs(model, &key);
-            let adj = &model.adjacency;
-            let mut used = std::collections::BTreeSet::new();
-            for p in 0..model.particle_count() {
-                let range = packed.offsets[p] as usize..packed.offsets[p + 1] as usize;
-                let slots: Vec<usize> = (adj.range(p))
-                    .filter(|&slot| strengths.contains_key(&(adj.spring[slot] as usize)))
-                    .collect();
-                assert_eq!(range.len(), slots.len(), "particle {p}");
-                for (end, slot) in packed.ends[range].iter().zip(slots) {
-                    let e = adj.spring[slot] as usize;
-                    let class = (end.other % MAX_CLASSES as u32) as usize;
-                    used.insert(class);
-                    assert_eq!(end.other >> CLASS_BITS, adj.other[slot]);
-                    assert_eq!(end.rest, model.springs.rest[e]);
-                    let [k, c, ..] = table[class];
-                    assert_eq!((k, c), strengths[&e], "spring {e}");
-                }
-            }
-            assert_eq!(used.len(), classes, "one class per kind sent: {used:?}");
-        }
-    }
+    use crate::gpu::packing::tests::unbent;
 
     /// A strength change that keeps which springs share a class (every kind scaled alike,
     /// or the damping of a kind that has a class of its own) sends only the class table;

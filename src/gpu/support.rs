@@ -11,11 +11,14 @@ use super::packing::{MAX_COLLIDERS, MAX_PARTICLES, Neighbour, Particle};
 pub const GPU_INTEGRATOR: IntegratorKind = IntegratorKind::SemiImplicitEuler;
 
 /// The integrators the GPU backend runs.
-pub const GPU_INTEGRATORS: [IntegratorKind; 2] =
-    [IntegratorKind::SemiImplicitEuler, IntegratorKind::Xpbd];
+pub const GPU_INTEGRATORS: [IntegratorKind; 3] = [
+    IntegratorKind::SemiImplicitEuler,
+    IntegratorKind::Xpbd,
+    IntegratorKind::Vbd,
+];
 
 /// What of `step`, `precision` and `effects` the GPU backend cannot run, if anything: it
-/// runs semi-implicit Euler and XPBD in `f32` with gravity, springs (and bend springs), dihedral
+/// runs semi-implicit Euler, XPBD and VBD in `f32` with gravity, springs (and bend springs), dihedral
 /// bending, wind, air damping, pins and up to four sphere and plane colliders.
 pub fn gpu_support(
     step: &StepConfig,
@@ -32,7 +35,7 @@ pub fn gpu_support(
         let runs: Vec<&str> = GPU_INTEGRATORS.iter().map(|k| k.label()).collect();
         return Err(GpuError::Unsupported(format!(
             "runs {} only, not {}",
-            runs.join(" and "),
+            runs.join(", "),
             step.integrator.label()
         )));
     }

@@ -29,13 +29,86 @@ const COLOUR_STRIDE: u64 = 256;
 /// Workgroups one dispatch may have along x.
 const MOST_GROUPS: u32 = 65_535;
 
-/// The constraints on the device and the colours to dispatch.
+/// Colours to dispatch one after another, each a range of entries (constraints or
+/// particles in colour order): a record per colour in a uniform buffer, bound at a dynamic
+/// offset.
+pub(super) struct Colours {
+    group: wgpu::BindGroup,
+    /// Workgroups per colour, in order.
+    groups: Vec<u32>,
+}
+
+impl Colours {
+    /// The colours `records` (`[first, count, serial, invocations]`) on `device`.
+    pub(super) fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        kernel: &SubstepKernel,
+        records: &[[u32; 4]],
+    ) -> Self {
+        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("colours"),
+            size: (records.len() as u64).max(1) * COLOUR_STRIDE,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        for (k, record) in records.iter().enumerate() {
+            let at = k as u64 * COLOUR_STRIDE;
+            queue.write_buffer(&uniform, at, bytemuck::bytes_of(record));
+        }
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("colour"),
+            layout: &kernel.colour_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &uniform,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(16),
+                }),
+            }],
+        });
+        Self {
+            group,
+            groups: records.iter().map(|c| c[3] / WORKGROUP).collect(),
+        }
+    }
+
+    /// Records `pipeline` over every colour in order, with the substep's `group`.
+    pub(super) fn sweep(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        pipeline: &wgpu::ComputePipeline,
+        group: &wgpu::BindGroup,
+    ) {
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, group, &[]);
+        for (k, &groups) in self.groups.iter().enumerate() {
+            let offset = (k as u64 * COLOUR_STRIDE) as u32;
+            pass.set_bind_group(1, &self.group, &[offset]);
+            pass.dispatch_workgroups(groups, 1, 1);
+        }
+    }
+}
+
+/// The record of a colour of `count` entries from `first`: `serial` when they may share a
+/// particle (one invocation takes them in order), else one invocation each (at most
+/// [`MOST_GROUPS`] workgroups, each invocation taking every so many).
+pub(super) fn colour_record(first: usize, count: usize, serial: bool) -> [u32; 4] {
+    let count = count as u32;
+    let groups = if serial {
+        1
+    } else {
+        count.div_ceil(WORKGROUP).clamp(1, MOST_GROUPS)
+    };
+    [first as u32, count, u32::from(serial), groups * WORKGROUP]
+}
+
+/// XPBD's constraints on the device and its colours.
 pub(super) struct XpbdPass {
     /// Bound in the substep's group 0.
     pub(super) constraints: wgpu::Buffer,
-    colour_group: wgpu::BindGroup,
-    /// Workgroups per colour, in order.
-    groups: Vec<u32>,
+    colours: Colours,
     pub(super) count: u32,
 }
 
@@ -56,16 +129,7 @@ pub(super) fn pack_constraints(halves: &Halves) -> (Vec<GpuConstraint>, Vec<[u32
     let order = (halves.halves.iter().flatten()).chain(&halves.seam);
     let colours = order
         .filter(|(range, _)| !range.is_empty())
-        .map(|(range, independent)| {
-            let count = range.len() as u32;
-            let groups = if *independent {
-                count.div_ceil(WORKGROUP).min(MOST_GROUPS)
-            } else {
-                1
-            };
-            let serial = u32::from(!*independent);
-            [range.start as u32, count, serial, groups * WORKGROUP]
-        })
+        .map(|(range, independent)| colour_record(range.start, range.len(), !*independent))
         .collect();
     (constraints, colours)
 }
@@ -79,45 +143,19 @@ impl XpbdPass {
         halves: Option<&Halves>,
     ) -> Self {
         let (constraints, colours) = halves.map(pack_constraints).unwrap_or_default();
-        let buffer = |label, size: u64, usage| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size,
-                usage: usage | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
         let bytes = (constraints.len() * size_of::<GpuConstraint>()) as u64;
-        let storage = buffer(
-            "xpbd constraints",
-            bytes.max(32),
-            wgpu::BufferUsages::STORAGE,
-        );
-        let records = (colours.len() as u64).max(1) * COLOUR_STRIDE;
-        let uniform = buffer("xpbd colours", records, wgpu::BufferUsages::UNIFORM);
+        let storage = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("xpbd constraints"),
+            size: bytes.max(32),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         if !constraints.is_empty() {
             queue.write_buffer(&storage, 0, bytemuck::cast_slice(&constraints));
         }
-        for (k, record) in colours.iter().enumerate() {
-            let at = k as u64 * COLOUR_STRIDE;
-            queue.write_buffer(&uniform, at, bytemuck::bytes_of(record));
-        }
-        let colour_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("xpbd colour"),
-            layout: &kernel.colour_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &uniform,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(16),
-                }),
-            }],
-        });
         Self {
             constraints: storage,
-            colour_group,
-            groups: colours.iter().map(|c| c[3] / WORKGROUP).collect(),
+            colours: Colours::new(device, queue, kernel, &colours),
             count: constraints.len() as u32,
         }
     }
@@ -129,12 +167,6 @@ impl XpbdPass {
         kernel: &SubstepKernel,
         group: &wgpu::BindGroup,
     ) {
-        pass.set_pipeline(&kernel.project);
-        pass.set_bind_group(0, group, &[]);
-        for (k, &groups) in self.groups.iter().enumerate() {
-            let offset = (k as u64 * COLOUR_STRIDE) as u32;
-            pass.set_bind_group(1, &self.colour_group, &[offset]);
-            pass.dispatch_workgroups(groups, 1, 1);
-        }
+        self.colours.sweep(pass, &kernel.project, group);
     }
 }

@@ -229,7 +229,7 @@ impl<R: Real> CpuStepper<R> {
         }
         if contacts > 0 {
             // Contacts changed positions and velocities after the integrator's step.
-            self.integrator.invalidate();
+            self.integrator.contacts_moved();
         }
         Ok(())
     }

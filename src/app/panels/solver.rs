@@ -24,8 +24,8 @@ impl Panel for SolverPanel {
             if ui
                 .selectable_label(on_gpu, "GPU")
                 .on_hover_text(
-                    "wgpu compute: semi-implicit Euler, springs, gravity, air damping, pins, \
-                     spheres and planes",
+                    "wgpu compute: semi-implicit Euler, XPBD and VBD; springs, gravity, air \
+                     damping, wind, dihedral bending, pins, spheres and planes",
                 )
                 .clicked()
                 && !on_gpu

@@ -46,8 +46,14 @@ pub trait Integrator<R: Real = f32>: Send {
     }
 
     /// Forgets what was kept from earlier steps: the state changed outside the integrator
-    /// (a contact, a rollback, a pin or density change, a drag).
+    /// (a rollback, a pin or density change, a drag).
     fn invalidate(&mut self) {}
+
+    /// Contacts moved particles and changed their velocities after the last step: by
+    /// default as [`Integrator::invalidate`].
+    fn contacts_moved(&mut self) {
+        self.invalidate();
+    }
 
     /// The forces or their strengths changed: drops whatever was derived from them, and
     /// whatever was kept from earlier steps.

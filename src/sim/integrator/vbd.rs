@@ -198,6 +198,13 @@ impl<R: Real> Integrator<R> for Vbd<R> {
         self.previous = None;
     }
 
+    /// Keeps the last velocities: what contacts did to a particle is part of the change of
+    /// velocity its next first guess reads, and a collider's push (against the external
+    /// acceleration) clamps to nothing there, so a particle resting on a collider starts
+    /// where it rests. Forgetting them would start every particle of a cloth that touches
+    /// anything from the inertial guess, below the surface it rests on.
+    fn contacts_moved(&mut self) {}
+
     /// The stencil keeps the springs' strengths: new strengths make it stale.
     fn forces_changed(&mut self) {
         self.stencil = None;

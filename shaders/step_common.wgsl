@@ -1,0 +1,171 @@
+// What the step shaders share (prepended to shaders/substep.wgsl and shaders/vbd.wgsl
+// when their pipelines are built, src/gpu/kernel.rs): the particle layout, the uniform
+// parameters, the bindings every step kernel has, the element forces' gather and the
+// colliders. The constants below are the host's (src/gpu/packing.rs; a test compares them).
+
+// Low bits of a spring end's `other` that hold its strength class.
+const CLASS_BITS: u32 = 4u;
+// Strength classes the table holds: 1 << CLASS_BITS.
+const CLASSES: u32 = 16u;
+
+struct Particle {
+    // xyz: position (m); w: inverse mass (1/kg), 0 for a pinned particle.
+    x: vec4<f32>,
+    // xyz: velocity (m/s).
+    v: vec4<f32>,
+}
+
+struct Neighbour {
+    // Low CLASS_BITS bits: the strength class; the bits above: the other end's index.
+    other: u32,
+    // Rest length (m).
+    rest: f32,
+}
+
+struct Collider {
+    // x: kind (0 none, 1 sphere, 2 plane); y: radius; z: friction.
+    info: vec4<f32>,
+    // Sphere: centre; plane: a point on it.
+    a: vec4<f32>,
+    // Sphere: angular velocity (rad/s); plane: unit normal.
+    b: vec4<f32>,
+}
+
+struct Params {
+    // xyz: gravity (m/s²); w: substep length h (s).
+    gravity: vec4<f32>,
+    // x: air damping rate (1/s); y: collision offset (m).
+    drag: vec4<f32>,
+    // x: particle count; y: collider count; z: constraints (XPBD); w: invocations a
+    // particle dispatch has (each zeroes the multipliers a stride of it apart).
+    counts: vec4<u32>,
+    // VBD: where the stencil's spans, links and per-particle memory start in its words, and
+    // 1 when the memory holds no last acceleration (the first step after a change).
+    solver: vec4<u32>,
+    colliders: array<Collider, 4>,
+}
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> src: array<Particle>;
+@group(0) @binding(2) var<storage, read_write> dst: array<Particle>;
+@group(0) @binding(3) var<storage, read> offsets: array<u32>;
+@group(0) @binding(4) var<storage, read> neighbours: array<Neighbour>;
+// Per strength class: x stiffness (N/m), y damping (N·s/m).
+@group(0) @binding(5) var<uniform> classes: array<vec4<f32>, CLASSES>;
+// [0].x: substeps the submission has taken (invocation 0 counts them for the element pass's
+// clock); then the element forces' slots.
+@group(0) @binding(6) var<storage, read_write> element_forces: array<vec4<f32>>;
+// Per particle its range of slots (the first particle count + 1 entries), then the slots.
+@group(0) @binding(7) var<storage, read> incidence: array<u32>;
+
+// The colour one dispatch of XPBD's projection or VBD's descent takes: x its first entry
+// (constraint or particle in colour order), y how many, z 1 when they may share a particle
+// (then one invocation takes them in order), w the invocations dispatched (each takes the
+// entries a stride of it apart).
+@group(1) @binding(0) var<uniform> colour: vec4<u32>;
+
+// Lengths at or below this are taken as zero (the CPU's `Real::TINY_LENGTH` for f32).
+const TINY_LENGTH: f32 = 1e-9;
+
+// The first point where the segment a→b (relative to the centre) enters the sphere of
+// radius r, if it starts outside and crosses in during the segment.
+fn first_entry(a: vec3<f32>, b: vec3<f32>, r: f32) -> vec4<f32> {
+    let d = b - a;
+    let aa = dot(a, a);
+    let dd = dot(d, d);
+    if (aa < r * r || dd == 0.0) {
+        return vec4<f32>(0.0);
+    }
+    let half_b = dot(a, d);
+    let disc = half_b * half_b - dd * (aa - r * r);
+    if (half_b >= 0.0 || disc < 0.0) {
+        return vec4<f32>(0.0);
+    }
+    let t = (-half_b - sqrt(disc)) / dd;
+    if (t < 0.0 || t > 1.0) {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(a + t * d, 1.0);
+}
+
+fn unit_or_up(p: vec3<f32>) -> vec3<f32> {
+    let len = length(p);
+    if (len > 1e-9) {
+        return p / len;
+    }
+    return vec3<f32>(0.0, 1.0, 0.0);
+}
+
+// The element forces (wind, dihedral bending) on particle `i`: its slots, summed.
+fn element_force(i: u32) -> vec3<f32> {
+    var f = vec3<f32>(0.0);
+    let slots = params.counts.x + 1u;
+    for (var s = incidence[i]; s < incidence[i + 1u]; s = s + 1u) {
+        f = f + element_forces[1u + incidence[slots + s]].xyz;
+    }
+    return f;
+}
+
+struct Motion {
+    x: vec3<f32>,
+    v: vec3<f32>,
+}
+
+// `end` (position and velocity after a substep that started at `x`) with the sphere and
+// plane colliders resolved against the substep's path, with friction.
+fn collide(x: vec3<f32>, end: Motion) -> Motion {
+    var nx = end.x;
+    var nv = end.v;
+    let offset = params.drag.y;
+    for (var c = 0u; c < params.counts.y; c = c + 1u) {
+        let col = params.colliders[c];
+        let mu = col.info.z;
+        var caught = false;
+        var n = vec3<f32>(0.0, 1.0, 0.0);
+        var v_surface = vec3<f32>(0.0);
+        if (col.info.x == 1.0) {
+            let centre = col.a.xyz;
+            let radius = col.info.y;
+            let reach = radius + offset;
+            let entry = first_entry(x - centre, nx - centre, reach);
+            let to = nx - centre;
+            if (entry.w == 1.0 || dot(to, to) < reach * reach) {
+                var moved = to;
+                if (entry.w == 1.0) {
+                    let hit = entry.xyz;
+                    let hn = unit_or_up(hit);
+                    let rest = to - hit;
+                    moved = hit + rest - min(dot(rest, hn), 0.0) * hn;
+                }
+                let len = length(moved);
+                n = unit_or_up(moved);
+                nx = centre + n * max(reach, len);
+                v_surface = cross(col.b.xyz, n * radius);
+                caught = true;
+            }
+        } else if (col.info.x == 2.0) {
+            let normal = col.b.xyz;
+            let depth = offset - dot(nx - col.a.xyz, normal);
+            if (depth > 0.0) {
+                nx = nx + depth * normal;
+                n = normal;
+                caught = true;
+            }
+        }
+        if (caught) {
+            let v_rel = nv - v_surface;
+            let vn = dot(v_rel, n);
+            if (vn < 0.0) {
+                let v_t = v_rel - vn * n;
+                let t_speed = length(v_t);
+                var keep = 0.0;
+                if (t_speed > 0.0) {
+                    keep = max(1.0 - mu * (-vn) / t_speed, 0.0);
+                }
+                nv = v_surface + keep * v_t;
+            }
+        }
+    }
+    return Motion(nx, nv);
+}
+
