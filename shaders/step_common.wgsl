@@ -42,6 +42,11 @@ struct Params {
     // VBD: where the stencil's spans, links and per-particle memory start in its words, and
     // 1 when the memory holds no last acceleration (the first step after a change).
     solver: vec4<u32>,
+    // A grid cloth: x its width (0: not a grid), y its height, z its links.
+    grid: vec4<u32>,
+    // Per link: the other particle x columns and y rows away (i32 bits), z the spring's
+    // strength class, w the bits of its rest length.
+    links: array<vec4<u32>, 16>,
     colliders: array<Collider, 4>,
 }
 

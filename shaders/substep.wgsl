@@ -26,6 +26,18 @@ struct Constraint {
 // XPBD's springs as constraints, in colour order.
 @group(0) @binding(8) var<storage, read_write> constraints: array<Constraint>;
 
+// The pull (N) of a spring of stiffness and damping `kc.xy` and rest length `rest` from a
+// particle at `x` moving at `v` to the particle `o`.
+fn spring_pull(x: vec3<f32>, v: vec3<f32>, o: Particle, kc: vec4<f32>, rest: f32) -> vec3<f32> {
+    let d = o.x.xyz - x;
+    let len = length(d);
+    if (len > 1e-9) {
+        let n = d / len;
+        return (kc.x * (len - rest) + kc.y * dot(o.v.xyz - v, n)) * n;
+    }
+    return vec3<f32>(0.0);
+}
+
 @compute @workgroup_size(64)
 fn substep(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
@@ -44,15 +56,26 @@ fn substep(@builtin(global_invocation_id) id: vec3<u32>) {
     let x = me.x.xyz;
     let v = me.v.xyz;
     var f = vec3<f32>(0.0);
-    for (var s = offsets[i]; s < offsets[i + 1u]; s = s + 1u) {
-        let nb = neighbours[s];
-        let o = src[nb.other >> CLASS_BITS];
-        let kc = classes[nb.other & (CLASSES - 1u)];
-        let d = o.x.xyz - x;
-        let len = length(d);
-        if (len > 1e-9) {
-            let n = d / len;
-            f = f + (kc.x * (len - nb.rest) + kc.y * dot(o.v.xyz - v, n)) * n;
+    if (params.grid.x > 0u) {
+        // A grid: the neighbours follow from the index, nothing is read to find them.
+        let width = i32(params.grid.x);
+        let height = i32(params.grid.y);
+        let col = i32(i % params.grid.x);
+        let row = i32(i / params.grid.x);
+        for (var l = 0u; l < params.grid.z; l = l + 1u) {
+            let link = params.links[l];
+            let c = col + bitcast<i32>(link.x);
+            let r = row + bitcast<i32>(link.y);
+            if (c >= 0 && r >= 0 && c < width && r < height) {
+                let o = src[u32(r * width + c)];
+                f = f + spring_pull(x, v, o, classes[link.z], bitcast<f32>(link.w));
+            }
+        }
+    } else {
+        for (var s = offsets[i]; s < offsets[i + 1u]; s = s + 1u) {
+            let nb = neighbours[s];
+            let o = src[nb.other >> CLASS_BITS];
+            f = f + spring_pull(x, v, o, classes[nb.other & (CLASSES - 1u)], nb.rest);
         }
     }
     f = f + element_force(i);

@@ -320,4 +320,50 @@ mod tests {
             assert!(!measured(&bad).motion.finite, "{which}: {value}");
         }
     }
+
+    /// The bench cloth is a grid: its substep gathers the springs from the index, and ends
+    /// where the gather over the spring ends takes it, to 10⁻⁶ m after 1 s (the sums in
+    /// another order); with each link given the next one's rest length, or rows taken for
+    /// columns, it ends metres away.
+    #[test]
+    fn the_grid_gather_steps_the_cloth_the_general_one_does() {
+        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let scene =
+            crate::bench::bench_scene(32, IntegratorKind::SemiImplicitEuler).expect("scene");
+        let (model, params) = (&scene.model, &scene.params);
+        let run = |grid: bool| {
+            let mut stepper =
+                GpuStepper::new(&gpu.device, &gpu.queue, model, params, &scene.effects, true)
+                    .expect("stepper");
+            assert_eq!(
+                stepper.params.grid[0], 32,
+                "the bench cloth is found a grid"
+            );
+            if !grid {
+                stepper.grid_path = false;
+                stepper.sent = None;
+                stepper.configure(
+                    model,
+                    params,
+                    &scene.effects,
+                    crate::sim::Changes::STRENGTHS,
+                );
+                assert_eq!(stepper.params.grid[0], 0);
+            }
+            let mut state = scene.initial.clone();
+            for _ in 0..60 {
+                stepper.frame(model, &mut state).expect("frame");
+            }
+            state
+        };
+        let (grid, general) = (run(true), run(false));
+        let worst = (grid.pos.iter().zip(&general.pos))
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0f32, f32::max);
+        let moved = (grid.pos.iter().zip(&scene.initial.pos))
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0f32, f32::max);
+        eprintln!("grid against general: {worst:e} m of {moved} m");
+        assert!(moved > 0.005 && worst < 1e-6, "{worst} m apart");
+    }
 }

@@ -105,6 +105,7 @@ pub(super) fn classify(material: &Material, effects: &[Effect]) -> (EndsKey, Cla
 
 /// The springs as the shader reads them: per particle its range of `ends` (CSR offsets),
 /// each end its other particle and class.
+#[derive(Clone)]
 pub(super) struct PackedSprings {
     pub(super) offsets: Vec<u32>,
     pub(super) ends: Vec<Neighbour>,
@@ -134,6 +135,98 @@ pub(super) fn pack_springs(model: &ClothModel, key: &EndsKey) -> PackedSprings {
     PackedSprings { offsets, ends }
 }
 
+/// Links a grid particle may have (a 12-neighbour stencil has 12).
+pub(super) const MAX_LINKS: usize = 16;
+
+/// One link of a grid's stencil: the other particle `di` columns and `dj` rows away (two's
+/// complement), the spring's strength class and the bits of its rest length.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub(super) struct GridLink {
+    pub(super) di: i32,
+    pub(super) dj: i32,
+    pub(super) class: u32,
+    pub(super) rest: f32,
+}
+
+/// A cloth whose particles are a `width` × `height` grid numbered row by row, every one
+/// joined to the same neighbours (those the grid's edges leave) by springs of the same
+/// class and rest length: the springs a particle gathers follow from its index.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct GridStencil {
+    pub(super) width: u32,
+    pub(super) height: u32,
+    pub(super) links: Vec<GridLink>,
+}
+
+/// Rest lengths of one link that differ by more than this fraction are not one link: the
+/// rest lengths come from positions in f32 and differ by about 10⁻⁶ of themselves along a
+/// regular grid (the flag's 5 cm structural springs by 6 × 10⁻⁸ m), so the grid path takes
+/// the first one's for all, a prestrain of at most this much.
+const REST_SPREAD: f32 = 1e-5;
+
+/// The grid `packed` (the spring ends of `count` particles) is, if it is one: tried for
+/// each width that particle 0's neighbours suggest.
+pub(super) fn grid_of(packed: &PackedSprings, count: usize) -> Option<GridStencil> {
+    let first = packed.offsets.first().copied()? as usize..*packed.offsets.get(1)? as usize;
+    let mut widths: Vec<usize> = (packed.ends[first].iter())
+        .map(|e| (e.other >> CLASS_BITS) as usize)
+        .flat_map(|q| [q.saturating_sub(1), q, q + 1])
+        .filter(|&w| w >= 2 && count.is_multiple_of(w) && count / w >= 2)
+        .collect();
+    widths.sort_unstable();
+    widths.dedup();
+    widths
+        .into_iter()
+        .find_map(|w| grid_with_width(packed, count, w))
+}
+
+/// [`grid_of`] for one width.
+fn grid_with_width(packed: &PackedSprings, count: usize, width: usize) -> Option<GridStencil> {
+    let height = count / width;
+    let mut links: Vec<GridLink> = Vec::new();
+    let place = |p: usize| ((p % width) as i32, (p / width) as i32);
+    for p in 0..count {
+        let (i, j) = place(p);
+        let range = packed.offsets[p] as usize..packed.offsets[p + 1] as usize;
+        for end in &packed.ends[range] {
+            let (oi, oj) = place((end.other >> CLASS_BITS) as usize);
+            let link = GridLink {
+                di: oi - i,
+                dj: oj - j,
+                class: end.other & ((1 << CLASS_BITS) - 1),
+                rest: end.rest,
+            };
+            match links.iter().find(|l| (l.di, l.dj) == (link.di, link.dj)) {
+                Some(l)
+                    if l.class == link.class
+                        && (l.rest - link.rest).abs() <= REST_SPREAD * l.rest.abs() => {}
+                Some(_) => return None,
+                None if links.len() < MAX_LINKS => links.push(link),
+                None => return None,
+            }
+        }
+    }
+    // Each end is one of the links; every link that stays on the grid must be one of the
+    // particle's ends (no more of them than links, no link twice).
+    let all = (0..count).all(|p| {
+        let (i, j) = place(p);
+        let on_grid = (links.iter())
+            .filter(|l| {
+                let (a, b) = (i + l.di, j + l.dj);
+                a >= 0 && b >= 0 && a < width as i32 && b < height as i32
+            })
+            .count();
+        on_grid == (packed.offsets[p + 1] - packed.offsets[p]) as usize
+    });
+    links.sort_by_key(|l| (l.dj, l.di));
+    all.then_some(GridStencil {
+        width: width as u32,
+        height: height as u32,
+        links,
+    })
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub(super) struct GpuCollider {
@@ -151,6 +244,9 @@ pub(super) struct Params {
     /// VBD: where its stencil's spans, links and memory start, and 1 when the memory is
     /// stale.
     pub(super) solver: [u32; 4],
+    /// A grid cloth's width and height in particles and its links (0 wide: not a grid).
+    pub(super) grid: [u32; 4],
+    pub(super) links: [GridLink; MAX_LINKS],
     pub(super) colliders: [GpuCollider; MAX_COLLIDERS],
 }
 
@@ -237,5 +333,45 @@ pub(super) mod tests {
             }
             assert_eq!(used.len(), classes, "one class per kind sent: {used:?}");
         }
+    }
+
+    /// The packed ends of `scene`'s springs as the GPU gets them.
+    fn packed(scene: &crate::scene::Scene) -> PackedSprings {
+        let (key, _) = classify(&scene.params.material, &scene.effects);
+        pack_springs(&scene.model, &key)
+    }
+
+    /// The bench cloth is a grid of 12 links (structural, shear, skip-one bends), its rows
+    /// N particles wide; the flag (dihedral bending: no bend springs sent) one of 8 links,
+    /// 31 wide; five cloths stacked one after another are not one grid (no springs between
+    /// them), nor is the bench cloth with one spring end gone.
+    #[test]
+    fn a_grid_cloth_is_found_with_its_links_and_nothing_else_is() {
+        let options = crate::mesh::ImportOptions::default();
+        let bench = crate::scene::Scene::open_resized("hanging-bench", None, &options, Some(15))
+            .expect("scene");
+        let ends = packed(&bench);
+        let grid = grid_of(&ends, 256).expect("the bench cloth is a grid");
+        assert_eq!((grid.width, grid.height, grid.links.len()), (16, 16, 12));
+        let offsets: Vec<(i32, i32)> = grid.links.iter().map(|l| (l.di, l.dj)).collect();
+        for o in [(1, 0), (0, 1), (1, 1), (-1, 1), (2, 0), (0, 2)] {
+            assert!(
+                offsets.contains(&o) && offsets.contains(&(-o.0, -o.1)),
+                "{o:?}"
+            );
+        }
+        let flag = crate::scene::Scene::builtin("flag").expect("scene");
+        let grid = grid_of(&packed(&flag), flag.model.particle_count()).expect("a grid");
+        assert_eq!((grid.width, grid.height, grid.links.len()), (31, 21, 8));
+        let layers = crate::scene::Scene::builtin("layers").expect("scene");
+        assert_eq!(
+            grid_of(&packed(&layers), layers.model.particle_count()),
+            None
+        );
+        let mut gone = ends.clone();
+        let p = 16 * 8 + 8;
+        gone.ends.remove(gone.offsets[p] as usize);
+        gone.offsets[p + 1..].iter_mut().for_each(|o| *o -= 1);
+        assert_eq!(grid_of(&gone, 256), None);
     }
 }

@@ -22,7 +22,7 @@ use super::error::GpuError;
 use super::health::{HealthKernel, Watch};
 use super::kernel::{SubstepKernel, WORKGROUP};
 use super::packing::{
-    ClassTable, EndsKey, Neighbour, Params, Particle, classify, pack_solids, pack_springs,
+    ClassTable, EndsKey, Neighbour, Params, Particle, classify, grid_of, pack_solids, pack_springs,
 };
 use super::snapshot::DeviceSnapshot;
 use super::support::{check_device, fits_buffers, fits_elements, gpu_support};
@@ -86,7 +86,7 @@ pub struct GpuStepper {
     display: Option<wgpu::Buffer>,
     pub(super) current: usize,
     count: u32,
-    params: Params,
+    pub(super) params: Params,
     pub(super) dt: f32,
     /// Substeps per frame in effect (the guard may have raised them), and as requested.
     pub(super) substeps: u32,
@@ -106,8 +106,10 @@ pub struct GpuStepper {
     stats: StepStats,
     /// The key the device's spring ends were packed with (`None` before the first
     /// upload), and how many times the ends were sent.
-    sent: Option<EndsKey>,
+    pub(super) sent: Option<EndsKey>,
     ends_sent: u32,
+    /// A grid cloth's substep gathers its springs from the index (else from the ends).
+    pub(super) grid_path: bool,
 }
 
 impl GpuStepper {
@@ -232,6 +234,7 @@ impl GpuStepper {
             stats: StepStats::default(),
             sent: None,
             ends_sent: 0,
+            grid_path: true,
         };
         stepper.configure(model, params, effects, Changes::all());
         match stepper.unsupported.take() {
@@ -280,6 +283,12 @@ impl GpuStepper {
             .write_buffer(&self.classes, 0, bytemuck::cast_slice(&table));
         if self.sent != Some(key) {
             let packed = pack_springs(model, &key);
+            let grid = grid_of(&packed, model.particle_count()).filter(|_| self.grid_path);
+            self.params.grid = [0; 4];
+            if let Some(g) = grid {
+                self.params.grid = [g.width, g.height, g.links.len() as u32, 0];
+                self.params.links[..g.links.len()].copy_from_slice(&g.links);
+            }
             self.queue
                 .write_buffer(&self.offsets, 0, bytemuck::cast_slice(&packed.offsets));
             if !packed.ends.is_empty() {
