@@ -5,12 +5,7 @@
 //   relative to the gusting air; a third goes to each corner, so the triangle has one slot.
 // - Dihedral bending (src/sim/forces/dihedral.rs): each hinge's force on its four points,
 //   four slots.
-// The arithmetic is the CPU's in its order, in f32.
-
-struct Particle {
-    x: vec4<f32>,
-    v: vec4<f32>,
-}
+// The arithmetic is the CPU's in its order, in f32. Prepended with shaders/cloth_layout.wgsl.
 
 struct Params {
     // x: the submission's start time (s); y: substep length h (s); z: dihedral stiffness

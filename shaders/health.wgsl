@@ -4,20 +4,9 @@
 // position and velocity is finite, the fastest speed squared, the largest relative
 // extension of a spring, the lowest height along `up` and the kinetic energy. No atomics:
 // the records fold in a fixed order, so the sums do not depend on how the GPU schedules.
-// The particle layout and the spring ends are the substep's (shaders/substep.wgsl).
+// Prepended with shaders/cloth_layout.wgsl (the particles and spring ends).
 
-const CLASS_BITS: u32 = 4u;
 const GROUP: u32 = 64u;
-
-struct Particle {
-    x: vec4<f32>,
-    v: vec4<f32>,
-}
-
-struct Neighbour {
-    other: u32,
-    rest: f32,
-}
 
 struct Health {
     // x: fastest speed² (m²/s²); y: largest strain; z: lowest height (m); w: joules.

@@ -1,26 +1,7 @@
-// What the step shaders share (prepended to shaders/substep.wgsl and shaders/vbd.wgsl
-// when their pipelines are built, src/gpu/kernel.rs): the particle layout, the uniform
-// parameters, the bindings every step kernel has, the element forces' gather and the
-// colliders. The constants below are the host's (src/gpu/packing.rs; a test compares them).
-
-// Low bits of a spring end's `other` that hold its strength class.
-const CLASS_BITS: u32 = 4u;
-// Strength classes the table holds: 1 << CLASS_BITS.
-const CLASSES: u32 = 16u;
-
-struct Particle {
-    // xyz: position (m); w: inverse mass (1/kg), 0 for a pinned particle.
-    x: vec4<f32>,
-    // xyz: velocity (m/s).
-    v: vec4<f32>,
-}
-
-struct Neighbour {
-    // Low CLASS_BITS bits: the strength class; the bits above: the other end's index.
-    other: u32,
-    // Rest length (m).
-    rest: f32,
-}
+// What the step shaders share (prepended, after shaders/cloth_layout.wgsl, to
+// shaders/substep.wgsl and shaders/vbd.wgsl when their pipelines are built,
+// src/gpu/kernel.rs): the uniform parameters, the bindings every step kernel has, the
+// element forces' gather and the colliders.
 
 struct Collider {
     // x: kind (0 none, 1 sphere, 2 plane); y: radius; z: friction.
@@ -174,3 +155,26 @@ fn collide(x: vec3<f32>, end: Motion) -> Motion {
     return Motion(nx, nv);
 }
 
+// The last pass of XPBD and VBD for particle `i`, with the state bound as `dst`: a free
+// particle moves by its displacement `d` with velocity d / h and the colliders are
+// resolved. Returns the particle's velocity before and after (equal for a pinned one,
+// which stays).
+fn move_by(i: u32, d: vec3<f32>) -> array<vec3<f32>, 2> {
+    let me = dst[i];
+    let w = me.x.w;
+    if (w == 0.0) {
+        return array<vec3<f32>, 2>(me.v.xyz, me.v.xyz);
+    }
+    let x = me.x.xyz;
+    let out = collide(x, Motion(x + d, d * (1.0 / params.gravity.w)));
+    dst[i] = Particle(vec4<f32>(out.x, w), vec4<f32>(out.v, 0.0));
+    return array<vec3<f32>, 2>(me.v.xyz, out.v);
+}
+
+// Counts the substep (invocation 0) and says whether invocation `i` has a particle.
+fn finishing(i: u32) -> bool {
+    if (i == 0u) {
+        element_forces[0].x = element_forces[0].x + 1.0;
+    }
+    return i < params.counts.x;
+}

@@ -160,19 +160,7 @@ fn xpbd_project(@builtin(global_invocation_id) id: vec3<u32>) {
 @compute @workgroup_size(64)
 fn xpbd_finish(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
-    if (i == 0u) {
-        element_forces[0].x = element_forces[0].x + 1.0;
+    if (finishing(i)) {
+        move_by(i, src[i].v.xyz);
     }
-    if (i >= params.counts.x) {
-        return;
-    }
-    let me = dst[i];
-    let w = me.x.w;
-    if (w == 0.0) {
-        return;
-    }
-    let d = src[i].v.xyz;
-    let x = me.x.xyz;
-    let out = collide(x, Motion(x + d, d * (1.0 / params.gravity.w)));
-    dst[i] = Particle(vec4<f32>(out.x, w), vec4<f32>(out.v, 0.0));
 }

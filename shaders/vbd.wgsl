@@ -154,23 +154,11 @@ fn vbd_descend(@builtin(global_invocation_id) id: vec3<u32>) {
 @compute @workgroup_size(64)
 fn vbd_finish(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
-    if (i == 0u) {
-        element_forces[0].x = element_forces[0].x + 1.0;
-    }
-    if (i >= params.counts.x) {
+    if (!finishing(i) || dst[i].x.w == 0.0) {
         return;
     }
-    let me = dst[i];
-    let w = me.x.w;
-    if (w == 0.0) {
-        return;
-    }
-    let h = params.gravity.w;
-    let d = src[i].x.xyz;
-    let x = me.x.xyz;
-    let out = collide(x, Motion(x + d, d * (1.0 / h)));
-    dst[i] = Particle(vec4<f32>(out.x, w), vec4<f32>(out.v, 0.0));
-    let last = (out.v - me.v.xyz) / h;
+    let v = move_by(i, src[i].x.xyz);
+    let last = (v[1] - v[0]) / params.gravity.w;
     let at = memory_at(i);
     stencil[at] = bitcast<u32>(last.x);
     stencil[at + 1u] = bitcast<u32>(last.y);

@@ -8,7 +8,7 @@ use crate::cloth::ClothModel;
 use crate::sim::forces::DihedralBending;
 use crate::sim::{Effect, Force, ForceSet, Wind};
 
-use super::kernel::{Slot, WORKGROUP, bind, layout, pipelines};
+use super::kernel::{LAYOUT, Slot, WORKGROUP, bind, layout, pipelines};
 
 /// The shader's source.
 const SOURCE: &str = include_str!("../../shaders/elements.wgsl");
@@ -108,7 +108,7 @@ impl ElementKernel {
         let [pipeline] = pipelines(
             device,
             "cloth elements",
-            SOURCE,
+            &format!("{LAYOUT}{SOURCE}"),
             [("elements_forces", &[&layout])],
         );
         let buffer = |label, bytes: usize, usage| {

@@ -9,7 +9,7 @@ use crate::device::map_read;
 use crate::sim::Motion;
 
 use super::error::GpuError;
-use super::kernel::{Slot, WORKGROUP, bind, layout, pipelines};
+use super::kernel::{LAYOUT, Slot, WORKGROUP, bind, layout, pipelines};
 
 /// The shader's source.
 const SOURCE: &str = include_str!("../../shaders/health.wgsl");
@@ -86,7 +86,7 @@ impl HealthKernel {
         let [partial, total] = pipelines(
             device,
             "cloth health",
-            SOURCE,
+            &format!("{LAYOUT}{SOURCE}"),
             [("partial", one), ("total", one)],
         );
         let first = count.div_ceil(WORKGROUP).max(1);
@@ -182,14 +182,12 @@ impl HealthKernel {
 
 #[cfg(test)]
 mod tests {
-    use super::super::packing::CLASS_BITS;
     use super::*;
 
-    /// The reduction's shader decodes spring ends and sizes its workgroups as the host
-    /// packs and dispatches them.
+    /// The reduction's shader sizes its workgroups as the host dispatches them (the spring
+    /// ends it decodes are the layout's, compared in `kernel`).
     #[test]
     fn the_health_shader_and_the_host_agree_on_their_constants() {
-        assert!(SOURCE.contains(&format!("const CLASS_BITS: u32 = {CLASS_BITS}u;")));
         assert!(SOURCE.contains(&format!("const GROUP: u32 = {WORKGROUP}u;")));
         assert_eq!(SOURCE.matches("@workgroup_size(64)").count(), 2);
         assert_eq!(WORKGROUP, 64);

@@ -5,7 +5,9 @@
 /// Particles per workgroup (the shader's `@workgroup_size`; a test compares them).
 pub(super) const WORKGROUP: u32 = 64;
 
-/// What the step shaders share: particles, parameters, bindings, element forces, colliders.
+/// What every compute shader of the backend reads the cloth as: particles and spring ends.
+pub(super) const LAYOUT: &str = include_str!("../../shaders/cloth_layout.wgsl");
+/// What the step shaders share: parameters, bindings, element forces, colliders.
 pub(super) const COMMON: &str = include_str!("../../shaders/step_common.wgsl");
 /// Semi-implicit Euler's and XPBD's entry points.
 pub(super) const SOURCE: &str = include_str!("../../shaders/substep.wgsl");
@@ -144,7 +146,7 @@ impl SubstepKernel {
         let [pipeline, predict, project, finish] = pipelines(
             device,
             "cloth substep",
-            &format!("{COMMON}{SOURCE}"),
+            &format!("{LAYOUT}{COMMON}{SOURCE}"),
             [
                 ("substep", one),
                 ("xpbd_predict", one),
@@ -155,7 +157,7 @@ impl SubstepKernel {
         let [vbd_predict, descend, vbd_finish] = pipelines(
             device,
             "cloth vbd",
-            &format!("{COMMON}{VBD}"),
+            &format!("{LAYOUT}{COMMON}{VBD}"),
             [
                 ("vbd_predict", one),
                 ("vbd_descend", two),
@@ -225,7 +227,7 @@ mod tests {
 
     /// The value of `const NAME: u32 = …u;` in the shader.
     fn shader_const(name: &str) -> u32 {
-        let line = (COMMON.lines())
+        let line = (LAYOUT.lines())
             .find(|l| l.starts_with(&format!("const {name}: u32 = ")))
             .unwrap_or_else(|| panic!("no `const {name}` in the shader"));
         let value = line.split('=').nth(1).unwrap_or_default();

@@ -628,11 +628,7 @@ impl StepBackend for GpuStepper {
         }
         self.params.drag[1] = params.contact.offset;
         self.dt = params.step.dt;
-        if changes.contains(Changes::GUARD) && self.guard.policy != params.guard {
-            self.guard = GuardState::new(params.guard.clone());
-        }
-        // Limits and rollback points belong to the old parameters.
-        self.guard.forget_history();
+        self.guard.reconfigure(&params.guard);
         // Substeps the guard raised stay unless the request changed.
         let requested = params.step.substeps.max(1);
         if requested != self.requested {

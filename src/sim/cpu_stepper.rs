@@ -561,11 +561,7 @@ impl<R: Real> StepBackend for CpuStepper<R> {
         self.solver = params.solver;
         self.dt = params.step.dt;
         self.offset = params.contact.offset;
-        if changes.contains(Changes::GUARD) && self.guard.policy != params.guard {
-            self.guard = GuardState::new(params.guard.clone());
-        }
-        // Limits and rollback points belong to the old parameters.
-        self.guard.forget_history();
+        self.guard.reconfigure(&params.guard);
         let requested = params.step.substeps.max(1);
         if requested != self.requested {
             self.requested = requested;

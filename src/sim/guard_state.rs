@@ -56,6 +56,15 @@ impl<S: Snapshot> GuardState<S> {
         }
     }
 
+    /// New parameters: a new `policy` starts the guard afresh; either way the limits and
+    /// rollback points belong to the old parameters.
+    pub fn reconfigure(&mut self, policy: &GuardPolicy) {
+        if self.policy != *policy {
+            *self = Self::new(policy.clone());
+        }
+        self.forget_history();
+    }
+
     /// The history changed outside the stepper: old rollback points and limits are stale.
     pub fn forget_history(&mut self) {
         self.limits = None;
