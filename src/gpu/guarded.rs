@@ -2,9 +2,10 @@
 //! ([`crate::sim::GuardLimits`], [`crate::sim::GuardState`]), with the state measured by a
 //! reduction on the device and rolled back from copies kept there. A frame that breaks a
 //! limit is redone from the last checkpoint with twice the substeps, up to the policy's
-//! refinements; raised substeps come back down after a run of healthy frames. The GPU runs
-//! one integrator, so the policy's fallback integrator is not tried: when every refinement
-//! fails the state is the frame's start and the run stops with the likely cause.
+//! refinements; raised substeps come back down after a run of healthy frames. When every
+//! refinement fails, the policy's fallback integrator is tried at the requested substeps if
+//! the GPU runs it (XPBD, VBD; not the default, implicit Euler); when that fails too, or is
+//! not tried, the state is the frame's start and the run stops with the likely cause.
 
 use std::time::Instant;
 
@@ -13,6 +14,7 @@ use crate::sim::{Cause, Diverged, FrameOutcome, GuardAction, GuardLimits, Troubl
 
 use super::health::Watch;
 use super::stepper::GpuStepper;
+use super::support::GPU_INTEGRATORS;
 
 /// Why a try at a frame failed.
 enum Failed {
@@ -159,6 +161,28 @@ impl GpuStepper {
             }
         }
         let tried = self.substeps;
+        let mut fallback = String::new();
+        if let Some(kind) = self.guard.policy.fallback
+            && kind != self.integrator
+            && GPU_INTEGRATORS.contains(&kind)
+        {
+            let original = self.integrator;
+            self.switch_integrator(kind);
+            self.set_substeps(self.requested);
+            match self.replay(model, state, end) {
+                Ok(()) => {
+                    let action = GuardAction::FellBack { integrator: kind };
+                    (self.guard).record(end, Some(&last), action, (before, self.substeps));
+                    return Ok(FrameOutcome::FellBack { integrator: kind });
+                }
+                Err(Failed::Limit(t)) => {
+                    last = t;
+                    self.switch_integrator(original);
+                    fallback = format!(", and with {}", kind.label());
+                }
+                Err(Failed::Device(why)) => return Err(self.device_failure(state.time, why)),
+            }
+        }
         let start = self.frame_start.clone();
         self.restore(&start);
         self.set_substeps(before);
@@ -180,7 +204,7 @@ impl GpuStepper {
             time: state.time,
             reason: last.to_string(),
             substeps: tried,
-            fallback: String::new(),
+            fallback,
             cause: cause.unwrap_or(Cause::Stiffness),
         })
     }

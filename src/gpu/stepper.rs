@@ -46,10 +46,10 @@ pub struct GpuStepper {
     kernel: SubstepKernel,
     /// Wind and dihedral bending, computed per element before each substep.
     elements: ElementKernel,
-    /// The integrator in effect (one of those the GPU runs), and its sweeps a substep
-    /// (XPBD's or VBD's).
+    /// The integrator in effect (one of those the GPU runs), and XPBD's and VBD's sweeps a
+    /// substep.
     pub(super) integrator: IntegratorKind,
-    sweeps: u32,
+    iterations: [u32; 2],
     /// XPBD's constraints in colour order and VBD's stencil, and whether the one in effect
     /// must be built again (XPBD's from the positions of the next step's start, as the CPU
     /// builds its own).
@@ -195,7 +195,7 @@ impl GpuStepper {
             kernel,
             elements,
             integrator: params.step.integrator,
-            sweeps: 1,
+            iterations: [1, 1],
             xpbd,
             vbd,
             solver_stale: true,
@@ -377,7 +377,7 @@ impl GpuStepper {
                     pass.set_pipeline(predict);
                     pass.set_bind_group(0, this, &[]);
                     pass.dispatch_workgroups(groups, 1, 1);
-                    for _ in 0..self.sweeps {
+                    for _ in 0..self.sweeps() {
                         if vbd {
                             self.vbd.sweep(&mut pass, &self.kernel, this);
                         } else {
@@ -410,7 +410,7 @@ impl GpuStepper {
         if vbd && substeps > 0 {
             self.vbd_fresh = false;
         }
-        let report = substep_report(if solver.is_some() { self.sweeps } else { 0 });
+        let report = substep_report(if solver.is_some() { self.sweeps() } else { 0 });
         for _ in 0..substeps {
             self.stats.record(&report);
         }
@@ -508,6 +508,23 @@ impl GpuStepper {
         time
     }
 
+    /// Sweeps a substep of the integrator in effect (XPBD's or VBD's).
+    fn sweeps(&self) -> u32 {
+        let [xpbd, vbd] = self.iterations;
+        match self.integrator {
+            IntegratorKind::Vbd => vbd,
+            _ => xpbd,
+        }
+        .max(1)
+    }
+
+    /// Makes `kind` (one the GPU runs) the integrator in effect, its data built before the
+    /// next step (the guard's fallback).
+    pub(super) fn switch_integrator(&mut self, kind: IntegratorKind) {
+        self.integrator = kind;
+        self.solver_stale = true;
+    }
+
     /// Makes `substeps` per frame the count in effect.
     pub(super) fn set_substeps(&mut self, substeps: u32) {
         self.substeps = substeps;
@@ -600,14 +617,11 @@ impl StepBackend for GpuStepper {
             self.upload_springs(model, &params.material, effects);
             (self.forces).apply(model, &params.material, effects, changes);
         }
-        if self.unsupported.is_none() {
+        // The integrator the guard fell back to stays until another is asked for.
+        if self.unsupported.is_none() && changes.contains(Changes::INTEGRATOR) {
             self.integrator = params.step.integrator;
         }
-        self.sweeps = match self.integrator {
-            IntegratorKind::Vbd => params.solver.vbd_iterations,
-            _ => params.solver.xpbd_iterations,
-        }
-        .max(1);
+        self.iterations = [params.solver.xpbd_iterations, params.solver.vbd_iterations];
         // New springs or strengths, or XPBD newly in effect: its constraints are built
         // again before the next step, as the CPU's are.
         if changes.intersects(Changes::INTEGRATOR | Changes::EFFECTS | Changes::STRENGTHS) {
@@ -668,7 +682,7 @@ impl StepBackend for GpuStepper {
         self.timed_run(model, state, 1)?;
         state.time += self.substep_length() as f64;
         let sweeps = match self.integrator {
-            IntegratorKind::Xpbd | IntegratorKind::Vbd => self.sweeps,
+            IntegratorKind::Xpbd | IntegratorKind::Vbd => self.sweeps(),
             _ => 0,
         };
         Ok(substep_report(sweeps))
