@@ -25,6 +25,9 @@ struct Params {
     solver: vec4<u32>,
     // A grid cloth: x its width (0: not a grid), y its height, z its links.
     grid: vec4<u32>,
+    // Handles: x where their targets start in `element_forces`, y how many particles they
+    // carry.
+    handles: vec4<u32>,
     // Per link: the other particle x columns and y rows away (i32 bits), z the spring's
     // strength class, w the bits of its rest length.
     links: array<vec4<u32>, 16>,
@@ -38,8 +41,9 @@ struct Params {
 @group(0) @binding(4) var<storage, read> neighbours: array<Neighbour>;
 // Per strength class: x stiffness (N/m), y damping (N·s/m).
 @group(0) @binding(5) var<uniform> classes: array<vec4<f32>, CLASSES>;
-// [0].x: substeps the submission has taken (invocation 0 counts them for the element pass's
-// clock); then the element forces' slots.
+// [0].x: substeps the submission has taken (`tick` counts them after each: the element
+// pass's clock, the handles' targets); then the element forces' slots, then the handles'
+// targets (position, velocity) per substep and carried particle.
 @group(0) @binding(6) var<storage, read_write> element_forces: array<vec4<f32>>;
 // Per particle its range of slots (the first particle count + 1 entries), then the slots.
 @group(0) @binding(7) var<storage, read> incidence: array<u32>;
@@ -155,15 +159,31 @@ fn collide(x: vec3<f32>, end: Motion) -> Motion {
     return Motion(nx, nv);
 }
 
+// A pinned particle `me` where its handle puts it at the end of the submission's current
+// substep (`me` itself when no handle carries it): the host's targets for this substep, the
+// particle's slot among them in `me.v.w` (slot + 1).
+fn placed(me: Particle) -> Particle {
+    let slot = u32(me.v.w);
+    if (slot == 0u) {
+        return me;
+    }
+    let substep = u32(element_forces[0].x);
+    let at = params.handles.x + 2u * (substep * params.handles.y + slot - 1u);
+    let target_x = element_forces[at].xyz;
+    return Particle(vec4<f32>(target_x, me.x.w), vec4<f32>(element_forces[at + 1u].xyz, me.v.w));
+}
+
 // The last pass of XPBD and VBD for particle `i`, with the state bound as `dst`: a free
 // particle moves by its displacement `d` with velocity d / h and the colliders are
-// resolved. Returns the particle's velocity before and after (equal for a pinned one,
-// which stays).
+// resolved; a pinned one goes where its handle puts it, if one does. Returns the particle's
+// velocity before and after.
 fn move_by(i: u32, d: vec3<f32>) -> array<vec3<f32>, 2> {
     let me = dst[i];
     let w = me.x.w;
     if (w == 0.0) {
-        return array<vec3<f32>, 2>(me.v.xyz, me.v.xyz);
+        let to = placed(me);
+        dst[i] = to;
+        return array<vec3<f32>, 2>(me.v.xyz, to.v.xyz);
     }
     let x = me.x.xyz;
     let out = collide(x, Motion(x + d, d * (1.0 / params.gravity.w)));
@@ -171,10 +191,7 @@ fn move_by(i: u32, d: vec3<f32>) -> array<vec3<f32>, 2> {
     return array<vec3<f32>, 2>(me.v.xyz, out.v);
 }
 
-// Counts the substep (invocation 0) and says whether invocation `i` has a particle.
+// Whether invocation `i` has a particle.
 fn finishing(i: u32) -> bool {
-    if (i == 0u) {
-        element_forces[0].x = element_forces[0].x + 1.0;
-    }
     return i < params.counts.x;
 }

@@ -41,16 +41,13 @@ fn spring_pull(x: vec3<f32>, v: vec3<f32>, o: Particle, kc: vec4<f32>, rest: f32
 @compute @workgroup_size(64)
 fn substep(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
-    if (i == 0u) {
-        element_forces[0].x = element_forces[0].x + 1.0;
-    }
     if (i >= params.counts.x) {
         return;
     }
     let me = src[i];
     let w = me.x.w;
     if (w == 0.0) {
-        dst[i] = me;
+        dst[i] = placed(me);
         return;
     }
     let x = me.x.xyz;
@@ -156,11 +153,17 @@ fn xpbd_project(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // XPBD, last, bound with `src` the predictions and `dst` the state: each free particle
 // moves by its displacement, with velocity displacement / h, and the colliders are
-// resolved; the first invocation counts the substep for the element pass's clock.
+// resolved; a pinned particle goes where its handle puts it, if one does.
 @compute @workgroup_size(64)
 fn xpbd_finish(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
     if (finishing(i)) {
         move_by(i, src[i].v.xyz);
     }
+}
+
+// After each substep, whatever the integrator: one invocation counts it.
+@compute @workgroup_size(1)
+fn tick() {
+    element_forces[0].x = element_forces[0].x + 1.0;
 }

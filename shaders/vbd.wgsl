@@ -149,15 +149,19 @@ fn vbd_descend(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // Last, bound with `src` the displacements and `dst` the state: each free particle moves
 // by its displacement, with velocity displacement / h; the colliders are resolved; the
-// change of velocity over h is kept for the next step's first guess. The first invocation
-// counts the substep (the element pass's clock, and the memory is then current).
+// change of velocity over h is kept for the next step's first guess; a pinned particle
+// goes where its handle puts it, if one does.
 @compute @workgroup_size(64)
 fn vbd_finish(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
-    if (!finishing(i) || dst[i].x.w == 0.0) {
+    if (!finishing(i)) {
         return;
     }
+    let free = dst[i].x.w != 0.0;
     let v = move_by(i, src[i].x.xyz);
+    if (!free) {
+        return;
+    }
     let last = (v[1] - v[0]) / params.gravity.w;
     let at = memory_at(i);
     stencil[at] = bitcast<u32>(last.x);

@@ -75,7 +75,6 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
     for (scene, what) in [
         ("self-fold", "self-collision"),
         ("tablecloth", "mesh obstacles"),
-        ("twist", "handles"),
         ("arm", "mesh obstacles"),
     ] {
         let mut scene = Scene::builtin(scene).expect("scene");

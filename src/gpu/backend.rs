@@ -15,7 +15,7 @@ pub enum Backend {
     #[default]
     Cpu,
     /// wgpu compute: semi-implicit Euler, XPBD and VBD; springs, gravity, air damping, wind,
-    /// dihedral bending, pins, spheres and planes, with the stability guard.
+    /// dihedral bending, pins, handles, spheres and planes, with the stability guard.
     Gpu,
 }
 

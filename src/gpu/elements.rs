@@ -83,11 +83,16 @@ pub(super) fn pack_elements(model: &ClothModel, forces: &ForceSet, wind: bool) -
 /// The element pass: its pipeline, buffers and bind groups (one per particle buffer).
 pub(super) struct ElementKernel {
     pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
     groups: [wgpu::BindGroup; 2],
     uniform: wgpu::Buffer,
-    /// The frame's substep count in the first `vec4`, then one `vec4` per slot: the
-    /// substep reads and counts here.
+    rows: wgpu::Buffer,
+    /// The frame's substep count in the first `vec4`, then one `vec4` per slot, then the
+    /// handles' targets: the substep reads and counts here.
     pub(super) forces: wgpu::Buffer,
+    /// `vec4`s before the targets (the count and the slots), and room for all.
+    slots: u64,
+    capacity: u64,
     /// [`PackedElements::incidence`], for the substep.
     pub(super) incidence: wgpu::Buffer,
     params: Params,
@@ -133,15 +138,7 @@ impl ElementKernel {
             queue.write_buffer(&rows, 0, bytemuck::cast_slice(&packed.rows));
         }
         queue.write_buffer(&incidence, 0, bytemuck::cast_slice(&packed.incidence));
-        let group = |p: &wgpu::Buffer| {
-            bind(
-                device,
-                "cloth elements",
-                &layout,
-                &[&uniform, p, &rows, &forces],
-            )
-        };
-        let groups = [group(&particles[0]), group(&particles[1])];
+        let groups = element_groups(device, &layout, particles, [&uniform, &rows, &forces]);
         let mut params = Params {
             counts: [packed.triangles, packed.hinges, 0, 0],
             ..Params::default()
@@ -168,12 +165,52 @@ impl ElementKernel {
         }
         Self {
             pipeline,
+            layout,
             groups,
             uniform,
+            rows,
             forces,
+            slots: slots as u64,
+            capacity: slots as u64,
             incidence,
             params,
         }
+    }
+
+    /// Where the handles' targets start in [`ElementKernel::forces`], in `vec4`s.
+    pub(super) fn targets_at(&self) -> u32 {
+        self.slots as u32
+    }
+
+    /// Sends the handles' `targets` after the slots, making room when there is too little
+    /// (over either of `particles`). Returns whether the buffer was made anew (its bind
+    /// groups elsewhere are then stale).
+    pub(super) fn write_targets(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        particles: &[wgpu::Buffer; 2],
+        targets: &[[f32; 4]],
+    ) -> bool {
+        let needed = self.slots + targets.len() as u64;
+        let grew = needed > self.capacity;
+        if grew {
+            self.capacity = needed.next_power_of_two();
+            self.forces = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("cloth element forces"),
+                size: self.capacity * 16,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let buffers = [&self.uniform, &self.rows, &self.forces];
+            self.groups = element_groups(device, &self.layout, particles, buffers);
+        }
+        if !targets.is_empty() {
+            queue.write_buffer(&self.forces, self.slots * 16, bytemuck::cast_slice(targets));
+        }
+        grew
     }
 
     /// Elements the pass computes (0: no pass).
@@ -205,6 +242,24 @@ impl ElementKernel {
             pass.dispatch_workgroups(count.div_ceil(WORKGROUP), 1, 1);
         }
     }
+}
+
+/// The element pass's bind groups over either of `particles`, with its uniform, rows and
+/// forces.
+fn element_groups(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    particles: &[wgpu::Buffer; 2],
+    [uniform, rows, forces]: [&wgpu::Buffer; 3],
+) -> [wgpu::BindGroup; 2] {
+    [0, 1].map(|k| {
+        bind(
+            device,
+            "cloth elements",
+            layout,
+            &[uniform, &particles[k], rows, forces],
+        )
+    })
 }
 
 #[cfg(test)]

@@ -238,8 +238,9 @@ mod tests {
     use super::super::stepper::GpuStepper;
     use crate::cloth::ClothState;
     use crate::device::{AdapterPreference, HeadlessDevice};
+    use crate::gpu::packing::tests::unbent;
     use crate::scene::Scene;
-    use crate::sim::{IntegratorKind, Motion, StepBackend};
+    use crate::sim::{Changes, IntegratorKind, Motion, SimParams, StepBackend};
 
     /// The rollback point kept on the device is a state the run passed through, to the
     /// bit, `checkpoint_frames` healthy frames or more before the latest: restored and read
@@ -366,12 +367,7 @@ mod tests {
             if !grid {
                 stepper.grid_path = false;
                 stepper.sent = None;
-                stepper.configure(
-                    model,
-                    params,
-                    &scene.effects,
-                    crate::sim::Changes::STRENGTHS,
-                );
+                stepper.configure(model, params, &scene.effects, Changes::STRENGTHS);
                 assert_eq!(stepper.params.grid[0], 0);
             }
             let mut state = scene.initial.clone();
@@ -389,5 +385,49 @@ mod tests {
             .fold(0.0f32, f32::max);
         eprintln!("grid against general: {worst:e} m of {moved} m");
         assert!(moved > 0.005 && worst < 1e-6, "{worst} m apart");
+    }
+
+    /// A strength change that keeps which springs share a class (every kind scaled alike,
+    /// or the damping of a kind that has a class of its own) sends only the class table;
+    /// one that splits or merges classes sends the ends again, once.
+    #[test]
+    fn the_spring_ends_are_sent_again_only_when_their_classes_change() {
+        use crate::device::{AdapterPreference, HeadlessDevice};
+        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        // The bench scene: one stiffness and damping for every kind of spring.
+        let scene = crate::scene::Scene::builtin("hanging-bench").expect("scene");
+        let (model, effects) = (&scene.model, &scene.effects);
+        let mut params = scene.params.clone();
+        let mut stepper = GpuStepper::new(&gpu.device, &gpu.queue, model, &params, effects, true)
+            .expect("stepper");
+        let mut change = |edit: &dyn Fn(&mut SimParams), sends: u32| {
+            let before = params.clone();
+            edit(&mut params);
+            stepper.configure(model, &params, effects, before.changes_to(&params));
+            assert_eq!(
+                stepper.ends_sent, sends,
+                "after {:?}",
+                params.material.stiffness
+            );
+        };
+        change(&|_| (), 1);
+        change(
+            &|p| p.material.stiffness = p.material.stiffness.map(|k| 3.0 * k),
+            1,
+        );
+        // The shear springs leave the one class all kinds shared: a class of their own,
+        // whose damping then moves alone.
+        change(&|p| p.material.stiffness[1] *= 0.5, 2);
+        change(&|p| p.material.damping[1] *= 2.0, 2);
+        // The structural springs leave the bend springs' class.
+        change(&|p| p.material.stiffness[0] *= 2.0, 3);
+        // Back to one stiffness (shear still damped apart), then one strength: merges.
+        change(&|p| p.material.stiffness = [p.material.stiffness[0]; 3], 4);
+        change(&|p| p.material.damping = [p.material.damping[0]; 3], 5);
+        change(&|_| (), 5);
+        // The bend springs switched off: their ends go.
+        let unbent = unbent(effects);
+        stepper.configure(model, &params, &unbent, Changes::EFFECTS);
+        assert_eq!(stepper.ends_sent, 6);
     }
 }

@@ -11,6 +11,7 @@ mod backend;
 mod elements;
 mod error;
 mod guarded;
+mod handles;
 mod health;
 mod kernel;
 mod packing;

@@ -246,6 +246,9 @@ pub(super) struct Params {
     pub(super) solver: [u32; 4],
     /// A grid cloth's width and height in particles and its links (0 wide: not a grid).
     pub(super) grid: [u32; 4],
+    /// Where the handles' targets start among the element forces, and how many particles
+    /// the handles carry.
+    pub(super) handles: [u32; 4],
     pub(super) links: [GridLink; MAX_LINKS],
     pub(super) colliders: [GpuCollider; MAX_COLLIDERS],
 }

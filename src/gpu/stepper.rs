@@ -19,6 +19,7 @@ use crate::sim::{
 
 use super::elements::{ElementKernel, pack_elements};
 use super::error::GpuError;
+use super::handles::Carried;
 use super::health::{HealthKernel, Watch};
 use super::kernel::{SubstepKernel, WORKGROUP};
 use super::packing::{
@@ -44,8 +45,13 @@ pub struct GpuStepper {
     pub(super) device: wgpu::Device,
     pub(super) queue: wgpu::Queue,
     kernel: SubstepKernel,
-    /// Wind and dihedral bending, computed per element before each substep.
+    /// Wind and dihedral bending, computed per element before each substep (their buffer
+    /// also holds the handles' targets).
     elements: ElementKernel,
+    /// The particles the handles carry, and whether the device's state must be stamped
+    /// with their slots anew.
+    carried: Carried,
+    restamp: bool,
     /// The integrator in effect (one of those the GPU runs), and XPBD's and VBD's sweeps a
     /// substep.
     pub(super) integrator: IntegratorKind,
@@ -107,7 +113,7 @@ pub struct GpuStepper {
     /// The key the device's spring ends were packed with (`None` before the first
     /// upload), and how many times the ends were sent.
     pub(super) sent: Option<EndsKey>,
-    ends_sent: u32,
+    pub(super) ends_sent: u32,
     /// A grid cloth's substep gathers its springs from the index (else from the ends).
     pub(super) grid_path: bool,
 }
@@ -194,6 +200,8 @@ impl GpuStepper {
             queue: queue.clone(),
             kernel,
             elements,
+            carried: Carried::default(),
+            restamp: false,
             integrator: params.step.integrator,
             iterations: [1, 1],
             xpbd,
@@ -301,11 +309,12 @@ impl GpuStepper {
     }
 
     fn upload_state(&mut self, model: &ClothModel, state: &ClothState) {
+        let stamps = self.carried.stamps(state.pos.len());
         let data: Vec<Particle> = (state.pos.iter().zip(&state.vel))
-            .zip(&model.inv_mass)
-            .map(|((x, v), &w)| Particle {
+            .zip(model.inv_mass.iter().zip(stamps))
+            .map(|((x, v), (&w, slot))| Particle {
                 x: [x.x, x.y, x.z, w],
-                v: [v.x, v.y, v.z, 0.0],
+                v: [v.x, v.y, v.z, slot],
             })
             .collect();
         if !data.is_empty() {
@@ -315,8 +324,23 @@ impl GpuStepper {
             }
         }
         self.upload = false;
+        self.restamp = false;
         self.vbd_fresh = true;
         self.behind = false;
+    }
+
+    /// Stamps the device's state with the handles' slots anew (the handles changed): the
+    /// latest state read back and sent again.
+    fn restamp(&mut self, model: &ClothModel, state: &ClothState) -> Result<(), StepError> {
+        let mut latest = state.clone();
+        if self.behind {
+            self.read_back(&mut latest)
+                .map_err(|e| StepError::Device(e.to_string()))?;
+        }
+        self.upload_state(model, &latest);
+        // The caller's state is still the older one.
+        self.behind = true;
+        Ok(())
     }
 
     /// Encodes and submits `substeps` substeps, with what `watch` asks for.
@@ -342,16 +366,30 @@ impl GpuStepper {
         if sweeping && self.solver_stale {
             self.rebuild_solver(model, state)?;
         }
+        if self.restamp {
+            self.restamp(model, state)?;
+        }
+        let carried = self.carried.len() as u32;
+        if carried > 0 {
+            let targets = (self.carried).targets(time, self.substep_length(), substeps);
+            let (device, queue) = (&self.device, &self.queue);
+            if (self.elements).write_targets(device, queue, &self.particles, &targets) {
+                self.regroup();
+            }
+            self.params.handles = [self.elements.targets_at(), carried, 0, 0];
+        }
+        if vbd {
+            self.params.solver[3] = u32::from(self.vbd_fresh);
+        }
+        if vbd || carried > 0 {
+            self.queue
+                .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+        }
         let solver = match self.integrator {
             IntegratorKind::Xpbd => Some((&self.kernel.predict, &self.kernel.finish)),
             IntegratorKind::Vbd => Some((&self.kernel.vbd_predict, &self.kernel.vbd_finish)),
             _ => None,
         };
-        if vbd {
-            self.params.solver[3] = u32::from(self.vbd_fresh);
-            self.queue
-                .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
-        }
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -393,6 +431,10 @@ impl GpuStepper {
                     pass.dispatch_workgroups(groups, 1, 1);
                     self.current = 1 - self.current;
                 }
+                // The substep counted (the clock the next one's element pass and targets
+                // read).
+                pass.set_pipeline(&self.kernel.tick);
+                pass.dispatch_workgroups(1, 1, 1);
             }
         }
         if watch.measure {
@@ -636,6 +678,12 @@ impl StepBackend for GpuStepper {
             self.params.colliders = solids;
             self.effects = effects.to_vec();
             (self.gravity, self.air_damping) = (g, drag);
+            let carried = Carried::of(effects);
+            if carried != self.carried {
+                self.carried = carried;
+                self.restamp = true;
+                self.params.handles = [0; 4];
+            }
             if self.unsupported.is_none() {
                 self.rebuild_elements(model, effects);
             }
@@ -736,55 +784,5 @@ impl StepBackend for GpuStepper {
     /// The calling thread records and submits the device's work.
     fn cpu_threads(&self) -> usize {
         1
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::gpu::packing::tests::unbent;
-
-    /// A strength change that keeps which springs share a class (every kind scaled alike,
-    /// or the damping of a kind that has a class of its own) sends only the class table;
-    /// one that splits or merges classes sends the ends again, once.
-    #[test]
-    fn the_spring_ends_are_sent_again_only_when_their_classes_change() {
-        use crate::device::{AdapterPreference, HeadlessDevice};
-        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
-        // The bench scene: one stiffness and damping for every kind of spring.
-        let scene = crate::scene::Scene::builtin("hanging-bench").expect("scene");
-        let (model, effects) = (&scene.model, &scene.effects);
-        let mut params = scene.params.clone();
-        let mut stepper = GpuStepper::new(&gpu.device, &gpu.queue, model, &params, effects, true)
-            .expect("stepper");
-        let mut change = |edit: &dyn Fn(&mut SimParams), sends: u32| {
-            let before = params.clone();
-            edit(&mut params);
-            stepper.configure(model, &params, effects, before.changes_to(&params));
-            assert_eq!(
-                stepper.ends_sent, sends,
-                "after {:?}",
-                params.material.stiffness
-            );
-        };
-        change(&|_| (), 1);
-        change(
-            &|p| p.material.stiffness = p.material.stiffness.map(|k| 3.0 * k),
-            1,
-        );
-        // The shear springs leave the one class all kinds shared: a class of their own,
-        // whose damping then moves alone.
-        change(&|p| p.material.stiffness[1] *= 0.5, 2);
-        change(&|p| p.material.damping[1] *= 2.0, 2);
-        // The structural springs leave the bend springs' class.
-        change(&|p| p.material.stiffness[0] *= 2.0, 3);
-        // Back to one stiffness (shear still damped apart), then one strength: merges.
-        change(&|p| p.material.stiffness = [p.material.stiffness[0]; 3], 4);
-        change(&|p| p.material.damping = [p.material.damping[0]; 3], 5);
-        change(&|_| (), 5);
-        // The bend springs switched off: their ends go.
-        let unbent = unbent(effects);
-        stepper.configure(model, &params, &unbent, Changes::EFFECTS);
-        assert_eq!(stepper.ends_sent, 6);
     }
 }

@@ -19,7 +19,7 @@ pub const GPU_INTEGRATORS: [IntegratorKind; 3] = [
 
 /// What of `step`, `precision` and `effects` the GPU backend cannot run, if anything: it
 /// runs semi-implicit Euler, XPBD and VBD in `f32` with gravity, springs (and bend springs), dihedral
-/// bending, wind, air damping, pins and up to four sphere and plane colliders.
+/// bending, wind, air damping, pins, handles and up to four sphere and plane colliders.
 pub fn gpu_support(
     step: &StepConfig,
     precision: Precision,

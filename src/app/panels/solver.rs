@@ -25,7 +25,7 @@ impl Panel for SolverPanel {
                 .selectable_label(on_gpu, "GPU")
                 .on_hover_text(
                     "wgpu compute: semi-implicit Euler, XPBD and VBD; springs, gravity, air \
-                     damping, wind, dihedral bending, pins, spheres and planes",
+                     damping, wind, dihedral bending, pins, handles, spheres and planes",
                 )
                 .clicked()
                 && !on_gpu

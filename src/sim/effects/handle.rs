@@ -72,7 +72,7 @@ impl EffectKind for Handle {
     }
 
     fn on_gpu(&self) -> Result<(), &'static str> {
-        Err("handles (moving pins)")
+        Ok(())
     }
 
     fn suggested(_cloth: &ClothBox) -> Self {
