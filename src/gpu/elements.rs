@@ -36,6 +36,14 @@ pub(super) struct PackedElements {
     pub(super) hinges: u32,
 }
 
+/// Whether `effects` have wind, and `forces` a dihedral term: what decides the element
+/// pass's buffers (their strengths are the uniform's).
+pub(super) fn elements_wanted(effects: &[Effect], forces: &ForceSet) -> (bool, bool) {
+    let wind = effects.iter().any(|e| matches!(e, Effect::Wind(_)));
+    let dihedral = (forces.terms().iter()).any(|t| t.get::<DihedralBending>().is_some());
+    (wind, dihedral)
+}
+
 /// The triangles of `model` when `wind` blows and the hinges of its dihedral term in
 /// `forces` when it has one, with each particle's slots.
 pub(super) fn pack_elements(model: &ClothModel, forces: &ForceSet, wind: bool) -> PackedElements {
@@ -80,7 +88,8 @@ pub(super) fn pack_elements(model: &ClothModel, forces: &ForceSet, wind: bool) -
     packed
 }
 
-/// The element pass: its pipeline, buffers and bind groups (one per particle buffer).
+/// The element pass: its pipeline (built once), buffers and bind groups (one per particle
+/// buffer).
 pub(super) struct ElementKernel {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
@@ -96,6 +105,21 @@ pub(super) struct ElementKernel {
     /// [`PackedElements::incidence`], for the substep.
     pub(super) incidence: wgpu::Buffer,
     params: Params,
+}
+
+/// A buffer of `bytes` (at least 16) for `usage`, written from the host.
+fn element_buffer(
+    device: &wgpu::Device,
+    label: &str,
+    bytes: u64,
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(16),
+        usage: usage | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
 }
 
 impl ElementKernel {
@@ -116,33 +140,66 @@ impl ElementKernel {
             &format!("{LAYOUT}{SOURCE}"),
             [("elements_forces", &[&layout])],
         );
-        let buffer = |label, bytes: usize, usage| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: (bytes as u64).max(16),
-                usage: usage | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
-        use wgpu::BufferUsages as U;
-        let slots = 1 + packed.triangles as usize + 4 * packed.hinges as usize;
-        let uniform = buffer("cloth elements params", size_of::<Params>(), U::UNIFORM);
-        let rows = buffer("cloth elements", packed.rows.len() * 16, U::STORAGE);
-        let forces = buffer("cloth element forces", slots * 16, U::STORAGE | U::COPY_SRC);
-        let incidence = buffer(
-            "cloth element slots",
-            packed.incidence.len() * 4,
-            U::STORAGE,
+        let uniform = element_buffer(
+            device,
+            "cloth elements params",
+            size_of::<Params>() as u64,
+            wgpu::BufferUsages::UNIFORM,
         );
-        if !packed.rows.is_empty() {
-            queue.write_buffer(&rows, 0, bytemuck::cast_slice(&packed.rows));
-        }
-        queue.write_buffer(&incidence, 0, bytemuck::cast_slice(&packed.incidence));
+        let empty = |label| element_buffer(device, label, 16, wgpu::BufferUsages::STORAGE);
+        let (rows, forces, incidence) = (empty("rows"), empty("forces"), empty("slots"));
         let groups = element_groups(device, &layout, particles, [&uniform, &rows, &forces]);
-        let mut params = Params {
-            counts: [packed.triangles, packed.hinges, 0, 0],
-            ..Params::default()
+        let mut kernel = Self {
+            pipeline,
+            layout,
+            groups,
+            uniform,
+            rows,
+            forces,
+            slots: 1,
+            capacity: 1,
+            incidence,
+            params: Params::default(),
         };
+        kernel.pack(device, queue, particles, packed);
+        kernel.tune(effects);
+        kernel
+    }
+
+    /// Sends `packed` (new buffers; the pipeline stays): the substep's bind groups that
+    /// read [`ElementKernel::forces`] and [`ElementKernel::incidence`] are then stale.
+    pub(super) fn pack(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        particles: &[wgpu::Buffer; 2],
+        packed: &PackedElements,
+    ) {
+        use wgpu::BufferUsages as U;
+        let slots = 1 + packed.triangles as u64 + 4 * packed.hinges as u64;
+        let rows = packed.rows.len() as u64 * 16;
+        self.rows = element_buffer(device, "cloth elements", rows, U::STORAGE);
+        self.forces = element_buffer(
+            device,
+            "cloth element forces",
+            slots * 16,
+            U::STORAGE | U::COPY_SRC,
+        );
+        let incidence = packed.incidence.len() as u64 * 4;
+        self.incidence = element_buffer(device, "cloth element slots", incidence, U::STORAGE);
+        if !packed.rows.is_empty() {
+            queue.write_buffer(&self.rows, 0, bytemuck::cast_slice(&packed.rows));
+        }
+        queue.write_buffer(&self.incidence, 0, bytemuck::cast_slice(&packed.incidence));
+        (self.slots, self.capacity) = (slots, slots);
+        let buffers = [&self.uniform, &self.rows, &self.forces];
+        self.groups = element_groups(device, &self.layout, particles, buffers);
+        self.params.counts = [packed.triangles, packed.hinges, 0, 0];
+    }
+
+    /// Takes the wind and the dihedral stiffness of `effects` (sent with the next
+    /// [`ElementKernel::start`]): a new strength needs no new buffers.
+    pub(super) fn tune(&mut self, effects: &[Effect]) {
         for effect in effects {
             match effect {
                 Effect::Wind(w) => {
@@ -154,26 +211,14 @@ impl ElementKernel {
                         lift,
                         air_density,
                     } = *w;
-                    params.wind = [v.x, v.y, v.z, gust];
-                    params.air = [gust_period, drag, lift, air_density];
+                    self.params.wind = [v.x, v.y, v.z, gust];
+                    self.params.air = [gust_period, drag, lift, air_density];
                 }
                 Effect::Bending(crate::sim::BendingModel::Dihedral { stiffness }) => {
-                    params.clock[2] = *stiffness;
+                    self.params.clock[2] = *stiffness;
                 }
                 _ => {}
             }
-        }
-        Self {
-            pipeline,
-            layout,
-            groups,
-            uniform,
-            rows,
-            forces,
-            slots: slots as u64,
-            capacity: slots as u64,
-            incidence,
-            params,
         }
     }
 
@@ -196,14 +241,9 @@ impl ElementKernel {
         let grew = needed > self.capacity;
         if grew {
             self.capacity = needed.next_power_of_two();
-            self.forces = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("cloth element forces"),
-                size: self.capacity * 16,
-                usage: wgpu::BufferUsages::STORAGE
-                    | wgpu::BufferUsages::COPY_DST
-                    | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
+            let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+            let bytes = self.capacity * 16;
+            self.forces = element_buffer(device, "cloth element forces", bytes, usage);
             let buffers = [&self.uniform, &self.rows, &self.forces];
             self.groups = element_groups(device, &self.layout, particles, buffers);
         }
@@ -214,7 +254,7 @@ impl ElementKernel {
     }
 
     /// Elements the pass computes (0: no pass).
-    fn elements(&self) -> u32 {
+    pub(super) fn elements(&self) -> u32 {
         self.params.counts[0] + self.params.counts[1]
     }
 

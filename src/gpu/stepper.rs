@@ -17,7 +17,7 @@ use crate::sim::{
     air_damping_of, gravity_of,
 };
 
-use super::elements::{ElementKernel, pack_elements};
+use super::elements::{ElementKernel, elements_wanted, pack_elements};
 use super::error::GpuError;
 use super::handles::Carried;
 use super::health::{HealthKernel, Watch};
@@ -46,8 +46,10 @@ pub struct GpuStepper {
     pub(super) queue: wgpu::Queue,
     kernel: SubstepKernel,
     /// Wind and dihedral bending, computed per element before each substep (their buffer
-    /// also holds the handles' targets).
+    /// also holds the handles' targets), and what its buffers were packed for: whether
+    /// wind blows and whether bending is dihedral (a new strength only retunes it).
     elements: ElementKernel,
+    elements_for: (bool, bool),
     /// The particles the handles carry, and whether the device's state must be stamped
     /// with their slots anew.
     carried: Carried,
@@ -200,6 +202,7 @@ impl GpuStepper {
             queue: queue.clone(),
             kernel,
             elements,
+            elements_for: (false, false),
             carried: Carried::default(),
             restamp: false,
             integrator: params.step.integrator,
@@ -406,6 +409,7 @@ impl GpuStepper {
                 timestamp_writes: None,
             });
             let groups = self.count.div_ceil(WORKGROUP);
+            let counting = vbd || carried > 0 || self.elements.elements() > 0;
             for _ in 0..substeps {
                 self.elements.dispatch(&mut pass, self.current);
                 let (this, other) = (&self.groups[self.current], &self.groups[1 - self.current]);
@@ -431,10 +435,12 @@ impl GpuStepper {
                     pass.dispatch_workgroups(groups, 1, 1);
                     self.current = 1 - self.current;
                 }
-                // The substep counted (the clock the next one's element pass and targets
-                // read).
-                pass.set_pipeline(&self.kernel.tick);
-                pass.dispatch_workgroups(1, 1, 1);
+                // The substep counted, when something reads the count: the element pass's
+                // clock, the handles' targets, VBD's first guess.
+                if counting {
+                    pass.set_pipeline(&self.kernel.tick);
+                    pass.dispatch_workgroups(1, 1, 1);
+                }
             }
         }
         if watch.measure {
@@ -515,18 +521,23 @@ impl GpuStepper {
             .groups(&self.device, &self.particles, fixed, extra);
     }
 
-    /// The element pass for `effects` (the forces' terms already theirs), and the substep's
-    /// bind groups that read its slots.
+    /// The element pass for `effects` (the forces' terms already theirs): packed anew, with
+    /// the substep's bind groups that read its slots, only when wind or dihedral bending
+    /// came or went; retuned otherwise.
     fn rebuild_elements(&mut self, model: &ClothModel, effects: &[Effect]) {
-        let wind = effects.iter().any(|e| matches!(e, Effect::Wind(_)));
-        let packed = pack_elements(model, &self.forces, wind);
-        if let Err(e) = fits_elements(&self.device.limits(), &packed) {
-            self.unsupported = Some(e.to_string());
-            return;
+        let wanted = elements_wanted(effects, &self.forces);
+        if wanted != self.elements_for {
+            let packed = pack_elements(model, &self.forces, wanted.0);
+            if let Err(e) = fits_elements(&self.device.limits(), &packed) {
+                self.unsupported = Some(e.to_string());
+                return;
+            }
+            let (device, queue) = (&self.device, &self.queue);
+            self.elements.pack(device, queue, &self.particles, &packed);
+            self.elements_for = wanted;
+            self.regroup();
         }
-        let (device, queue) = (&self.device, &self.queue);
-        self.elements = ElementKernel::new(device, queue, &self.particles, &packed, effects);
-        self.regroup();
+        self.elements.tune(effects);
     }
 
     /// Encodes and submits the copy of `snapshot` into the live particle buffer (and the
