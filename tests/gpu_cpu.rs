@@ -234,3 +234,30 @@ fn a_handle_taken_away_mid_run_stops_on_the_gpu_as_on_the_cpu() {
     eprintln!("a handle taken away: worst {worst:e} m");
     assert!(worst < 5e-6, "GPU and CPU differ by {worst} m");
 }
+
+/// The wind turned and strengthened mid-run reaches the GPU's element pass (a new strength
+/// retunes it, its buffers stay): the flag goes on as the CPU's does.
+#[test]
+fn a_wind_changed_mid_run_reaches_the_gpu() {
+    let scene = small("flag");
+    let mut cpu = Simulation::new(scene.clone());
+    let (mut gpu, _) = gpu_simulation(scene, true).expect("GPU backend");
+    for sim in [&mut cpu, &mut gpu] {
+        for _ in 0..6 {
+            sim.step_frame().expect("frame");
+        }
+        let mut effects = sim.effects().to_vec();
+        for e in &mut effects {
+            if let Effect::Wind(w) = e {
+                w.velocity = glam::Vec3::new(3.0, 0.0, 9.0);
+            }
+        }
+        sim.set_effects(effects).expect("valid");
+        for _ in 0..6 {
+            sim.step_frame().expect("frame");
+        }
+    }
+    let worst = farthest(&cpu.state().pos, &gpu.state().pos);
+    eprintln!("wind changed: worst {worst:e} m");
+    assert!(worst < 1e-5, "GPU and CPU differ by {worst} m");
+}
