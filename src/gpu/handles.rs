@@ -55,22 +55,26 @@ impl Carried {
         stamps
     }
 
-    /// The targets of a submission of `substeps` substeps of `h` seconds from `time`:
-    /// per substep, per slot, the position and the velocity where the handle has the
-    /// particle at the substep's end (the clock advanced as the CPU's, by `h` in f64).
-    pub(super) fn targets(&self, time: f64, h: f32, substeps: u32) -> Vec<[f32; 4]> {
-        let mut out = Vec::with_capacity(2 * self.slots.len() * substeps as usize);
+    /// Into `out`, the targets of a submission of `substeps` substeps of `h` seconds from
+    /// `time`: per substep, per slot, the position and the velocity where the handle has
+    /// the particle at the substep's end (the clock advanced as the CPU's, by `h` in f64).
+    /// Each handle's pose is found once a substep; `out` keeps its storage.
+    pub(super) fn targets(&self, (time, h, substeps): (f64, f32, u32), out: &mut Vec<[f32; 4]>) {
+        let n = self.slots.len();
+        out.clear();
+        out.resize(2 * n * substeps as usize, [0.0; 4]);
         let mut t = time;
-        for _ in 0..substeps {
+        for step in out.chunks_exact_mut((2 * n).max(1)) {
             t += h as f64;
-            let poses: Vec<_> = self.handles.iter().map(|h| h.motion.at(t)).collect();
-            for &(_, k, rest) in &self.slots {
-                let (pose, pivot) = (&poses[k], self.handles[k].pivot);
-                let at = pose.apply(pivot, rest);
-                out.push(at.extend(0.0).to_array());
-                out.push(pose.velocity_at(pivot, at).extend(0.0).to_array());
+            for (k, handle) in self.handles.iter().enumerate() {
+                let pose = handle.motion.at(t);
+                let mine = (self.slots.iter().enumerate()).filter(|(_, s)| s.1 == k);
+                for (slot, &(_, _, rest)) in mine {
+                    let at = pose.apply(handle.pivot, rest);
+                    step[2 * slot] = at.extend(0.0).to_array();
+                    step[2 * slot + 1] = pose.velocity_at(handle.pivot, at).extend(0.0).to_array();
+                }
             }
         }
-        out
     }
 }

@@ -54,6 +54,8 @@ pub struct GpuStepper {
     /// with their slots anew.
     carried: Carried,
     restamp: bool,
+    /// The handles' targets of the last submission (kept for its storage).
+    targets: Vec<[f32; 4]>,
     /// The integrator in effect (one of those the GPU runs), and XPBD's and VBD's sweeps a
     /// substep.
     pub(super) integrator: IntegratorKind,
@@ -205,6 +207,7 @@ impl GpuStepper {
             elements_for: (false, false),
             carried: Carried::default(),
             restamp: false,
+            targets: Vec::new(),
             integrator: params.step.integrator,
             iterations: [1, 1],
             xpbd,
@@ -374,9 +377,12 @@ impl GpuStepper {
         }
         let carried = self.carried.len() as u32;
         if carried > 0 {
-            let targets = (self.carried).targets(time, self.substep_length(), substeps);
+            let mut targets = std::mem::take(&mut self.targets);
+            (self.carried).targets((time, self.substep_length(), substeps), &mut targets);
             let (device, queue) = (&self.device, &self.queue);
-            if (self.elements).write_targets(device, queue, &self.particles, &targets) {
+            let grew = (self.elements).write_targets(device, queue, &self.particles, &targets);
+            self.targets = targets;
+            if grew {
                 self.regroup();
             }
             self.params.handles = [self.elements.targets_at(), carried, 0, 0];
