@@ -430,4 +430,50 @@ mod tests {
         stepper.configure(model, &params, &unbent, Changes::EFFECTS);
         assert_eq!(stepper.ends_sent, 6);
     }
+
+    /// On a device that binds at most 32 KiB, the 16 × 16 bench cloth's state and spring
+    /// ends fit (8 and 22 KiB) but XPBD's constraints (36 KiB) and VBD's stencil (55 KiB) do
+    /// not: switching to either fails the next frame with the sizes, keeps the state, and
+    /// every later frame says the same, where the buffers would have failed validation.
+    #[test]
+    fn a_solver_too_big_for_the_device_is_refused_with_its_size() {
+        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let small = wgpu::Limits {
+            max_storage_buffer_binding_size: 32 << 10,
+            max_buffer_size: 32 << 10,
+            ..crate::device::compute_limits(&gpu.adapter)
+        };
+        let (device, queue) =
+            pollster::block_on(gpu.adapter.request_device(&wgpu::DeviceDescriptor {
+                required_limits: small,
+                ..Default::default()
+            }))
+            .expect("a device with small buffers");
+        let mut scene =
+            crate::bench::bench_scene(16, IntegratorKind::SemiImplicitEuler).expect("scene");
+        scene.params.guard.enabled = true;
+        for (kind, what) in [
+            (IntegratorKind::Xpbd, "XPBD constraints"),
+            (IntegratorKind::Vbd, "VBD stencil"),
+        ] {
+            let (model, effects) = (&scene.model, &scene.effects);
+            let mut params = scene.params.clone();
+            let mut stepper = GpuStepper::new(&device, &queue, model, &params, effects, true)
+                .expect("the semi-implicit step fits");
+            let mut state = scene.initial.clone();
+            stepper.frame(model, &mut state).expect("a frame");
+            let before = state.clone();
+            params.step.integrator = kind;
+            stepper.configure(model, &params, effects, Changes::INTEGRATOR);
+            for _ in 0..2 {
+                let err = stepper.frame(model, &mut state).expect_err("too big");
+                let said = &err.reason;
+                assert!(
+                    said.contains(what) && said.contains("(32768 bytes)"),
+                    "{said}"
+                );
+                assert_eq!(state.pos, before.pos);
+            }
+        }
+    }
 }

@@ -15,6 +15,7 @@ mod handles;
 mod health;
 mod kernel;
 mod packing;
+mod rebuild;
 mod snapshot;
 mod stepper;
 mod support;

@@ -17,7 +17,7 @@ use crate::sim::{
     air_damping_of, gravity_of,
 };
 
-use super::elements::{ElementKernel, elements_wanted, pack_elements};
+use super::elements::{ElementKernel, pack_elements};
 use super::error::GpuError;
 use super::handles::Carried;
 use super::health::{HealthKernel, Watch};
@@ -26,7 +26,7 @@ use super::packing::{
     ClassTable, EndsKey, Neighbour, Params, Particle, classify, grid_of, pack_solids, pack_springs,
 };
 use super::snapshot::DeviceSnapshot;
-use super::support::{check_device, fits_buffers, fits_elements, gpu_support};
+use super::support::{check_device, fits_buffers, gpu_support};
 use super::vbd::VbdPass;
 use super::xpbd::XpbdPass;
 
@@ -44,15 +44,15 @@ fn substep_report(sweeps: u32) -> StepReport {
 pub struct GpuStepper {
     pub(super) device: wgpu::Device,
     pub(super) queue: wgpu::Queue,
-    kernel: SubstepKernel,
+    pub(super) kernel: SubstepKernel,
     /// Wind and dihedral bending, computed per element before each substep (their buffer
     /// also holds the handles' targets), and what its buffers were packed for: whether
     /// wind blows and whether bending is dihedral (a new strength only retunes it).
-    elements: ElementKernel,
-    elements_for: (bool, bool),
+    pub(super) elements: ElementKernel,
+    pub(super) elements_for: (bool, bool),
     /// The particles the handles carry, and whether the device's state must be stamped
     /// with their slots anew.
-    carried: Carried,
+    pub(super) carried: Carried,
     restamp: bool,
     /// The handles' targets of the last submission (kept for its storage).
     targets: Vec<[f32; 4]>,
@@ -63,20 +63,20 @@ pub struct GpuStepper {
     /// XPBD's constraints in colour order and VBD's stencil, and whether the one in effect
     /// must be built again (XPBD's from the positions of the next step's start, as the CPU
     /// builds its own).
-    xpbd: XpbdPass,
-    vbd: VbdPass,
-    solver_stale: bool,
+    pub(super) xpbd: XpbdPass,
+    pub(super) vbd: VbdPass,
+    pub(super) solver_stale: bool,
     /// VBD's memory of each particle's last acceleration is stale (the state changed
     /// outside, was rolled back, or VBD has not stepped it yet).
-    vbd_fresh: bool,
-    uniform: wgpu::Buffer,
+    pub(super) vbd_fresh: bool,
+    pub(super) uniform: wgpu::Buffer,
     /// The two particle buffers; `current` holds the latest state.
-    particles: [wgpu::Buffer; 2],
-    offsets: wgpu::Buffer,
-    neighbours: wgpu::Buffer,
-    classes: wgpu::Buffer,
+    pub(super) particles: [wgpu::Buffer; 2],
+    pub(super) offsets: wgpu::Buffer,
+    pub(super) neighbours: wgpu::Buffer,
+    pub(super) classes: wgpu::Buffer,
     /// `groups[i]` reads `particles[i]` and writes the other.
-    groups: [wgpu::BindGroup; 2],
+    pub(super) groups: [wgpu::BindGroup; 2],
     /// The guard's measure of a frame.
     pub(super) health: HealthKernel,
     /// The guard's memory, with its rollback points on the device.
@@ -108,7 +108,7 @@ pub struct GpuStepper {
     /// Copy the state back into the caller's after every frame (else only on `sync`).
     pub(super) read_every_frame: bool,
     /// Why the current configuration cannot run, if it cannot.
-    unsupported: Option<String>,
+    pub(super) unsupported: Option<String>,
     /// Why the state could not be read back, if it could not: every later frame fails with
     /// it (the GPU copy and the caller's state can no longer be brought together).
     pub(super) lost: Option<String>,
@@ -192,8 +192,8 @@ impl GpuStepper {
         );
         let none = pack_elements(model, &ForceSet::default(), false);
         let elements = ElementKernel::new(device, queue, &particles, &none, &[]);
-        let xpbd = XpbdPass::new(device, queue, &kernel, None);
-        let vbd = VbdPass::new(device, queue, &kernel, None);
+        let xpbd = XpbdPass::new(device, queue, &kernel, None)?;
+        let vbd = VbdPass::new(device, queue, &kernel, None)?;
         let fixed = [&uniform, &offsets, &neighbours, &classes];
         let extra = [&elements.forces, &elements.incidence, &xpbd.constraints];
         let groups = kernel.groups(device, &particles, fixed, extra);
@@ -314,7 +314,7 @@ impl GpuStepper {
         }
     }
 
-    fn upload_state(&mut self, model: &ClothModel, state: &ClothState) {
+    pub(super) fn upload_state(&mut self, model: &ClothModel, state: &ClothState) {
         let stamps = self.carried.stamps(state.pos.len());
         let data: Vec<Particle> = (state.pos.iter().zip(&state.vel))
             .zip(model.inv_mass.iter().zip(stamps))
@@ -333,20 +333,6 @@ impl GpuStepper {
         self.restamp = false;
         self.vbd_fresh = true;
         self.behind = false;
-    }
-
-    /// Stamps the device's state with the handles' slots anew (the handles changed): the
-    /// latest state read back and sent again.
-    fn restamp(&mut self, model: &ClothModel, state: &ClothState) -> Result<(), StepError> {
-        let mut latest = state.clone();
-        if self.behind {
-            self.read_back(&mut latest)
-                .map_err(|e| StepError::Device(e.to_string()))?;
-        }
-        self.upload_state(model, &latest);
-        // The caller's state is still the older one.
-        self.behind = true;
-        Ok(())
     }
 
     /// Encodes and submits `substeps` substeps, with what `watch` asks for.
@@ -469,81 +455,6 @@ impl GpuStepper {
             self.stats.record(&report);
         }
         Ok(())
-    }
-
-    /// The solver's data from the forces' springs, and the substep's bind groups that read
-    /// it: XPBD's constraints coloured as the CPU colours them from the positions the next
-    /// step starts from (the caller's state, or the device's when that is ahead); VBD's
-    /// stencil, coloured by particle number.
-    fn rebuild_solver(&mut self, model: &ClothModel, state: &ClothState) -> Result<(), StepError> {
-        if self.integrator == IntegratorKind::Vbd {
-            let springs = Some((model, &self.forces));
-            self.vbd = VbdPass::new(&self.device, &self.queue, &self.kernel, springs);
-            let [spans, links, memory] = self.vbd.starts;
-            self.params.solver = [spans, links, memory, 1];
-            self.vbd_fresh = true;
-            self.regroup();
-            self.solver_stale = false;
-            return Ok(());
-        }
-        let positions = if self.behind {
-            let mut latest = state.clone();
-            self.read_back(&mut latest)
-                .map_err(|e| StepError::Device(e.to_string()))?;
-            // The caller's state is still the older one.
-            self.behind = true;
-            latest.pos
-        } else {
-            state.pos.clone()
-        };
-        let halves = self.forces.constraints(model).halves(&positions);
-        self.xpbd = XpbdPass::new(&self.device, &self.queue, &self.kernel, Some(&halves));
-        self.params.counts[2] = self.xpbd.count;
-        self.queue
-            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
-        self.regroup();
-        self.solver_stale = false;
-        Ok(())
-    }
-
-    /// The substep's bind groups for the buffers in place.
-    fn regroup(&mut self) {
-        let fixed = [
-            &self.uniform,
-            &self.offsets,
-            &self.neighbours,
-            &self.classes,
-        ];
-        let extra = [
-            &self.elements.forces,
-            &self.elements.incidence,
-            match self.integrator {
-                IntegratorKind::Vbd => &self.vbd.stencil,
-                _ => &self.xpbd.constraints,
-            },
-        ];
-        self.groups = self
-            .kernel
-            .groups(&self.device, &self.particles, fixed, extra);
-    }
-
-    /// The element pass for `effects` (the forces' terms already theirs): packed anew, with
-    /// the substep's bind groups that read its slots, only when wind or dihedral bending
-    /// came or went; retuned otherwise.
-    fn rebuild_elements(&mut self, model: &ClothModel, effects: &[Effect]) {
-        let wanted = elements_wanted(effects, &self.forces);
-        if wanted != self.elements_for {
-            let packed = pack_elements(model, &self.forces, wanted.0);
-            if let Err(e) = fits_elements(&self.device.limits(), &packed) {
-                self.unsupported = Some(e.to_string());
-                return;
-            }
-            let (device, queue) = (&self.device, &self.queue);
-            self.elements.pack(device, queue, &self.particles, &packed);
-            self.elements_for = wanted;
-            self.regroup();
-        }
-        self.elements.tune(effects);
     }
 
     /// Encodes and submits the copy of `snapshot` into the live particle buffer (and the

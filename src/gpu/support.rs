@@ -126,7 +126,11 @@ pub(super) fn fits_elements(
 
 /// The first of `need` (bytes, what) that one storage binding of a device with `limits`
 /// cannot hold, said with `cloth`'s sizes.
-fn fits(limits: &wgpu::Limits, need: &[(u64, &str)], cloth: &str) -> Result<(), GpuError> {
+pub(super) fn fits(
+    limits: &wgpu::Limits,
+    need: &[(u64, &str)],
+    cloth: &str,
+) -> Result<(), GpuError> {
     let most = limits
         .max_storage_buffer_binding_size
         .min(limits.max_buffer_size);

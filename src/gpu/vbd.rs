@@ -7,7 +7,9 @@ use crate::cloth::ClothModel;
 use crate::sim::ForceSet;
 use crate::sim::kernels::Stencil;
 
+use super::error::GpuError;
 use super::kernel::SubstepKernel;
+use super::support::fits;
 use super::xpbd::{Colours, colour_record};
 
 /// The stencil of `model`'s springs in `forces` as the shader reads it: the words, where
@@ -52,16 +54,22 @@ pub(super) struct VbdPass {
 
 impl VbdPass {
     /// The pass for `model`'s springs in `forces`, or an empty one (`None`).
+    ///
+    /// # Errors
+    /// [`GpuError::Unsupported`] with the sizes when the stencil exceeds one binding.
     pub(super) fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         kernel: &SubstepKernel,
         springs: Option<(&ClothModel, &ForceSet)>,
-    ) -> Self {
+    ) -> Result<Self, GpuError> {
         let (words, starts, colours) = match springs {
             Some((model, forces)) => pack_stencil(model, forces),
             None => Default::default(),
         };
+        let bytes = words.len() as u64 * 4;
+        let size = format!("{} words", words.len());
+        fits(&device.limits(), &[(bytes, "VBD stencil")], &size)?;
         let stencil = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("vbd stencil"),
             size: (words.len() as u64 * 4).max(32),
@@ -71,11 +79,11 @@ impl VbdPass {
         if !words.is_empty() {
             queue.write_buffer(&stencil, 0, bytemuck::cast_slice(&words));
         }
-        Self {
+        Ok(Self {
             stencil,
             colours: Colours::new(device, queue, kernel, &colours),
             starts,
-        }
+        })
     }
 
     /// Records one sweep: every colour's particles take their Newton steps, colour by

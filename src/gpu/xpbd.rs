@@ -7,7 +7,9 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::sim::Halves;
 
+use super::error::GpuError;
 use super::kernel::{SubstepKernel, WORKGROUP};
+use super::support::fits;
 
 /// A constraint as the shader reads it (its `Constraint`).
 #[repr(C)]
@@ -136,14 +138,19 @@ pub(super) fn pack_constraints(halves: &Halves) -> (Vec<GpuConstraint>, Vec<[u32
 
 impl XpbdPass {
     /// The pass for `halves` (none: nothing to project) on `device`.
+    ///
+    /// # Errors
+    /// [`GpuError::Unsupported`] with the sizes when the constraints exceed one binding.
     pub(super) fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         kernel: &SubstepKernel,
         halves: Option<&Halves>,
-    ) -> Self {
+    ) -> Result<Self, GpuError> {
         let (constraints, colours) = halves.map(pack_constraints).unwrap_or_default();
         let bytes = (constraints.len() * size_of::<GpuConstraint>()) as u64;
+        let count = format!("{} constraints", constraints.len());
+        fits(&device.limits(), &[(bytes, "XPBD constraints")], &count)?;
         let storage = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("xpbd constraints"),
             size: bytes.max(32),
@@ -153,11 +160,11 @@ impl XpbdPass {
         if !constraints.is_empty() {
             queue.write_buffer(&storage, 0, bytemuck::cast_slice(&constraints));
         }
-        Self {
+        Ok(Self {
             constraints: storage,
             colours: Colours::new(device, queue, kernel, &colours),
             count: constraints.len() as u32,
-        }
+        })
     }
 
     /// Records one Gauss–Seidel sweep: every colour, in order, on the substep's `group`.

@@ -1,0 +1,123 @@
+//! What the GPU stepper builds anew when its parameters change: XPBD's constraints or
+//! VBD's stencil, the element pass's buffers, the handles' stamps on the device's state,
+//! and the substep's bind groups over them.
+
+use crate::cloth::{ClothModel, ClothState};
+use crate::sim::{Effect, IntegratorKind, StepError};
+
+use super::elements::{elements_wanted, pack_elements};
+use super::error::GpuError;
+use super::stepper::GpuStepper;
+use super::support::fits_elements;
+use super::vbd::VbdPass;
+use super::xpbd::XpbdPass;
+
+impl GpuStepper {
+    /// Stamps the device's state with the handles' slots anew (the handles changed): the
+    /// latest state read back and sent again.
+    pub(super) fn restamp(
+        &mut self,
+        model: &ClothModel,
+        state: &ClothState,
+    ) -> Result<(), StepError> {
+        let latest = self.latest(state)?;
+        self.upload_state(model, &latest);
+        // The caller's state is still the older one.
+        self.behind = true;
+        Ok(())
+    }
+
+    /// A copy of the latest state: the device's when it stepped past `state` (read back
+    /// without bringing `state` up to date), else `state`.
+    fn latest(&mut self, state: &ClothState) -> Result<ClothState, StepError> {
+        let mut latest = state.clone();
+        if self.behind {
+            self.read_back(&mut latest)
+                .map_err(|e| StepError::Device(e.to_string()))?;
+            self.behind = true;
+        }
+        Ok(latest)
+    }
+
+    /// The solver's data from the forces' springs, and the substep's bind groups that read
+    /// it: XPBD's constraints coloured as the CPU colours them from the positions the next
+    /// step starts from (the caller's state, or the device's when that is ahead); VBD's
+    /// stencil, coloured by particle number.
+    pub(super) fn rebuild_solver(
+        &mut self,
+        model: &ClothModel,
+        state: &ClothState,
+    ) -> Result<(), StepError> {
+        let refused = |e: GpuError| StepError::Unsupported(e.to_string());
+        if self.integrator == IntegratorKind::Vbd {
+            let springs = Some((model, &self.forces));
+            self.vbd =
+                VbdPass::new(&self.device, &self.queue, &self.kernel, springs).map_err(refused)?;
+            let [spans, links, memory] = self.vbd.starts;
+            self.params.solver = [spans, links, memory, 1];
+            self.vbd_fresh = true;
+            self.regroup();
+            self.solver_stale = false;
+            return Ok(());
+        }
+        let positions = self.latest(state)?.pos;
+        let halves = self.forces.constraints(model).halves(&positions);
+        let pass = XpbdPass::new(&self.device, &self.queue, &self.kernel, Some(&halves));
+        self.xpbd = self.refuse_unless(pass)?;
+        self.params.counts[2] = self.xpbd.count;
+        self.queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+        self.regroup();
+        self.solver_stale = false;
+        Ok(())
+    }
+
+    /// The substep's bind groups for the buffers in place.
+    pub(super) fn regroup(&mut self) {
+        let fixed = [
+            &self.uniform,
+            &self.offsets,
+            &self.neighbours,
+            &self.classes,
+        ];
+        let extra = [
+            &self.elements.forces,
+            &self.elements.incidence,
+            match self.integrator {
+                IntegratorKind::Vbd => &self.vbd.stencil,
+                _ => &self.xpbd.constraints,
+            },
+        ];
+        self.groups = self
+            .kernel
+            .groups(&self.device, &self.particles, fixed, extra);
+    }
+
+    /// The element pass for `effects` (the forces' terms already theirs): packed anew, with
+    /// the substep's bind groups that read its slots, only when wind or dihedral bending
+    /// came or went; retuned otherwise.
+    pub(super) fn rebuild_elements(&mut self, model: &ClothModel, effects: &[Effect]) {
+        let wanted = elements_wanted(effects, &self.forces);
+        if wanted != self.elements_for {
+            let packed = pack_elements(model, &self.forces, wanted.0);
+            if let Err(e) = fits_elements(&self.device.limits(), &packed) {
+                self.unsupported = Some(e.to_string());
+                return;
+            }
+            let (device, queue) = (&self.device, &self.queue);
+            self.elements.pack(device, queue, &self.particles, &packed);
+            self.elements_for = wanted;
+            self.regroup();
+        }
+        self.elements.tune(effects);
+    }
+
+    /// `built`, or the reason it could not be, kept (every later frame fails with it).
+    fn refuse_unless<T>(&mut self, built: Result<T, GpuError>) -> Result<T, StepError> {
+        built.map_err(|e| {
+            let why = e.to_string();
+            self.unsupported = Some(why.clone());
+            StepError::Unsupported(why)
+        })
+    }
+}
