@@ -3,7 +3,7 @@
 use plotters::prelude::*;
 
 use super::map::StabilityMap;
-use super::plot::{Area, dashed_level, err, integrator_color, label_axes, legend, range, render};
+use super::plot::{Area, dashed_level, err, integrator_line, label_axes, legend, range, render};
 use crate::sim::IntegratorKind;
 
 /// Draws the map into an RGB buffer of [`PLOT_SIZE`](super::PLOT_SIZE): one line per integrator of its
@@ -54,13 +54,7 @@ fn chart(root: &Area<'_>, map: &StabilityMap) -> Result<(), String> {
         if line.is_empty() {
             continue;
         }
-        let (r, g, b) = integrator_color(kind);
-        let color = RGBColor(r, g, b);
-        chart
-            .draw_series(LineSeries::new(line.clone(), color.stroke_width(3)))
-            .map_err(err)?
-            .label(kind.name())
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(3)));
+        let color = integrator_line(&mut chart, kind, line.clone())?;
         chart
             .draw_series(line.iter().map(|&p| Circle::new(p, 6, color.filled())))
             .map_err(err)?;

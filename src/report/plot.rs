@@ -75,6 +75,22 @@ pub(super) fn err(e: impl std::fmt::Display) -> String {
 pub(super) type LogChart<'a, 'b> =
     ChartContext<'a, BitMapBackend<'b>, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
 
+/// `line` drawn in `kind`'s colour, 3 px wide, with its legend entry; returns the colour.
+pub(super) fn integrator_line(
+    chart: &mut LogChart<'_, '_>,
+    kind: IntegratorKind,
+    line: Vec<(f64, f64)>,
+) -> Result<RGBColor, String> {
+    let (r, g, b) = integrator_color(kind);
+    let color = RGBColor(r, g, b);
+    chart
+        .draw_series(LineSeries::new(line, color.stroke_width(3)))
+        .map_err(err)?
+        .label(kind.name())
+        .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(3)));
+    Ok(color)
+}
+
 /// The axes' descriptions, in both plots' label style.
 pub(super) fn label_axes(chart: &mut LogChart<'_, '_>, x: &str, y: &str) -> Result<(), String> {
     chart
@@ -217,13 +233,7 @@ fn chart(root: &Area<'_>, report: &AccuracyReport) -> Result<(), String> {
             continue;
         }
         line.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let (r, g, b) = integrator_color(kind);
-        let color = RGBColor(r, g, b);
-        chart
-            .draw_series(LineSeries::new(line.clone(), color.stroke_width(3)))
-            .map_err(err)?
-            .label(kind.name())
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(3)));
+        let color = integrator_line(&mut chart, kind, line.clone())?;
         // Resolved errors filled, unresolved ones (within ten times the floor) hollow.
         let resolved: Vec<bool> = {
             let mut mine: Vec<&crate::report::Point> =
