@@ -22,9 +22,8 @@ pub(super) struct SubstepKernel {
     pub(super) predict: wgpu::ComputePipeline,
     pub(super) project: wgpu::ComputePipeline,
     pub(super) finish: wgpu::ComputePipeline,
-    pub(super) vbd_predict: wgpu::ComputePipeline,
-    pub(super) descend: wgpu::ComputePipeline,
-    pub(super) vbd_finish: wgpu::ComputePipeline,
+    /// VBD's three, built the first time VBD steps (most runs never compile its shader).
+    pub(super) vbd: Option<VbdPipelines>,
     /// Counts a substep.
     pub(super) tick: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
@@ -135,7 +134,36 @@ pub(super) fn bind(
     })
 }
 
+/// VBD's entry points' pipelines.
+pub(super) struct VbdPipelines {
+    pub(super) predict: wgpu::ComputePipeline,
+    pub(super) descend: wgpu::ComputePipeline,
+    pub(super) finish: wgpu::ComputePipeline,
+}
+
 impl SubstepKernel {
+    /// VBD's pipelines, built on the first call.
+    pub(super) fn vbd(&mut self, device: &wgpu::Device) -> &VbdPipelines {
+        let (layout, colour) = (&self.layout, &self.colour_layout);
+        self.vbd.get_or_insert_with(|| {
+            let [predict, descend, finish] = pipelines(
+                device,
+                "cloth vbd",
+                &format!("{LAYOUT}{COMMON}{VBD}"),
+                [
+                    ("vbd_predict", &[layout]),
+                    ("vbd_descend", &[layout, colour]),
+                    ("vbd_finish", &[layout]),
+                ],
+            );
+            VbdPipelines {
+                predict,
+                descend,
+                finish,
+            }
+        })
+    }
+
     pub(super) fn new(device: &wgpu::Device) -> Self {
         use Slot::{Dynamic, Read, Uniform, Write};
         let slots = [
@@ -157,24 +185,12 @@ impl SubstepKernel {
                 ("tick", one),
             ],
         );
-        let [vbd_predict, descend, vbd_finish] = pipelines(
-            device,
-            "cloth vbd",
-            &format!("{LAYOUT}{COMMON}{VBD}"),
-            [
-                ("vbd_predict", one),
-                ("vbd_descend", two),
-                ("vbd_finish", one),
-            ],
-        );
         Self {
             pipeline,
             predict,
             project,
             finish,
-            vbd_predict,
-            descend,
-            vbd_finish,
+            vbd: None,
             tick,
             layout,
             colour_layout,

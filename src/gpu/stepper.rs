@@ -380,9 +380,18 @@ impl GpuStepper {
             self.queue
                 .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
         }
-        let solver = match self.integrator {
-            IntegratorKind::Xpbd => Some((&self.kernel.predict, &self.kernel.finish)),
-            IntegratorKind::Vbd => Some((&self.kernel.vbd_predict, &self.kernel.vbd_finish)),
+        if vbd {
+            self.kernel.vbd(&self.device);
+        }
+        // XPBD's and VBD's passes: predict, sweep the colours, finish.
+        let k = &self.kernel;
+        let solver = match (self.integrator, &k.vbd) {
+            (IntegratorKind::Xpbd, _) => {
+                Some((&k.predict, &k.project, &self.xpbd.colours, &k.finish))
+            }
+            (IntegratorKind::Vbd, Some(v)) => {
+                Some((&v.predict, &v.descend, &self.vbd.colours, &v.finish))
+            }
             _ => None,
         };
         let mut encoder = self
@@ -405,18 +414,14 @@ impl GpuStepper {
             for _ in 0..substeps {
                 self.elements.dispatch(&mut pass, self.current);
                 let (this, other) = (&self.groups[self.current], &self.groups[1 - self.current]);
-                if let Some((predict, finish)) = solver {
+                if let Some((predict, sweep, colours, finish)) = solver {
                     // The state stays where it is; the other buffer holds the predictions
                     // (XPBD) or the displacements (VBD).
                     pass.set_pipeline(predict);
                     pass.set_bind_group(0, this, &[]);
                     pass.dispatch_workgroups(groups, 1, 1);
                     for _ in 0..self.sweeps() {
-                        if vbd {
-                            self.vbd.sweep(&mut pass, &self.kernel, this);
-                        } else {
-                            self.xpbd.sweep(&mut pass, &self.kernel, this);
-                        }
+                        colours.sweep(&mut pass, sweep, this);
                     }
                     pass.set_pipeline(finish);
                     pass.set_bind_group(0, other, &[]);

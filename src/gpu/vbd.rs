@@ -47,7 +47,8 @@ pub(super) fn pack_stencil(
 pub(super) struct VbdPass {
     /// Bound in the substep's group 0 (where XPBD binds its constraints).
     pub(super) stencil: wgpu::Buffer,
-    colours: Colours,
+    /// Its colours, one dispatch each a sweep.
+    pub(super) colours: Colours,
     /// Where the spans, links and memory start in the stencil's words.
     pub(super) starts: [u32; 3],
 }
@@ -84,16 +85,5 @@ impl VbdPass {
             colours: Colours::new(device, queue, kernel, &colours),
             starts,
         })
-    }
-
-    /// Records one sweep: every colour's particles take their Newton steps, colour by
-    /// colour, on the substep's `group`.
-    pub(super) fn sweep(
-        &self,
-        pass: &mut wgpu::ComputePass<'_>,
-        kernel: &SubstepKernel,
-        group: &wgpu::BindGroup,
-    ) {
-        self.colours.sweep(pass, &kernel.descend, group);
     }
 }

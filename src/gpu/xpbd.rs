@@ -110,7 +110,8 @@ pub(super) fn colour_record(first: usize, count: usize, serial: bool) -> [u32; 4
 pub(super) struct XpbdPass {
     /// Bound in the substep's group 0.
     pub(super) constraints: wgpu::Buffer,
-    colours: Colours,
+    /// Its colours, one dispatch each a sweep.
+    pub(super) colours: Colours,
     pub(super) count: u32,
 }
 
@@ -165,15 +166,5 @@ impl XpbdPass {
             colours: Colours::new(device, queue, kernel, &colours),
             count: constraints.len() as u32,
         })
-    }
-
-    /// Records one Gauss–Seidel sweep: every colour, in order, on the substep's `group`.
-    pub(super) fn sweep(
-        &self,
-        pass: &mut wgpu::ComputePass<'_>,
-        kernel: &SubstepKernel,
-        group: &wgpu::BindGroup,
-    ) {
-        self.colours.sweep(pass, &kernel.project, group);
     }
 }
