@@ -476,4 +476,30 @@ mod tests {
             }
         }
     }
+
+    /// A device lost mid-run (destroyed here) stops the run with the device's message and
+    /// keeps the last state the caller had; every later frame says the same.
+    #[test]
+    fn a_lost_device_stops_the_run_and_keeps_the_last_state() {
+        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let mut scene =
+            crate::bench::bench_scene(16, IntegratorKind::SemiImplicitEuler).expect("scene");
+        scene.params.guard.enabled = true;
+        let (model, params) = (&scene.model, &scene.params);
+        let mut stepper =
+            GpuStepper::new(&gpu.device, &gpu.queue, model, params, &scene.effects, true)
+                .expect("stepper");
+        let mut state = scene.initial.clone();
+        for _ in 0..3 {
+            stepper.frame(model, &mut state).expect("a frame");
+        }
+        let kept = state.clone();
+        gpu.device.destroy();
+        for _ in 0..2 {
+            let err = stepper.frame(model, &mut state).expect_err("no device");
+            eprintln!("{err}");
+            assert_eq!(err.cause, crate::sim::Cause::Backend, "{err}");
+            assert_eq!(state.pos, kept.pos);
+        }
+    }
 }
