@@ -55,6 +55,8 @@ pub struct Vbd<R: Real = f32> {
 const PARALLEL_COLOUR: usize = 1024;
 /// Particles per piece of a colour (a multiple of the groups of eight).
 const PIECE: usize = 256;
+/// Particles per piece of the step's start and end.
+const SETUP_PIECE: usize = 2048;
 
 impl<R: Real> Vbd<R> {
     /// The descent's starting point (the adaptive start of Chen et al.): `d = h·v + h²·ã`,
@@ -111,6 +113,17 @@ impl<R: Real> Vbd<R> {
     }
 }
 
+/// `work(range)` over `0..n` in pieces, shared between the team's members from
+/// [`PARALLEL_COLOUR`] particles on: per-particle work whose result does not depend on who
+/// does a piece (the step's start and its end).
+fn by_piece(n: usize, work: &(dyn Fn(std::ops::Range<usize>) + Sync)) {
+    let pieces = n.div_ceil(SETUP_PIECE);
+    Team::current().run_pieces_if(n >= PARALLEL_COLOUR, pieces, &|_, piece| {
+        let start = piece * SETUP_PIECE;
+        work(start..(start + SETUP_PIECE).min(n));
+    });
+}
+
 /// `descend(particles, range)` over every colour of `stencil` in order, each colour in
 /// pieces that the team's members take as they come where the colour is large.
 fn by_colour<P: Send>(
@@ -150,21 +163,30 @@ impl<R: Real> Integrator<R> for Vbd<R> {
         };
         let not_springs = |t: &Force<R>| t.springs().is_none();
         ctx.forces_where(&state.pos, &state.vel, not_springs, &mut self.force);
-        let w = &model.inv_mass;
         let (mut inertial, mut rows) = (
             std::mem::take(&mut self.inertial),
             std::mem::take(&mut self.particles),
         );
-        inertial.clear();
-        rows.clear();
-        for (p, (&pos, &v)) in state.pos.iter().zip(&state.vel).enumerate() {
-            let f = self.force[p];
-            inertial.push((v + f * R::of_f32(w[p]) * h) * h);
-            rows.push(Particle {
-                pos,
-                disp: self.first_guess(v, f, w[p], p, h),
-                inv_mass: R::of_f32(w[p]),
-                mass: R::of_f32(model.mass[p]),
+        inertial.resize(n, R::V3::ZERO);
+        rows.resize(n, Particle::default());
+        {
+            let (pos, vel, force) = (&state.pos, &state.vel, &self.force);
+            let (w, mass) = (&model.inv_mass, &model.mass);
+            let (inertial, rows) = (Disjoint::new(&mut inertial), Disjoint::new(&mut rows));
+            by_piece(n, &|range| {
+                // SAFETY: the pieces' ranges do not overlap.
+                let (inertial, rows) =
+                    unsafe { (inertial.part(range.clone()), rows.part(range.clone())) };
+                for ((p, y), row) in range.zip(inertial).zip(rows) {
+                    let (v, f) = (vel[p], force[p]);
+                    *y = (v + f * R::of_f32(w[p]) * h) * h;
+                    *row = Particle {
+                        pos: pos[p],
+                        disp: self.first_guess(v, f, w[p], p, h),
+                        inv_mass: R::of_f32(w[p]),
+                        mass: R::of_f32(mass[p]),
+                    };
+                }
             });
         }
         (self.inertial, self.particles) = (inertial, rows);
@@ -183,13 +205,18 @@ impl<R: Real> Integrator<R> for Vbd<R> {
         previous.clone_from(&state.vel);
         self.previous = Some((previous, h));
         let inv_h = R::ONE / h;
-        let states = state.pos.iter_mut().zip(state.vel.iter_mut());
-        for ((x, v), row) in states.zip(&self.particles) {
-            if row.inv_mass != R::ZERO {
-                *v = row.disp * inv_h;
-                *x += row.disp;
+        let (pos, vel) = (Disjoint::new(&mut state.pos), Disjoint::new(&mut state.vel));
+        let particles = &self.particles;
+        by_piece(n, &|range| {
+            // SAFETY: the pieces' ranges do not overlap.
+            let (pos, vel) = unsafe { (pos.part(range.clone()), vel.part(range.clone())) };
+            for ((x, v), row) in pos.iter_mut().zip(vel).zip(&particles[range]) {
+                if row.inv_mass != R::ZERO {
+                    *v = row.disp * inv_h;
+                    *x += row.disp;
+                }
             }
-        }
+        });
         state.time += h.to_f64();
         Ok(ctx.report())
     }
