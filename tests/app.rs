@@ -926,3 +926,45 @@ fn the_accuracy_window_answers_the_stability_map_and_small_steps() {
     assert_eq!(map.points.len(), kinds * clothsim::report::MAP_SCALES.len());
     harness.get_by_label_contains("Stability map (fewest stable substeps");
 }
+
+/// The Solver section's precision switch puts the cloth on the `f64` stepper, from the
+/// state it had: the app's next frame has the bits of a headless `f64` frame from that
+/// state, not those of an `f32` one. On the way to the GPU, `f64` is refused with the reason.
+#[test]
+fn the_precision_switch_steps_the_cloth_in_f64() {
+    use clothsim::sim::Precision;
+    // Tall enough that the switch is not under the status bar.
+    let mut harness = harness_sized(1280.0, 1000.0);
+    harness.state_mut().set_scenario("sphere-drop");
+    harness.get_by_label("Step").click();
+    run_settled(&mut harness, 3);
+    let before = harness.state().sim().state().clone();
+    harness.get_by_label("f64").click();
+    run_settled(&mut harness, 2);
+    assert_eq!(
+        harness.state().sim().params().solver.precision,
+        Precision::F64,
+        "{:?}",
+        harness.state().last_error()
+    );
+    let frame_in = |precision: Precision| {
+        let mut scene = harness.state().sim().to_scene();
+        scene.params.solver.precision = precision;
+        let mut sim = clothsim::scene::Simulation::new(scene);
+        sim.modify_state(|s| *s = before.clone());
+        sim.step_frame().expect("a frame");
+        sim.state().pos.clone()
+    };
+    let (f64_frame, f32_frame) = (frame_in(Precision::F64), frame_in(Precision::F32));
+    assert_ne!(f64_frame, f32_frame, "the precisions round differently");
+    harness.get_by_label("Step").click();
+    run_settled(&mut harness, 3);
+    assert_eq!(harness.state().sim().frames(), 2);
+    assert_eq!(harness.state().sim().state().pos, f64_frame);
+    // The GPU computes in f32 only: it is not entered, and the message says why.
+    harness.get_by_label("GPU").click();
+    run_settled(&mut harness, 2);
+    assert_eq!(harness.state().in_effect().backend, "cpu");
+    let error = harness.state().last_error().unwrap_or_default();
+    assert!(error.contains("f32 only"), "{error:?}");
+}
