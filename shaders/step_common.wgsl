@@ -1,7 +1,7 @@
 // What the step shaders share (prepended, after shaders/cloth_layout.wgsl, to
-// shaders/substep.wgsl and shaders/vbd.wgsl when their pipelines are built,
-// src/gpu/kernel.rs): the uniform parameters, the bindings every step kernel has, the
-// element forces' gather and the colliders.
+// shaders/substep.wgsl, shaders/vbd.wgsl and shaders/implicit.wgsl when their pipelines
+// are built, src/gpu/kernel.rs): the uniform parameters, the bindings every step kernel
+// has, a spring's pull, the element forces' gather and the colliders.
 
 struct Collider {
     // x: kind (0 none, 1 sphere, 2 plane); y: radius; z: friction.
@@ -22,6 +22,8 @@ struct Params {
     counts: vec4<u32>,
     // VBD: where the stencil's spans, links and per-particle memory start in its words, and
     // 1 when the memory holds no last acceleration (the first step after a change).
+    // Implicit Euler: where the vectors start in its buffer, the bits of the tolerance (y
+    // unused), and the workgroups a particle dispatch has.
     solver: vec4<u32>,
     // A grid cloth: x its width (0: not a grid), y its height, z its links.
     grid: vec4<u32>,
@@ -84,6 +86,18 @@ fn unit_or_up(p: vec3<f32>) -> vec3<f32> {
         return p / len;
     }
     return vec3<f32>(0.0, 1.0, 0.0);
+}
+
+// The pull (N) of a spring of stiffness and damping `kc.xy` and rest length `rest` from a
+// particle at `x` moving at `v` to the particle `o`.
+fn spring_pull(x: vec3<f32>, v: vec3<f32>, o: Particle, kc: vec4<f32>, rest: f32) -> vec3<f32> {
+    let d = o.x.xyz - x;
+    let len = length(d);
+    if (len > 1e-9) {
+        let n = d / len;
+        return (kc.x * (len - rest) + kc.y * dot(o.v.xyz - v, n)) * n;
+    }
+    return vec3<f32>(0.0);
 }
 
 // The element forces (wind, dihedral bending) on particle `i`: its slots, summed.

@@ -26,18 +26,6 @@ struct Constraint {
 // XPBD's springs as constraints, in colour order.
 @group(0) @binding(8) var<storage, read_write> constraints: array<Constraint>;
 
-// The pull (N) of a spring of stiffness and damping `kc.xy` and rest length `rest` from a
-// particle at `x` moving at `v` to the particle `o`.
-fn spring_pull(x: vec3<f32>, v: vec3<f32>, o: Particle, kc: vec4<f32>, rest: f32) -> vec3<f32> {
-    let d = o.x.xyz - x;
-    let len = length(d);
-    if (len > 1e-9) {
-        let n = d / len;
-        return (kc.x * (len - rest) + kc.y * dot(o.v.xyz - v, n)) * n;
-    }
-    return vec3<f32>(0.0);
-}
-
 @compute @workgroup_size(64)
 fn substep(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;

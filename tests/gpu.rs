@@ -89,7 +89,8 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
     rk4.params.step.integrator = IntegratorKind::Rk4;
     let err = gpu_support(&rk4.params.step, f32, &rk4.effects).expect_err("RK4 is CPU only");
     let err = err.to_string();
-    let runs = "runs Semi-implicit Euler, XPBD, VBD (vertex block descent) only, not RK4";
+    let runs = "runs Semi-implicit Euler, Implicit Euler (CG), XPBD, VBD (vertex block descent) only, \
+                not RK4";
     assert!(err.contains(runs), "{err}");
     assert_eq!(Backend::default(), Backend::Cpu);
     // Switching the integrator of a running GPU simulation fails the next frame, with the
@@ -313,8 +314,6 @@ fn gpu_bench_row_has_the_run_mean_but_no_frame_spread() {
     );
 }
 
-/// `bench --backend gpu` with no `--integrators` runs the one integrator the GPU has (not
-/// the CPU's default list, which it would refuse): one row, from the GPU.
 /// Without `--integrators`, `bench --backend gpu` has a row for every integrator the GPU
 /// runs.
 #[test]
@@ -335,7 +334,7 @@ fn gpu_bench_cli_defaults_to_the_integrators_it_runs() {
         .collect();
     assert_eq!(
         integrators,
-        ["semi-implicit-euler", "xpbd", "vbd"],
+        ["semi-implicit-euler", "implicit-euler", "xpbd", "vbd"],
         "{rows:?}"
     );
     for row in &rows {

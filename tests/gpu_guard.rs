@@ -139,8 +139,9 @@ fn without_the_guard_the_gpu_cloth_blows_up() {
 
 /// With XPBD as the fallback, a frame that more substeps cannot save is redone by XPBD at
 /// the requested substeps, on the GPU as on the CPU; XPBD then stays, and the two cloths
-/// go on together (here to the bit: XPBD's arithmetic is the same on both). Implicit Euler (the default fallback) is not on the GPU: there the run
-/// stops without trying it.
+/// go on together (here to the bit: XPBD's arithmetic is the same on both). The default
+/// fallback, implicit Euler, runs on the GPU too: both fall back to it at the same frame, and
+/// their cloths agree to the solve's tolerance.
 #[test]
 fn the_gpu_falls_back_to_xpbd_as_the_cpu_does() {
     let policy = GuardPolicy {
@@ -165,12 +166,22 @@ fn the_gpu_falls_back_to_xpbd_as_the_cpu_does() {
     let worst = farthest(&cpu.state().pos, &gpu.state().pos);
     eprintln!("after the fallback the backends are {worst:e} m apart");
     assert!(worst < 1e-5, "GPU and CPU differ by {worst} m");
-    // The default fallback is not tried on the GPU; the message says the GPU's count.
     let policy = GuardPolicy {
         max_refinements: 1,
         ..GuardPolicy::default()
     };
-    let (mut gpu, _) = gpu_simulation(stiff_cloth(8, policy), false).expect("GPU backend");
-    let err = gpu.step_frame().expect_err("nothing saves it on the GPU");
-    assert_eq!((err.substeps, err.fallback.as_str()), (16, ""));
+    assert_eq!(policy.fallback, Some(IntegratorKind::ImplicitEuler));
+    let (mut cpu, mut gpu, on_cpu, on_gpu) = both(stiff_cloth(8, policy), 12);
+    let fell_back = GuardAction::FellBack {
+        integrator: IntegratorKind::ImplicitEuler,
+    };
+    let expected = [("0.0167".to_string(), fell_back, 8, 8)];
+    assert_eq!(actions(&on_cpu), expected);
+    assert_eq!(actions(&on_gpu), expected);
+    assert_eq!(gpu.integrator_in_effect(), IntegratorKind::ImplicitEuler);
+    cpu.sync_state().expect("cpu");
+    gpu.sync_state().expect("read back");
+    let worst = farthest(&cpu.state().pos, &gpu.state().pos);
+    eprintln!("after falling back to implicit Euler the backends are {worst:e} m apart");
+    assert!(worst < 1e-4, "GPU and CPU differ by {worst} m");
 }

@@ -243,7 +243,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub quads: Option<u32>,
     /// What steps the cloth: cpu (every integrator and effect) or gpu (wgpu compute:
-    /// semi-implicit Euler, XPBD and VBD; springs, gravity, air damping, wind, dihedral
+    /// semi-implicit and implicit Euler, XPBD and VBD; springs, gravity, air damping, wind, dihedral
     /// bending, pins, handles, spheres, planes).
     #[arg(long, value_enum, default_value_t = Backend::Cpu)]
     pub backend: Backend,

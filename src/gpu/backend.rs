@@ -14,7 +14,7 @@ pub enum Backend {
     /// The CPU solver: every integrator and effect, with the stability guard.
     #[default]
     Cpu,
-    /// wgpu compute: semi-implicit Euler, XPBD and VBD; springs, gravity, air damping, wind,
+    /// wgpu compute: semi-implicit and implicit Euler, XPBD and VBD; springs, gravity, air damping, wind,
     /// dihedral bending, pins, handles, spheres and planes, with the stability guard.
     Gpu,
 }

@@ -4,7 +4,7 @@
 //! limit is redone from the last checkpoint with twice the substeps, up to the policy's
 //! refinements; raised substeps come back down after a run of healthy frames. When every
 //! refinement fails, the policy's fallback integrator is tried at the requested substeps if
-//! the GPU runs it (XPBD, VBD; not the default, implicit Euler); when that fails too, or is
+//! the GPU runs it (implicit Euler, the default, XPBD, VBD); when that fails too, or is
 //! not tried, the state is the frame's start and the run stops with the likely cause.
 
 use std::time::Instant;
@@ -432,9 +432,10 @@ mod tests {
     }
 
     /// On a device that binds at most 32 KiB, the 16 × 16 bench cloth's state and spring
-    /// ends fit (8 and 22 KiB) but XPBD's constraints (36 KiB) and VBD's stencil (55 KiB) do
-    /// not: switching to either fails the next frame with the sizes, keeps the state, and
-    /// every later frame says the same, where the buffers would have failed validation.
+    /// ends fit (8 and 22 KiB) but XPBD's constraints (36 KiB), VBD's stencil (55 KiB) and
+    /// implicit Euler's solve (41 KiB) do not: switching to any of them fails the next frame
+    /// with the sizes, keeps the state, and every later frame says the same, where the
+    /// buffers would have failed validation.
     #[test]
     fn a_solver_too_big_for_the_device_is_refused_with_its_size() {
         let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
@@ -455,6 +456,7 @@ mod tests {
         for (kind, what) in [
             (IntegratorKind::Xpbd, "XPBD constraints"),
             (IntegratorKind::Vbd, "VBD stencil"),
+            (IntegratorKind::ImplicitEuler, "implicit Euler's solve"),
         ] {
             let (model, effects) = (&scene.model, &scene.effects);
             let mut params = scene.params.clone();

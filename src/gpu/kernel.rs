@@ -26,7 +26,7 @@ pub(super) struct SubstepKernel {
     pub(super) vbd: Option<VbdPipelines>,
     /// Counts a substep.
     pub(super) tick: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    pub(super) layout: wgpu::BindGroupLayout,
     pub(super) colour_layout: wgpu::BindGroupLayout,
 }
 
@@ -265,7 +265,7 @@ mod tests {
     fn the_shader_and_the_host_agree_on_their_constants() {
         assert_eq!(shader_const("CLASS_BITS"), CLASS_BITS);
         assert_eq!(shader_const("CLASSES") as usize, MAX_CLASSES);
-        for source in [SOURCE, VBD] {
+        for source in [SOURCE, VBD, super::super::implicit::SOURCE] {
             let ours = format!("@workgroup_size({WORKGROUP})");
             assert!(source.contains(&ours));
             // Besides the one-invocation `tick`.

@@ -1,8 +1,9 @@
-//! The GPU step backend: semi-implicit Euler, XPBD and VBD for the mass-spring cloth in
-//! wgpu compute shaders, under the stability guard. It sits beside the CPU solver (which knows nothing of
+//! The GPU step backend: semi-implicit Euler, implicit Euler, XPBD and VBD for the
+//! mass-spring cloth in wgpu compute shaders, under the stability guard. It sits beside the CPU solver (which knows nothing of
 //! graphics) and plugs into [`crate::scene::Simulation`] through the same
 //! [`crate::sim::StepBackend`] seam. What it runs (`support`), how it lays the cloth out
-//! (`packing`), its kernels (`kernel`, `elements`, `health`, `xpbd`, `vbd`), the stepper that
+//! (`packing`), its kernels (`kernel`, `elements`, `health`, `xpbd`, `vbd`,
+//! `implicit`), the stepper that
 //! drives them (`stepper`)
 //! and the guard's frame with its rollback points on the device (`guarded`, `snapshot`) are
 //! files of their own; it reaches the device through [`crate::device`] only.
@@ -13,6 +14,7 @@ mod error;
 mod guarded;
 mod handles;
 mod health;
+mod implicit;
 mod kernel;
 mod packing;
 mod rebuild;

@@ -7,6 +7,7 @@ use crate::sim::{Effect, IntegratorKind, StepError};
 
 use super::elements::{elements_wanted, pack_elements};
 use super::error::GpuError;
+use super::implicit::ImplicitPass;
 use super::stepper::GpuStepper;
 use super::support::fits_elements;
 use super::vbd::VbdPass;
@@ -49,6 +50,18 @@ impl GpuStepper {
         state: &ClothState,
     ) -> Result<(), StepError> {
         let refused = |e: GpuError| StepError::Unsupported(e.to_string());
+        if self.integrator == IntegratorKind::ImplicitEuler {
+            if self.implicit.is_none() {
+                let pass = ImplicitPass::new(&self.device, &self.kernel.layout, self.count);
+                self.implicit = Some(self.refuse_unless(pass)?);
+            }
+            if let Some(pass) = &mut self.implicit {
+                pass.fresh = true;
+            }
+            self.regroup();
+            self.solver_stale = false;
+            return Ok(());
+        }
         if self.integrator == IntegratorKind::Vbd {
             let springs = Some((model, &self.forces));
             self.vbd =
@@ -83,8 +96,9 @@ impl GpuStepper {
         let extra = [
             &self.elements.forces,
             &self.elements.incidence,
-            match self.integrator {
-                IntegratorKind::Vbd => &self.vbd.stencil,
+            match (self.integrator, &self.implicit) {
+                (IntegratorKind::Vbd, _) => &self.vbd.stencil,
+                (IntegratorKind::ImplicitEuler, Some(pass)) => &pass.solve,
                 _ => &self.xpbd.constraints,
             },
         ];

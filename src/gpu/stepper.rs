@@ -13,7 +13,7 @@ use crate::cloth::{ClothModel, ClothState};
 use crate::device::map_read;
 use crate::sim::{
     Changes, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent, GuardState, IntegratorKind,
-    Material, PhaseTimings, SimParams, StepBackend, StepError, StepReport, StepStats,
+    Material, PhaseTimings, SimParams, SolverConfig, StepBackend, StepError, StepReport, StepStats,
     air_damping_of, gravity_of,
 };
 
@@ -21,6 +21,7 @@ use super::elements::{ElementKernel, pack_elements};
 use super::error::GpuError;
 use super::handles::Carried;
 use super::health::{HealthKernel, Watch};
+use super::implicit::ImplicitPass;
 use super::kernel::{SubstepKernel, WORKGROUP};
 use super::packing::{
     ClassTable, EndsKey, Neighbour, Params, Particle, classify, grid_of, pack_solids, pack_springs,
@@ -40,7 +41,7 @@ fn substep_report(sweeps: u32) -> StepReport {
     }
 }
 
-/// Steps a cloth with semi-implicit Euler on a wgpu device (see the module documentation).
+/// Steps a cloth on a wgpu device (see the module documentation).
 pub struct GpuStepper {
     pub(super) device: wgpu::Device,
     pub(super) queue: wgpu::Queue,
@@ -65,6 +66,9 @@ pub struct GpuStepper {
     /// builds its own).
     pub(super) xpbd: XpbdPass,
     pub(super) vbd: VbdPass,
+    /// Implicit Euler's solve, built the first time it steps, and its tolerance and cap.
+    pub(super) implicit: Option<ImplicitPass>,
+    pub(super) solver: SolverConfig,
     pub(super) solver_stale: bool,
     /// VBD's memory of each particle's last acceleration is stale (the state changed
     /// outside, was rolled back, or VBD has not stepped it yet).
@@ -95,7 +99,7 @@ pub struct GpuStepper {
     /// made on the first [`GpuStepper::display_buffer`], then kept current.
     display: Option<wgpu::Buffer>,
     pub(super) current: usize,
-    count: u32,
+    pub(super) count: u32,
     pub(super) params: Params,
     pub(super) dt: f32,
     /// Substeps per frame in effect (the guard may have raised them), and as requested.
@@ -113,7 +117,7 @@ pub struct GpuStepper {
     /// it (the GPU copy and the caller's state can no longer be brought together).
     pub(super) lost: Option<String>,
     pub(super) timings: PhaseTimings,
-    stats: StepStats,
+    pub(super) stats: StepStats,
     /// The key the device's spring ends were packed with (`None` before the first
     /// upload), and how many times the ends were sent.
     pub(super) sent: Option<EndsKey>,
@@ -212,6 +216,8 @@ impl GpuStepper {
             iterations: [1, 1],
             xpbd,
             vbd,
+            implicit: None,
+            solver: params.solver,
             solver_stale: true,
             vbd_fresh: true,
             uniform,
@@ -331,7 +337,7 @@ impl GpuStepper {
         }
         self.upload = false;
         self.restamp = false;
-        self.vbd_fresh = true;
+        self.forget_guesses();
         self.behind = false;
     }
 
@@ -354,8 +360,8 @@ impl GpuStepper {
             self.upload_state(model, state);
         }
         let vbd = self.integrator == IntegratorKind::Vbd;
-        let sweeping = vbd || self.integrator == IntegratorKind::Xpbd;
-        if sweeping && self.solver_stale {
+        let implicit = self.integrator == IntegratorKind::ImplicitEuler;
+        if self.integrator != IntegratorKind::SemiImplicitEuler && self.solver_stale {
             self.rebuild_solver(model, state)?;
         }
         if self.restamp {
@@ -376,12 +382,32 @@ impl GpuStepper {
         if vbd {
             self.params.solver[3] = u32::from(self.vbd_fresh);
         }
-        if vbd || carried > 0 {
+        if let Some(pass) = self.implicit.as_mut().filter(|_| implicit) {
+            self.params.solver = pass.words(&self.solver);
+            pass.prepare(&self.queue);
+        }
+        if vbd || implicit || carried > 0 {
             self.queue
                 .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
         }
         if vbd {
             self.kernel.vbd(&self.device);
+        }
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("cloth substeps"),
+            });
+        if watch.keep_start {
+            let live = &self.particles[self.current];
+            self.frame_start.take(&mut encoder, live, time);
+        }
+        self.elements.start(&self.queue, time);
+        // The substep counted, when something reads the count: the element pass's clock, the
+        // handles' targets, VBD's first guess.
+        let counting = vbd || carried > 0 || self.elements.elements() > 0;
+        if implicit {
+            self.implicit_substeps(&mut encoder, substeps, counting)?;
         }
         // XPBD's and VBD's passes: predict, sweep the colours, finish.
         let k = &self.kernel;
@@ -394,23 +420,12 @@ impl GpuStepper {
             }
             _ => None,
         };
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("cloth substeps"),
-            });
-        if watch.keep_start {
-            let live = &self.particles[self.current];
-            self.frame_start.take(&mut encoder, live, time);
-        }
-        self.elements.start(&self.queue, time);
-        {
+        if !implicit {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("cloth substeps"),
                 timestamp_writes: None,
             });
             let groups = self.count.div_ceil(WORKGROUP);
-            let counting = vbd || carried > 0 || self.elements.elements() > 0;
             for _ in 0..substeps {
                 self.elements.dispatch(&mut pass, self.current);
                 let (this, other) = (&self.groups[self.current], &self.groups[1 - self.current]);
@@ -432,8 +447,6 @@ impl GpuStepper {
                     pass.dispatch_workgroups(groups, 1, 1);
                     self.current = 1 - self.current;
                 }
-                // The substep counted, when something reads the count: the element pass's
-                // clock, the handles' targets, VBD's first guess.
                 if counting {
                     pass.set_pipeline(&self.kernel.tick);
                     pass.dispatch_workgroups(1, 1, 1);
@@ -455,8 +468,9 @@ impl GpuStepper {
         if vbd && substeps > 0 {
             self.vbd_fresh = false;
         }
+        // Implicit Euler's substeps recorded their iterations themselves.
         let report = substep_report(if solver.is_some() { self.sweeps() } else { 0 });
-        for _ in 0..substeps {
+        for _ in 0..substeps * u32::from(!implicit) {
             self.stats.record(&report);
         }
         Ok(())
@@ -478,7 +492,7 @@ impl GpuStepper {
         }
         self.queue.submit([encoder.finish()]);
         self.upload = false;
-        self.vbd_fresh = true;
+        self.forget_guesses();
         self.behind = true;
         time
     }
@@ -500,8 +514,23 @@ impl GpuStepper {
         self.solver_stale = true;
     }
 
-    /// Makes `substeps` per frame the count in effect.
+    /// The state changed outside: VBD's last accelerations and implicit Euler's last Δv
+    /// are no first guess for the next step.
+    fn forget_guesses(&mut self) {
+        self.vbd_fresh = true;
+        if let Some(pass) = &mut self.implicit {
+            pass.fresh = true;
+        }
+    }
+
+    /// Makes `substeps` per frame the count in effect (implicit Euler's last Δv, of
+    /// another step length, is then no first guess, as on the CPU).
     pub(super) fn set_substeps(&mut self, substeps: u32) {
+        if substeps != self.substeps
+            && let Some(pass) = &mut self.implicit
+        {
+            pass.fresh = true;
+        }
         self.substeps = substeps;
         self.params.gravity[3] = self.substep_length();
         self.elements.set_step(self.substep_length());
@@ -597,6 +626,14 @@ impl StepBackend for GpuStepper {
             self.integrator = params.step.integrator;
         }
         self.iterations = [params.solver.xpbd_iterations, params.solver.vbd_iterations];
+        self.solver = params.solver;
+        if self.integrator == IntegratorKind::ImplicitEuler && params.solver.newton_iterations > 1 {
+            self.unsupported = Some(format!(
+                "runs implicit Euler as one linearised step, not {} Newton iterations; run \
+                 them on the CPU backend",
+                params.solver.newton_iterations
+            ));
+        }
         // New springs or strengths, or XPBD newly in effect: its constraints are built
         // again before the next step, as the CPU's are.
         if changes.intersects(Changes::INTEGRATOR | Changes::EFFECTS | Changes::STRENGTHS) {

@@ -11,15 +11,17 @@ use super::packing::{MAX_COLLIDERS, MAX_PARTICLES, Neighbour, Particle};
 pub const GPU_INTEGRATOR: IntegratorKind = IntegratorKind::SemiImplicitEuler;
 
 /// The integrators the GPU backend runs.
-pub const GPU_INTEGRATORS: [IntegratorKind; 3] = [
+pub const GPU_INTEGRATORS: [IntegratorKind; 4] = [
     IntegratorKind::SemiImplicitEuler,
+    IntegratorKind::ImplicitEuler,
     IntegratorKind::Xpbd,
     IntegratorKind::Vbd,
 ];
 
 /// What of `step`, `precision` and `effects` the GPU backend cannot run, if anything: it
-/// runs semi-implicit Euler, XPBD and VBD in `f32` with gravity, springs (and bend springs), dihedral
-/// bending, wind, air damping, pins, handles and up to four sphere and plane colliders.
+/// runs semi-implicit Euler, implicit Euler (one linearised step), XPBD and VBD in `f32` with
+/// gravity, springs (and bend springs), dihedral bending, wind, air damping, pins, handles
+/// and up to four sphere and plane colliders.
 pub fn gpu_support(
     step: &StepConfig,
     precision: Precision,

@@ -24,7 +24,7 @@ impl Panel for SolverPanel {
             if ui
                 .selectable_label(on_gpu, "GPU")
                 .on_hover_text(
-                    "wgpu compute: semi-implicit Euler, XPBD and VBD; springs, gravity, air \
+                    "wgpu compute: semi-implicit and implicit Euler, XPBD and VBD; springs, gravity, air \
                      damping, wind, dihedral bending, pins, handles, spheres and planes",
                 )
                 .clicked()
