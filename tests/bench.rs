@@ -291,7 +291,7 @@ fn bench_cli_refuses_bad_thread_counts_and_gpu_integrators_in_one_line() {
         "rk4",
     ]);
     assert!(
-        err.contains("semi-implicit-euler, xpbd, vbd only, not rk4"),
+        err.contains("semi-implicit-euler, implicit-euler, xpbd, vbd only, not rk4"),
         "{err}"
     );
     let err = run(&["bench", "--sizes", "8", "--backend", "tpu"]);

@@ -9,15 +9,11 @@
 //! iteration count, with one wait a substep where the last solve's count was enough.
 
 use crate::device::map_read;
-use crate::sim::{IntegratorKind, SolverConfig, StepError, StepReport};
+use crate::sim::SolverConfig;
 
 use super::error::GpuError;
-use super::kernel::{COMMON, LAYOUT, WORKGROUP, pipelines};
-use super::stepper::GpuStepper;
+use super::kernel::{COMMON, IMPLICIT, LAYOUT, WORKGROUP, pipelines};
 use super::support::fits;
-
-/// Implicit Euler's entry points.
-pub(super) const SOURCE: &str = include_str!("../../shaders/implicit.wgsl");
 
 /// Storage buffers the solve's kernels bind: the substep's seven and the workgroup counts.
 pub(super) const STORAGE_BUFFERS: u32 = 8;
@@ -148,7 +144,7 @@ impl ImplicitPass {
         ] = pipelines(
             device,
             "cloth implicit",
-            &format!("{LAYOUT}{COMMON}{SOURCE}"),
+            &format!("{LAYOUT}{COMMON}{IMPLICIT}"),
             [
                 ("ie_begin", one),
                 ("ie_norm", two),
@@ -202,7 +198,7 @@ impl ImplicitPass {
 
     /// Records a solve's start with the substep's `group` (reading the state): forces,
     /// right-hand side, preconditioner, first guess, residual.
-    fn start(&self, pass: &mut wgpu::ComputePass<'_>, group: &wgpu::BindGroup) {
+    pub(super) fn start(&self, pass: &mut wgpu::ComputePass<'_>, group: &wgpu::BindGroup) {
         let p = &self.pipelines;
         self.bind(pass, group);
         self.direct(pass, &p.begin, self.groups);
@@ -212,7 +208,12 @@ impl ImplicitPass {
     }
 
     /// Records `iterations` iterations, those past convergence empty.
-    fn iterate(&self, pass: &mut wgpu::ComputePass<'_>, group: &wgpu::BindGroup, iterations: u32) {
+    pub(super) fn iterate(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        group: &wgpu::BindGroup,
+        iterations: u32,
+    ) {
         let p = &self.pipelines;
         self.bind(pass, group);
         for _ in 0..iterations {
@@ -225,7 +226,7 @@ impl ImplicitPass {
     }
 
     /// Records the step's end: the state into the other buffer.
-    fn finish(&self, pass: &mut wgpu::ComputePass<'_>, group: &wgpu::BindGroup) {
+    pub(super) fn finish(&self, pass: &mut wgpu::ComputePass<'_>, group: &wgpu::BindGroup) {
         self.bind(pass, group);
         self.direct(pass, &self.pipelines.finish, self.groups);
     }
@@ -252,7 +253,7 @@ impl ImplicitPass {
 
     /// Submits `encoder` with a copy of the solve's state, and reads it: whether the solve
     /// is done, and its iterations so far.
-    fn submit_and_read(
+    pub(super) fn submit_and_read(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -270,74 +271,5 @@ impl ImplicitPass {
         };
         self.state.unmap();
         Ok((words[1] > 0.5, words[0] as u32))
-    }
-}
-
-impl GpuStepper {
-    /// Encodes `substeps` implicit-Euler substeps into `encoder`, submitting it (and going
-    /// on in a new one) after each chunk of a solve's iterations, to read whether it goes on
-    /// and, at its end, how many it took.
-    /// `counting`: each substep is counted for what reads the count.
-    ///
-    /// # Errors
-    /// [`StepError::Device`] when the solve's state cannot be read.
-    pub(super) fn implicit_substeps(
-        &mut self,
-        encoder: &mut wgpu::CommandEncoder,
-        substeps: u32,
-        counting: bool,
-    ) -> Result<(), StepError> {
-        let Some(solve) = self
-            .implicit
-            .as_mut()
-            .filter(|_| self.integrator == IntegratorKind::ImplicitEuler)
-        else {
-            return Ok(());
-        };
-        let cap = self.solver.max_iterations;
-        let new_encoder = |device: &wgpu::Device| {
-            device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("cloth implicit substeps"),
-            })
-        };
-        let lost = |e: GpuError| StepError::Device(e.to_string());
-        for _ in 0..substeps {
-            let this = &self.groups[self.current];
-            let mut encoded = solve.last.max(FIRST_CHUNK).min(cap);
-            {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
-                self.elements.dispatch(&mut pass, self.current);
-                solve.start(&mut pass, this);
-                solve.iterate(&mut pass, this, encoded);
-            }
-            let (done, taken) = loop {
-                let full = std::mem::replace(encoder, new_encoder(&self.device));
-                let (device, queue) = (&self.device, &self.queue);
-                let (done, taken) = solve.submit_and_read(device, queue, full).map_err(lost)?;
-                if done || encoded == cap {
-                    break (done, taken);
-                }
-                let more = encoded.min(cap - encoded);
-                let mut pass = encoder.begin_compute_pass(&Default::default());
-                solve.iterate(&mut pass, this, more);
-                encoded += more;
-            };
-            solve.last = taken;
-            self.stats.record(&StepReport {
-                force_evals: 1,
-                solver_iterations: taken,
-                residual: None,
-                converged: done,
-            });
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            solve.finish(&mut pass, this);
-            if counting {
-                pass.set_pipeline(&self.kernel.tick);
-                pass.dispatch_workgroups(1, 1, 1);
-            }
-            drop(pass);
-            self.current = 1 - self.current;
-        }
-        Ok(())
     }
 }

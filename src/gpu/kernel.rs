@@ -13,6 +13,8 @@ pub(super) const COMMON: &str = include_str!("../../shaders/step_common.wgsl");
 pub(super) const SOURCE: &str = include_str!("../../shaders/substep.wgsl");
 /// VBD's entry points.
 pub(super) const VBD: &str = include_str!("../../shaders/vbd.wgsl");
+/// Implicit Euler's entry points (`implicit`).
+pub(super) const IMPLICIT: &str = include_str!("../../shaders/implicit.wgsl");
 
 /// The substep's pipelines (semi-implicit Euler's one, XPBD's three, VBD's three) and the
 /// layouts of what they bind: group 0 for all, and for XPBD's projection and VBD's descent
@@ -265,7 +267,7 @@ mod tests {
     fn the_shader_and_the_host_agree_on_their_constants() {
         assert_eq!(shader_const("CLASS_BITS"), CLASS_BITS);
         assert_eq!(shader_const("CLASSES") as usize, MAX_CLASSES);
-        for source in [SOURCE, VBD, super::super::implicit::SOURCE] {
+        for source in [SOURCE, VBD, IMPLICIT] {
             let ours = format!("@workgroup_size({WORKGROUP})");
             assert!(source.contains(&ours));
             // Besides the one-invocation `tick`.

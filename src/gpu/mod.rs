@@ -3,7 +3,7 @@
 //! graphics) and plugs into [`crate::scene::Simulation`] through the same
 //! [`crate::sim::StepBackend`] seam. What it runs (`support`), how it lays the cloth out
 //! (`packing`), its kernels (`kernel`, `elements`, `health`, `xpbd`, `vbd`,
-//! `implicit`), the stepper that
+//! `implicit`, with its substeps in `implicit_steps`), the stepper that
 //! drives them (`stepper`)
 //! and the guard's frame with its rollback points on the device (`guarded`, `snapshot`) are
 //! files of their own; it reaches the device through [`crate::device`] only.
@@ -15,6 +15,7 @@ mod guarded;
 mod handles;
 mod health;
 mod implicit;
+mod implicit_steps;
 mod kernel;
 mod packing;
 mod rebuild;
