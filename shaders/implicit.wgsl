@@ -302,15 +302,21 @@ fn ie_residual(
     reduce_into(lid.x, group.x, mine);
 }
 
+// Done when the residual's `r·r` meets the target; the particle kernels dispatch nothing
+// from then on.
+fn done_at(rr: f32) {
+    let finished = !(rr > cg[1].x);
+    cg[2].y = select(0.0, 1.0, finished);
+    dispatch_while(!finished);
+}
+
 // `r·z` and `r·r` of the first guess; done when it already meets the target.
 @compute @workgroup_size(64)
 fn ie_start(@builtin(local_invocation_id) lid: vec3<u32>) {
     let sum = total(lid.x);
     if (lid.x == 0u && !done()) {
         cg[0] = vec4<f32>(sum.x, 0.0, 0.0, sum.y);
-        let finished = !(sum.y > cg[1].x);
-        cg[2].y = select(0.0, 1.0, finished);
-        dispatch_while(!finished);
+        done_at(sum.y);
     }
 }
 
@@ -378,9 +384,7 @@ fn ie_beta(@builtin(local_invocation_id) lid: vec3<u32>) {
     let sum = total(lid.x);
     if (lid.x == 0u && !done()) {
         cg[0] = vec4<f32>(sum.x, cg[0].y, sum.x / cg[0].x, sum.y);
-        let finished = !(sum.y > cg[1].x);
-        cg[2].y = select(0.0, 1.0, finished);
-        dispatch_while(!finished);
+        done_at(sum.y);
     }
 }
 
