@@ -7,20 +7,21 @@
 // as on the CPU. Pinned particles are held out of the solve (their unknowns stay zero).
 //
 // A substep's dispatches, in order: `ie_begin` (forces, right-hand side, preconditioner,
-// first guess), `ie_norm` (‖b‖, the target), `ie_residual` (r, z, p), `ie_start`, then per
-// iteration `ie_product` (q = A·p), `ie_alpha`, `ie_update` (x, r, z), `ie_beta`,
-// `ie_direction` (p), and last `ie_finish` (the state, with the colliders). The host
-// encodes the iteration cap's worth of iterations; the one-workgroup kernels write the
-// particle kernels' workgroup counts into `args`, zero once the solve is done, so the
-// iterations past convergence dispatch nothing (no read-back decides when to stop).
+// first guess), `ie_norm` (‖b‖, the target), `ie_residual` (r, z), `ie_start`, then per
+// iteration `ie_product` (the direction p = z + β·p and q = A·p), `ie_alpha`, `ie_update`
+// (x, r, z), `ie_beta`, and last `ie_finish` (the state, with the colliders). The host
+// encodes the iterations in chunks and reads `cg[2]` between them (src/gpu/implicit_steps.rs);
+// the one-workgroup kernels write the particle kernels' workgroup counts into `args`, zero
+// once the solve is done, so the iterations of a chunk past convergence dispatch nothing.
 // Prepended with shaders/step_common.wgsl.
 
 // The solve's scalars, partial sums and vectors (src/gpu/implicit.rs): [0] x rz, y α,
 // z β, w r·r; [1] x the target (tolerance·‖b‖)², y ‖b‖²; [2] x iterations, y 1 when done,
 // z the first guess's history (0 none, 1 the last Δv, 2 the last two), w 1 when a collider
 // moved a particle (the history is then no guess); from 4 one partial sum per workgroup;
-// from params.solver.x the vectors, n entries each: x (Δv), r, z, p, q, b, the Δv before
-// the last, then the preconditioner's inverse blocks, three columns per particle.
+// from params.solver.x the vectors, n entries each: x (Δv), r, z, the direction p of even
+// and of odd iterations, q, b, the Δv before the last, then the preconditioner's inverse
+// blocks, three columns per particle.
 @group(0) @binding(8) var<storage, read_write> cg: array<vec4<f32>>;
 // The particle kernels' workgroup counts (x, y, z), read by their indirect dispatches.
 @group(1) @binding(1) var<storage, read_write> args: array<u32>;
@@ -29,11 +30,14 @@ const PARTIALS: u32 = 4u;
 const X: u32 = 0u;
 const R: u32 = 1u;
 const Z: u32 = 2u;
+// The two directions: an iteration reads its last one and writes its own.
 const P: u32 = 3u;
-const Q: u32 = 4u;
-const B: u32 = 5u;
-const PREVIOUS: u32 = 6u;
-const INVERSE: u32 = 7u;
+const Q: u32 = 5u;
+const B: u32 = 6u;
+const PREVIOUS: u32 = 7u;
+const INVERSE: u32 = 8u;
+// `which` meaning this iteration's direction, formed where it is read.
+const DIRECTION: u32 = 0xffffffffu;
 
 var<workgroup> sums: array<vec2<f32>, 64>;
 
@@ -264,21 +268,44 @@ fn preconditioned(i: u32, r: vec3<f32>) -> vec3<f32> {
     return mat3x3<f32>(cg[base].xyz, cg[base + 1u].xyz, cg[base + 2u].xyz) * r;
 }
 
-// `A·u` for free particle `i`, `u` read from vector `which` (zero at pinned particles).
+// Where the direction of the iteration under way (`cg[2].x` done before it) is written,
+// and where the last one's is read.
+fn direction_slot(last: bool) -> u32 {
+    return P + ((u32(cg[2].x) + select(0u, 1u, last)) & 1u);
+}
+
+// This iteration's direction at particle `j`: `z` on the first, else `z + β·p` (the last
+// direction): formed by each particle that reads it, so no pass of its own writes it first.
+fn direction(j: u32) -> vec3<f32> {
+    if (cg[2].x < 0.5) {
+        return vec_at(Z, j);
+    }
+    return vec_at(Z, j) + vec_at(direction_slot(true), j) * cg[0].z;
+}
+
+fn operand(which: u32, j: u32) -> vec3<f32> {
+    if (which == DIRECTION) {
+        return direction(j);
+    }
+    return vec_at(which, j);
+}
+
+// `A·u` for free particle `i`, `u` read from vector `which` or, for [`DIRECTION`], this
+// iteration's direction (zero at pinned particles).
 fn product(i: u32, which: u32) -> vec3<f32> {
     let x = src[i].x.xyz;
-    let mine = vec_at(which, i);
+    let mine = operand(which, i);
     var sum = mine * own_diagonal(src[i].x.w);
     for (var l = 0u; l < links_of(i); l = l + 1u) {
         let to = link_of(i, l);
         if (to.ok) {
-            sum = sum + times(block_of(x, to), mine - vec_at(which, to.other));
+            sum = sum + times(block_of(x, to), mine - operand(which, to.other));
         }
     }
     return sum;
 }
 
-// `r = b − A·x`, `z = P·r`, `p = z`; each workgroup sums `r·z` and `r·r`.
+// `r = b − A·x`, `z = P·r`; each workgroup sums `r·z` and `r·r`.
 @compute @workgroup_size(64)
 fn ie_residual(
     @builtin(global_invocation_id) id: vec3<u32>,
@@ -292,12 +319,12 @@ fn ie_residual(
         let z = preconditioned(i, r);
         set_vec(R, i, r);
         set_vec(Z, i, z);
-        set_vec(P, i, z);
         mine = vec2<f32>(dot(r, z), dot(r, r));
     } else if (i < params.counts.x) {
         set_vec(R, i, vec3<f32>(0.0));
         set_vec(Z, i, vec3<f32>(0.0));
         set_vec(P, i, vec3<f32>(0.0));
+        set_vec(P + 1u, i, vec3<f32>(0.0));
     }
     reduce_into(lid.x, group.x, mine);
 }
@@ -320,7 +347,8 @@ fn ie_start(@builtin(local_invocation_id) lid: vec3<u32>) {
     }
 }
 
-// `q = A·p` (zero at pinned particles); each workgroup sums `p·q`.
+// This iteration's direction `p` (kept for the update and the next direction) and `q = A·p`
+// (zero at pinned particles); each workgroup sums `p·q`.
 @compute @workgroup_size(64)
 fn ie_product(
     @builtin(global_invocation_id) id: vec3<u32>,
@@ -330,9 +358,11 @@ fn ie_product(
     let i = id.x;
     var mine = vec2<f32>(0.0);
     if (moves(i)) {
-        let q = product(i, P);
+        let p = direction(i);
+        let q = product(i, DIRECTION);
+        set_vec(direction_slot(false), i, p);
         set_vec(Q, i, q);
-        mine = vec2<f32>(dot(vec_at(P, i), q), 0.0);
+        mine = vec2<f32>(dot(p, q), 0.0);
     } else if (i < params.counts.x) {
         set_vec(Q, i, vec3<f32>(0.0));
     }
@@ -367,7 +397,8 @@ fn ie_update(
     var mine = vec2<f32>(0.0);
     if (moves(i)) {
         let alpha = cg[0].y;
-        set_vec(X, i, vec_at(X, i) + vec_at(P, i) * alpha);
+        // The iteration is counted by now: its direction is the "last" one.
+        set_vec(X, i, vec_at(X, i) + vec_at(direction_slot(true), i) * alpha);
         let r = vec_at(R, i) - vec_at(Q, i) * alpha;
         let z = preconditioned(i, r);
         set_vec(R, i, r);
@@ -385,15 +416,6 @@ fn ie_beta(@builtin(local_invocation_id) lid: vec3<u32>) {
     if (lid.x == 0u && !done()) {
         cg[0] = vec4<f32>(sum.x, cg[0].y, sum.x / cg[0].x, sum.y);
         done_at(sum.y);
-    }
-}
-
-// `p = z + β·p`.
-@compute @workgroup_size(64)
-fn ie_direction(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
-    if (moves(i)) {
-        set_vec(P, i, vec_at(Z, i) + vec_at(P, i) * cg[0].z);
     }
 }
 

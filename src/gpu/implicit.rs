@@ -23,8 +23,8 @@ pub(super) const FIRST_CHUNK: u32 = 8;
 
 /// `vec4`s before the vectors: four of scalars, then a partial sum per workgroup.
 const HEADER: u32 = 4;
-/// `vec4`s per particle: seven vectors and three columns of the preconditioner.
-const PER_PARTICLE: u64 = 10;
+/// `vec4`s per particle: eight vectors and three columns of the preconditioner.
+const PER_PARTICLE: u64 = 11;
 
 /// The pipelines, in the order a substep dispatches them.
 struct Pipelines {
@@ -36,7 +36,6 @@ struct Pipelines {
     alpha: wgpu::ComputePipeline,
     update: wgpu::ComputePipeline,
     beta: wgpu::ComputePipeline,
-    direction: wgpu::ComputePipeline,
     finish: wgpu::ComputePipeline,
 }
 
@@ -139,7 +138,6 @@ impl ImplicitPass {
             alpha,
             update,
             beta,
-            direction,
             finish,
         ] = pipelines(
             device,
@@ -154,7 +152,6 @@ impl ImplicitPass {
                 ("ie_alpha", two),
                 ("ie_update", one),
                 ("ie_beta", two),
-                ("ie_direction", one),
                 ("ie_finish", one),
             ],
         );
@@ -173,7 +170,6 @@ impl ImplicitPass {
                 alpha,
                 update,
                 beta,
-                direction,
                 finish,
             },
             groups,
@@ -221,7 +217,6 @@ impl ImplicitPass {
             self.direct(pass, &p.alpha, 1);
             self.indirect(pass, &p.update);
             self.direct(pass, &p.beta, 1);
-            self.indirect(pass, &p.direction);
         }
     }
 
