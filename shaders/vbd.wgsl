@@ -20,9 +20,9 @@ fn memory_at(p: u32) -> u32 {
 
 // First: per free particle `dst` gets x = the first guess of its displacement (w its mass)
 // and v = its inertial displacement `(v + h·a)·h`, `a` the acceleration of the forces that
-// are not springs. The first guess is the adaptive start: the part of `a` the particle
-// showed in its last step, `â·clamp(a_last·â, 0, |a|)`, in place of `a` (all of `a`
-// without a last step).
+// are not springs. The first guess takes the particle's acceleration over its last step in
+// place of `a`, scaled down to `|a|` where larger (all of `a` without a last step), as the
+// CPU's does (src/sim/integrator/vbd.rs).
 @compute @workgroup_size(64)
 fn vbd_predict(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
@@ -51,11 +51,11 @@ fn vbd_predict(@builtin(global_invocation_id) id: vec3<u32>) {
                 bitcast<f32>(stencil[at + 1u]),
                 bitcast<f32>(stencil[at + 2u]),
             );
-            let size = length(a);
-            taken = vec3<f32>(0.0);
-            if (size > 0.0) {
-                let along = a / size;
-                taken = along * min(max(dot(last, along), 0.0), size);
+            let size = length(last);
+            let most = length(a);
+            taken = last;
+            if (size > most) {
+                taken = last * (most / size);
             }
         }
         guess = (v + taken * h) * h;

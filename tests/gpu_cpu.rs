@@ -54,16 +54,22 @@ fn compare(scene: Scene, frames: usize) -> (f32, f32, Simulation, Simulation) {
 /// 10⁻⁷ m at the start is 6 µm apart four frames in, 70 µm two frames later), and the flag
 /// (the element forces move the predictions).
 /// VBD over the same runs: the GPU descends the CPU's stencil colour by colour, with the
-/// CPU's adaptive first guess, and agrees with it to 2–6 µm.
+/// CPU's first guess, and agrees with it to 2–4 µm, and to 16 µm on the swinging cloth at
+/// one sweep: there the guess follows the swing and carries rounding further (on the CPU
+/// alone, particles moved by 5 × 10⁻⁸ m end 4.9 µm apart after the same 30 frames, against
+/// 2.6 µm with the guess along gravity alone). The GPU starting from that older guess ends
+/// 2.4 cm away.
 #[test]
 fn gpu_xpbd_and_vbd_are_the_cpus() {
     for kind in [IntegratorKind::Xpbd, IntegratorKind::Vbd] {
+        // Metres: XPBD's, then VBD's.
         for (name, sweeps, frames, least, tolerance) in [
-            ("hanging", 1, 30, 0.3, 1e-5),
-            ("hanging", 2, 30, 0.3, 1e-5),
-            ("sphere-drop", 1, 22, 0.3, 2e-5),
-            ("flag", 1, 12, 0.05, 1e-5),
+            ("hanging", 1, 30, 0.3, [1e-5, 3e-5]),
+            ("hanging", 2, 30, 0.3, [1e-5, 1e-5]),
+            ("sphere-drop", 1, 22, 0.3, [2e-5, 2e-5]),
+            ("flag", 1, 12, 0.05, [1e-5, 1e-5]),
         ] {
+            let tolerance = tolerance[usize::from(kind == IntegratorKind::Vbd)];
             let (worst, moved, ..) = compare(with(kind, name, sweeps), frames);
             let name = format!("{kind:?} {name} × {sweeps}");
             eprintln!("{name}: worst {worst:e} m of {moved} m moved");
