@@ -290,6 +290,15 @@ fn operand(which: u32, j: u32) -> vec3<f32> {
     return vec_at(which, j);
 }
 
+// Keeps the residual `r` of free particle `i` and its preconditioned `z = P·r`; returns its
+// `r·z` and `r·r`.
+fn keep_residual(i: u32, r: vec3<f32>) -> vec2<f32> {
+    let z = preconditioned(i, r);
+    set_vec(R, i, r);
+    set_vec(Z, i, z);
+    return vec2<f32>(dot(r, z), dot(r, r));
+}
+
 // `A·u` for free particle `i`, `u` read from vector `which` or, for [`DIRECTION`], this
 // iteration's direction (zero at pinned particles).
 fn product(i: u32, which: u32) -> vec3<f32> {
@@ -315,11 +324,7 @@ fn ie_residual(
     let i = id.x;
     var mine = vec2<f32>(0.0);
     if (moves(i)) {
-        let r = vec_at(B, i) - product(i, X);
-        let z = preconditioned(i, r);
-        set_vec(R, i, r);
-        set_vec(Z, i, z);
-        mine = vec2<f32>(dot(r, z), dot(r, r));
+        mine = keep_residual(i, vec_at(B, i) - product(i, X));
     } else if (i < params.counts.x) {
         set_vec(R, i, vec3<f32>(0.0));
         set_vec(Z, i, vec3<f32>(0.0));
@@ -399,11 +404,7 @@ fn ie_update(
         let alpha = cg[0].y;
         // The iteration is counted by now: its direction is the "last" one.
         set_vec(X, i, vec_at(X, i) + vec_at(direction_slot(true), i) * alpha);
-        let r = vec_at(R, i) - vec_at(Q, i) * alpha;
-        let z = preconditioned(i, r);
-        set_vec(R, i, r);
-        set_vec(Z, i, z);
-        mine = vec2<f32>(dot(r, z), dot(r, r));
+        mine = keep_residual(i, vec_at(R, i) - vec_at(Q, i) * alpha);
     }
     reduce_into(lid.x, group.x, mine);
 }
