@@ -933,8 +933,7 @@ fn the_accuracy_window_answers_the_stability_map_and_small_steps() {
 #[test]
 fn the_precision_switch_steps_the_cloth_in_f64() {
     use clothsim::sim::Precision;
-    // Tall enough that the switch is not under the status bar.
-    let mut harness = harness_sized(1280.0, 1000.0);
+    let mut harness = harness();
     harness.state_mut().set_scenario("sphere-drop");
     harness.get_by_label("Step").click();
     run_settled(&mut harness, 3);

@@ -15,6 +15,8 @@ impl Panel for SolverPanel {
     fn ui(&mut self, ui: &mut egui::Ui, ctx: &mut PanelContext<'_>) {
         ui.heading("Solver");
         let in_effect = ctx.status.in_effect;
+        let mut params = ctx.sim.params().clone();
+        let mut changed = false;
         ui.horizontal(|ui| {
             ui.label("Backend");
             let on_gpu = in_effect.on_gpu();
@@ -32,9 +34,28 @@ impl Panel for SolverPanel {
             {
                 ctx.ask(Action::SetBackend(Backend::Gpu));
             }
+            ui.separator();
+            for precision in Precision::ALL {
+                let chosen = params.solver.precision == precision;
+                // The GPU computes in f32 only: f64 is offered on the CPU.
+                let offered = precision == Precision::F32 || !on_gpu;
+                let button = ui
+                    .add_enabled(offered, egui::Button::selectable(chosen, precision.name()))
+                    .on_hover_text(
+                        "precision: what the CPU computes in. f32 is fast; f64 keeps rounding \
+                         far below what the accuracy report measures (1.6–8× slower, by \
+                         integrator)",
+                    )
+                    .on_disabled_hover_text(
+                        "the GPU computes in f32 only (WGSL has no f64): switch to the CPU for \
+                         f64",
+                    );
+                if button.clicked() && !chosen {
+                    params.solver.precision = precision;
+                    changed = true;
+                }
+            }
         });
-        let mut params = ctx.sim.params().clone();
-        let mut changed = false;
         for kind in IntegratorKind::ALL {
             changed |= ui
                 .radio_value(&mut params.step.integrator, kind, kind.label())
@@ -88,29 +109,6 @@ impl Panel for SolverPanel {
                     .changed();
                 ui.end_row();
             }
-            ui.label("Precision");
-            ui.horizontal(|ui| {
-                for precision in Precision::ALL {
-                    let chosen = params.solver.precision == precision;
-                    // The GPU computes in f32 only: f64 is offered on the CPU.
-                    let offered = precision == Precision::F32 || !in_effect.on_gpu();
-                    let button = ui
-                        .add_enabled(offered, egui::Button::selectable(chosen, precision.name()))
-                        .on_hover_text(
-                            "what the CPU computes in: f32 is fast, f64 keeps rounding far \
-                             below what the accuracy report measures (1.6–8× slower, by integrator)",
-                        )
-                        .on_disabled_hover_text(
-                            "the GPU computes in f32 only (WGSL has no f64): switch to the CPU \
-                             for f64",
-                        );
-                    if button.clicked() && !chosen {
-                        params.solver.precision = precision;
-                        changed = true;
-                    }
-                }
-            });
-            ui.end_row();
             ui.label("Substep");
             ui.label(format!("{:.3} ms", 1e3 * in_effect.substep_length));
             ui.end_row();
