@@ -101,35 +101,6 @@ fn dispatch_while(going: bool) {
     args[2] = 1u;
 }
 
-// Spring `l` of particle `i`: the other particle, its strength class and rest length; `ok`
-// false for a grid link that leaves the cloth.
-struct Link {
-    other: u32,
-    strength: u32,
-    rest: f32,
-    ok: bool,
-}
-
-fn links_of(i: u32) -> u32 {
-    if (params.grid.x > 0u) {
-        return params.grid.z;
-    }
-    return offsets[i + 1u] - offsets[i];
-}
-
-fn link_of(i: u32, l: u32) -> Link {
-    if (params.grid.x > 0u) {
-        let width = i32(params.grid.x);
-        let col = i32(i % params.grid.x) + bitcast<i32>(params.links[l].x);
-        let row = i32(i / params.grid.x) + bitcast<i32>(params.links[l].y);
-        let ok = col >= 0 && row >= 0 && col < width && row < i32(params.grid.y);
-        let other = select(0u, u32(row * width + col), ok);
-        return Link(other, params.links[l].z, bitcast<f32>(params.links[l].w), ok);
-    }
-    let nb = neighbours[offsets[i] + l];
-    return Link(nb.other >> CLASS_BITS, nb.other & (CLASSES - 1u), nb.rest, true);
-}
-
 // A spring's system block `alpha·I + beta·n nᵀ` (the CPU's `SpringBlock`) and the
 // stretch `s` it was made with, from particle `i`'s end.
 struct Block {
@@ -185,8 +156,9 @@ fn ie_begin(
         var dfdx_v = vec3<f32>(0.0);
         let own = own_diagonal(w);
         var diag = mat3x3<f32>(own, 0.0, 0.0, 0.0, own, 0.0, 0.0, 0.0, own);
-        for (var l = 0u; l < links_of(i); l = l + 1u) {
-            let to = link_of(i, l);
+        let links = links_of(i);
+        for (var l = 0u; l < links.count; l = l + 1u) {
+            let to = link_of(links, l);
             if (!to.ok) {
                 continue;
             }
@@ -305,8 +277,9 @@ fn product(i: u32, which: u32) -> vec3<f32> {
     let x = src[i].x.xyz;
     let mine = operand(which, i);
     var sum = mine * own_diagonal(src[i].x.w);
-    for (var l = 0u; l < links_of(i); l = l + 1u) {
-        let to = link_of(i, l);
+    let links = links_of(i);
+    for (var l = 0u; l < links.count; l = l + 1u) {
+        let to = link_of(links, l);
         if (to.ok) {
             sum = sum + times(block_of(x, to), mine - operand(which, to.other));
         }
@@ -427,13 +400,7 @@ fn ie_beta(@builtin(local_invocation_id) lid: vec3<u32>) {
 @compute @workgroup_size(64)
 fn ie_finish(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
-    if (i >= params.counts.x) {
-        return;
-    }
-    let me = src[i];
-    let w = me.x.w;
-    if (w == 0.0) {
-        dst[i] = placed(me);
+    if (held(i)) {
         return;
     }
     var dv = vec_at(X, i);
@@ -441,13 +408,7 @@ fn ie_finish(@builtin(global_invocation_id) id: vec3<u32>) {
         dv = vec3<f32>(0.0);
         set_vec(X, i, dv);
     }
-    let x = me.x.xyz;
-    let nv = me.v.xyz + dv;
-    let h = params.gravity.w;
-    let free_end = Motion(x + nv * h, nv);
-    let out = collide(x, free_end);
-    if (any(out.x != free_end.x) || any(out.v != free_end.v)) {
+    if (advance(i, src[i].v.xyz + dv)) {
         cg[2].w = 1.0;
     }
-    dst[i] = Particle(vec4<f32>(out.x, w), vec4<f32>(out.v, 0.0));
 }

@@ -1,7 +1,9 @@
 // What the step shaders share (prepended, after shaders/cloth_layout.wgsl, to
 // shaders/substep.wgsl, shaders/vbd.wgsl and shaders/implicit.wgsl when their pipelines
 // are built, src/gpu/kernel.rs): the uniform parameters, the bindings every step kernel
-// has, a spring's pull, the element forces' gather and the colliders.
+// has, a particle's springs (from the grid or its spring ends) and a spring's pull, the
+// element forces' gather, the colliders, and a substep's end for a pinned particle and a
+// free one.
 
 struct Collider {
     // x: kind (0 none, 1 sphere, 2 plane); y: radius; z: friction.
@@ -100,6 +102,44 @@ fn spring_pull(x: vec3<f32>, v: vec3<f32>, o: Particle, kc: vec4<f32>, rest: f32
     return vec3<f32>(0.0);
 }
 
+// Particle `i`'s springs: on a grid its column and row, from which its links follow (no
+// spring end is read to find them), else where its spring ends start and how many.
+struct Links {
+    col: i32,
+    row: i32,
+    first: u32,
+    count: u32,
+}
+
+fn links_of(i: u32) -> Links {
+    if (params.grid.x > 0u) {
+        return Links(i32(i % params.grid.x), i32(i / params.grid.x), 0u, params.grid.z);
+    }
+    return Links(0, 0, offsets[i], offsets[i + 1u] - offsets[i]);
+}
+
+// Spring `l` of `links`: the other particle, its strength class and rest length; `ok` false
+// for a grid link that leaves the cloth.
+struct Link {
+    other: u32,
+    strength: u32,
+    rest: f32,
+    ok: bool,
+}
+
+fn link_of(links: Links, l: u32) -> Link {
+    if (params.grid.x > 0u) {
+        let link = params.links[l];
+        let width = i32(params.grid.x);
+        let col = links.col + bitcast<i32>(link.x);
+        let row = links.row + bitcast<i32>(link.y);
+        let ok = col >= 0 && row >= 0 && col < width && row < i32(params.grid.y);
+        return Link(select(0u, u32(row * width + col), ok), link.z, bitcast<f32>(link.w), ok);
+    }
+    let nb = neighbours[links.first + l];
+    return Link(nb.other >> CLASS_BITS, nb.other & (CLASSES - 1u), nb.rest, true);
+}
+
 // The element forces (wind, dihedral bending) on particle `i`: its slots, summed.
 fn element_force(i: u32) -> vec3<f32> {
     var f = vec3<f32>(0.0);
@@ -185,6 +225,32 @@ fn placed(me: Particle) -> Particle {
     let at = params.handles.x + 2u * (substep * params.handles.y + slot - 1u);
     let target_x = element_forces[at].xyz;
     return Particle(vec4<f32>(target_x, me.x.w), vec4<f32>(element_forces[at + 1u].xyz, me.v.w));
+}
+
+// True when invocation `i` has no free particle to step: none at all, or a pinned one,
+// which then goes where its handle puts it, if one does (from `src` into `dst`).
+fn held(i: u32) -> bool {
+    if (i >= params.counts.x) {
+        return true;
+    }
+    let me = src[i];
+    if (me.x.w == 0.0) {
+        dst[i] = placed(me);
+        return true;
+    }
+    return false;
+}
+
+// Free particle `i` (read from `src`) takes the velocity `v` and moves by `v·h` into `dst`,
+// the colliders resolved against that path; true when they changed where it ends or how
+// it moves.
+fn advance(i: u32, v: vec3<f32>) -> bool {
+    let me = src[i];
+    let x = me.x.xyz;
+    let free = Motion(x + v * params.gravity.w, v);
+    let out = collide(x, free);
+    dst[i] = Particle(vec4<f32>(out.x, me.x.w), vec4<f32>(out.v, 0.0));
+    return any(out.x != free.x) || any(out.v != free.v);
 }
 
 // The last pass of XPBD and VBD for particle `i`, with the state bound as `dst`: a free

@@ -29,46 +29,24 @@ struct Constraint {
 @compute @workgroup_size(64)
 fn substep(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
-    if (i >= params.counts.x) {
+    if (held(i)) {
         return;
     }
     let me = src[i];
     let w = me.x.w;
-    if (w == 0.0) {
-        dst[i] = placed(me);
-        return;
-    }
     let x = me.x.xyz;
     let v = me.v.xyz;
     var f = vec3<f32>(0.0);
-    if (params.grid.x > 0u) {
-        // A grid: the neighbours follow from the index, nothing is read to find them.
-        let width = i32(params.grid.x);
-        let height = i32(params.grid.y);
-        let col = i32(i % params.grid.x);
-        let row = i32(i / params.grid.x);
-        for (var l = 0u; l < params.grid.z; l = l + 1u) {
-            let link = params.links[l];
-            let c = col + bitcast<i32>(link.x);
-            let r = row + bitcast<i32>(link.y);
-            if (c >= 0 && r >= 0 && c < width && r < height) {
-                let o = src[u32(r * width + c)];
-                f = f + spring_pull(x, v, o, classes[link.z], bitcast<f32>(link.w));
-            }
-        }
-    } else {
-        for (var s = offsets[i]; s < offsets[i + 1u]; s = s + 1u) {
-            let nb = neighbours[s];
-            let o = src[nb.other >> CLASS_BITS];
-            f = f + spring_pull(x, v, o, classes[nb.other & (CLASSES - 1u)], nb.rest);
+    let links = links_of(i);
+    for (var l = 0u; l < links.count; l = l + 1u) {
+        let to = link_of(links, l);
+        if (to.ok) {
+            f = f + spring_pull(x, v, src[to.other], classes[to.strength], to.rest);
         }
     }
     f = f + element_force(i);
-    let h = params.gravity.w;
     let a = f * w + params.gravity.xyz - params.drag.x * v;
-    let nv = v + a * h;
-    let out = collide(x, Motion(x + nv * h, nv));
-    dst[i] = Particle(vec4<f32>(out.x, w), vec4<f32>(out.v, 0.0));
+    advance(i, v + a * params.gravity.w);
 }
 
 // XPBD, first: zeroes the multipliers and moves each free particle by the forces that are
