@@ -196,3 +196,33 @@ fn gpu_implicit_euler_follows_the_handles_as_the_cpu_does() {
     assert!(moved > 0.05, "the handle moves the cloth ({moved} m)");
     assert!(worst < 5e-6, "GPU and CPU differ by {worst} m");
 }
+
+/// A tolerance changed mid-run reaches the GPU's solve: from 10⁻⁶ to 10⁻², both backends'
+/// solves take far fewer iterations, the same number within a few per cent.
+#[test]
+fn a_tolerance_changed_mid_run_reaches_the_gpu() {
+    let scene = implicit("hanging", 3, 1e-6, 200);
+    let mut cpu = Simulation::new(scene.clone());
+    let (mut gpu, _) = gpu_simulation(scene, true).expect("GPU backend");
+    let mut counts = Vec::new();
+    for tolerance in [1e-6, 1e-2] {
+        for sim in [&mut cpu, &mut gpu] {
+            let mut params = sim.params().clone();
+            params.solver.tolerance = tolerance;
+            sim.set_params(params).expect("valid");
+            sim.take_stats();
+            for _ in 0..3 {
+                sim.step_frame().expect("frame");
+            }
+            counts.push(sim.take_stats().solver_iterations as f64);
+        }
+    }
+    eprintln!("iterations, CPU and GPU, tight then loose: {counts:?}");
+    let [tight_cpu, tight_gpu, loose_cpu, loose_gpu] = counts[..] else {
+        unreachable!()
+    };
+    assert!(loose_cpu < 0.5 * tight_cpu, "{counts:?}");
+    for (a, b) in [(tight_cpu, tight_gpu), (loose_cpu, loose_gpu)] {
+        assert!((a - b).abs() <= 0.05 * a, "{counts:?}");
+    }
+}

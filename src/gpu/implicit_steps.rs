@@ -1,7 +1,7 @@
 //! Implicit Euler's substeps on the GPU: each solve's iterations encoded in chunks, with a
 //! read of the solve's state between them (see `implicit`).
 
-use crate::sim::{IntegratorKind, StepError, StepReport};
+use crate::sim::{StepError, StepReport};
 
 use super::error::GpuError;
 use super::implicit::FIRST_CHUNK;
@@ -21,11 +21,7 @@ impl GpuStepper {
         substeps: u32,
         counting: bool,
     ) -> Result<(), StepError> {
-        let Some(solve) = self
-            .implicit
-            .as_mut()
-            .filter(|_| self.integrator == IntegratorKind::ImplicitEuler)
-        else {
+        let Some(solve) = self.implicit.as_mut() else {
             return Ok(());
         };
         let cap = self.solver.max_iterations;

@@ -57,7 +57,10 @@ impl GpuStepper {
             }
             if let Some(pass) = &mut self.implicit {
                 pass.fresh = true;
+                self.params.solver = pass.words(&self.solver);
             }
+            self.queue
+                .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
             self.regroup();
             self.solver_stale = false;
             return Ok(());

@@ -383,10 +383,9 @@ impl GpuStepper {
             self.params.solver[3] = u32::from(self.vbd_fresh);
         }
         if let Some(pass) = self.implicit.as_mut().filter(|_| implicit) {
-            self.params.solver = pass.words(&self.solver);
             pass.prepare(&self.queue);
         }
-        if vbd || implicit || carried > 0 {
+        if vbd || carried > 0 {
             self.queue
                 .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
         }
@@ -627,6 +626,12 @@ impl StepBackend for GpuStepper {
         }
         self.iterations = [params.solver.xpbd_iterations, params.solver.vbd_iterations];
         self.solver = params.solver;
+        if let Some(pass) =
+            (self.implicit.as_ref()).filter(|_| self.integrator == IntegratorKind::ImplicitEuler)
+        {
+            // A new tolerance reaches the solve with the uniform written below.
+            self.params.solver = pass.words(&self.solver);
+        }
         if self.integrator == IntegratorKind::ImplicitEuler && params.solver.newton_iterations > 1 {
             self.unsupported = Some(format!(
                 "runs implicit Euler as one linearised step, not {} Newton iterations; run \
