@@ -249,9 +249,7 @@ mod tests {
     #[test]
     fn the_devices_checkpoint_is_an_earlier_frames_state_to_the_bit() {
         let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
-        let mut scene =
-            crate::bench::bench_scene(16, IntegratorKind::SemiImplicitEuler).expect("scene");
-        scene.params.guard.enabled = true;
+        let scene = guarded_bench();
         let (model, params) = (&scene.model, &scene.params);
         let mut stepper =
             GpuStepper::new(&gpu.device, &gpu.queue, model, params, &scene.effects, true)
@@ -431,6 +429,51 @@ mod tests {
         assert_eq!(stepper.ends_sent, 6);
     }
 
+    /// The 16 × 16 bench cloth under semi-implicit Euler, with the guard on.
+    fn guarded_bench() -> Scene {
+        let mut scene =
+            crate::bench::bench_scene(16, IntegratorKind::SemiImplicitEuler).expect("scene");
+        scene.params.guard.enabled = true;
+        scene
+    }
+
+    /// A device of the first adapter with its compute limits changed by `limit`.
+    fn limited_device(limit: impl FnOnce(&mut wgpu::Limits)) -> (wgpu::Device, wgpu::Queue) {
+        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let mut limits = crate::device::compute_limits(&gpu.adapter);
+        limit(&mut limits);
+        pollster::block_on(gpu.adapter.request_device(&wgpu::DeviceDescriptor {
+            required_limits: limits,
+            ..Default::default()
+        }))
+        .expect("a device with those limits")
+    }
+
+    /// Steps `scene` one frame on `device` (the semi-implicit step runs), switches to `kind`
+    /// and returns why each of the next two frames failed; they keep the state.
+    fn refused_on_switch(
+        (device, queue): &(wgpu::Device, wgpu::Queue),
+        scene: &Scene,
+        kind: IntegratorKind,
+    ) -> Vec<String> {
+        let (model, effects) = (&scene.model, &scene.effects);
+        let mut params = scene.params.clone();
+        let mut stepper = GpuStepper::new(device, queue, model, &params, effects, true)
+            .expect("the semi-implicit step runs");
+        let mut state = scene.initial.clone();
+        stepper.frame(model, &mut state).expect("a frame");
+        let before = state.clone();
+        params.step.integrator = kind;
+        stepper.configure(model, &params, effects, Changes::INTEGRATOR);
+        (0..2)
+            .map(|_| {
+                let err = stepper.frame(model, &mut state).expect_err("refused");
+                assert_eq!(state.pos, before.pos);
+                err.reason
+            })
+            .collect()
+    }
+
     /// On a device that binds at most 32 KiB, the 16 × 16 bench cloth's state and spring
     /// ends fit (8 and 22 KiB) but XPBD's constraints (36 KiB), VBD's stencil (55 KiB) and
     /// implicit Euler's solve (41 KiB) do not: switching to any of them fails the next frame
@@ -438,44 +481,37 @@ mod tests {
     /// buffers would have failed validation.
     #[test]
     fn a_solver_too_big_for_the_device_is_refused_with_its_size() {
-        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
-        let small = wgpu::Limits {
-            max_storage_buffer_binding_size: 32 << 10,
-            max_buffer_size: 32 << 10,
-            ..crate::device::compute_limits(&gpu.adapter)
-        };
-        let (device, queue) =
-            pollster::block_on(gpu.adapter.request_device(&wgpu::DeviceDescriptor {
-                required_limits: small,
-                ..Default::default()
-            }))
-            .expect("a device with small buffers");
-        let mut scene =
-            crate::bench::bench_scene(16, IntegratorKind::SemiImplicitEuler).expect("scene");
-        scene.params.guard.enabled = true;
+        let small = limited_device(|l| {
+            l.max_storage_buffer_binding_size = 32 << 10;
+            l.max_buffer_size = 32 << 10;
+        });
+        let scene = guarded_bench();
         for (kind, what) in [
             (IntegratorKind::Xpbd, "XPBD constraints"),
             (IntegratorKind::Vbd, "VBD stencil"),
             (IntegratorKind::ImplicitEuler, "implicit Euler's solve"),
         ] {
-            let (model, effects) = (&scene.model, &scene.effects);
-            let mut params = scene.params.clone();
-            let mut stepper = GpuStepper::new(&device, &queue, model, &params, effects, true)
-                .expect("the semi-implicit step fits");
-            let mut state = scene.initial.clone();
-            stepper.frame(model, &mut state).expect("a frame");
-            let before = state.clone();
-            params.step.integrator = kind;
-            stepper.configure(model, &params, effects, Changes::INTEGRATOR);
-            for _ in 0..2 {
-                let err = stepper.frame(model, &mut state).expect_err("too big");
-                let said = &err.reason;
+            for said in refused_on_switch(&small, &scene, kind) {
                 assert!(
                     said.contains(what) && said.contains("(32768 bytes)"),
                     "{said}"
                 );
-                assert_eq!(state.pos, before.pos);
             }
+        }
+    }
+
+    /// Implicit Euler's solve binds an eighth storage buffer (its indirect dispatches'
+    /// counts): on a device that offers seven a stage, the substep runs but switching to
+    /// implicit Euler fails the next frames with the counts, keeping the state.
+    #[test]
+    fn implicit_euler_on_a_device_with_seven_storage_buffers_is_refused() {
+        let seven = limited_device(|l| l.max_storage_buffers_per_shader_stage = 7);
+        let scene = guarded_bench();
+        for said in refused_on_switch(&seven, &scene, IntegratorKind::ImplicitEuler) {
+            assert!(
+                said.contains("8 storage buffers") && said.contains("offers 7"),
+                "{said}"
+            );
         }
     }
 
@@ -484,9 +520,7 @@ mod tests {
     #[test]
     fn a_lost_device_stops_the_run_and_keeps_the_last_state() {
         let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
-        let mut scene =
-            crate::bench::bench_scene(16, IntegratorKind::SemiImplicitEuler).expect("scene");
-        scene.params.guard.enabled = true;
+        let scene = guarded_bench();
         let (model, params) = (&scene.model, &scene.params);
         let mut stepper =
             GpuStepper::new(&gpu.device, &gpu.queue, model, params, &scene.effects, true)
