@@ -149,7 +149,9 @@ fn the_gpu_reports_the_solves_iterations() {
         let (on_cpu, on_gpu) = (cpu.take_stats(), gpu.take_stats());
         eprintln!("cap {cap}: CPU {on_cpu:?}, GPU {on_gpu:?}");
         assert_eq!(on_gpu.steps, 18);
-        assert!(on_cpu.solver_iterations > 18 * u64::from(converges) * 3);
+        // The solves do iterate: more than the cap of 3 on average when uncapped.
+        let most = if converges { 3 } else { 0 };
+        assert!(on_cpu.solver_iterations > 18 * most, "{on_cpu:?}");
         let (a, b) = (
             on_cpu.solver_iterations as f64,
             on_gpu.solver_iterations as f64,
