@@ -247,3 +247,44 @@ impl<R: Real> Integrator<R> for Vbd<R> {
         self.invalidate();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicU32, Ordering};
+
+    /// The step's start and end reach every particle once, on one thread and on two, for
+    /// cloths below, at and past a piece's size and the size from which pieces are shared.
+    #[test]
+    fn by_piece_visits_every_particle_once() {
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a pool");
+            for n in [
+                0,
+                1,
+                1023,
+                1024,
+                SETUP_PIECE,
+                SETUP_PIECE + 1,
+                5 * SETUP_PIECE - 7,
+            ] {
+                let visits: Vec<AtomicU32> = (0..n).map(|_| AtomicU32::new(0)).collect();
+                pool.install(|| {
+                    by_piece(n, &|range| {
+                        for p in range {
+                            visits[p].fetch_add(1, Ordering::Relaxed);
+                        }
+                    })
+                });
+                let counts: Vec<u32> = visits.iter().map(|v| v.load(Ordering::Relaxed)).collect();
+                assert!(
+                    counts.iter().all(|&c| c == 1),
+                    "{threads} threads, {n} particles"
+                );
+            }
+        }
+    }
+}
