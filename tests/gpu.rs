@@ -6,13 +6,8 @@ use clothsim::gpu::{Backend, gpu_simulation, gpu_support};
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::{Effect, IntegratorKind, Precision};
 
-/// The largest distance between the same particle in `a` and `b`, metres.
-fn farthest(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
-    a.iter()
-        .zip(b)
-        .map(|(p, q)| p.distance(*q))
-        .fold(0.0, f32::max)
-}
+mod common;
+use common::farthest;
 
 /// Runs `scene` for `seconds` on both backends; the largest distance between the same
 /// particle's positions, and the largest distance any particle moved (for scale).

@@ -7,12 +7,8 @@ use clothsim::gpu::gpu_simulation;
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::{BendingModel, Effect, IntegratorKind, Wind};
 
-/// The largest distance between the same particle in `a` and `b`, metres.
-fn farthest(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
-    (a.iter().zip(b))
-        .map(|(p, q)| p.distance(*q))
-        .fold(0.0, f32::max)
-}
+mod common;
+use common::farthest;
 
 /// The built-in scene `name` with its grid at 16 quads.
 fn small(name: &str) -> Scene {

@@ -6,6 +6,9 @@ use clothsim::gpu::gpu_simulation;
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::{GuardAction, GuardEvent, GuardPolicy, IntegratorKind};
 
+mod common;
+use common::farthest;
+
 /// The 16 × 16 bench cloth with semi-implicit Euler at `substeps` a frame, springs 30×
 /// stiffer, under the guard with `policy`.
 fn stiff_cloth(substeps: u32, policy: GuardPolicy) -> Scene {
@@ -40,13 +43,6 @@ fn both(scene: Scene, frames: usize) -> (Simulation, Simulation, Vec<GuardEvent>
         on_gpu.extend(gpu.take_guard_events());
     }
     (cpu, gpu, on_cpu, on_gpu)
-}
-
-/// The largest distance between the same particle in `a` and `b`, metres.
-fn farthest(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
-    (a.iter().zip(b))
-        .map(|(p, q)| p.distance(*q))
-        .fold(0.0, f32::max)
 }
 
 /// Semi-implicit Euler needs about 52 substeps a frame on the stiff cloth: at 30 the first
