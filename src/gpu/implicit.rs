@@ -13,7 +13,7 @@ use crate::sim::SolverConfig;
 
 use super::error::GpuError;
 use super::kernel::{COMMON, IMPLICIT, LAYOUT, WORKGROUP, pipelines};
-use super::support::fits;
+use super::support::{fits, offers_storage};
 
 /// Storage buffers the solve's kernels bind: the substep's seven and the workgroup counts.
 pub(super) const STORAGE_BUFFERS: u32 = 8;
@@ -70,13 +70,7 @@ impl ImplicitPass {
         layout: &wgpu::BindGroupLayout,
         count: u32,
     ) -> Result<Self, GpuError> {
-        let storage = device.limits().max_storage_buffers_per_shader_stage;
-        if storage < STORAGE_BUFFERS {
-            return Err(GpuError::Unsupported(format!(
-                "runs implicit Euler with {STORAGE_BUFFERS} storage buffers in a compute \
-                 shader; this device offers {storage}"
-            )));
-        }
+        offers_storage(&device.limits(), STORAGE_BUFFERS, "implicit Euler")?;
         let groups = count.div_ceil(WORKGROUP).max(1);
         let vectors = HEADER + groups;
         let bytes = (vectors as u64 + PER_PARTICLE * count as u64) * 16;

@@ -66,13 +66,7 @@ pub(super) const STORAGE_BUFFERS: u32 = 7;
 /// [`STORAGE_BUFFERS`] storage buffers in a compute stage, and workgroups of [`WORKGROUP`]
 /// enough of them.
 pub(super) fn check_device(limits: &wgpu::Limits, count: u32) -> Result<(), GpuError> {
-    let storage = limits.max_storage_buffers_per_shader_stage;
-    if storage < STORAGE_BUFFERS {
-        return Err(GpuError::Unsupported(format!(
-            "needs {STORAGE_BUFFERS} storage buffers in a compute shader; this device offers \
-             {storage}"
-        )));
-    }
+    offers_storage(limits, STORAGE_BUFFERS, "the substep")?;
     let groups = limits.max_compute_workgroups_per_dimension as u64 * WORKGROUP as u64;
     if limits.max_compute_workgroup_size_x < WORKGROUP
         || limits.max_compute_invocations_per_workgroup < WORKGROUP
@@ -81,6 +75,23 @@ pub(super) fn check_device(limits: &wgpu::Limits, count: u32) -> Result<(), GpuE
         return Err(GpuError::Unsupported(format!(
             "needs compute workgroups of {WORKGROUP} for {count} particles, which this \
          device does not offer"
+        )));
+    }
+    Ok(())
+}
+
+/// Whether a device with `limits` offers `needed` storage buffers in a compute shader, for
+/// `what` (the kernels that bind them).
+pub(super) fn offers_storage(
+    limits: &wgpu::Limits,
+    needed: u32,
+    what: &str,
+) -> Result<(), GpuError> {
+    let storage = limits.max_storage_buffers_per_shader_stage;
+    if storage < needed {
+        return Err(GpuError::Unsupported(format!(
+            "{what} needs {needed} storage buffers in a compute shader; this device offers \
+             {storage}"
         )));
     }
     Ok(())

@@ -2,7 +2,7 @@
 
 use egui::RichText;
 
-use crate::gpu::Backend;
+use crate::gpu::{Backend, gpu_support};
 use crate::sim::{IntegratorKind, Precision};
 
 use super::super::panel::{Action, Panel, PanelContext};
@@ -46,10 +46,12 @@ impl Panel for SolverPanel {
                          far below what the accuracy report measures (1.6–8× slower, by \
                          integrator)",
                     )
-                    .on_disabled_hover_text(
-                        "the GPU computes in f32 only (WGSL has no f64): switch to the CPU for \
-                         f64",
-                    );
+                    .on_disabled_hover_ui(|ui| {
+                        // The GPU backend's own reason.
+                        if let Err(why) = gpu_support(&params.step, precision, &[]) {
+                            ui.label(why.to_string());
+                        }
+                    });
                 if button.clicked() && !chosen {
                     params.solver.precision = precision;
                     changed = true;
