@@ -57,17 +57,17 @@ pub struct GpuStepper {
     restamp: bool,
     /// The handles' targets of the last submission (kept for its storage).
     targets: Vec<[f32; 4]>,
-    /// The integrator in effect (one of those the GPU runs), and XPBD's and VBD's sweeps a
-    /// substep.
+    /// The integrator in effect (one of those the GPU runs).
     pub(super) integrator: IntegratorKind,
-    iterations: [u32; 2],
     /// XPBD's constraints in colour order and VBD's stencil, and whether the one in effect
     /// must be built again (XPBD's from the positions of the next step's start, as the CPU
     /// builds its own).
     pub(super) xpbd: XpbdPass,
     pub(super) vbd: VbdPass,
-    /// Implicit Euler's solve, built the first time it steps, and its tolerance and cap.
+    /// Implicit Euler's solve, built the first time it steps.
     pub(super) implicit: Option<ImplicitPass>,
+    /// The solvers' settings: XPBD's and VBD's sweeps a substep, implicit Euler's
+    /// tolerance and cap.
     pub(super) solver: SolverConfig,
     pub(super) solver_stale: bool,
     /// VBD's memory of each particle's last acceleration is stale (the state changed
@@ -213,7 +213,6 @@ impl GpuStepper {
             restamp: false,
             targets: Vec::new(),
             integrator: params.step.integrator,
-            iterations: [1, 1],
             xpbd,
             vbd,
             implicit: None,
@@ -498,10 +497,9 @@ impl GpuStepper {
 
     /// Sweeps a substep of the integrator in effect (XPBD's or VBD's).
     fn sweeps(&self) -> u32 {
-        let [xpbd, vbd] = self.iterations;
         match self.integrator {
-            IntegratorKind::Vbd => vbd,
-            _ => xpbd,
+            IntegratorKind::Vbd => self.solver.vbd_iterations,
+            _ => self.solver.xpbd_iterations,
         }
         .max(1)
     }
@@ -624,7 +622,6 @@ impl StepBackend for GpuStepper {
         if self.unsupported.is_none() && changes.contains(Changes::INTEGRATOR) {
             self.integrator = params.step.integrator;
         }
-        self.iterations = [params.solver.xpbd_iterations, params.solver.vbd_iterations];
         self.solver = params.solver;
         if let Some(pass) =
             (self.implicit.as_ref()).filter(|_| self.integrator == IntegratorKind::ImplicitEuler)
