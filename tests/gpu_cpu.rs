@@ -8,7 +8,7 @@ use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::{BendingModel, Effect, IntegratorKind, Wind};
 
 mod common;
-use common::farthest;
+use common::{apart_after_a_push, farthest};
 
 /// The built-in scene `name` with its grid at 16 quads.
 fn small(name: &str) -> Scene {
@@ -108,17 +108,7 @@ fn gpu_switches_to_xpbd_and_back_mid_run_as_the_cpu_does() {
 fn gpu_vbd_starts_afresh_after_an_outside_change_as_the_cpu_does() {
     let mut scene = with(IntegratorKind::Vbd, "hanging", 1);
     scene.params.step.substeps = 4;
-    let mut cpu = Simulation::new(scene.clone());
-    let (mut gpu, _) = gpu_simulation(scene, true).expect("GPU backend");
-    for sim in [&mut cpu, &mut gpu] {
-        for _ in 0..10 {
-            sim.step_frame().expect("frame");
-        }
-        sim.sync_state().expect("read back");
-        sim.modify_state(|s| s.vel.iter_mut().for_each(|v| v.z += 0.5));
-        sim.step_frame().expect("frame");
-    }
-    let worst = farthest(&cpu.state().pos, &gpu.state().pos);
+    let worst = apart_after_a_push(scene, 10);
     eprintln!("pushed: worst {worst:e} m");
     assert!(worst < 5e-6, "GPU and CPU differ by {worst} m");
 }

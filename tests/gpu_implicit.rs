@@ -8,7 +8,7 @@ use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::IntegratorKind;
 
 mod common;
-use common::farthest;
+use common::{apart_after_a_push, farthest};
 
 /// The built-in scene `name` at 16 quads, stepped by implicit Euler at `substeps` a frame
 /// with the solve's `tolerance` and iteration cap.
@@ -112,18 +112,7 @@ fn the_gpu_forgets_its_guess_where_a_collider_moved_the_cloth() {
 /// decides much of the step, the two cloths stay together.
 #[test]
 fn the_gpu_forgets_its_guess_after_an_outside_change() {
-    let scene = implicit("hanging", 2, 1e-6, 2);
-    let mut cpu = Simulation::new(scene.clone());
-    let (mut gpu, _) = gpu_simulation(scene, true).expect("GPU backend");
-    for sim in [&mut cpu, &mut gpu] {
-        for _ in 0..4 {
-            sim.step_frame().expect("frame");
-        }
-        sim.sync_state().expect("read back");
-        sim.modify_state(|s| s.vel.iter_mut().for_each(|v| v.z += 0.5));
-        sim.step_frame().expect("frame");
-    }
-    let worst = farthest(&cpu.state().pos, &gpu.state().pos);
+    let worst = apart_after_a_push(implicit("hanging", 2, 1e-6, 2), 4);
     eprintln!("pushed: worst {worst:e} m");
     assert!(worst < 2e-6, "GPU and CPU differ by {worst} m");
 }

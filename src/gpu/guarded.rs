@@ -250,10 +250,8 @@ mod tests {
     fn the_devices_checkpoint_is_an_earlier_frames_state_to_the_bit() {
         let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
         let scene = guarded_bench();
-        let (model, params) = (&scene.model, &scene.params);
-        let mut stepper =
-            GpuStepper::new(&gpu.device, &gpu.queue, model, params, &scene.effects, true)
-                .expect("stepper");
+        let model = &scene.model;
+        let mut stepper = stepper_on(&gpu, &scene);
         let mut state = scene.initial.clone();
         let mut seen = vec![state.clone()];
         for _ in 0..16 {
@@ -261,6 +259,7 @@ mod tests {
             seen.push(state.clone());
         }
         let checkpoint = stepper.guard.checkpoint.clone().expect("a checkpoint");
+        let params = &scene.params;
         let frame = (checkpoint.time / params.step.dt as f64).round() as usize;
         let age = params.guard.checkpoint_frames as usize;
         assert!(
@@ -437,6 +436,12 @@ mod tests {
         scene
     }
 
+    /// A stepper for `scene` on `gpu`'s device, reading back every frame.
+    fn stepper_on(gpu: &HeadlessDevice, scene: &Scene) -> GpuStepper {
+        let (model, params, effects) = (&scene.model, &scene.params, &scene.effects);
+        GpuStepper::new(&gpu.device, &gpu.queue, model, params, effects, true).expect("stepper")
+    }
+
     /// A device of the first adapter with its compute limits changed by `limit`.
     fn limited_device(limit: impl FnOnce(&mut wgpu::Limits)) -> (wgpu::Device, wgpu::Queue) {
         let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
@@ -521,10 +526,8 @@ mod tests {
     fn a_lost_device_stops_the_run_and_keeps_the_last_state() {
         let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
         let scene = guarded_bench();
-        let (model, params) = (&scene.model, &scene.params);
-        let mut stepper =
-            GpuStepper::new(&gpu.device, &gpu.queue, model, params, &scene.effects, true)
-                .expect("stepper");
+        let model = &scene.model;
+        let mut stepper = stepper_on(&gpu, &scene);
         let mut state = scene.initial.clone();
         for _ in 0..3 {
             stepper.frame(model, &mut state).expect("a frame");
