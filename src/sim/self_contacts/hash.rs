@@ -14,6 +14,10 @@ const MAX_LEVEL: u32 = 20;
 /// Most cells one triangle is binned in: two along each axis.
 pub const CELLS_PER_TRIANGLE: usize = 8;
 
+/// The boxes of a cell a search reads into a local array before it pairs them (the rest,
+/// in a fuller cell, are read where they are).
+const LOCAL: usize = 48;
+
 /// The key of cell `c` at `level`, in [`KEY_BITS`] bits: three coordinates wrapped into
 /// 21 bits each, mixed with the level, then hashed (the top bits of an odd multiple).
 /// Distinct cells rarely share a key, and a shared key only adds entries that the level,
@@ -192,6 +196,7 @@ impl BoxHash {
         if piece < run_pieces {
             let first = piece * RUNS_PER_PIECE;
             let last = (first + RUNS_PER_PIECE).min(self.runs.len());
+            let mut local = [(Vec3::ZERO, Vec3::ZERO, [0; 3], 0, 0); LOCAL];
             for r in first..last {
                 let start = self.runs[r] as usize;
                 let end = self
@@ -200,20 +205,33 @@ impl BoxHash {
                     .map_or(self.bins.len(), |&e| e as usize);
                 let cell = &self.bins[start..end];
                 let key = entry_key(cell[0]);
-                for (i, &a) in cell.iter().enumerate() {
-                    let a = entry_box(a);
-                    let (level, first) = (self.level[a], self.first[a]);
-                    for &b in &cell[i + 1..] {
-                        let b = entry_box(b);
+                // The cell's boxes read once into `local` (most cells hold a few dozen),
+                // not once per pair.
+                let n = cell.len().min(LOCAL);
+                for (slot, &e) in local.iter_mut().zip(&cell[..n]) {
+                    let b = entry_box(e);
+                    *slot = (lo[b], hi[b], self.first[b], self.level[b], b as u32);
+                }
+                let read = |i: usize| {
+                    if i < n {
+                        local[i]
+                    } else {
+                        let b = entry_box(cell[i]);
+                        (lo[b], hi[b], self.first[b], self.level[b], b as u32)
+                    }
+                };
+                for i in 0..cell.len() {
+                    let (alo, ahi, first, level, a) = read(i);
+                    for j in i + 1..cell.len() {
+                        let (blo, bhi, bfirst, blevel, b) = read(j);
                         // A shared key from another level is not a shared cell; the pair is
                         // taken in the cell of its overlap's lowest corner, which is this
                         // one when the larger of the boxes' first cells has its key.
-                        let lowest = std::array::from_fn(|k| first[k].max(self.first[b][k]));
-                        if self.level[b] == level
-                            && cell_key(lowest, u32::from(level)) == key
-                            && lo[a].max(lo[b]).cmple(hi[a].min(hi[b])).all()
-                        {
-                            pair(a as u32, b as u32);
+                        if blevel == level && alo.max(blo).cmple(ahi.min(bhi)).all() {
+                            let lowest = std::array::from_fn(|k| first[k].max(bfirst[k]));
+                            if cell_key(lowest, u32::from(level)) == key {
+                                pair(a, b);
+                            }
                         }
                     }
                 }

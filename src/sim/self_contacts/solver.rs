@@ -355,6 +355,10 @@ impl SelfContacts {
         let list = &self.dirty_list;
         let pieces = list.len().div_ceil(REFRESHED_PER_PIECE);
         let work = |piece: usize, out: &mut Vec<StoredPair>| {
+            if piece >= pieces {
+                // The pairs of triangles sharing a corner, where either is one of those.
+                return search.neighbours(piece - pieces, Some(dirty), out);
+            }
             let first = piece * REFRESHED_PER_PIECE;
             for &a in &list[first..(first + REFRESHED_PER_PIECE).min(list.len())] {
                 let a = a as usize;
@@ -369,7 +373,7 @@ impl SelfContacts {
         };
         // A triangle looked up costs about what one searched with the whole hash does.
         let parallel = list.len() >= PARALLEL_TRIANGLES / 4;
-        self.found.extend(pieces, parallel, &work);
+        (self.found).extend(pieces + search.neighbour_pieces(), parallel, &work);
         self.work.refreshes += 1;
         self.work.refreshed += list.len() as u64;
         self.found_for = Some(thickness);
@@ -428,12 +432,16 @@ impl SelfContacts {
         };
         let hash = &self.hash;
         let work = |piece: usize, out: &mut Vec<StoredPair>| {
+            if piece >= hash.pieces() {
+                return search.neighbours(piece - hash.pieces(), None, out);
+            }
             hash.piece_pairs(piece, &search.boxes.lo, &search.boxes.hi, |a, b| {
                 search.pairs_of(a as usize, b as usize, out);
             });
         };
         let parallel = model.triangles.len() >= PARALLEL_TRIANGLES;
-        self.found.extend(hash.pieces(), parallel, &work);
+        let pieces = hash.pieces() + search.neighbour_pieces();
+        self.found.extend(pieces, parallel, &work);
         self.work.searches += 1;
         self.found_for = Some(thickness);
         Ok(())
