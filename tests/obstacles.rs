@@ -807,3 +807,34 @@ fn a_cloth_thrown_at_a_wire_between_its_particles_hangs_on_it() {
         );
     }
 }
+
+/// The cloth's edges in colours (the order both backends keep them off an obstacle's sharp
+/// edges in): every structural and shear spring once, no run sharing a particle, and a
+/// grid in few colours.
+#[test]
+fn each_colour_of_a_grids_edges_shares_no_particle() {
+    let mesh = clothsim::mesh::GridSpec::square(
+        9,
+        1.0,
+        clothsim::mesh::GridOrientation::Horizontal,
+        glam::Vec3::ZERO,
+    )
+    .build()
+    .unwrap();
+    let model = clothsim::cloth::ClothModel::new(&mesh, 0.2, &[]);
+    let c = &model.edge_colours;
+    let mut seen: Vec<u32> = c.order.clone();
+    seen.sort_unstable();
+    assert_eq!(seen, (0..model.bend_start() as u32).collect::<Vec<_>>());
+    for (range, shared) in &c.runs {
+        assert!(!shared);
+        let mut ends: Vec<u32> = (c.order[range.clone()].iter())
+            .flat_map(|&e| [model.springs.a[e as usize], model.springs.b[e as usize]])
+            .collect();
+        let n = ends.len();
+        ends.sort_unstable();
+        ends.dedup();
+        assert_eq!(ends.len(), n, "a colour shares a particle");
+    }
+    assert!(c.runs.len() <= 12, "{} colours", c.runs.len());
+}

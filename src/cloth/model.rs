@@ -5,6 +5,7 @@ use glam::{Vec2, Vec3};
 use crate::mesh::{ClothMesh, SpringKind};
 
 use super::adjacency::Adjacency;
+use super::edge_colours::EdgeColours;
 use super::springs::Springs;
 
 /// How a cloth's mass is shared among its particles.
@@ -38,6 +39,9 @@ pub struct ClothModel {
     pub hinges: Vec<[u32; 4]>,
     /// Which springs meet at each particle.
     pub adjacency: Adjacency,
+    /// The structural and shear springs in colours: the order contacts with an obstacle's
+    /// sharp edges take them in, on either backend.
+    pub edge_colours: EdgeColours,
     /// Particle mass, kg (lumped from areal density by triangle area).
     pub mass: Vec<f32>,
     /// 1/mass, 1/kg; 0 for pinned particles.
@@ -65,8 +69,10 @@ impl ClothModel {
                 .push(mesh.positions[a as usize].distance(mesh.positions[b as usize]));
             springs.kind.push(kind);
         }
+        let edges = springs.len() - mesh.bend_pairs.len();
         let mut model = Self {
             adjacency: Adjacency::new(n, &springs),
+            edge_colours: EdgeColours::of(n, &springs, edges),
             rest_positions: mesh.positions.clone(),
             uvs: mesh.uvs.clone(),
             triangles: mesh.triangles.clone(),
@@ -94,16 +100,16 @@ impl ClothModel {
         pins: &[u32],
     ) -> Self {
         let n = rest_positions.len();
+        let bend = (springs.kind.iter())
+            .filter(|k| **k == SpringKind::Bend)
+            .count();
         let mut model = Self {
             adjacency: Adjacency::new(n, &springs),
+            edge_colours: EdgeColours::of(n, &springs, springs.len() - bend),
             uvs: vec![Vec2::ZERO; n],
             triangles: Vec::new(),
             mesh_edges: 0,
-            bend_springs: springs
-                .kind
-                .iter()
-                .filter(|k| **k == SpringKind::Bend)
-                .count(),
+            bend_springs: bend,
             hinges: Vec::new(),
             springs,
             rest_positions,

@@ -379,8 +379,8 @@ struct EdgeFrame<S, L, W, V> {
     velocity: V,
 }
 
-/// Keeps every cloth edge (its structural and shear springs) `pass.offset` from the sharp
-/// `edges` where it ends the substep: the two particles are moved apart from the edge in
+/// Keeps every cloth edge (its structural and shear springs, in the model's colour order)
+/// `pass.offset` from the sharp `edges` where it ends the substep: the two particles are moved apart from the edge in
 /// proportion to how near each is to the nearest point, which moves by exactly what was
 /// missing; their velocity towards the edge is removed, with Coulomb friction `mu` along it.
 /// Returns how many cloth edges it moved.
@@ -407,7 +407,9 @@ where
     // repeats (a few times at most) while it finds crossings.
     for _ in 0..EDGE_SWEEPS {
         let mut crossings = 0;
-        for e in 0..pass.model.bend_start() {
+        // In colours (the GPU's order too, a colour's edges side by side there).
+        for &e in &pass.model.edge_colours.order {
+            let e = e as usize;
             let (i, j) = (springs.a[e] as usize, springs.b[e] as usize);
             let free = [inv_mass[i] > 0.0, inv_mass[j] > 0.0].map(f32::from);
             if free == [0.0, 0.0] {
@@ -779,7 +781,10 @@ impl EffectKind for Obstacle {
     }
 
     fn on_gpu(&self) -> Result<(), &'static str> {
-        Err("mesh obstacles")
+        match self.frames {
+            Some(_) => Err("deforming (OBJ sequence) obstacles"),
+            None => Ok(()),
+        }
     }
 
     fn suggested(_cloth: &ClothBox) -> Self {
