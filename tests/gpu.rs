@@ -69,8 +69,7 @@ fn gpu_backend_refuses_what_it_cannot_run_with_a_clear_reason() {
     let f32 = Precision::F32;
     for (scene, what) in [
         ("self-fold", "self-collision"),
-        ("tablecloth", "mesh obstacles"),
-        ("arm", "mesh obstacles"),
+        ("arm", "deforming (OBJ sequence) obstacles"),
     ] {
         let mut scene = Scene::builtin(scene).expect("scene");
         // Without the twist's self-collision, which is refused first.

@@ -15,7 +15,8 @@ pub enum Backend {
     #[default]
     Cpu,
     /// wgpu compute: semi-implicit and implicit Euler, XPBD and VBD; springs, gravity, air damping, wind,
-    /// dihedral bending, pins, handles, spheres and planes, with the stability guard.
+    /// dihedral bending, pins, handles, spheres and planes, rigid mesh obstacles with
+    /// semi-implicit Euler; with the stability guard.
     Gpu,
 }
 

@@ -17,6 +17,7 @@ mod health;
 mod implicit;
 mod implicit_steps;
 mod kernel;
+mod obstacles;
 mod packing;
 mod rebuild;
 mod snapshot;

@@ -11,6 +11,9 @@ use crate::sim::{BendingModel, Effect, Material};
 /// Colliders the shader has room for.
 pub(super) const MAX_COLLIDERS: usize = 4;
 
+/// Rigid mesh obstacles the obstacle pass has room for (its shader's `array<Obstacle, 4>`).
+pub(super) const MAX_OBSTACLES: usize = 4;
+
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub(super) struct Particle {

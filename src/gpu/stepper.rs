@@ -23,6 +23,7 @@ use super::handles::Carried;
 use super::health::{HealthKernel, Watch};
 use super::implicit::ImplicitPass;
 use super::kernel::{SubstepKernel, WORKGROUP};
+use super::obstacles::ObstaclePass;
 use super::packing::{
     ClassTable, EndsKey, Neighbour, Params, Particle, classify, grid_of, pack_solids, pack_springs,
 };
@@ -66,6 +67,8 @@ pub struct GpuStepper {
     pub(super) vbd: VbdPass,
     /// Implicit Euler's solve, built the first time it steps.
     pub(super) implicit: Option<ImplicitPass>,
+    /// The scene's rigid mesh obstacles, when it has any.
+    pub(super) obstacles: Option<ObstaclePass>,
     /// The solvers' settings: XPBD's and VBD's sweeps a substep, implicit Euler's
     /// tolerance and cap.
     pub(super) solver: SolverConfig,
@@ -254,6 +257,7 @@ impl GpuStepper {
             sent: None,
             ends_sent: 0,
             grid_path: true,
+            obstacles: None,
         };
         stepper.configure(model, params, effects, Changes::all());
         match stepper.unsupported.take() {
@@ -388,6 +392,10 @@ impl GpuStepper {
             self.queue
                 .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
         }
+        let when = (substeps, time, self.substep_length());
+        if let Some(obstacles) = self.obstacles.as_mut() {
+            obstacles.write_poses(&self.device, &self.queue, when);
+        }
         if vbd {
             self.kernel.vbd(&self.device);
         }
@@ -424,7 +432,7 @@ impl GpuStepper {
                 timestamp_writes: None,
             });
             let groups = self.count.div_ceil(WORKGROUP);
-            for _ in 0..substeps {
+            for k in 0..substeps {
                 self.elements.dispatch(&mut pass, self.current);
                 let (this, other) = (&self.groups[self.current], &self.groups[1 - self.current]);
                 if let Some((predict, sweep, colours, finish)) = solver {
@@ -443,6 +451,9 @@ impl GpuStepper {
                     pass.set_pipeline(&self.kernel.pipeline);
                     pass.set_bind_group(0, this, &[]);
                     pass.dispatch_workgroups(groups, 1, 1);
+                    if let Some(obstacles) = &self.obstacles {
+                        obstacles.encode(&mut pass, k, self.current);
+                    }
                     self.current = 1 - self.current;
                 }
                 if counting {
@@ -658,6 +669,14 @@ impl StepBackend for GpuStepper {
             }
             if self.unsupported.is_none() {
                 self.rebuild_elements(model, effects);
+            }
+        }
+        if changes.intersects(Changes::EFFECTS | Changes::CONTACT) && self.unsupported.is_none() {
+            let scene = (model, effects, &params.contact);
+            let (device, queue) = (&self.device, &self.queue);
+            match ObstaclePass::new(device, queue, &self.kernel, &self.particles, scene) {
+                Ok(pass) => self.obstacles = pass,
+                Err(e) => self.unsupported = Some(e.to_string()),
             }
         }
         self.params.drag[1] = params.contact.offset;

@@ -5,7 +5,7 @@ use crate::sim::{Effect, IntegratorKind, Precision, StepConfig};
 use super::elements::PackedElements;
 use super::error::GpuError;
 use super::kernel::WORKGROUP;
-use super::packing::{MAX_COLLIDERS, MAX_PARTICLES, Neighbour, Particle};
+use super::packing::{MAX_COLLIDERS, MAX_OBSTACLES, MAX_PARTICLES, Neighbour, Particle};
 
 /// The integrator the GPU backend runs unless told otherwise.
 pub const GPU_INTEGRATOR: IntegratorKind = IntegratorKind::SemiImplicitEuler;
@@ -20,8 +20,9 @@ pub const GPU_INTEGRATORS: [IntegratorKind; 4] = [
 
 /// What of `step`, `precision` and `effects` the GPU backend cannot run, if anything: it
 /// runs semi-implicit Euler, implicit Euler (one linearised step), XPBD and VBD in `f32` with
-/// gravity, springs (and bend springs), dihedral bending, wind, air damping, pins, handles
-/// and up to four sphere and plane colliders.
+/// gravity, springs (and bend springs), dihedral bending, wind, air damping, pins, handles,
+/// up to four sphere and plane colliders, and (with semi-implicit Euler) up to four rigid
+/// mesh obstacles, still or keyframed.
 pub fn gpu_support(
     step: &StepConfig,
     precision: Precision,
@@ -52,6 +53,22 @@ pub fn gpu_support(
     if solids.count() > MAX_COLLIDERS {
         return Err(GpuError::Unsupported(format!(
             "takes at most {MAX_COLLIDERS} colliders"
+        )));
+    }
+    let obstacles = (effects.iter())
+        .filter(|e| matches!(e, Effect::Obstacle(_)))
+        .count();
+    if obstacles > MAX_OBSTACLES {
+        return Err(GpuError::Unsupported(format!(
+            "takes at most {MAX_OBSTACLES} mesh obstacles"
+        )));
+    }
+    if obstacles > 0 && step.integrator != IntegratorKind::SemiImplicitEuler {
+        return Err(GpuError::Unsupported(format!(
+            "runs mesh obstacles with semi-implicit Euler only, not {}; run {} on the CPU \
+             backend",
+            step.integrator.label(),
+            step.integrator.label()
         )));
     }
     Ok(())

@@ -76,6 +76,11 @@ impl Colours {
         }
     }
 
+    /// The colours' bind group (each colour at its own dynamic offset).
+    pub(super) fn group(&self) -> &wgpu::BindGroup {
+        &self.group
+    }
+
     /// Records `pipeline` over every colour in order, with the substep's `group`.
     pub(super) fn sweep(
         &self,

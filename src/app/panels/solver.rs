@@ -27,7 +27,8 @@ impl Panel for SolverPanel {
                 .selectable_label(on_gpu, "GPU")
                 .on_hover_text(
                     "wgpu compute: semi-implicit and implicit Euler, XPBD and VBD; springs, gravity, air \
-                     damping, wind, dihedral bending, pins, handles, spheres and planes",
+                     damping, wind, dihedral bending, pins, handles, spheres and planes; rigid mesh \
+                     obstacles with semi-implicit Euler",
                 )
                 .clicked()
                 && !on_gpu

@@ -75,6 +75,11 @@ impl SharpEdges {
         self.tree.refit(|e| as_triangle(edges[e]));
     }
 
+    /// The tree over the edges (each a triangle with its second end twice).
+    pub fn tree(&self) -> &TriangleTree {
+        &self.tree
+    }
+
     pub fn len(&self) -> usize {
         self.edges.len()
     }

@@ -121,6 +121,16 @@ impl Surface {
         self.edges.refit(vertices);
     }
 
+    /// Each triangle's unit normal (zero for a degenerate one).
+    pub fn normals(&self) -> &[Vec3] {
+        &self.normals
+    }
+
+    /// The tree over its triangles.
+    pub fn tree(&self) -> &TriangleTree {
+        &self.tree
+    }
+
     pub fn vertices(&self) -> &[Vec3] {
         &self.vertices
     }

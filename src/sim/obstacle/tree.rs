@@ -87,6 +87,19 @@ impl TriangleTree {
         }
     }
 
+    /// Its nodes in order, as (box low corner, high corner, first, count): a leaf holds
+    /// `count` places from `first`; an inner node (`count` 0) has its children right after
+    /// it and at `first`. For a walk of the tree elsewhere (the GPU's).
+    pub fn nodes(&self) -> impl Iterator<Item = (Vec3, Vec3, u32, u32)> + '_ {
+        self.nodes.iter().map(|n| (n.lo, n.hi, n.first, n.count))
+    }
+
+    /// Each place's corners and the triangle it holds (as numbered when the tree was
+    /// built), in the tree's order.
+    pub fn places(&self) -> impl Iterator<Item = ([Vec3; 3], u32)> + '_ {
+        self.corners.iter().copied().zip(self.index.iter().copied())
+    }
+
     /// How many triangles it holds.
     pub fn len(&self) -> usize {
         self.corners.len()

@@ -1,0 +1,672 @@
+// Mesh obstacles on the GPU (prepended with shaders/cloth_layout.wgsl; src/gpu/obstacles.rs
+// builds and dispatches them): the CPU's contact with a rigid obstacle, placed and moved by
+// its keyframes. After a substep, `catch` takes each free particle's move from the
+// substep's start to its end into the obstacle's frame (the start where the obstacle was
+// then, the end where it is now), catches it at its first crossings and pushes its end out
+// to the thickness through the obstacle's box tree, and answers with an inelastic velocity
+// response and Coulomb friction against the surface's own velocity. Then `edges`, one
+// dispatch per colour of the cloth's edges, keeps each cloth edge off the obstacle's sharp
+// edges (creases and open borders) as the CPU's sweep over them does.
+
+struct Obstacle {
+    // In `surface`'s entries: where its tree's nodes, its places (triangles in the tree's
+    // order), its sharp edges' tree's nodes and their places start.
+    starts: vec4<u32>,
+    // x: nodes; y: places; z: edge nodes; w: edge places.
+    counts: vec4<u32>,
+    // xyz: the pivot its motion turns about.
+    pivot: vec4<f32>,
+    // x: its thickness (m); y: its friction.
+    info: vec4<f32>,
+}
+
+struct ObstacleParams {
+    // x: particles; y: obstacles; z: cloth edges.
+    counts: vec4<u32>,
+    obstacles: array<Obstacle, 4>,
+}
+
+@group(0) @binding(0) var<uniform> op: ObstacleParams;
+// The substep's start, and its end, which the contacts move.
+@group(0) @binding(1) var<storage, read> start: array<Particle>;
+@group(0) @binding(2) var<storage, read_write> state: array<Particle>;
+// Every obstacle's tree and triangles: a node is two entries (lo and its first, hi and its
+// count, as bits in w); a place four (its corners, the first's w the triangle's number as
+// bits; its unit normal); a sharp edge's place two (its ends).
+@group(0) @binding(3) var<storage, read> surface: array<vec4<f32>>;
+// The cloth's edges (structural and shear springs' ends) in colour order.
+@group(0) @binding(4) var<storage, read> cloth_edges: array<vec2<u32>>;
+// Crossings each sweep of the edge pass found (`catch_moves` zeroes them).
+@group(0) @binding(5) var<storage, read_write> crossings: array<atomic<u32>, 4>;
+// The colour one dispatch of `edges` takes: x its first edge, y how many, z 1 when they
+// may share a particle plus twice the sweep, w the invocations dispatched.
+@group(1) @binding(0) var<uniform> colour: vec4<u32>;
+// One obstacle's poses in the substep: where it starts (translation, rotation), where it
+// ends (translation, rotation, velocity, spin), and its number (x, as bits).
+@group(2) @binding(0) var<uniform> poses: array<vec4<f32>, 16>;
+
+// Corners a move may be caught at in one substep, and pushes of its end out of the
+// thickness (the CPU's `CROSSINGS` and `PUSHES`).
+const CROSSINGS: u32 = 3u;
+const PUSHES: u32 = 3u;
+// Nodes a walk of a tree holds at once (median splits keep its depth near log2(n / 4)).
+const STACK: u32 = 64u;
+
+fn rotate(q: vec4<f32>, v: vec3<f32>) -> vec3<f32> {
+    let t = 2.0 * cross(q.xyz, v);
+    return v + q.w * t + cross(q.xyz, t);
+}
+
+fn unrotate(q: vec4<f32>, v: vec3<f32>) -> vec3<f32> {
+    return rotate(vec4<f32>(-q.xyz, q.w), v);
+}
+
+struct Pose {
+    translation: vec3<f32>,
+    rotation: vec4<f32>,
+    velocity: vec3<f32>,
+    spin: vec3<f32>,
+}
+
+fn pose(end: bool) -> Pose {
+    let at = select(0u, 2u, end);
+    return Pose(poses[at].xyz, poses[at + 1u], poses[4].xyz, poses[5].xyz);
+}
+
+// The obstacle this dispatch takes.
+fn obstacle() -> u32 {
+    return bitcast<u32>(poses[6].x);
+}
+
+fn apply(p: Pose, pivot: vec3<f32>, x: vec3<f32>) -> vec3<f32> {
+    return pivot + p.translation + rotate(p.rotation, x - pivot);
+}
+
+fn unapply(p: Pose, pivot: vec3<f32>, moved: vec3<f32>) -> vec3<f32> {
+    return pivot + unrotate(p.rotation, moved - pivot - p.translation);
+}
+
+fn velocity_at(p: Pose, pivot: vec3<f32>, moved: vec3<f32>) -> vec3<f32> {
+    return p.velocity + cross(p.spin, moved - pivot - p.translation);
+}
+
+// The velocity `v` of a particle touching a surface moving at `vs` (unit normal `n`),
+// `part` of it bearing on the contact (the CPU's `touching`).
+fn touching(v: vec3<f32>, vs: vec3<f32>, n: vec3<f32>, mu: f32, part: f32) -> vec3<f32> {
+    let rel = v - vs;
+    let vn = dot(rel, n);
+    if (vn >= 0.0) {
+        return v;
+    }
+    let vt = rel - vn * n;
+    let speed = length(vt);
+    var keep = 0.0;
+    if (speed > 0.0) {
+        keep = max(1.0 - mu * part * (-vn) / speed, 0.0);
+    }
+    return vs + (1.0 - part) * vn * n + keep * vt;
+}
+
+struct Node {
+    lo: vec3<f32>,
+    hi: vec3<f32>,
+    first: u32,
+    count: u32,
+}
+
+fn node(base: u32, k: u32) -> Node {
+    let a = surface[base + 2u * k];
+    let b = surface[base + 2u * k + 1u];
+    return Node(a.xyz, b.xyz, bitcast<u32>(a.w), bitcast<u32>(b.w));
+}
+
+fn corner(o: u32, place: u32, k: u32) -> vec3<f32> {
+    return surface[op.obstacles[o].starts.y + 4u * place + k].xyz;
+}
+
+fn face_normal(o: u32, place: u32) -> vec3<f32> {
+    return surface[op.obstacles[o].starts.y + 4u * place + 3u].xyz;
+}
+
+// Ericson's closest point of triangle (a, b, c) to p, as weights (the CPU's
+// `closest_weights`).
+fn closest_on_triangle(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
+    let ab = b - a;
+    let ac = c - a;
+    let ap = p - a;
+    let d1 = dot(ab, ap);
+    let d2 = dot(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0) {
+        return a;
+    }
+    let bp = p - b;
+    let d3 = dot(ab, bp);
+    let d4 = dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+        let v = d1 / (d1 - d3);
+        return (1.0 - v) * a + v * b;
+    }
+    let cp = p - c;
+    let d5 = dot(ab, cp);
+    let d6 = dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+        let w = d2 / (d2 - d6);
+        return (1.0 - w) * a + w * c;
+    }
+    let va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (1.0 - w) * b + w * c;
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let v = vb * denom;
+    let w = vc * denom;
+    return (1.0 - v - w) * a + v * b + w * c;
+}
+
+// Where along from→to the segment crosses triangle (a, b, c), or -1 (the CPU's
+// `segment_crosses`).
+fn segment_crosses(origin: vec3<f32>, to: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
+    let d = to - origin;
+    let e1 = b - a;
+    let e2 = c - a;
+    let p = cross(d, e2);
+    let det = dot(e1, p);
+    let eps = 1.1920929e-7;
+    if (abs(det) <= eps * max(dot(e1, e1), dot(e2, e2)) * length(d)) {
+        return -1.0;
+    }
+    let inv = 1.0 / det;
+    let s = origin - a;
+    let u = dot(s, p) * inv;
+    if (u < 0.0 || u > 1.0) {
+        return -1.0;
+    }
+    let q = cross(s, e1);
+    let v = dot(d, q) * inv;
+    if (v < 0.0 || u + v > 1.0) {
+        return -1.0;
+    }
+    let t = dot(e2, q) * inv;
+    if (t < 0.0 || t > 1.0) {
+        return -1.0;
+    }
+    return t;
+}
+
+fn box_d2(p: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> f32 {
+    let d = max(max(lo - p, p - hi), vec3<f32>(0.0));
+    return dot(d, d);
+}
+
+fn segment_meets_box(origin: vec3<f32>, to: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> bool {
+    let d = to - origin;
+    var t0 = 0.0;
+    var t1 = 1.0;
+    for (var k = 0u; k < 3u; k++) {
+        if (abs(d[k]) < 1e-12) {
+            if (origin[k] < lo[k] || origin[k] > hi[k]) {
+                return false;
+            }
+            continue;
+        }
+        let inv = 1.0 / d[k];
+        let a = (lo[k] - origin[k]) * inv;
+        let b = (hi[k] - origin[k]) * inv;
+        t0 = max(t0, min(a, b));
+        t1 = min(t1, max(a, b));
+        if (t0 > t1) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// The first place of obstacle `o` the segment from→to crosses (x, as bits; none: u32 max)
+// and where along it (y): the CPU's `first_crossing`, its tree walked in the same order.
+fn first_crossing(o: u32, origin: vec3<f32>, to: vec3<f32>) -> vec2<f32> {
+    let base = op.obstacles[o].starts.x;
+    var best_place = 0xffffffffu;
+    var best_t = 2.0;
+    var stack: array<u32, 64>;
+    var top = 0u;
+    if (op.obstacles[o].counts.x > 0u) {
+        let root = node(base, 0u);
+        if (segment_meets_box(origin, to, root.lo, root.hi)) {
+            stack[0] = 0u;
+            top = 1u;
+        }
+    }
+    while (top > 0u) {
+        top -= 1u;
+        let at = stack[top];
+        let n = node(base, at);
+        let end = select(to, origin + (to - origin) * best_t, best_place != 0xffffffffu);
+        if (!segment_meets_box(origin, end, n.lo, n.hi)) {
+            continue;
+        }
+        if (n.count > 0u) {
+            for (var place = n.first; place < n.first + n.count; place++) {
+                let t = segment_crosses(origin, to, corner(o, place, 0u), corner(o, place, 1u), corner(o, place, 2u));
+                if (t >= 0.0 && (best_place == 0xffffffffu || t < best_t)) {
+                    best_place = place;
+                    best_t = t;
+                }
+            }
+            continue;
+        }
+        // The child pushed last is walked first: the one right after it.
+        for (var k = 0u; k < 2u; k++) {
+            let child = select(at + 1u, n.first, k == 0u);
+            let c = node(base, child);
+            let bound = select(to, origin + (to - origin) * best_t, best_place != 0xffffffffu);
+            if (segment_meets_box(origin, bound, c.lo, c.hi) && top < STACK) {
+                stack[top] = child;
+                top += 1u;
+            }
+        }
+    }
+    return vec2<f32>(bitcast<f32>(best_place), best_t);
+}
+
+struct Near {
+    place: u32,
+    point: vec3<f32>,
+    distance: f32,
+}
+
+// The point of obstacle `o` nearest to p within `reach` (place u32 max: none): the CPU's
+// `nearest`, nearer children first.
+fn nearest(o: u32, p: vec3<f32>, reach: f32) -> Near {
+    let base = op.obstacles[o].starts.x;
+    var best = Near(0xffffffffu, vec3<f32>(0.0), reach * reach);
+    var stack: array<u32, 64>;
+    var top = 0u;
+    if (op.obstacles[o].counts.x > 0u) {
+        let root = node(base, 0u);
+        if (box_d2(p, root.lo, root.hi) <= best.distance) {
+            stack[0] = 0u;
+            top = 1u;
+        }
+    }
+    while (top > 0u) {
+        top -= 1u;
+        let at = stack[top];
+        let n = node(base, at);
+        if (box_d2(p, n.lo, n.hi) > best.distance) {
+            continue;
+        }
+        if (n.count > 0u) {
+            for (var place = n.first; place < n.first + n.count; place++) {
+                let q = closest_on_triangle(p, corner(o, place, 0u), corner(o, place, 1u), corner(o, place, 2u));
+                let d = p - q;
+                let d2 = dot(d, d);
+                if (d2 <= best.distance) {
+                    best = Near(place, q, d2);
+                }
+            }
+            continue;
+        }
+        let one = node(base, at + 1u);
+        let two = node(base, n.first);
+        var last = n.first;
+        var first = at + 1u;
+        if (box_d2(p, one.lo, one.hi) > box_d2(p, two.lo, two.hi)) {
+            last = at + 1u;
+            first = n.first;
+        }
+        for (var k = 0u; k < 2u; k++) {
+            let child = select(first, last, k == 0u);
+            let c = node(base, child);
+            if (box_d2(p, c.lo, c.hi) <= best.distance && top < STACK) {
+                stack[top] = child;
+                top += 1u;
+            }
+        }
+    }
+    best.distance = sqrt(best.distance);
+    return best;
+}
+
+// The way out for `end`, `distance` from `point` of place `place`: away from the point, or
+// on the surface, off it on the side of `from` (the CPU's `away`).
+fn away(o: u32, place: u32, point: vec3<f32>, distance: f32, end: vec3<f32>, origin: vec3<f32>, thickness: f32) -> vec3<f32> {
+    if (distance > thickness * 1e-3) {
+        return (end - point) / distance;
+    }
+    let face = face_normal(o, place);
+    return select(-face, face, dot(origin - point, face) >= 0.0);
+}
+
+struct Caught {
+    caught: bool,
+    at: vec3<f32>,
+    normal: vec3<f32>,
+}
+
+// Where a move from→to (in obstacle `o`'s frame) ends: caught at its first crossings a
+// thickness off the side it came from, sliding on along the surface, then pushed out to the
+// thickness (the CPU's general catch, `catch_among` with the tree).
+fn catch_move(o: u32, origin: vec3<f32>, to: vec3<f32>, thickness: f32) -> Caught {
+    var s = origin;
+    var e = to;
+    var out = Caught(false, to, vec3<f32>(0.0));
+    for (var k = 0u; k < CROSSINGS; k++) {
+        let hit = first_crossing(o, s, e);
+        let place = bitcast<u32>(hit.x);
+        if (place == 0xffffffffu) {
+            break;
+        }
+        let face = face_normal(o, place);
+        let at = s + (e - s) * hit.y;
+        let facing = dot(s - at, face);
+        var side = select(-1.0, 1.0, facing > 0.0);
+        if (facing == 0.0) {
+            side = select(-1.0, 1.0, dot(e - s, face) < 0.0);
+        }
+        let n = face * side;
+        let rest = e - at;
+        let along = rest - min(dot(rest, n), 0.0) * n;
+        s = at + n * thickness;
+        e = s + along;
+        out = Caught(true, e, n);
+    }
+    for (var k = 0u; k < PUSHES; k++) {
+        let near = nearest(o, e, thickness);
+        if (near.place == 0xffffffffu || near.distance >= thickness * (1.0 - 1e-4)) {
+            break;
+        }
+        let n = away(o, near.place, near.point, near.distance, e, s, thickness);
+        e = near.point + n * thickness;
+        out = Caught(true, e, n);
+    }
+    out.at = e;
+    return out;
+}
+
+@compute @workgroup_size(64)
+fn catch_moves(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i >= op.counts.x) {
+        return;
+    }
+    if (i == 0u) {
+        for (var k = 0u; k < 4u; k++) {
+            atomicStore(&crossings[k], 0u);
+        }
+    }
+    var p = state[i];
+    if (p.x.w <= 0.0) {
+        return;
+    }
+    let o = obstacle();
+    let ob = op.obstacles[o];
+    let pivot = ob.pivot.xyz;
+    let end = pose(true);
+    let c = catch_move(o, unapply(pose(false), pivot, start[i].x.xyz), unapply(end, pivot, p.x.xyz), ob.info.x);
+    if (!c.caught) {
+        return;
+    }
+    let at = apply(end, pivot, c.at);
+    let n = rotate(end.rotation, c.normal);
+    p.x = vec4<f32>(at, p.x.w);
+    p.v = vec4<f32>(touching(p.v.xyz, velocity_at(end, pivot, at), n, ob.info.y, 1.0), p.v.w);
+    state[i] = p;
+}
+
+// The nearest points of segments a–b and p–q: x where along a–b, y along p–q (the CPU's
+// `segments_closest`, which runs in f64).
+fn segments_closest(p0: vec3<f32>, p1: vec3<f32>, q0: vec3<f32>, q1: vec3<f32>) -> vec2<f32> {
+    let d1 = p1 - p0;
+    let d2 = q1 - q0;
+    let r = p0 - q0;
+    let a = dot(d1, d1);
+    let e = dot(d2, d2);
+    let f = dot(d2, r);
+    let tiny = 1e-20;
+    if (a <= tiny && e <= tiny) {
+        return vec2<f32>(0.0);
+    }
+    if (a <= tiny) {
+        return vec2<f32>(0.0, clamp(f / e, 0.0, 1.0));
+    }
+    let c = dot(d1, r);
+    if (e <= tiny) {
+        return vec2<f32>(clamp(-c / a, 0.0, 1.0), 0.0);
+    }
+    let b = dot(d1, d2);
+    let denom = a * e - b * b;
+    var s = 0.0;
+    if (denom > 0.0) {
+        s = clamp((b * f - c * e) / denom, 0.0, 1.0);
+    }
+    var t = (b * s + f) / e;
+    if (t < 0.0) {
+        t = 0.0;
+        s = clamp(-c / a, 0.0, 1.0);
+    } else if (t > 1.0) {
+        t = 1.0;
+        s = clamp((b - c) / a, 0.0, 1.0);
+    }
+    return vec2<f32>(s, t);
+}
+
+struct EdgeHit {
+    along: f32,
+    on_segment: vec3<f32>,
+    on_edge: vec3<f32>,
+    distance: f32,
+}
+
+fn between(a: vec3<f32>, b: vec3<f32>, p: vec3<f32>, q: vec3<f32>) -> EdgeHit {
+    let st = segments_closest(a, b, p, q);
+    let on_segment = a + (b - a) * st.x;
+    let on_edge = p + (q - p) * st.y;
+    return EdgeHit(st.x, on_segment, on_edge, distance(on_segment, on_edge));
+}
+
+fn edge_end(o: u32, place: u32, k: u32) -> vec3<f32> {
+    return surface[op.obstacles[o].starts.w + 2u * place + k].xyz;
+}
+
+fn boxes_meet(alo: vec3<f32>, ahi: vec3<f32>, blo: vec3<f32>, bhi: vec3<f32>) -> bool {
+    return all(alo <= bhi) && all(blo <= ahi);
+}
+
+// The first time in 0..1 the segment moving from `b0`–`b1` to `a0`–`a1` meets the segment
+// p–q, or -1 (the CPU's `sweep_meets`).
+fn sweep_meets(b0: vec3<f32>, b1: vec3<f32>, a0: vec3<f32>, a1: vec3<f32>, p: vec3<f32>, q: vec3<f32>) -> f32 {
+    let u = q - p;
+    let a = b0 - p;
+    let da = a0 - b0;
+    let c = b1 - b0;
+    let dc = (a1 - b1) - da;
+    let k0 = dot(a, cross(c, u));
+    let k1 = dot(a, cross(dc, u)) + dot(da, cross(c, u));
+    let k2 = dot(da, cross(dc, u));
+    let scale = (length(c) + length(dc) + length(da)) * length(u);
+    var r0 = 2.0;
+    var r1 = 2.0;
+    if (abs(k2) > 1e-9 * scale * max(scale, 1e-12)) {
+        let disc = k1 * k1 - 4.0 * k2 * k0;
+        if (disc >= 0.0) {
+            let s = sqrt(disc);
+            let x = (-k1 - s) / (2.0 * k2);
+            let y = (-k1 + s) / (2.0 * k2);
+            r0 = min(x, y);
+            r1 = max(x, y);
+        }
+    } else if (abs(k1) > 0.0) {
+        r0 = -k0 / k1;
+    }
+    let touch = 1e-5 * (length(c) + length(u));
+    for (var k = 0u; k < 2u; k++) {
+        let t = select(r1, r0, k == 0u);
+        if (t >= 0.0 && t <= 1.0) {
+            let x = b0 + da * t;
+            let y = b1 + (a1 - b1) * t;
+            if (between(x, y, p, q).distance <= touch) {
+                return t;
+            }
+        }
+    }
+    return -1.0;
+}
+
+// Obstacle `o`'s sharp edges whose boxes meet lo..hi, walked as the CPU's `overlapping`
+// walks them: the nearest to segment a–b within `reach` (`nearest` true), or the first the
+// segment moving from b0–b1 to a–b passes through, with the side it came from.
+struct EdgeFound {
+    found: bool,
+    hit: EdgeHit,
+    p: vec3<f32>,
+    q: vec3<f32>,
+    side: vec3<f32>,
+}
+
+fn sharp_edges(o: u32, lo: vec3<f32>, hi: vec3<f32>, a: vec3<f32>, b: vec3<f32>, b0: vec3<f32>, b1: vec3<f32>, reach: f32, nearest_one: bool) -> EdgeFound {
+    let base = op.obstacles[o].starts.z;
+    var out = EdgeFound(false, EdgeHit(0.0, vec3<f32>(0.0), vec3<f32>(0.0), 0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    var first_t = 2.0;
+    var stack: array<u32, 64>;
+    var top = 0u;
+    if (op.obstacles[o].counts.z > 0u) {
+        let root = node(base, 0u);
+        if (boxes_meet(root.lo, root.hi, lo, hi)) {
+            stack[0] = 0u;
+            top = 1u;
+        }
+    }
+    while (top > 0u) {
+        top -= 1u;
+        let at = stack[top];
+        let n = node(base, at);
+        if (n.count > 0u) {
+            for (var place = n.first; place < n.first + n.count; place++) {
+                let p = edge_end(o, place, 0u);
+                let q = edge_end(o, place, 1u);
+                if (!boxes_meet(min(p, q), max(p, q), lo, hi)) {
+                    continue;
+                }
+                if (nearest_one) {
+                    let h = between(a, b, p, q);
+                    if (h.distance <= reach && (!out.found || h.distance < out.hit.distance)) {
+                        out = EdgeFound(true, h, p, q, vec3<f32>(0.0));
+                    }
+                } else {
+                    let t = sweep_meets(b0, b1, a, b, p, q);
+                    if (t < 0.0 || (out.found && first_t <= t)) {
+                        continue;
+                    }
+                    let s = between(b0, b1, p, q);
+                    if (s.distance > 0.0) {
+                        first_t = t;
+                        out = EdgeFound(true, s, p, q, (s.on_segment - s.on_edge) / s.distance);
+                    }
+                }
+            }
+            continue;
+        }
+        for (var k = 0u; k < 2u; k++) {
+            let child = select(at + 1u, n.first, k == 0u);
+            let c = node(base, child);
+            if (boxes_meet(c.lo, c.hi, lo, hi) && top < STACK) {
+                stack[top] = child;
+                top += 1u;
+            }
+        }
+    }
+    return out;
+}
+
+// Keeps each cloth edge of this dispatch's colour the thickness off every obstacle's sharp
+// edges where the substep ends (the CPU's `push_edges`): an edge it passed through puts
+// it back on the side it came from, one it ends within the thickness of pushes it out;
+// the two particles move in proportion to how near each is to the nearest point.
+@compute @workgroup_size(64)
+fn edges(@builtin(global_invocation_id) id: vec3<u32>) {
+    // A sweep runs only after one that found a crossing (the first always).
+    let sweep = colour.z >> 1u;
+    if (sweep > 0u && atomicLoad(&crossings[sweep - 1u]) == 0u) {
+        return;
+    }
+    // A colour whose edges may share a particle is taken in order by one invocation.
+    var stride = colour.w;
+    if ((colour.z & 1u) == 1u) {
+        if (id.x > 0u) {
+            return;
+        }
+        stride = 1u;
+    }
+    for (var k = id.x; k < colour.y; k += stride) {
+        let e = cloth_edges[colour.x + k];
+        var pi = state[e.x];
+        var pj = state[e.y];
+        let free = vec2<f32>(select(0.0, 1.0, pi.x.w > 0.0), select(0.0, 1.0, pj.x.w > 0.0));
+        if (free.x == 0.0 && free.y == 0.0) {
+            continue;
+        }
+        let o = obstacle();
+        let ob = op.obstacles[o];
+        let pivot = ob.pivot.xyz;
+        let thickness = ob.info.x;
+        let begin = pose(false);
+        let end = pose(true);
+        let l0 = unapply(end, pivot, pi.x.xyz);
+        let l1 = unapply(end, pivot, pj.x.xyz);
+        let b0 = unapply(begin, pivot, start[e.x].x.xyz);
+        let b1 = unapply(begin, pivot, start[e.y].x.xyz);
+        let travel = max(length(l0 - b0), length(l1 - b1));
+        let reach = max(thickness, travel);
+        let pad = vec3<f32>(reach);
+        let near = sharp_edges(o, min(l0, l1) - pad, max(l0, l1) + pad, l0, l1, b0, b1, reach, true);
+        if (!near.found) {
+            continue;
+        }
+        var hit = near.hit;
+        var side = vec3<f32>(0.0);
+        var crossed = EdgeFound(false, hit, vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+        if (near.hit.distance <= travel) {
+            let lo = min(min(b0, b1), min(l0, l1));
+            let hi = max(max(b0, b1), max(l0, l1));
+            crossed = sharp_edges(o, lo, hi, l0, l1, b0, b1, 0.0, false);
+        }
+        if (crossed.found) {
+            atomicAdd(&crossings[sweep], 1u);
+            hit = between(l0, l1, crossed.p, crossed.q);
+            side = crossed.side;
+        } else {
+            if (near.hit.distance <= thickness * 1e-3 || near.hit.distance >= thickness) {
+                continue;
+            }
+            side = (near.hit.on_segment - near.hit.on_edge) / near.hit.distance;
+        }
+        let gap = rotate(end.rotation, side * thickness - (hit.on_segment - hit.on_edge));
+        let n = rotate(end.rotation, side);
+        let share = vec2<f32>(1.0 - hit.along, hit.along);
+        let weight = share.x * share.x * free.x + share.y * share.y * free.y;
+        if (weight <= 0.0) {
+            continue;
+        }
+        let vs = velocity_at(end, pivot, apply(end, pivot, hit.on_edge));
+        let part = share * free;
+        if (part.x > 0.0) {
+            pi.x = vec4<f32>(pi.x.xyz + gap * (part.x / weight), pi.x.w);
+            pi.v = vec4<f32>(touching(pi.v.xyz, vs, n, ob.info.y, part.x), pi.v.w);
+        }
+        if (part.y > 0.0) {
+            pj.x = vec4<f32>(pj.x.xyz + gap * (part.y / weight), pj.x.w);
+            pj.v = vec4<f32>(touching(pj.v.xyz, vs, n, ob.info.y, part.y), pj.v.w);
+        }
+        state[e.x] = pi;
+        state[e.y] = pj;
+    }
+}
