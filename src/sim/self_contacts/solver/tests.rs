@@ -23,6 +23,19 @@ fn crumpled() -> (ClothModel, Vec<Vec3>) {
     (model, pos)
 }
 
+/// A solver for `model` with the pairs found for every particle moving by `motion` from
+/// `start`.
+fn searched(model: &ClothModel, start: &[Vec3], motion: Vec3) -> SelfContacts {
+    let mut contacts = SelfContacts {
+        owners: Owners::build(model),
+        ..SelfContacts::default()
+    };
+    let end: Vec<Vec3> = start.iter().map(|&p| p + motion).collect();
+    contacts.relative(start, &end, Vec3::ZERO, Vec3::ZERO);
+    contacts.update_pairs(model, THICKNESS, THICKNESS).unwrap();
+    contacts
+}
+
 /// Pairs found for every particle moving by `motion` (none: the boxes get room, and the
 /// pairs are judged by them alone; a fast one: by the motion too), then the particles in
 /// the band `x < band` moved by `shift` more, which takes them out of their boxes, and the
@@ -34,18 +47,12 @@ fn refreshed(
     within: f32,
 ) -> (SelfContacts, Vec<StoredPair>, Vec<StoredPair>) {
     let (model, start) = crumpled();
-    let mut contacts = SelfContacts {
-        owners: Owners::build(&model),
-        ..SelfContacts::default()
-    };
-    let end: Vec<Vec3> = start.iter().map(|&p| p + motion).collect();
-    contacts.relative(&start, &end, Vec3::ZERO, Vec3::ZERO);
-    contacts.update_pairs(&model, THICKNESS, THICKNESS).unwrap();
+    let mut contacts = searched(&model, &start, motion);
     assert_eq!(contacts.work.searches, 1);
     assert_eq!(contacts.boxes.swept, motion != Vec3::ZERO);
     let before: Vec<StoredPair> = contacts.found.stored().copied().collect();
-    let end: Vec<Vec3> = (end.iter().zip(&start))
-        .map(|(&p, s)| if s.x < band { p + shift } else { p })
+    let end: Vec<Vec3> = (start.iter())
+        .map(|&s| s + motion + if s.x < band { shift } else { Vec3::ZERO })
         .collect();
     contacts.relative(&start, &end, Vec3::ZERO, Vec3::ZERO);
     contacts.update_pairs(&model, THICKNESS, within).unwrap();
@@ -81,13 +88,7 @@ fn a_search_finds_what_testing_every_two_triangles_finds() {
     let (model, start) = crumpled();
     let triangles = &model.triangles;
     for motion in [Vec3::ZERO, FAST] {
-        let mut contacts = SelfContacts {
-            owners: Owners::build(&model),
-            ..SelfContacts::default()
-        };
-        let end: Vec<Vec3> = start.iter().map(|&p| p + motion).collect();
-        contacts.relative(&start, &end, Vec3::ZERO, Vec3::ZERO);
-        contacts.update_pairs(&model, THICKNESS, THICKNESS).unwrap();
+        let contacts = searched(&model, &start, motion);
         let found = sorted(contacts.found.stored().copied().collect());
         let search = Search {
             owners: &contacts.owners,
