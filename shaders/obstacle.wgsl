@@ -670,3 +670,12 @@ fn edges(@builtin(global_invocation_id) id: vec3<u32>) {
         state[e.y] = pj;
     }
 }
+
+// Copies the substep's start (bound as `start`) into `state` (bound to the kept copy), for
+// an integrator that writes its end over its start.
+@compute @workgroup_size(64)
+fn keep_start(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x < op.counts.x) {
+        state[id.x] = start[id.x];
+    }
+}

@@ -16,7 +16,7 @@ pub enum Backend {
     Cpu,
     /// wgpu compute: semi-implicit and implicit Euler, XPBD and VBD; springs, gravity, air damping, wind,
     /// dihedral bending, pins, handles, spheres and planes, rigid mesh obstacles with
-    /// semi-implicit Euler; with the stability guard.
+    /// semi-implicit Euler or XPBD; with the stability guard.
     Gpu,
 }
 

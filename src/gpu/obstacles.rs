@@ -1,5 +1,6 @@
 //! Mesh obstacles on the GPU (`shaders/obstacle.wgsl`): the CPU's contact with a rigid
-//! obstacle, placed and moved by its keyframes, after each substep of semi-implicit Euler.
+//! obstacle, placed and moved by its keyframes, after each substep of semi-implicit Euler
+//! or XPBD.
 //! Each obstacle's box tree, triangles and sharp edges go to the device once, in the CPU's
 //! tree order, so a walk visits what the CPU's visits; the obstacles' poses at each
 //! substep's start and end are written before each submission. The cloth's edges (its
@@ -48,12 +49,25 @@ struct ObstacleParams {
     obstacles: [GpuObstacle; MAX_OBSTACLES],
 }
 
+/// Where a substep's start and end are for the contacts.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Start {
+    /// The start in `particles[i]`, the end in the other (semi-implicit Euler).
+    In(usize),
+    /// The start in the copy [`ObstaclePass::keep_start`] made, the end in `particles[i]`
+    /// (XPBD, which writes its end over its start).
+    Kept(usize),
+}
+
 /// The rigid mesh obstacles of a scene on the device.
 pub(super) struct ObstaclePass {
     catch: wgpu::ComputePipeline,
     edges: wgpu::ComputePipeline,
-    /// `groups[i]` reads the substep's start from `particles[i]` and moves the other.
-    groups: [wgpu::BindGroup; 2],
+    keep: wgpu::ComputePipeline,
+    /// By [`Start`]: `groups[i]` reads the substep's start from `particles[i]` and moves
+    /// the other; `groups[2 + i]` reads it from the kept copy and moves `particles[i]`;
+    /// `groups[4 + i]` copies `particles[i]` into the kept copy.
+    groups: [wgpu::BindGroup; 6],
     colours: Colours,
     poses_layout: wgpu::BindGroupLayout,
     poses: wgpu::Buffer,
@@ -63,7 +77,7 @@ pub(super) struct ObstaclePass {
     /// Each obstacle's motion, for its poses at each substep.
     moving: Vec<RigidMotion>,
     /// Kept alive for the bind groups.
-    _buffers: [wgpu::Buffer; 4],
+    _buffers: [wgpu::Buffer; 5],
     count: u32,
 }
 
@@ -195,14 +209,26 @@ impl ObstaclePass {
         let main = layout(device, "obstacles", &slots);
         let poses_layout = layout(device, "obstacle poses", &[Dynamic]);
         let all: &[&wgpu::BindGroupLayout] = &[&main, &kernel.colour_layout, &poses_layout];
-        let [catch, edges_pipeline] = pipelines(
+        let [catch, edges_pipeline, keep] = pipelines(
             device,
             "obstacles",
             &format!("{LAYOUT}{SOURCE}"),
-            [("catch_moves", all), ("edges", all)],
+            [("catch_moves", all), ("edges", all), ("keep_start", all)],
         );
-        let groups = [0, 1].map(|from| {
-            let (start, end) = (&particles[from], &particles[1 - from]);
+        // The substep's start, for an integrator that writes its end over it (XPBD).
+        let kept = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("obstacle substep start"),
+            size: particles[0].size(),
+            usage: U::STORAGE,
+            mapped_at_creation: false,
+        });
+        let groups = [0, 1, 2, 3, 4, 5].map(|g| {
+            let i = g % 2;
+            let (start, end) = match g / 2 {
+                0 => (&particles[i], &particles[1 - i]),
+                1 => (&kept, &particles[i]),
+                _ => (&particles[i], &kept),
+            };
             let buffers = [&uniform, start, end, &surface, &cloth_edges, &crossings];
             bind(device, "obstacles", &main, &buffers)
         });
@@ -210,6 +236,7 @@ impl ObstaclePass {
         Ok(Some(Self {
             catch,
             edges: edges_pipeline,
+            keep,
             groups,
             colours: Colours::new(device, queue, kernel, &records),
             poses_layout,
@@ -217,7 +244,7 @@ impl ObstaclePass {
             poses_group,
             room: 1,
             moving,
-            _buffers: [uniform, surface, cloth_edges, crossings],
+            _buffers: [uniform, surface, cloth_edges, crossings, kept],
             count,
         }))
     }
@@ -289,19 +316,33 @@ impl ObstaclePass {
         queue.write_buffer(&self.poses, 0, bytemuck::cast_slice(&data));
     }
 
-    /// Records substep `k`'s contacts, its start in `particles[from]` and its end in the
-    /// other: each obstacle in turn (as the CPU's effects, in the scene's order) catches the
-    /// particles' moves, then sweeps the cloth's edges.
-    pub(super) fn encode(&self, pass: &mut wgpu::ComputePass<'_>, k: u32, from: usize) {
+    /// Records a copy of the substep's start, `particles[at]`, for an integrator that
+    /// writes its end over it ([`Start::Kept`] then reads it).
+    pub(super) fn keep_start(&self, pass: &mut wgpu::ComputePass<'_>, at: usize) {
+        pass.set_bind_group(2, &self.poses_group, &[0]);
+        pass.set_bind_group(1, self.colours.group(), &[0]);
+        pass.set_pipeline(&self.keep);
+        pass.set_bind_group(0, &self.groups[4 + at], &[]);
+        pass.dispatch_workgroups(self.count.div_ceil(WORKGROUP), 1, 1);
+    }
+
+    /// Records substep `k`'s contacts, where `start` says its start and end are: each
+    /// obstacle in turn (as the CPU's effects, in the scene's order) catches the particles'
+    /// moves, then sweeps the cloth's edges.
+    pub(super) fn encode(&self, pass: &mut wgpu::ComputePass<'_>, k: u32, start: Start) {
+        let group = &self.groups[match start {
+            Start::In(i) => i,
+            Start::Kept(i) => 2 + i,
+        }];
         let obstacles = self.moving.len() as u32;
         for o in 0..obstacles {
             let offset = (u64::from(k * obstacles + o) * POSE_STRIDE) as u32;
             pass.set_bind_group(2, &self.poses_group, &[offset]);
             pass.set_pipeline(&self.catch);
-            pass.set_bind_group(0, &self.groups[from], &[]);
+            pass.set_bind_group(0, group, &[]);
             pass.set_bind_group(1, self.colours.group(), &[0]);
             pass.dispatch_workgroups(self.count.div_ceil(WORKGROUP), 1, 1);
-            self.colours.sweep(pass, &self.edges, &self.groups[from]);
+            self.colours.sweep(pass, &self.edges, group);
         }
     }
 }

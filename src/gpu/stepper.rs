@@ -23,7 +23,7 @@ use super::handles::Carried;
 use super::health::{HealthKernel, Watch};
 use super::implicit::ImplicitPass;
 use super::kernel::{SubstepKernel, WORKGROUP};
-use super::obstacles::ObstaclePass;
+use super::obstacles::{ObstaclePass, Start};
 use super::packing::{
     ClassTable, EndsKey, Neighbour, Params, Particle, classify, grid_of, pack_solids, pack_springs,
 };
@@ -436,6 +436,9 @@ impl GpuStepper {
                 self.elements.dispatch(&mut pass, self.current);
                 let (this, other) = (&self.groups[self.current], &self.groups[1 - self.current]);
                 if let Some((predict, sweep, colours, finish)) = solver {
+                    if let Some(obstacles) = &self.obstacles {
+                        obstacles.keep_start(&mut pass, self.current);
+                    }
                     // The state stays where it is; the other buffer holds the predictions
                     // (XPBD) or the displacements (VBD).
                     pass.set_pipeline(predict);
@@ -447,12 +450,15 @@ impl GpuStepper {
                     pass.set_pipeline(finish);
                     pass.set_bind_group(0, other, &[]);
                     pass.dispatch_workgroups(groups, 1, 1);
+                    if let Some(obstacles) = &self.obstacles {
+                        obstacles.encode(&mut pass, k, Start::Kept(self.current));
+                    }
                 } else {
                     pass.set_pipeline(&self.kernel.pipeline);
                     pass.set_bind_group(0, this, &[]);
                     pass.dispatch_workgroups(groups, 1, 1);
                     if let Some(obstacles) = &self.obstacles {
-                        obstacles.encode(&mut pass, k, self.current);
+                        obstacles.encode(&mut pass, k, Start::In(self.current));
                     }
                     self.current = 1 - self.current;
                 }

@@ -21,8 +21,8 @@ pub const GPU_INTEGRATORS: [IntegratorKind; 4] = [
 /// What of `step`, `precision` and `effects` the GPU backend cannot run, if anything: it
 /// runs semi-implicit Euler, implicit Euler (one linearised step), XPBD and VBD in `f32` with
 /// gravity, springs (and bend springs), dihedral bending, wind, air damping, pins, handles,
-/// up to four sphere and plane colliders, and (with semi-implicit Euler) up to four rigid
-/// mesh obstacles, still or keyframed.
+/// up to four sphere and plane colliders, and (with semi-implicit Euler or XPBD) up to
+/// four rigid mesh obstacles, still or keyframed.
 pub fn gpu_support(
     step: &StepConfig,
     precision: Precision,
@@ -63,10 +63,11 @@ pub fn gpu_support(
             "takes at most {MAX_OBSTACLES} mesh obstacles"
         )));
     }
-    if obstacles > 0 && step.integrator != IntegratorKind::SemiImplicitEuler {
+    let with_obstacles = [IntegratorKind::SemiImplicitEuler, IntegratorKind::Xpbd];
+    if obstacles > 0 && !with_obstacles.contains(&step.integrator) {
         return Err(GpuError::Unsupported(format!(
-            "runs mesh obstacles with semi-implicit Euler only, not {}; run {} on the CPU \
-             backend",
+            "runs mesh obstacles with semi-implicit Euler and XPBD only, not {}; run {} on \
+             the CPU backend",
             step.integrator.label(),
             step.integrator.label()
         )));
