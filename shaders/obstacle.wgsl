@@ -38,11 +38,15 @@ struct ObstacleParams {
 @group(0) @binding(4) var<storage, read> cloth_edges: array<vec2<u32>>;
 // Crossings each sweep of the edge pass found (`catch_moves` zeroes them).
 @group(0) @binding(5) var<storage, read_write> crossings: array<atomic<u32>, 4>;
+// Implicit Euler's solve, where it steps (else a stand-in): [2].w is raised when a contact
+// moves a particle, so that its next first guess has no history (as the CPU's forgets it).
+@group(0) @binding(6) var<storage, read_write> solve: array<vec4<f32>>;
 // The colour one dispatch of `edges` takes: x its first edge, y how many, z 1 when they
 // may share a particle plus twice the sweep, w the invocations dispatched.
 @group(1) @binding(0) var<uniform> colour: vec4<u32>;
 // One obstacle's poses in the substep: where it starts (translation, rotation), where it
-// ends (translation, rotation, velocity, spin), and its number (x, as bits).
+// ends (translation, rotation, velocity, spin), its number (x, as bits) and 1 (y) when
+// implicit Euler steps the cloth.
 @group(2) @binding(0) var<uniform> poses: array<vec4<f32>, 16>;
 
 // Corners a move may be caught at in one substep, and pushes of its end out of the
@@ -76,6 +80,13 @@ fn pose(end: bool) -> Pose {
 // The obstacle this dispatch takes.
 fn obstacle() -> u32 {
     return bitcast<u32>(poses[6].x);
+}
+
+// A contact moved a particle: implicit Euler's next first guess has no history.
+fn moved() {
+    if (poses[6].y > 0.5) {
+        solve[2].w = 1.0;
+    }
 }
 
 fn apply(p: Pose, pivot: vec3<f32>, x: vec3<f32>) -> vec3<f32> {
@@ -420,6 +431,7 @@ fn catch_moves(@builtin(global_invocation_id) id: vec3<u32>) {
     p.x = vec4<f32>(at, p.x.w);
     p.v = vec4<f32>(touching(p.v.xyz, velocity_at(end, pivot, at), n, ob.info.y, 1.0), p.v.w);
     state[i] = p;
+    moved();
 }
 
 // The nearest points of segments a–b and p–q: x where along a–b, y along p–q (the CPU's
@@ -668,6 +680,7 @@ fn edges(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         state[e.x] = pi;
         state[e.y] = pj;
+        moved();
     }
 }
 

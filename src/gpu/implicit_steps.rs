@@ -5,6 +5,7 @@ use crate::sim::{StepError, StepReport};
 
 use super::error::GpuError;
 use super::implicit::FIRST_CHUNK;
+use super::obstacles::Start;
 use super::stepper::GpuStepper;
 
 impl GpuStepper {
@@ -31,7 +32,8 @@ impl GpuStepper {
             })
         };
         let lost = |e: GpuError| StepError::Device(e.to_string());
-        for _ in 0..substeps {
+        let obstacles = self.obstacles.as_ref();
+        for k in 0..substeps {
             let this = &self.groups[self.current];
             let mut encoded = solve.last.max(FIRST_CHUNK).min(cap);
             {
@@ -61,6 +63,9 @@ impl GpuStepper {
             });
             let mut pass = encoder.begin_compute_pass(&Default::default());
             solve.finish(&mut pass, this);
+            if let Some(obstacles) = obstacles {
+                obstacles.encode(&mut pass, k, Start::In(self.current));
+            }
             if counting {
                 pass.set_pipeline(&self.kernel.tick);
                 pass.dispatch_workgroups(1, 1, 1);

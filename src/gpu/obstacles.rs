@@ -1,6 +1,6 @@
 //! Mesh obstacles on the GPU (`shaders/obstacle.wgsl`): the CPU's contact with a rigid
-//! obstacle, placed and moved by its keyframes, after each substep of semi-implicit Euler
-//! or XPBD.
+//! obstacle, placed and moved by its keyframes, after each substep of semi-implicit or
+//! implicit Euler or XPBD.
 //! Each obstacle's box tree, triangles and sharp edges go to the device once, in the CPU's
 //! tree order, so a walk visits what the CPU's visits; the obstacles' poses at each
 //! substep's start and end are written before each submission. The cloth's edges (its
@@ -76,8 +76,11 @@ pub(super) struct ObstaclePass {
     room: u32,
     /// Each obstacle's motion, for its poses at each substep.
     moving: Vec<RigidMotion>,
-    /// Kept alive for the bind groups.
-    _buffers: [wgpu::Buffer; 5],
+    /// What the bind groups bind besides the particles: the uniform, the surfaces, the
+    /// cloth's edges, the crossings, the kept start, and a stand-in for implicit Euler's
+    /// solve (whose "a contact moved a particle" flag the pass raises), and their layout.
+    buffers: [wgpu::Buffer; 6],
+    layout: wgpu::BindGroupLayout,
     count: u32,
 }
 
@@ -204,8 +207,9 @@ impl ObstaclePass {
         );
         let cloth_edges = buffer("cloth edges", bytemuck::cast_slice(&edges), U::STORAGE);
         let crossings = buffer("edge crossings", &[0; 16], U::STORAGE);
+        let no_solve = buffer("no implicit solve", &[0; 48], U::STORAGE);
         use Slot::{Dynamic, Read, Uniform, Write};
-        let slots = [Uniform, Read, Write, Read, Read, Write];
+        let slots = [Uniform, Read, Write, Read, Read, Write, Write];
         let main = layout(device, "obstacles", &slots);
         let poses_layout = layout(device, "obstacle poses", &[Dynamic]);
         let all: &[&wgpu::BindGroupLayout] = &[&main, &kernel.colour_layout, &poses_layout];
@@ -222,16 +226,8 @@ impl ObstaclePass {
             usage: U::STORAGE,
             mapped_at_creation: false,
         });
-        let groups = [0, 1, 2, 3, 4, 5].map(|g| {
-            let i = g % 2;
-            let (start, end) = match g / 2 {
-                0 => (&particles[i], &particles[1 - i]),
-                1 => (&kept, &particles[i]),
-                _ => (&particles[i], &kept),
-            };
-            let buffers = [&uniform, start, end, &surface, &cloth_edges, &crossings];
-            bind(device, "obstacles", &main, &buffers)
-        });
+        let buffers = [uniform, surface, cloth_edges, crossings, kept, no_solve];
+        let groups = Self::groups_for(device, &main, particles, &buffers, None);
         let (poses, poses_group) = Self::poses_for(device, &poses_layout, 1);
         Ok(Some(Self {
             catch,
@@ -244,9 +240,42 @@ impl ObstaclePass {
             poses_group,
             room: 1,
             moving,
-            _buffers: [uniform, surface, cloth_edges, crossings, kept],
+            buffers,
+            layout: main,
             count,
         }))
+    }
+
+    /// The six bind groups (see `groups`), binding implicit Euler's `solve` where it steps.
+    fn groups_for(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        particles: &[wgpu::Buffer; 2],
+        [uniform, surface, cloth_edges, crossings, kept, no_solve]: &[wgpu::Buffer; 6],
+        solve: Option<&wgpu::Buffer>,
+    ) -> [wgpu::BindGroup; 6] {
+        let solve = solve.unwrap_or(no_solve);
+        [0, 1, 2, 3, 4, 5].map(|g| {
+            let i = g % 2;
+            let (start, end) = match g / 2 {
+                0 => (&particles[i], &particles[1 - i]),
+                1 => (kept, &particles[i]),
+                _ => (&particles[i], kept),
+            };
+            let buffers = [uniform, start, end, surface, cloth_edges, crossings, solve];
+            bind(device, "obstacles", layout, &buffers)
+        })
+    }
+
+    /// Binds implicit Euler's `solve` (`None`: another integrator steps), whose first guess
+    /// forgets its history when a contact moves a particle, as the CPU's does.
+    pub(super) fn attach_solve(
+        &mut self,
+        device: &wgpu::Device,
+        particles: &[wgpu::Buffer; 2],
+        solve: Option<&wgpu::Buffer>,
+    ) {
+        self.groups = Self::groups_for(device, &self.layout, particles, &self.buffers, solve);
     }
 
     /// A poses buffer with room for `blocks` obstacles' substeps and its bind group.
@@ -277,12 +306,14 @@ impl ObstaclePass {
     }
 
     /// Writes every obstacle's poses at the start and end of `substeps` substeps of
-    /// `substep` seconds from `time`, for the submission about to be encoded.
+    /// `substep` seconds from `time`, for the submission about to be encoded (`implicit`:
+    /// implicit Euler steps it, and its solve is attached).
     pub(super) fn write_poses(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         (substeps, time, substep): (u32, f64, f32),
+        implicit: bool,
     ) {
         let blocks = substeps * self.moving.len() as u32;
         if blocks > self.room {
@@ -308,7 +339,12 @@ impl ObstaclePass {
                         end.rotation.to_array(),
                         v(end.velocity),
                         v(end.spin),
-                        [f32::from_bits(o as u32), 0.0, 0.0, 0.0],
+                        [
+                            f32::from_bits(o as u32),
+                            f32::from(u8::from(implicit)),
+                            0.0,
+                            0.0,
+                        ],
                     ]);
                 }
             }

@@ -108,6 +108,12 @@ impl GpuStepper {
         self.groups = self
             .kernel
             .groups(&self.device, &self.particles, fixed, extra);
+        if let Some(obstacles) = self.obstacles.as_mut() {
+            let solve = (self.implicit.as_ref())
+                .filter(|_| self.integrator == IntegratorKind::ImplicitEuler)
+                .map(|pass| &pass.solve);
+            obstacles.attach_solve(&self.device, &self.particles, solve);
+        }
     }
 
     /// The element pass for `effects` (the forces' terms already theirs): packed anew, with

@@ -394,7 +394,7 @@ impl GpuStepper {
         }
         let when = (substeps, time, self.substep_length());
         if let Some(obstacles) = self.obstacles.as_mut() {
-            obstacles.write_poses(&self.device, &self.queue, when);
+            obstacles.write_poses(&self.device, &self.queue, when, implicit);
         }
         if vbd {
             self.kernel.vbd(&self.device);
