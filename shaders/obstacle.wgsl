@@ -38,15 +38,19 @@ struct ObstacleParams {
 @group(0) @binding(4) var<storage, read> cloth_edges: array<vec2<u32>>;
 // Crossings each sweep of the edge pass found (`catch_moves` zeroes them).
 @group(0) @binding(5) var<storage, read_write> crossings: array<atomic<u32>, 4>;
-// Implicit Euler's solve, where it steps (else a stand-in): [2].w is raised when a contact
-// moves a particle, so that its next first guess has no history (as the CPU's forgets it).
-@group(0) @binding(6) var<storage, read_write> solve: array<vec4<f32>>;
+// The solver's words the contacts tell of what they moved (else a stand-in): implicit
+// Euler's solve, whose flag (the bits of [2].w) is raised when a contact moves a particle,
+// so that its next first guess has no history (as the CPU's forgets it); or VBD's stencil,
+// whose memory of each particle's last acceleration takes the contacts' change of
+// velocity too (the CPU's reads the velocity after the contacts).
+@group(0) @binding(6) var<storage, read_write> solver: array<u32>;
 // The colour one dispatch of `edges` takes: x its first edge, y how many, z 1 when they
 // may share a particle plus twice the sweep, w the invocations dispatched.
 @group(1) @binding(0) var<uniform> colour: vec4<u32>;
 // One obstacle's poses in the substep: where it starts (translation, rotation), where it
-// ends (translation, rotation, velocity, spin), its number (x, as bits) and 1 (y) when
-// implicit Euler steps the cloth.
+// ends (translation, rotation, velocity, spin); then its number (x, as bits), what the
+// contacts tell the solver (y: 0 nothing, 1 implicit Euler's flag, 2 VBD's memory from
+// the word in z, as bits) and the substep's length (w).
 @group(2) @binding(0) var<uniform> poses: array<vec4<f32>, 16>;
 
 // Corners a move may be caught at in one substep, and pushes of its end out of the
@@ -82,10 +86,17 @@ fn obstacle() -> u32 {
     return bitcast<u32>(poses[6].x);
 }
 
-// A contact moved a particle: implicit Euler's next first guess has no history.
-fn moved() {
-    if (poses[6].y > 0.5) {
-        solve[2].w = 1.0;
+// A contact moved particle `i` and changed its velocity by `dv`: implicit Euler's next
+// first guess has no history; VBD's memory of its last acceleration takes the change.
+fn moved(i: u32, dv: vec3<f32>) {
+    let mode = poses[6].y;
+    if (mode > 1.5) {
+        let at = bitcast<u32>(poses[6].z) + 4u * i;
+        for (var k = 0u; k < 3u; k++) {
+            solver[at + k] = bitcast<u32>(bitcast<f32>(solver[at + k]) + dv[k] / poses[6].w);
+        }
+    } else if (mode > 0.5) {
+        solver[11] = bitcast<u32>(1.0);
     }
 }
 
@@ -428,10 +439,11 @@ fn catch_moves(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let at = apply(end, pivot, c.at);
     let n = rotate(end.rotation, c.normal);
+    let v = p.v.xyz;
     p.x = vec4<f32>(at, p.x.w);
-    p.v = vec4<f32>(touching(p.v.xyz, velocity_at(end, pivot, at), n, ob.info.y, 1.0), p.v.w);
+    p.v = vec4<f32>(touching(v, velocity_at(end, pivot, at), n, ob.info.y, 1.0), p.v.w);
     state[i] = p;
-    moved();
+    moved(i, p.v.xyz - v);
 }
 
 // The nearest points of segments a–b and p–q: x where along a–b, y along p–q (the CPU's
@@ -670,6 +682,7 @@ fn edges(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         let vs = velocity_at(end, pivot, apply(end, pivot, hit.on_edge));
         let part = share * free;
+        let before = array<vec3<f32>, 2>(pi.v.xyz, pj.v.xyz);
         if (part.x > 0.0) {
             pi.x = vec4<f32>(pi.x.xyz + gap * (part.x / weight), pi.x.w);
             pi.v = vec4<f32>(touching(pi.v.xyz, vs, n, ob.info.y, part.x), pi.v.w);
@@ -680,7 +693,12 @@ fn edges(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         state[e.x] = pi;
         state[e.y] = pj;
-        moved();
+        if (part.x > 0.0) {
+            moved(e.x, pi.v.xyz - before[0]);
+        }
+        if (part.y > 0.0) {
+            moved(e.y, pj.v.xyz - before[1]);
+        }
     }
 }
 

@@ -104,6 +104,14 @@ fn implicit_euler_forgets_its_guess_where_the_table_moves_the_cloth_as_on_the_cp
     meets_the_table(IntegratorKind::ImplicitEuler, 4, 2, 6e-5);
 }
 
+/// VBD at 12 substeps, which writes a substep's end over its start as XPBD does, and
+/// counts its substeps (the count's dispatch binds the substep's group again after the
+/// contacts' own). Measured: 65 µm apart.
+#[test]
+fn a_tablecloth_under_vbd_meets_the_table_as_on_the_cpu() {
+    meets_the_table(IntegratorKind::Vbd, 12, 40, 1e-4);
+}
+
 /// Draped for half a second on the GPU, the cloth never crosses the table: the exact
 /// intersection check finds no cloth triangle through it after any frame.
 #[test]
@@ -124,18 +132,9 @@ fn a_tablecloth_on_the_gpu_never_passes_through_the_table() {
     assert!(lowest < 0.5, "the cloth hangs over the rim: {lowest}");
 }
 
-/// What the GPU does not run with a mesh obstacle is refused with the reason: another
-/// integrator, and an obstacle that deforms (an OBJ sequence).
+/// An obstacle that deforms (an OBJ sequence) is refused on the GPU with the reason.
 #[test]
-fn the_gpu_refuses_obstacles_it_cannot_run_with_the_reason() {
-    let mut s = scene("tablecloth", 8);
-    s.params.step.integrator = IntegratorKind::Vbd;
-    let why = gpu_support(&s.params.step, s.params.solver.precision, &s.effects).unwrap_err();
-    let why = why.to_string();
-    assert!(
-        why.contains("semi-implicit and implicit Euler and XPBD only"),
-        "{why}"
-    );
+fn the_gpu_refuses_a_deforming_obstacle_with_the_reason() {
     let arm = scene("arm", 8);
     assert!(arm.effects.iter().any(|e| matches!(e, Effect::Obstacle(_))));
     let why = gpu_support(&arm.params.step, arm.params.solver.precision, &arm.effects);

@@ -15,8 +15,8 @@ pub enum Backend {
     #[default]
     Cpu,
     /// wgpu compute: semi-implicit and implicit Euler, XPBD and VBD; springs, gravity, air damping, wind,
-    /// dihedral bending, pins, handles, spheres and planes, rigid mesh obstacles
-    /// (except under VBD); with the stability guard.
+    /// dihedral bending, pins, handles, spheres and planes, rigid mesh obstacles;
+    /// with the stability guard.
     Gpu,
 }
 

@@ -14,7 +14,7 @@ use crate::sim::{Cause, Diverged, FrameOutcome, GuardAction, GuardLimits, Troubl
 
 use super::health::Watch;
 use super::stepper::GpuStepper;
-use super::support::{GPU_INTEGRATORS, takes_obstacles};
+use super::support::GPU_INTEGRATORS;
 
 /// Why a try at a frame failed.
 enum Failed {
@@ -165,7 +165,6 @@ impl GpuStepper {
         if let Some(kind) = self.guard.policy.fallback
             && kind != self.integrator
             && GPU_INTEGRATORS.contains(&kind)
-            && takes_obstacles(kind, &self.effects).is_ok()
         {
             let original = self.integrator;
             self.switch_integrator(kind);

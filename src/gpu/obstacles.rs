@@ -49,6 +49,17 @@ struct ObstacleParams {
     obstacles: [GpuObstacle; MAX_OBSTACLES],
 }
 
+/// What the integrator keeps that a contact changes, which the contacts then update.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Memory {
+    None,
+    /// Implicit Euler's first guess: a contact that moves a particle leaves it no history.
+    Guess,
+    /// VBD's last accelerations, from this word of its stencil, four a particle: a contact
+    /// adds its change of velocity over the substep.
+    Accelerations(u32),
+}
+
 /// Where a substep's start and end are for the contacts.
 #[derive(Clone, Copy, Debug)]
 pub(super) enum Start {
@@ -77,8 +88,8 @@ pub(super) struct ObstaclePass {
     /// Each obstacle's motion, for its poses at each substep.
     moving: Vec<RigidMotion>,
     /// What the bind groups bind besides the particles: the uniform, the surfaces, the
-    /// cloth's edges, the crossings, the kept start, and a stand-in for implicit Euler's
-    /// solve (whose "a contact moved a particle" flag the pass raises), and their layout.
+    /// cloth's edges, the crossings, the kept start, and a stand-in for the solver's words
+    /// the contacts tell of what they moved (see [`Memory`]), and their layout.
     buffers: [wgpu::Buffer; 6],
     layout: wgpu::BindGroupLayout,
     count: u32,
@@ -267,8 +278,8 @@ impl ObstaclePass {
         })
     }
 
-    /// Binds implicit Euler's `solve` (`None`: another integrator steps), whose first guess
-    /// forgets its history when a contact moves a particle, as the CPU's does.
+    /// Binds the solver's words the contacts tell of what they moved (`None`: the
+    /// integrator keeps nothing they change): implicit Euler's solve or VBD's stencil.
     pub(super) fn attach_solve(
         &mut self,
         device: &wgpu::Device,
@@ -306,14 +317,14 @@ impl ObstaclePass {
     }
 
     /// Writes every obstacle's poses at the start and end of `substeps` substeps of
-    /// `substep` seconds from `time`, for the submission about to be encoded (`implicit`:
-    /// implicit Euler steps it, and its solve is attached).
+    /// `substep` seconds from `time`, for the submission about to be encoded, and what the
+    /// integrator keeps that the contacts change (`memory`; its words attached).
     pub(super) fn write_poses(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         (substeps, time, substep): (u32, f64, f32),
-        implicit: bool,
+        memory: Memory,
     ) {
         let blocks = substeps * self.moving.len() as u32;
         if blocks > self.room {
@@ -322,6 +333,11 @@ impl ObstaclePass {
         }
         let entries = (POSE_STRIDE / 16) as usize;
         let mut data = vec![[0.0f32; 4]; blocks as usize * entries];
+        let (mode, at) = match memory {
+            Memory::None => (0.0, 0),
+            Memory::Guess => (1.0, 0),
+            Memory::Accelerations(at) => (2.0, at),
+        };
         let mut blocks = data.chunks_mut(entries);
         // The times as the CPU's clock reaches them: a substep added at a time.
         let mut t = time;
@@ -339,12 +355,7 @@ impl ObstaclePass {
                         end.rotation.to_array(),
                         v(end.velocity),
                         v(end.spin),
-                        [
-                            f32::from_bits(o as u32),
-                            f32::from(u8::from(implicit)),
-                            0.0,
-                            0.0,
-                        ],
+                        [f32::from_bits(o as u32), mode, f32::from_bits(at), substep],
                     ]);
                 }
             }

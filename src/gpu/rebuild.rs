@@ -109,10 +109,12 @@ impl GpuStepper {
             .kernel
             .groups(&self.device, &self.particles, fixed, extra);
         if let Some(obstacles) = self.obstacles.as_mut() {
-            let solve = (self.implicit.as_ref())
-                .filter(|_| self.integrator == IntegratorKind::ImplicitEuler)
-                .map(|pass| &pass.solve);
-            obstacles.attach_solve(&self.device, &self.particles, solve);
+            let words = match (self.integrator, &self.implicit) {
+                (IntegratorKind::ImplicitEuler, Some(pass)) => Some(&pass.solve),
+                (IntegratorKind::Vbd, _) => Some(&self.vbd.stencil),
+                _ => None,
+            };
+            obstacles.attach_solve(&self.device, &self.particles, words);
         }
     }
 

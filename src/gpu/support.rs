@@ -21,8 +21,8 @@ pub const GPU_INTEGRATORS: [IntegratorKind; 4] = [
 /// What of `step`, `precision` and `effects` the GPU backend cannot run, if anything: it
 /// runs semi-implicit Euler, implicit Euler (one linearised step), XPBD and VBD in `f32` with
 /// gravity, springs (and bend springs), dihedral bending, wind, air damping, pins, handles,
-/// up to four sphere and plane colliders, and (under any of them but VBD) up to four
-/// rigid mesh obstacles, still or keyframed.
+/// up to four sphere and plane colliders, and up to four rigid mesh obstacles, still or
+/// keyframed.
 pub fn gpu_support(
     step: &StepConfig,
     precision: Precision,
@@ -61,29 +61,6 @@ pub fn gpu_support(
     if obstacles > MAX_OBSTACLES {
         return Err(GpuError::Unsupported(format!(
             "takes at most {MAX_OBSTACLES} mesh obstacles"
-        )));
-    }
-    takes_obstacles(step.integrator, effects)
-}
-
-/// Whether `integrator` runs with the mesh obstacles among `effects` on the GPU: every
-/// GPU integrator but VBD does (the guard's fallback asks too).
-pub(super) fn takes_obstacles(
-    integrator: IntegratorKind,
-    effects: &[Effect],
-) -> Result<(), GpuError> {
-    let with_obstacles = [
-        IntegratorKind::SemiImplicitEuler,
-        IntegratorKind::ImplicitEuler,
-        IntegratorKind::Xpbd,
-    ];
-    let obstacles = effects.iter().any(|e| matches!(e, Effect::Obstacle(_)));
-    if obstacles && !with_obstacles.contains(&integrator) {
-        return Err(GpuError::Unsupported(format!(
-            "runs mesh obstacles with semi-implicit and implicit Euler and XPBD only, not {}; \
-             run {} on the CPU backend",
-            integrator.label(),
-            integrator.label()
         )));
     }
     Ok(())

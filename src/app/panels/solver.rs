@@ -28,7 +28,7 @@ impl Panel for SolverPanel {
                 .on_hover_text(
                     "wgpu compute: semi-implicit and implicit Euler, XPBD and VBD; springs, gravity, air \
                      damping, wind, dihedral bending, pins, handles, spheres and planes; rigid mesh \
-                     obstacles with semi-implicit or implicit Euler or XPBD",
+                     obstacles",
                 )
                 .clicked()
                 && !on_gpu
