@@ -8,6 +8,7 @@ use bytemuck::{Pod, Zeroable};
 
 use super::frame::{DevicePositions, Frame};
 use crate::device::GrowBuffer;
+use crate::mesh::triangles_around;
 
 const SOURCE: &str = include_str!("../../shaders/display.wgsl");
 /// Invocations per workgroup (the shader's `@workgroup_size`).
@@ -267,23 +268,8 @@ impl DisplayPass {
 /// twice is listed twice, as the CPU's normals count it twice), then three corners per
 /// triangle.
 fn incident_triangles(count: usize, triangles: &[[u32; 3]]) -> Vec<u32> {
-    let mut offsets = vec![0u32; count + 1];
-    for &i in triangles.iter().flatten() {
-        offsets[i as usize + 1] += 1;
-    }
-    for p in 0..count {
-        offsets[p + 1] += offsets[p];
-    }
-    let mut words = offsets.clone();
-    words.resize(count + 1 + 3 * triangles.len(), 0);
-    let mut next = offsets;
-    for (t, corners) in triangles.iter().enumerate() {
-        for &i in corners {
-            let slot = &mut next[i as usize];
-            words[count + 1 + *slot as usize] = t as u32;
-            *slot += 1;
-        }
-    }
+    let (mut words, list) = triangles_around(count, triangles);
+    words.extend(list);
     words.extend(triangles.iter().flatten());
     words
 }

@@ -9,6 +9,7 @@ use super::ccd::closing_bound;
 use super::found::Found;
 use super::primitives::{Pair, StoredPair, distance};
 use crate::cloth::ClothModel;
+use crate::mesh::triangles_around;
 
 /// Which vertices and edges each triangle owns: each vertex and each edge belongs to the
 /// first triangle that has it, so a pair of triangles yields each vertex–triangle and
@@ -108,30 +109,13 @@ impl Owners {
     /// corner, each pair of triangles taken once (from the lower-numbered, at the first
     /// corner they share).
     fn neighbour_pairs(&self, triangles: &[[u32; 3]], particles: usize) -> Vec<StoredPair> {
-        // The triangles around each particle: those of particle i are
-        // `around[start[i]..start[i + 1]]`.
-        let mut start = vec![0usize; particles + 1];
-        for &i in triangles.iter().flatten() {
-            start[i as usize + 1] += 1;
-        }
-        for i in 0..particles {
-            start[i + 1] += start[i];
-        }
-        let mut around = vec![0u32; start[particles]];
-        let mut next = start.clone();
-        for (n, &i) in triangles
-            .iter()
-            .enumerate()
-            .flat_map(|(n, t)| t.iter().map(move |i| (n, i)))
-        {
-            around[next[i as usize]] = n as u32;
-            next[i as usize] += 1;
-        }
+        let (start, around) = triangles_around(particles, triangles);
         let mut out = Vec::new();
         for (a, ta) in triangles.iter().enumerate() {
             for (k, &corner) in ta.iter().enumerate() {
                 let corner = corner as usize;
-                for &b in &around[start[corner]..start[corner + 1]] {
+                let (from, to) = (start[corner] as usize, start[corner + 1] as usize);
+                for &b in &around[from..to] {
                     let b = b as usize;
                     if b > a && !ta[..k].iter().any(|i| triangles[b].contains(i)) {
                         self.each_pair(triangles, a, b, |_, stored| out.push(stored));
