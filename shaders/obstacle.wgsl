@@ -1,4 +1,5 @@
-// Mesh obstacles on the GPU (prepended with shaders/cloth_layout.wgsl; src/gpu/obstacles.rs
+// Mesh obstacles on the GPU (prepended with shaders/cloth_layout.wgsl and
+// shaders/contact.wgsl; src/gpu/obstacles.rs
 // builds and dispatches them): the CPU's contact with a rigid obstacle, placed and moved by
 // its keyframes. After a substep, `catch` takes each free particle's move from the
 // substep's start to its end into the obstacle's frame (the start where the obstacle was
@@ -21,7 +22,7 @@ struct Obstacle {
 }
 
 struct ObstacleParams {
-    // x: particles; y: obstacles; z: cloth edges.
+    // x: particles.
     counts: vec4<u32>,
     obstacles: array<Obstacle, 4>,
 }
@@ -37,7 +38,7 @@ struct ObstacleParams {
 // The cloth's edges (structural and shear springs' ends) in colour order.
 @group(0) @binding(4) var<storage, read> cloth_edges: array<vec2<u32>>;
 // Crossings each sweep of the edge pass found (`catch_moves` zeroes them).
-@group(0) @binding(5) var<storage, read_write> crossings: array<atomic<u32>, 4>;
+@group(0) @binding(5) var<storage, read_write> crossings: array<atomic<u32>, SWEEPS>;
 // The solver's words the contacts tell of what they moved (else a stand-in): implicit
 // Euler's solve, whose flag (the bits of [2].w) is raised when a contact moves a particle,
 // so that its next first guess has no history (as the CPU's forgets it); or VBD's stencil,
@@ -49,14 +50,16 @@ struct ObstacleParams {
 @group(1) @binding(0) var<uniform> colour: vec4<u32>;
 // One obstacle's poses in the substep: where it starts (translation, rotation), where it
 // ends (translation, rotation, velocity, spin); then its number (x, as bits), what the
-// contacts tell the solver (y: 0 nothing, 1 implicit Euler's flag, 2 VBD's memory from
-// the word in z, as bits) and the substep's length (w).
+// contacts tell the solver (y: 0 nothing, 1 implicit Euler's flag, the word in z; 2 VBD's
+// memory, from the word in z) and the substep's length (w).
 @group(2) @binding(0) var<uniform> poses: array<vec4<f32>, 16>;
 
 // Corners a move may be caught at in one substep, and pushes of its end out of the
 // thickness (the CPU's `CROSSINGS` and `PUSHES`).
 const CROSSINGS: u32 = 3u;
 const PUSHES: u32 = 3u;
+// Sweeps of the edge pass a substep at most (the host's `EDGE_SWEEPS`; a test compares).
+const SWEEPS: u32 = 4u;
 // Nodes a walk of a tree holds at once (median splits keep its depth near log2(n / 4)).
 const STACK: u32 = 64u;
 
@@ -90,13 +93,14 @@ fn obstacle() -> u32 {
 // first guess has no history; VBD's memory of its last acceleration takes the change.
 fn moved(i: u32, dv: vec3<f32>) {
     let mode = poses[6].y;
+    let word = bitcast<u32>(poses[6].z);
     if (mode > 1.5) {
-        let at = bitcast<u32>(poses[6].z) + 4u * i;
+        let at = word + 4u * i;
         for (var k = 0u; k < 3u; k++) {
             solver[at + k] = bitcast<u32>(bitcast<f32>(solver[at + k]) + dv[k] / poses[6].w);
         }
     } else if (mode > 0.5) {
-        solver[11] = bitcast<u32>(1.0);
+        solver[word] = bitcast<u32>(1.0);
     }
 }
 
@@ -110,23 +114,6 @@ fn unapply(p: Pose, pivot: vec3<f32>, moved: vec3<f32>) -> vec3<f32> {
 
 fn velocity_at(p: Pose, pivot: vec3<f32>, moved: vec3<f32>) -> vec3<f32> {
     return p.velocity + cross(p.spin, moved - pivot - p.translation);
-}
-
-// The velocity `v` of a particle touching a surface moving at `vs` (unit normal `n`),
-// `part` of it bearing on the contact (the CPU's `touching`).
-fn touching(v: vec3<f32>, vs: vec3<f32>, n: vec3<f32>, mu: f32, part: f32) -> vec3<f32> {
-    let rel = v - vs;
-    let vn = dot(rel, n);
-    if (vn >= 0.0) {
-        return v;
-    }
-    let vt = rel - vn * n;
-    let speed = length(vt);
-    var keep = 0.0;
-    if (speed > 0.0) {
-        keep = max(1.0 - mu * part * (-vn) / speed, 0.0);
-    }
-    return vs + (1.0 - part) * vn * n + keep * vt;
 }
 
 struct Node {
@@ -271,6 +258,7 @@ fn first_crossing(o: u32, origin: vec3<f32>, to: vec3<f32>) -> vec2<f32> {
         top -= 1u;
         let at = stack[top];
         let n = node(base, at);
+        // Only the part of the segment before the best crossing so far matters.
         let end = select(to, origin + (to - origin) * best_t, best_place != 0xffffffffu);
         if (!segment_meets_box(origin, end, n.lo, n.hi)) {
             continue;
@@ -289,8 +277,7 @@ fn first_crossing(o: u32, origin: vec3<f32>, to: vec3<f32>) -> vec2<f32> {
         for (var k = 0u; k < 2u; k++) {
             let child = select(at + 1u, n.first, k == 0u);
             let c = node(base, child);
-            let bound = select(to, origin + (to - origin) * best_t, best_place != 0xffffffffu);
-            if (segment_meets_box(origin, bound, c.lo, c.hi) && top < STACK) {
+            if (segment_meets_box(origin, end, c.lo, c.hi) && top < STACK) {
                 stack[top] = child;
                 top += 1u;
             }
@@ -421,7 +408,7 @@ fn catch_moves(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     if (i == 0u) {
-        for (var k = 0u; k < 4u; k++) {
+        for (var k = 0u; k < SWEEPS; k++) {
             atomicStore(&crossings[k], 0u);
         }
     }
@@ -546,7 +533,7 @@ fn sweep_meets(b0: vec3<f32>, b1: vec3<f32>, a0: vec3<f32>, a1: vec3<f32>, p: ve
 }
 
 // Obstacle `o`'s sharp edges whose boxes meet lo..hi, walked as the CPU's `overlapping`
-// walks them: the nearest to segment a–b within `reach` (`nearest` true), or the first the
+// walks them: the nearest to segment a–b within `reach` (`nearest_one`), or the first the
 // segment moving from b0–b1 to a–b passes through, with the side it came from.
 struct EdgeFound {
     found: bool,
@@ -611,8 +598,8 @@ fn sharp_edges(o: u32, lo: vec3<f32>, hi: vec3<f32>, a: vec3<f32>, b: vec3<f32>,
     return out;
 }
 
-// Keeps each cloth edge of this dispatch's colour the thickness off every obstacle's sharp
-// edges where the substep ends (the CPU's `push_edges`): an edge it passed through puts
+// Keeps each cloth edge of this dispatch's colour the thickness off this dispatch's
+// obstacle's sharp edges where the substep ends (the CPU's `push_edges`): an edge it passed through puts
 // it back on the side it came from, one it ends within the thickness of pushes it out;
 // the two particles move in proportion to how near each is to the nearest point.
 @compute @workgroup_size(64)

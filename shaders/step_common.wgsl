@@ -1,4 +1,5 @@
-// What the step shaders share (prepended, after shaders/cloth_layout.wgsl, to
+// What the step shaders share (prepended, after shaders/cloth_layout.wgsl and
+// shaders/contact.wgsl, to
 // shaders/substep.wgsl, shaders/vbd.wgsl and shaders/implicit.wgsl when their pipelines
 // are built, src/gpu/kernel.rs): the uniform parameters, the bindings every step kernel
 // has, a particle's springs (from the grid or its spring ends) and a spring's pull, the
@@ -197,17 +198,7 @@ fn collide(x: vec3<f32>, end: Motion) -> Motion {
             }
         }
         if (caught) {
-            let v_rel = nv - v_surface;
-            let vn = dot(v_rel, n);
-            if (vn < 0.0) {
-                let v_t = v_rel - vn * n;
-                let t_speed = length(v_t);
-                var keep = 0.0;
-                if (t_speed > 0.0) {
-                    keep = max(1.0 - mu * (-vn) / t_speed, 0.0);
-                }
-                nv = v_surface + keep * v_t;
-            }
+            nv = touching(nv, v_surface, n, mu, 1.0);
         }
     }
     return Motion(nx, nv);

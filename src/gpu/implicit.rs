@@ -18,6 +18,10 @@ use super::support::{fits, offers_storage};
 /// Storage buffers the solve's kernels bind: the substep's seven and the workgroup counts.
 pub(super) const STORAGE_BUFFERS: u32 = 8;
 
+/// The word of the solve's buffer that holds its "a contact moved a particle" flag (the
+/// bits of `cg[2].w` in `shaders/implicit.wgsl`): the next first guess then has no history.
+pub(super) const MOVED_FLAG: u32 = 2 * 4 + 3;
+
 /// Iterations the first chunk of a solve has at least.
 pub(super) const FIRST_CHUNK: u32 = 8;
 

@@ -67,10 +67,7 @@ impl GpuStepper {
                 obstacles.encode(&mut pass, k, Start::In(self.current));
             }
             if counting {
-                // (The obstacles' pass, if any, bound its own group 0.)
-                pass.set_pipeline(&self.kernel.tick);
-                pass.set_bind_group(0, this, &[]);
-                pass.dispatch_workgroups(1, 1, 1);
+                self.kernel.count_substep(&mut pass, this);
             }
             drop(pass);
             self.current = 1 - self.current;

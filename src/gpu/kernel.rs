@@ -7,8 +7,14 @@ pub(super) const WORKGROUP: u32 = 64;
 
 /// What every compute shader of the backend reads the cloth as: particles and spring ends.
 pub(super) const LAYOUT: &str = include_str!("../../shaders/cloth_layout.wgsl");
-/// What the step shaders share: parameters, bindings, element forces, colliders.
-pub(super) const COMMON: &str = include_str!("../../shaders/step_common.wgsl");
+/// What the step shaders share: the contact response, then parameters, bindings, element
+/// forces, colliders.
+pub(super) const COMMON: &str = concat!(
+    include_str!("../../shaders/contact.wgsl"),
+    include_str!("../../shaders/step_common.wgsl")
+);
+/// The contact response every contact shares (part of [`COMMON`] too).
+pub(super) const CONTACT: &str = include_str!("../../shaders/contact.wgsl");
 /// Semi-implicit Euler's and XPBD's entry points.
 pub(super) const SOURCE: &str = include_str!("../../shaders/substep.wgsl");
 /// VBD's entry points.
@@ -202,6 +208,14 @@ impl SubstepKernel {
     /// The substep's bind groups: `[i]` reads particle buffer `i` and writes the other, with
     /// the `fixed` uniform, spring offsets, spring ends and class table, and the element
     /// pass's forces and slots and XPBD's constraints.
+    /// Records the substep's count (`tick`) with the substep's `group` bound: what ran
+    /// before it in the pass may have bound a group of another layout.
+    pub(super) fn count_substep(&self, pass: &mut wgpu::ComputePass<'_>, group: &wgpu::BindGroup) {
+        pass.set_pipeline(&self.tick);
+        pass.set_bind_group(0, group, &[]);
+        pass.dispatch_workgroups(1, 1, 1);
+    }
+
     pub(super) fn groups(
         &self,
         device: &wgpu::Device,

@@ -1,6 +1,6 @@
 //! Mesh obstacles on the GPU (`shaders/obstacle.wgsl`): the CPU's contact with a rigid
-//! obstacle, placed and moved by its keyframes, after each substep of semi-implicit or
-//! implicit Euler or XPBD.
+//! obstacle, placed and moved by its keyframes, after each substep of every integrator
+//! the GPU runs.
 //! Each obstacle's box tree, triangles and sharp edges go to the device once, in the CPU's
 //! tree order, so a walk visits what the CPU's visits; the obstacles' poses at each
 //! substep's start and end are written before each submission. The cloth's edges (its
@@ -15,7 +15,7 @@ use crate::sim::obstacle::TriangleTree;
 use crate::sim::{ContactConfig, Effect, RigidMotion};
 
 use super::error::GpuError;
-use super::kernel::{LAYOUT, Slot, SubstepKernel, WORKGROUP, bind, layout, pipelines};
+use super::kernel::{CONTACT, LAYOUT, Slot, SubstepKernel, WORKGROUP, bind, layout, pipelines};
 use super::packing::MAX_OBSTACLES;
 use super::support::fits;
 use super::xpbd::{Colours, colour_record};
@@ -49,12 +49,14 @@ struct ObstacleParams {
     obstacles: [GpuObstacle; MAX_OBSTACLES],
 }
 
-/// What the integrator keeps that a contact changes, which the contacts then update.
+/// What the integrator keeps that a contact changes, which the contacts then update, in
+/// the words [`ObstaclePass::attach_solve`] bound.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Memory {
     None,
-    /// Implicit Euler's first guess: a contact that moves a particle leaves it no history.
-    Guess,
+    /// Implicit Euler's first guess, whose flag is this word of its solve: a contact that
+    /// moves a particle leaves the guess no history.
+    Guess(u32),
     /// VBD's last accelerations, from this word of its stencil, four a particle: a contact
     /// adds its change of velocity over the substep.
     Accelerations(u32),
@@ -66,7 +68,7 @@ pub(super) enum Start {
     /// The start in `particles[i]`, the end in the other (semi-implicit Euler).
     In(usize),
     /// The start in the copy [`ObstaclePass::keep_start`] made, the end in `particles[i]`
-    /// (XPBD, which writes its end over its start).
+    /// (XPBD and VBD, which write their end over their start).
     Kept(usize),
 }
 
@@ -83,8 +85,10 @@ pub(super) struct ObstaclePass {
     poses_layout: wgpu::BindGroupLayout,
     poses: wgpu::Buffer,
     poses_group: wgpu::BindGroup,
-    /// Substeps `poses` has room for.
+    /// Obstacles' substeps `poses` has room for, and the host's copy of what it holds
+    /// (kept, so that a frame allocates nothing).
     room: u32,
+    staging: Vec<[f32; 4]>,
     /// Each obstacle's motion, for its poses at each substep.
     moving: Vec<RigidMotion>,
     /// What the bind groups bind besides the particles: the uniform, the surfaces, the
@@ -145,7 +149,6 @@ fn pack(
             pivot: [pivot.x, pivot.y, pivot.z, 0.0],
             info: [thickness, obstacle.friction, 0.0, 0.0],
         };
-        params.counts[1] += 1;
         moving.push(placed.motion.clone());
     }
     (!moving.is_empty()).then_some((params, surface, moving))
@@ -198,7 +201,6 @@ impl ObstaclePass {
         )?;
         let count = model.particle_count() as u32;
         params.counts[0] = count;
-        params.counts[2] = edges.len() as u32;
         let buffer = |label: &str, data: &[u8], usage: wgpu::BufferUsages| {
             let buffer = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -217,8 +219,8 @@ impl ObstaclePass {
             U::STORAGE,
         );
         let cloth_edges = buffer("cloth edges", bytemuck::cast_slice(&edges), U::STORAGE);
-        let crossings = buffer("edge crossings", &[0; 16], U::STORAGE);
-        let no_solve = buffer("no implicit solve", &[0; 48], U::STORAGE);
+        let crossings = buffer("edge crossings", &[0; 4 * EDGE_SWEEPS], U::STORAGE);
+        let no_solve = buffer("no solver words", &[0; 48], U::STORAGE);
         use Slot::{Dynamic, Read, Uniform, Write};
         let slots = [Uniform, Read, Write, Read, Read, Write, Write];
         let main = layout(device, "obstacles", &slots);
@@ -227,10 +229,10 @@ impl ObstaclePass {
         let [catch, edges_pipeline, keep] = pipelines(
             device,
             "obstacles",
-            &format!("{LAYOUT}{SOURCE}"),
+            &format!("{LAYOUT}{CONTACT}{SOURCE}"),
             [("catch_moves", all), ("edges", all), ("keep_start", all)],
         );
-        // The substep's start, for an integrator that writes its end over it (XPBD).
+        // The substep's start, for an integrator that writes its end over it (XPBD, VBD).
         let kept = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("obstacle substep start"),
             size: particles[0].size(),
@@ -250,6 +252,7 @@ impl ObstaclePass {
             poses,
             poses_group,
             room: 1,
+            staging: Vec::new(),
             moving,
             buffers,
             layout: main,
@@ -257,7 +260,8 @@ impl ObstaclePass {
         }))
     }
 
-    /// The six bind groups (see `groups`), binding implicit Euler's `solve` where it steps.
+    /// The six bind groups (see `groups`), binding the solver's words `solve` (a stand-in
+    /// without).
     fn groups_for(
         device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,
@@ -332,10 +336,12 @@ impl ObstaclePass {
             self.room = blocks;
         }
         let entries = (POSE_STRIDE / 16) as usize;
-        let mut data = vec![[0.0f32; 4]; blocks as usize * entries];
+        let data = &mut self.staging;
+        data.clear();
+        data.resize(blocks as usize * entries, [0.0; 4]);
         let (mode, at) = match memory {
             Memory::None => (0.0, 0),
-            Memory::Guess => (1.0, 0),
+            Memory::Guess(at) => (1.0, at),
             Memory::Accelerations(at) => (2.0, at),
         };
         let mut blocks = data.chunks_mut(entries);
@@ -360,7 +366,7 @@ impl ObstaclePass {
                 }
             }
         }
-        queue.write_buffer(&self.poses, 0, bytemuck::cast_slice(&data));
+        queue.write_buffer(&self.poses, 0, bytemuck::cast_slice(data));
     }
 
     /// Records a copy of the substep's start, `particles[at]`, for an integrator that
@@ -391,5 +397,17 @@ impl ObstaclePass {
             pass.dispatch_workgroups(self.count.div_ceil(WORKGROUP), 1, 1);
             self.colours.sweep(pass, &self.edges, group);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shader counts the crossings of as many sweeps as the host records.
+    #[test]
+    fn the_shader_has_room_for_every_sweeps_crossings() {
+        let line = format!("const SWEEPS: u32 = {EDGE_SWEEPS}u;");
+        assert!(SOURCE.contains(&line), "obstacle.wgsl lacks `{line}`");
     }
 }

@@ -7,7 +7,8 @@ use crate::sim::{Effect, IntegratorKind, StepError};
 
 use super::elements::{elements_wanted, pack_elements};
 use super::error::GpuError;
-use super::implicit::ImplicitPass;
+use super::implicit::{ImplicitPass, MOVED_FLAG};
+use super::obstacles::Memory;
 use super::stepper::GpuStepper;
 use super::support::fits_elements;
 use super::vbd::VbdPass;
@@ -108,13 +109,24 @@ impl GpuStepper {
         self.groups = self
             .kernel
             .groups(&self.device, &self.particles, fixed, extra);
+        let words = self.contact_memory().1.cloned();
         if let Some(obstacles) = self.obstacles.as_mut() {
-            let words = match (self.integrator, &self.implicit) {
-                (IntegratorKind::ImplicitEuler, Some(pass)) => Some(&pass.solve),
-                (IntegratorKind::Vbd, _) => Some(&self.vbd.stencil),
-                _ => None,
-            };
-            obstacles.attach_solve(&self.device, &self.particles, words);
+            obstacles.attach_solve(&self.device, &self.particles, words.as_ref());
+        }
+    }
+
+    /// What the integrator in effect keeps that a contact changes (see [`Memory`]), and
+    /// the buffer it keeps it in: implicit Euler's solve, VBD's stencil.
+    pub(super) fn contact_memory(&self) -> (Memory, Option<&wgpu::Buffer>) {
+        match (self.integrator, &self.implicit) {
+            (IntegratorKind::ImplicitEuler, Some(pass)) => {
+                (Memory::Guess(MOVED_FLAG), Some(&pass.solve))
+            }
+            (IntegratorKind::Vbd, _) => (
+                Memory::Accelerations(self.params.solver[2]),
+                Some(&self.vbd.stencil),
+            ),
+            _ => (Memory::None, None),
         }
     }
 

@@ -23,7 +23,7 @@ use super::handles::Carried;
 use super::health::{HealthKernel, Watch};
 use super::implicit::ImplicitPass;
 use super::kernel::{SubstepKernel, WORKGROUP};
-use super::obstacles::{Memory, ObstaclePass, Start};
+use super::obstacles::{ObstaclePass, Start};
 use super::packing::{
     ClassTable, EndsKey, Neighbour, Params, Particle, classify, grid_of, pack_solids, pack_springs,
 };
@@ -393,11 +393,7 @@ impl GpuStepper {
                 .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
         }
         let when = (substeps, time, self.substep_length());
-        let memory = match self.integrator {
-            IntegratorKind::ImplicitEuler => Memory::Guess,
-            IntegratorKind::Vbd => Memory::Accelerations(self.params.solver[2]),
-            _ => Memory::None,
-        };
+        let memory = self.contact_memory().0;
         if let Some(obstacles) = self.obstacles.as_mut() {
             obstacles.write_poses(&self.device, &self.queue, when, memory);
         }
@@ -468,10 +464,7 @@ impl GpuStepper {
                     self.current = 1 - self.current;
                 }
                 if counting {
-                    // (The obstacles' pass, if any, bound its own group 0.)
-                    pass.set_pipeline(&self.kernel.tick);
-                    pass.set_bind_group(0, &self.groups[self.current], &[]);
-                    pass.dispatch_workgroups(1, 1, 1);
+                    (self.kernel).count_substep(&mut pass, &self.groups[self.current]);
                 }
             }
         }
