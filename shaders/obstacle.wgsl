@@ -1,7 +1,9 @@
 // Mesh obstacles on the GPU (prepended with shaders/cloth_layout.wgsl and
 // shaders/contact.wgsl; src/gpu/obstacles.rs
-// builds and dispatches them): the CPU's contact with a rigid obstacle, placed and moved by
-// its keyframes. After a substep, `catch` takes each free particle's move from the
+// builds and dispatches them): the CPU's contact with a mesh obstacle, rigid (placed and
+// moved by its keyframes) or deforming (an OBJ sequence, whose surface where each substep
+// ends the host writes for each submission, with each vertex's move over the substep and
+// velocity). After a substep, `catch` takes each free particle's move from the
 // substep's start to its end into the obstacle's frame (the start where the obstacle was
 // then, the end where it is now), catches it at its first crossings and pushes its end out
 // to the thickness through the obstacle's box tree, and answers with an inelastic velocity
@@ -11,13 +13,16 @@
 
 struct Obstacle {
     // In `surface`'s entries: where its tree's nodes, its places (triangles in the tree's
-    // order), its sharp edges' tree's nodes and their places start.
+    // order), its sharp edges' tree's nodes and their places start (a deforming obstacle's:
+    // from where its surface at the substep's end starts, which its poses give).
     starts: vec4<u32>,
     // x: nodes; y: places; z: edge nodes; w: edge places.
     counts: vec4<u32>,
     // xyz: the pivot its motion turns about.
     pivot: vec4<f32>,
-    // x: its thickness (m); y: its friction.
+    // x: its thickness (m); y: its friction; z: a deforming obstacle's vertices' moves and
+    // velocities (bits; two entries a vertex, after `starts` as they are); w: 1 when it
+    // deforms.
     info: vec4<f32>,
 }
 
@@ -32,8 +37,9 @@ struct ObstacleParams {
 @group(0) @binding(1) var<storage, read> start: array<Particle>;
 @group(0) @binding(2) var<storage, read_write> state: array<Particle>;
 // Every obstacle's tree and triangles: a node is two entries (lo and its first, hi and its
-// count, as bits in w); a place four (its corners, the first's w the triangle's number as
-// bits; its unit normal); a sharp edge's place two (its ends).
+// count, as bits in w); a place four (its corners, each w its vertex's number as bits; its
+// unit normal); a sharp edge's place two (its ends); a deforming obstacle's vertex two (its
+// move over the substep, its velocity).
 @group(0) @binding(3) var<storage, read> surface: array<vec4<f32>>;
 // The cloth's edges (structural and shear springs' ends) in colour order.
 @group(0) @binding(4) var<storage, read> cloth_edges: array<vec2<u32>>;
@@ -51,7 +57,9 @@ struct ObstacleParams {
 // One obstacle's poses in the substep: where it starts (translation, rotation), where it
 // ends (translation, rotation, velocity, spin); then its number (x, as bits), what the
 // contacts tell the solver (y: 0 nothing, 1 implicit Euler's flag, the word in z; 2 VBD's
-// memory, from the word in z) and the substep's length (w).
+// memory, from the word in z) and the substep's length (w); then, for a deforming obstacle
+// (whose poses are the identity), where its surface at the substep's end starts in
+// `surface` (x, as bits) and the largest move of a vertex over the substep (y).
 @group(2) @binding(0) var<uniform> poses: array<vec4<f32>, 16>;
 
 // Corners a move may be caught at in one substep, and pushes of its end out of the
@@ -87,6 +95,50 @@ fn pose(end: bool) -> Pose {
 // The obstacle this dispatch takes.
 fn obstacle() -> u32 {
     return bitcast<u32>(poses[6].x);
+}
+
+// Where obstacle `o`'s nodes, places, edge nodes and edge places start in `surface` in
+// this substep.
+fn starts(o: u32) -> vec4<u32> {
+    return op.obstacles[o].starts + vec4<u32>(bitcast<u32>(poses[7].x));
+}
+
+fn deforming(o: u32) -> bool {
+    return op.obstacles[o].info.w > 0.5;
+}
+
+// A deforming obstacle's vertex field (`field` 0: each vertex's move over the substep; 1:
+// its velocity) at `point` of place `place` (the CPU's `Moment::at`).
+fn field_at(o: u32, place: u32, point: vec3<f32>, field: u32) -> vec3<f32> {
+    let first = starts(o).y + 4u * place;
+    let fields = bitcast<u32>(op.obstacles[o].info.z) + bitcast<u32>(poses[7].x) + field;
+    let a = surface[first];
+    let b = surface[first + 1u];
+    let c = surface[first + 2u];
+    let w = barycentric(point, a.xyz, b.xyz, c.xyz);
+    return surface[fields + 2u * bitcast<u32>(a.w)].xyz * w.x
+        + surface[fields + 2u * bitcast<u32>(b.w)].xyz * w.y
+        + surface[fields + 2u * bitcast<u32>(c.w)].xyz * w.z;
+}
+
+// The weights of `p` (a point of the triangle's plane) on a, b, c (a degenerate triangle:
+// all on a), as the CPU's `barycentric`.
+fn barycentric(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
+    let e0 = b - a;
+    let e1 = c - a;
+    let e2 = p - a;
+    let d00 = dot(e0, e0);
+    let d01 = dot(e0, e1);
+    let d11 = dot(e1, e1);
+    let d20 = dot(e2, e0);
+    let d21 = dot(e2, e1);
+    let denom = d00 * d11 - d01 * d01;
+    if (denom <= 1.1920929e-7 * d00 * d11 || denom <= 0.0) {
+        return vec3<f32>(1.0, 0.0, 0.0);
+    }
+    let v = (d11 * d20 - d01 * d21) / denom;
+    let w = (d00 * d21 - d01 * d20) / denom;
+    return vec3<f32>(1.0 - v - w, v, w);
 }
 
 // A contact moved particle `i` and changed its velocity by `dv`: implicit Euler's next
@@ -130,11 +182,11 @@ fn node(base: u32, k: u32) -> Node {
 }
 
 fn corner(o: u32, place: u32, k: u32) -> vec3<f32> {
-    return surface[op.obstacles[o].starts.y + 4u * place + k].xyz;
+    return surface[starts(o).y + 4u * place + k].xyz;
 }
 
 fn face_normal(o: u32, place: u32) -> vec3<f32> {
-    return surface[op.obstacles[o].starts.y + 4u * place + 3u].xyz;
+    return surface[starts(o).y + 4u * place + 3u].xyz;
 }
 
 // Ericson's closest point of triangle (a, b, c) to p, as weights (the CPU's
@@ -242,7 +294,7 @@ fn segment_meets_box(origin: vec3<f32>, to: vec3<f32>, lo: vec3<f32>, hi: vec3<f
 // The first place of obstacle `o` the segment from→to crosses (x, as bits; none: u32 max)
 // and where along it (y): the CPU's `first_crossing`, its tree walked in the same order.
 fn first_crossing(o: u32, origin: vec3<f32>, to: vec3<f32>) -> vec2<f32> {
-    let base = op.obstacles[o].starts.x;
+    let base = starts(o).x;
     var best_place = 0xffffffffu;
     var best_t = 2.0;
     var stack: array<u32, 64>;
@@ -295,7 +347,7 @@ struct Near {
 // The point of obstacle `o` nearest to p within `reach` (place u32 max: none): the CPU's
 // `nearest`, nearer children first.
 fn nearest(o: u32, p: vec3<f32>, reach: f32) -> Near {
-    let base = op.obstacles[o].starts.x;
+    let base = starts(o).x;
     var best = Near(0xffffffffu, vec3<f32>(0.0), reach * reach);
     var stack: array<u32, 64>;
     var top = 0u;
@@ -359,6 +411,9 @@ struct Caught {
     caught: bool,
     at: vec3<f32>,
     normal: vec3<f32>,
+    // The place that held it last, and the point of it.
+    place: u32,
+    on_surface: vec3<f32>,
 }
 
 // Where a move from→to (in obstacle `o`'s frame) ends: caught at its first crossings a
@@ -367,7 +422,7 @@ struct Caught {
 fn catch_move(o: u32, origin: vec3<f32>, to: vec3<f32>, thickness: f32) -> Caught {
     var s = origin;
     var e = to;
-    var out = Caught(false, to, vec3<f32>(0.0));
+    var out = Caught(false, to, vec3<f32>(0.0), 0u, vec3<f32>(0.0));
     for (var k = 0u; k < CROSSINGS; k++) {
         let hit = first_crossing(o, s, e);
         let place = bitcast<u32>(hit.x);
@@ -386,7 +441,7 @@ fn catch_move(o: u32, origin: vec3<f32>, to: vec3<f32>, thickness: f32) -> Caugh
         let along = rest - min(dot(rest, n), 0.0) * n;
         s = at + n * thickness;
         e = s + along;
-        out = Caught(true, e, n);
+        out = Caught(true, e, n, place, at);
     }
     for (var k = 0u; k < PUSHES; k++) {
         let near = nearest(o, e, thickness);
@@ -395,7 +450,7 @@ fn catch_move(o: u32, origin: vec3<f32>, to: vec3<f32>, thickness: f32) -> Caugh
         }
         let n = away(o, near.place, near.point, near.distance, e, s, thickness);
         e = near.point + n * thickness;
-        out = Caught(true, e, n);
+        out = Caught(true, e, n, near.place, near.point);
     }
     out.at = e;
     return out;
@@ -420,15 +475,31 @@ fn catch_moves(@builtin(global_invocation_id) id: vec3<u32>) {
     let ob = op.obstacles[o];
     let pivot = ob.pivot.xyz;
     let end = pose(true);
-    let c = catch_move(o, unapply(pose(false), pivot, start[i].x.xyz), unapply(end, pivot, p.x.xyz), ob.info.x);
+    let thickness = ob.info.x;
+    var begin = unapply(pose(false), pivot, start[i].x.xyz);
+    // A deforming obstacle's: a start near the surface is carried by the surface's own move
+    // over the substep, where it moves as much as half the thickness (the CPU's
+    // `Deforming::contact`).
+    let largest = poses[7].y;
+    if (deforming(o) && largest >= 0.5 * thickness) {
+        let near = nearest(o, begin, 2.0 * (thickness + largest));
+        if (near.place != 0xffffffffu) {
+            begin += field_at(o, near.place, near.point, 0u);
+        }
+    }
+    let c = catch_move(o, begin, unapply(end, pivot, p.x.xyz), thickness);
     if (!c.caught) {
         return;
     }
     let at = apply(end, pivot, c.at);
     let n = rotate(end.rotation, c.normal);
+    var vs = velocity_at(end, pivot, at);
+    if (deforming(o)) {
+        vs = field_at(o, c.place, c.on_surface, 1u);
+    }
     let v = p.v.xyz;
     p.x = vec4<f32>(at, p.x.w);
-    p.v = vec4<f32>(touching(v, velocity_at(end, pivot, at), n, ob.info.y, 1.0), p.v.w);
+    p.v = vec4<f32>(touching(v, vs, n, ob.info.y, 1.0), p.v.w);
     state[i] = p;
     moved(i, p.v.xyz - v);
 }
@@ -485,7 +556,7 @@ fn between(a: vec3<f32>, b: vec3<f32>, p: vec3<f32>, q: vec3<f32>) -> EdgeHit {
 }
 
 fn edge_end(o: u32, place: u32, k: u32) -> vec3<f32> {
-    return surface[op.obstacles[o].starts.w + 2u * place + k].xyz;
+    return surface[starts(o).w + 2u * place + k].xyz;
 }
 
 fn boxes_meet(alo: vec3<f32>, ahi: vec3<f32>, blo: vec3<f32>, bhi: vec3<f32>) -> bool {
@@ -544,7 +615,7 @@ struct EdgeFound {
 }
 
 fn sharp_edges(o: u32, lo: vec3<f32>, hi: vec3<f32>, a: vec3<f32>, b: vec3<f32>, b0: vec3<f32>, b1: vec3<f32>, reach: f32, nearest_one: bool) -> EdgeFound {
-    let base = op.obstacles[o].starts.z;
+    let base = starts(o).z;
     var out = EdgeFound(false, EdgeHit(0.0, vec3<f32>(0.0), vec3<f32>(0.0), 0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     var first_t = 2.0;
     var stack: array<u32, 64>;
@@ -667,7 +738,16 @@ fn edges(@builtin(global_invocation_id) id: vec3<u32>) {
         if (weight <= 0.0) {
             continue;
         }
-        let vs = velocity_at(end, pivot, apply(end, pivot, hit.on_edge));
+        var vs = velocity_at(end, pivot, apply(end, pivot, hit.on_edge));
+        if (deforming(o)) {
+            // The surface's velocity at the point of it nearest to the edge's (the CPU's
+            // `Moment::velocity_near`).
+            vs = vec3<f32>(0.0);
+            let near = nearest(o, hit.on_edge, thickness);
+            if (near.place != 0xffffffffu) {
+                vs = field_at(o, near.place, near.point, 1u);
+            }
+        }
         let part = share * free;
         let before = array<vec3<f32>, 2>(pi.v.xyz, pj.v.xyz);
         if (part.x > 0.0) {

@@ -1,18 +1,19 @@
 //! Mesh obstacles on the GPU (`shaders/obstacle.wgsl`): the CPU's contact with a rigid
-//! obstacle, placed and moved by its keyframes, after each substep of every integrator
-//! the GPU runs.
-//! Each obstacle's box tree, triangles and sharp edges go to the device once, in the CPU's
-//! tree order, so a walk visits what the CPU's visits; the obstacles' poses at each
-//! substep's start and end are written before each submission. The cloth's edges (its
+//! obstacle, placed and moved by its keyframes, or a deforming one (an OBJ sequence), after
+//! each substep of every integrator the GPU runs.
+//! Each rigid obstacle's box tree, triangles and sharp edges go to the device once, in the
+//! CPU's tree order, so a walk visits what the CPU's visits; the obstacles' poses at each
+//! substep's start and end are written before each submission, and a deforming obstacle's
+//! surface where each substep ends (the CPU's, refitted), after the rigid ones'. The cloth's edges (its
 //! structural and shear springs) are coloured so that a dispatch per colour sweeps them as
 //! the CPU's loop does, in another order.
 
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
+use glam::{Quat, Vec3};
 
 use crate::cloth::ClothModel;
-use crate::sim::obstacle::TriangleTree;
-use crate::sim::{ContactConfig, Effect, RigidMotion};
+use crate::sim::obstacle::{Moment, Surface, TriangleTree};
+use crate::sim::{ContactConfig, Effect, Obstacle, RigidMotion};
 
 use super::error::GpuError;
 use super::kernel::{CONTACT, LAYOUT, Slot, SubstepKernel, WORKGROUP, bind, layout, pipelines};
@@ -89,13 +90,22 @@ pub(super) struct ObstaclePass {
     /// (kept, so that a frame allocates nothing).
     room: u32,
     staging: Vec<[f32; 4]>,
-    /// Each obstacle's motion, for its poses at each substep.
-    moving: Vec<RigidMotion>,
+    /// Each obstacle's motion, for its poses (or surface) at each substep.
+    moving: Vec<Motion>,
+    /// The rigid obstacles' surfaces, at the start of `surface`; after them, the deforming
+    /// ones' at each substep of a submission (the host's copy, kept as `staging`), for as
+    /// many entries in all as `surface_room`.
+    fixed: Vec<[f32; 4]>,
+    moments: Vec<[f32; 4]>,
+    surface_room: usize,
     /// What the bind groups bind besides the particles: the uniform, the surfaces, the
     /// cloth's edges, the crossings, the kept start, and a stand-in for the solver's words
-    /// the contacts tell of what they moved (see [`Memory`]), and their layout.
+    /// the contacts tell of what they moved (see [`Memory`]), and their layout, and the
+    /// solver's words bound instead.
     buffers: [wgpu::Buffer; 6],
     layout: wgpu::BindGroupLayout,
+    solve: Option<wgpu::Buffer>,
+    particles: [wgpu::Buffer; 2],
     count: u32,
 }
 
@@ -110,12 +120,62 @@ fn push_nodes(tree: &TriangleTree, out: &mut Vec<[f32; 4]>) -> (u32, u32) {
     (start, out.len() as u32 - start)
 }
 
-/// The rigid obstacles of `effects` as the shader reads them, their surfaces packed into
-/// one list, and their motions; `None` when there is none.
+/// Appends `surface` to `out` as the shader reads it: its tree's nodes, its places (each
+/// corner with its vertex's number, then the normal), its sharp edges' nodes and places;
+/// returns where each starts and how many there are.
+fn push_surface(s: &Surface, out: &mut Vec<[f32; 4]>) -> ([u32; 4], [u32; 4]) {
+    let (nodes, node_count) = push_nodes(s.tree(), out);
+    let places = out.len() as u32;
+    for (corners, t) in s.tree().places() {
+        let vertices = s.triangles()[t as usize];
+        for (c, v) in corners.iter().zip(vertices) {
+            out.push([c.x, c.y, c.z, f32::from_bits(v)]);
+        }
+        let n = s.normals()[t as usize];
+        out.push([n.x, n.y, n.z, 0.0]);
+    }
+    let place_count = s.tree().len() as u32;
+    let (edge_nodes, edge_node_count) = push_nodes(s.sharp_edges().tree(), out);
+    let edge_places = out.len() as u32;
+    for ([p, q, _], _) in s.sharp_edges().tree().places() {
+        out.push([p.x, p.y, p.z, 0.0]);
+        out.push([q.x, q.y, q.z, 0.0]);
+    }
+    let edge_count = s.sharp_edges().tree().len() as u32;
+    (
+        [nodes, places, edge_nodes, edge_places],
+        [node_count, place_count, edge_node_count, edge_count],
+    )
+}
+
+/// Appends a deforming obstacle's surface where a substep ends, each vertex's move over the
+/// substep and velocity after it (the shader's layout of it, which [`pack`] gave).
+fn push_moment(moment: &Moment, out: &mut Vec<[f32; 4]>) {
+    push_surface(&moment.surface, out);
+    for (shift, velocity) in moment.shift.iter().zip(&moment.velocity) {
+        out.push([shift.x, shift.y, shift.z, 0.0]);
+        out.push([velocity.x, velocity.y, velocity.z, 0.0]);
+    }
+}
+
+/// How an obstacle moves.
+enum Motion {
+    /// Rigidly, by its keyframes: its poses at each substep's start and end.
+    Rigid(RigidMotion),
+    /// As its OBJ sequence deforms it: its surface where each substep ends is written for
+    /// each submission, `entries` long.
+    Deforming {
+        obstacle: Box<Obstacle>,
+        entries: u32,
+    },
+}
+
+/// The obstacles of `effects` as the shader reads them, the rigid ones' surfaces packed
+/// into one list, and their motions; `None` when there is none.
 fn pack(
     effects: &[Effect],
     contact: &ContactConfig,
-) -> Option<(ObstacleParams, Vec<[f32; 4]>, Vec<RigidMotion>)> {
+) -> Option<(ObstacleParams, Vec<[f32; 4]>, Vec<Motion>)> {
     let mut params = ObstacleParams::default();
     let (mut surface, mut moving) = (Vec::new(), Vec::new());
     let placed = effects.iter().filter_map(|e| match e {
@@ -123,33 +183,34 @@ fn pack(
         _ => None,
     });
     for (slot, (obstacle, placed)) in placed.take(MAX_OBSTACLES).enumerate() {
-        let s = &placed.surface;
-        let (nodes, node_count) = push_nodes(s.tree(), &mut surface);
-        let places = surface.len() as u32;
-        for ([a, b, c], t) in s.tree().places() {
-            let n = s.normals()[t as usize];
-            surface.push([a.x, a.y, a.z, f32::from_bits(t)]);
-            surface.push([b.x, b.y, b.z, 0.0]);
-            surface.push([c.x, c.y, c.z, 0.0]);
-            surface.push([n.x, n.y, n.z, 0.0]);
-        }
-        let place_count = s.tree().len() as u32;
-        let (edge_nodes, edge_node_count) = push_nodes(s.sharp_edges().tree(), &mut surface);
-        let edge_places = surface.len() as u32;
-        for ([p, q, _], _) in s.sharp_edges().tree().places() {
-            surface.push([p.x, p.y, p.z, 0.0]);
-            surface.push([q.x, q.y, q.z, 0.0]);
-        }
-        let edge_count = s.sharp_edges().tree().len() as u32;
         let thickness = obstacle.thickness.unwrap_or(contact.offset);
-        let pivot = placed.pivot;
-        params.obstacles[slot] = GpuObstacle {
-            starts: [nodes, places, edge_nodes, edge_places],
-            counts: [node_count, place_count, edge_node_count, edge_count],
-            pivot: [pivot.x, pivot.y, pivot.z, 0.0],
-            info: [thickness, obstacle.friction, 0.0, 0.0],
+        let mut info = [thickness, obstacle.friction, 0.0, 0.0];
+        let (starts, counts, pivot) = match &placed.sequence {
+            None => {
+                moving.push(Motion::Rigid(placed.motion.clone()));
+                let (starts, counts) = push_surface(&placed.surface, &mut surface);
+                (starts, counts, placed.pivot)
+            }
+            Some(sequence) => {
+                // Laid out from 0: each substep's copy starts where its poses say.
+                let mut layout = Vec::new();
+                push_moment(&sequence.moment(0.0, 0.0), &mut layout);
+                let (starts, counts) = push_surface(&placed.surface, &mut Vec::new());
+                let fields = layout.len() - 2 * placed.surface.vertices().len();
+                info[2] = f32::from_bits(fields as u32);
+                info[3] = 1.0;
+                let entries = layout.len() as u32;
+                let obstacle = Box::new(obstacle.clone());
+                moving.push(Motion::Deforming { obstacle, entries });
+                (starts, counts, Vec3::ZERO)
+            }
         };
-        moving.push(placed.motion.clone());
+        params.obstacles[slot] = GpuObstacle {
+            starts,
+            counts,
+            pivot: [pivot.x, pivot.y, pivot.z, 0.0],
+            info,
+        };
     }
     (!moving.is_empty()).then_some((params, surface, moving))
 }
@@ -186,7 +247,7 @@ impl ObstaclePass {
         particles: &[wgpu::Buffer; 2],
         (model, effects, contact): (&ClothModel, &[Effect], &ContactConfig),
     ) -> Result<Option<Self>, GpuError> {
-        let Some((mut params, surface, moving)) = pack(effects, contact) else {
+        let Some((mut params, fixed, moving)) = pack(effects, contact) else {
             return Ok(None);
         };
         let (edges, records) = sweeps_of(model);
@@ -194,10 +255,10 @@ impl ObstaclePass {
         fits(
             &device.limits(),
             &[
-                (bytes(surface.len(), 16), "obstacle surfaces"),
+                (bytes(fixed.len(), 16), "obstacle surfaces"),
                 (bytes(edges.len(), 8), "cloth edges"),
             ],
-            &format!("{} surface entries", surface.len()),
+            &format!("{} surface entries", fixed.len()),
         )?;
         let count = model.particle_count() as u32;
         params.counts[0] = count;
@@ -215,7 +276,7 @@ impl ObstaclePass {
         let uniform = buffer("obstacle params", bytemuck::bytes_of(&params), U::UNIFORM);
         let surface = buffer(
             "obstacle surfaces",
-            bytemuck::cast_slice(&surface),
+            bytemuck::cast_slice(&fixed),
             U::STORAGE,
         );
         let cloth_edges = buffer("cloth edges", bytemuck::cast_slice(&edges), U::STORAGE);
@@ -254,8 +315,13 @@ impl ObstaclePass {
             room: 1,
             staging: Vec::new(),
             moving,
+            surface_room: fixed.len(),
+            fixed,
+            moments: Vec::new(),
             buffers,
             layout: main,
+            solve: None,
+            particles: particles.clone(),
             count,
         }))
     }
@@ -290,6 +356,12 @@ impl ObstaclePass {
         particles: &[wgpu::Buffer; 2],
         solve: Option<&wgpu::Buffer>,
     ) {
+        (self.particles, self.solve) = (particles.clone(), solve.cloned());
+        self.regroup(device);
+    }
+
+    fn regroup(&mut self, device: &wgpu::Device) {
+        let (particles, solve) = (&self.particles, self.solve.as_ref());
         self.groups = Self::groups_for(device, &self.layout, particles, &self.buffers, solve);
     }
 
@@ -321,24 +393,31 @@ impl ObstaclePass {
     }
 
     /// Writes every obstacle's poses at the start and end of `substeps` substeps of
-    /// `substep` seconds from `time`, for the submission about to be encoded, and what the
-    /// integrator keeps that the contacts change (`memory`; its words attached).
+    /// `substep` seconds from `time` (a deforming obstacle's surface where each ends), for
+    /// the submission about to be encoded, and what the integrator keeps that the contacts
+    /// change (`memory`; its words attached).
+    ///
+    /// # Errors
+    /// [`GpuError::Unsupported`] when the deforming obstacles' surfaces over the
+    /// submission's substeps exceed one binding.
     pub(super) fn write_poses(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         (substeps, time, substep): (u32, f64, f32),
         memory: Memory,
-    ) {
+    ) -> Result<(), GpuError> {
         let blocks = substeps * self.moving.len() as u32;
         if blocks > self.room {
             (self.poses, self.poses_group) = Self::poses_for(device, &self.poses_layout, blocks);
             self.room = blocks;
         }
+        self.make_room(device, queue, substeps)?;
         let entries = (POSE_STRIDE / 16) as usize;
         let data = &mut self.staging;
         data.clear();
         data.resize(blocks as usize * entries, [0.0; 4]);
+        self.moments.clear();
         let (mode, at) = match memory {
             Memory::None => (0.0, 0),
             Memory::Guess(at) => (1.0, at),
@@ -351,22 +430,93 @@ impl ObstaclePass {
             let t0 = t;
             t += f64::from(substep);
             for (o, motion) in self.moving.iter().enumerate() {
-                let (start, end) = (motion.at(t0), motion.at(t));
                 let v = |v: Vec3| [v.x, v.y, v.z, 0.0];
-                if let Some(block) = blocks.next() {
-                    block[..7].copy_from_slice(&[
-                        v(start.translation),
-                        start.rotation.to_array(),
-                        v(end.translation),
-                        end.rotation.to_array(),
-                        v(end.velocity),
-                        v(end.spin),
-                        [f32::from_bits(o as u32), mode, f32::from_bits(at), substep],
-                    ]);
+                let Some(block) = blocks.next() else {
+                    break;
+                };
+                let which = [f32::from_bits(o as u32), mode, f32::from_bits(at), substep];
+                match motion {
+                    Motion::Rigid(motion) => {
+                        let (start, end) = (motion.at(t0), motion.at(t));
+                        block[..7].copy_from_slice(&[
+                            v(start.translation),
+                            start.rotation.to_array(),
+                            v(end.translation),
+                            end.rotation.to_array(),
+                            v(end.velocity),
+                            v(end.spin),
+                            which,
+                        ]);
+                    }
+                    Motion::Deforming { obstacle, .. } => {
+                        let Some(sequence) = obstacle.placed().and_then(|p| p.sequence.as_ref())
+                        else {
+                            continue;
+                        };
+                        // Where the CPU's contact asks for it: back a substep from its end.
+                        let moment = sequence.moment(t - f64::from(substep), t);
+                        let at = (self.fixed.len() + self.moments.len()) as u32;
+                        push_moment(&moment, &mut self.moments);
+                        let still = Quat::IDENTITY.to_array();
+                        block[..8].copy_from_slice(&[
+                            [0.0; 4],
+                            still,
+                            [0.0; 4],
+                            still,
+                            [0.0; 4],
+                            [0.0; 4],
+                            which,
+                            [f32::from_bits(at), moment.largest_shift, 0.0, 0.0],
+                        ]);
+                    }
                 }
             }
         }
         queue.write_buffer(&self.poses, 0, bytemuck::cast_slice(data));
+        if !self.moments.is_empty() {
+            let offset = (self.fixed.len() * 16) as u64;
+            queue.write_buffer(
+                &self.buffers[1],
+                offset,
+                bytemuck::cast_slice(&self.moments),
+            );
+        }
+        Ok(())
+    }
+
+    /// Makes room in the surfaces' buffer for the deforming obstacles' surfaces over
+    /// `substeps` substeps (a larger buffer, the rigid ones' surfaces written again, bound
+    /// anew).
+    fn make_room(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        substeps: u32,
+    ) -> Result<(), GpuError> {
+        let each: u32 = (self.moving.iter())
+            .map(|m| match m {
+                Motion::Deforming { entries, .. } => *entries,
+                Motion::Rigid(_) => 0,
+            })
+            .sum();
+        let need = self.fixed.len() + substeps as usize * each as usize;
+        if need <= self.surface_room {
+            return Ok(());
+        }
+        let bytes = (need * 16) as u64;
+        let what = format!("{substeps} substeps of a deforming obstacle");
+        fits(&device.limits(), &[(bytes, "obstacle surfaces")], &what)?;
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("obstacle surfaces"),
+            size: bytes.next_multiple_of(16),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        queue.write_buffer(&buffer, 0, bytemuck::cast_slice(&self.fixed));
+        self.buffers[1] = buffer;
+        self.surface_room = need;
+        self.regroup(device);
+        Ok(())
     }
 
     /// Records a copy of the substep's start, `particles[at]`, for an integrator that

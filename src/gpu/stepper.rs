@@ -395,7 +395,8 @@ impl GpuStepper {
         let when = (substeps, time, self.substep_length());
         let memory = self.contact_memory().0;
         if let Some(obstacles) = self.obstacles.as_mut() {
-            obstacles.write_poses(&self.device, &self.queue, when, memory);
+            (obstacles.write_poses(&self.device, &self.queue, when, memory))
+                .map_err(|e| StepError::Unsupported(e.to_string()))?;
         }
         if vbd {
             self.kernel.vbd(&self.device);

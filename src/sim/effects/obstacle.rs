@@ -781,10 +781,7 @@ impl EffectKind for Obstacle {
     }
 
     fn on_gpu(&self) -> Result<(), &'static str> {
-        match self.frames {
-            Some(_) => Err("deforming (OBJ sequence) obstacles"),
-            None => Ok(()),
-        }
+        Ok(())
     }
 
     fn suggested(_cloth: &ClothBox) -> Self {
