@@ -32,7 +32,7 @@ impl GpuStepper {
             })
         };
         let lost = |e: GpuError| StepError::Device(e.to_string());
-        let obstacles = self.obstacles.as_ref();
+        let contacts = &self.contacts;
         for k in 0..substeps {
             let this = &self.groups[self.current];
             let mut encoded = solve.last.max(FIRST_CHUNK).min(cap);
@@ -63,9 +63,7 @@ impl GpuStepper {
             });
             let mut pass = encoder.begin_compute_pass(&Default::default());
             solve.finish(&mut pass, this);
-            if let Some(obstacles) = obstacles {
-                obstacles.encode(&mut pass, k, Start::In(self.current));
-            }
+            contacts.encode(&mut pass, k, Start::In(self.current));
             if counting {
                 self.kernel.count_substep(&mut pass, this);
             }

@@ -142,6 +142,31 @@ pub(super) fn bind(
     })
 }
 
+/// The six bind groups of a contact pass that binds `uniform`, a substep's start and its
+/// end, then `rest`: `[i]` reads the start from `particles[i]` and moves the other;
+/// `[2 + i]` reads it from `kept` and moves `particles[i]`; `[4 + i]` binds `particles[i]`
+/// as the start and `kept` as the end (to copy the one into the other).
+pub(super) fn start_end_groups(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    (particles, kept): (&[wgpu::Buffer; 2], &wgpu::Buffer),
+    uniform: &wgpu::Buffer,
+    rest: &[&wgpu::Buffer],
+) -> [wgpu::BindGroup; 6] {
+    [0, 1, 2, 3, 4, 5].map(|g| {
+        let i = g % 2;
+        let (start, end) = match g / 2 {
+            0 => (&particles[i], &particles[1 - i]),
+            1 => (kept, &particles[i]),
+            _ => (&particles[i], kept),
+        };
+        let mut buffers = vec![uniform, start, end];
+        buffers.extend_from_slice(rest);
+        bind(device, label, layout, &buffers)
+    })
+}
+
 /// VBD's entry points' pipelines.
 pub(super) struct VbdPipelines {
     pub(super) predict: wgpu::ComputePipeline,

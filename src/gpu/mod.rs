@@ -3,12 +3,14 @@
 //! graphics) and plugs into [`crate::scene::Simulation`] through the same
 //! [`crate::sim::StepBackend`] seam. What it runs (`support`), how it lays the cloth out
 //! (`packing`), its kernels (`kernel`, `elements`, `health`, `xpbd`, `vbd`,
-//! `implicit`, with its substeps in `implicit_steps`), the stepper that
+//! `implicit`, with its substeps in `implicit_steps`; the contacts after each substep,
+//! `contacts`, `obstacles`, `self_contact`), the stepper that
 //! drives them (`stepper`)
 //! and the guard's frame with its rollback points on the device (`guarded`, `snapshot`) are
 //! files of their own; it reaches the device through [`crate::device`] only.
 
 mod backend;
+mod contacts;
 mod elements;
 mod error;
 mod guarded;
@@ -20,6 +22,7 @@ mod kernel;
 mod obstacles;
 mod packing;
 mod rebuild;
+mod self_contact;
 mod snapshot;
 mod stepper;
 mod support;

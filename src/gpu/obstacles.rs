@@ -16,7 +16,9 @@ use crate::sim::obstacle::{Moment, Surface, TriangleTree};
 use crate::sim::{ContactConfig, Effect, Obstacle, RigidMotion};
 
 use super::error::GpuError;
-use super::kernel::{CONTACT, LAYOUT, Slot, SubstepKernel, WORKGROUP, bind, layout, pipelines};
+use super::kernel::{
+    CONTACT, LAYOUT, Slot, SubstepKernel, WORKGROUP, layout, pipelines, start_end_groups,
+};
 use super::packing::MAX_OBSTACLES;
 use super::support::fits;
 use super::xpbd::{Colours, colour_record};
@@ -335,17 +337,15 @@ impl ObstaclePass {
         [uniform, surface, cloth_edges, crossings, kept, no_solve]: &[wgpu::Buffer; 6],
         solve: Option<&wgpu::Buffer>,
     ) -> [wgpu::BindGroup; 6] {
-        let solve = solve.unwrap_or(no_solve);
-        [0, 1, 2, 3, 4, 5].map(|g| {
-            let i = g % 2;
-            let (start, end) = match g / 2 {
-                0 => (&particles[i], &particles[1 - i]),
-                1 => (kept, &particles[i]),
-                _ => (&particles[i], kept),
-            };
-            let buffers = [uniform, start, end, surface, cloth_edges, crossings, solve];
-            bind(device, "obstacles", layout, &buffers)
-        })
+        let rest = [surface, cloth_edges, crossings, solve.unwrap_or(no_solve)];
+        start_end_groups(
+            device,
+            "obstacles",
+            layout,
+            (particles, kept),
+            uniform,
+            &rest,
+        )
     }
 
     /// Binds the solver's words the contacts tell of what they moved (`None`: the

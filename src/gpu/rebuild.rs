@@ -110,9 +110,7 @@ impl GpuStepper {
             .kernel
             .groups(&self.device, &self.particles, fixed, extra);
         let words = self.contact_memory().1.cloned();
-        if let Some(obstacles) = self.obstacles.as_mut() {
-            obstacles.attach_solve(&self.device, &self.particles, words.as_ref());
-        }
+        (self.contacts).attach_solve(&self.device, &self.particles, words.as_ref());
     }
 
     /// What the integrator in effect keeps that a contact changes (see [`Memory`]), and

@@ -17,18 +17,19 @@ use crate::sim::{
     air_damping_of, gravity_of,
 };
 
+use super::contacts::Contacts;
 use super::elements::{ElementKernel, pack_elements};
 use super::error::GpuError;
 use super::handles::Carried;
 use super::health::{HealthKernel, Watch};
 use super::implicit::ImplicitPass;
 use super::kernel::{SubstepKernel, WORKGROUP};
-use super::obstacles::{ObstaclePass, Start};
+use super::obstacles::Start;
 use super::packing::{
     ClassTable, EndsKey, Neighbour, Params, Particle, classify, grid_of, pack_solids, pack_springs,
 };
 use super::snapshot::DeviceSnapshot;
-use super::support::{check_device, fits_buffers, gpu_support};
+use super::support::{check_device, fits_buffers, gpu_support_trying};
 use super::vbd::VbdPass;
 use super::xpbd::XpbdPass;
 
@@ -67,8 +68,10 @@ pub struct GpuStepper {
     pub(super) vbd: VbdPass,
     /// Implicit Euler's solve, built the first time it steps.
     pub(super) implicit: Option<ImplicitPass>,
-    /// The scene's rigid mesh obstacles, when it has any.
-    pub(super) obstacles: Option<ObstaclePass>,
+    /// The scene's mesh obstacles and self-contact, where it has them.
+    pub(super) contacts: Contacts,
+    /// Whether the scene's self-contact runs (its pass is not yet offered).
+    self_contact: bool,
     /// The solvers' settings: XPBD's and VBD's sweeps a substep, implicit Euler's
     /// tolerance and cap.
     pub(super) solver: SolverConfig,
@@ -145,7 +148,20 @@ impl GpuStepper {
         effects: &[Effect],
         read_every_frame: bool,
     ) -> Result<Self, GpuError> {
-        gpu_support(&params.step, params.solver.precision, effects)?;
+        let scene = (model, params, effects);
+        Self::trying(device, queue, scene, read_every_frame, false)
+    }
+
+    /// [`GpuStepper::new`], running the scene's self-contact too where `self_contact`
+    /// says (not yet offered: see `self_contact`).
+    pub(super) fn trying(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        (model, params, effects): (&ClothModel, &SimParams, &[Effect]),
+        read_every_frame: bool,
+        self_contact: bool,
+    ) -> Result<Self, GpuError> {
+        gpu_support_trying(&params.step, params.solver.precision, effects, self_contact)?;
         let limits = device.limits();
         let count = model.particle_count() as u32;
         check_device(&limits, count)?;
@@ -257,7 +273,8 @@ impl GpuStepper {
             sent: None,
             ends_sent: 0,
             grid_path: true,
-            obstacles: None,
+            contacts: Contacts::default(),
+            self_contact,
         };
         stepper.configure(model, params, effects, Changes::all());
         match stepper.unsupported.take() {
@@ -394,10 +411,8 @@ impl GpuStepper {
         }
         let when = (substeps, time, self.substep_length());
         let memory = self.contact_memory().0;
-        if let Some(obstacles) = self.obstacles.as_mut() {
-            (obstacles.write_poses(&self.device, &self.queue, when, memory))
-                .map_err(|e| StepError::Unsupported(e.to_string()))?;
-        }
+        let prepared = (self.contacts).prepare(&self.device, &self.queue, when, memory);
+        prepared.map_err(|e| StepError::Unsupported(e.to_string()))?;
         if vbd {
             self.kernel.vbd(&self.device);
         }
@@ -438,9 +453,7 @@ impl GpuStepper {
                 self.elements.dispatch(&mut pass, self.current);
                 let (this, other) = (&self.groups[self.current], &self.groups[1 - self.current]);
                 if let Some((predict, sweep, colours, finish)) = solver {
-                    if let Some(obstacles) = &self.obstacles {
-                        obstacles.keep_start(&mut pass, self.current);
-                    }
+                    self.contacts.keep_start(&mut pass, self.current);
                     // The state stays where it is; the other buffer holds the predictions
                     // (XPBD) or the displacements (VBD).
                     pass.set_pipeline(predict);
@@ -452,16 +465,12 @@ impl GpuStepper {
                     pass.set_pipeline(finish);
                     pass.set_bind_group(0, other, &[]);
                     pass.dispatch_workgroups(groups, 1, 1);
-                    if let Some(obstacles) = &self.obstacles {
-                        obstacles.encode(&mut pass, k, Start::Kept(self.current));
-                    }
+                    (self.contacts).encode(&mut pass, k, Start::Kept(self.current));
                 } else {
                     pass.set_pipeline(&self.kernel.pipeline);
                     pass.set_bind_group(0, this, &[]);
                     pass.dispatch_workgroups(groups, 1, 1);
-                    if let Some(obstacles) = &self.obstacles {
-                        obstacles.encode(&mut pass, k, Start::In(self.current));
-                    }
+                    (self.contacts).encode(&mut pass, k, Start::In(self.current));
                     self.current = 1 - self.current;
                 }
                 if counting {
@@ -479,6 +488,7 @@ impl GpuStepper {
         if let Some(display) = &self.display {
             encoder.copy_buffer_to_buffer(&self.particles[self.current], 0, display, 0, None);
         }
+        self.contacts.after_submission(&mut encoder);
         self.queue.submit([encoder.finish()]);
         self.behind = true;
         if vbd && substeps > 0 {
@@ -628,7 +638,8 @@ impl StepBackend for GpuStepper {
         changes: Changes,
     ) {
         if changes.intersects(Changes::INTEGRATOR | Changes::EFFECTS | Changes::PRECISION) {
-            self.unsupported = gpu_support(&params.step, params.solver.precision, effects)
+            let (step, precision) = (&params.step, params.solver.precision);
+            self.unsupported = gpu_support_trying(step, precision, effects, self.self_contact)
                 .err()
                 .map(|e| e.to_string());
         }
@@ -681,8 +692,8 @@ impl StepBackend for GpuStepper {
         if changes.intersects(Changes::EFFECTS | Changes::CONTACT) && self.unsupported.is_none() {
             let scene = (model, effects, &params.contact);
             let (device, queue) = (&self.device, &self.queue);
-            match ObstaclePass::new(device, queue, &self.kernel, &self.particles, scene) {
-                Ok(pass) => self.obstacles = pass,
+            match Contacts::new(device, queue, &self.kernel, &self.particles, scene) {
+                Ok(contacts) => self.contacts = contacts,
                 Err(e) => self.unsupported = Some(e.to_string()),
             }
         }

@@ -28,6 +28,17 @@ pub fn gpu_support(
     precision: Precision,
     effects: &[Effect],
 ) -> Result<(), GpuError> {
+    gpu_support_trying(step, precision, effects, false)
+}
+
+/// [`gpu_support`], with self-contact run too where `self_contact` says (its pass is built
+/// but not yet offered: see `self_contact`).
+pub(super) fn gpu_support_trying(
+    step: &StepConfig,
+    precision: Precision,
+    effects: &[Effect],
+    self_contact: bool,
+) -> Result<(), GpuError> {
     if precision != Precision::F32 {
         return Err(GpuError::Unsupported(format!(
             "computes in f32 only, not {precision} (f64 is slow or absent on most GPUs, and \
@@ -43,6 +54,9 @@ pub fn gpu_support(
         )));
     }
     for e in effects {
+        if self_contact && matches!(e, Effect::SelfCollision(_)) {
+            continue;
+        }
         if let Err(what) = e.on_gpu() {
             return Err(GpuError::Unsupported(format!(
                 "has no {what}; run this scene on the CPU backend"

@@ -22,4 +22,5 @@ mod solver;
 pub use error::ContactError;
 pub use hash::CELLS_PER_TRIANGLE;
 pub(crate) use primitives::point_triangle_distance;
+pub use search::owned_parts;
 pub use solver::{SelfContacts, SelfWork};

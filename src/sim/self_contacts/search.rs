@@ -157,6 +157,20 @@ impl Owners {
     }
 }
 
+/// Which of each of `model`'s triangles' corners (bits 0–2) and edges (bits 3–5, edge k
+/// from corner k to the next) it owns, as [`Owners`] deals them out: for a search that
+/// runs elsewhere (the GPU's) and must keep each pair once, as this one does.
+pub fn owned_parts(model: &ClothModel) -> Vec<u32> {
+    let owners = Owners::build(model);
+    (owners.vertices.iter().zip(&owners.edges))
+        .map(|(v, e)| {
+            (0..3)
+                .map(|k| (u32::from(v[k] != NONE) << k) | (u32::from(e[k][0] != NONE) << (3 + k)))
+                .sum()
+        })
+        .collect()
+}
+
 /// Pairs of [`Owners::neighbours`] tested in one piece of a search.
 pub(super) const NEIGHBOURS_PER_PIECE: usize = 4096;
 

@@ -1,0 +1,659 @@
+// Self-contact on the GPU (prepended with shaders/cloth_layout.wgsl and
+// shaders/self_contact_geometry.wgsl; src/gpu/self_contact.rs builds and dispatches it):
+// the cloth kept off itself after each substep. Each particle's motion over the substep,
+// grown by half the thickness, is its box; each triangle's box (its corners' together)
+// goes into a hashed grid of cells (a list per bucket, linked through an atomic exchange);
+// each triangle then walks the cells its box covers and keeps, with every other triangle
+// whose box overlaps its own in the first cell both cover, their vertex–triangle and
+// edge–edge pairs (each vertex and edge owned by one triangle, as on the CPU) whose sides'
+// boxes overlap. A triangle whose box covers too many cells is checked against every
+// triangle instead. The pairs closer than the thickness at the substep's end are pushed a
+// thickness apart, side by side, each particle taking the average of its pushes (in fixed
+// point, so the sum is the same in any order); the search runs again on the motion as
+// pushed, and its pairs go through rounds of conservative continuous collision detection
+// (additive CCD, as the CPU's, in f32 on coordinates taken from the pair's first
+// particle): a pair whose sides could come within a tenth of the thickness along the
+// motion has its free particles' motion cut short where they are still apart (each
+// particle keeps the smallest cut, an atomic minimum of its bits); after four rounds the
+// cut is to the substep's start. Where the rounds recorded do not end it, or the grid's
+// or the pairs' room ran out, every free particle goes back to its start.
+
+struct SelfParams {
+    // x: particles; y: triangles; z: buckets (a power of two); w: room for grid entries.
+    counts: vec4<u32>,
+    // x: room for pairs; y: what the contacts tell the solver (0 nothing, 1 implicit
+    // Euler's flag, 2 VBD's memory); z: the solver's word for it; w: rounds recorded.
+    more: vec4<u32>,
+    // x: thickness (m); y: the separation the check keeps (m); z: the grid's cell (m);
+    // w: the substep (s).
+    lengths: vec4<f32>,
+    // x: Coulomb friction between layers.
+    friction: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> sp: SelfParams;
+// The substep's start, and its end, which the cuts move.
+@group(0) @binding(1) var<storage, read> start: array<Particle>;
+@group(0) @binding(2) var<storage, read_write> state: array<Particle>;
+// Each triangle's corners, and which of its corners (bits 0–2) and edges (bits 3–5, edge
+// k from corner k to the next) it owns.
+@group(0) @binding(3) var<storage, read> triangles: array<vec4<u32>>;
+// Each particle's box (lo, hi), then each triangle's (lo, hi; lo.w 1 where it is checked
+// against every triangle).
+@group(0) @binding(4) var<storage, read_write> boxes: array<vec4<f32>>;
+// Counters (see below), then each bucket's first entry, then each particle's cut (the
+// bits of its share of the motion).
+@group(0) @binding(5) var<storage, read_write> atomics: array<atomic<u32>>;
+// Each grid entry's next in its bucket, then the entries (triangle and cell, four words),
+// then the triangles checked against all, then the pairs (four words), then each
+// particle's share of its motion as the last round left it.
+@group(0) @binding(6) var<storage, read_write> lists: array<u32>;
+// The solver's words the contacts tell of what they moved (see the obstacles' shader).
+@group(0) @binding(7) var<storage, read_write> solver: array<u32>;
+// The round this dispatch takes (x).
+@group(1) @binding(0) var<uniform> this_round: vec4<u32>;
+
+// Counters in `atomics`: grid entries, pairs, triangles checked against all, and per round
+// the pairs it found could meet and those of them it could not cut.
+const ENTRIES: u32 = 0u;
+const PAIRS: u32 = 1u;
+const BIG: u32 = 2u;
+const IMPACTS: u32 = 4u;
+const STUCK: u32 = 20u;
+// The most grid entries and pairs any substep of the submission asked for (zeroed by the
+// host before each, not by `clear`).
+const MOST_ENTRIES: u32 = 34u;
+const MOST_PAIRS: u32 = 35u;
+const COUNTERS: u32 = 36u;
+// Rounds of cuts by the safe fraction; later rounds cut to the start (the CPU's).
+const SCALED_ROUNDS: u32 = 4u;
+// Cells a triangle's box may cover and still go into the grid.
+const MOST_CELLS: i32 = 64;
+const EMPTY: u32 = 0xffffffffu;
+// The least separation the check keeps, as a share of the thickness: a thousand times
+// what f32 resolves on a pair of centimetre-long edges.
+const FLOOR: f32 = 1e-3;
+const EDGES: u32 = 0x80000000u;
+
+fn heads_at() -> u32 {
+    return COUNTERS;
+}
+
+fn cuts_at() -> u32 {
+    return COUNTERS + sp.counts.z;
+}
+
+// Each particle's pushes in a sweep, in fixed point (8 words: its move, how many pushed
+// it, its change of velocity), after the cuts.
+fn pushes_at() -> u32 {
+    return COUNTERS + sp.counts.z + sp.counts.x;
+}
+
+// Fixed point of the pushes: metres and metres a second per unit (a sum is the same in
+// any order).
+const MOVE_UNIT: f32 = 9.313226e-10;
+const SPEED_UNIT: f32 = 5.9604645e-8;
+
+fn next_at() -> u32 {
+    return 0u;
+}
+
+fn entries_at() -> u32 {
+    return sp.counts.w;
+}
+
+fn big_at() -> u32 {
+    return 5u * sp.counts.w;
+}
+
+fn pairs_at() -> u32 {
+    return 5u * sp.counts.w + sp.counts.y;
+}
+
+fn scales_at() -> u32 {
+    return pairs_at() + 4u * sp.more.x;
+}
+
+fn cell_of(p: vec3<f32>) -> vec3<i32> {
+    return vec3<i32>(floor(p / sp.lengths.z));
+}
+
+fn bucket(c: vec3<i32>) -> u32 {
+    let h = (c.x * 73856093) ^ (c.y * 19349663) ^ (c.z * 83492791);
+    return bitcast<u32>(h) & (sp.counts.z - 1u);
+}
+
+// Zeroes the counters and empties the buckets.
+@compute @workgroup_size(64)
+fn clear(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i < MOST_ENTRIES) {
+        atomicStore(&atomics[i], 0u);
+    } else if (i >= COUNTERS && i < COUNTERS + sp.counts.z) {
+        atomicStore(&atomics[i], EMPTY);
+    }
+}
+
+// Each particle's box: its motion over the substep grown by half the thickness; its whole
+// motion kept so far.
+@compute @workgroup_size(64)
+fn particle_boxes(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i >= sp.counts.x) {
+        return;
+    }
+    let a = start[i].x.xyz;
+    let b = state[i].x.xyz;
+    let g = vec3<f32>(0.5 * sp.lengths.x);
+    boxes[2u * i] = vec4<f32>(min(a, b) - g, 0.0);
+    boxes[2u * i + 1u] = vec4<f32>(max(a, b) + g, 0.0);
+    lists[scales_at() + i] = bitcast<u32>(1.0);
+    atomicStore(&atomics[cuts_at() + i], bitcast<u32>(1.0));
+    for (var k = 0u; k < 8u; k++) {
+        atomicStore(&atomics[pushes_at() + 8u * i + k], 0u);
+    }
+}
+
+fn triangle_box_at(t: u32) -> u32 {
+    return 2u * sp.counts.x + 2u * t;
+}
+
+// Each triangle's box goes into the grid, in every cell it covers, or where it covers too
+// many, onto the list of those checked against every triangle.
+@compute @workgroup_size(64)
+fn insert(@builtin(global_invocation_id) id: vec3<u32>) {
+    let t = id.x;
+    if (t >= sp.counts.y) {
+        return;
+    }
+    let tri = triangles[t];
+    var lo = boxes[2u * tri.x].xyz;
+    var hi = boxes[2u * tri.x + 1u].xyz;
+    for (var k = 1u; k < 3u; k++) {
+        let v = tri[k];
+        lo = min(lo, boxes[2u * v].xyz);
+        hi = max(hi, boxes[2u * v + 1u].xyz);
+    }
+    let c0 = cell_of(lo);
+    let c1 = cell_of(hi);
+    let span = c1 - c0 + vec3<i32>(1);
+    let big = any(span > vec3<i32>(MOST_CELLS)) || span.x * span.y * span.z > MOST_CELLS;
+    boxes[triangle_box_at(t)] = vec4<f32>(lo, select(0.0, 1.0, big));
+    boxes[triangle_box_at(t) + 1u] = vec4<f32>(hi, 0.0);
+    if (big) {
+        let at = atomicAdd(&atomics[BIG], 1u);
+        lists[big_at() + at] = t;
+        return;
+    }
+    for (var z = c0.z; z <= c1.z; z++) {
+        for (var y = c0.y; y <= c1.y; y++) {
+            for (var x = c0.x; x <= c1.x; x++) {
+                let e = atomicAdd(&atomics[ENTRIES], 1u);
+                if (e >= sp.counts.w) {
+                    return;
+                }
+                let at = entries_at() + 4u * e;
+                lists[at] = t;
+                lists[at + 1u] = bitcast<u32>(x);
+                lists[at + 2u] = bitcast<u32>(y);
+                lists[at + 3u] = bitcast<u32>(z);
+                lists[next_at() + e] = atomicExchange(&atomics[heads_at() + bucket(vec3<i32>(x, y, z))], e);
+            }
+        }
+    }
+}
+
+fn boxes_meet(alo: vec3<f32>, ahi: vec3<f32>, blo: vec3<f32>, bhi: vec3<f32>) -> bool {
+    return all(alo <= bhi) && all(blo <= ahi);
+}
+
+fn particle_lo(i: u32) -> vec3<f32> {
+    return boxes[2u * i].xyz;
+}
+
+fn particle_hi(i: u32) -> vec3<f32> {
+    return boxes[2u * i + 1u].xyz;
+}
+
+fn keep_pair(pair: vec4<u32>) {
+    let at = atomicAdd(&atomics[PAIRS], 1u);
+    if (at < sp.more.x) {
+        let p = pairs_at() + 4u * at;
+        lists[p] = pair.x;
+        lists[p + 1u] = pair.y;
+        lists[p + 2u] = pair.z;
+        lists[p + 3u] = pair.w;
+    }
+}
+
+// Keeps the vertex–triangle and edge–edge pairs triangles `a` and `b` own whose sides'
+// boxes overlap (the CPU's `each_pair` and `sides_meet`).
+fn pairs_of(a: u32, b: u32) {
+    let ta = triangles[a];
+    let tb = triangles[b];
+    for (var side = 0u; side < 2u; side++) {
+        let own = select(ta, tb, side == 1u);
+        let other = select(tb, ta, side == 1u);
+        let other_t = select(b, a, side == 1u);
+        let olo = boxes[triangle_box_at(other_t)].xyz;
+        let ohi = boxes[triangle_box_at(other_t) + 1u].xyz;
+        for (var k = 0u; k < 3u; k++) {
+            let v = own[k];
+            if ((own.w & (1u << k)) == 0u || v == other.x || v == other.y || v == other.z) {
+                continue;
+            }
+            if (boxes_meet(particle_lo(v), particle_hi(v), olo, ohi)) {
+                keep_pair(vec4<u32>(v, other.x, other.y, other.z));
+            }
+        }
+    }
+    for (var j = 0u; j < 3u; j++) {
+        if ((ta.w & (8u << j)) == 0u) {
+            continue;
+        }
+        let e0 = ta[j];
+        let e1 = ta[(j + 1u) % 3u];
+        let elo = min(particle_lo(e0), particle_lo(e1));
+        let ehi = max(particle_hi(e0), particle_hi(e1));
+        for (var k = 0u; k < 3u; k++) {
+            if ((tb.w & (8u << k)) == 0u) {
+                continue;
+            }
+            let f0 = tb[k];
+            let f1 = tb[(k + 1u) % 3u];
+            if (e0 == f0 || e0 == f1 || e1 == f0 || e1 == f1) {
+                continue;
+            }
+            let flo = min(particle_lo(f0), particle_lo(f1));
+            let fhi = max(particle_hi(f0), particle_hi(f1));
+            if (boxes_meet(elo, ehi, flo, fhi)) {
+                keep_pair(vec4<u32>(e0 | EDGES, e1, f0, f1));
+            }
+        }
+    }
+}
+
+// Each triangle keeps its pairs with every triangle whose box meets its own: from the
+// grid, each two once (from the lower-numbered, in the first cell both cover); a triangle
+// on the list of those checked against all, with every triangle.
+@compute @workgroup_size(64)
+fn find(@builtin(global_invocation_id) id: vec3<u32>) {
+    let a = id.x;
+    if (a >= sp.counts.y) {
+        return;
+    }
+    let box_a = boxes[triangle_box_at(a)];
+    let lo = box_a.xyz;
+    let hi = boxes[triangle_box_at(a) + 1u].xyz;
+    if (box_a.w > 0.5) {
+        for (var b = 0u; b < sp.counts.y; b++) {
+            let box_b = boxes[triangle_box_at(b)];
+            if (b == a || (box_b.w > 0.5 && b < a)) {
+                continue;
+            }
+            if (boxes_meet(lo, hi, box_b.xyz, boxes[triangle_box_at(b) + 1u].xyz)) {
+                pairs_of(a, b);
+            }
+        }
+        return;
+    }
+    let c0 = cell_of(lo);
+    let c1 = cell_of(hi);
+    for (var z = c0.z; z <= c1.z; z++) {
+        for (var y = c0.y; y <= c1.y; y++) {
+            for (var x = c0.x; x <= c1.x; x++) {
+                let c = vec3<i32>(x, y, z);
+                var e = atomicLoad(&atomics[heads_at() + bucket(c)]);
+                while (e != EMPTY && e < sp.counts.w) {
+                    let at = entries_at() + 4u * e;
+                    let b = lists[at];
+                    let cb = vec3<i32>(bitcast<i32>(lists[at + 1u]), bitcast<i32>(lists[at + 2u]), bitcast<i32>(lists[at + 3u]));
+                    e = lists[next_at() + e];
+                    if (b <= a || any(cb != c)) {
+                        continue;
+                    }
+                    let blo = boxes[triangle_box_at(b)].xyz;
+                    let bhi = boxes[triangle_box_at(b) + 1u].xyz;
+                    // The first cell both cover: where their boxes' overlap starts.
+                    if (!boxes_meet(lo, hi, blo, bhi) || any(cell_of(max(lo, blo)) != c)) {
+                        continue;
+                    }
+                    pairs_of(a, b);
+                }
+            }
+        }
+    }
+}
+
+
+fn add_fixed(at: u32, x: f32, unit: f32) {
+    let n = i32(clamp(x / unit, -1.0e9, 1.0e9));
+    atomicAdd(&atomics[at], bitcast<u32>(n));
+}
+
+// One sweep of the pushes, side by side: each pair whose sides are closer than the
+// thickness at the substep's end is pushed a thickness apart on the side it started on,
+// as the CPU's `push_apart` pushes it (with Coulomb friction on its relative sliding);
+// each particle then takes the average of its pushes.
+@compute @workgroup_size(64)
+fn push(@builtin(global_invocation_id) id: vec3<u32>) {
+    let n = min(atomicLoad(&atomics[PAIRS]), sp.more.x);
+    let p = id.x;
+    if (p >= n) {
+        return;
+    }
+    let at = pairs_at() + 4u * p;
+    let raw = vec4<u32>(lists[at], lists[at + 1u], lists[at + 2u], lists[at + 3u]);
+    let edges = (raw.x & EDGES) != 0u;
+    let ids = vec4<u32>(raw.x & ~EDGES, raw.y, raw.z, raw.w);
+    let thickness = sp.lengths.x;
+    let origin = state[ids.x].x.xyz;
+    let origin0 = start[ids.x].x.xyz;
+    var x: array<vec3<f32>, 4>;
+    var x0: array<vec3<f32>, 4>;
+    var inv: array<f32, 4>;
+    for (var k = 0u; k < 4u; k++) {
+        let q = state[ids[k]].x;
+        x[k] = q.xyz - origin;
+        x0[k] = start[ids[k]].x.xyz - origin0;
+        inv[k] = q.w;
+    }
+    var w: array<f32, 4>;
+    if (edges) {
+        let st = segments_closest(x[0], x[1], x[2], x[3]);
+        w = array<f32, 4>(1.0 - st.x, st.x, 1.0 - st.y, st.y);
+    } else {
+        let b = closest_weights(x[0], x[1], x[2], x[3]);
+        w = array<f32, 4>(1.0, b.x, b.y, b.z);
+    }
+    let first = select(1u, 2u, edges);
+    var gap = vec3<f32>(0.0);
+    var before = vec3<f32>(0.0);
+    var sign: array<f32, 4>;
+    for (var k = 0u; k < 4u; k++) {
+        sign[k] = select(-1.0, 1.0, k < first);
+        gap += sign[k] * w[k] * x[k];
+        before += sign[k] * w[k] * x0[k];
+    }
+    let dist = length(gap);
+    if (dist >= thickness) {
+        return;
+    }
+    var direction = vec3<f32>(0.0);
+    if (dot(before, before) > 0.0 && dot(gap, before) > 0.0 && dist > 1e-9) {
+        direction = gap / dist;
+    } else if (dot(before, before) > 0.0) {
+        direction = normalize(before);
+    } else if (dist > 0.0) {
+        direction = gap / dist;
+    } else {
+        return;
+    }
+    let depth = thickness - dot(gap, direction);
+    if (depth <= 0.0) {
+        return;
+    }
+    var weight = 0.0;
+    var most = 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        weight += w[k] * w[k] * inv[k];
+        most = max(most, w[k] * inv[k]);
+    }
+    if (weight <= 0.0) {
+        return;
+    }
+    let share = min(weight / most, 1.0);
+    let lambda = share * depth / weight;
+    var relative = vec3<f32>(0.0);
+    for (var k = 0u; k < 4u; k++) {
+        relative += sign[k] * w[k] * state[ids[k]].v.xyz;
+    }
+    let approach = dot(relative, direction);
+    var impulse = vec3<f32>(0.0);
+    if (approach < 0.0) {
+        let sliding = relative - approach * direction;
+        let speed = length(sliding);
+        var friction = 0.0;
+        if (speed > 0.0) {
+            friction = min(sp.friction.x * -approach / speed, 1.0);
+        }
+        impulse = share * (-approach * direction - friction * sliding) / weight;
+    }
+    for (var k = 0u; k < 4u; k++) {
+        let part = sign[k] * w[k] * inv[k];
+        if (part == 0.0) {
+            continue;
+        }
+        let slot = pushes_at() + 8u * ids[k];
+        let dx = (part * lambda) * direction;
+        let dv = part * impulse;
+        for (var c = 0u; c < 3u; c++) {
+            add_fixed(slot + c, dx[c], MOVE_UNIT);
+            add_fixed(slot + 4u + c, dv[c], SPEED_UNIT);
+        }
+        atomicAdd(&atomics[slot + 3u], 1u);
+    }
+}
+
+// Each particle takes the average of the sweep's pushes.
+@compute @workgroup_size(64)
+fn push_apply(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i >= sp.counts.x) {
+        return;
+    }
+    let slot = pushes_at() + 8u * i;
+    let count = atomicLoad(&atomics[slot + 3u]);
+    if (count == 0u) {
+        return;
+    }
+    var dx = vec3<f32>(0.0);
+    var dv = vec3<f32>(0.0);
+    for (var c = 0u; c < 3u; c++) {
+        dx[c] = f32(bitcast<i32>(atomicLoad(&atomics[slot + c]))) * MOVE_UNIT;
+        dv[c] = f32(bitcast<i32>(atomicLoad(&atomics[slot + 4u + c]))) * SPEED_UNIT;
+    }
+    for (var k = 0u; k < 8u; k++) {
+        atomicStore(&atomics[slot + k], 0u);
+    }
+    var q = state[i];
+    let share = 1.0 / f32(count);
+    q.x = vec4<f32>(q.x.xyz + dx * share, q.x.w);
+    q.v = vec4<f32>(q.v.xyz + dv * share, q.v.w);
+    state[i] = q;
+}
+
+// Where particle i is with `share` of its motion over the substep (the one expression both
+// the check and the cut take).
+fn moved_to(i: u32, share: f32) -> vec3<f32> {
+    let a = start[i].x.xyz;
+    return a + share * (state[i].x.xyz - a);
+}
+
+// The largest share in [0, 1] of the motion `moves` from `from` over which the pair's
+// sides stay more than `keep` apart, or half the distance they start at where that is
+// less (the CPU's `safe_fraction`): additive CCD, each advance a share of the gap over
+// the most the sides can close on each other.
+fn safe_fraction(edges: bool, x0_in: array<vec3<f32>, 4>, moves_in: array<vec3<f32>, 4>, keep_at_most: f32) -> f32 {
+    var x0 = x0_in;
+    var moves = moves_in;
+    let k = select(1u, 2u, edges);
+    var alo = vec3<f32>(3.4e38);
+    var ahi = vec3<f32>(-3.4e38);
+    var blo = vec3<f32>(3.4e38);
+    var bhi = vec3<f32>(-3.4e38);
+    var mean = vec3<f32>(0.0);
+    for (var i = 0u; i < 4u; i++) {
+        let to = x0[i] + moves[i];
+        if (i < k) {
+            alo = min(alo, min(x0[i], to));
+            ahi = max(ahi, max(x0[i], to));
+        } else {
+            blo = min(blo, min(x0[i], to));
+            bhi = max(bhi, max(x0[i], to));
+        }
+        mean += 0.25 * moves[i];
+    }
+    let apart = max(blo - ahi, alo - bhi);
+    if (max(apart.x, max(apart.y, apart.z)) > keep_at_most) {
+        return 1.0;
+    }
+    var reach_a = 0.0;
+    var reach_b = 0.0;
+    for (var i = 0u; i < 4u; i++) {
+        let r = length(moves[i] - mean);
+        if (i < k) {
+            reach_a = max(reach_a, r);
+        } else {
+            reach_b = max(reach_b, r);
+        }
+    }
+    // A little more than the bound, for rounding.
+    let speed = (reach_a + reach_b) * (1.0 + 1e-5);
+    if (speed == 0.0) {
+        return 1.0;
+    }
+    let d0 = pair_distance(edges, x0);
+    if (d0 <= 0.0) {
+        return 1.0;
+    }
+    // Kept at least at the floor where the pair starts above twice it, so that no pair
+    // comes nearer than f32 resolves by halving its distance substep after substep.
+    var keep = min(keep_at_most, 0.5 * d0);
+    if (d0 > 2.0 * FLOOR * sp.lengths.x) {
+        keep = max(keep, FLOOR * sp.lengths.x);
+    }
+    if (d0 - speed > keep) {
+        return 1.0;
+    }
+    let stop = keep + 0.1 * (d0 - keep);
+    var t = 0.0;
+    var d = d0;
+    for (var n = 0u; n < 64u; n++) {
+        let step = 0.9 * (d - keep) / speed;
+        if (t + step >= 1.0) {
+            return 1.0;
+        }
+        t += step;
+        var x: array<vec3<f32>, 4>;
+        for (var i = 0u; i < 4u; i++) {
+            x[i] = x0[i] + t * moves[i];
+        }
+        d = pair_distance(edges, x);
+        if (d <= stop) {
+            break;
+        }
+    }
+    return t;
+}
+
+fn share_of(i: u32) -> f32 {
+    return bitcast<f32>(lists[scales_at() + i]);
+}
+
+// One round of cuts: each pair whose sides could come within what is kept along the
+// motion as the last round left it cuts its free particles' motion short (a scaled round:
+// to where the pair is still apart; later ones: to the start).
+@compute @workgroup_size(64)
+fn cut(@builtin(global_invocation_id) id: vec3<u32>) {
+    let r = this_round.x;
+    // A round runs only after one that cut something.
+    if (r > 0u && atomicLoad(&atomics[IMPACTS + r - 1u]) == atomicLoad(&atomics[STUCK + r - 1u])) {
+        return;
+    }
+    let n = min(atomicLoad(&atomics[PAIRS]), sp.more.x);
+    let p = id.x;
+    if (p >= n) {
+        return;
+    }
+    let at = pairs_at() + 4u * p;
+    let raw = vec4<u32>(lists[at], lists[at + 1u], lists[at + 2u], lists[at + 3u]);
+    let edges = (raw.x & EDGES) != 0u;
+    let ids = vec4<u32>(raw.x & ~EDGES, raw.y, raw.z, raw.w);
+    let origin = start[ids.x].x.xyz;
+    var x0: array<vec3<f32>, 4>;
+    var moves: array<vec3<f32>, 4>;
+    for (var k = 0u; k < 4u; k++) {
+        let i = ids[k];
+        x0[k] = start[i].x.xyz - origin;
+        moves[k] = (moved_to(i, share_of(i)) - origin) - x0[k];
+    }
+    let t = safe_fraction(edges, x0, moves, sp.lengths.y);
+    if (t >= 1.0) {
+        return;
+    }
+    atomicAdd(&atomics[IMPACTS + r], 1u);
+    var cut_any = false;
+    for (var k = 0u; k < 4u; k++) {
+        let i = ids[k];
+        let s = share_of(i);
+        if (start[i].x.w > 0.0 && s > 0.0) {
+            let to = select(0.0, s * t, r < SCALED_ROUNDS);
+            atomicMin(&atomics[cuts_at() + i], bitcast<u32>(to));
+            cut_any = true;
+        }
+    }
+    if (!cut_any) {
+        atomicAdd(&atomics[STUCK + r], 1u);
+    }
+}
+
+// Each particle takes the round's cut.
+@compute @workgroup_size(64)
+fn cut_apply(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i < sp.counts.x) {
+        lists[scales_at() + i] = atomicLoad(&atomics[cuts_at() + i]);
+    }
+}
+
+// Each particle ends at its share of its motion, moving at the average velocity of what
+// it kept. Every free particle goes back to its start where the last round recorded
+// still cut something, or the grid's or the pairs' room ran out.
+@compute @workgroup_size(64)
+fn finish(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i >= sp.counts.x) {
+        return;
+    }
+    let last = sp.more.w - 1u;
+    let unfinished = atomicLoad(&atomics[IMPACTS + last]) != atomicLoad(&atomics[STUCK + last]);
+    let entries = atomicLoad(&atomics[ENTRIES]);
+    let pairs = atomicLoad(&atomics[PAIRS]);
+    let overflow = entries > sp.counts.w || pairs > sp.more.x;
+    if (i == 0u) {
+        atomicMax(&atomics[MOST_ENTRIES], entries);
+        atomicMax(&atomics[MOST_PAIRS], pairs);
+    }
+    var s = share_of(i);
+    if ((unfinished || overflow) && start[i].x.w > 0.0) {
+        s = 0.0;
+    }
+    if (s >= 1.0) {
+        return;
+    }
+    var p = state[i];
+    let v = p.v.xyz;
+    let to = moved_to(i, s);
+    p.v = vec4<f32>((to - start[i].x.xyz) / sp.lengths.w, p.v.w);
+    p.x = vec4<f32>(to, p.x.w);
+    state[i] = p;
+    let dv = p.v.xyz - v;
+    if (sp.more.y == 2u) {
+        let word = sp.more.z + 4u * i;
+        for (var k = 0u; k < 3u; k++) {
+            solver[word + k] = bitcast<u32>(bitcast<f32>(solver[word + k]) + dv[k] / sp.lengths.w);
+        }
+    } else if (sp.more.y == 1u) {
+        solver[sp.more.z] = bitcast<u32>(1.0);
+    }
+}
+
+// Copies the substep's start (bound as `start`) into `state` (bound to the kept copy), for
+// an integrator that writes its end over its start.
+@compute @workgroup_size(64)
+fn keep_start(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x < sp.counts.x) {
+        state[id.x] = start[id.x];
+    }
+}

@@ -1,0 +1,110 @@
+//! The contacts that run after each substep on the GPU, in order: the mesh obstacles
+//! (`obstacles.rs`), then the cloth against itself (`self_contact.rs`), whose cuts come
+//! last so that nothing after them can undo its guarantee.
+
+use crate::cloth::ClothModel;
+use crate::sim::{ContactConfig, Effect};
+
+use super::error::GpuError;
+use super::kernel::SubstepKernel;
+use super::obstacles::{Memory, ObstaclePass, Start};
+use super::self_contact::SelfPass;
+
+/// The scene's mesh obstacles and self-contact on the device, where it has them.
+#[derive(Default)]
+pub(super) struct Contacts {
+    pub(super) obstacles: Option<ObstaclePass>,
+    pub(super) own: Option<SelfPass>,
+}
+
+impl Contacts {
+    /// The passes for `model` under `effects` and `contact`, over the particles in
+    /// `particles`.
+    ///
+    /// # Errors
+    /// As [`ObstaclePass::new`] and [`SelfPass::new`].
+    pub(super) fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        kernel: &SubstepKernel,
+        particles: &[wgpu::Buffer; 2],
+        (model, effects, contact): (&ClothModel, &[Effect], &ContactConfig),
+    ) -> Result<Self, GpuError> {
+        let scene = (model, effects, contact);
+        let obstacles = ObstaclePass::new(device, queue, kernel, particles, scene)?;
+        let own = effects.iter().find_map(|e| match e {
+            Effect::SelfCollision(own) => Some(own),
+            _ => None,
+        });
+        let own = match own {
+            Some(own) => SelfPass::new(device, queue, particles, model, own)?,
+            None => None,
+        };
+        Ok(Self { obstacles, own })
+    }
+
+    /// Before a submission of `substeps` substeps of `substep` seconds from `time`: the
+    /// obstacles' poses, self-contact's room and uniform, and what the integrator keeps
+    /// that the contacts change (`memory`).
+    ///
+    /// # Errors
+    /// As [`ObstaclePass::write_poses`] and [`SelfPass::prepare`].
+    pub(super) fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        (substeps, time, substep): (u32, f64, f32),
+        memory: Memory,
+    ) -> Result<(), GpuError> {
+        if let Some(obstacles) = self.obstacles.as_mut() {
+            obstacles.write_poses(device, queue, (substeps, time, substep), memory)?;
+        }
+        if let Some(own) = self.own.as_mut() {
+            own.prepare(device, queue, substep, memory)?;
+        }
+        Ok(())
+    }
+
+    /// Binds the solver's words the contacts tell of what they moved.
+    pub(super) fn attach_solve(
+        &mut self,
+        device: &wgpu::Device,
+        particles: &[wgpu::Buffer; 2],
+        solve: Option<&wgpu::Buffer>,
+    ) {
+        if let Some(obstacles) = self.obstacles.as_mut() {
+            obstacles.attach_solve(device, particles, solve);
+        }
+        if let Some(own) = self.own.as_mut() {
+            own.attach_solve(device, particles, solve);
+        }
+    }
+
+    /// Records copies of the substep's start, `particles[at]`, for an integrator that
+    /// writes its end over it.
+    pub(super) fn keep_start(&self, pass: &mut wgpu::ComputePass<'_>, at: usize) {
+        if let Some(obstacles) = &self.obstacles {
+            obstacles.keep_start(pass, at);
+        }
+        if let Some(own) = &self.own {
+            own.keep_start(pass, at);
+        }
+    }
+
+    /// Records substep `k`'s contacts, where `start` says its start and end are.
+    pub(super) fn encode(&self, pass: &mut wgpu::ComputePass<'_>, k: u32, start: Start) {
+        if let Some(obstacles) = &self.obstacles {
+            obstacles.encode(pass, k, start);
+        }
+        if let Some(own) = &self.own {
+            own.encode(pass, start);
+        }
+    }
+
+    /// Records what is read back after the submission (self-contact's counters).
+    pub(super) fn after_submission(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        if let Some(own) = self.own.as_mut() {
+            own.copy_counters(encoder);
+        }
+    }
+}
