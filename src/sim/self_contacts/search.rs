@@ -158,7 +158,7 @@ impl Owners {
 }
 
 /// Which of each of `model`'s triangles' corners (bits 0–2) and edges (bits 3–5, edge k
-/// from corner k to the next) it owns, as [`Owners`] deals them out: for a search that
+/// from corner k to the next) it owns, as the CPU's search deals them out: for a search that
 /// runs elsewhere (the GPU's) and must keep each pair once, as this one does.
 pub fn owned_parts(model: &ClothModel) -> Vec<u32> {
     let owners = Owners::build(model);
