@@ -70,9 +70,9 @@ const SCALED_ROUNDS: u32 = 4u;
 // Cells a triangle's box may cover and still go into the grid.
 const MOST_CELLS: i32 = 64;
 const EMPTY: u32 = 0xffffffffu;
-// The least separation the check keeps, as a share of the thickness: a thousand times
+// The least separation the check keeps, as a share of the thickness: hundreds of times
 // what f32 resolves on a pair of centimetre-long edges.
-const FLOOR: f32 = 1e-3;
+const FLOOR: f32 = 5e-4;
 const EDGES: u32 = 0x80000000u;
 
 fn heads_at() -> u32 {
@@ -517,11 +517,13 @@ fn safe_fraction(edges: bool, x0_in: array<vec3<f32>, 4>, moves_in: array<vec3<f
     if (d0 <= 0.0) {
         return 1.0;
     }
-    // Kept at least at the floor where the pair starts above twice it, so that no pair
-    // comes nearer than f32 resolves by halving its distance substep after substep.
+    // Never nearer than the floor where the pair starts above it: a pair pressed substep
+    // after substep stops there, where f32 still resolves it, instead of halving its
+    // distance each time (it may still move apart).
     var keep = min(keep_at_most, 0.5 * d0);
-    if (d0 > 2.0 * FLOOR * sp.lengths.x) {
-        keep = max(keep, FLOOR * sp.lengths.x);
+    let floor = FLOOR * sp.lengths.x;
+    if (d0 > floor) {
+        keep = max(keep, floor);
     }
     if (d0 - speed > keep) {
         return 1.0;
