@@ -1,5 +1,5 @@
-// Mesh obstacles on the GPU (prepended with shaders/cloth_layout.wgsl and
-// shaders/contact.wgsl; src/gpu/obstacles.rs
+// Mesh obstacles on the GPU (prepended with shaders/cloth_layout.wgsl,
+// shaders/contact.wgsl and shaders/segments.wgsl; src/gpu/obstacles.rs
 // builds and dispatches them): the CPU's contact with a mesh obstacle, rigid (placed and
 // moved by its keyframes) or deforming (an OBJ sequence, whose surface where each substep
 // ends the host writes for each submission, with each vertex's move over the substep and
@@ -502,43 +502,6 @@ fn catch_moves(@builtin(global_invocation_id) id: vec3<u32>) {
     p.v = vec4<f32>(touching(v, vs, n, ob.info.y, 1.0), p.v.w);
     state[i] = p;
     moved(i, p.v.xyz - v);
-}
-
-// The nearest points of segments a–b and p–q: x where along a–b, y along p–q (the CPU's
-// `segments_closest`, which runs in f64).
-fn segments_closest(p0: vec3<f32>, p1: vec3<f32>, q0: vec3<f32>, q1: vec3<f32>) -> vec2<f32> {
-    let d1 = p1 - p0;
-    let d2 = q1 - q0;
-    let r = p0 - q0;
-    let a = dot(d1, d1);
-    let e = dot(d2, d2);
-    let f = dot(d2, r);
-    let tiny = 1e-20;
-    if (a <= tiny && e <= tiny) {
-        return vec2<f32>(0.0);
-    }
-    if (a <= tiny) {
-        return vec2<f32>(0.0, clamp(f / e, 0.0, 1.0));
-    }
-    let c = dot(d1, r);
-    if (e <= tiny) {
-        return vec2<f32>(clamp(-c / a, 0.0, 1.0), 0.0);
-    }
-    let b = dot(d1, d2);
-    let denom = a * e - b * b;
-    var s = 0.0;
-    if (denom > 0.0) {
-        s = clamp((b * f - c * e) / denom, 0.0, 1.0);
-    }
-    var t = (b * s + f) / e;
-    if (t < 0.0) {
-        t = 0.0;
-        s = clamp(-c / a, 0.0, 1.0);
-    } else if (t > 1.0) {
-        t = 1.0;
-        s = clamp((b - c) / a, 0.0, 1.0);
-    }
-    return vec2<f32>(s, t);
 }
 
 struct EdgeHit {

@@ -1,5 +1,5 @@
-// Self-contact on the GPU (prepended with shaders/cloth_layout.wgsl and
-// shaders/self_contact_geometry.wgsl; src/gpu/self_contact.rs builds and dispatches it):
+// Self-contact on the GPU (prepended with shaders/cloth_layout.wgsl, shaders/segments.wgsl
+// and shaders/self_contact_geometry.wgsl; src/gpu/self_contact.rs builds and dispatches it):
 // the cloth kept off itself after each substep. Each particle's motion over the substep,
 // grown by half the thickness, is its box; each triangle's box (its corners' together)
 // goes into a hashed grid of cells (a list per bucket, linked through an atomic exchange);
@@ -215,6 +215,12 @@ fn particle_hi(i: u32) -> vec3<f32> {
     return boxes[2u * i + 1u].xyz;
 }
 
+// Pair `p` as kept: its four particles, the first with EDGES set for an edge–edge pair.
+fn pair_at(p: u32) -> vec4<u32> {
+    let at = pairs_at() + 4u * p;
+    return vec4<u32>(lists[at], lists[at + 1u], lists[at + 2u], lists[at + 3u]);
+}
+
 fn keep_pair(pair: vec4<u32>) {
     let at = atomicAdd(&atomics[PAIRS], 1u);
     if (at < sp.more.x) {
@@ -342,8 +348,7 @@ fn push(@builtin(global_invocation_id) id: vec3<u32>) {
     if (p >= n) {
         return;
     }
-    let at = pairs_at() + 4u * p;
-    let raw = vec4<u32>(lists[at], lists[at + 1u], lists[at + 2u], lists[at + 3u]);
+    let raw = pair_at(p);
     let edges = (raw.x & EDGES) != 0u;
     let ids = vec4<u32>(raw.x & ~EDGES, raw.y, raw.z, raw.w);
     let thickness = sp.lengths.x;
@@ -568,8 +573,7 @@ fn cut(@builtin(global_invocation_id) id: vec3<u32>) {
     if (p >= n) {
         return;
     }
-    let at = pairs_at() + 4u * p;
-    let raw = vec4<u32>(lists[at], lists[at + 1u], lists[at + 2u], lists[at + 3u]);
+    let raw = pair_at(p);
     let edges = (raw.x & EDGES) != 0u;
     let ids = vec4<u32>(raw.x & ~EDGES, raw.y, raw.z, raw.w);
     let origin = start[ids.x].x.xyz;

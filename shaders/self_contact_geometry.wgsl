@@ -1,7 +1,6 @@
-// The geometry of self-contact's pairs on the GPU (prepended to
-// shaders/self_contact.wgsl): the nearest points of a point and a triangle and of two
-// segments, and a pair's distance, as the CPU's `closest_weights`, `segments_closest`
-// and `distance` give them, in f32.
+// The geometry of self-contact's pairs on the GPU (prepended to shaders/self_contact.wgsl,
+// after shaders/segments.wgsl): the nearest point of a triangle to a point, as the CPU's
+// `closest_weights` gives it, and a pair's distance, in f32.
 
 // The point of triangle (a, b, c) nearest to p.
 fn closest_on_triangle(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
@@ -67,37 +66,3 @@ fn closest_weights(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> ve
     return vec3<f32>(1.0 - v - w, v, w);
 }
 
-// Where along each of segments p0–p1 and q0–q1 their nearest points are.
-fn segments_closest(p0: vec3<f32>, p1: vec3<f32>, q0: vec3<f32>, q1: vec3<f32>) -> vec2<f32> {
-    let d1 = p1 - p0;
-    let d2 = q1 - q0;
-    let r = p0 - q0;
-    let a = dot(d1, d1);
-    let e = dot(d2, d2);
-    let f = dot(d2, r);
-    if (a <= 1e-30 && e <= 1e-30) {
-        return vec2<f32>(0.0);
-    }
-    if (a <= 1e-30) {
-        return vec2<f32>(0.0, clamp(f / e, 0.0, 1.0));
-    }
-    let c = dot(d1, r);
-    if (e <= 1e-30) {
-        return vec2<f32>(clamp(-c / a, 0.0, 1.0), 0.0);
-    }
-    let b = dot(d1, d2);
-    let denom = a * e - b * b;
-    var s = 0.0;
-    if (denom > 0.0) {
-        s = clamp((b * f - c * e) / denom, 0.0, 1.0);
-    }
-    var t = (b * s + f) / e;
-    if (t < 0.0) {
-        t = 0.0;
-        s = clamp(-c / a, 0.0, 1.0);
-    } else if (t > 1.0) {
-        t = 1.0;
-        s = clamp((b - c) / a, 0.0, 1.0);
-    }
-    return vec2<f32>(s, t);
-}

@@ -24,6 +24,8 @@ use super::support::fits;
 use super::xpbd::{Colours, colour_record};
 
 const SOURCE: &str = include_str!("../../shaders/obstacle.wgsl");
+/// The nearest points of two segments (the edge pass's).
+const SEGMENTS: &str = include_str!("../../shaders/segments.wgsl");
 
 /// Bytes of one obstacle's poses in one substep (its start, its end, its number), at an
 /// offset that is a multiple of the device's uniform alignment (at most 256).
@@ -292,7 +294,7 @@ impl ObstaclePass {
         let [catch, edges_pipeline, keep] = pipelines(
             device,
             "obstacles",
-            &format!("{LAYOUT}{CONTACT}{SOURCE}"),
+            &format!("{LAYOUT}{CONTACT}{SEGMENTS}{SOURCE}"),
             [("catch_moves", all), ("edges", all), ("keep_start", all)],
         );
         // The substep's start, for an integrator that writes its end over it (XPBD, VBD).

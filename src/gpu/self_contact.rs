@@ -28,6 +28,8 @@ use super::support::fits;
 const SOURCE: &str = include_str!("../../shaders/self_contact.wgsl");
 /// Its pairs' geometry.
 const GEOMETRY: &str = include_str!("../../shaders/self_contact_geometry.wgsl");
+/// The nearest points of two segments.
+const SEGMENTS: &str = include_str!("../../shaders/segments.wgsl");
 
 /// Rounds of cuts recorded a substep: four by the safe fraction, four to the start (the
 /// shader's counters have room for 16).
@@ -176,7 +178,7 @@ impl SelfPass {
         ] = pipelines(
             device,
             "self-contact",
-            &format!("{LAYOUT}{GEOMETRY}{SOURCE}"),
+            &format!("{LAYOUT}{SEGMENTS}{GEOMETRY}{SOURCE}"),
             [
                 ("clear", all),
                 ("particle_boxes", all),
