@@ -59,8 +59,8 @@ struct SelfParams {
 }
 
 /// Room in the grid and for pairs, per triangle, to start with.
-const ENTRIES_PER_TRIANGLE: u32 = 128;
-const PAIRS_PER_TRIANGLE: u32 = 128;
+const ENTRIES_PER_TRIANGLE: u32 = 16;
+const PAIRS_PER_TRIANGLE: u32 = 16;
 
 /// The cloth's self-contact on the device.
 pub(super) struct SelfPass {
