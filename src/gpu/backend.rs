@@ -15,7 +15,8 @@ pub enum Backend {
     #[default]
     Cpu,
     /// wgpu compute: semi-implicit and implicit Euler, XPBD and VBD; springs, gravity, air damping, wind,
-    /// dihedral bending, pins, handles, spheres and planes, rigid mesh obstacles;
+    /// dihedral bending, pins, handles, spheres and planes, mesh obstacles (rigid or OBJ
+    /// sequences);
     /// with the stability guard.
     Gpu,
 }

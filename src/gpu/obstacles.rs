@@ -77,7 +77,7 @@ pub(super) enum Start {
     Kept(usize),
 }
 
-/// The rigid mesh obstacles of a scene on the device.
+/// The mesh obstacles of a scene on the device.
 pub(super) struct ObstaclePass {
     catch: wgpu::ComputePipeline,
     edges: wgpu::ComputePipeline,

@@ -21,8 +21,8 @@ pub const GPU_INTEGRATORS: [IntegratorKind; 4] = [
 /// What of `step`, `precision` and `effects` the GPU backend cannot run, if anything: it
 /// runs semi-implicit Euler, implicit Euler (one linearised step), XPBD and VBD in `f32` with
 /// gravity, springs (and bend springs), dihedral bending, wind, air damping, pins, handles,
-/// up to four sphere and plane colliders, and up to four rigid mesh obstacles, still or
-/// keyframed.
+/// up to four sphere and plane colliders, and up to four mesh obstacles, still, keyframed
+/// or OBJ sequences.
 pub fn gpu_support(
     step: &StepConfig,
     precision: Precision,
