@@ -71,6 +71,13 @@ impl Owners {
     }
 
     pub(super) fn build(model: &ClothModel) -> Owners {
+        let mut owners = Self::owned(model);
+        owners.neighbours = owners.neighbour_pairs(&model.triangles, model.particle_count());
+        owners
+    }
+
+    /// Which vertices and edges each triangle owns, without the neighbours' pairs.
+    fn owned(model: &ClothModel) -> Owners {
         let mut seen = vec![false; model.particle_count()];
         let mut edges: FxHashMap<[u32; 2], ()> = FxHashMap::default();
         let mut owners = Owners {
@@ -101,7 +108,6 @@ impl Owners {
             owners.vertices.push(v);
             owners.edges.push(e);
         }
-        owners.neighbours = owners.neighbour_pairs(&model.triangles, model.particle_count());
         owners
     }
 
@@ -161,7 +167,7 @@ impl Owners {
 /// from corner k to the next) it owns, as the CPU's search deals them out: for a search that
 /// runs elsewhere (the GPU's) and must keep each pair once, as this one does.
 pub fn owned_parts(model: &ClothModel) -> Vec<u32> {
-    let owners = Owners::build(model);
+    let owners = Owners::owned(model);
     (owners.vertices.iter().zip(&owners.edges))
         .map(|(v, e)| {
             (0..3)
