@@ -20,9 +20,25 @@ fn scene(name: &str, quads: u32) -> Scene {
     Scene::open_resized(name, None, &options, Some(quads)).expect("a grid scene")
 }
 
+/// The height of `sim`'s lowest particle, metres.
+fn lowest(sim: &Simulation) -> f32 {
+    (sim.state().pos.iter())
+        .map(|p| p.y)
+        .fold(f32::INFINITY, f32::min)
+}
+
 /// `frames` frames of `scene` on both backends: how far apart the cloths end, and the
 /// CPU's cloth. The guard acts alike on both (where it acts at all).
 fn compare(scene: Scene, frames: usize) -> (f32, Simulation) {
+    compare_checking(scene, frames, |_, _| {})
+}
+
+/// [`compare`], with `check` run on the GPU's simulation after each frame (by number).
+fn compare_checking(
+    scene: Scene,
+    frames: usize,
+    check: impl Fn(usize, &Simulation),
+) -> (f32, Simulation) {
     let mut cpu = Simulation::new(scene.clone());
     let (mut gpu, _) = gpu_simulation(scene, true).expect("GPU backend on the software adapter");
     for frame in 0..frames {
@@ -33,8 +49,19 @@ fn compare(scene: Scene, frames: usize) -> (f32, Simulation) {
             events[0], events[1],
             "frame {frame}: guard events (CPU, GPU)"
         );
+        check(frame, &gpu);
     }
     (farthest(&cpu.state().pos, &gpu.state().pos), cpu)
+}
+
+/// Fails when any cloth triangle passes through a solid of `sim` (the exact check).
+fn passes_through_nothing(frame: usize, sim: &Simulation) {
+    let found = sim.intersections();
+    assert!(
+        found.obstacles.iter().all(|&n| n == 0),
+        "frame {frame}: {:?}",
+        found.obstacles
+    );
 }
 
 /// `carousel`'s drum, turning at 1 rad/s: the cloth lands on it and is carried round by
@@ -44,9 +71,7 @@ fn compare(scene: Scene, frames: usize) -> (f32, Simulation) {
 #[test]
 fn a_turning_drum_carries_the_cloth_as_on_the_cpu() {
     let (apart, cpu) = compare(scene("carousel", 8), 15);
-    let lowest = (cpu.state().pos.iter())
-        .map(|p| p.y)
-        .fold(f32::INFINITY, f32::min);
+    let lowest = lowest(&cpu);
     // The drum's top is 0.3 m up: the cloth rests on it, not on the ground.
     assert!(
         lowest > 0.1 && lowest < 0.32,
@@ -67,9 +92,7 @@ fn meets_the_table(integrator: IntegratorKind, substeps: u32, iterations: u32, w
     (s.params.step.integrator, s.params.step.substeps) = (integrator, substeps);
     (s.params.solver.tolerance, s.params.solver.max_iterations) = (1e-5, iterations);
     let (apart, cpu) = compare(s, 16);
-    let lowest = (cpu.state().pos.iter())
-        .map(|p| p.y)
-        .fold(f32::INFINITY, f32::min);
+    let lowest = lowest(&cpu);
     assert!(lowest < 0.74, "the cloth falls past the rim: {lowest}");
     eprintln!("tablecloth under {integrator:?}: {apart:e} m apart");
     assert!(apart < within, "GPU and CPU differ by {apart} m");
@@ -125,16 +148,9 @@ fn a_tablecloth_on_the_gpu_never_passes_through_the_table() {
     let (mut gpu, _) = gpu_simulation(scene("tablecloth", 8), true).expect("GPU backend");
     for frame in 0..30 {
         gpu.step_frame().expect("gpu frame");
-        let found = gpu.intersections();
-        assert!(
-            found.obstacles.iter().all(|&n| n == 0),
-            "frame {frame}: {:?}",
-            found.obstacles
-        );
+        passes_through_nothing(frame, &gpu);
     }
-    let lowest = (gpu.state().pos.iter())
-        .map(|p| p.y)
-        .fold(f32::INFINITY, f32::min);
+    let lowest = lowest(&gpu);
     assert!(lowest < 0.5, "the cloth hangs over the rim: {lowest}");
 }
 
@@ -167,9 +183,7 @@ fn a_table_thrown_up_through_the_cloth_sweeps_it_along_as_on_the_cpu() {
     let moves = "obj = \"table.obj\"\nkeyframes = [ { time = 0.0, translate = [0.0, -3.0, 0.0] }, \
                  { time = 0.0666667, translate = [0.0, 1.0, 0.0] } ]\n";
     let (apart, cpu) = compare(thrown_table(moves, &table_dir()), 5);
-    let lowest = (cpu.state().pos.iter())
-        .map(|p| p.y)
-        .fold(f32::INFINITY, f32::min);
+    let lowest = lowest(&cpu);
     eprintln!("thrown table: {apart:e} m apart, lowest {lowest}");
     assert!(
         lowest > 2.5,
@@ -212,9 +226,7 @@ fn a_table_thrown_up_as_an_obj_sequence_sweeps_the_cloth_along_as_on_the_cpu() {
     let pattern = dir.path().join("table_%d.obj");
     let moves = format!("frames = '{}'\nfps = 15.0\n", pattern.display());
     let (apart, cpu) = compare(thrown_table(&moves, dir.path()), 6);
-    let lowest = (cpu.state().pos.iter())
-        .map(|p| p.y)
-        .fold(f32::INFINITY, f32::min);
+    let lowest = lowest(&cpu);
     eprintln!("thrown sequence: {apart:e} m apart, lowest {lowest}");
     assert!(
         lowest > 3.5,
@@ -230,23 +242,8 @@ fn a_table_thrown_up_as_an_obj_sequence_sweeps_the_cloth_along_as_on_the_cpu() {
 /// twelve; with no surface velocity where the edge pass moves the cloth, 2.6 cm.
 #[test]
 fn a_napkin_on_a_bending_arm_moves_as_on_the_cpu() {
-    let arm = scene("arm", 7);
-    let mut cpu = Simulation::new(arm.clone());
-    let (mut gpu, _) = gpu_simulation(arm, true).expect("GPU backend");
-    for frame in 0..16 {
-        cpu.step_frame().expect("cpu frame");
-        gpu.step_frame().expect("gpu frame");
-        let found = gpu.intersections();
-        assert!(
-            found.obstacles.iter().all(|&n| n == 0),
-            "frame {frame}: {:?}",
-            found.obstacles
-        );
-    }
-    let apart = farthest(&cpu.state().pos, &gpu.state().pos);
-    let lowest = (cpu.state().pos.iter())
-        .map(|p| p.y)
-        .fold(f32::INFINITY, f32::min);
+    let (apart, cpu) = compare_checking(scene("arm", 7), 16, passes_through_nothing);
+    let lowest = lowest(&cpu);
     eprintln!("arm: {apart:e} m apart, lowest {lowest}");
     // The arm's top is 0.85 m up: the napkin hangs from it, above the ground.
     assert!(
