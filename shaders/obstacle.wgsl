@@ -1,5 +1,5 @@
 // Mesh obstacles on the GPU (prepended with shaders/cloth_layout.wgsl,
-// shaders/contact.wgsl and shaders/segments.wgsl; src/gpu/obstacles.rs
+// shaders/contact.wgsl and shaders/geometry.wgsl; src/gpu/obstacles.rs
 // builds and dispatches them): the CPU's contact with a mesh obstacle, rigid (placed and
 // moved by its keyframes) or deforming (an OBJ sequence, whose surface where each substep
 // ends the host writes for each submission, with each vertex's move over the substep and
@@ -187,50 +187,6 @@ fn corner(o: u32, place: u32, k: u32) -> vec3<f32> {
 
 fn face_normal(o: u32, place: u32) -> vec3<f32> {
     return surface[starts(o).y + 4u * place + 3u].xyz;
-}
-
-// Ericson's closest point of triangle (a, b, c) to p, as weights (the CPU's
-// `closest_weights`).
-fn closest_on_triangle(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
-    let ab = b - a;
-    let ac = c - a;
-    let ap = p - a;
-    let d1 = dot(ab, ap);
-    let d2 = dot(ac, ap);
-    if (d1 <= 0.0 && d2 <= 0.0) {
-        return a;
-    }
-    let bp = p - b;
-    let d3 = dot(ab, bp);
-    let d4 = dot(ac, bp);
-    if (d3 >= 0.0 && d4 <= d3) {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-        let v = d1 / (d1 - d3);
-        return (1.0 - v) * a + v * b;
-    }
-    let cp = p - c;
-    let d5 = dot(ab, cp);
-    let d6 = dot(ac, cp);
-    if (d6 >= 0.0 && d5 <= d6) {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-        let w = d2 / (d2 - d6);
-        return (1.0 - w) * a + w * c;
-    }
-    let va = d3 * d6 - d5 * d4;
-    if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (1.0 - w) * b + w * c;
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let v = vb * denom;
-    let w = vc * denom;
-    return (1.0 - v - w) * a + v * b + w * c;
 }
 
 // Where along from→to the segment crosses triangle (a, b, c), or -1 (the CPU's

@@ -1,5 +1,5 @@
-// Self-contact on the GPU (prepended with shaders/cloth_layout.wgsl, shaders/segments.wgsl
-// and shaders/self_contact_geometry.wgsl; src/gpu/self_contact.rs builds and dispatches it):
+// Self-contact on the GPU (prepended with shaders/cloth_layout.wgsl and
+// shaders/geometry.wgsl; src/gpu/self_contact.rs builds and dispatches it):
 // the cloth kept off itself after each substep. Each particle's motion over the substep,
 // grown by half the thickness, is its box; each triangle's box (its corners' together)
 // goes into a hashed grid of cells (a list per bucket, linked through an atomic exchange);
@@ -215,10 +215,22 @@ fn particle_hi(i: u32) -> vec3<f32> {
     return boxes[2u * i + 1u].xyz;
 }
 
-// Pair `p` as kept: its four particles, the first with EDGES set for an edge–edge pair.
-fn pair_at(p: u32) -> vec4<u32> {
+// A pair kept: an edge–edge pair or a vertex–triangle one, and its four particles.
+struct Pair {
+    edges: bool,
+    ids: vec4<u32>,
+}
+
+// The pairs kept this substep (those that had room).
+fn pairs_kept() -> u32 {
+    return min(atomicLoad(&atomics[PAIRS]), sp.more.x);
+}
+
+// Pair `p` (stored with EDGES set in its first particle for an edge–edge pair).
+fn pair_at(p: u32) -> Pair {
     let at = pairs_at() + 4u * p;
-    return vec4<u32>(lists[at], lists[at + 1u], lists[at + 2u], lists[at + 3u]);
+    let first = lists[at];
+    return Pair((first & EDGES) != 0u, vec4<u32>(first & ~EDGES, lists[at + 1u], lists[at + 2u], lists[at + 3u]));
 }
 
 fn keep_pair(pair: vec4<u32>) {
@@ -343,14 +355,12 @@ fn add_fixed(at: u32, x: f32, unit: f32) {
 // each particle then takes the average of its pushes.
 @compute @workgroup_size(64)
 fn push(@builtin(global_invocation_id) id: vec3<u32>) {
-    let n = min(atomicLoad(&atomics[PAIRS]), sp.more.x);
-    let p = id.x;
-    if (p >= n) {
+    if (id.x >= pairs_kept()) {
         return;
     }
-    let raw = pair_at(p);
-    let edges = (raw.x & EDGES) != 0u;
-    let ids = vec4<u32>(raw.x & ~EDGES, raw.y, raw.z, raw.w);
+    let pair = pair_at(id.x);
+    let edges = pair.edges;
+    let ids = pair.ids;
     let thickness = sp.lengths.x;
     let origin = state[ids.x].x.xyz;
     let origin0 = start[ids.x].x.xyz;
@@ -475,6 +485,20 @@ fn moved_to(i: u32, share: f32) -> vec3<f32> {
     return a + share * (state[i].x.xyz - a);
 }
 
+// The distance between segments p0–p1 and q0–q1.
+fn segments_distance(p0: vec3<f32>, p1: vec3<f32>, q0: vec3<f32>, q1: vec3<f32>) -> f32 {
+    let st = segments_closest(p0, p1, q0, q1);
+    return length((p0 + st.x * (p1 - p0)) - (q0 + st.y * (q1 - q0)));
+}
+
+// The distance between the pair's sides with its particles at x (relative to one point).
+fn pair_distance(edges: bool, x: array<vec3<f32>, 4>) -> f32 {
+    if (edges) {
+        return segments_distance(x[0], x[1], x[2], x[3]);
+    }
+    return length(x[0] - closest_on_triangle(x[0], x[1], x[2], x[3]));
+}
+
 // The largest share in [0, 1] of the motion `moves` from `from` over which the pair's
 // sides stay more than `keep` apart, or half the distance they start at where that is
 // less (the CPU's `safe_fraction`): additive CCD, each advance a share of the gap over
@@ -568,14 +592,12 @@ fn cut(@builtin(global_invocation_id) id: vec3<u32>) {
     if (r > 0u && atomicLoad(&atomics[IMPACTS + r - 1u]) == atomicLoad(&atomics[STUCK + r - 1u])) {
         return;
     }
-    let n = min(atomicLoad(&atomics[PAIRS]), sp.more.x);
-    let p = id.x;
-    if (p >= n) {
+    if (id.x >= pairs_kept()) {
         return;
     }
-    let raw = pair_at(p);
-    let edges = (raw.x & EDGES) != 0u;
-    let ids = vec4<u32>(raw.x & ~EDGES, raw.y, raw.z, raw.w);
+    let pair = pair_at(id.x);
+    let edges = pair.edges;
+    let ids = pair.ids;
     let origin = start[ids.x].x.xyz;
     var x0: array<vec3<f32>, 4>;
     var moves: array<vec3<f32>, 4>;

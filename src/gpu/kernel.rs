@@ -13,6 +13,9 @@ pub(super) const COMMON: &str = concat!(
     include_str!("../../shaders/contact.wgsl"),
     include_str!("../../shaders/step_common.wgsl")
 );
+/// The closest points of a triangle and of two segments, which the obstacles and
+/// self-contact share.
+pub(super) const GEOMETRY: &str = include_str!("../../shaders/geometry.wgsl");
 /// The contact response every contact shares (part of [`COMMON`] too).
 pub(super) const CONTACT: &str = include_str!("../../shaders/contact.wgsl");
 /// Semi-implicit Euler's and XPBD's entry points.

@@ -17,15 +17,13 @@ use crate::sim::{ContactConfig, Effect, Obstacle, RigidMotion};
 
 use super::error::GpuError;
 use super::kernel::{
-    CONTACT, LAYOUT, Slot, SubstepKernel, WORKGROUP, layout, pipelines, start_end_groups,
+    CONTACT, GEOMETRY, LAYOUT, Slot, SubstepKernel, WORKGROUP, layout, pipelines, start_end_groups,
 };
 use super::packing::MAX_OBSTACLES;
 use super::support::fits;
 use super::xpbd::{Colours, colour_record};
 
 const SOURCE: &str = include_str!("../../shaders/obstacle.wgsl");
-/// The nearest points of two segments (the edge pass's).
-const SEGMENTS: &str = include_str!("../../shaders/segments.wgsl");
 
 /// Bytes of one obstacle's poses in one substep (its start, its end, its number), at an
 /// offset that is a multiple of the device's uniform alignment (at most 256).
@@ -152,14 +150,17 @@ fn push_surface(s: &Surface, out: &mut Vec<[f32; 4]>) -> ([u32; 4], [u32; 4]) {
     )
 }
 
-/// Appends a deforming obstacle's surface where a substep ends, each vertex's move over the
-/// substep and velocity after it (the shader's layout of it, which [`pack`] gave).
-fn push_moment(moment: &Moment, out: &mut Vec<[f32; 4]>) {
-    push_surface(&moment.surface, out);
+/// Appends a deforming obstacle's surface where a substep ends, then each vertex's move
+/// over the substep and velocity after it; returns where its parts start (the fields
+/// last) and how many there are.
+fn push_moment(moment: &Moment, out: &mut Vec<[f32; 4]>) -> ([u32; 4], [u32; 4], u32) {
+    let (starts, counts) = push_surface(&moment.surface, out);
+    let fields = out.len() as u32;
     for (shift, velocity) in moment.shift.iter().zip(&moment.velocity) {
         out.push([shift.x, shift.y, shift.z, 0.0]);
         out.push([velocity.x, velocity.y, velocity.z, 0.0]);
     }
+    (starts, counts, fields)
 }
 
 /// How an obstacle moves.
@@ -198,10 +199,8 @@ fn pack(
             Some(sequence) => {
                 // Laid out from 0: each substep's copy starts where its poses say.
                 let mut layout = Vec::new();
-                push_moment(&sequence.moment(0.0, 0.0), &mut layout);
-                let (starts, counts) = push_surface(&placed.surface, &mut Vec::new());
-                let fields = layout.len() - 2 * placed.surface.vertices().len();
-                info[2] = f32::from_bits(fields as u32);
+                let (starts, counts, fields) = push_moment(&sequence.moment(0.0, 0.0), &mut layout);
+                info[2] = f32::from_bits(fields);
                 info[3] = 1.0;
                 let entries = layout.len() as u32;
                 let obstacle = Box::new(obstacle.clone());
@@ -294,7 +293,7 @@ impl ObstaclePass {
         let [catch, edges_pipeline, keep] = pipelines(
             device,
             "obstacles",
-            &format!("{LAYOUT}{CONTACT}{SEGMENTS}{SOURCE}"),
+            &format!("{LAYOUT}{CONTACT}{GEOMETRY}{SOURCE}"),
             [("catch_moves", all), ("edges", all), ("keep_start", all)],
         );
         // The substep's start, for an integrator that writes its end over it (XPBD, VBD).

@@ -21,15 +21,11 @@ use crate::device::map_read;
 use crate::sim::{SelfCollision, owned_parts};
 
 use super::error::GpuError;
-use super::kernel::{LAYOUT, Slot, WORKGROUP, layout, pipelines, start_end_groups};
+use super::kernel::{GEOMETRY, LAYOUT, Slot, WORKGROUP, layout, pipelines, start_end_groups};
 use super::obstacles::{Memory, Start};
 use super::support::fits;
 
 const SOURCE: &str = include_str!("../../shaders/self_contact.wgsl");
-/// Its pairs' geometry.
-const GEOMETRY: &str = include_str!("../../shaders/self_contact_geometry.wgsl");
-/// The nearest points of two segments.
-const SEGMENTS: &str = include_str!("../../shaders/segments.wgsl");
 
 /// Rounds of cuts recorded a substep: four by the safe fraction, four to the start (the
 /// shader's counters have room for 16).
@@ -178,7 +174,7 @@ impl SelfPass {
         ] = pipelines(
             device,
             "self-contact",
-            &format!("{LAYOUT}{SEGMENTS}{GEOMETRY}{SOURCE}"),
+            &format!("{LAYOUT}{GEOMETRY}{SOURCE}"),
             [
                 ("clear", all),
                 ("particle_boxes", all),
