@@ -3,9 +3,9 @@
 
 use crate::sim::{StepError, StepReport};
 
+use super::contacts::Start;
 use super::error::GpuError;
 use super::implicit::FIRST_CHUNK;
-use super::obstacles::Start;
 use super::stepper::GpuStepper;
 
 impl GpuStepper {

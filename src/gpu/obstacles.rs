@@ -15,6 +15,7 @@ use crate::cloth::ClothModel;
 use crate::sim::obstacle::{Moment, Surface, TriangleTree};
 use crate::sim::{ContactConfig, Effect, Obstacle, RigidMotion};
 
+use super::contacts::{Memory, Start};
 use super::error::GpuError;
 use super::kernel::{
     CONTACT, GEOMETRY, LAYOUT, Slot, SubstepKernel, WORKGROUP, layout, pipelines, start_end_groups,
@@ -50,29 +51,6 @@ struct GpuObstacle {
 struct ObstacleParams {
     counts: [u32; 4],
     obstacles: [GpuObstacle; MAX_OBSTACLES],
-}
-
-/// What the integrator keeps that a contact changes, which the contacts then update, in
-/// the words [`ObstaclePass::attach_solve`] bound.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Memory {
-    None,
-    /// Implicit Euler's first guess, whose flag is this word of its solve: a contact that
-    /// moves a particle leaves the guess no history.
-    Guess(u32),
-    /// VBD's last accelerations, from this word of its stencil, four a particle: a contact
-    /// adds its change of velocity over the substep.
-    Accelerations(u32),
-}
-
-/// Where a substep's start and end are for the contacts.
-#[derive(Clone, Copy, Debug)]
-pub(super) enum Start {
-    /// The start in `particles[i]`, the end in the other (semi-implicit Euler).
-    In(usize),
-    /// The start in the copy [`ObstaclePass::keep_start`] made, the end in `particles[i]`
-    /// (XPBD and VBD, which write their end over their start).
-    Kept(usize),
 }
 
 /// The mesh obstacles of a scene on the device.

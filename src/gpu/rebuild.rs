@@ -5,10 +5,10 @@
 use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{Effect, IntegratorKind, StepError};
 
+use super::contacts::Memory;
 use super::elements::{elements_wanted, pack_elements};
 use super::error::GpuError;
 use super::implicit::{ImplicitPass, MOVED_FLAG};
-use super::obstacles::Memory;
 use super::stepper::GpuStepper;
 use super::support::fits_elements;
 use super::vbd::VbdPass;

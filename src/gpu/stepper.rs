@@ -17,14 +17,13 @@ use crate::sim::{
     air_damping_of, gravity_of,
 };
 
-use super::contacts::Contacts;
+use super::contacts::{Contacts, Start};
 use super::elements::{ElementKernel, pack_elements};
 use super::error::GpuError;
 use super::handles::Carried;
 use super::health::{HealthKernel, Watch};
 use super::implicit::ImplicitPass;
 use super::kernel::{SubstepKernel, WORKGROUP};
-use super::obstacles::Start;
 use super::packing::{
     ClassTable, EndsKey, Neighbour, Params, Particle, classify, grid_of, pack_solids, pack_springs,
 };
