@@ -3,10 +3,10 @@
 
 use crate::sim::{StepError, StepReport};
 
-use super::contacts::Start;
 use super::error::GpuError;
 use super::implicit::FIRST_CHUNK;
 use super::stepper::GpuStepper;
+use super::substep_ends::Start;
 
 impl GpuStepper {
     /// Encodes `substeps` implicit-Euler substeps into `encoder`, submitting it (and going

@@ -4,7 +4,7 @@
 //! [`crate::sim::StepBackend`] seam. What it runs (`support`), how it lays the cloth out
 //! (`packing`), its kernels (`kernel`, `elements`, `health`, `xpbd`, `vbd`,
 //! `implicit`, with its substeps in `implicit_steps`; the contacts after each substep,
-//! `contacts`, `obstacles`, `self_contact`), the stepper that
+//! `contacts`, `obstacles`, `self_contact`, what they share in `substep_ends`), the stepper that
 //! drives them (`stepper`)
 //! and the guard's frame with its rollback points on the device (`guarded`, `snapshot`) are
 //! files of their own; it reaches the device through [`crate::device`] only.
@@ -25,6 +25,7 @@ mod rebuild;
 mod self_contact;
 mod snapshot;
 mod stepper;
+mod substep_ends;
 mod support;
 mod vbd;
 mod xpbd;

@@ -15,12 +15,12 @@ use crate::cloth::ClothModel;
 use crate::sim::obstacle::{Moment, Surface, TriangleTree};
 use crate::sim::{ContactConfig, Effect, Obstacle, RigidMotion};
 
-use super::contacts::{Memory, Start};
 use super::error::GpuError;
 use super::kernel::{
     CONTACT, GEOMETRY, LAYOUT, Slot, SubstepKernel, WORKGROUP, layout, pipelines, start_end_groups,
 };
 use super::packing::MAX_OBSTACLES;
+use super::substep_ends::{Memory, Start};
 use super::support::fits;
 use super::xpbd::{Colours, colour_record};
 

@@ -5,11 +5,11 @@
 use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{Effect, IntegratorKind, StepError};
 
-use super::contacts::Memory;
 use super::elements::{elements_wanted, pack_elements};
 use super::error::GpuError;
 use super::implicit::{ImplicitPass, MOVED_FLAG};
 use super::stepper::GpuStepper;
+use super::substep_ends::Memory;
 use super::support::fits_elements;
 use super::vbd::VbdPass;
 use super::xpbd::XpbdPass;

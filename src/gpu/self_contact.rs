@@ -20,9 +20,9 @@ use crate::cloth::ClothModel;
 use crate::device::map_read;
 use crate::sim::{SelfCollision, owned_parts};
 
-use super::contacts::{Memory, Start};
 use super::error::GpuError;
 use super::kernel::{GEOMETRY, LAYOUT, Slot, WORKGROUP, layout, pipelines, start_end_groups};
+use super::substep_ends::{Memory, Start};
 use super::support::fits;
 
 const SOURCE: &str = include_str!("../../shaders/self_contact.wgsl");

@@ -17,7 +17,7 @@ use crate::sim::{
     air_damping_of, gravity_of,
 };
 
-use super::contacts::{Contacts, Start};
+use super::contacts::Contacts;
 use super::elements::{ElementKernel, pack_elements};
 use super::error::GpuError;
 use super::handles::Carried;
@@ -28,6 +28,7 @@ use super::packing::{
     ClassTable, EndsKey, Neighbour, Params, Particle, classify, grid_of, pack_solids, pack_springs,
 };
 use super::snapshot::DeviceSnapshot;
+use super::substep_ends::Start;
 use super::support::{check_device, fits_buffers, gpu_support_trying};
 use super::vbd::VbdPass;
 use super::xpbd::XpbdPass;
