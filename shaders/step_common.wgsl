@@ -6,15 +6,6 @@
 // element forces' gather, the colliders, and a substep's end for a pinned particle and a
 // free one.
 
-struct Collider {
-    // x: kind (0 none, 1 sphere, 2 plane); y: radius; z: friction.
-    info: vec4<f32>,
-    // Sphere: centre; plane: a point on it.
-    a: vec4<f32>,
-    // Sphere: angular velocity (rad/s); plane: unit normal.
-    b: vec4<f32>,
-}
-
 struct Params {
     // xyz: gravity (m/s²); w: substep length h (s).
     gravity: vec4<f32>,
@@ -61,35 +52,6 @@ struct Params {
 
 // Lengths at or below this are taken as zero (the CPU's `Real::TINY_LENGTH` for f32).
 const TINY_LENGTH: f32 = 1e-9;
-
-// The first point where the segment a→b (relative to the centre) enters the sphere of
-// radius r, if it starts outside and crosses in during the segment.
-fn first_entry(a: vec3<f32>, b: vec3<f32>, r: f32) -> vec4<f32> {
-    let d = b - a;
-    let aa = dot(a, a);
-    let dd = dot(d, d);
-    if (aa < r * r || dd == 0.0) {
-        return vec4<f32>(0.0);
-    }
-    let half_b = dot(a, d);
-    let disc = half_b * half_b - dd * (aa - r * r);
-    if (half_b >= 0.0 || disc < 0.0) {
-        return vec4<f32>(0.0);
-    }
-    let t = (-half_b - sqrt(disc)) / dd;
-    if (t < 0.0 || t > 1.0) {
-        return vec4<f32>(0.0);
-    }
-    return vec4<f32>(a + t * d, 1.0);
-}
-
-fn unit_or_up(p: vec3<f32>) -> vec3<f32> {
-    let len = length(p);
-    if (len > 1e-9) {
-        return p / len;
-    }
-    return vec3<f32>(0.0, 1.0, 0.0);
-}
 
 // The pull (N) of a spring of stiffness and damping `kc.xy` and rest length `rest` from a
 // particle at `x` moving at `v` to the particle `o`.
@@ -151,57 +113,10 @@ fn element_force(i: u32) -> vec3<f32> {
     return f;
 }
 
-struct Motion {
-    x: vec3<f32>,
-    v: vec3<f32>,
-}
-
 // `end` (position and velocity after a substep that started at `x`) with the sphere and
 // plane colliders resolved against the substep's path, with friction.
 fn collide(x: vec3<f32>, end: Motion) -> Motion {
-    var nx = end.x;
-    var nv = end.v;
-    let offset = params.drag.y;
-    for (var c = 0u; c < params.counts.y; c = c + 1u) {
-        let col = params.colliders[c];
-        let mu = col.info.z;
-        var caught = false;
-        var n = vec3<f32>(0.0, 1.0, 0.0);
-        var v_surface = vec3<f32>(0.0);
-        if (col.info.x == 1.0) {
-            let centre = col.a.xyz;
-            let radius = col.info.y;
-            let reach = radius + offset;
-            let entry = first_entry(x - centre, nx - centre, reach);
-            let to = nx - centre;
-            if (entry.w == 1.0 || dot(to, to) < reach * reach) {
-                var moved = to;
-                if (entry.w == 1.0) {
-                    let hit = entry.xyz;
-                    let hn = unit_or_up(hit);
-                    let rest = to - hit;
-                    moved = hit + rest - min(dot(rest, hn), 0.0) * hn;
-                }
-                let len = length(moved);
-                n = unit_or_up(moved);
-                nx = centre + n * max(reach, len);
-                v_surface = cross(col.b.xyz, n * radius);
-                caught = true;
-            }
-        } else if (col.info.x == 2.0) {
-            let normal = col.b.xyz;
-            let depth = offset - dot(nx - col.a.xyz, normal);
-            if (depth > 0.0) {
-                nx = nx + depth * normal;
-                n = normal;
-                caught = true;
-            }
-        }
-        if (caught) {
-            nv = touching(nv, v_surface, n, mu, 1.0);
-        }
-    }
-    return Motion(nx, nv);
+    return collide_among(params.colliders, params.counts.y, params.drag.y, x, end);
 }
 
 // A pinned particle `me` where its handle puts it at the end of the submission's current
