@@ -1,5 +1,5 @@
-// Self-contact on the GPU (prepended with shaders/cloth_layout.wgsl and
-// shaders/geometry.wgsl; src/gpu/self_contact.rs builds and dispatches it):
+// Self-contact on the GPU (prepended with shaders/cloth_layout.wgsl, shaders/contact.wgsl
+// and shaders/geometry.wgsl; src/gpu/self_contact.rs builds and dispatches it):
 // the cloth kept off itself after each substep. Each particle's motion over the substep,
 // grown by half the thickness, is its box; each triangle's box (its corners' together)
 // goes into a hashed grid of cells (a list per bucket, linked through an atomic exchange);
@@ -9,7 +9,9 @@
 // boxes overlap. A triangle whose box covers too many cells is checked against every
 // triangle instead. The pairs closer than the thickness at the substep's end are pushed a
 // thickness apart, side by side, each particle taking the average of its pushes (in fixed
-// point, so the sum is the same in any order); the search runs again on the motion as
+// point, so the sum is the same in any order), a particle resting on a sphere or plane
+// moving only where nothing else in its pair can (the CPU's `held`); the colliders then
+// act again on what the pushes moved into them; the search runs again on the motion as
 // pushed, and its pairs go through rounds of conservative continuous collision detection
 // (additive CCD, as the CPU's, in f32 on coordinates taken from the pair's first
 // particle): a pair whose sides could come within a tenth of the thickness along the
@@ -27,8 +29,12 @@ struct SelfParams {
     // x: thickness (m); y: the separation the check keeps (m); z: the grid's cell (m);
     // w: the substep (s).
     lengths: vec4<f32>,
-    // x: Coulomb friction between layers.
+    // x: Coulomb friction between layers; y: the colliders' offset (m).
     friction: vec4<f32>,
+    // x: how many colliders.
+    solids: vec4<u32>,
+    // The sphere and plane colliders (the step's).
+    colliders: array<Collider, 4>,
 }
 
 @group(0) @binding(0) var<uniform> sp: SelfParams;
@@ -70,8 +76,8 @@ const SCALED_ROUNDS: u32 = 4u;
 // Cells a triangle's box may cover and still go into the grid.
 const MOST_CELLS: i32 = 64;
 const EMPTY: u32 = 0xffffffffu;
-// The least separation the check keeps, as a share of the thickness: hundreds of times
-// what f32 resolves on a pair of centimetre-long edges.
+// The least separation the check keeps, as a share of the thickness (or four times what
+// f32 resolves at the pair's coordinates, where that is more).
 const FLOOR: f32 = 5e-4;
 const EDGES: u32 = 0x80000000u;
 
@@ -84,7 +90,7 @@ fn cuts_at() -> u32 {
 }
 
 // Each particle's pushes in a sweep, in fixed point (8 words: its move, how many pushed
-// it, its change of velocity), after the cuts.
+// it, its change of velocity, and 1 where it rests on a collider), after the cuts.
 fn pushes_at() -> u32 {
     return COUNTERS + sp.counts.z + sp.counts.x;
 }
@@ -149,9 +155,51 @@ fn particle_boxes(@builtin(global_invocation_id) id: vec3<u32>) {
     boxes[2u * i + 1u] = vec4<f32>(max(a, b) + g, 0.0);
     lists[scales_at() + i] = bitcast<u32>(1.0);
     atomicStore(&atomics[cuts_at() + i], bitcast<u32>(1.0));
-    for (var k = 0u; k < 8u; k++) {
-        atomicStore(&atomics[pushes_at() + 8u * i + k], 0u);
+    for (var k = 0u; k < HELD; k++) {
+        atomicStore(&atomics[pushes_at() + PUSH_WORDS * i + k], 0u);
     }
+    atomicStore(&atomics[pushes_at() + PUSH_WORDS * i + HELD], select(0u, 1u, on_solid(b)));
+    atomicStore(&atomics[owner_at(i)], 0u);
+}
+
+// The word of a particle's eight where it rests on a collider.
+const HELD: u32 = 7u;
+const PUSH_WORDS: u32 = 8u;
+
+// Whether a particle at `x` rests on a sphere or plane (within a hair of where the
+// colliders put what they catch).
+fn on_solid(x: vec3<f32>) -> bool {
+    let offset = sp.friction.y;
+    for (var c = 0u; c < sp.solids.x; c++) {
+        let col = sp.colliders[c];
+        let hair = 1e-5 * (col.info.y + offset) + 1e-6;
+        if (col.info.x == 1.0 && length(x - col.a.xyz) <= col.info.y + offset + hair) {
+            return true;
+        }
+        if (col.info.x == 2.0 && dot(x - col.a.xyz, col.b.xyz) <= offset + hair) {
+            return true;
+        }
+    }
+    return false;
+}
+
+fn held(i: u32) -> bool {
+    return atomicLoad(&atomics[pushes_at() + PUSH_WORDS * i + HELD]) != 0u;
+}
+
+// The colliders act again on the substep's end, as pushed (a stack pressed its lowest
+// layer into one).
+@compute @workgroup_size(64)
+fn solids(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i >= sp.counts.x || start[i].x.w <= 0.0) {
+        return;
+    }
+    var q = state[i];
+    let out = collide_among(sp.colliders, sp.solids.x, sp.friction.y, start[i].x.xyz, Motion(q.x.xyz, q.v.xyz));
+    q.x = vec4<f32>(out.x, q.x.w);
+    q.v = vec4<f32>(out.v, q.v.w);
+    state[i] = q;
 }
 
 fn triangle_box_at(t: u32) -> u32 {
@@ -241,6 +289,7 @@ fn keep_pair(pair: vec4<u32>) {
         lists[p + 1u] = pair.y;
         lists[p + 2u] = pair.z;
         lists[p + 3u] = pair.w;
+        lists[done_at(at)] = 0u;
     }
 }
 
@@ -344,21 +393,36 @@ fn find(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 
+// How hard the pair is to move at its closest points' weights `w`, its particles' inverse
+// masses `inv`.
+fn pair_weight(w: array<f32, 4>, inv: array<f32, 4>) -> f32 {
+    var weight = 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        weight += w[k] * w[k] * inv[k];
+    }
+    return weight;
+}
+
 fn add_fixed(at: u32, x: f32, unit: f32) {
     let n = i32(clamp(x / unit, -1.0e9, 1.0e9));
     atomicAdd(&atomics[at], bitcast<u32>(n));
 }
 
-// One sweep of the pushes, side by side: each pair whose sides are closer than the
-// thickness at the substep's end is pushed a thickness apart on the side it started on,
-// as the CPU's `push_apart` pushes it (with Coulomb friction on its relative sliding);
-// each particle then takes the average of its pushes.
-@compute @workgroup_size(64)
-fn push(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= pairs_kept()) {
-        return;
-    }
-    let pair = pair_at(id.x);
+// A pair's push: each of its particles' move and change of velocity (`pushed` false where
+// its sides are a thickness apart already).
+struct Push {
+    pushed: bool,
+    dx: array<vec3<f32>, 4>,
+    dv: array<vec3<f32>, 4>,
+}
+
+// The push that keeps the pair's sides a thickness apart at the substep's end, on the side
+// they started on (the CPU's `push_apart`, with Coulomb friction on their sliding): each
+// particle moves by its share (its weight times its inverse mass), what rests on a
+// collider only where nothing else in the pair can.
+fn push_of(pair: Pair) -> Push {
+    var none: Push;
+    none.pushed = false;
     let edges = pair.edges;
     let ids = pair.ids;
     let thickness = sp.lengths.x;
@@ -392,7 +456,7 @@ fn push(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let dist = length(gap);
     if (dist >= thickness) {
-        return;
+        return none;
     }
     var direction = vec3<f32>(0.0);
     if (dot(before, before) > 0.0 && dot(gap, before) > 0.0 && dist > 1e-9) {
@@ -402,20 +466,29 @@ fn push(@builtin(global_invocation_id) id: vec3<u32>) {
     } else if (dist > 0.0) {
         direction = gap / dist;
     } else {
-        return;
+        return none;
     }
     let depth = thickness - dot(gap, direction);
     if (depth <= 0.0) {
-        return;
+        return none;
     }
-    var weight = 0.0;
+    // What rests on a collider moves only where nothing else in the pair can.
+    var unheld = inv;
+    for (var k = 0u; k < 4u; k++) {
+        if (held(ids[k])) {
+            unheld[k] = 0.0;
+        }
+    }
+    if (pair_weight(w, unheld) > 0.0) {
+        inv = unheld;
+    }
+    let weight = pair_weight(w, inv);
     var most = 0.0;
     for (var k = 0u; k < 4u; k++) {
-        weight += w[k] * w[k] * inv[k];
         most = max(most, w[k] * inv[k]);
     }
     if (weight <= 0.0) {
-        return;
+        return none;
     }
     let share = min(weight / most, 1.0);
     let lambda = share * depth / weight;
@@ -434,30 +507,131 @@ fn push(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         impulse = share * (-approach * direction - friction * sliding) / weight;
     }
+    var out: Push;
+    out.pushed = true;
     for (var k = 0u; k < 4u; k++) {
         let part = sign[k] * w[k] * inv[k];
-        if (part == 0.0) {
+        out.dx[k] = (part * lambda) * direction;
+        out.dv[k] = part * impulse;
+    }
+    return out;
+}
+
+// Pushes in a sweep come in rounds: in each, every pair still to push this sweep whose
+// sides are nearer than the thickness claims its free particles with its key (the round,
+// then a hash of the pair, so that the claims depend on the pairs, not on where they were
+// stored); a pair that holds all of its claims moves its particles itself, no other pair
+// touching them (the CPU's sweep, one pair after another, taken as sets of pairs that share
+// no particle). What is left after the rounds is pushed side by side (`push`).
+
+// The pair's key in push round `r`.
+fn key_of(pair: Pair, r: u32) -> u32 {
+    var h = pair.ids.x * 747796405u + select(0u, 2891336453u, pair.edges);
+    for (var k = 1u; k < 4u; k++) {
+        h = (h ^ (h >> 16u)) * 2246822519u + pair.ids[k];
+    }
+    h = (h ^ (h >> 13u)) * 3266489917u;
+    return ((r + 1u) << 24u) | ((h ^ (h >> 16u)) & 0xffffffu);
+}
+
+fn owner_at(i: u32) -> u32 {
+    return pushes_at() + PUSH_WORDS * sp.counts.x + i;
+}
+
+fn done_at(p: u32) -> u32 {
+    return scales_at() + sp.counts.x + p;
+}
+
+// Whether pair `p` was pushed in this sweep (`this_round.y`).
+fn pushed_this_sweep(p: u32) -> bool {
+    return lists[done_at(p)] == this_round.y + 1u;
+}
+
+@compute @workgroup_size(64)
+fn claim(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= pairs_kept() || pushed_this_sweep(id.x)) {
+        return;
+    }
+    let pair = pair_at(id.x);
+    if (!push_of(pair).pushed) {
+        return;
+    }
+    let key = key_of(pair, this_round.x);
+    for (var k = 0u; k < 4u; k++) {
+        let i = pair.ids[k];
+        if (start[i].x.w > 0.0) {
+            atomicMax(&atomics[owner_at(i)], key);
+        }
+    }
+}
+
+@compute @workgroup_size(64)
+fn push_alone(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= pairs_kept() || pushed_this_sweep(id.x)) {
+        return;
+    }
+    let pair = pair_at(id.x);
+    let key = key_of(pair, this_round.x);
+    for (var k = 0u; k < 4u; k++) {
+        let i = pair.ids[k];
+        if (start[i].x.w > 0.0 && atomicLoad(&atomics[owner_at(i)]) != key) {
+            return;
+        }
+    }
+    let push = push_of(pair);
+    lists[done_at(id.x)] = this_round.y + 1u;
+    if (!push.pushed) {
+        return;
+    }
+    for (var k = 0u; k < 4u; k++) {
+        let i = pair.ids[k];
+        if (start[i].x.w <= 0.0) {
             continue;
         }
-        let slot = pushes_at() + 8u * ids[k];
-        let dx = (part * lambda) * direction;
-        let dv = part * impulse;
+        var q = state[i];
+        q.x = vec4<f32>(q.x.xyz + push.dx[k], q.x.w);
+        q.v = vec4<f32>(q.v.xyz + push.dv[k], q.v.w);
+        state[i] = q;
+    }
+}
+
+// The pairs the rounds left, side by side: each particle takes half the sum of their
+// pushes (`push_apply`), summed in fixed point so that the sum is the same in any order.
+// Half, not the average: these are the pairs of a crowded contact, a stack pressed
+// together, and the average of a particle's pushes, one from each layer, barely moves it
+// (measured: `layers` at 8 quads pressed to 3 µm apart, where it should be 6 mm); the
+// whole sum overshoots there (it blew `layers` up).
+const LEFT_SHARE: f32 = 0.5;
+@compute @workgroup_size(64)
+fn push(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= pairs_kept() || pushed_this_sweep(id.x)) {
+        return;
+    }
+    let pair = pair_at(id.x);
+    let push = push_of(pair);
+    if (!push.pushed) {
+        return;
+    }
+    for (var k = 0u; k < 4u; k++) {
+        if (all(push.dx[k] == vec3<f32>(0.0)) && all(push.dv[k] == vec3<f32>(0.0))) {
+            continue;
+        }
+        let slot = pushes_at() + PUSH_WORDS * pair.ids[k];
         for (var c = 0u; c < 3u; c++) {
-            add_fixed(slot + c, dx[c], MOVE_UNIT);
-            add_fixed(slot + 4u + c, dv[c], SPEED_UNIT);
+            add_fixed(slot + c, push.dx[k][c], MOVE_UNIT);
+            add_fixed(slot + 4u + c, push.dv[k][c], SPEED_UNIT);
         }
         atomicAdd(&atomics[slot + 3u], 1u);
     }
 }
 
-// Each particle takes the average of the sweep's pushes.
-@compute @workgroup_size(64)
-fn push_apply(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
+// Particle `i` takes the side-by-side pushes summed for it: `share` of their sum, or
+// their average where `share` is 0.
+fn take_pushes(i: u32, share: f32) {
     if (i >= sp.counts.x) {
         return;
     }
-    let slot = pushes_at() + 8u * i;
+    let slot = pushes_at() + PUSH_WORDS * i;
     let count = atomicLoad(&atomics[slot + 3u]);
     if (count == 0u) {
         return;
@@ -468,14 +642,83 @@ fn push_apply(@builtin(global_invocation_id) id: vec3<u32>) {
         dx[c] = f32(bitcast<i32>(atomicLoad(&atomics[slot + c]))) * MOVE_UNIT;
         dv[c] = f32(bitcast<i32>(atomicLoad(&atomics[slot + 4u + c]))) * SPEED_UNIT;
     }
-    for (var k = 0u; k < 8u; k++) {
+    for (var k = 0u; k < HELD; k++) {
         atomicStore(&atomics[slot + k], 0u);
     }
+    let part = select(share, 1.0 / f32(count), share == 0.0);
     var q = state[i];
-    let share = 1.0 / f32(count);
-    q.x = vec4<f32>(q.x.xyz + dx * share, q.x.w);
-    q.v = vec4<f32>(q.v.xyz + dv * share, q.v.w);
+    q.x = vec4<f32>(q.x.xyz + dx * part, q.x.w);
+    q.v = vec4<f32>(q.v.xyz + dv * part, q.v.w);
     state[i] = q;
+}
+
+// Each particle takes its share of the side-by-side pushes.
+@compute @workgroup_size(64)
+fn push_apply(@builtin(global_invocation_id) id: vec3<u32>) {
+    take_pushes(id.x, LEFT_SHARE);
+}
+
+// Each triangle's interior is kept out of the spheres too, not only its corners (the
+// CPU's `keep_faces_out`: self-contact's guarantee covers the surface, and a triangle
+// over a small sphere dips in between its corners however far out they are): a triangle
+// whose point nearest a centre is within the sphere and the offset is pushed out along
+// the line from the centre, its corners by their weights and inverse masses, their
+// velocities losing what points in; side by side, each corner taking the average.
+@compute @workgroup_size(64)
+fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
+    let t = id.x;
+    if (t >= sp.counts.y) {
+        return;
+    }
+    let tri = triangles[t];
+    var x: array<vec3<f32>, 3>;
+    var inv: array<f32, 3>;
+    for (var k = 0u; k < 3u; k++) {
+        let q = state[tri[k]].x;
+        x[k] = q.xyz;
+        inv[k] = q.w;
+    }
+    let longest = max(distance(x[0], x[1]), max(distance(x[1], x[2]), distance(x[2], x[0])));
+    for (var c = 0u; c < sp.solids.x; c++) {
+        let col = sp.colliders[c];
+        if (col.info.x != 1.0) {
+            continue;
+        }
+        let centre = col.a.xyz;
+        let reach = col.info.y + sp.friction.y;
+        let near = min(distance(x[0], centre), min(distance(x[1], centre), distance(x[2], centre)));
+        if (near > reach + longest) {
+            continue;
+        }
+        let w = closest_weights(centre, x[0], x[1], x[2]);
+        let gap = w.x * x[0] + w.y * x[1] + w.z * x[2] - centre;
+        let d = length(gap);
+        let weight = w.x * w.x * inv[0] + w.y * w.y * inv[1] + w.z * w.z * inv[2];
+        if (d >= reach || d < 1e-9 || weight <= 0.0) {
+            continue;
+        }
+        let n = gap / d;
+        let lambda = (reach - d) / weight;
+        for (var k = 0u; k < 3u; k++) {
+            if (inv[k] == 0.0 || w[k] == 0.0) {
+                continue;
+            }
+            let slot = pushes_at() + PUSH_WORDS * tri[k];
+            let dx = (w[k] * inv[k] * lambda) * n;
+            let inward = min(dot(state[tri[k]].v.xyz, n), 0.0);
+            for (var e = 0u; e < 3u; e++) {
+                add_fixed(slot + e, dx[e], MOVE_UNIT);
+                add_fixed(slot + 4u + e, -inward * n[e], SPEED_UNIT);
+            }
+            atomicAdd(&atomics[slot + 3u], 1u);
+        }
+    }
+}
+
+// Each corner takes the average of its triangles' pushes out of the spheres.
+@compute @workgroup_size(64)
+fn faces_apply(@builtin(global_invocation_id) id: vec3<u32>) {
+    take_pushes(id.x, 0.0);
 }
 
 // Where particle i is with `share` of its motion over the substep (the one expression both
@@ -499,11 +742,22 @@ fn pair_distance(edges: bool, x: array<vec3<f32>, 4>) -> f32 {
     return length(x[0] - closest_on_triangle(x[0], x[1], x[2], x[3]));
 }
 
-// The largest share in [0, 1] of the motion `moves` from `from` over which the pair's
-// sides stay more than `keep` apart, or half the distance they start at where that is
-// less (the CPU's `safe_fraction`): additive CCD, each advance a share of the gap over
-// the most the sides can close on each other.
-fn safe_fraction(edges: bool, x0_in: array<vec3<f32>, 4>, moves_in: array<vec3<f32>, 4>, keep_at_most: f32) -> f32 {
+// The least change of a pair's distance that counts as one, for a pair whose coordinates
+// are at most `scale` (m) from the origin: eight units in the last place of f32 there, more
+// than the rounding of its positions and of the distance itself.
+fn resolved(scale: f32) -> f32 {
+    return 8.0 * 1.1920929e-7 * scale;
+}
+
+// The largest share in [0, 1] of the motion `moves` from `x0` (relative to one point; the
+// pair's coordinates at most `scale` from the origin) over which the pair's sides stay
+// more than `keep_at_most` apart, or half the distance they start at where that is less
+// (the CPU's `safe_fraction`): additive CCD, each advance a share of the gap over the most
+// the sides can close on each other. A floor, a little above what f32 resolves, is kept
+// as well: a pair that starts above it stops above it, one within it stops at half of it,
+// and one below that (by rounding) moves only where it ends farther apart than it started
+// (else 0): a pair pressed substep after substep never creeps closer.
+fn safe_fraction(edges: bool, x0_in: array<vec3<f32>, 4>, moves_in: array<vec3<f32>, 4>, keep_at_most: f32, scale: f32) -> f32 {
     var x0 = x0_in;
     var moves = moves_in;
     let k = select(1u, 2u, edges);
@@ -512,14 +766,15 @@ fn safe_fraction(edges: bool, x0_in: array<vec3<f32>, 4>, moves_in: array<vec3<f
     var blo = vec3<f32>(3.4e38);
     var bhi = vec3<f32>(-3.4e38);
     var mean = vec3<f32>(0.0);
+    var x1: array<vec3<f32>, 4>;
     for (var i = 0u; i < 4u; i++) {
-        let to = x0[i] + moves[i];
+        x1[i] = x0[i] + moves[i];
         if (i < k) {
-            alo = min(alo, min(x0[i], to));
-            ahi = max(ahi, max(x0[i], to));
+            alo = min(alo, min(x0[i], x1[i]));
+            ahi = max(ahi, max(x0[i], x1[i]));
         } else {
-            blo = min(blo, min(x0[i], to));
-            bhi = max(bhi, max(x0[i], to));
+            blo = min(blo, min(x0[i], x1[i]));
+            bhi = max(bhi, max(x0[i], x1[i]));
         }
         mean += 0.25 * moves[i];
     }
@@ -546,13 +801,18 @@ fn safe_fraction(edges: bool, x0_in: array<vec3<f32>, 4>, moves_in: array<vec3<f
     if (d0 <= 0.0) {
         return 1.0;
     }
-    // Never nearer than the floor where the pair starts above it: a pair pressed substep
-    // after substep stops there, where f32 still resolves it, instead of halving its
-    // distance each time (it may still move apart).
+    // Above the floor, the pair stops above it; within it, at half the floor, so that it may
+    // still slide; below that (only rounding takes it there) it moves only where it ends
+    // farther apart than it started, so that it never creeps closer.
+    let margin = resolved(scale);
+    let floor = max(FLOOR * sp.lengths.x, 4.0 * margin);
+    let stuck = d0 <= 0.5 * floor;
+    if (stuck && pair_distance(edges, x1) < d0 + margin) {
+        return 0.0;
+    }
     var keep = min(keep_at_most, 0.5 * d0);
-    let floor = FLOOR * sp.lengths.x;
-    if (d0 > floor) {
-        keep = max(keep, floor);
+    if (!stuck) {
+        keep = max(keep, select(0.5 * floor, floor, d0 > floor));
     }
     if (d0 - speed > keep) {
         return 1.0;
@@ -575,7 +835,7 @@ fn safe_fraction(edges: bool, x0_in: array<vec3<f32>, 4>, moves_in: array<vec3<f
             break;
         }
     }
-    return t;
+    return select(t, 0.0, stuck);
 }
 
 fn share_of(i: u32) -> f32 {
@@ -601,21 +861,32 @@ fn cut(@builtin(global_invocation_id) id: vec3<u32>) {
     let origin = start[ids.x].x.xyz;
     var x0: array<vec3<f32>, 4>;
     var moves: array<vec3<f32>, 4>;
+    var scale = 0.0;
     for (var k = 0u; k < 4u; k++) {
         let i = ids[k];
+        let to = moved_to(i, share_of(i));
         x0[k] = start[i].x.xyz - origin;
-        moves[k] = (moved_to(i, share_of(i)) - origin) - x0[k];
+        moves[k] = (to - origin) - x0[k];
+        let far = max(abs(start[i].x.xyz), abs(to));
+        scale = max(scale, max(far.x, max(far.y, far.z)));
     }
-    let t = safe_fraction(edges, x0, moves, sp.lengths.y);
+    let t = safe_fraction(edges, x0, moves, sp.lengths.y, scale);
     if (t >= 1.0) {
         return;
     }
     atomicAdd(&atomics[IMPACTS + r], 1u);
+    // What rests on a collider is cut only where nothing else in the pair can be (the
+    // CPU's `fixed`).
+    var only_held = true;
+    for (var k = 0u; k < 4u; k++) {
+        let i = ids[k];
+        only_held = only_held && !(start[i].x.w > 0.0 && share_of(i) > 0.0 && !held(i));
+    }
     var cut_any = false;
     for (var k = 0u; k < 4u; k++) {
         let i = ids[k];
         let s = share_of(i);
-        if (start[i].x.w > 0.0 && s > 0.0) {
+        if (start[i].x.w > 0.0 && s > 0.0 && (only_held || !held(i))) {
             let to = select(0.0, s * t, r < SCALED_ROUNDS);
             atomicMin(&atomics[cuts_at() + i], bitcast<u32>(to));
             cut_any = true;

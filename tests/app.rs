@@ -754,8 +754,18 @@ fn the_gpu_button_moves_the_cloth_to_the_gpu_and_back_keeping_its_state() {
         gpu.pos,
         "the state came back"
     );
-    // A scene the GPU cannot run (self-collision) stays on the CPU and says why.
+    // A scene with self-collision goes to the GPU too.
     harness.state_mut().set_scenario("self-fold");
+    harness.run_steps(1);
+    harness.get_by_label("GPU").click();
+    run_settled(&mut harness, 2);
+    assert_eq!(harness.state().in_effect().backend, "gpu");
+    harness.get_by_label("CPU").click();
+    run_settled(&mut harness, 2);
+    // A setting the GPU cannot run (RK4) stays on the CPU and says why.
+    let mut params = harness.state().sim().params().clone();
+    params.step.integrator = clothsim::sim::IntegratorKind::Rk4;
+    harness.state_mut().apply_params(params);
     harness.run_steps(1);
     harness.get_by_label("GPU").click();
     run_settled(&mut harness, 2);

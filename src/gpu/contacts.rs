@@ -8,6 +8,7 @@ use crate::sim::{ContactConfig, Effect};
 use super::error::GpuError;
 use super::kernel::SubstepKernel;
 use super::obstacles::ObstaclePass;
+use super::packing::Params;
 use super::self_contact::SelfPass;
 use super::substep_ends::{Memory, Start};
 
@@ -44,9 +45,18 @@ impl Contacts {
         Ok(Self { obstacles, own })
     }
 
+    /// These passes, self-contact's pushes swept as often as in `old` (which tests set).
+    pub(super) fn swept_as(mut self, old: &Contacts) -> Self {
+        if let (Some(own), Some(old)) = (self.own.as_mut(), old.own.as_ref()) {
+            own.sweeps = old.sweeps;
+        }
+        self
+    }
+
     /// Before a submission of `substeps` substeps of `substep` seconds from `time`: the
-    /// obstacles' poses, self-contact's room and uniform, and what the integrator keeps
-    /// that the contacts change (`memory`).
+    /// obstacles' poses, self-contact's room and uniform (with the step's colliders, from
+    /// `cloth`, its uniform), and what the integrator keeps that the contacts change
+    /// (`memory`).
     ///
     /// # Errors
     /// As [`ObstaclePass::write_poses`] and [`SelfPass::prepare`].
@@ -56,12 +66,13 @@ impl Contacts {
         queue: &wgpu::Queue,
         (substeps, time, substep): (u32, f64, f32),
         memory: Memory,
+        cloth: &Params,
     ) -> Result<(), GpuError> {
         if let Some(obstacles) = self.obstacles.as_mut() {
             obstacles.write_poses(device, queue, (substeps, time, substep), memory)?;
         }
         if let Some(own) = self.own.as_mut() {
-            own.prepare(device, queue, substep, memory)?;
+            own.prepare(device, queue, substep, memory, cloth)?;
         }
         Ok(())
     }

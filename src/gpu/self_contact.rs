@@ -1,18 +1,13 @@
 //! Self-contact on the GPU (`shaders/self_contact.wgsl`): after each substep of every
 //! integrator the GPU runs (after the mesh obstacles), the cloth's pairs that could touch
-//! are found through a hashed grid of the triangles' boxes built on the device, pushed a
-//! thickness apart, and the motion as pushed is cut short where a pair could meet, in
-//! rounds, as the CPU's continuous check cuts it.
+//! are found through a hashed grid of the triangles' boxes built on the device and pushed
+//! a thickness apart, in sweeps of rounds of pairs that share no particle (the CPU's
+//! sweep, pair after pair), then side by side for what the rounds leave; the spheres and
+//! planes put back what the pushes moved into them (triangles too); and the motion as
+//! pushed is cut short where a pair could meet, in rounds, as the CPU's continuous check
+//! cuts it, with a floor where f32 still resolves a pair's distance.
 //! Where the grid's or the pairs' room ran out in a submission, the substeps concerned
 //! keep the cloth where it started them and the room is grown before the next.
-//!
-//! Not yet offered (the support check refuses self-collision; `GpuStepper::trying`
-//! runs it for its tests): it does not yet give the CPU's guarantee. Measured on the
-//! software adapter: `twist` at 12 quads, a turn in 2 s, never passes through itself, but
-//! with the pushes left out it does at frame 57 (the CPU's cuts alone hold it); and
-//! `layers` at 8 quads presses its stack to nanometres, where each pair's check should
-//! keep it 5·10⁻⁴ of the thickness apart. A pair is judged safe along a path it is not
-//! safe on, or drops out of the pairs checked; where is not yet found.
 
 use bytemuck::{Pod, Zeroable};
 
@@ -21,7 +16,10 @@ use crate::device::map_read;
 use crate::sim::{SelfCollision, owned_parts};
 
 use super::error::GpuError;
-use super::kernel::{GEOMETRY, LAYOUT, Slot, WORKGROUP, layout, pipelines, start_end_groups};
+use super::kernel::{
+    CONTACT, GEOMETRY, LAYOUT, Slot, WORKGROUP, layout, pipelines, start_end_groups,
+};
+use super::packing::{GpuCollider, MAX_COLLIDERS, Params};
 use super::substep_ends::{Memory, Start};
 use super::support::fits;
 
@@ -33,6 +31,13 @@ const ROUNDS: u32 = 8;
 
 /// Sweeps of the pushes a substep (the CPU's `PUSH_SWEEPS`).
 const PUSH_SWEEPS: u32 = 4;
+
+/// Rounds of pushes by pairs that share no particle, a sweep, before what is left is
+/// pushed side by side.
+const PUSH_ROUNDS: u32 = 8;
+
+/// Entries of the rounds' uniform: the cuts' rounds, then each sweep's push rounds.
+const ROUND_ENTRIES: u32 = ROUNDS + PUSH_SWEEPS * PUSH_ROUNDS;
 
 /// Bytes between two rounds' uniforms (a multiple of any device's uniform alignment).
 const ROUND_STRIDE: u64 = 256;
@@ -46,12 +51,17 @@ const MOST_AT: u64 = 4 * 34;
 
 /// The pass's uniform (the shader's `SelfParams`).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+#[derive(Clone, Copy, Pod, Zeroable)]
 struct SelfParams {
     counts: [u32; 4],
     more: [u32; 4],
     lengths: [f32; 4],
+    /// Friction between layers, the colliders' offset.
     friction: [f32; 4],
+    /// How many colliders.
+    solids: [u32; 4],
+    /// The step's sphere and plane colliders.
+    colliders: [GpuCollider; MAX_COLLIDERS],
 }
 
 /// Room in the grid and for pairs, per triangle, to start with.
@@ -70,6 +80,14 @@ pub(super) struct SelfPass {
     keep: wgpu::ComputePipeline,
     push: wgpu::ComputePipeline,
     push_apply: wgpu::ComputePipeline,
+    claim: wgpu::ComputePipeline,
+    push_alone: wgpu::ComputePipeline,
+    solids: wgpu::ComputePipeline,
+    faces: wgpu::ComputePipeline,
+    faces_apply: wgpu::ComputePipeline,
+    /// Sweeps of the pushes a substep (at most [`PUSH_SWEEPS`]; none leaves the cuts
+    /// alone, for tests).
+    pub(super) sweeps: u32,
     /// As the obstacles' (see `start_end_groups`).
     groups: [wgpu::BindGroup; 6],
     rounds: wgpu::BindGroup,
@@ -124,6 +142,8 @@ impl SelfPass {
                 0.0,
             ],
             friction: [own.friction, 0.0, 0.0, 0.0],
+            solids: [0; 4],
+            colliders: [GpuCollider::zeroed(); MAX_COLLIDERS],
         };
         use wgpu::BufferUsages as U;
         let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
@@ -134,7 +154,8 @@ impl SelfPass {
                 mapped_at_creation: false,
             })
         };
-        let uniform = buffer("self-contact params", 64, U::UNIFORM);
+        let size = std::mem::size_of::<SelfParams>() as u64;
+        let uniform = buffer("self-contact params", size, U::UNIFORM);
         let tris = buffer("self-contact triangles", u64::from(n) * 16, U::STORAGE);
         queue.write_buffer(&tris, 0, bytemuck::cast_slice(&triangles));
         let boxes = buffer(
@@ -171,10 +192,15 @@ impl SelfPass {
             keep,
             push,
             push_apply,
+            claim,
+            push_alone,
+            solids,
+            faces,
+            faces_apply,
         ] = pipelines(
             device,
             "self-contact",
-            &format!("{LAYOUT}{GEOMETRY}{SOURCE}"),
+            &format!("{LAYOUT}{CONTACT}{GEOMETRY}{SOURCE}"),
             [
                 ("clear", all),
                 ("particle_boxes", all),
@@ -186,6 +212,11 @@ impl SelfPass {
                 ("keep_start", all),
                 ("push", all),
                 ("push_apply", all),
+                ("claim", all),
+                ("push_alone", all),
+                ("solids", all),
+                ("faces", all),
+                ("faces_apply", all),
             ],
         );
         let rounds = Self::rounds(device, queue, &round_layout);
@@ -202,6 +233,12 @@ impl SelfPass {
             keep,
             push,
             push_apply,
+            claim,
+            push_alone,
+            solids,
+            faces,
+            faces_apply,
+            sweeps: PUSH_SWEEPS,
             groups,
             rounds,
             buffers,
@@ -221,8 +258,8 @@ impl SelfPass {
     ) -> Result<(wgpu::Buffer, wgpu::Buffer), GpuError> {
         let [count, triangles, buckets, entries] = params.counts.map(u64::from);
         let pairs = u64::from(params.more[0]);
-        let atomic_words = u64::from(COUNTERS) + buckets + 9 * count;
-        let list_words = 5 * entries + triangles + 4 * pairs + count;
+        let atomic_words = u64::from(COUNTERS) + buckets + 10 * count;
+        let list_words = 5 * entries + triangles + 5 * pairs + count;
         let need = [
             (4 * atomic_words, "self-contact buckets"),
             (4 * list_words, "self-contact pairs"),
@@ -245,20 +282,25 @@ impl SelfPass {
         ))
     }
 
-    /// Each round's number, at its own offset.
+    /// Each round's number, at its own offset: the cuts' rounds, then each sweep's push
+    /// rounds (the round counted through the substep's sweeps, and the sweep).
     fn rounds(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         layout: &wgpu::BindGroupLayout,
     ) -> wgpu::BindGroup {
         let stride = ROUND_STRIDE as usize / 4;
-        let mut words = vec![0u32; ROUNDS as usize * stride];
-        for r in 0..ROUNDS as usize {
-            words[r * stride] = r as u32;
+        let mut words = vec![0u32; ROUND_ENTRIES as usize * stride];
+        for r in 0..ROUNDS {
+            words[r as usize * stride] = r;
+        }
+        for n in 0..PUSH_SWEEPS * PUSH_ROUNDS {
+            let at = (ROUNDS + n) as usize * stride;
+            (words[at], words[at + 1]) = (n, n / PUSH_ROUNDS);
         }
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("self-contact rounds"),
-            size: u64::from(ROUNDS) * ROUND_STRIDE,
+            size: u64::from(ROUND_ENTRIES) * ROUND_STRIDE,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -313,7 +355,8 @@ impl SelfPass {
 
     /// Before a submission of substeps `substep` seconds long: grows the room where the
     /// last submission ran out of it, and writes the uniform with what the integrator
-    /// keeps that the contacts change (`memory`).
+    /// keeps that the contacts change (`memory`) and the step's colliders (from `cloth`,
+    /// its uniform).
     ///
     /// # Errors
     /// [`GpuError::Unsupported`] when the room needed exceeds one binding;
@@ -324,6 +367,7 @@ impl SelfPass {
         queue: &wgpu::Queue,
         substep: f32,
         memory: Memory,
+        cloth: &Params,
     ) -> Result<(), GpuError> {
         if self.pending {
             self.pending = false;
@@ -343,7 +387,7 @@ impl SelfPass {
             if pairs > grown.more[0] {
                 grown.more[0] = pairs.saturating_mul(2);
             }
-            if grown != self.params {
+            if (grown.counts, grown.more) != (self.params.counts, self.params.more) {
                 let (atomics, lists) = Self::rooms(device, &grown)?;
                 (self.buffers[3], self.buffers[4]) = (atomics, lists);
                 self.params = grown;
@@ -351,6 +395,9 @@ impl SelfPass {
             }
         }
         self.params.lengths[3] = substep;
+        self.params.friction[1] = cloth.drag[1];
+        self.params.solids[0] = cloth.counts[1];
+        self.params.colliders = cloth.colliders;
         (self.params.more[1], self.params.more[2]) = match memory {
             Memory::None => (0, 0),
             Memory::Guess(at) => (1, at),
@@ -393,11 +440,31 @@ impl SelfPass {
             pass.set_pipeline(pipeline);
             pass.dispatch_workgroups(over(n), 1, 1);
         }
-        for _ in 0..PUSH_SWEEPS {
+        let round = |n: u32| (u64::from(ROUNDS + n) * ROUND_STRIDE) as u32;
+        for sweep in 0..self.sweeps.min(PUSH_SWEEPS) {
+            for r in 0..PUSH_ROUNDS {
+                pass.set_bind_group(1, &self.rounds, &[round(sweep * PUSH_ROUNDS + r)]);
+                pass.set_pipeline(&self.claim);
+                pass.dispatch_workgroups(over(pairs), 1, 1);
+                pass.set_pipeline(&self.push_alone);
+                pass.dispatch_workgroups(over(pairs), 1, 1);
+            }
             pass.set_pipeline(&self.push);
             pass.dispatch_workgroups(over(pairs), 1, 1);
             pass.set_pipeline(&self.push_apply);
             pass.dispatch_workgroups(over(count), 1, 1);
+        }
+        // What the pushes moved into a sphere or plane goes back out, triangles too.
+        if self.params.solids[0] > 0 {
+            let solids = [
+                (&self.solids, count),
+                (&self.faces, triangles),
+                (&self.faces_apply, count),
+            ];
+            for (pipeline, n) in solids {
+                pass.set_pipeline(pipeline);
+                pass.dispatch_workgroups(over(n), 1, 1);
+            }
         }
         for (pipeline, n) in search {
             pass.set_pipeline(pipeline);

@@ -29,7 +29,7 @@ use super::packing::{
 };
 use super::snapshot::DeviceSnapshot;
 use super::substep_ends::Start;
-use super::support::{check_device, fits_buffers, gpu_support_trying};
+use super::support::{check_device, fits_buffers, gpu_support};
 use super::vbd::VbdPass;
 use super::xpbd::XpbdPass;
 
@@ -70,8 +70,6 @@ pub struct GpuStepper {
     pub(super) implicit: Option<ImplicitPass>,
     /// The scene's mesh obstacles and self-contact, where it has them.
     pub(super) contacts: Contacts,
-    /// Whether the scene's self-contact runs (its pass is not yet offered).
-    self_contact: bool,
     /// The solvers' settings: XPBD's and VBD's sweeps a substep, implicit Euler's
     /// tolerance and cap.
     pub(super) solver: SolverConfig,
@@ -148,20 +146,7 @@ impl GpuStepper {
         effects: &[Effect],
         read_every_frame: bool,
     ) -> Result<Self, GpuError> {
-        let scene = (model, params, effects);
-        Self::trying(device, queue, scene, read_every_frame, false)
-    }
-
-    /// [`GpuStepper::new`], running the scene's self-contact too where `self_contact`
-    /// says (not yet offered: see `self_contact`).
-    pub(super) fn trying(
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        (model, params, effects): (&ClothModel, &SimParams, &[Effect]),
-        read_every_frame: bool,
-        self_contact: bool,
-    ) -> Result<Self, GpuError> {
-        gpu_support_trying(&params.step, params.solver.precision, effects, self_contact)?;
+        gpu_support(&params.step, params.solver.precision, effects)?;
         let limits = device.limits();
         let count = model.particle_count() as u32;
         check_device(&limits, count)?;
@@ -274,7 +259,6 @@ impl GpuStepper {
             ends_sent: 0,
             grid_path: true,
             contacts: Contacts::default(),
-            self_contact,
         };
         stepper.configure(model, params, effects, Changes::all());
         match stepper.unsupported.take() {
@@ -411,7 +395,8 @@ impl GpuStepper {
         }
         let when = (substeps, time, self.substep_length());
         let memory = self.contact_memory().0;
-        let prepared = (self.contacts).prepare(&self.device, &self.queue, when, memory);
+        let prepared =
+            (self.contacts).prepare(&self.device, &self.queue, when, memory, &self.params);
         prepared.map_err(|e| StepError::Unsupported(e.to_string()))?;
         if vbd {
             self.kernel.vbd(&self.device);
@@ -639,7 +624,7 @@ impl StepBackend for GpuStepper {
     ) {
         if changes.intersects(Changes::INTEGRATOR | Changes::EFFECTS | Changes::PRECISION) {
             let (step, precision) = (&params.step, params.solver.precision);
-            self.unsupported = gpu_support_trying(step, precision, effects, self.self_contact)
+            self.unsupported = gpu_support(step, precision, effects)
                 .err()
                 .map(|e| e.to_string());
         }
@@ -693,7 +678,7 @@ impl StepBackend for GpuStepper {
             let scene = (model, effects, &params.contact);
             let (device, queue) = (&self.device, &self.queue);
             match Contacts::new(device, queue, &self.kernel, &self.particles, scene) {
-                Ok(contacts) => self.contacts = contacts,
+                Ok(contacts) => self.contacts = contacts.swept_as(&self.contacts),
                 Err(e) => self.unsupported = Some(e.to_string()),
             }
         }

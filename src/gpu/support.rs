@@ -21,23 +21,12 @@ pub const GPU_INTEGRATORS: [IntegratorKind; 4] = [
 /// What of `step`, `precision` and `effects` the GPU backend cannot run, if anything: it
 /// runs semi-implicit Euler, implicit Euler (one linearised step), XPBD and VBD in `f32` with
 /// gravity, springs (and bend springs), dihedral bending, wind, air damping, pins, handles,
-/// up to four sphere and plane colliders, and up to four mesh obstacles, still, keyframed
-/// or OBJ sequences.
+/// up to four sphere and plane colliders, up to four mesh obstacles, still, keyframed or
+/// OBJ sequences, and self-collision.
 pub fn gpu_support(
     step: &StepConfig,
     precision: Precision,
     effects: &[Effect],
-) -> Result<(), GpuError> {
-    gpu_support_trying(step, precision, effects, false)
-}
-
-/// [`gpu_support`], with self-contact run too where `self_contact` says (its pass is built
-/// but not yet offered: see `self_contact`).
-pub(super) fn gpu_support_trying(
-    step: &StepConfig,
-    precision: Precision,
-    effects: &[Effect],
-    self_contact: bool,
 ) -> Result<(), GpuError> {
     if precision != Precision::F32 {
         return Err(GpuError::Unsupported(format!(
@@ -54,9 +43,6 @@ pub(super) fn gpu_support_trying(
         )));
     }
     for e in effects {
-        if self_contact && matches!(e, Effect::SelfCollision(_)) {
-            continue;
-        }
         if let Err(what) = e.on_gpu() {
             return Err(GpuError::Unsupported(format!(
                 "has no {what}; run this scene on the CPU backend"
