@@ -244,7 +244,8 @@ pub struct RunArgs {
     pub quads: Option<u32>,
     /// What steps the cloth: cpu (every integrator and effect) or gpu (wgpu compute:
     /// semi-implicit and implicit Euler, XPBD and VBD; springs, gravity, air damping, wind, dihedral
-    /// bending, pins, handles, spheres, planes; mesh obstacles, rigid or OBJ sequences).
+    /// bending, pins, handles, spheres, planes; mesh obstacles, rigid or OBJ sequences;
+    /// self-collision).
     #[arg(long, value_enum, default_value_t = Backend::Cpu)]
     pub backend: Backend,
     #[command(flatten)]

@@ -14,10 +14,9 @@ pub enum Backend {
     /// The CPU solver: every integrator and effect, with the stability guard.
     #[default]
     Cpu,
-    /// wgpu compute: semi-implicit and implicit Euler, XPBD and VBD; springs, gravity, air damping, wind,
-    /// dihedral bending, pins, handles, spheres and planes, mesh obstacles (rigid or OBJ
-    /// sequences);
-    /// with the stability guard.
+    /// wgpu compute: semi-implicit and implicit Euler, XPBD and VBD; springs, gravity, air
+    /// damping, wind, dihedral bending, pins, handles, spheres and planes, mesh obstacles
+    /// (rigid or OBJ sequences), self-collision; with the stability guard.
     Gpu,
 }
 

@@ -429,12 +429,27 @@ impl GpuStepper {
             _ => None,
         };
         if !implicit {
+            let groups = self.count.div_ceil(WORKGROUP);
+            // Self-contact's substeps go one submission each: a frame of them is a long run
+            // of dispatches, which a GL device (the software adapter) executes within one
+            // submission while the window waits for its context.
+            let chunk = if self.contacts.own.is_some() {
+                1
+            } else {
+                substeps.max(1)
+            };
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("cloth substeps"),
                 timestamp_writes: None,
             });
-            let groups = self.count.div_ceil(WORKGROUP);
             for k in 0..substeps {
+                if k > 0 && k % chunk == 0 {
+                    drop(pass);
+                    let next = self.device.create_command_encoder(&Default::default());
+                    let full = std::mem::replace(&mut encoder, next);
+                    self.queue.submit([full.finish()]);
+                    pass = encoder.begin_compute_pass(&Default::default());
+                }
                 self.elements.dispatch(&mut pass, self.current);
                 let (this, other) = (&self.groups[self.current], &self.groups[1 - self.current]);
                 if let Some((predict, sweep, colours, finish)) = solver {
