@@ -23,7 +23,10 @@ use super::packing::{GpuCollider, MAX_COLLIDERS, Params};
 use super::substep_ends::{Memory, Start};
 use super::support::fits;
 
-const SOURCE: &str = include_str!("../../shaders/self_contact.wgsl");
+const SOURCE: &str = concat!(
+    include_str!("../../shaders/self_contact.wgsl"),
+    include_str!("../../shaders/self_pushes.wgsl")
+);
 
 /// Rounds of cuts recorded a substep: four by the safe fraction, four to the start (the
 /// shader's counters have room for 16).

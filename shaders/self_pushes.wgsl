@@ -1,0 +1,334 @@
+// Self-contact's pushes on the GPU (appended to shaders/self_contact.wgsl, whose bindings,
+// pairs and counters they use; src/gpu/self_contact.rs builds and dispatches them): the
+// pairs closer than the thickness pushed apart, in rounds of pairs that share no particle
+// and then side by side, and the triangles pushed out of the spheres after the colliders'
+// second pass.
+
+// How hard the pair is to move at its closest points' weights `w`, its particles' inverse
+// masses `inv`.
+fn pair_weight(w: array<f32, 4>, inv: array<f32, 4>) -> f32 {
+    var weight = 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        weight += w[k] * w[k] * inv[k];
+    }
+    return weight;
+}
+
+fn add_fixed(at: u32, x: f32, unit: f32) {
+    let n = i32(clamp(x / unit, -1.0e9, 1.0e9));
+    atomicAdd(&atomics[at], bitcast<u32>(n));
+}
+
+// A pair's push: each of its particles' move and change of velocity (`pushed` false where
+// its sides are a thickness apart already).
+struct Push {
+    pushed: bool,
+    dx: array<vec3<f32>, 4>,
+    dv: array<vec3<f32>, 4>,
+}
+
+// The push that keeps the pair's sides a thickness apart at the substep's end, on the side
+// they started on (the CPU's `push_apart`, with Coulomb friction on their sliding): each
+// particle moves by its share (its weight times its inverse mass), what rests on a
+// collider only where nothing else in the pair can.
+fn push_of(pair: Pair) -> Push {
+    var none: Push;
+    none.pushed = false;
+    let edges = pair.edges;
+    let ids = pair.ids;
+    let thickness = sp.lengths.x;
+    let origin = state[ids.x].x.xyz;
+    let origin0 = start[ids.x].x.xyz;
+    var x: array<vec3<f32>, 4>;
+    var x0: array<vec3<f32>, 4>;
+    var inv: array<f32, 4>;
+    for (var k = 0u; k < 4u; k++) {
+        let q = state[ids[k]].x;
+        x[k] = q.xyz - origin;
+        x0[k] = start[ids[k]].x.xyz - origin0;
+        inv[k] = q.w;
+    }
+    var w: array<f32, 4>;
+    if (edges) {
+        let st = segments_closest(x[0], x[1], x[2], x[3]);
+        w = array<f32, 4>(1.0 - st.x, st.x, 1.0 - st.y, st.y);
+    } else {
+        let b = closest_weights(x[0], x[1], x[2], x[3]);
+        w = array<f32, 4>(1.0, b.x, b.y, b.z);
+    }
+    let first = select(1u, 2u, edges);
+    var gap = vec3<f32>(0.0);
+    var before = vec3<f32>(0.0);
+    var sign: array<f32, 4>;
+    for (var k = 0u; k < 4u; k++) {
+        sign[k] = select(-1.0, 1.0, k < first);
+        gap += sign[k] * w[k] * x[k];
+        before += sign[k] * w[k] * x0[k];
+    }
+    let dist = length(gap);
+    if (dist >= thickness) {
+        return none;
+    }
+    var direction = vec3<f32>(0.0);
+    if (dot(before, before) > 0.0 && dot(gap, before) > 0.0 && dist > 1e-9) {
+        direction = gap / dist;
+    } else if (dot(before, before) > 0.0) {
+        direction = normalize(before);
+    } else if (dist > 0.0) {
+        direction = gap / dist;
+    } else {
+        return none;
+    }
+    let depth = thickness - dot(gap, direction);
+    if (depth <= 0.0) {
+        return none;
+    }
+    // What rests on a collider moves only where nothing else in the pair can.
+    var unheld = inv;
+    for (var k = 0u; k < 4u; k++) {
+        if (held(ids[k])) {
+            unheld[k] = 0.0;
+        }
+    }
+    if (pair_weight(w, unheld) > 0.0) {
+        inv = unheld;
+    }
+    let weight = pair_weight(w, inv);
+    var most = 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        most = max(most, w[k] * inv[k]);
+    }
+    if (weight <= 0.0) {
+        return none;
+    }
+    let share = min(weight / most, 1.0);
+    let lambda = share * depth / weight;
+    var relative = vec3<f32>(0.0);
+    for (var k = 0u; k < 4u; k++) {
+        relative += sign[k] * w[k] * state[ids[k]].v.xyz;
+    }
+    let approach = dot(relative, direction);
+    var impulse = vec3<f32>(0.0);
+    if (approach < 0.0) {
+        let sliding = relative - approach * direction;
+        let speed = length(sliding);
+        var friction = 0.0;
+        if (speed > 0.0) {
+            friction = min(sp.friction.x * -approach / speed, 1.0);
+        }
+        impulse = share * (-approach * direction - friction * sliding) / weight;
+    }
+    var out: Push;
+    out.pushed = true;
+    for (var k = 0u; k < 4u; k++) {
+        let part = sign[k] * w[k] * inv[k];
+        out.dx[k] = (part * lambda) * direction;
+        out.dv[k] = part * impulse;
+    }
+    return out;
+}
+
+// Pushes in a sweep come in rounds: in each, every pair still to push this sweep whose
+// sides are nearer than the thickness claims its free particles with its key (the round,
+// then a hash of the pair, so that the claims depend on the pairs, not on where they were
+// stored); a pair that holds all of its claims moves its particles itself, no other pair
+// touching them (the CPU's sweep, one pair after another, taken as sets of pairs that share
+// no particle). What is left after the rounds is pushed side by side (`push`).
+
+// The pair's key in push round `r`.
+fn key_of(pair: Pair, r: u32) -> u32 {
+    var h = pair.ids.x * 747796405u + select(0u, 2891336453u, pair.edges);
+    for (var k = 1u; k < 4u; k++) {
+        h = (h ^ (h >> 16u)) * 2246822519u + pair.ids[k];
+    }
+    h = (h ^ (h >> 13u)) * 3266489917u;
+    return ((r + 1u) << 24u) | ((h ^ (h >> 16u)) & 0xffffffu);
+}
+
+fn owner_at(i: u32) -> u32 {
+    return pushes_at() + PUSH_WORDS * sp.counts.x + i;
+}
+
+fn done_at(p: u32) -> u32 {
+    return scales_at() + sp.counts.x + p;
+}
+
+// Whether pair `p` was pushed in this sweep (`this_round.y`).
+fn pushed_this_sweep(p: u32) -> bool {
+    return lists[done_at(p)] == this_round.y + 1u;
+}
+
+@compute @workgroup_size(64)
+fn claim(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= pairs_kept() || pushed_this_sweep(id.x)) {
+        return;
+    }
+    let pair = pair_at(id.x);
+    if (!push_of(pair).pushed) {
+        return;
+    }
+    let key = key_of(pair, this_round.x);
+    for (var k = 0u; k < 4u; k++) {
+        let i = pair.ids[k];
+        if (start[i].x.w > 0.0) {
+            atomicMax(&atomics[owner_at(i)], key);
+        }
+    }
+}
+
+@compute @workgroup_size(64)
+fn push_alone(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= pairs_kept() || pushed_this_sweep(id.x)) {
+        return;
+    }
+    let pair = pair_at(id.x);
+    let key = key_of(pair, this_round.x);
+    for (var k = 0u; k < 4u; k++) {
+        let i = pair.ids[k];
+        if (start[i].x.w > 0.0 && atomicLoad(&atomics[owner_at(i)]) != key) {
+            return;
+        }
+    }
+    let push = push_of(pair);
+    lists[done_at(id.x)] = this_round.y + 1u;
+    if (!push.pushed) {
+        return;
+    }
+    for (var k = 0u; k < 4u; k++) {
+        let i = pair.ids[k];
+        if (start[i].x.w <= 0.0) {
+            continue;
+        }
+        var q = state[i];
+        q.x = vec4<f32>(q.x.xyz + push.dx[k], q.x.w);
+        q.v = vec4<f32>(q.v.xyz + push.dv[k], q.v.w);
+        state[i] = q;
+    }
+}
+
+// The pairs the rounds left, side by side: each particle takes half the sum of their
+// pushes (`push_apply`), summed in fixed point so that the sum is the same in any order.
+// Half, not the average: these are the pairs of a crowded contact, a stack pressed
+// together, and the average of a particle's pushes, one from each layer, barely moves it
+// (measured: `layers` at 8 quads pressed to 3 µm apart, where it should be 6 mm); the
+// whole sum overshoots there (it blew `layers` up).
+const LEFT_SHARE: f32 = 0.5;
+@compute @workgroup_size(64)
+fn push(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= pairs_kept() || pushed_this_sweep(id.x)) {
+        return;
+    }
+    let pair = pair_at(id.x);
+    let push = push_of(pair);
+    if (!push.pushed) {
+        return;
+    }
+    for (var k = 0u; k < 4u; k++) {
+        if (all(push.dx[k] == vec3<f32>(0.0)) && all(push.dv[k] == vec3<f32>(0.0))) {
+            continue;
+        }
+        let slot = pushes_at() + PUSH_WORDS * pair.ids[k];
+        for (var c = 0u; c < 3u; c++) {
+            add_fixed(slot + c, push.dx[k][c], MOVE_UNIT);
+            add_fixed(slot + 4u + c, push.dv[k][c], SPEED_UNIT);
+        }
+        atomicAdd(&atomics[slot + 3u], 1u);
+    }
+}
+
+// Particle `i` takes the side-by-side pushes summed for it: `share` of their sum, or
+// their average where `share` is 0.
+fn take_pushes(i: u32, share: f32) {
+    if (i >= sp.counts.x) {
+        return;
+    }
+    let slot = pushes_at() + PUSH_WORDS * i;
+    let count = atomicLoad(&atomics[slot + 3u]);
+    if (count == 0u) {
+        return;
+    }
+    var dx = vec3<f32>(0.0);
+    var dv = vec3<f32>(0.0);
+    for (var c = 0u; c < 3u; c++) {
+        dx[c] = f32(bitcast<i32>(atomicLoad(&atomics[slot + c]))) * MOVE_UNIT;
+        dv[c] = f32(bitcast<i32>(atomicLoad(&atomics[slot + 4u + c]))) * SPEED_UNIT;
+    }
+    for (var k = 0u; k < HELD; k++) {
+        atomicStore(&atomics[slot + k], 0u);
+    }
+    let part = select(share, 1.0 / f32(count), share == 0.0);
+    var q = state[i];
+    q.x = vec4<f32>(q.x.xyz + dx * part, q.x.w);
+    q.v = vec4<f32>(q.v.xyz + dv * part, q.v.w);
+    state[i] = q;
+}
+
+// Each particle takes its share of the side-by-side pushes.
+@compute @workgroup_size(64)
+fn push_apply(@builtin(global_invocation_id) id: vec3<u32>) {
+    take_pushes(id.x, LEFT_SHARE);
+}
+
+// Each triangle's interior is kept out of the spheres too, not only its corners (the
+// CPU's `keep_faces_out`: self-contact's guarantee covers the surface, and a triangle
+// over a small sphere dips in between its corners however far out they are): a triangle
+// whose point nearest a centre is within the sphere and the offset is pushed out along
+// the line from the centre, its corners by their weights and inverse masses, their
+// velocities losing what points in; side by side, each corner taking the average.
+@compute @workgroup_size(64)
+fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
+    let t = id.x;
+    if (t >= sp.counts.y) {
+        return;
+    }
+    let tri = triangles[t];
+    var x: array<vec3<f32>, 3>;
+    var inv: array<f32, 3>;
+    for (var k = 0u; k < 3u; k++) {
+        let q = state[tri[k]].x;
+        x[k] = q.xyz;
+        inv[k] = q.w;
+    }
+    let longest = max(distance(x[0], x[1]), max(distance(x[1], x[2]), distance(x[2], x[0])));
+    for (var c = 0u; c < sp.solids.x; c++) {
+        let col = sp.colliders[c];
+        if (col.info.x != 1.0) {
+            continue;
+        }
+        let centre = col.a.xyz;
+        let reach = col.info.y + sp.friction.y;
+        let near = min(distance(x[0], centre), min(distance(x[1], centre), distance(x[2], centre)));
+        if (near > reach + longest) {
+            continue;
+        }
+        let w = closest_weights(centre, x[0], x[1], x[2]);
+        let gap = w.x * x[0] + w.y * x[1] + w.z * x[2] - centre;
+        let d = length(gap);
+        let weight = w.x * w.x * inv[0] + w.y * w.y * inv[1] + w.z * w.z * inv[2];
+        if (d >= reach || d < 1e-9 || weight <= 0.0) {
+            continue;
+        }
+        let n = gap / d;
+        let lambda = (reach - d) / weight;
+        for (var k = 0u; k < 3u; k++) {
+            if (inv[k] == 0.0 || w[k] == 0.0) {
+                continue;
+            }
+            let slot = pushes_at() + PUSH_WORDS * tri[k];
+            let dx = (w[k] * inv[k] * lambda) * n;
+            let inward = min(dot(state[tri[k]].v.xyz, n), 0.0);
+            for (var e = 0u; e < 3u; e++) {
+                add_fixed(slot + e, dx[e], MOVE_UNIT);
+                add_fixed(slot + 4u + e, -inward * n[e], SPEED_UNIT);
+            }
+            atomicAdd(&atomics[slot + 3u], 1u);
+        }
+    }
+}
+
+// Each corner takes the average of its triangles' pushes out of the spheres.
+@compute @workgroup_size(64)
+fn faces_apply(@builtin(global_invocation_id) id: vec3<u32>) {
+    take_pushes(id.x, 0.0);
+}
+
