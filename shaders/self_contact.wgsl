@@ -610,7 +610,13 @@ fn finish(@builtin(global_invocation_id) id: vec3<u32>) {
     p.v = vec4<f32>((to - start[i].x.xyz) / sp.lengths.w, p.v.w);
     p.x = vec4<f32>(to, p.x.w);
     state[i] = p;
-    let dv = p.v.xyz - v;
+    tell_solver(i, p.v.xyz - v);
+}
+
+// Tells the solver that particle `i`'s velocity changed by `dv` after its step (see the
+// obstacles' shader): VBD's last acceleration takes it, implicit Euler's first guess keeps
+// no history.
+fn tell_solver(i: u32, dv: vec3<f32>) {
     if (sp.more.y == 2u) {
         let word = sp.more.z + 4u * i;
         for (var k = 0u; k < 3u; k++) {

@@ -203,6 +203,7 @@ fn push_alone(@builtin(global_invocation_id) id: vec3<u32>) {
         q.x = vec4<f32>(q.x.xyz + push.dx[k], q.x.w);
         q.v = vec4<f32>(q.v.xyz + push.dv[k], q.v.w);
         state[i] = q;
+        tell_solver(i, push.dv[k]);
     }
 }
 
@@ -261,6 +262,7 @@ fn take_pushes(i: u32, share: f32) {
     q.x = vec4<f32>(q.x.xyz + dx * part, q.x.w);
     q.v = vec4<f32>(q.v.xyz + dv * part, q.v.w);
     state[i] = q;
+    tell_solver(i, dv * part);
 }
 
 // Each particle takes its share of the side-by-side pushes.
