@@ -109,7 +109,12 @@ impl Contacts {
             obstacles.encode(pass, k, start);
         }
         if let Some(own) = &self.own {
-            own.encode(pass, start);
+            own.encode_pushes(pass, start);
+            // What the pushes pressed into a mesh obstacle goes back out, before the cuts.
+            if let Some(obstacles) = &self.obstacles {
+                obstacles.encode(pass, k, start);
+            }
+            own.encode_cuts(pass, start);
         }
     }
 

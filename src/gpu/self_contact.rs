@@ -420,25 +420,36 @@ impl SelfPass {
         pass.dispatch_workgroups(self.params.counts[0].div_ceil(WORKGROUP), 1, 1);
     }
 
-    /// Records a substep's self-contact, where `start` says its start and end are.
-    pub(super) fn encode(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
+    /// The bind group for a substep whose start and end `start` says, bound with the first
+    /// round, and the search's dispatches.
+    fn begin<'a>(
+        &'a self,
+        pass: &mut wgpu::ComputePass<'_>,
+        start: Start,
+    ) -> [(&'a wgpu::ComputePipeline, u32); 4] {
         let group = &self.groups[match start {
             Start::In(i) => i,
             Start::Kept(i) => 2 + i,
         }];
-        let [count, triangles, buckets, _] = self.params.counts;
-        let pairs = self.params.more[0];
-        let over = |n: u32| n.div_ceil(WORKGROUP);
         pass.set_bind_group(0, group, &[]);
         pass.set_bind_group(1, &self.rounds, &[0]);
-        let search = [
+        let [count, triangles, buckets, _] = self.params.counts;
+        [
             (&self.clear, COUNTERS + buckets),
             (&self.boxes, count),
             (&self.insert, triangles),
             (&self.find, triangles),
-        ];
-        // The pairs of the substep's motion, pushed a thickness apart; then those of the
-        // motion as pushed, checked along it.
+        ]
+    }
+
+    /// Records a substep's pushes, where `start` says its start and end are: the pairs of
+    /// the substep's motion pushed a thickness apart, and what they moved into a sphere or
+    /// plane put back out.
+    pub(super) fn encode_pushes(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
+        let search = self.begin(pass, start);
+        let [count, triangles, _, _] = self.params.counts;
+        let pairs = self.params.more[0];
+        let over = |n: u32| n.div_ceil(WORKGROUP);
         for (pipeline, n) in search {
             pass.set_pipeline(pipeline);
             pass.dispatch_workgroups(over(n), 1, 1);
@@ -457,7 +468,6 @@ impl SelfPass {
             pass.set_pipeline(&self.push_apply);
             pass.dispatch_workgroups(over(count), 1, 1);
         }
-        // What the pushes moved into a sphere or plane goes back out, triangles too.
         if self.params.solids[0] > 0 {
             let solids = [
                 (&self.solids, count),
@@ -469,10 +479,18 @@ impl SelfPass {
                 pass.dispatch_workgroups(over(n), 1, 1);
             }
         }
+    }
+
+    /// Records a substep's cuts, where `start` says its start and end are: the pairs of the
+    /// motion as pushed, checked along it.
+    pub(super) fn encode_cuts(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
+        let search = self.begin(pass, start);
+        let over = |n: u32| n.div_ceil(WORKGROUP);
         for (pipeline, n) in search {
             pass.set_pipeline(pipeline);
             pass.dispatch_workgroups(over(n), 1, 1);
         }
+        let (count, pairs) = (self.params.counts[0], self.params.more[0]);
         for r in 0..ROUNDS {
             pass.set_bind_group(1, &self.rounds, &[(u64::from(r) * ROUND_STRIDE) as u32]);
             pass.set_pipeline(&self.cut);
