@@ -71,23 +71,50 @@ struct SelfParams {
 const ENTRIES_PER_TRIANGLE: u32 = 16;
 const PAIRS_PER_TRIANGLE: u32 = 16;
 
+/// The shader's entry points (`ENTRY_POINTS` names them in this order).
+#[derive(Clone, Copy)]
+enum Kernel {
+    Clear,
+    Boxes,
+    Insert,
+    Find,
+    Cut,
+    CutApply,
+    Finish,
+    KeepStart,
+    Push,
+    PushApply,
+    Claim,
+    PushAlone,
+    Solids,
+    Faces,
+    FacesApply,
+}
+
+const KERNELS: usize = Kernel::FacesApply as usize + 1;
+
+const ENTRY_POINTS: [&str; KERNELS] = [
+    "clear",
+    "particle_boxes",
+    "insert",
+    "find",
+    "cut",
+    "cut_apply",
+    "finish",
+    "keep_start",
+    "push",
+    "push_apply",
+    "claim",
+    "push_alone",
+    "solids",
+    "faces",
+    "faces_apply",
+];
+
 /// The cloth's self-contact on the device.
 pub(super) struct SelfPass {
-    clear: wgpu::ComputePipeline,
-    boxes: wgpu::ComputePipeline,
-    insert: wgpu::ComputePipeline,
-    find: wgpu::ComputePipeline,
-    cut: wgpu::ComputePipeline,
-    apply: wgpu::ComputePipeline,
-    finish: wgpu::ComputePipeline,
-    keep: wgpu::ComputePipeline,
-    push: wgpu::ComputePipeline,
-    push_apply: wgpu::ComputePipeline,
-    claim: wgpu::ComputePipeline,
-    push_alone: wgpu::ComputePipeline,
-    solids: wgpu::ComputePipeline,
-    faces: wgpu::ComputePipeline,
-    faces_apply: wgpu::ComputePipeline,
+    /// The shader's entry points, in [`Kernel`]'s order.
+    kernels: [wgpu::ComputePipeline; KERNELS],
     /// Sweeps of the pushes a substep (at most [`PUSH_SWEEPS`]; none leaves the cuts
     /// alone, for tests).
     pub(super) sweeps: u32,
@@ -184,63 +211,17 @@ impl SelfPass {
         let main = layout(device, "self-contact", &slots);
         let round_layout = layout(device, "self-contact round", &[Dynamic]);
         let all: &[&wgpu::BindGroupLayout] = &[&main, &round_layout];
-        let [
-            clear,
-            boxes_pipeline,
-            insert,
-            find,
-            cut,
-            apply,
-            finish,
-            keep,
-            push,
-            push_apply,
-            claim,
-            push_alone,
-            solids,
-            faces,
-            faces_apply,
-        ] = pipelines(
+        let kernels = pipelines(
             device,
             "self-contact",
             &format!("{LAYOUT}{CONTACT}{GEOMETRY}{SOURCE}"),
-            [
-                ("clear", all),
-                ("particle_boxes", all),
-                ("insert", all),
-                ("find", all),
-                ("cut", all),
-                ("cut_apply", all),
-                ("finish", all),
-                ("keep_start", all),
-                ("push", all),
-                ("push_apply", all),
-                ("claim", all),
-                ("push_alone", all),
-                ("solids", all),
-                ("faces", all),
-                ("faces_apply", all),
-            ],
+            ENTRY_POINTS.map(|entry| (entry, all)),
         );
         let rounds = Self::rounds(device, queue, &round_layout);
         let buffers = [uniform, tris, boxes, atomics, lists, kept, no_solve];
         let groups = Self::groups_for(device, &main, particles, &buffers, None);
         Ok(Some(Self {
-            clear,
-            boxes: boxes_pipeline,
-            insert,
-            find,
-            cut,
-            apply,
-            finish,
-            keep,
-            push,
-            push_apply,
-            claim,
-            push_alone,
-            solids,
-            faces,
-            faces_apply,
+            kernels,
             sweeps: PUSH_SWEEPS,
             groups,
             rounds,
@@ -415,68 +396,57 @@ impl SelfPass {
     /// writes its end over it.
     pub(super) fn keep_start(&self, pass: &mut wgpu::ComputePass<'_>, at: usize) {
         pass.set_bind_group(1, &self.rounds, &[0]);
-        pass.set_pipeline(&self.keep);
         pass.set_bind_group(0, &self.groups[4 + at], &[]);
-        pass.dispatch_workgroups(self.params.counts[0].div_ceil(WORKGROUP), 1, 1);
+        self.run(pass, Kernel::KeepStart);
     }
 
-    /// The bind group for a substep whose start and end `start` says, bound with the first
-    /// round, and the search's dispatches.
-    fn begin<'a>(
-        &'a self,
-        pass: &mut wgpu::ComputePass<'_>,
-        start: Start,
-    ) -> [(&'a wgpu::ComputePipeline, u32); 4] {
+    /// Dispatches `kernel` over what it runs on: a particle, a triangle, a pair or a
+    /// counter or bucket each invocation.
+    fn run(&self, pass: &mut wgpu::ComputePass<'_>, kernel: Kernel) {
+        use Kernel::*;
+        let [count, triangles, buckets, _] = self.params.counts;
+        let n = match kernel {
+            Clear => COUNTERS + buckets,
+            Insert | Find | Faces => triangles,
+            Cut | Push | Claim | PushAlone => self.params.more[0],
+            Boxes | CutApply | Finish | KeepStart | PushApply | Solids | FacesApply => count,
+        };
+        pass.set_pipeline(&self.kernels[kernel as usize]);
+        pass.dispatch_workgroups(n.div_ceil(WORKGROUP), 1, 1);
+    }
+
+    /// Binds the substep whose start and end `start` says, and searches its pairs: each
+    /// particle's and triangle's box, the grid, the pairs.
+    fn search(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
         let group = &self.groups[match start {
             Start::In(i) => i,
             Start::Kept(i) => 2 + i,
         }];
         pass.set_bind_group(0, group, &[]);
         pass.set_bind_group(1, &self.rounds, &[0]);
-        let [count, triangles, buckets, _] = self.params.counts;
-        [
-            (&self.clear, COUNTERS + buckets),
-            (&self.boxes, count),
-            (&self.insert, triangles),
-            (&self.find, triangles),
-        ]
+        for kernel in [Kernel::Clear, Kernel::Boxes, Kernel::Insert, Kernel::Find] {
+            self.run(pass, kernel);
+        }
     }
 
     /// Records a substep's pushes, where `start` says its start and end are: the pairs of
     /// the substep's motion pushed a thickness apart, and what they moved into a sphere or
     /// plane put back out.
     pub(super) fn encode_pushes(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
-        let search = self.begin(pass, start);
-        let [count, triangles, _, _] = self.params.counts;
-        let pairs = self.params.more[0];
-        let over = |n: u32| n.div_ceil(WORKGROUP);
-        for (pipeline, n) in search {
-            pass.set_pipeline(pipeline);
-            pass.dispatch_workgroups(over(n), 1, 1);
-        }
+        self.search(pass, start);
         let round = |n: u32| (u64::from(ROUNDS + n) * ROUND_STRIDE) as u32;
         for sweep in 0..self.sweeps.min(PUSH_SWEEPS) {
             for r in 0..PUSH_ROUNDS {
                 pass.set_bind_group(1, &self.rounds, &[round(sweep * PUSH_ROUNDS + r)]);
-                pass.set_pipeline(&self.claim);
-                pass.dispatch_workgroups(over(pairs), 1, 1);
-                pass.set_pipeline(&self.push_alone);
-                pass.dispatch_workgroups(over(pairs), 1, 1);
+                self.run(pass, Kernel::Claim);
+                self.run(pass, Kernel::PushAlone);
             }
-            pass.set_pipeline(&self.push);
-            pass.dispatch_workgroups(over(pairs), 1, 1);
-            pass.set_pipeline(&self.push_apply);
-            pass.dispatch_workgroups(over(count), 1, 1);
+            self.run(pass, Kernel::Push);
+            self.run(pass, Kernel::PushApply);
         }
         if self.params.solids[0] > 0 {
-            let solids = [
-                (&self.solids, count),
-                (&self.faces, triangles),
-                (&self.faces_apply, count),
-            ];
-            for (pipeline, n) in solids {
-                pass.set_pipeline(pipeline);
-                pass.dispatch_workgroups(over(n), 1, 1);
+            for kernel in [Kernel::Solids, Kernel::Faces, Kernel::FacesApply] {
+                self.run(pass, kernel);
             }
         }
     }
@@ -484,22 +454,13 @@ impl SelfPass {
     /// Records a substep's cuts, where `start` says its start and end are: the pairs of the
     /// motion as pushed, checked along it.
     pub(super) fn encode_cuts(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
-        let search = self.begin(pass, start);
-        let over = |n: u32| n.div_ceil(WORKGROUP);
-        for (pipeline, n) in search {
-            pass.set_pipeline(pipeline);
-            pass.dispatch_workgroups(over(n), 1, 1);
-        }
-        let (count, pairs) = (self.params.counts[0], self.params.more[0]);
+        self.search(pass, start);
         for r in 0..ROUNDS {
             pass.set_bind_group(1, &self.rounds, &[(u64::from(r) * ROUND_STRIDE) as u32]);
-            pass.set_pipeline(&self.cut);
-            pass.dispatch_workgroups(over(pairs), 1, 1);
-            pass.set_pipeline(&self.apply);
-            pass.dispatch_workgroups(over(count), 1, 1);
+            self.run(pass, Kernel::Cut);
+            self.run(pass, Kernel::CutApply);
         }
-        pass.set_pipeline(&self.finish);
-        pass.dispatch_workgroups(over(count), 1, 1);
+        self.run(pass, Kernel::Finish);
     }
 
     /// Records a copy of the last substep's counters, read before the next submission.
