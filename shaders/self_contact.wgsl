@@ -31,7 +31,7 @@ struct SelfParams {
     // w: the substep (s).
     lengths: vec4<f32>,
     // x: Coulomb friction between layers; y: the colliders' offset (m).
-    friction: vec4<f32>,
+    contact: vec4<f32>,
     // x: how many colliders.
     solids: vec4<u32>,
     // The sphere and plane colliders (the step's).
@@ -170,7 +170,7 @@ const PUSH_WORDS: u32 = 8u;
 // Whether a particle at `x` rests on a sphere or plane (within a hair of where the
 // colliders put what they catch).
 fn on_solid(x: vec3<f32>) -> bool {
-    let offset = sp.friction.y;
+    let offset = sp.contact.y;
     for (var c = 0u; c < sp.solids.x; c++) {
         let col = sp.colliders[c];
         let hair = 1e-5 * (col.info.y + offset) + 1e-6;
@@ -197,7 +197,7 @@ fn solids(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     var q = state[i];
-    let out = collide_among(sp.colliders, sp.solids.x, sp.friction.y, start[i].x.xyz, Motion(q.x.xyz, q.v.xyz));
+    let out = collide_among(sp.colliders, sp.solids.x, sp.contact.y, start[i].x.xyz, Motion(q.x.xyz, q.v.xyz));
     q.x = vec4<f32>(out.x, q.x.w);
     q.v = vec4<f32>(out.v, q.v.w);
     state[i] = q;

@@ -114,7 +114,7 @@ fn push_of(pair: Pair) -> Push {
         let speed = length(sliding);
         var friction = 0.0;
         if (speed > 0.0) {
-            friction = min(sp.friction.x * -approach / speed, 1.0);
+            friction = min(sp.contact.x * -approach / speed, 1.0);
         }
         impulse = share * (-approach * direction - friction * sliding) / weight;
     }
@@ -298,7 +298,7 @@ fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
             continue;
         }
         let centre = col.a.xyz;
-        let reach = col.info.y + sp.friction.y;
+        let reach = col.info.y + sp.contact.y;
         let near = min(distance(x[0], centre), min(distance(x[1], centre), distance(x[2], centre)));
         if (near > reach + longest) {
             continue;

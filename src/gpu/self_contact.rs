@@ -60,7 +60,7 @@ struct SelfParams {
     more: [u32; 4],
     lengths: [f32; 4],
     /// Friction between layers, the colliders' offset.
-    friction: [f32; 4],
+    contact: [f32; 4],
     /// How many colliders.
     solids: [u32; 4],
     /// The step's sphere and plane colliders.
@@ -171,7 +171,7 @@ impl SelfPass {
                 (2.0 * longest).max(2.0 * own.thickness).max(1e-6),
                 0.0,
             ],
-            friction: [own.friction, 0.0, 0.0, 0.0],
+            contact: [own.friction, 0.0, 0.0, 0.0],
             solids: [0; 4],
             colliders: [GpuCollider::zeroed(); MAX_COLLIDERS],
         };
@@ -379,7 +379,7 @@ impl SelfPass {
             }
         }
         self.params.lengths[3] = substep;
-        self.params.friction[1] = cloth.drag[1];
+        self.params.contact[1] = cloth.drag[1];
         self.params.solids[0] = cloth.counts[1];
         self.params.colliders = cloth.colliders;
         (self.params.more[1], self.params.more[2]) = match memory {

@@ -433,17 +433,13 @@ impl GpuStepper {
             // Self-contact's substeps go one submission each: a frame of them is a long run
             // of dispatches, which a GL device (the software adapter) executes within one
             // submission while the window waits for its context.
-            let chunk = if self.contacts.own.is_some() {
-                1
-            } else {
-                substeps.max(1)
-            };
+            let each_alone = self.contacts.own.is_some();
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("cloth substeps"),
                 timestamp_writes: None,
             });
             for k in 0..substeps {
-                if k > 0 && k % chunk == 0 {
+                if k > 0 && each_alone {
                     drop(pass);
                     let next = self.device.create_command_encoder(&Default::default());
                     let full = std::mem::replace(&mut encoder, next);
