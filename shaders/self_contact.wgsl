@@ -1,6 +1,9 @@
 // Self-contact on the GPU (prepended with shaders/cloth_layout.wgsl, shaders/contact.wgsl
-// and shaders/geometry.wgsl, followed by shaders/self_pushes.wgsl; src/gpu/self_contact.rs
-// builds and dispatches it): the cloth kept off itself after each substep.
+// and shaders/geometry.wgsl, followed by shaders/self_pushes.wgsl and
+// shaders/self_together.wgsl; src/gpu/self_contact.rs builds and dispatches it): the cloth
+// kept off itself after each substep. Each kernel's work is a function of one particle,
+// triangle or pair (`…_one`), which the wide path dispatches over the device and the small
+// cloth's one workgroup loops over.
 // Each particle's motion over the substep, grown by half the thickness, is its box; each
 // triangle's box (its corners' together) goes into a hashed grid of cells (a list per
 // bucket, linked through an atomic exchange); each triangle then walks the cells its box
@@ -32,8 +35,8 @@ struct SelfParams {
     lengths: vec4<f32>,
     // x: Coulomb friction between layers; y: the colliders' offset (m).
     contact: vec4<f32>,
-    // x: how many colliders.
-    solids: vec4<u32>,
+    // x: how many colliders; y: sweeps of the pushes a substep; z: push rounds a sweep.
+    passes: vec4<u32>,
     // The sphere and plane colliders (the step's).
     colliders: array<Collider, 4>,
 }
@@ -131,9 +134,7 @@ fn bucket(c: vec3<i32>) -> u32 {
 }
 
 // Zeroes the counters and empties the buckets.
-@compute @workgroup_size(64)
-fn clear(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
+fn clear_one(i: u32) {
     if (i < MOST_ENTRIES) {
         atomicStore(&atomics[i], 0u);
     } else if (i >= COUNTERS && i < COUNTERS + sp.counts.z) {
@@ -141,11 +142,14 @@ fn clear(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
+@compute @workgroup_size(64)
+fn clear(@builtin(global_invocation_id) id: vec3<u32>) {
+    clear_one(id.x);
+}
+
 // Each particle's box: its motion over the substep grown by half the thickness; its whole
 // motion kept so far.
-@compute @workgroup_size(64)
-fn particle_boxes(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
+fn particle_boxes_one(i: u32) {
     if (i >= sp.counts.x) {
         return;
     }
@@ -163,6 +167,11 @@ fn particle_boxes(@builtin(global_invocation_id) id: vec3<u32>) {
     atomicStore(&atomics[owner_at(i)], 0u);
 }
 
+@compute @workgroup_size(64)
+fn particle_boxes(@builtin(global_invocation_id) id: vec3<u32>) {
+    particle_boxes_one(id.x);
+}
+
 // The word of a particle's eight where it rests on a collider.
 const HELD: u32 = 7u;
 const PUSH_WORDS: u32 = 8u;
@@ -171,7 +180,7 @@ const PUSH_WORDS: u32 = 8u;
 // colliders put what they catch).
 fn on_solid(x: vec3<f32>) -> bool {
     let offset = sp.contact.y;
-    for (var c = 0u; c < sp.solids.x; c++) {
+    for (var c = 0u; c < sp.passes.x; c++) {
         let col = sp.colliders[c];
         let hair = 1e-5 * (col.info.y + offset) + 1e-6;
         if (col.info.x == 1.0 && length(x - col.a.xyz) <= col.info.y + offset + hair) {
@@ -190,17 +199,20 @@ fn held(i: u32) -> bool {
 
 // The colliders act again on the substep's end, as pushed (a stack pressed its lowest
 // layer into one).
-@compute @workgroup_size(64)
-fn solids(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
+fn solids_one(i: u32) {
     if (i >= sp.counts.x || start[i].x.w <= 0.0) {
         return;
     }
     var q = state[i];
-    let out = collide_among(sp.colliders, sp.solids.x, sp.contact.y, start[i].x.xyz, Motion(q.x.xyz, q.v.xyz));
+    let out = collide_among(sp.colliders, sp.passes.x, sp.contact.y, start[i].x.xyz, Motion(q.x.xyz, q.v.xyz));
     q.x = vec4<f32>(out.x, q.x.w);
     q.v = vec4<f32>(out.v, q.v.w);
     state[i] = q;
+}
+
+@compute @workgroup_size(64)
+fn solids(@builtin(global_invocation_id) id: vec3<u32>) {
+    solids_one(id.x);
 }
 
 fn triangle_box_at(t: u32) -> u32 {
@@ -209,9 +221,7 @@ fn triangle_box_at(t: u32) -> u32 {
 
 // Each triangle's box goes into the grid, in every cell it covers, or where it covers too
 // many, onto the list of those checked against every triangle.
-@compute @workgroup_size(64)
-fn insert(@builtin(global_invocation_id) id: vec3<u32>) {
-    let t = id.x;
+fn insert_one(t: u32) {
     if (t >= sp.counts.y) {
         return;
     }
@@ -250,6 +260,11 @@ fn insert(@builtin(global_invocation_id) id: vec3<u32>) {
             }
         }
     }
+}
+
+@compute @workgroup_size(64)
+fn insert(@builtin(global_invocation_id) id: vec3<u32>) {
+    insert_one(id.x);
 }
 
 fn boxes_meet(alo: vec3<f32>, ahi: vec3<f32>, blo: vec3<f32>, bhi: vec3<f32>) -> bool {
@@ -344,9 +359,7 @@ fn pairs_of(a: u32, b: u32) {
 // Each triangle keeps its pairs with every triangle whose box meets its own: from the
 // grid, each two once (from the lower-numbered, in the first cell both cover); a triangle
 // on the list of those checked against all, with every triangle.
-@compute @workgroup_size(64)
-fn find(@builtin(global_invocation_id) id: vec3<u32>) {
-    let a = id.x;
+fn find_one(a: u32) {
     if (a >= sp.counts.y) {
         return;
     }
@@ -391,6 +404,11 @@ fn find(@builtin(global_invocation_id) id: vec3<u32>) {
             }
         }
     }
+}
+
+@compute @workgroup_size(64)
+fn find(@builtin(global_invocation_id) id: vec3<u32>) {
+    find_one(id.x);
 }
 
 
@@ -518,17 +536,15 @@ fn share_of(i: u32) -> f32 {
 // One round of cuts: each pair whose sides could come within what is kept along the
 // motion as the last round left it cuts its free particles' motion short (a scaled round:
 // to where the pair is still apart; later ones: to the start).
-@compute @workgroup_size(64)
-fn cut(@builtin(global_invocation_id) id: vec3<u32>) {
-    let r = this_round.x;
+fn cut_one(p: u32, r: u32) {
     // A round runs only after one that cut something.
     if (r > 0u && atomicLoad(&atomics[IMPACTS + r - 1u]) == atomicLoad(&atomics[STUCK + r - 1u])) {
         return;
     }
-    if (id.x >= pairs_kept()) {
+    if (p >= pairs_kept()) {
         return;
     }
-    let pair = pair_at(id.x);
+    let pair = pair_at(p);
     let edges = pair.edges;
     let ids = pair.ids;
     let origin = start[ids.x].x.xyz;
@@ -570,21 +586,27 @@ fn cut(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-// Each particle takes the round's cut.
 @compute @workgroup_size(64)
-fn cut_apply(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
+fn cut(@builtin(global_invocation_id) id: vec3<u32>) {
+    cut_one(id.x, this_round.x);
+}
+
+// Each particle takes the round's cut.
+fn cut_apply_one(i: u32) {
     if (i < sp.counts.x) {
         lists[scales_at() + i] = atomicLoad(&atomics[cuts_at() + i]);
     }
 }
 
+@compute @workgroup_size(64)
+fn cut_apply(@builtin(global_invocation_id) id: vec3<u32>) {
+    cut_apply_one(id.x);
+}
+
 // Each particle ends at its share of its motion, moving at the average velocity of what
 // it kept. Every free particle goes back to its start where the last round recorded
 // still cut something, or the grid's or the pairs' room ran out.
-@compute @workgroup_size(64)
-fn finish(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
+fn finish_one(i: u32) {
     if (i >= sp.counts.x) {
         return;
     }
@@ -611,6 +633,11 @@ fn finish(@builtin(global_invocation_id) id: vec3<u32>) {
     p.x = vec4<f32>(to, p.x.w);
     state[i] = p;
     tell_solver(i, p.v.xyz - v);
+}
+
+@compute @workgroup_size(64)
+fn finish(@builtin(global_invocation_id) id: vec3<u32>) {
+    finish_one(id.x);
 }
 
 // Tells the solver that particle `i`'s velocity changed by `dv` after its step (see the

@@ -153,21 +153,22 @@ fn done_at(p: u32) -> u32 {
     return scales_at() + sp.counts.x + p;
 }
 
-// Whether pair `p` was pushed in this sweep (`this_round.y`).
-fn pushed_this_sweep(p: u32) -> bool {
-    return lists[done_at(p)] == this_round.y + 1u;
+// Whether pair `p` was pushed in sweep `sweep`.
+fn pushed_in(p: u32, sweep: u32) -> bool {
+    return lists[done_at(p)] == sweep + 1u;
 }
 
-@compute @workgroup_size(64)
-fn claim(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= pairs_kept() || pushed_this_sweep(id.x)) {
+// Pair `p` claims its free particles for push round `round` (counted through the
+// substep's sweeps) of sweep `sweep`.
+fn claim_one(p: u32, round: u32, sweep: u32) {
+    if (p >= pairs_kept() || pushed_in(p, sweep)) {
         return;
     }
-    let pair = pair_at(id.x);
+    let pair = pair_at(p);
     if (!push_of(pair).pushed) {
         return;
     }
-    let key = key_of(pair, this_round.x);
+    let key = key_of(pair, round);
     for (var k = 0u; k < 4u; k++) {
         let i = pair.ids[k];
         if (start[i].x.w > 0.0) {
@@ -177,12 +178,17 @@ fn claim(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 @compute @workgroup_size(64)
-fn push_alone(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= pairs_kept() || pushed_this_sweep(id.x)) {
+fn claim(@builtin(global_invocation_id) id: vec3<u32>) {
+    claim_one(id.x, this_round.x, this_round.y);
+}
+
+// Pair `p` pushes its particles where it holds all its claims of the round.
+fn push_alone_one(p: u32, round: u32, sweep: u32) {
+    if (p >= pairs_kept() || pushed_in(p, sweep)) {
         return;
     }
-    let pair = pair_at(id.x);
-    let key = key_of(pair, this_round.x);
+    let pair = pair_at(p);
+    let key = key_of(pair, round);
     for (var k = 0u; k < 4u; k++) {
         let i = pair.ids[k];
         if (start[i].x.w > 0.0 && atomicLoad(&atomics[owner_at(i)]) != key) {
@@ -190,7 +196,7 @@ fn push_alone(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     let push = push_of(pair);
-    lists[done_at(id.x)] = this_round.y + 1u;
+    lists[done_at(p)] = sweep + 1u;
     if (!push.pushed) {
         return;
     }
@@ -207,6 +213,11 @@ fn push_alone(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
+@compute @workgroup_size(64)
+fn push_alone(@builtin(global_invocation_id) id: vec3<u32>) {
+    push_alone_one(id.x, this_round.x, this_round.y);
+}
+
 // The pairs the rounds left, side by side: each particle takes half the sum of their
 // pushes (`push_apply`), summed in fixed point so that the sum is the same in any order.
 // Half, not the average: these are the pairs of a crowded contact, a stack pressed
@@ -214,12 +225,13 @@ fn push_alone(@builtin(global_invocation_id) id: vec3<u32>) {
 // (measured: `layers` at 8 quads pressed to 3 µm apart, where it should be 6 mm); the
 // whole sum overshoots there (it blew `layers` up).
 const LEFT_SHARE: f32 = 0.5;
-@compute @workgroup_size(64)
-fn push(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= pairs_kept() || pushed_this_sweep(id.x)) {
+
+// Pair `p`, left by sweep `sweep`'s rounds, adds its pushes to its particles' sums.
+fn push_one(p: u32, sweep: u32) {
+    if (p >= pairs_kept() || pushed_in(p, sweep)) {
         return;
     }
-    let pair = pair_at(id.x);
+    let pair = pair_at(p);
     let push = push_of(pair);
     if (!push.pushed) {
         return;
@@ -235,6 +247,11 @@ fn push(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         atomicAdd(&atomics[slot + 3u], 1u);
     }
+}
+
+@compute @workgroup_size(64)
+fn push(@builtin(global_invocation_id) id: vec3<u32>) {
+    push_one(id.x, this_round.y);
 }
 
 // Particle `i` takes the side-by-side pushes summed for it: `share` of their sum, or
@@ -277,9 +294,7 @@ fn push_apply(@builtin(global_invocation_id) id: vec3<u32>) {
 // whose point nearest a centre is within the sphere and the offset is pushed out along
 // the line from the centre, its corners by their weights and inverse masses, their
 // velocities losing what points in; side by side, each corner taking the average.
-@compute @workgroup_size(64)
-fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
-    let t = id.x;
+fn faces_one(t: u32) {
     if (t >= sp.counts.y) {
         return;
     }
@@ -292,7 +307,7 @@ fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
         inv[k] = q.w;
     }
     let longest = max(distance(x[0], x[1]), max(distance(x[1], x[2]), distance(x[2], x[0])));
-    for (var c = 0u; c < sp.solids.x; c++) {
+    for (var c = 0u; c < sp.passes.x; c++) {
         let col = sp.colliders[c];
         if (col.info.x != 1.0) {
             continue;
@@ -326,6 +341,11 @@ fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
             atomicAdd(&atomics[slot + 3u], 1u);
         }
     }
+}
+
+@compute @workgroup_size(64)
+fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
+    faces_one(id.x);
 }
 
 // Each corner takes the average of its triangles' pushes out of the spheres.

@@ -45,10 +45,11 @@ impl Contacts {
         Ok(Self { obstacles, own })
     }
 
-    /// These passes, self-contact's pushes swept as often as in `old` (which tests set).
-    pub(super) fn swept_as(mut self, old: &Contacts) -> Self {
+    /// These passes, with self-contact's settings for tests as in `old`: how often its
+    /// pushes sweep, and whether one workgroup runs it whatever the size.
+    pub(super) fn tuned_as(mut self, old: &Contacts) -> Self {
         if let (Some(own), Some(old)) = (self.own.as_mut(), old.own.as_ref()) {
-            own.sweeps = old.sweeps;
+            (own.sweeps, own.forced) = (old.sweeps, old.forced);
         }
         self
     }

@@ -6,6 +6,9 @@
 //! planes put back what the pushes moved into them (triangles too); and the motion as
 //! pushed is cut short where a pair could meet, in rounds, as the CPU's continuous check
 //! cuts it, with a floor where f32 still resolves a pair's distance.
+//! A small cloth runs each phase (the search, the pushes, the colliders again, the cuts) in
+//! one dispatch of one workgroup instead (`shaders/self_together.wgsl`), the same steps in
+//! the same order, with the same bits.
 //! Where the grid's or the pairs' room ran out in a submission, the substeps concerned
 //! keep the cloth where it started them and the room is grown before the next.
 
@@ -25,7 +28,8 @@ use super::support::fits;
 
 const SOURCE: &str = concat!(
     include_str!("../../shaders/self_contact.wgsl"),
-    include_str!("../../shaders/self_pushes.wgsl")
+    include_str!("../../shaders/self_pushes.wgsl"),
+    include_str!("../../shaders/self_together.wgsl")
 );
 
 /// Rounds of cuts recorded a substep: four by the safe fraction, four to the start (the
@@ -61,8 +65,8 @@ struct SelfParams {
     lengths: [f32; 4],
     /// Friction between layers, the colliders' offset.
     contact: [f32; 4],
-    /// How many colliders.
-    solids: [u32; 4],
+    /// How many colliders, sweeps of the pushes, push rounds a sweep.
+    passes: [u32; 4],
     /// The step's sphere and plane colliders.
     colliders: [GpuCollider; MAX_COLLIDERS],
 }
@@ -89,9 +93,13 @@ enum Kernel {
     Solids,
     Faces,
     FacesApply,
+    SearchTogether,
+    PushesTogether,
+    SolidsTogether,
+    CutsTogether,
 }
 
-const KERNELS: usize = Kernel::FacesApply as usize + 1;
+const KERNELS: usize = Kernel::CutsTogether as usize + 1;
 
 const ENTRY_POINTS: [&str; KERNELS] = [
     "clear",
@@ -109,7 +117,21 @@ const ENTRY_POINTS: [&str; KERNELS] = [
     "solids",
     "faces",
     "faces_apply",
+    "search_together",
+    "pushes_together",
+    "solids_together",
+    "cuts_together",
 ];
+
+/// The most triangles, and pairs the last submission found in a substep, for which one
+/// workgroup runs each phase of a substep (`shaders/self_together.wgsl`): five dispatches
+/// where the wide path has about a hundred. Measured on the software adapter (two
+/// threads), where the wide path's dispatches cost about 8 ms a substep: with a few
+/// hundred pairs (`twist` at 12 quads) one workgroup steps 2.8 times faster; with 1 400
+/// (`layers` at 6 quads before it lands) 1.6 times slower, its one thread doing all the
+/// work.
+const TOGETHER_TRIANGLES: u32 = 1024;
+const TOGETHER_PAIRS: u32 = 768;
 
 /// The cloth's self-contact on the device.
 pub(super) struct SelfPass {
@@ -132,6 +154,11 @@ pub(super) struct SelfPass {
     /// The counters read after a submission, and whether one is waiting there.
     readout: wgpu::Buffer,
     pending: bool,
+    /// Whether one workgroup runs the submission's substeps (see [`TOGETHER_TRIANGLES`]).
+    together: bool,
+    /// Whether one workgroup runs every substep (`Some(true)`) or none, whatever the size
+    /// (for tests).
+    pub(super) forced: Option<bool>,
 }
 
 impl SelfPass {
@@ -172,7 +199,7 @@ impl SelfPass {
                 0.0,
             ],
             contact: [own.friction, 0.0, 0.0, 0.0],
-            solids: [0; 4],
+            passes: [0, PUSH_SWEEPS, PUSH_ROUNDS, 0],
             colliders: [GpuCollider::zeroed(); MAX_COLLIDERS],
         };
         use wgpu::BufferUsages as U;
@@ -232,6 +259,8 @@ impl SelfPass {
             params,
             readout,
             pending: false,
+            together: n <= TOGETHER_TRIANGLES,
+            forced: None,
         }))
     }
 
@@ -364,6 +393,7 @@ impl SelfPass {
             };
             self.readout.unmap();
             let (entries, pairs) = (words[0], words[1]);
+            self.together = self.params.counts[1] <= TOGETHER_TRIANGLES && pairs <= TOGETHER_PAIRS;
             let mut grown = self.params;
             if entries > grown.counts[3] {
                 grown.counts[3] = entries.saturating_mul(2);
@@ -378,9 +408,11 @@ impl SelfPass {
                 self.regroup(device);
             }
         }
+        self.together = self.forced.unwrap_or(self.together);
         self.params.lengths[3] = substep;
         self.params.contact[1] = cloth.drag[1];
-        self.params.solids[0] = cloth.counts[1];
+        self.params.passes[0] = cloth.counts[1];
+        self.params.passes[1] = self.sweeps.min(PUSH_SWEEPS);
         self.params.colliders = cloth.colliders;
         (self.params.more[1], self.params.more[2]) = match memory {
             Memory::None => (0, 0),
@@ -410,6 +442,7 @@ impl SelfPass {
             Insert | Find | Faces => triangles,
             Cut | Push | Claim | PushAlone => self.params.more[0],
             Boxes | CutApply | Finish | KeepStart | PushApply | Solids | FacesApply => count,
+            SearchTogether | PushesTogether | SolidsTogether | CutsTogether => WORKGROUP,
         };
         pass.set_pipeline(&self.kernels[kernel as usize]);
         pass.dispatch_workgroups(n.div_ceil(WORKGROUP), 1, 1);
@@ -424,6 +457,9 @@ impl SelfPass {
         }];
         pass.set_bind_group(0, group, &[]);
         pass.set_bind_group(1, &self.rounds, &[0]);
+        if self.together {
+            return self.run(pass, Kernel::SearchTogether);
+        }
         for kernel in [Kernel::Clear, Kernel::Boxes, Kernel::Insert, Kernel::Find] {
             self.run(pass, kernel);
         }
@@ -434,6 +470,14 @@ impl SelfPass {
     /// plane put back out.
     pub(super) fn encode_pushes(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
         self.search(pass, start);
+        let solids = self.params.passes[0] > 0;
+        if self.together {
+            self.run(pass, Kernel::PushesTogether);
+            if solids {
+                self.run(pass, Kernel::SolidsTogether);
+            }
+            return;
+        }
         let round = |n: u32| (u64::from(ROUNDS + n) * ROUND_STRIDE) as u32;
         for sweep in 0..self.sweeps.min(PUSH_SWEEPS) {
             for r in 0..PUSH_ROUNDS {
@@ -444,7 +488,7 @@ impl SelfPass {
             self.run(pass, Kernel::Push);
             self.run(pass, Kernel::PushApply);
         }
-        if self.params.solids[0] > 0 {
+        if solids {
             for kernel in [Kernel::Solids, Kernel::Faces, Kernel::FacesApply] {
                 self.run(pass, kernel);
             }
@@ -455,6 +499,9 @@ impl SelfPass {
     /// motion as pushed, checked along it.
     pub(super) fn encode_cuts(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
         self.search(pass, start);
+        if self.together {
+            return self.run(pass, Kernel::CutsTogether);
+        }
         for r in 0..ROUNDS {
             pass.set_bind_group(1, &self.rounds, &[(u64::from(r) * ROUND_STRIDE) as u32]);
             self.run(pass, Kernel::Cut);

@@ -689,7 +689,7 @@ impl StepBackend for GpuStepper {
             let scene = (model, effects, &params.contact);
             let (device, queue) = (&self.device, &self.queue);
             match Contacts::new(device, queue, &self.kernel, &self.particles, scene) {
-                Ok(contacts) => self.contacts = contacts.swept_as(&self.contacts),
+                Ok(contacts) => self.contacts = contacts.tuned_as(&self.contacts),
                 Err(e) => self.unsupported = Some(e.to_string()),
             }
         }

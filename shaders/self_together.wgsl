@@ -1,0 +1,106 @@
+// Self-contact by one workgroup (appended to shaders/self_pushes.wgsl; src/gpu/self_contact.rs
+// picks it for a small cloth): each phase of a substep in one dispatch (the search, the
+// pushes' sweeps, the colliders' second pass, the cuts), where the wide path dispatches
+// each step of each round over the whole device, about a hundred dispatches a substep.
+// The steps are the wide path's own functions, in its order, with a barrier where it ends a
+// dispatch; each result is a fixed-point sum, an atomic maximum or minimum, or the write of
+// the one pair or particle that owns it, so both paths give the same bits. On the software
+// adapter a dispatch costs far more than a small cloth's work in it.
+
+const TEAM: u32 = 64u;
+
+var<workgroup> team_count: u32;
+
+// The pairs the search kept, the same for every invocation of the team.
+fn pairs_for_team(l: u32) -> u32 {
+    if (l == 0u) {
+        team_count = pairs_kept();
+    }
+    return workgroupUniformLoad(&team_count);
+}
+
+// The substep's pairs: the counters cleared, the particles' and triangles' boxes, the grid,
+// the pairs (the wide path's `clear`, `particle_boxes`, `insert` and `find`).
+@compute @workgroup_size(64)
+fn search_together(@builtin(local_invocation_index) l: u32) {
+    for (var i = l; i < COUNTERS + sp.counts.z; i += TEAM) {
+        clear_one(i);
+    }
+    storageBarrier();
+    for (var i = l; i < sp.counts.x; i += TEAM) {
+        particle_boxes_one(i);
+    }
+    storageBarrier();
+    for (var t = l; t < sp.counts.y; t += TEAM) {
+        insert_one(t);
+    }
+    storageBarrier();
+    for (var t = l; t < sp.counts.y; t += TEAM) {
+        find_one(t);
+    }
+}
+
+// Each particle takes `share` of the side-by-side pushes summed for it.
+fn take_pushes_together(l: u32, share: f32) {
+    for (var i = l; i < sp.counts.x; i += TEAM) {
+        take_pushes(i, share);
+    }
+}
+
+// The sweeps of push rounds, each with what its rounds leave pushed side by side.
+@compute @workgroup_size(64)
+fn pushes_together(@builtin(local_invocation_index) l: u32) {
+    let n = pairs_for_team(l);
+    for (var sweep = 0u; sweep < sp.passes.y; sweep++) {
+        for (var r = 0u; r < sp.passes.z; r++) {
+            let round = sweep * sp.passes.z + r;
+            for (var p = l; p < n; p += TEAM) {
+                claim_one(p, round, sweep);
+            }
+            storageBarrier();
+            for (var p = l; p < n; p += TEAM) {
+                push_alone_one(p, round, sweep);
+            }
+            storageBarrier();
+        }
+        for (var p = l; p < n; p += TEAM) {
+            push_one(p, sweep);
+        }
+        storageBarrier();
+        take_pushes_together(l, LEFT_SHARE);
+        storageBarrier();
+    }
+}
+
+// The colliders again on what the pushes moved, and the triangles kept out of the spheres.
+@compute @workgroup_size(64)
+fn solids_together(@builtin(local_invocation_index) l: u32) {
+    for (var i = l; i < sp.counts.x; i += TEAM) {
+        solids_one(i);
+    }
+    storageBarrier();
+    for (var t = l; t < sp.counts.y; t += TEAM) {
+        faces_one(t);
+    }
+    storageBarrier();
+    take_pushes_together(l, 0.0);
+}
+
+// The rounds of cuts on the motion as pushed, then each particle's end.
+@compute @workgroup_size(64)
+fn cuts_together(@builtin(local_invocation_index) l: u32) {
+    let n = pairs_for_team(l);
+    for (var r = 0u; r < sp.more.w; r++) {
+        for (var p = l; p < n; p += TEAM) {
+            cut_one(p, r);
+        }
+        storageBarrier();
+        for (var i = l; i < sp.counts.x; i += TEAM) {
+            cut_apply_one(i);
+        }
+        storageBarrier();
+    }
+    for (var i = l; i < sp.counts.x; i += TEAM) {
+        finish_one(i);
+    }
+}
