@@ -218,12 +218,15 @@ fn push_alone(@builtin(global_invocation_id) id: vec3<u32>) {
     push_alone_one(id.x, this_round.x, this_round.y);
 }
 
-// The pairs the rounds left, side by side: each particle takes half the sum of their
+// The pairs the rounds left, side by side: each particle moves by half the sum of their
 // pushes (`push_apply`), summed in fixed point so that the sum is the same in any order.
 // Half, not the average: these are the pairs of a crowded contact, a stack pressed
 // together, and the average of a particle's pushes, one from each layer, barely moves it
 // (measured: `layers` at 8 quads pressed to 3 µm apart, where it should be 6 mm); the
-// whole sum overshoots there (it blew `layers` up).
+// whole sum overshoots there (it blew `layers` up). Its velocity changes by the average of
+// theirs: each pair takes away the whole of its sides' approach, so a particle landing on
+// several triangles at once lost it several times over in half the sum (a cloth landing
+// flat on another on the ground flung a corner up at ten times its landing speed).
 const LEFT_SHARE: f32 = 0.5;
 
 // Pair `p`, left by sweep `sweep`'s rounds, adds its pushes to its particles' sums.
@@ -254,8 +257,8 @@ fn push(@builtin(global_invocation_id) id: vec3<u32>) {
     push_one(id.x, this_round.y);
 }
 
-// Particle `i` takes the side-by-side pushes summed for it: `share` of their sum, or
-// their average where `share` is 0.
+// Particle `i` takes the side-by-side pushes summed for it: `share` of their moves' sum,
+// or their average where `share` is 0, and the average of their changes of velocity.
 fn take_pushes(i: u32, share: f32) {
     if (i >= sp.counts.x) {
         return;
@@ -274,12 +277,13 @@ fn take_pushes(i: u32, share: f32) {
     for (var k = 0u; k < HELD; k++) {
         atomicStore(&atomics[slot + k], 0u);
     }
-    let part = select(share, 1.0 / f32(count), share == 0.0);
+    let average = 1.0 / f32(count);
+    let part = select(share, average, share == 0.0);
     var q = state[i];
     q.x = vec4<f32>(q.x.xyz + dx * part, q.x.w);
-    q.v = vec4<f32>(q.v.xyz + dv * part, q.v.w);
+    q.v = vec4<f32>(q.v.xyz + dv * average, q.v.w);
     state[i] = q;
-    tell_solver(i, dv * part);
+    tell_solver(i, dv * average);
 }
 
 // Each particle takes its share of the side-by-side pushes.
