@@ -62,6 +62,9 @@ struct SelfParams {
 @group(0) @binding(7) var<storage, read_write> solver: array<u32>;
 // The round this dispatch takes (x).
 @group(1) @binding(0) var<uniform> this_round: vec4<u32>;
+// The pair kernels' workgroup counts (x, y, z), read by their indirect dispatches (bound to
+// `size_pairs` alone).
+@group(2) @binding(0) var<storage, read_write> pair_groups: array<u32>;
 
 // Counters in `atomics`: grid entries, pairs, triangles checked against all, and per round
 // the pairs it found could meet and those of them it could not cut.
@@ -411,6 +414,15 @@ fn find(@builtin(global_invocation_id) id: vec3<u32>) {
     find_one(id.x);
 }
 
+
+// The workgroups the pair kernels dispatch: as many as the pairs the search kept need (the
+// room for pairs is far more, and a workgroup past them would do nothing).
+@compute @workgroup_size(1)
+fn size_pairs() {
+    pair_groups[0] = (pairs_kept() + 63u) / 64u;
+    pair_groups[1] = 1u;
+    pair_groups[2] = 1u;
+}
 
 // Where particle i is with `share` of its motion over the substep (the one expression both
 // the check and the cut take).

@@ -20,7 +20,7 @@ use crate::sim::{SelfCollision, owned_parts};
 
 use super::error::GpuError;
 use super::kernel::{
-    CONTACT, GEOMETRY, LAYOUT, Slot, WORKGROUP, layout, pipelines, start_end_groups,
+    CONTACT, GEOMETRY, LAYOUT, Slot, WORKGROUP, bind, layout, pipelines, start_end_groups,
 };
 use super::packing::{GpuCollider, MAX_COLLIDERS, Params};
 use super::substep_ends::{Memory, Start};
@@ -97,9 +97,10 @@ enum Kernel {
     PushesTogether,
     SolidsTogether,
     CutsTogether,
+    SizePairs,
 }
 
-const KERNELS: usize = Kernel::CutsTogether as usize + 1;
+const KERNELS: usize = Kernel::SizePairs as usize + 1;
 
 const ENTRY_POINTS: [&str; KERNELS] = [
     "clear",
@@ -121,6 +122,7 @@ const ENTRY_POINTS: [&str; KERNELS] = [
     "pushes_together",
     "solids_together",
     "cuts_together",
+    "size_pairs",
 ];
 
 /// The most triangles, and pairs the last submission found in a substep, for which one
@@ -143,6 +145,10 @@ pub(super) struct SelfPass {
     /// As the obstacles' (see `start_end_groups`).
     groups: [wgpu::BindGroup; 6],
     rounds: wgpu::BindGroup,
+    /// The pair kernels' workgroup counts (x, y, z), which `size_pairs` writes after each
+    /// search and their indirect dispatches read, and its group (2).
+    pair_groups: wgpu::Buffer,
+    pair_groups_group: wgpu::BindGroup,
     /// What the groups bind: the uniform, the triangles, the boxes, the counters and
     /// buckets, the lists, the kept start and a stand-in for the solver's words; the
     /// solver's words bound instead, the particles.
@@ -237,12 +243,26 @@ impl SelfPass {
         let slots = [Uniform, Read, Write, Read, Write, Write, Write, Write];
         let main = layout(device, "self-contact", &slots);
         let round_layout = layout(device, "self-contact round", &[Dynamic]);
+        let sizes_layout = layout(device, "self-contact pair groups", &[Write]);
         let all: &[&wgpu::BindGroupLayout] = &[&main, &round_layout];
+        let sizing: &[&wgpu::BindGroupLayout] = &[&main, &round_layout, &sizes_layout];
         let kernels = pipelines(
             device,
             "self-contact",
             &format!("{LAYOUT}{CONTACT}{GEOMETRY}{SOURCE}"),
-            ENTRY_POINTS.map(|entry| (entry, all)),
+            ENTRY_POINTS.map(|entry| (entry, if entry == "size_pairs" { sizing } else { all })),
+        );
+        let pair_groups = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("self-contact pair groups"),
+            size: 16,
+            usage: U::STORAGE | U::INDIRECT,
+            mapped_at_creation: false,
+        });
+        let pair_groups_group = bind(
+            device,
+            "self-contact pair groups",
+            &sizes_layout,
+            &[&pair_groups],
         );
         let rounds = Self::rounds(device, queue, &round_layout);
         let buffers = [uniform, tris, boxes, atomics, lists, kept, no_solve];
@@ -252,6 +272,8 @@ impl SelfPass {
             sweeps: PUSH_SWEEPS,
             groups,
             rounds,
+            pair_groups,
+            pair_groups_group,
             buffers,
             solve: None,
             particles: particles.clone(),
@@ -432,17 +454,21 @@ impl SelfPass {
         self.run(pass, Kernel::KeepStart);
     }
 
-    /// Dispatches `kernel` over what it runs on: a particle, a triangle, a pair or a
-    /// counter or bucket each invocation.
+    /// Dispatches `kernel` over what it runs on: a particle, a triangle, a pair (as many
+    /// workgroups as the search's pairs need, which `size_pairs` wrote) or a counter or
+    /// bucket each invocation; or the one workgroup that runs all.
     fn run(&self, pass: &mut wgpu::ComputePass<'_>, kernel: Kernel) {
         use Kernel::*;
         let [count, triangles, buckets, _] = self.params.counts;
         let n = match kernel {
             Clear => COUNTERS + buckets,
             Insert | Find | Faces => triangles,
-            Cut | Push | Claim | PushAlone => self.params.more[0],
+            Cut | Push | Claim | PushAlone => {
+                pass.set_pipeline(&self.kernels[kernel as usize]);
+                return pass.dispatch_workgroups_indirect(&self.pair_groups, 0);
+            }
             Boxes | CutApply | Finish | KeepStart | PushApply | Solids | FacesApply => count,
-            SearchTogether | PushesTogether | SolidsTogether | CutsTogether => WORKGROUP,
+            SearchTogether | PushesTogether | SolidsTogether | CutsTogether | SizePairs => 1,
         };
         pass.set_pipeline(&self.kernels[kernel as usize]);
         pass.dispatch_workgroups(n.div_ceil(WORKGROUP), 1, 1);
@@ -463,6 +489,8 @@ impl SelfPass {
         for kernel in [Kernel::Clear, Kernel::Boxes, Kernel::Insert, Kernel::Find] {
             self.run(pass, kernel);
         }
+        pass.set_bind_group(2, &self.pair_groups_group, &[]);
+        self.run(pass, Kernel::SizePairs);
     }
 
     /// Records a substep's pushes, where `start` says its start and end are: the pairs of
