@@ -135,6 +135,12 @@ const ENTRY_POINTS: [&str; KERNELS] = [
 const TOGETHER_TRIANGLES: u32 = 1024;
 const TOGETHER_PAIRS: u32 = 768;
 
+/// Whether one workgroup runs the substeps of a cloth of `triangles` whose last submission
+/// found at most `pairs` in a substep.
+fn small(triangles: u32, pairs: u32) -> bool {
+    triangles <= TOGETHER_TRIANGLES && pairs <= TOGETHER_PAIRS
+}
+
 /// The cloth's self-contact on the device.
 pub(super) struct SelfPass {
     /// The shader's entry points, in [`Kernel`]'s order.
@@ -281,7 +287,7 @@ impl SelfPass {
             params,
             readout,
             pending: false,
-            together: n <= TOGETHER_TRIANGLES,
+            together: small(n, 0),
             forced: None,
         }))
     }
@@ -415,7 +421,7 @@ impl SelfPass {
             };
             self.readout.unmap();
             let (entries, pairs) = (words[0], words[1]);
-            self.together = self.params.counts[1] <= TOGETHER_TRIANGLES && pairs <= TOGETHER_PAIRS;
+            self.together = small(self.params.counts[1], pairs);
             let mut grown = self.params;
             if entries > grown.counts[3] {
                 grown.counts[3] = entries.saturating_mul(2);
@@ -507,7 +513,7 @@ impl SelfPass {
             return;
         }
         let round = |n: u32| (u64::from(ROUNDS + n) * ROUND_STRIDE) as u32;
-        for sweep in 0..self.sweeps.min(PUSH_SWEEPS) {
+        for sweep in 0..self.params.passes[1] {
             for r in 0..PUSH_ROUNDS {
                 pass.set_bind_group(1, &self.rounds, &[round(sweep * PUSH_ROUNDS + r)]);
                 self.run(pass, Kernel::Claim);
