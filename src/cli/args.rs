@@ -136,8 +136,7 @@ pub enum Command {
         /// Comma-separated particles per side.
         #[arg(long, value_delimiter = ',', default_value = "32,64,128,256")]
         sizes: Vec<u32>,
-        /// Comma-separated integrators [default: semi-implicit-euler,implicit-euler,xpbd,vbd;
-        /// with --backend gpu, semi-implicit-euler, the one it runs].
+        /// Comma-separated integrators [default: semi-implicit-euler,implicit-euler,xpbd,vbd].
         #[arg(long, value_delimiter = ',')]
         integrators: Option<Vec<IntegratorKind>>,
         /// Comma-separated thread counts.
@@ -146,7 +145,8 @@ pub enum Command {
         /// Print one JSON object per row.
         #[arg(long)]
         json: bool,
-        /// cpu, or gpu (semi-implicit Euler on wgpu compute; --threads does not apply).
+        /// cpu, or gpu (wgpu compute: semi-implicit and implicit Euler, XPBD, VBD; --threads
+        /// does not apply).
         #[arg(long, value_enum, default_value_t = Backend::Cpu)]
         backend: Backend,
         /// What the CPU computes in: f32 or f64 (the GPU refuses f64).
