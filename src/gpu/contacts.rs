@@ -49,7 +49,7 @@ impl Contacts {
     /// pushes sweep, and whether one workgroup runs it whatever the size.
     pub(super) fn tuned_as(mut self, old: &Contacts) -> Self {
         if let (Some(own), Some(old)) = (self.own.as_mut(), old.own.as_ref()) {
-            (own.sweeps, own.forced) = (old.sweeps, old.forced);
+            (own.sweeps, own.forced, own.room) = (old.sweeps, old.forced, old.room);
         }
         self
     }
@@ -123,6 +123,18 @@ impl Contacts {
     pub(super) fn after_submission(&mut self, encoder: &mut wgpu::CommandEncoder) {
         if let Some(own) = self.own.as_mut() {
             own.copy_counters(encoder);
+        }
+    }
+
+    /// Whether self-contact's room for pairs or grid entries ran out in the last
+    /// submission (read once; the room is grown then).
+    ///
+    /// # Errors
+    /// [`GpuError::Readback`] when the counters cannot be read.
+    pub(super) fn room_ran_out(&mut self, device: &wgpu::Device) -> Result<bool, GpuError> {
+        match self.own.as_mut() {
+            Some(own) => own.read_counters(device),
+            None => Ok(false),
         }
     }
 }

@@ -6,6 +6,9 @@
 //! refinement fails, the policy's fallback integrator is tried at the requested substeps if
 //! the GPU runs it (implicit Euler, the default, XPBD, VBD); when that fails too, or is
 //! not tried, the state is the frame's start and the run stops with the likely cause.
+//! A frame in which self-contact's room for pairs or grid entries ran out (the substeps
+//! concerned left the cloth where they started it) is redone with the room grown, from its
+//! start or, in a replay, from the rollback point.
 
 use std::time::Instant;
 
@@ -22,7 +25,13 @@ enum Failed {
     Limit(Trouble),
     /// The device failed (said in the text); nothing more can be stepped.
     Device(String),
+    /// Self-contact's room ran out (and has grown since): the try is to be redone.
+    RanOut,
 }
+
+/// Tries a frame has at being redone where self-contact's room ran out; past them a frame
+/// that ran out stands as stepped (safe: the substeps concerned did not move the cloth).
+const ROOM_TRIES: u32 = 4;
 
 /// The frame as stepped, and its end measured.
 const FRAME: Watch = Watch {
@@ -66,8 +75,16 @@ impl GpuStepper {
             self.derive_limits(model, state)
                 .map_err(|why| self.device_failure(state.time, why))?;
         }
-        let outcome = match self.try_frame(model, state, state.time, FRAME) {
-            Ok(()) => {
+        self.room_tries = ROOM_TRIES;
+        let mut tried = self.try_frame(model, state, state.time, FRAME);
+        while let Err(Failed::RanOut) = tried {
+            let start = self.frame_start.clone();
+            self.restore(&start);
+            tried = self.try_frame(model, state, state.time, FRAME);
+        }
+        let outcome = match tried {
+            // `try_frame` stops saying so once the tries are spent.
+            Ok(()) | Err(Failed::RanOut) => {
                 self.guard.healthy_frame(&self.frame_start);
                 Ok(self.maybe_recover(end).unwrap_or(FrameOutcome::Stepped))
             }
@@ -117,6 +134,12 @@ impl GpuStepper {
             self.lost = Some(why.clone());
             Failed::Device(why)
         })?;
+        let ran_out = (self.contacts.room_ran_out(&self.device))
+            .map_err(|e| Failed::Device(e.to_string()))?;
+        if ran_out && self.room_tries > 0 {
+            self.room_tries -= 1;
+            return Err(Failed::RanOut);
+        }
         let limits = (self.guard.limits.as_ref()).ok_or(Failed::Limit(Trouble::NonFinite))?;
         match limits.judge(&health.motion, || health.strain) {
             Some(trouble) => Err(Failed::Limit(trouble)),
@@ -124,8 +147,23 @@ impl GpuStepper {
         }
     }
 
-    /// Replays from the rollback point to `end` at the substeps in effect.
+    /// Replays from the rollback point to `end` at the substeps in effect, from the start
+    /// again where self-contact's room ran out.
     fn replay(&mut self, model: &ClothModel, state: &ClothState, end: f64) -> Result<(), Failed> {
+        loop {
+            match self.replay_once(model, state, end) {
+                Err(Failed::RanOut) => continue,
+                done => return done,
+            }
+        }
+    }
+
+    fn replay_once(
+        &mut self,
+        model: &ClothModel,
+        state: &ClothState,
+        end: f64,
+    ) -> Result<(), Failed> {
         let from = (self.guard.checkpoint.clone()).unwrap_or_else(|| self.frame_start.clone());
         let time = self.restore(&from);
         let frames = ((end - time) / self.dt as f64).round().max(1.0) as u32;
@@ -158,6 +196,8 @@ impl GpuStepper {
                 }
                 Err(Failed::Limit(t)) => last = t,
                 Err(Failed::Device(why)) => return Err(self.device_failure(state.time, why)),
+                // `replay` redoes these itself.
+                Err(Failed::RanOut) => {}
             }
         }
         let tried = self.substeps;
@@ -181,6 +221,7 @@ impl GpuStepper {
                     fallback = format!(", and with {}", kind.label());
                 }
                 Err(Failed::Device(why)) => return Err(self.device_failure(state.time, why)),
+                Err(Failed::RanOut) => self.switch_integrator(original),
             }
         }
         let start = self.frame_start.clone();

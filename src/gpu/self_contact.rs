@@ -171,6 +171,9 @@ pub(super) struct SelfPass {
     /// Whether one workgroup runs every substep (`Some(true)`) or none, whatever the size
     /// (for tests).
     pub(super) forced: Option<bool>,
+    /// Room for only this many pairs and grid entries from the next submission on, as if
+    /// an earlier one had needed no more (for tests: the room running out).
+    pub(super) room: Option<[u32; 2]>,
 }
 
 impl SelfPass {
@@ -289,6 +292,7 @@ impl SelfPass {
             pending: false,
             together: small(n, 0),
             forced: None,
+            room: None,
         }))
     }
 
@@ -410,31 +414,11 @@ impl SelfPass {
         memory: Memory,
         cloth: &Params,
     ) -> Result<(), GpuError> {
-        if self.pending {
-            self.pending = false;
-            let slice = self.readout.slice(..);
-            let failed = |e: &dyn std::fmt::Display| GpuError::Readback(e.to_string());
-            map_read(device, &slice).map_err(|e| failed(&e))?;
-            let words: Vec<u32> = {
-                let view = slice.get_mapped_range().map_err(|e| failed(&e))?;
-                bytemuck::cast_slice(&view).to_vec()
-            };
-            self.readout.unmap();
-            let (entries, pairs) = (words[0], words[1]);
-            self.together = small(self.params.counts[1], pairs);
-            let mut grown = self.params;
-            if entries > grown.counts[3] {
-                grown.counts[3] = entries.saturating_mul(2);
-            }
-            if pairs > grown.more[0] {
-                grown.more[0] = pairs.saturating_mul(2);
-            }
-            if (grown.counts, grown.more) != (self.params.counts, self.params.more) {
-                let (atomics, lists) = Self::rooms(device, &grown)?;
-                (self.buffers[3], self.buffers[4]) = (atomics, lists);
-                self.params = grown;
-                self.regroup(device);
-            }
+        self.read_counters(device)?;
+        if let Some([pairs, entries]) = self.room.take() {
+            let mut shrunk = self.params;
+            (shrunk.more[0], shrunk.counts[3]) = (pairs, entries);
+            self.resize(device, shrunk)?;
         }
         self.together = self.forced.unwrap_or(self.together);
         self.params.lengths[3] = substep;
@@ -449,6 +433,51 @@ impl SelfPass {
         };
         queue.write_buffer(&self.buffers[0], 0, bytemuck::bytes_of(&self.params));
         queue.write_buffer(&self.buffers[3], MOST_AT, &[0; 8]);
+        Ok(())
+    }
+
+    /// Reads what the last submission's substeps asked for, if it has not been read: grows
+    /// the room where they ran out of it (to twice what they asked) and picks the path for
+    /// the next. Returns whether they ran out (then the substeps concerned left the cloth
+    /// where they started it).
+    ///
+    /// # Errors
+    /// As [`Self::prepare`].
+    pub(super) fn read_counters(&mut self, device: &wgpu::Device) -> Result<bool, GpuError> {
+        if !self.pending {
+            return Ok(false);
+        }
+        self.pending = false;
+        let slice = self.readout.slice(..);
+        let failed = |e: &dyn std::fmt::Display| GpuError::Readback(e.to_string());
+        map_read(device, &slice).map_err(|e| failed(&e))?;
+        let words: Vec<u32> = {
+            let view = slice.get_mapped_range().map_err(|e| failed(&e))?;
+            bytemuck::cast_slice(&view).to_vec()
+        };
+        self.readout.unmap();
+        let (entries, pairs) = (words[0], words[1]);
+        self.together = small(self.params.counts[1], pairs);
+        let mut grown = self.params;
+        if entries > grown.counts[3] {
+            grown.counts[3] = entries.saturating_mul(2);
+        }
+        if pairs > grown.more[0] {
+            grown.more[0] = pairs.saturating_mul(2);
+        }
+        let ran_out = (grown.counts, grown.more) != (self.params.counts, self.params.more);
+        self.resize(device, grown)?;
+        Ok(ran_out)
+    }
+
+    /// Makes the room for pairs and grid entries `params`' (new buffers where it changes).
+    fn resize(&mut self, device: &wgpu::Device, params: SelfParams) -> Result<(), GpuError> {
+        if (params.counts, params.more) != (self.params.counts, self.params.more) {
+            let (atomics, lists) = Self::rooms(device, &params)?;
+            (self.buffers[3], self.buffers[4]) = (atomics, lists);
+            self.params = params;
+            self.regroup(device);
+        }
         Ok(())
     }
 

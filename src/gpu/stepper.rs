@@ -128,6 +128,8 @@ pub struct GpuStepper {
     pub(super) ends_sent: u32,
     /// A grid cloth's substep gathers its springs from the index (else from the ends).
     pub(super) grid_path: bool,
+    /// Tries left in the frame under way at redoing it where self-contact's room ran out.
+    pub(super) room_tries: u32,
 }
 
 impl GpuStepper {
@@ -258,6 +260,7 @@ impl GpuStepper {
             sent: None,
             ends_sent: 0,
             grid_path: true,
+            room_tries: 0,
             contacts: Contacts::default(),
         };
         stepper.configure(model, params, effects, Changes::all());

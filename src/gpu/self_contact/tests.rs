@@ -286,22 +286,7 @@ fn one_workgroup_and_the_wide_path_give_the_same_bits() {
 /// speed) and blew the step up.
 fn lands_a_thickness_apart(integrator: &str, substeps: u32) {
     let thickness = 0.006;
-    let scene = edited(
-        include_str!("../../../assets/scenes/layers.toml"),
-        &[
-            (
-                "integrator = \"implicit-euler\"",
-                &format!("integrator = \"{integrator}\""),
-            ),
-            ("substeps = 4", &format!("substeps = {substeps}")),
-            ("layers = 5", "layers = 2"),
-            (
-                "type = \"sphere\"\ncenter = [0.0, 0.3, 0.0]\nradius = 0.3\nfriction = 0.5",
-                "type = \"gravity\"",
-            ),
-        ],
-        4,
-    );
+    let scene = two_cloths(integrator, substeps);
     let mut gpu = Some(stepper(&scene, true, None));
     let mut sim = Simulation::new(scene);
     let mut fastest = 0.0f32;
@@ -333,6 +318,27 @@ fn lands_a_thickness_apart(integrator: &str, substeps: u32) {
     );
 }
 
+/// `layers` at 4 quads with two cloths and no sphere, stepped by `integrator` at
+/// `substeps` a frame: they fall flat onto the ground from 1 m, the lower one first.
+fn two_cloths(integrator: &str, substeps: u32) -> Scene {
+    edited(
+        include_str!("../../../assets/scenes/layers.toml"),
+        &[
+            (
+                "integrator = \"implicit-euler\"",
+                &format!("integrator = \"{integrator}\""),
+            ),
+            ("substeps = 4", &format!("substeps = {substeps}")),
+            ("layers = 5", "layers = 2"),
+            (
+                "type = \"sphere\"\ncenter = [0.0, 0.3, 0.0]\nradius = 0.3\nfriction = 0.5",
+                "type = \"gravity\"",
+            ),
+        ],
+        4,
+    )
+}
+
 #[test]
 fn a_cloth_landing_on_another_rests_on_it_a_thickness_apart_under_xpbd_on_the_gpu() {
     lands_a_thickness_apart("xpbd", 8);
@@ -351,4 +357,47 @@ fn a_cloth_landing_on_another_rests_on_it_a_thickness_apart_under_implicit_euler
 #[test]
 fn a_cloth_landing_on_another_rests_on_it_a_thickness_apart_under_semi_implicit_euler_on_the_gpu() {
     lands_a_thickness_apart("semi-implicit-euler", 48);
+}
+
+/// Self-contact's room for grid entries and pairs running out: the two cloths of
+/// [`lands_a_thickness_apart`] (on the GPU from frame 10) with room for 64 entries and 8
+/// pairs to start with, where they need about 100–220 entries from the first frame and 226
+/// pairs once they are near each other. A submission that runs out leaves the cloth where
+/// it started the substeps concerned; the guard's frame then grows the room and redoes the
+/// frame, so the run is the one that had room enough from the start, to the bit, after
+/// every frame, at the cost of the substeps redone. (With the frame taken as it ran out
+/// instead, the cloth stops dead in the air at frames 10, 11 and 21 and has not reached the
+/// ground at frame 40.)
+#[test]
+fn a_frame_whose_room_for_pairs_ran_out_is_redone_with_more_on_the_gpu() {
+    let [(roomy, plain), (tight, redone)] = [None, Some([8, 64])].map(|room| {
+        let scene = two_cloths("xpbd", 8);
+        let mut gpu = stepper(&scene, true, None);
+        gpu.contacts.own.as_mut().expect("self-contact").room = room;
+        let mut gpu = Some(gpu);
+        let mut sim = Simulation::new(scene);
+        let mut states = Vec::new();
+        for frame in 0..30 {
+            if let Some(gpu) = gpu.take_if(|_| frame == 10) {
+                sim.set_backend(Box::new(gpu)).expect("on the gpu");
+                sim.take_stats();
+            }
+            let outcome = sim.step_frame().expect("a frame");
+            assert_eq!(outcome, FrameOutcome::Stepped, "frame {frame}");
+            states.push((sim.state().pos.clone(), sim.state().vel.clone()));
+        }
+        (states, sim.take_stats().steps)
+    });
+    let lowest = (roomy[29].0.iter()).fold(f32::INFINITY, |m, p| m.min(p.y));
+    assert!(lowest < 0.011, "the cloths have landed: {lowest}");
+    for (frame, (a, b)) in roomy.iter().zip(&tight).enumerate() {
+        assert!(
+            a == b,
+            "frame {frame}: the run with too little room differs"
+        );
+    }
+    assert!(
+        redone > plain,
+        "frames were redone: {redone} substeps against {plain}"
+    );
 }
