@@ -74,7 +74,10 @@ impl VbdPass {
         let stencil = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("vbd stencil"),
             size: (words.len() as u64 * 4).max(32),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            // Read back by tests (what VBD remembers of a step).
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
         if !words.is_empty() {

@@ -9,7 +9,7 @@ use glam::Vec3;
 use crate::device::{AdapterPreference, HeadlessDevice};
 use crate::gpu::stepper::GpuStepper;
 use crate::scene::{Scene, SceneFile, Simulation};
-use crate::sim::FrameOutcome;
+use crate::sim::{FrameOutcome, StepBackend};
 
 /// A GPU stepper for `scene` on its own headless device; with `pushes` false its
 /// self-contact only cuts; `together` says whether one workgroup runs it (`None`: as the
@@ -400,4 +400,64 @@ fn a_frame_whose_room_for_pairs_ran_out_is_redone_with_more_on_the_gpu() {
         redone > plain,
         "frames were redone: {redone} substeps against {plain}"
     );
+}
+
+/// `count` words of `buffer` from word `at`, read back from the device.
+fn read_words(gpu: &GpuStepper, buffer: &wgpu::Buffer, at: u32, count: u32) -> Vec<u32> {
+    let bytes = u64::from(count) * 4;
+    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("test read"),
+        size: bytes,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    encoder.copy_buffer_to_buffer(buffer, u64::from(at) * 4, &staging, 0, bytes);
+    gpu.queue.submit([encoder.finish()]);
+    let slice = staging.slice(..);
+    crate::device::map_read(&gpu.device, &slice).expect("mapped");
+    let words = bytemuck::cast_slice(&slice.get_mapped_range().expect("a view")).to_vec();
+    staging.unmap();
+    words
+}
+
+/// VBD's first guess of a substep starts from the acceleration each particle took over the
+/// last one, so that acceleration must include what self-contact did to it after VBD's
+/// descent (the pushes and the cuts change velocities; `tell_solver` adds their change over
+/// the substep, as the CPU's VBD measures its acceleration after its contacts). The two
+/// cloths of [`lands_a_thickness_apart`] under VBD, on the GPU substep by substep through
+/// the upper one landing on the lower (a frame of 8 substeps each from frame 17; the
+/// landing decelerates particles at up to 2 722 m/s²): after every substep, each free
+/// particle's remembered acceleration is its change of velocity over the substep divided
+/// by the substep's length, to 7.6 µm/s² (checked to 1 mm/s²; rounding of f32 velocities
+/// over a substep of 2 ms could reach 0.14 mm/s²).
+#[test]
+fn vbd_remembers_the_acceleration_self_contact_left_on_the_gpu() {
+    let scene = two_cloths("vbd", 8);
+    let mut gpu = stepper(&scene, true, None);
+    let mut sim = Simulation::new(scene);
+    for _ in 0..17 {
+        sim.step_frame().expect("a frame");
+    }
+    let model = sim.model().clone();
+    let mut state = sim.state().clone();
+    let h = gpu.substep_length();
+    let n = model.particle_count() as u32;
+    let mut worst = 0.0f32;
+    let mut most = 0.0f32;
+    for _ in 0..64 {
+        let before = state.vel.clone();
+        gpu.substep(&model, &mut state).expect("a substep");
+        // Where the memory starts is known once the first substep has built the stencil.
+        let memory = read_words(&gpu, &gpu.vbd.stencil, gpu.vbd.starts[2], 4 * n);
+        for i in (0..n as usize).filter(|&i| model.inv_mass[i] > 0.0) {
+            let kept = glam::Vec3::from_array([0, 1, 2].map(|c| f32::from_bits(memory[4 * i + c])));
+            let taken = (state.vel[i] - before[i]) / h;
+            worst = worst.max((kept - taken).length());
+            most = most.max(taken.length());
+        }
+    }
+    eprintln!("remembered against taken: {worst} m/s² at most, of {most}");
+    assert!(most > 1000.0, "the cloths landed: {most} m/s² at most");
+    assert!(worst < 1e-3, "VBD remembers what it took: {worst} m/s² off");
 }
