@@ -273,6 +273,29 @@ fn one_workgroup_and_the_wide_path_give_the_same_bits() {
     assert!(closest < 0.006, "the layers have met: {closest}");
 }
 
+/// `scene` stepped for `frames` frames, on the GPU from frame `on_cpu`: every frame stands
+/// as stepped and leaves no two triangles through each other; `each` sees the simulation
+/// after every frame.
+fn clean_frames(
+    scene: Scene,
+    (on_cpu, frames): (usize, usize),
+    mut each: impl FnMut(&Simulation),
+) -> Simulation {
+    let mut gpu = Some(stepper(&scene, true, None));
+    let mut sim = Simulation::new(scene);
+    for frame in 0..frames {
+        if let Some(gpu) = gpu.take_if(|_| frame == on_cpu) {
+            sim.set_backend(Box::new(gpu)).expect("on the gpu");
+        }
+        let outcome = sim.step_frame().expect("a frame");
+        assert_eq!(outcome, FrameOutcome::Stepped, "frame {frame}");
+        let found = sim.intersections();
+        assert_eq!(found.total(), 0, "frame {frame}: {found:?}");
+        each(&sim);
+    }
+    sim
+}
+
 /// Two cloths 4 cm apart (`layers` at 4 quads with two layers and no sphere) fall flat onto
 /// the ground at 4.75 m/s, on the GPU from frame 10, under `integrator` at `substeps`: the
 /// lower one lands and rests on the ground, and the upper one lands on it a substep later,
@@ -286,21 +309,11 @@ fn one_workgroup_and_the_wide_path_give_the_same_bits() {
 /// speed) and blew the step up.
 fn lands_a_thickness_apart(integrator: &str, substeps: u32) {
     let thickness = 0.006;
-    let scene = two_cloths(integrator, substeps);
-    let mut gpu = Some(stepper(&scene, true, None));
-    let mut sim = Simulation::new(scene);
     let mut fastest = 0.0f32;
-    for frame in 0..40 {
-        if let Some(gpu) = gpu.take_if(|_| frame == 10) {
-            sim.set_backend(Box::new(gpu)).expect("on the gpu");
-        }
-        let outcome = sim.step_frame().expect("a frame");
-        assert_eq!(outcome, FrameOutcome::Stepped, "frame {frame}");
-        let found = sim.intersections();
-        assert_eq!(found.total(), 0, "frame {frame}: {found:?}");
+    let sim = clean_frames(two_cloths(integrator, substeps), (10, 40), |sim| {
         let speed = (sim.state().vel.iter()).fold(0.0f32, |m, v| m.max(v.length()));
         fastest = fastest.max(speed);
-    }
+    });
     let lowest = (sim.state().pos.iter()).fold(f32::INFINITY, |m, p| m.min(p.y));
     let closest = closest_layers(&sim.model().triangles, &sim.state().pos);
     eprintln!("{integrator}: lowest {lowest}, closest layers {closest}, fastest {fastest} m/s");
@@ -329,17 +342,7 @@ fn lands_a_thickness_apart(integrator: &str, substeps: u32) {
 #[test]
 fn a_flap_flung_over_at_10_m_per_s_folds_without_a_guard_event_on_the_gpu() {
     let scene = Scene::open_resized("fast-fold", None, &Default::default(), None).unwrap();
-    let mut gpu = Some(stepper(&scene, true, None));
-    let mut sim = Simulation::new(scene);
-    for frame in 0..19 {
-        if let Some(gpu) = gpu.take_if(|_| frame == 11) {
-            sim.set_backend(Box::new(gpu)).expect("on the gpu");
-        }
-        let outcome = sim.step_frame().expect("a frame");
-        assert_eq!(outcome, FrameOutcome::Stepped, "frame {frame}");
-        let found = sim.intersections();
-        assert_eq!(found.total(), 0, "frame {frame}: {found:?}");
-    }
+    let sim = clean_frames(scene, (11, 19), |_| {});
     let top = (sim.state().pos.iter()).fold(0.0f32, |m, p| m.max(p.y));
     assert!(top > 0.2, "the flap is in the air over the cloth: {top}");
 }
