@@ -204,7 +204,8 @@ impl XpbdPass {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::{ForceSet, IntegratorKind};
+    use crate::scene::Scene;
+    use crate::sim::ForceSet;
 
     /// The bench cloth's constraints, packed: each once; no two in a colour that runs at
     /// once share a particle; each particle meets its constraints in the CPU's order (the
@@ -212,7 +213,8 @@ mod tests {
     /// halves' colours share dispatches.
     #[test]
     fn the_halves_colours_share_dispatches_and_each_particle_keeps_the_cpus_order() {
-        let scene = crate::bench::bench_scene(24, IntegratorKind::Xpbd).expect("a scene");
+        let scene = Scene::open_resized("hanging-bench", None, &Default::default(), Some(23))
+            .expect("a scene");
         let forces = ForceSet::new(&scene.model, &scene.params.material, &scene.effects);
         let halves = forces.constraints(&scene.model).halves(&scene.initial.pos);
         let (packed, records) = pack_constraints(&halves);
