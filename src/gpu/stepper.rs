@@ -130,6 +130,9 @@ pub struct GpuStepper {
     pub(super) grid_path: bool,
     /// Tries left in the frame under way at redoing it where self-contact's room ran out.
     pub(super) room_tries: u32,
+    /// The device runs through GL (the software adapter here), which executes a submission
+    /// while the window waits for its context.
+    gl: bool,
 }
 
 impl GpuStepper {
@@ -261,6 +264,7 @@ impl GpuStepper {
             ends_sent: 0,
             grid_path: true,
             room_tries: 0,
+            gl: device.adapter_info().backend == wgpu::Backend::Gl,
             contacts: Contacts::default(),
         };
         stepper.configure(model, params, effects, Changes::all());
@@ -433,10 +437,11 @@ impl GpuStepper {
         };
         if !implicit {
             let groups = self.count.div_ceil(WORKGROUP);
-            // Self-contact's substeps go one submission each: a frame of them is a long run
-            // of dispatches, which a GL device (the software adapter) executes within one
-            // submission while the window waits for its context.
-            let each_alone = self.contacts.own.is_some();
+            // On GL, self-contact's substeps go one submission each: a frame of them is a
+            // long run of dispatches, which a GL device (the software adapter) executes
+            // within one submission while the window waits for its context. Elsewhere a
+            // frame is one submission.
+            let each_alone = self.contacts.own.is_some() && self.gl;
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("cloth substeps"),
                 timestamp_writes: None,
