@@ -130,8 +130,7 @@ pub struct GpuStepper {
     pub(super) grid_path: bool,
     /// Tries left in the frame under way at redoing it where self-contact's room ran out.
     pub(super) room_tries: u32,
-    /// The device runs through GL (the software adapter here), which executes a submission
-    /// while the window waits for its context.
+    /// The device runs through GL, whose submissions hold the window's context.
     gl: bool,
 }
 
