@@ -25,7 +25,13 @@ enum Failed {
     Limit(Trouble),
     /// The device failed (said in the text); nothing more can be stepped.
     Device(String),
-    /// Self-contact's room ran out (and has grown since): the try is to be redone.
+}
+
+/// A try at a frame that broke no limit.
+enum Tried {
+    /// It stands.
+    Stood,
+    /// Self-contact's room ran out (and has grown since): the frame is to be redone.
     RanOut,
 }
 
@@ -76,20 +82,19 @@ impl GpuStepper {
                 .map_err(|why| self.device_failure(state.time, why))?;
         }
         self.room_tries = ROOM_TRIES;
-        let mut tried = self.try_frame(model, state, state.time, FRAME);
-        while let Err(Failed::RanOut) = tried {
-            let start = self.frame_start.clone();
-            self.restore(&start);
-            tried = self.try_frame(model, state, state.time, FRAME);
-        }
-        let outcome = match tried {
-            // `try_frame` stops saying so once the tries are spent.
-            Ok(()) | Err(Failed::RanOut) => {
-                self.guard.healthy_frame(&self.frame_start);
-                Ok(self.maybe_recover(end).unwrap_or(FrameOutcome::Stepped))
+        let outcome = loop {
+            match self.try_frame(model, state, state.time, FRAME) {
+                Ok(Tried::RanOut) => {
+                    let start = self.frame_start.clone();
+                    self.restore(&start);
+                }
+                Ok(Tried::Stood) => {
+                    self.guard.healthy_frame(&self.frame_start);
+                    break Ok(self.maybe_recover(end).unwrap_or(FrameOutcome::Stepped));
+                }
+                Err(Failed::Limit(trouble)) => break self.rescue(model, state, end, trouble),
+                Err(Failed::Device(why)) => break Err(self.device_failure(state.time, why)),
             }
-            Err(Failed::Limit(trouble)) => self.rescue(model, state, end, trouble),
-            Err(Failed::Device(why)) => Err(self.device_failure(state.time, why)),
         }?;
         state.time = end;
         if self.read_every_frame {
@@ -119,14 +124,15 @@ impl GpuStepper {
     }
 
     /// One frame from `time` (seconds) at the substeps in effect, submitted with what
-    /// `watch` asks, and its end judged against the guard's limits.
+    /// `watch` asks, and its end judged against the guard's limits; or, while the frame has
+    /// tries left, to be redone where self-contact's room ran out.
     fn try_frame(
         &mut self,
         model: &ClothModel,
         state: &ClothState,
         time: f64,
         watch: Watch,
-    ) -> Result<(), Failed> {
+    ) -> Result<Tried, Failed> {
         (self.run(model, state, (self.substeps, time), watch))
             .map_err(|e| Failed::Device(e.to_string()))?;
         let health = self.health.read(&self.device).map_err(|e| {
@@ -138,40 +144,30 @@ impl GpuStepper {
             .map_err(|e| Failed::Device(e.to_string()))?;
         if ran_out && self.room_tries > 0 {
             self.room_tries -= 1;
-            return Err(Failed::RanOut);
+            return Ok(Tried::RanOut);
         }
         let limits = (self.guard.limits.as_ref()).ok_or(Failed::Limit(Trouble::NonFinite))?;
         match limits.judge(&health.motion, || health.strain) {
             Some(trouble) => Err(Failed::Limit(trouble)),
-            None => Ok(()),
+            None => Ok(Tried::Stood),
         }
     }
 
     /// Replays from the rollback point to `end` at the substeps in effect, from the start
     /// again where self-contact's room ran out.
     fn replay(&mut self, model: &ClothModel, state: &ClothState, end: f64) -> Result<(), Failed> {
-        loop {
-            match self.replay_once(model, state, end) {
-                Err(Failed::RanOut) => continue,
-                done => return done,
+        'again: loop {
+            let from = (self.guard.checkpoint.clone()).unwrap_or_else(|| self.frame_start.clone());
+            let time = self.restore(&from);
+            let frames = ((end - time) / self.dt as f64).round().max(1.0) as u32;
+            for k in 0..frames {
+                let start = time + k as f64 * self.dt as f64;
+                if let Tried::RanOut = self.try_frame(model, state, start, REPLAY)? {
+                    continue 'again;
+                }
             }
+            return Ok(());
         }
-    }
-
-    fn replay_once(
-        &mut self,
-        model: &ClothModel,
-        state: &ClothState,
-        end: f64,
-    ) -> Result<(), Failed> {
-        let from = (self.guard.checkpoint.clone()).unwrap_or_else(|| self.frame_start.clone());
-        let time = self.restore(&from);
-        let frames = ((end - time) / self.dt as f64).round().max(1.0) as u32;
-        for k in 0..frames {
-            let start = time + k as f64 * self.dt as f64;
-            self.try_frame(model, state, start, REPLAY)?;
-        }
-        Ok(())
     }
 
     /// A frame failed with `trouble`: roll back and redo it with more substeps; else
@@ -196,8 +192,6 @@ impl GpuStepper {
                 }
                 Err(Failed::Limit(t)) => last = t,
                 Err(Failed::Device(why)) => return Err(self.device_failure(state.time, why)),
-                // `replay` redoes these itself.
-                Err(Failed::RanOut) => {}
             }
         }
         let tried = self.substeps;
@@ -221,7 +215,6 @@ impl GpuStepper {
                     fallback = format!(", and with {}", kind.label());
                 }
                 Err(Failed::Device(why)) => return Err(self.device_failure(state.time, why)),
-                Err(Failed::RanOut) => self.switch_integrator(original),
             }
         }
         let start = self.frame_start.clone();
