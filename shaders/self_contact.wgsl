@@ -414,12 +414,14 @@ fn find(@builtin(global_invocation_id) id: vec3<u32>) {
     find_one(id.x);
 }
 
+// Invocations a workgroup has (the host's `WORKGROUP`, every `@workgroup_size` here).
+const WIDTH: u32 = 64u;
 
 // The workgroups the pair kernels dispatch: as many as the pairs the search kept need (the
 // room for pairs is far more, and a workgroup past them would do nothing).
 @compute @workgroup_size(1)
 fn size_pairs() {
-    pair_groups[0] = (pairs_kept() + 63u) / 64u;
+    pair_groups[0] = (pairs_kept() + WIDTH - 1u) / WIDTH;
     pair_groups[1] = 1u;
     pair_groups[2] = 1u;
 }

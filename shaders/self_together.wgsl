@@ -7,8 +7,6 @@
 // the one pair or particle that owns it, so both paths give the same bits. On the software
 // adapter a dispatch costs far more than a small cloth's work in it.
 
-const TEAM: u32 = 64u;
-
 var<workgroup> team_count: u32;
 
 // The pairs the search kept, the same for every invocation of the team.
@@ -21,49 +19,49 @@ fn pairs_for_team(l: u32) -> u32 {
 
 // The substep's pairs: the counters cleared, the particles' and triangles' boxes, the grid,
 // the pairs (the wide path's `clear`, `particle_boxes`, `insert` and `find`).
-@compute @workgroup_size(64)
+@compute @workgroup_size(WIDTH)
 fn search_together(@builtin(local_invocation_index) l: u32) {
-    for (var i = l; i < COUNTERS + sp.counts.z; i += TEAM) {
+    for (var i = l; i < COUNTERS + sp.counts.z; i += WIDTH) {
         clear_one(i);
     }
     storageBarrier();
-    for (var i = l; i < sp.counts.x; i += TEAM) {
+    for (var i = l; i < sp.counts.x; i += WIDTH) {
         particle_boxes_one(i);
     }
     storageBarrier();
-    for (var t = l; t < sp.counts.y; t += TEAM) {
+    for (var t = l; t < sp.counts.y; t += WIDTH) {
         insert_one(t);
     }
     storageBarrier();
-    for (var t = l; t < sp.counts.y; t += TEAM) {
+    for (var t = l; t < sp.counts.y; t += WIDTH) {
         find_one(t);
     }
 }
 
 // Each particle takes `share` of the side-by-side pushes summed for it.
 fn take_pushes_together(l: u32, share: f32) {
-    for (var i = l; i < sp.counts.x; i += TEAM) {
+    for (var i = l; i < sp.counts.x; i += WIDTH) {
         take_pushes(i, share);
     }
 }
 
 // The sweeps of push rounds, each with what its rounds leave pushed side by side.
-@compute @workgroup_size(64)
+@compute @workgroup_size(WIDTH)
 fn pushes_together(@builtin(local_invocation_index) l: u32) {
     let n = pairs_for_team(l);
     for (var sweep = 0u; sweep < sp.passes.y; sweep++) {
         for (var r = 0u; r < sp.passes.z; r++) {
             let round = sweep * sp.passes.z + r;
-            for (var p = l; p < n; p += TEAM) {
+            for (var p = l; p < n; p += WIDTH) {
                 claim_one(p, round, sweep);
             }
             storageBarrier();
-            for (var p = l; p < n; p += TEAM) {
+            for (var p = l; p < n; p += WIDTH) {
                 push_alone_one(p, round, sweep);
             }
             storageBarrier();
         }
-        for (var p = l; p < n; p += TEAM) {
+        for (var p = l; p < n; p += WIDTH) {
             push_one(p, sweep);
         }
         storageBarrier();
@@ -73,13 +71,13 @@ fn pushes_together(@builtin(local_invocation_index) l: u32) {
 }
 
 // The colliders again on what the pushes moved, and the triangles kept out of the spheres.
-@compute @workgroup_size(64)
+@compute @workgroup_size(WIDTH)
 fn solids_together(@builtin(local_invocation_index) l: u32) {
-    for (var i = l; i < sp.counts.x; i += TEAM) {
+    for (var i = l; i < sp.counts.x; i += WIDTH) {
         solids_one(i);
     }
     storageBarrier();
-    for (var t = l; t < sp.counts.y; t += TEAM) {
+    for (var t = l; t < sp.counts.y; t += WIDTH) {
         faces_one(t);
     }
     storageBarrier();
@@ -87,20 +85,20 @@ fn solids_together(@builtin(local_invocation_index) l: u32) {
 }
 
 // The rounds of cuts on the motion as pushed, then each particle's end.
-@compute @workgroup_size(64)
+@compute @workgroup_size(WIDTH)
 fn cuts_together(@builtin(local_invocation_index) l: u32) {
     let n = pairs_for_team(l);
     for (var r = 0u; r < sp.more.w; r++) {
-        for (var p = l; p < n; p += TEAM) {
+        for (var p = l; p < n; p += WIDTH) {
             cut_one(p, r);
         }
         storageBarrier();
-        for (var i = l; i < sp.counts.x; i += TEAM) {
+        for (var i = l; i < sp.counts.x; i += WIDTH) {
             cut_apply_one(i);
         }
         storageBarrier();
     }
-    for (var i = l; i < sp.counts.x; i += TEAM) {
+    for (var i = l; i < sp.counts.x; i += WIDTH) {
         finish_one(i);
     }
 }

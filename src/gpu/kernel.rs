@@ -284,31 +284,33 @@ impl SubstepKernel {
     }
 }
 
+/// The value of `const NAME: u32 = …u;` in the shader `source` (for tests that hold the
+/// host's copies of a shader's constants to it).
+#[cfg(test)]
+pub(super) fn shader_const(source: &str, name: &str) -> u32 {
+    let line = (source.lines())
+        .find(|l| l.starts_with(&format!("const {name}: u32 = ")))
+        .unwrap_or_else(|| panic!("no `const {name}` in the shader"));
+    let value = line.split('=').nth(1).unwrap_or_default();
+    value
+        .trim()
+        .trim_end_matches(';')
+        .trim_end_matches('u')
+        .parse()
+        .unwrap()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::gpu::packing::{CLASS_BITS, MAX_CLASSES};
 
-    /// The value of `const NAME: u32 = …u;` in the shader.
-    fn shader_const(name: &str) -> u32 {
-        let line = (LAYOUT.lines())
-            .find(|l| l.starts_with(&format!("const {name}: u32 = ")))
-            .unwrap_or_else(|| panic!("no `const {name}` in the shader"));
-        let value = line.split('=').nth(1).unwrap_or_default();
-        value
-            .trim()
-            .trim_end_matches(';')
-            .trim_end_matches('u')
-            .parse()
-            .unwrap()
-    }
-
     /// The shader's constants are the packing's: an end's class bits, the class table's
     /// size, the workgroup.
     #[test]
     fn the_shader_and_the_host_agree_on_their_constants() {
-        assert_eq!(shader_const("CLASS_BITS"), CLASS_BITS);
-        assert_eq!(shader_const("CLASSES") as usize, MAX_CLASSES);
+        assert_eq!(shader_const(LAYOUT, "CLASS_BITS"), CLASS_BITS);
+        assert_eq!(shader_const(LAYOUT, "CLASSES") as usize, MAX_CLASSES);
         for source in [SOURCE, VBD, IMPLICIT] {
             let ours = format!("@workgroup_size({WORKGROUP})");
             assert!(source.contains(&ours));

@@ -7,9 +7,32 @@
 use glam::Vec3;
 
 use crate::device::{AdapterPreference, HeadlessDevice};
+use crate::gpu::kernel::{WORKGROUP, shader_const};
 use crate::gpu::stepper::GpuStepper;
 use crate::scene::{Scene, SceneFile, Simulation};
 use crate::sim::{FrameOutcome, StepBackend};
+
+/// The host's copies of the shader's counter layout are the shader's: where the buckets
+/// start and where the most entries and pairs a submission asked for are read from; each
+/// round of cuts has its two counters, clear of those; the pair kernels' indirect
+/// dispatches are sized by the workgroup they run in.
+#[test]
+fn the_host_and_the_shader_agree_on_the_counters() {
+    let c = |name: &str| shader_const(super::SOURCE, name);
+    assert_eq!(c("COUNTERS"), super::COUNTERS);
+    assert_eq!(4 * u64::from(c("MOST_ENTRIES")), super::MOST_AT);
+    assert_eq!(c("MOST_PAIRS"), c("MOST_ENTRIES") + 1);
+    assert!(c("MOST_PAIRS") < c("COUNTERS"));
+    assert!(
+        c("IMPACTS") + super::ROUNDS <= c("STUCK"),
+        "the rounds' impacts fit"
+    );
+    assert!(
+        c("STUCK") + super::ROUNDS <= c("MOST_ENTRIES"),
+        "the rounds' stuck fit"
+    );
+    assert_eq!(c("WIDTH"), WORKGROUP);
+}
 
 /// A GPU stepper for `scene` on its own headless device; with `pushes` false its
 /// self-contact only cuts; `together` says whether one workgroup runs it (`None`: as the
