@@ -12,3 +12,5 @@ pub use error::DeviceError;
 pub use headless::{AdapterPreference, HeadlessDevice, describe_adapter};
 pub use limits::{compute_limits, window_device_descriptor};
 pub use readback::map_read;
+#[cfg(test)]
+pub use readback::read_buffer;

@@ -308,7 +308,7 @@ mod tests {
 
     use super::super::packing::Particle;
     use super::*;
-    use crate::device::{AdapterPreference, HeadlessDevice, map_read};
+    use crate::device::{AdapterPreference, HeadlessDevice, read_buffer};
     use crate::scene::Scene;
     use crate::sim::{BendingModel, ForceTerm};
 
@@ -379,24 +379,14 @@ mod tests {
         let mut kernel = ElementKernel::new(device, queue, &particles, &packed, &scene.effects);
         kernel.set_step(1e-3);
         kernel.start(queue, time);
-        let size = kernel.forces.size();
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: None,
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             kernel.dispatch(&mut pass, 0);
         }
-        encoder.copy_buffer_to_buffer(&kernel.forces, 0, &readback, 0, size);
         queue.submit([encoder.finish()]);
-        let slice = readback.slice(..);
-        map_read(device, &slice).expect("read");
-        let slots: Vec<[f32; 4]> =
-            bytemuck::cast_slice(&slice.get_mapped_range().expect("map")).to_vec();
+        let slots = kernel.forces.size() as usize / size_of::<[f32; 4]>();
+        let slots: Vec<[f32; 4]> = read_buffer(device, queue, &kernel.forces, 0, slots);
         let n = model.particle_count();
         let (offsets, list) = packed.incidence.split_at(n + 1);
         let mut worst = 0.0f32;

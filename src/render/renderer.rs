@@ -561,25 +561,13 @@ mod tests {
     use glam::Vec2;
 
     use super::*;
-    use crate::device::{AdapterPreference, HeadlessDevice, map_read};
+    use crate::device::{AdapterPreference, HeadlessDevice};
     use crate::mesh::{GridOrientation, GridSpec};
     use crate::render::{DevicePositions, RgbaImage, SpringLines, read_target};
 
     /// The first `floats` floats of `buffer`, read back.
     fn read_floats(gpu: &HeadlessDevice, buffer: &GrowBuffer, floats: usize) -> Vec<f32> {
-        let bytes = (floats * 4) as u64;
-        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("test readback"),
-            size: bytes.max(4),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(buffer.buffer(), 0, &staging, 0, bytes);
-        gpu.queue.submit([encoder.finish()]);
-        let slice = staging.slice(..);
-        map_read(&gpu.device, &slice).expect("mapped");
-        bytemuck::cast_slice(&slice.get_mapped_range().expect("range")).to_vec()
+        crate::device::read_buffer(&gpu.device, &gpu.queue, buffer.buffer(), 0, floats)
     }
 
     /// The cloth, line and point vertices a renderer drew last, and the picture.

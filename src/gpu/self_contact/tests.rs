@@ -6,7 +6,7 @@
 
 use glam::Vec3;
 
-use crate::device::{AdapterPreference, HeadlessDevice};
+use crate::device::{AdapterPreference, HeadlessDevice, read_buffer};
 use crate::gpu::kernel::{WORKGROUP, shader_const};
 use crate::gpu::stepper::GpuStepper;
 use crate::scene::{Scene, SceneFile, Simulation};
@@ -454,25 +454,6 @@ fn a_frame_whose_room_for_pairs_ran_out_is_redone_with_more_on_the_gpu() {
     );
 }
 
-/// `count` words of `buffer` from word `at`, read back from the device.
-fn read_words(gpu: &GpuStepper, buffer: &wgpu::Buffer, at: u32, count: u32) -> Vec<u32> {
-    let bytes = u64::from(count) * 4;
-    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("test read"),
-        size: bytes,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    encoder.copy_buffer_to_buffer(buffer, u64::from(at) * 4, &staging, 0, bytes);
-    gpu.queue.submit([encoder.finish()]);
-    let slice = staging.slice(..);
-    crate::device::map_read(&gpu.device, &slice).expect("mapped");
-    let words = bytemuck::cast_slice(&slice.get_mapped_range().expect("a view")).to_vec();
-    staging.unmap();
-    words
-}
-
 /// VBD's first guess of a substep starts from the acceleration each particle took over the
 /// last one, so that acceleration must include what self-contact did to it after VBD's
 /// descent (the pushes and the cuts change velocities; `tell_solver` adds their change over
@@ -501,7 +482,14 @@ fn vbd_remembers_the_acceleration_self_contact_left_on_the_gpu() {
         let before = state.vel.clone();
         gpu.substep(&model, &mut state).expect("a substep");
         // Where the memory starts is known once the first substep has built the stencil.
-        let memory = read_words(&gpu, &gpu.vbd.stencil, gpu.vbd.starts[2], 4 * n);
+        let at = u64::from(gpu.vbd.starts[2]) * 4;
+        let memory: Vec<u32> = read_buffer(
+            &gpu.device,
+            &gpu.queue,
+            &gpu.vbd.stencil,
+            at,
+            4 * n as usize,
+        );
         for i in (0..n as usize).filter(|&i| model.inv_mass[i] > 0.0) {
             let kept = glam::Vec3::from_array([0, 1, 2].map(|c| f32::from_bits(memory[4 * i + c])));
             let taken = (state.vel[i] - before[i]) / h;
