@@ -451,12 +451,12 @@ impl SelfPass {
         let slice = self.readout.slice(..);
         let failed = |e: &dyn std::fmt::Display| GpuError::Readback(e.to_string());
         map_read(device, &slice).map_err(|e| failed(&e))?;
-        let words: Vec<u32> = {
+        let (entries, pairs) = {
             let view = slice.get_mapped_range().map_err(|e| failed(&e))?;
-            bytemuck::cast_slice(&view).to_vec()
+            let words: &[u32] = bytemuck::cast_slice(&view);
+            (words[0], words[1])
         };
         self.readout.unmap();
-        let (entries, pairs) = (words[0], words[1]);
         self.together = small(self.params.counts[1], pairs);
         let mut grown = self.params;
         if entries > grown.counts[3] {
