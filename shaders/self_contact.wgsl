@@ -550,9 +550,14 @@ fn share_of(i: u32) -> f32 {
 // One round of cuts: each pair whose sides could come within what is kept along the
 // motion as the last round left it cuts its free particles' motion short (a scaled round:
 // to where the pair is still apart; later ones: to the start).
+// Whether round `r` of cuts cut some particle's motion.
+fn cut_something(r: u32) -> bool {
+    return atomicLoad(&atomics[IMPACTS + r]) != atomicLoad(&atomics[STUCK + r]);
+}
+
 fn cut_one(p: u32, r: u32) {
     // A round runs only after one that cut something.
-    if (r > 0u && atomicLoad(&atomics[IMPACTS + r - 1u]) == atomicLoad(&atomics[STUCK + r - 1u])) {
+    if (r > 0u && !cut_something(r - 1u)) {
         return;
     }
     if (p >= pairs_kept()) {
@@ -625,7 +630,7 @@ fn finish_one(i: u32) {
         return;
     }
     let last = sp.more.w - 1u;
-    let unfinished = atomicLoad(&atomics[IMPACTS + last]) != atomicLoad(&atomics[STUCK + last]);
+    let unfinished = cut_something(last);
     let entries = atomicLoad(&atomics[ENTRIES]);
     let pairs = atomicLoad(&atomics[PAIRS]);
     let overflow = entries > sp.counts.w || pairs > sp.more.x;

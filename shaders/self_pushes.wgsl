@@ -159,27 +159,30 @@ fn pushed_in(p: u32, sweep: u32) -> bool {
 }
 
 // Pair `p` claims its free particles for push round `round` (counted through the
-// substep's sweeps) of sweep `sweep`.
-fn claim_one(p: u32, round: u32, sweep: u32) {
+// substep's sweeps) of sweep `sweep`; returns whether it claimed any.
+fn claim_one(p: u32, round: u32, sweep: u32) -> bool {
     if (p >= pairs_kept() || pushed_in(p, sweep)) {
-        return;
+        return false;
     }
     let pair = pair_at(p);
     if (!push_of(pair).pushed) {
-        return;
+        return false;
     }
     let key = key_of(pair, round);
+    var claimed = false;
     for (var k = 0u; k < 4u; k++) {
         let i = pair.ids[k];
         if (start[i].x.w > 0.0) {
             atomicMax(&atomics[owner_at(i)], key);
+            claimed = true;
         }
     }
+    return claimed;
 }
 
 @compute @workgroup_size(64)
 fn claim(@builtin(global_invocation_id) id: vec3<u32>) {
-    claim_one(id.x, this_round.x, this_round.y);
+    _ = claim_one(id.x, this_round.x, this_round.y);
 }
 
 // Pair `p` pushes its particles where it holds all its claims of the round.

@@ -4,10 +4,26 @@
 // each step of each round over the whole device, about a hundred dispatches a substep.
 // The steps are the wide path's own functions, in its order, with a barrier where it ends a
 // dispatch; each result is a fixed-point sum, an atomic maximum or minimum, or the write of
-// the one pair or particle that owns it, so both paths give the same bits. On the software
+// the one pair or particle that owns it, so both paths give the same bits. Where a round
+// of pushes or cuts finds nothing to do, every later one would find the same, and the team
+// stops there (the wide path dispatches them, and they return at once). On the software
 // adapter a dispatch costs far more than a small cloth's work in it.
 
 var<workgroup> team_count: u32;
+var<workgroup> team_any: atomic<u32>;
+var<workgroup> team_flag: u32;
+
+// Whether any invocation of the team says `mine`, the same answer for every invocation.
+fn any_in_team(l: u32, mine: bool) -> bool {
+    if (mine) {
+        atomicOr(&team_any, 1u);
+    }
+    workgroupBarrier();
+    if (l == 0u) {
+        team_flag = atomicExchange(&team_any, 0u);
+    }
+    return workgroupUniformLoad(&team_flag) != 0u;
+}
 
 // The pairs the search kept, the same for every invocation of the team.
 fn pairs_for_team(l: u32) -> u32 {
@@ -52,10 +68,22 @@ fn pushes_together(@builtin(local_invocation_index) l: u32) {
     for (var sweep = 0u; sweep < sp.passes.y; sweep++) {
         for (var r = 0u; r < sp.passes.z; r++) {
             let round = sweep * sp.passes.z + r;
+            var mine = false;
             for (var p = l; p < n; p += WIDTH) {
-                claim_one(p, round, sweep);
+                if (claim_one(p, round, sweep)) {
+                    mine = true;
+                }
             }
             storageBarrier();
+            // A round in which no pair claims a particle finds every pair not yet pushed
+            // this sweep apart: the rest of the sweep moves nothing, and if it is the
+            // sweep's first round nor does any later sweep.
+            if (!any_in_team(l, mine)) {
+                if (r == 0u) {
+                    return;
+                }
+                break;
+            }
             for (var p = l; p < n; p += WIDTH) {
                 push_alone_one(p, round, sweep);
             }
@@ -89,6 +117,11 @@ fn solids_together(@builtin(local_invocation_index) l: u32) {
 fn cuts_together(@builtin(local_invocation_index) l: u32) {
     let n = pairs_for_team(l);
     for (var r = 0u; r < sp.more.w; r++) {
+        // A round runs only after one that cut something (`cut_one`); the rounds not run
+        // leave their counters cleared, as the wide path's rounds that return at once do.
+        if (r > 0u && !any_in_team(l, l == 0u && cut_something(r - 1u))) {
+            break;
+        }
         for (var p = l; p < n; p += WIDTH) {
             cut_one(p, r);
         }
