@@ -308,6 +308,56 @@ mod tests {
         assert_ne!(back.pos, state.pos, "the cloth moved since");
     }
 
+    /// A replay (the guard's redo from its rollback point after a broken limit) in which a
+    /// frame runs out of self-contact's room starts again from the rollback point with the
+    /// room grown, and ends where the same replay with room enough ends, to the bit.
+    /// `layers` at 4 quads under XPBD at 8 substeps, on the GPU from frame 10 to 15, as its
+    /// five cloths reach the sphere and each other; then replayed from the checkpoint to
+    /// there at 16 substeps, once as it was and once with the room shrunk to 8 pairs and 64
+    /// grid entries just before.
+    #[test]
+    fn a_replay_that_runs_out_of_room_starts_again_with_more() {
+        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let options = Default::default();
+        let mut scene = Scene::open_resized("layers", None, &options, Some(4)).expect("scene");
+        scene.params.step.integrator = IntegratorKind::Xpbd;
+        scene.params.step.substeps = 8;
+        scene.params.guard.enabled = true;
+        let mut cpu = crate::scene::Simulation::new(scene.clone());
+        for _ in 0..10 {
+            cpu.step_frame().expect("a frame");
+        }
+        scene.initial = cpu.state().clone();
+        let model = &scene.model;
+        let replayed = |room: Option<[u32; 2]>| {
+            let mut stepper = stepper_on(&gpu, &scene);
+            let mut state = scene.initial.clone();
+            for frame in 10..15 {
+                let outcome = stepper.frame(model, &mut state).expect("a frame");
+                assert_eq!(outcome, crate::sim::FrameOutcome::Stepped, "frame {frame}");
+            }
+            assert!(stepper.guard.checkpoint.is_some(), "a rollback point");
+            let own = stepper.contacts.own.as_mut().expect("self-contact");
+            own.room = room;
+            stepper.set_substeps(16);
+            let before = stepper.stats.steps;
+            let end = state.time;
+            assert!(
+                stepper.replay(model, &state, end).is_ok(),
+                "the replay stands"
+            );
+            stepper.read_back(&mut state).expect("read back");
+            (state, stepper.stats.steps - before)
+        };
+        let ((roomy, plain), (tight, again)) = (replayed(None), replayed(Some([8, 64])));
+        assert!(roomy.pos == tight.pos, "positions differ");
+        assert!(roomy.vel == tight.vel, "velocities differ");
+        assert!(
+            again > plain,
+            "started again: {again} substeps against {plain}"
+        );
+    }
+
     /// The largest relative extension of a spring of `state` (0 when none is stretched).
     fn strain(scene: &Scene, state: &ClothState) -> f32 {
         let s = &scene.model.springs;

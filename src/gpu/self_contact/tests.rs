@@ -513,3 +513,68 @@ fn vbd_remembers_the_acceleration_self_contact_left_on_the_gpu() {
     assert!(most > 1000.0, "the cloths landed: {most} m/s² at most");
     assert!(worst < 1e-3, "VBD remembers what it took: {worst} m/s² off");
 }
+
+/// Implicit Euler's first guess of a substep extrapolates the last substeps' changes of
+/// velocity, which is no guess where a contact changed them after the solve: self-contact
+/// then sets the solve's flag (`tell_solver`), and the next solve starts without history,
+/// as the CPU's does after its contacts. The two cloths of [`lands_a_thickness_apart`]
+/// with no ground, the upper one thrown down at 1 m/s onto the lower (4 cm below), on the
+/// GPU substep by substep (4 a frame): before they come near, no substep sets the flag
+/// (nothing else does here: no collider); every substep in which contact changed a
+/// particle's velocity by more than 0.1 m/s from its fall sets it; and the substep after a
+/// flagged one starts its guess afresh (its history counts one substep, not two).
+#[test]
+fn implicit_euler_forgets_its_guess_where_self_contact_changed_velocities_on_the_gpu() {
+    let mut scene = two_cloths("implicit-euler", 4);
+    scene
+        .effects
+        .retain(|e| !matches!(e, crate::sim::Effect::Plane(_)));
+    let middle = (scene.initial.pos.iter()).map(|p| p.y).sum::<f32>() / 50.0;
+    for (v, p) in scene.initial.vel.iter_mut().zip(&scene.initial.pos) {
+        if p.y > middle {
+            v.y = -1.0;
+        }
+    }
+    let mut gpu = stepper(&scene, true, None);
+    let model = scene.model.clone();
+    let mut state = scene.initial.clone();
+    let h = gpu.substep_length();
+    let gravity = glam::Vec3::new(0.0, -9.81 * h, 0.0);
+    let (mut apart, mut struck, mut afresh) = (0, 0, 0);
+    let mut flagged_before = false;
+    for substep in 0..40 {
+        let before = state.vel.clone();
+        let near = closest_layers(&model.triangles, &state.pos) < 0.006 + 2.5 * h;
+        gpu.substep(&model, &mut state).expect("a substep");
+        let solve = &gpu.implicit.as_ref().expect("the solve").solve;
+        let cg2: Vec<f32> = read_buffer(&gpu.device, &gpu.queue, solve, 4 * 8, 4);
+        let (history, flag) = (cg2[2], cg2[3]);
+        if flagged_before {
+            assert_eq!(history, 1.0, "substep {substep}: the guess starts afresh");
+            afresh += 1;
+        }
+        flagged_before = flag > 0.5;
+        let jolt = (state.vel.iter().zip(&before))
+            .map(|(v, b)| (*v - *b - gravity).length())
+            .fold(0.0f32, f32::max);
+        if !near {
+            assert!(
+                !flagged_before,
+                "substep {substep}: flagged, the cloths apart"
+            );
+            apart += 1;
+        }
+        if jolt > 0.1 {
+            assert!(
+                flagged_before,
+                "substep {substep}: a jolt of {jolt} m/s unflagged"
+            );
+            struck += 1;
+        }
+    }
+    eprintln!("{apart} substeps apart, {struck} struck, {afresh} started afresh");
+    assert!(
+        apart >= 4 && struck >= 1 && afresh >= 1,
+        "{apart}, {struck}, {afresh}"
+    );
+}
