@@ -437,3 +437,40 @@ fn a_scene_file_built_in_code_without_a_cloth_is_an_error_not_a_panic() {
     assert!(matches!(err, SceneError::NoCloth { .. }), "{err:?}");
     assert!(err.to_string().contains("`hanging` has no cloth"), "{err}");
 }
+
+/// An effect a scene has at most one of (gravity, air damping, the bending model, a
+/// ground plane, wind, self-collision) listed twice is refused at its second `type`, naming
+/// the first: the CPU's forces would sum two gravities where everything that reads one
+/// number (the GPU's uniform, the guard's limits) takes the first. Two spheres are two
+/// obstacles. A running simulation refuses a second one too, and keeps its effects.
+#[test]
+fn an_effect_a_scene_has_once_listed_twice_is_refused_naming_both() {
+    let twice = "[[effects]]\ntype = \"gravity\"\n\n[[effects]]\ntype = \"air-damping\"\n\
+                 rate = 0.1\n\n[[effects]]\ntype = \"gravity\"\n";
+    let (line, _, message) = parse_error(&scene_text(twice));
+    assert_eq!(line, 13, "{message}");
+    assert!(
+        message.contains("`gravity` is already effect 1"),
+        "{message}"
+    );
+    let sphere = |x: f32| {
+        format!("[[effects]]\ntype = \"sphere\"\ncenter = [{x:?}, 0.0, 0.0]\nradius = 0.2\n")
+    };
+    let spheres = sphere(0.0) + &sphere(1.0);
+    SceneFile::parse(&scene_text(&spheres), Path::new("t.toml")).expect("two spheres");
+
+    let mut sim = Simulation::new(Scene::builtin("hanging").unwrap());
+    let before = sim.effects().to_vec();
+    let mut effects = before.clone();
+    let damping = (before.iter())
+        .find(|e| matches!(e, Effect::AirDamping(_)))
+        .expect("the hanging cloth has air damping")
+        .clone();
+    effects.push(damping);
+    let err = sim.set_effects(effects).unwrap_err().to_string();
+    assert!(
+        err.contains("air-damping") && err.contains("is already effect"),
+        "{err}"
+    );
+    assert_eq!(sim.effects(), before);
+}

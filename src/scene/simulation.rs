@@ -375,6 +375,14 @@ impl Simulation {
                 });
             }
         }
+        if let Some((first, again)) = crate::sim::listed_twice(&effects) {
+            let kind = effects[again].phase();
+            let why = format!("is already effect {}; a scene has at most one", first + 1);
+            return Err(SceneError::Effect {
+                effect: kind,
+                error: ParamError::new("type", kind, &why),
+            });
+        }
         thickness_fits(&effects, &self.model).map_err(|error| SceneError::Thickness {
             cloth: self.cloth_name.clone(),
             error,

@@ -18,6 +18,16 @@ pub fn gravity_of(effects: &[Effect]) -> Vec3 {
         .unwrap_or(Vec3::ZERO)
 }
 
+/// The first effect of `effects` whose kind a scene may have once ([`Effect::many`]) and
+/// that an earlier one has: (the earlier's index, its own). Two gravities would be summed
+/// by the CPU's forces and taken once by what reads one number (the GPU, the guard).
+pub fn listed_twice(effects: &[Effect]) -> Option<(usize, usize)> {
+    effects.iter().enumerate().find_map(|(i, e)| {
+        let first = effects[..i].iter().position(|o| o.same_kind(e));
+        first.filter(|_| !e.many()).map(|first| (first, i))
+    })
+}
+
 /// The air damping rate among `effects` (0 without air damping), 1/s.
 pub fn air_damping_of(effects: &[Effect]) -> f32 {
     effects
