@@ -96,8 +96,9 @@ fn cuts_at() -> u32 {
     return COUNTERS + sp.counts.z;
 }
 
-// Each particle's pushes in a sweep, in fixed point (8 words: its move, how many pushed
-// it, its change of velocity, and 1 where it rests on a collider), after the cuts.
+// Each particle's pushes in a sweep, in fixed point (9 words: its move, how many pushed
+// it, its change of velocity, 1 where it rests on a collider, and its longest push), after
+// the cuts.
 fn pushes_at() -> u32 {
     return COUNTERS + sp.counts.z + sp.counts.x;
 }
@@ -167,6 +168,7 @@ fn particle_boxes_one(i: u32) {
         atomicStore(&atomics[pushes_at() + PUSH_WORDS * i + k], 0u);
     }
     atomicStore(&atomics[pushes_at() + PUSH_WORDS * i + HELD], select(0u, 1u, on_solid(b)));
+    atomicStore(&atomics[pushes_at() + PUSH_WORDS * i + LONGEST], 0u);
     atomicStore(&atomics[owner_at(i)], 0u);
 }
 
@@ -175,9 +177,11 @@ fn particle_boxes(@builtin(global_invocation_id) id: vec3<u32>) {
     particle_boxes_one(id.x);
 }
 
-// The word of a particle's eight where it rests on a collider.
+// The word of a particle's nine where it rests on a collider, and the one that holds the
+// longest move a pair pushed side by side gave it in the sweep (an `f32`'s bits).
 const HELD: u32 = 7u;
-const PUSH_WORDS: u32 = 8u;
+const LONGEST: u32 = 8u;
+const PUSH_WORDS: u32 = 9u;
 
 // Whether a particle at `x` rests on a sphere or plane (within a hair of where the
 // colliders put what they catch).

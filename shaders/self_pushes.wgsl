@@ -252,6 +252,7 @@ fn push_one(p: u32, sweep: u32) {
             add_fixed(slot + 4u + c, push.dv[k][c], SPEED_UNIT);
         }
         atomicAdd(&atomics[slot + 3u], 1u);
+        atomicMax(&atomics[slot + LONGEST], bitcast<u32>(length(push.dx[k])));
     }
 }
 
@@ -277,13 +278,23 @@ fn take_pushes(i: u32, share: f32) {
         dx[c] = f32(bitcast<i32>(atomicLoad(&atomics[slot + c]))) * MOVE_UNIT;
         dv[c] = f32(bitcast<i32>(atomicLoad(&atomics[slot + 4u + c]))) * SPEED_UNIT;
     }
+    let longest = bitcast<f32>(atomicLoad(&atomics[slot + LONGEST]));
     for (var k = 0u; k < HELD; k++) {
         atomicStore(&atomics[slot + k], 0u);
     }
+    atomicStore(&atomics[slot + LONGEST], 0u);
     let average = 1.0 / f32(count);
-    let part = select(share, average, share == 0.0);
+    var shift = dx * select(share, average, share == 0.0);
+    // A share of the sum moves a particle no further than its longest push: where many
+    // pairs push it the same way (one landing within the thickness of a dozen of the
+    // other cloth's), each alone would have moved it clear, as the CPU's sweep does with
+    // the first; half their sum flung it by many thicknesses.
+    let far = length(shift);
+    if (share > 0.0 && far > longest) {
+        shift *= longest / far;
+    }
     var q = state[i];
-    q.x = vec4<f32>(q.x.xyz + dx * part, q.x.w);
+    q.x = vec4<f32>(q.x.xyz + shift, q.x.w);
     q.v = vec4<f32>(q.v.xyz + dv * average, q.v.w);
     state[i] = q;
     tell_solver(i, dv * average);

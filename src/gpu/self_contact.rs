@@ -49,6 +49,9 @@ const ROUND_ENTRIES: u32 = ROUNDS + PUSH_SWEEPS * PUSH_ROUNDS;
 /// Bytes between two rounds' uniforms (a multiple of any device's uniform alignment).
 const ROUND_STRIDE: u64 = 256;
 
+/// Words of a particle's pushes in a sweep (the shader's `PUSH_WORDS`).
+const PUSH_WORDS: u64 = 9;
+
 /// The shader's counters before the buckets (its `COUNTERS`).
 const COUNTERS: u32 = 36;
 
@@ -303,7 +306,8 @@ impl SelfPass {
     ) -> Result<(wgpu::Buffer, wgpu::Buffer), GpuError> {
         let [count, triangles, buckets, entries] = params.counts.map(u64::from);
         let pairs = u64::from(params.more[0]);
-        let atomic_words = u64::from(COUNTERS) + buckets + 10 * count;
+        // Per particle: its cut, its pushes' words and its owner in a push round.
+        let atomic_words = u64::from(COUNTERS) + buckets + (2 + PUSH_WORDS) * count;
         let list_words = 5 * entries + triangles + 5 * pairs + count;
         let need = [
             (4 * atomic_words, "self-contact buckets"),
