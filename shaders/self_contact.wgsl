@@ -551,14 +551,14 @@ fn share_of(i: u32) -> f32 {
     return bitcast<f32>(lists[scales_at() + i]);
 }
 
-// One round of cuts: each pair whose sides could come within what is kept along the
-// motion as the last round left it cuts its free particles' motion short (a scaled round:
-// to where the pair is still apart; later ones: to the start).
 // Whether round `r` of cuts cut some particle's motion.
 fn cut_something(r: u32) -> bool {
     return atomicLoad(&atomics[IMPACTS + r]) != atomicLoad(&atomics[STUCK + r]);
 }
 
+// One round of cuts: each pair whose sides could come within what is kept along the
+// motion as the last round left it cuts its free particles' motion short (a scaled round:
+// to where the pair is still apart; later ones: to the start).
 fn cut_one(p: u32, r: u32) {
     // A round runs only after one that cut something.
     if (r > 0u && !cut_something(r - 1u)) {
