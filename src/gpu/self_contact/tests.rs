@@ -116,38 +116,49 @@ fn closest_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
 }
 
 /// Runs `scene` for `frames` frames, the first `on_cpu` of them on the CPU (whose
-/// self-contact keeps the same guarantee) and the rest on the GPU (with `pushes` or
-/// without): after every one, no two of the cloth's triangles pass through each other, nor
-/// any through a solid. Returns the simulation and the nearest its layers came to each
-/// other after any frame.
-fn never_passes_through(
+/// self-contact keeps the same guarantee) and the rest on `gpu`: after every one, no two
+/// of the cloth's triangles pass through each other, nor any through a solid, and `each`
+/// sees the frame's number, how it went and the simulation.
+fn cpu_then_gpu(
     scene: Scene,
+    gpu: GpuStepper,
     (on_cpu, frames): (usize, usize),
-    pushes: bool,
-) -> (Simulation, f32) {
-    let mut gpu = Some(stepper(&scene, pushes, None));
+    mut each: impl FnMut(usize, FrameOutcome, &mut Simulation),
+) -> Simulation {
+    let mut gpu = Some(gpu);
     let mut sim = Simulation::new(scene);
-    let mut closest = f32::INFINITY;
     for frame in 0..frames {
         if let Some(gpu) = gpu.take_if(|_| frame == on_cpu) {
             sim.set_backend(Box::new(gpu)).expect("on the gpu");
         }
-        sim.step_frame().expect("frame");
+        let outcome = sim.step_frame().expect("a frame");
         let found = sim.intersections();
         assert_eq!(found.total(), 0, "frame {frame}: {found:?}");
-        let now = closest_layers(&sim.model().triangles, &sim.state().pos);
-        closest = closest.min(now);
+        each(frame, outcome, &mut sim);
     }
     assert_eq!(sim.backend_name(), "gpu", "the last frames ran on the gpu");
+    sim
+}
+
+/// [`cpu_then_gpu`] with self-contact's pushes or without. Returns the simulation and the
+/// nearest its layers came to each other after any frame.
+fn never_passes_through(scene: Scene, frames: (usize, usize), pushes: bool) -> (Simulation, f32) {
+    let gpu = stepper(&scene, pushes, None);
+    let mut closest = f32::INFINITY;
+    let sim = cpu_then_gpu(scene, gpu, frames, |_, _, sim| {
+        let now = closest_layers(&sim.model().triangles, &sim.state().pos);
+        closest = closest.min(now);
+    });
     (sim, closest)
 }
 
 /// `crumple` at 12 quads: dropped from 2 m onto its sphere and the ground under implicit
 /// Euler at 4 substeps (on the GPU from frame 30 to 42; it meets the sphere at 36 and the
-/// ground at 39), with the pass after every substep, it comes down to the ground (a pass that held the cloth where each
-/// substep started fails here) and never passes through itself. At this size it does not fold onto itself (its layers come no nearer
-/// than 10 cm in 60 frames, and with the pass left out nothing crosses either): the
-/// guarantee itself is tested by the twisting strip.
+/// ground at 39), with the pass after every substep, it comes down to the ground (a pass
+/// that held the cloth where each substep started fails here) and never passes through
+/// itself. At this size it does not fold onto itself (its layers come no nearer than 10 cm
+/// in 60 frames, and with the pass left out nothing crosses either): the guarantee itself
+/// is tested by the twisting strip.
 #[test]
 fn a_crumpling_cloth_comes_down_and_never_passes_through_itself_on_the_gpu() {
     let scene = Scene::open_resized("crumple", None, &Default::default(), Some(12)).unwrap();
@@ -197,10 +208,10 @@ fn a_twisting_strip_never_passes_through_itself_on_the_gpu() {
     );
 }
 
-/// With no pushes, the cuts alone hold the twisting strip (on the GPU from frame 50 to
-/// 74): its layers are pressed together substep after substep and stop at the floor the
-/// check keeps (a few µm, from frame 70), never through. A floor that let a pair below it creep closer by half its distance each
-/// substep let the strip through at frame 57.
+/// With no pushes, the cuts alone hold the twisting strip (on the GPU from frame 50 to 74):
+/// its layers are pressed together substep after substep and stop at the floor the check
+/// keeps (a few µm, from frame 70), never through. A floor that let a pair below it creep
+/// closer by half its distance each substep let the strip through at frame 57.
 #[test]
 fn the_cuts_alone_keep_a_pressed_strip_from_passing_through_itself_on_the_gpu() {
     let (_, closest) = never_passes_through(twisting_strip(), (50, 74), false);
@@ -309,27 +320,18 @@ fn one_workgroup_and_the_wide_path_give_the_same_bits() {
     assert!(closest < 0.006, "the layers have met: {closest}");
 }
 
-/// `scene` stepped for `frames` frames, on the GPU from frame `on_cpu`: every frame stands
-/// as stepped and leaves no two triangles through each other; `each` sees the simulation
-/// after every frame.
+/// [`cpu_then_gpu`] in which every frame also stands as stepped; `each` sees the
+/// simulation after every frame.
 fn clean_frames(
     scene: Scene,
-    (on_cpu, frames): (usize, usize),
+    frames: (usize, usize),
     mut each: impl FnMut(&Simulation),
 ) -> Simulation {
-    let mut gpu = Some(stepper(&scene, true, None));
-    let mut sim = Simulation::new(scene);
-    for frame in 0..frames {
-        if let Some(gpu) = gpu.take_if(|_| frame == on_cpu) {
-            sim.set_backend(Box::new(gpu)).expect("on the gpu");
-        }
-        let outcome = sim.step_frame().expect("a frame");
+    let gpu = stepper(&scene, true, None);
+    cpu_then_gpu(scene, gpu, frames, |frame, outcome, sim| {
         assert_eq!(outcome, FrameOutcome::Stepped, "frame {frame}");
-        let found = sim.intersections();
-        assert_eq!(found.total(), 0, "frame {frame}: {found:?}");
-        each(&sim);
-    }
-    sim
+        each(sim);
+    })
 }
 
 /// Two cloths 4 cm apart (`layers` at 4 quads with two layers and no sphere) fall flat onto
@@ -431,30 +433,27 @@ fn a_cloth_landing_on_another_rests_on_it_a_thickness_apart_under_semi_implicit_
 /// Self-contact's room for grid entries and pairs running out: the two cloths of
 /// [`lands_a_thickness_apart`] (on the GPU from frame 24 to 31) with room for 64 entries
 /// and 8 pairs to start with, where they need about 100–220 entries from the first frame
-/// and 226 pairs once they are near each other. A submission that runs out leaves the cloth where
-/// it started the substeps concerned; the guard's frame then grows the room and redoes the
-/// frame, so the run is the one that had room enough from the start, to the bit, after
-/// every frame, at the cost of the substeps redone. (With the frame taken as it ran out
-/// instead, and on the GPU from frame 10, the cloth stopped dead in the air at frames 10,
-/// 11 and 21 and had not reached the ground at frame 40.)
+/// and 226 pairs once they are near each other. A submission that runs out leaves the cloth
+/// where it started the substeps concerned; the guard's frame then grows the room and
+/// redoes the frame, so the run is the one that had room enough from the start, to the bit,
+/// after every frame, at the cost of the substeps redone. (With the frame taken as it ran
+/// out instead, and on the GPU from frame 10, the cloth stopped dead in the air at frames
+/// 10, 11 and 21 and had not reached the ground at frame 40.)
 #[test]
 fn a_frame_whose_room_for_pairs_ran_out_is_redone_with_more_on_the_gpu() {
     let [(roomy, plain), (tight, redone)] = [None, Some([8, 64])].map(|room| {
         let scene = two_cloths("xpbd", 8);
         let mut gpu = stepper(&scene, true, None);
         gpu.contacts.own.as_mut().expect("self-contact").room = room;
-        let mut gpu = Some(gpu);
-        let mut sim = Simulation::new(scene);
         let mut states = Vec::new();
-        for frame in 0..31 {
-            if let Some(gpu) = gpu.take_if(|_| frame == 24) {
-                sim.set_backend(Box::new(gpu)).expect("on the gpu");
-                sim.take_stats();
-            }
-            let outcome = sim.step_frame().expect("a frame");
+        let mut sim = cpu_then_gpu(scene, gpu, (24, 31), |frame, outcome, sim| {
             assert_eq!(outcome, FrameOutcome::Stepped, "frame {frame}");
             states.push((sim.state().pos.clone(), sim.state().vel.clone()));
-        }
+            if frame == 23 {
+                // Only the GPU's substeps are counted.
+                sim.take_stats();
+            }
+        });
         (states, sim.take_stats().steps)
     });
     let lowest = (roomy[30].0.iter()).fold(f32::INFINITY, |m, p| m.min(p.y));
