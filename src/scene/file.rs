@@ -435,15 +435,9 @@ impl SceneFile {
                 return Err((path, detail));
             }
         }
-        if let Some((first, again)) = crate::sim::listed_twice(&self.effects) {
-            let kind = self.effects[again].phase();
-            return Err((
-                vec![Key("effects"), At(again), Key("type")],
-                format!(
-                    "`{kind}` is already effect {}; a scene has at most one",
-                    first + 1
-                ),
-            ));
+        if let Some(twice) = crate::sim::listed_twice(&self.effects) {
+            let path = vec![Key("effects"), At(twice.again), Key("type")];
+            return Err((path, format!("`{}` {}", twice.kind, twice.rule())));
         }
         for (h, handle) in self.handles.iter().enumerate() {
             let at = |key| vec![Key("handles"), At(h), Key(key)];

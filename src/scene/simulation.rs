@@ -375,12 +375,10 @@ impl Simulation {
                 });
             }
         }
-        if let Some((first, again)) = crate::sim::listed_twice(&effects) {
-            let kind = effects[again].phase();
-            let why = format!("is already effect {}; a scene has at most one", first + 1);
+        if let Some(twice) = crate::sim::listed_twice(&effects) {
             return Err(SceneError::Effect {
-                effect: kind,
-                error: ParamError::new("type", kind, &why),
+                effect: twice.kind,
+                error: ParamError::new("type", twice.kind, twice.rule()),
             });
         }
         thickness_fits(&effects, &self.model).map_err(|error| SceneError::Thickness {

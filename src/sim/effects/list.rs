@@ -18,13 +18,37 @@ pub fn gravity_of(effects: &[Effect]) -> Vec3 {
         .unwrap_or(Vec3::ZERO)
 }
 
-/// The first effect of `effects` whose kind a scene may have once ([`Effect::many`]) and
-/// that an earlier one has: (the earlier's index, its own). Two gravities would be summed
-/// by the CPU's forces and taken once by what reads one number (the GPU, the guard).
-pub fn listed_twice(effects: &[Effect]) -> Option<(usize, usize)> {
+/// An effect listed again whose kind a scene may have once ([`Effect::many`]): two
+/// gravities would be summed by the CPU's forces and taken once by what reads one number
+/// (the GPU, the guard).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ListedTwice {
+    /// The effects' indices: the first of its kind, and the one listed again.
+    pub first: usize,
+    pub again: usize,
+    /// Its `type` in scene files.
+    pub kind: &'static str,
+}
+
+impl ListedTwice {
+    /// What is wrong with the second, after its `type`.
+    pub fn rule(&self) -> String {
+        format!(
+            "is already effect {}; a scene has at most one",
+            self.first + 1
+        )
+    }
+}
+
+/// The first effect of `effects` whose kind a scene may have once and an earlier one has.
+pub fn listed_twice(effects: &[Effect]) -> Option<ListedTwice> {
     effects.iter().enumerate().find_map(|(i, e)| {
         let first = effects[..i].iter().position(|o| o.same_kind(e));
-        first.filter(|_| !e.many()).map(|first| (first, i))
+        first.filter(|_| !e.many()).map(|first| ListedTwice {
+            first,
+            again: i,
+            kind: e.phase(),
+        })
     })
 }
 

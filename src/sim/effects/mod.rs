@@ -23,8 +23,8 @@ pub use effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 pub use gravity::Gravity;
 pub use handle::Handle;
 pub use list::{
-    air_damping_of, gravity_of, listed_twice, min_surface_distance, obstacle_overlap_warnings,
-    small_sphere_warnings, thickness_fits,
+    ListedTwice, air_damping_of, gravity_of, listed_twice, min_surface_distance,
+    obstacle_overlap_warnings, small_sphere_warnings, thickness_fits,
 };
 pub use obstacle::{DEFAULT_FPS, Obstacle, ObstacleError, Placed, Shape, frame_path};
 pub use plane::Plane;
