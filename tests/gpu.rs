@@ -336,9 +336,11 @@ fn gpu_bench_cli_defaults_to_the_integrators_it_runs() {
 #[test]
 fn a_cloth_is_refused_with_its_size_exactly_where_the_device_cannot_bind_its_springs() {
     use clothsim::gpu::GpuStepper;
-    let bench = |n| clothsim::bench::bench_scene(n, IntegratorKind::SemiImplicitEuler);
+    let [fits, over] = [40, 41].map(|n| {
+        clothsim::bench::bench_scene(n, IntegratorKind::SemiImplicitEuler).expect("scene")
+    });
     let ends = |scene: &Scene| scene.model.springs.len() as u64 * 2 * 8;
-    let most = ends(&bench(40).expect("scene"));
+    let (most, bytes) = (ends(&fits), ends(&over));
     let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
     let mut limits = clothsim::device::compute_limits(&gpu.adapter);
     limits.max_storage_buffer_binding_size = most;
@@ -348,32 +350,21 @@ fn a_cloth_is_refused_with_its_size_exactly_where_the_device_cannot_bind_its_spr
         ..Default::default()
     }))
     .expect("a device that binds less");
-    for n in [40, 41] {
-        let scene = bench(n).expect("scene");
-        let bytes = ends(&scene);
-        let (model, params, effects) = (&scene.model, &scene.params, &scene.effects);
-        match GpuStepper::new(&device, &queue, model, params, effects, false) {
-            Err(e) => {
-                let text = format!("{e:#}");
-                assert!(bytes > most, "N = {n} refused though it fits: {text}");
-                let size = format!(
-                    "needs {:.1} MiB ({bytes} bytes)",
-                    bytes as f64 / (1u64 << 20) as f64
-                );
-                assert!(
-                    text.contains(&size) && text.contains("spring ends"),
-                    "{size}: {text}"
-                );
-            }
-            Ok(_) => assert!(
-                bytes <= most,
-                "N = {n} built though {bytes} bytes exceed {most}"
-            ),
-        }
-        assert_eq!(
-            n == 40,
-            bytes <= most,
-            "N = {n}: {bytes} bytes against {most}"
-        );
+    let build =
+        |s: &Scene| GpuStepper::new(&device, &queue, &s.model, &s.params, &s.effects, false);
+    if let Err(e) = build(&fits) {
+        panic!("40 × 40 refused though its {most} bytes fit: {e:#}");
     }
+    let text = match build(&over) {
+        Ok(_) => panic!("41 × 41 built though its {bytes} bytes exceed {most}"),
+        Err(e) => format!("{e:#}"),
+    };
+    let size = format!(
+        "needs {:.1} MiB ({bytes} bytes)",
+        bytes as f64 / (1u64 << 20) as f64
+    );
+    assert!(
+        text.contains(&size) && text.contains("spring ends"),
+        "{size}: {text}"
+    );
 }
