@@ -372,3 +372,18 @@ fn faces_apply(@builtin(global_invocation_id) id: vec3<u32>) {
     take_pushes(id.x, 0.0);
 }
 
+// The same before the pushes, and what it moved rests on a sphere (the pushes move it only
+// where nothing else in a pair can: the CPU holds what its colliders moved).
+@compute @workgroup_size(64)
+fn faces_lift(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i >= sp.counts.x) {
+        return;
+    }
+    let slot = pushes_at() + PUSH_WORDS * i;
+    if (atomicLoad(&atomics[slot + 3u]) != 0u) {
+        atomicOr(&atomics[slot + HELD], LIFTED);
+    }
+    take_pushes(i, 0.0);
+}
+

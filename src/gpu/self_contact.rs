@@ -1,5 +1,6 @@
 //! Self-contact on the GPU (`shaders/self_contact.wgsl`): after each substep of every
-//! integrator the GPU runs (after the mesh obstacles), the cloth's pairs that could touch
+//! integrator the GPU runs (after the mesh obstacles), the triangles are kept out of the
+//! spheres (what that lifts is held as resting on them), the cloth's pairs that could touch
 //! are found through a hashed grid of the triangles' boxes built on the device and pushed
 //! a thickness apart, in sweeps of rounds of pairs that share no particle (the CPU's
 //! sweep, pair after pair), then side by side for what the rounds leave; the spheres and
@@ -96,6 +97,7 @@ enum Kernel {
     Solids,
     Faces,
     FacesApply,
+    FacesLift,
     SearchTogether,
     PushesTogether,
     SolidsTogether,
@@ -121,6 +123,7 @@ const ENTRY_POINTS: [&str; KERNELS] = [
     "solids",
     "faces",
     "faces_apply",
+    "faces_lift",
     "search_together",
     "pushes_together",
     "solids_together",
@@ -506,7 +509,9 @@ impl SelfPass {
                 pass.set_pipeline(&self.kernels[kernel as usize]);
                 return pass.dispatch_workgroups_indirect(&self.pair_groups, 0);
             }
-            Boxes | CutApply | Finish | KeepStart | PushApply | Solids | FacesApply => count,
+            Boxes | CutApply | Finish | KeepStart | PushApply | Solids | FacesApply | FacesLift => {
+                count
+            }
             SearchTogether | PushesTogether | SolidsTogether | CutsTogether | SizePairs => 1,
         };
         pass.set_pipeline(&self.kernels[kernel as usize]);
@@ -516,12 +521,7 @@ impl SelfPass {
     /// Binds the substep whose start and end `start` says, and searches its pairs: each
     /// particle's and triangle's box, the grid, the pairs.
     fn search(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
-        let group = &self.groups[match start {
-            Start::In(i) => i,
-            Start::Kept(i) => 2 + i,
-        }];
-        pass.set_bind_group(0, group, &[]);
-        pass.set_bind_group(1, &self.rounds, &[0]);
+        self.bind(pass, start);
         if self.together {
             return self.run(pass, Kernel::SearchTogether);
         }
@@ -532,12 +532,33 @@ impl SelfPass {
         self.run(pass, Kernel::SizePairs);
     }
 
-    /// Records a substep's pushes, where `start` says its start and end are: the pairs of
-    /// the substep's motion pushed a thickness apart, and what they moved into a sphere or
-    /// plane put back out.
+    /// Binds the groups of the substep whose start and end `start` says.
+    fn bind(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
+        let group = &self.groups[match start {
+            Start::In(i) => i,
+            Start::Kept(i) => 2 + i,
+        }];
+        pass.set_bind_group(0, group, &[]);
+        pass.set_bind_group(1, &self.rounds, &[0]);
+    }
+
+    /// Records a substep's pushes, where `start` says its start and end are: the triangles
+    /// kept out of the spheres (the substep's colliders kept out only its particles), the
+    /// pairs of the substep's motion pushed a thickness apart, and what they moved into a
+    /// sphere or plane put back out.
     pub(super) fn encode_pushes(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
-        self.search(pass, start);
         let solids = self.params.passes[0] > 0;
+        if solids {
+            // Before the search, as the CPU's colliders keep the faces out before its
+            // self-contact, and what they lift held as resting on the sphere: pushed
+            // down by the layer above, the lowest layer of a stack on a sphere was lifted
+            // back into it after the pushes, substep after substep, and the cuts held
+            // the two pressed together.
+            self.bind(pass, start);
+            self.run(pass, Kernel::Faces);
+            self.run(pass, Kernel::FacesLift);
+        }
+        self.search(pass, start);
         if self.together {
             self.run(pass, Kernel::PushesTogether);
             if solids {
