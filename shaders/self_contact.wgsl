@@ -167,10 +167,10 @@ fn particle_boxes_one(i: u32) {
     for (var k = 0u; k < HELD; k++) {
         atomicStore(&atomics[pushes_at() + PUSH_WORDS * i + k], 0u);
     }
-    // Held: on a collider, or lifted out of a sphere by its triangles this substep.
+    // Held: on a sphere or plane, or moved by a solid this substep (`MOVED`).
     let word = pushes_at() + PUSH_WORDS * i + HELD;
-    let lifted = atomicLoad(&atomics[word]) & LIFTED;
-    atomicStore(&atomics[word], lifted | select(0u, 1u, on_solid(b)));
+    let moved = atomicLoad(&atomics[word]) & MOVED;
+    atomicStore(&atomics[word], moved | select(0u, 1u, on_solid(b)));
     atomicStore(&atomics[pushes_at() + PUSH_WORDS * i + LONGEST], 0u);
     atomicStore(&atomics[owner_at(i)], 0u);
 }
@@ -183,9 +183,9 @@ fn particle_boxes(@builtin(global_invocation_id) id: vec3<u32>) {
 // The word of a particle's nine where it rests on a collider, and the one that holds the
 // longest move a pair pushed side by side gave it in the sweep (an `f32`'s bits).
 const HELD: u32 = 7u;
-// The bit of the held word that says the triangles' pass before the pushes (`faces_lift`)
-// moved the particle.
-const LIFTED: u32 = 2u;
+// The bit of the held word that says a solid moved the particle this substep, before the
+// pushes: a mesh obstacle (`obstacles_moved`) or the triangles' pass (`faces_lift`).
+const MOVED: u32 = 2u;
 const LONGEST: u32 = 8u;
 const PUSH_WORDS: u32 = 9u;
 
@@ -648,7 +648,7 @@ fn finish_one(i: u32) {
         atomicMax(&atomics[MOST_ENTRIES], entries);
         atomicMax(&atomics[MOST_PAIRS], pairs);
     }
-    atomicAnd(&atomics[pushes_at() + PUSH_WORDS * i + HELD], ~LIFTED);
+    atomicAnd(&atomics[pushes_at() + PUSH_WORDS * i + HELD], ~MOVED);
     var s = share_of(i);
     if ((unfinished || overflow) && start[i].x.w > 0.0) {
         s = 0.0;

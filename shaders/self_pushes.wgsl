@@ -373,7 +373,7 @@ fn faces_apply(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // The same before the pushes, and what it moved rests on a sphere (the pushes move it only
-// where nothing else in a pair can: the CPU holds what its colliders moved).
+// where nothing else in a pair can: the CPU holds what its solids moved).
 @compute @workgroup_size(64)
 fn faces_lift(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
@@ -382,8 +382,27 @@ fn faces_lift(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let slot = pushes_at() + PUSH_WORDS * i;
     if (atomicLoad(&atomics[slot + 3u]) != 0u) {
-        atomicOr(&atomics[slot + HELD], LIFTED);
+        atomicOr(&atomics[slot + HELD], MOVED);
     }
     take_pushes(i, 0.0);
+}
+
+// Each particle's position before the mesh obstacles act, kept where the search will put
+// its box.
+@compute @workgroup_size(64)
+fn before_obstacles(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i < sp.counts.x) {
+        boxes[2u * i] = vec4<f32>(state[i].x.xyz, 0.0);
+    }
+}
+
+// What the mesh obstacles moved rests on them, as on the CPU.
+@compute @workgroup_size(64)
+fn obstacles_moved(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i < sp.counts.x && any(boxes[2u * i].xyz != state[i].x.xyz)) {
+        atomicOr(&atomics[pushes_at() + PUSH_WORDS * i + HELD], MOVED);
+    }
 }
 

@@ -106,11 +106,14 @@ impl Contacts {
 
     /// Records substep `k`'s contacts, where `start` says its start and end are.
     pub(super) fn encode(&self, pass: &mut wgpu::ComputePass<'_>, k: u32, start: Start) {
+        if let (Some(own), Some(_)) = (&self.own, &self.obstacles) {
+            own.before_obstacles(pass, start);
+        }
         if let Some(obstacles) = &self.obstacles {
             obstacles.encode(pass, k, start);
         }
         if let Some(own) = &self.own {
-            own.encode_pushes(pass, start);
+            own.encode_pushes(pass, start, self.obstacles.is_some());
             // What the pushes pressed into a mesh obstacle goes back out, before the cuts.
             if let Some(obstacles) = &self.obstacles {
                 obstacles.encode(pass, k, start);

@@ -98,6 +98,8 @@ enum Kernel {
     Faces,
     FacesApply,
     FacesLift,
+    BeforeObstacles,
+    ObstaclesMoved,
     SearchTogether,
     PushesTogether,
     SolidsTogether,
@@ -124,6 +126,8 @@ const ENTRY_POINTS: [&str; KERNELS] = [
     "faces",
     "faces_apply",
     "faces_lift",
+    "before_obstacles",
+    "obstacles_moved",
     "search_together",
     "pushes_together",
     "solids_together",
@@ -509,9 +513,8 @@ impl SelfPass {
                 pass.set_pipeline(&self.kernels[kernel as usize]);
                 return pass.dispatch_workgroups_indirect(&self.pair_groups, 0);
             }
-            Boxes | CutApply | Finish | KeepStart | PushApply | Solids | FacesApply | FacesLift => {
-                count
-            }
+            Boxes | CutApply | Finish | KeepStart | PushApply | Solids | FacesApply | FacesLift
+            | BeforeObstacles | ObstaclesMoved => count,
             SearchTogether | PushesTogether | SolidsTogether | CutsTogether | SizePairs => 1,
         };
         pass.set_pipeline(&self.kernels[kernel as usize]);
@@ -542,11 +545,31 @@ impl SelfPass {
         pass.set_bind_group(1, &self.rounds, &[0]);
     }
 
-    /// Records a substep's pushes, where `start` says its start and end are: the triangles
-    /// kept out of the spheres (the substep's colliders kept out only its particles), the
-    /// pairs of the substep's motion pushed a thickness apart, and what they moved into a
-    /// sphere or plane put back out.
-    pub(super) fn encode_pushes(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
+    /// Records, before the mesh obstacles act on substep's end (`start` says where it is),
+    /// where each particle is, so that [`SelfPass::encode_pushes`] holds what they moved.
+    pub(super) fn before_obstacles(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
+        self.bind(pass, start);
+        self.run(pass, Kernel::BeforeObstacles);
+    }
+
+    /// Records a substep's pushes, where `start` says its start and end are: what the mesh
+    /// obstacles moved held as resting on them (with `obstacles`), the triangles kept out of
+    /// the spheres (the substep's colliders kept out only its particles), the pairs of the
+    /// substep's motion pushed a thickness apart, and what they moved into a sphere or plane
+    /// put back out.
+    pub(super) fn encode_pushes(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        start: Start,
+        obstacles: bool,
+    ) {
+        if obstacles {
+            // Pushed into a table top by the layer above and put back by the obstacles'
+            // pass after the pushes, the lowest layer of a stack was pressed into the next
+            // one, as on a sphere (below).
+            self.bind(pass, start);
+            self.run(pass, Kernel::ObstaclesMoved);
+        }
         let solids = self.params.passes[0] > 0;
         if solids {
             // Before the search, as the CPU's colliders keep the faces out before its
