@@ -23,6 +23,8 @@ fn add_fixed(at: u32, x: f32, unit: f32) {
 // its sides are a thickness apart already).
 struct Push {
     pushed: bool,
+    // How far the sides are within the thickness (m).
+    depth: f32,
     dx: array<vec3<f32>, 4>,
     dv: array<vec3<f32>, 4>,
 }
@@ -34,6 +36,7 @@ struct Push {
 fn push_of(pair: Pair) -> Push {
     var none: Push;
     none.pushed = false;
+    none.depth = 0.0;
     let edges = pair.edges;
     let ids = pair.ids;
     let thickness = sp.lengths.x;
@@ -120,6 +123,7 @@ fn push_of(pair: Pair) -> Push {
     }
     var out: Push;
     out.pushed = true;
+    out.depth = depth;
     for (var k = 0u; k < 4u; k++) {
         let part = sign[k] * w[k] * inv[k];
         out.dx[k] = (part * lambda) * direction;
@@ -130,19 +134,24 @@ fn push_of(pair: Pair) -> Push {
 
 // Pushes in a sweep come in rounds: in each, every pair still to push this sweep whose
 // sides are nearer than the thickness claims its free particles with its key (the round,
-// then a hash of the pair, so that the claims depend on the pairs, not on where they were
-// stored); a pair that holds all of its claims moves its particles itself, no other pair
-// touching them (the CPU's sweep, one pair after another, taken as sets of pairs that share
-// no particle). What is left after the rounds is pushed side by side (`push`).
+// then how deep the pair is, the deepest first, then a hash of the pair, so that the claims
+// depend on the pairs, not on where they were stored); a pair that holds all of its claims
+// moves its particles itself, no other pair touching them (the CPU's sweep, one pair after
+// another, taken as sets of pairs that share no particle). What is left after the rounds is
+// pushed side by side (`push`). Deepest first: in a stack the pair that most needs its
+// push gets it before those its push would undo; in an order that ignored depth, `layers`
+// at 6 quads under XPBD at 8 substeps came within 0.92 mm, against 4.7 mm (the CPU 4.9).
 
-// The pair's key in push round `r`.
-fn key_of(pair: Pair, r: u32) -> u32 {
+// The pair's key in push round `r`, its push `depth` deep: the round in the top 8 bits,
+// then 12 bits of the depth as a share of the thickness, then 12 of the hash.
+fn key_of(pair: Pair, r: u32, depth: f32) -> u32 {
     var h = pair.ids.x * 747796405u + select(0u, 2891336453u, pair.edges);
     for (var k = 1u; k < 4u; k++) {
         h = (h ^ (h >> 16u)) * 2246822519u + pair.ids[k];
     }
     h = (h ^ (h >> 13u)) * 3266489917u;
-    return ((r + 1u) << 24u) | ((h ^ (h >> 16u)) & 0xffffffu);
+    let d = u32(clamp(depth / sp.lengths.x, 0.0, 1.0) * 4095.0);
+    return ((r + 1u) << 24u) | (d << 12u) | ((h ^ (h >> 16u)) & 0xfffu);
 }
 
 fn owner_at(i: u32) -> u32 {
@@ -165,10 +174,11 @@ fn claim_one(p: u32, round: u32, sweep: u32) -> bool {
         return false;
     }
     let pair = pair_at(p);
-    if (!push_of(pair).pushed) {
+    let push = push_of(pair);
+    if (!push.pushed) {
         return false;
     }
-    let key = key_of(pair, round);
+    let key = key_of(pair, round, push.depth);
     var claimed = false;
     for (var k = 0u; k < 4u; k++) {
         let i = pair.ids[k];
@@ -191,14 +201,14 @@ fn push_alone_one(p: u32, round: u32, sweep: u32) {
         return;
     }
     let pair = pair_at(p);
-    let key = key_of(pair, round);
+    let push = push_of(pair);
+    let key = key_of(pair, round, push.depth);
     for (var k = 0u; k < 4u; k++) {
         let i = pair.ids[k];
         if (start[i].x.w > 0.0 && atomicLoad(&atomics[owner_at(i)]) != key) {
             return;
         }
     }
-    let push = push_of(pair);
     lists[done_at(p)] = sweep + 1u;
     if (!push.pushed) {
         return;

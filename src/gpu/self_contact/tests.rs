@@ -221,26 +221,27 @@ fn the_cuts_alone_keep_a_pressed_strip_from_passing_through_itself_on_the_gpu() 
     assert!(closest > 1e-6, "they stop at the floor: {closest}");
 }
 
-/// `layers` at 4 quads (five cloths 4 cm apart) under XPBD at 8 substeps falls onto its
-/// sphere (on the GPU from frame 14 to 19; the first lands at 15, the rest by 18) and the
+/// `layers` at 6 quads (five cloths 4 cm apart) under XPBD at 8 substeps falls onto its
+/// sphere (on the GPU from frame 13 to 19; the first lands at 15, the rest by 18) and the
 /// layers land on each other: the stack never passes through itself, nor through the
 /// sphere (its triangles' interiors kept out as well as its particles, and what the pushes
 /// press into the sphere put back out), and the pushes hold its layers apart. Measured:
-/// they come no nearer than 4.7 mm (frame 18; the CPU's 5.4 mm; the thickness is 6 mm).
-/// The triangles are kept out of the sphere before the pushes as well as after, and what
-/// that lifts is held as resting on the sphere, as the CPU holds what its colliders moved:
-/// left free, the lowest layer was pushed down into the sphere by the layer above, lifted
-/// back into it after the pushes, and held pressed there by the cuts, substep after
-/// substep: 0.11 mm apart by frame 18 (at 6 quads, 6 µm, and 3 µm with the triangles kept
-/// out only after the pushes).
+/// they come no nearer than 4.7 mm (the CPU's 4.9 mm; the thickness is 6 mm).
+/// - The triangles are kept out of the sphere before the pushes as well as after, and what
+///   that lifts is held as resting on the sphere, as the CPU holds what its solids moved:
+///   left free, the lowest layer was pushed down into the sphere by the layer above,
+///   lifted back into it after the pushes, and held pressed there by the cuts, substep
+///   after substep: 64 µm apart (3 µm with the triangles kept out only after the pushes).
+/// - The deepest pairs claim their particles first in each round of pushes: with the
+///   claims in an order that ignores depth, 0.92 mm.
 #[test]
 fn a_stack_of_cloths_on_a_sphere_never_passes_through_on_the_gpu() {
-    let (_, closest) = never_passes_through(stack(4, None), (14, 19), true);
+    let (_, closest) = never_passes_through(stack(6, None), (13, 19), true);
     eprintln!("layers: closest layers {closest}");
     assert!(closest < 0.006, "the layers land on each other: {closest}");
     assert!(
-        closest > 0.002,
-        "the pushes hold them apart (a third of the thickness): {closest}"
+        closest > 0.003,
+        "the pushes hold them apart (half the thickness): {closest}"
     );
 }
 
@@ -270,10 +271,11 @@ fn stack(quads: u32, solid: Option<&str>) -> Scene {
 /// apart. What the table's pass moved before the pushes is held as resting on it, as the
 /// CPU holds what its solids moved: left free, it was pushed down into the table by the
 /// layer above and put back into that layer by the table's pass after the pushes (the
-/// CPU's recheck runs every solid again), and the layers came within 1.46 mm by frame 14;
-/// with that second pass left out as well, the lowest layer was pressed 4 mm into the
-/// table's 10 mm. Measured: the lowest particle 10 mm above the table top to 0.1 µm, the
-/// layers no nearer than 3.65 mm (the CPU's 5.6 mm).
+/// CPU's recheck runs every solid again), and the layers came within 2.65 mm; with that
+/// second pass left out as well, the lowest layer was pressed 3 mm into the table's 10 mm.
+/// With the pushes' claims in an order that ignores depth, 3.65 mm. Measured: the lowest
+/// particle 10 mm above the table top to 0.1 µm, the layers no nearer than 5.1 mm (the
+/// CPU's 5.6 mm).
 #[test]
 fn a_stack_of_cloths_on_a_table_never_passes_through_it_on_the_gpu() {
     let table = format!(
@@ -298,7 +300,7 @@ fn a_stack_of_cloths_on_a_table_never_passes_through_it_on_the_gpu() {
         "the lowest layer rests on the table top: {lowest}"
     );
     assert!(
-        (0.0025..0.006).contains(&closest),
+        (0.004..0.006).contains(&closest),
         "the layers land on each other and are held apart: {closest}"
     );
 }
