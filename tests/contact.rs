@@ -9,6 +9,9 @@ use clothsim::sim::intersections::{self_intersections, triangles_meet};
 use clothsim::sim::{GuardAction, IntegratorKind, SelfContacts};
 use glam::{DVec3, Vec3};
 
+mod common;
+use common::{incline, slope_acceleration, slope_speed};
+
 fn d(x: f64, y: f64, z: f64) -> DVec3 {
     DVec3::new(x, y, z)
 }
@@ -279,31 +282,6 @@ fn fast_fold_never_passes_through_itself() {
     never_passes_through_under_each("fast-fold", Some(16), 24, 0.8);
 }
 
-/// Two 8 × 8-quad cloths of 0.5 m, one 1.05 thickness above the other; the lower pinned;
-/// gravity tilted by `degrees` from the normal (an incline); friction `mu` between them.
-fn incline(degrees: f32, mu: f32) -> Simulation {
-    let thickness = 0.01;
-    let text = format!(
-        "name = \"incline\"\n[cloth]\ngrid = {{ quads = 8, size = 0.5, layers = 2, spacing = {} }}\n\
-         [solver]\nintegrator = \"semi-implicit-euler\"\nsubsteps = 16\n\
-         [material]\nstiffness = {{ structural = 400.0, shear = 150.0, bend = 20.0 }}\n\
-         [pins]\nregion = {{ min = [-1.0, -1.0, -1.0], max = [1.0, 0.001, 1.0] }}\n\
-         [[effects]]\ntype = \"gravity\"\nacceleration = [0.0, {}, {}]\n\
-         [[effects]]\ntype = \"self-collision\"\nthickness = {thickness}\nfriction = {mu}\n",
-        1.05 * thickness,
-        -9.81 * degrees.to_radians().cos(),
-        9.81 * degrees.to_radians().sin(),
-    );
-    let file = SceneFile::parse(&text, std::path::Path::new("incline.toml")).unwrap();
-    Simulation::new(Scene::from_file(file, None).unwrap())
-}
-
-/// The upper cloth's mean velocity along the slope (+z).
-fn slope_speed(sim: &Simulation) -> f32 {
-    let n = sim.model().particle_count() / 2;
-    sim.state().vel[n..].iter().map(|v| v.z).sum::<f32>() / n as f32
-}
-
 /// Coulomb's law on an incline: the upper cloth slides with acceleration g (sin θ − μ cos
 /// θ) when tan θ > μ, and stays when tan θ < μ: it does not freeze into the one below, and
 /// friction is not lost.
@@ -311,20 +289,15 @@ fn slope_speed(sim: &Simulation) -> f32 {
 fn a_cloth_slides_off_another_as_coulomb_friction_says() {
     let mu = 0.3f32;
     for degrees in [30.0f32, 40.0] {
-        let mut sim = incline(degrees, mu);
-        sim.run(0.05);
-        let (t0, v0) = (sim.state().time, slope_speed(&sim));
-        sim.run(0.2);
-        let a = (slope_speed(&sim) - v0) / (sim.state().time - t0) as f32;
-        let th = degrees.to_radians();
-        let expected = 9.81 * (th.sin() - mu * th.cos());
+        let mut sim = Simulation::new(incline(degrees, mu, 8));
+        let (a, expected) = slope_acceleration(&mut sim, (degrees, mu), (0.05, 0.2));
         assert!(
             (a - expected).abs() < 0.1 * expected,
             "{degrees}°: {a} m/s² against Coulomb's {expected}"
         );
     }
     // tan 10° = 0.18 < 0.3: it holds.
-    let mut sim = incline(10.0, mu);
+    let mut sim = Simulation::new(incline(10.0, mu, 8));
     sim.run(0.3);
     assert!(slope_speed(&sim).abs() < 0.01, "{} m/s", slope_speed(&sim));
 }

@@ -1,14 +1,15 @@
 //! The GPU backend (run here on the software adapter) against the CPU per effect and per
 //! integrator over runs short enough to stay non-chaotic: wind and dihedral bending, each
 //! alone and together; XPBD and VBD, the same constraints projected, or particles
-//! descended, colour by colour in the same order, so the two agree to rounding.
+//! descended, colour by colour in the same order, so the two agree to rounding. And
+//! friction between layers of the cloth, against Coulomb's law on an incline.
 
 use clothsim::gpu::gpu_simulation;
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::{BendingModel, Effect, IntegratorKind, Wind};
 
 mod common;
-use common::{apart_after_a_push, farthest};
+use common::{apart_after_a_push, farthest, incline, slope_acceleration, slope_speed};
 
 /// The built-in scene `name` with its grid at 16 quads.
 fn small(name: &str) -> Scene {
@@ -271,4 +272,34 @@ fn a_wind_changed_mid_run_reaches_the_gpu() {
     let worst = farthest(&cpu.state().pos, &gpu.state().pos);
     eprintln!("wind changed: worst {worst:e} m");
     assert!(worst < 1e-5, "GPU and CPU differ by {worst} m");
+}
+
+/// Friction between layers on the GPU is Coulomb's, as on the CPU (`tests/contact.rs`):
+/// two 4-quad cloths, the upper resting on the lower, pinned one on an incline of 30° with
+/// friction 0.3 between them. The upper slides with acceleration g (sin θ − μ cos θ) =
+/// 2.356 m/s² (measured over 0.05 s after 0.02 s settling: 2.3561 on the GPU, 2.3582 on
+/// the CPU; with no friction it would be g sin θ = 4.9).
+#[test]
+fn a_cloth_slides_off_another_as_coulomb_friction_says_on_the_gpu() {
+    let (degrees, mu) = (30.0, 0.3);
+    let (mut gpu, _) = gpu_simulation(incline(degrees, mu, 4), false).expect("GPU backend");
+    let (a, expected) = slope_acceleration(&mut gpu, (degrees, mu), (0.02, 0.05));
+    eprintln!("{degrees}°: {a} m/s² against Coulomb's {expected}");
+    assert!(
+        (a - expected).abs() < 0.02 * expected,
+        "{a} m/s² against Coulomb's {expected}"
+    );
+}
+
+/// Below the angle of friction the upper cloth stays on the lower on the GPU: at 10°, tan
+/// θ = 0.18 < μ = 0.3 (measured: 0.4 µm/s along the slope after 0.07 s; with no friction
+/// it slid at 11 cm/s by then, g sin θ = 1.7 m/s²).
+#[test]
+fn a_cloth_on_another_holds_below_the_angle_of_friction_on_the_gpu() {
+    let (mut gpu, _) = gpu_simulation(incline(10.0, 0.3, 4), false).expect("GPU backend");
+    gpu.run(0.07);
+    gpu.sync_state().expect("read back");
+    let speed = slope_speed(&gpu);
+    eprintln!("10°: {speed} m/s along the slope");
+    assert!(speed.abs() < 0.001, "{speed} m/s along the slope");
 }

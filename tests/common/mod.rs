@@ -1,4 +1,4 @@
-//! What the GPU test files share.
+//! What the test files share (the GPU's, and the contact tests).
 
 /// The largest distance between the same particle in `a` and `b`, metres.
 pub fn farthest(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
@@ -23,4 +23,52 @@ pub fn apart_after_a_push(scene: clothsim::scene::Scene, frames: usize) -> f32 {
         sim.step_frame().expect("frame");
     }
     farthest(&cpu.state().pos, &gpu.state().pos)
+}
+
+/// Two `quads` × `quads` cloths of 0.5 m, one 1.05 thickness (10 mm) above the other, the
+/// lower pinned, under semi-implicit Euler at 16 substeps; gravity tilted by `degrees` from
+/// the normal (an incline); friction `mu` between them.
+#[allow(dead_code)] // Not every test file has one.
+pub fn incline(degrees: f32, mu: f32, quads: u32) -> clothsim::scene::Scene {
+    let thickness = 0.01;
+    let text = format!(
+        "name = \"incline\"\n[cloth]\ngrid = {{ quads = {quads}, size = 0.5, layers = 2, spacing = {} }}\n\
+         [solver]\nintegrator = \"semi-implicit-euler\"\nsubsteps = 16\n\
+         [material]\nstiffness = {{ structural = 400.0, shear = 150.0, bend = 20.0 }}\n\
+         [pins]\nregion = {{ min = [-1.0, -1.0, -1.0], max = [1.0, 0.001, 1.0] }}\n\
+         [[effects]]\ntype = \"gravity\"\nacceleration = [0.0, {}, {}]\n\
+         [[effects]]\ntype = \"self-collision\"\nthickness = {thickness}\nfriction = {mu}\n",
+        1.05 * thickness,
+        -9.81 * degrees.to_radians().cos(),
+        9.81 * degrees.to_radians().sin(),
+    );
+    let path = std::path::Path::new("incline.toml");
+    let file = clothsim::scene::SceneFile::parse(&text, path).expect("parses");
+    clothsim::scene::Scene::from_file(file, None).expect("loads")
+}
+
+/// The upper cloth's mean velocity along the slope (+z) of an [`incline`].
+#[allow(dead_code)]
+pub fn slope_speed(sim: &clothsim::scene::Simulation) -> f32 {
+    let n = sim.model().particle_count() / 2;
+    sim.state().vel[n..].iter().map(|v| v.z).sum::<f32>() / n as f32
+}
+
+/// How the upper cloth of [`incline`]`(degrees, mu, …)`, stepped by `sim`, accelerates
+/// along the slope from `settle` seconds on over `over` seconds (m/s²), against Coulomb's
+/// g (sin θ − μ cos θ).
+#[allow(dead_code)]
+pub fn slope_acceleration(
+    sim: &mut clothsim::scene::Simulation,
+    (degrees, mu): (f32, f32),
+    (settle, over): (f64, f64),
+) -> (f32, f32) {
+    sim.run(settle);
+    sim.sync_state().expect("read back");
+    let (t0, v0) = (sim.state().time, slope_speed(sim));
+    sim.run(over);
+    sim.sync_state().expect("read back");
+    let a = (slope_speed(sim) - v0) / (sim.state().time - t0) as f32;
+    let th = degrees.to_radians();
+    (a, 9.81 * (th.sin() - mu * th.cos()))
 }
