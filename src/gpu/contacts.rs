@@ -46,10 +46,12 @@ impl Contacts {
     }
 
     /// These passes, with self-contact's settings for tests as in `old`: how often its
-    /// pushes sweep, and whether one workgroup runs it whatever the size.
+    /// pushes sweep and in how many rounds, whether one workgroup runs it whatever the
+    /// size, and its room.
     pub(super) fn tuned_as(mut self, old: &Contacts) -> Self {
         if let (Some(own), Some(old)) = (self.own.as_mut(), old.own.as_ref()) {
-            (own.sweeps, own.forced, own.room) = (old.sweeps, old.forced, old.room);
+            (own.sweeps, own.push_rounds) = (old.sweeps, old.push_rounds);
+            (own.forced, own.room) = (old.forced, old.room);
         }
         self
     }

@@ -158,6 +158,9 @@ pub(super) struct SelfPass {
     /// Sweeps of the pushes a substep (at most [`PUSH_SWEEPS`]; none leaves the cuts
     /// alone, for tests).
     pub(super) sweeps: u32,
+    /// Rounds of pairs that share no particle a sweep (at most [`PUSH_ROUNDS`]; none
+    /// pushes every pair side by side, for tests).
+    pub(super) push_rounds: u32,
     /// As the obstacles' (see `start_end_groups`).
     groups: [wgpu::BindGroup; 6],
     rounds: wgpu::BindGroup,
@@ -289,6 +292,7 @@ impl SelfPass {
         Ok(Some(Self {
             kernels,
             sweeps: PUSH_SWEEPS,
+            push_rounds: PUSH_ROUNDS,
             groups,
             rounds,
             pair_groups,
@@ -436,6 +440,7 @@ impl SelfPass {
         self.params.contact[1] = cloth.drag[1];
         self.params.passes[0] = cloth.counts[1];
         self.params.passes[1] = self.sweeps.min(PUSH_SWEEPS);
+        self.params.passes[2] = self.push_rounds.min(PUSH_ROUNDS);
         self.params.colliders = cloth.colliders;
         (self.params.more[1], self.params.more[2]) = match memory {
             Memory::None => (0, 0),
@@ -591,7 +596,7 @@ impl SelfPass {
         }
         let round = |n: u32| (u64::from(ROUNDS + n) * ROUND_STRIDE) as u32;
         for sweep in 0..self.params.passes[1] {
-            for r in 0..PUSH_ROUNDS {
+            for r in 0..self.params.passes[2] {
                 pass.set_bind_group(1, &self.rounds, &[round(sweep * PUSH_ROUNDS + r)]);
                 self.run(pass, Kernel::Claim);
                 self.run(pass, Kernel::PushAlone);
