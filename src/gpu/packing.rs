@@ -230,6 +230,10 @@ fn grid_with_width(packed: &PackedSprings, count: usize, width: usize) -> Option
     })
 }
 
+/// A collider's kind, `GpuCollider::info[0]` (the shaders compare `info.x` with 1 and 2).
+pub(super) const SPHERE: f32 = 1.0;
+pub(super) const PLANE: f32 = 2.0;
+
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub(super) struct GpuCollider {
@@ -262,12 +266,12 @@ pub(super) fn pack_solids(effects: &[Effect]) -> ([GpuCollider; MAX_COLLIDERS], 
     let mut out = [GpuCollider::zeroed(); MAX_COLLIDERS];
     let solids = effects.iter().filter_map(|e| match e {
         Effect::Sphere(s) => Some(GpuCollider {
-            info: [1.0, s.radius, s.friction, 0.0],
+            info: [SPHERE, s.radius, s.friction, 0.0],
             a: s.center.extend(0.0).to_array(),
             b: s.spin.extend(0.0).to_array(),
         }),
         Effect::Plane(p) => Some(GpuCollider {
-            info: [2.0, 0.0, p.friction, 0.0],
+            info: [PLANE, 0.0, p.friction, 0.0],
             a: p.point.extend(0.0).to_array(),
             b: p.unit_normal().extend(0.0).to_array(),
         }),

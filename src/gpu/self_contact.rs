@@ -23,7 +23,7 @@ use super::error::GpuError;
 use super::kernel::{
     CONTACT, GEOMETRY, LAYOUT, Slot, WORKGROUP, bind, layout, pipelines, start_end_groups,
 };
-use super::packing::{GpuCollider, MAX_COLLIDERS, Params};
+use super::packing::{GpuCollider, MAX_COLLIDERS, Params, SPHERE};
 use super::substep_ends::{Memory, Start};
 use super::support::fits;
 
@@ -576,7 +576,12 @@ impl SelfPass {
             self.run(pass, Kernel::ObstaclesMoved);
         }
         let solids = self.params.passes[0] > 0;
-        if solids {
+        let colliders = self
+            .params
+            .colliders
+            .iter()
+            .take(self.params.passes[0] as usize);
+        if colliders.map(|c| c.info[0]).any(|kind| kind == SPHERE) {
             // Before the search, as the CPU's colliders keep the faces out before its
             // self-contact, and what they lift held as resting on the sphere: pushed
             // down by the layer above, the lowest layer of a stack on a sphere was lifted
