@@ -526,10 +526,9 @@ impl SelfPass {
         pass.dispatch_workgroups(n.div_ceil(WORKGROUP), 1, 1);
     }
 
-    /// Binds the substep whose start and end `start` says, and searches its pairs: each
-    /// particle's and triangle's box, the grid, the pairs.
-    fn search(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
-        self.bind(pass, start);
+    /// Searches the pairs of the substep bound ([`SelfPass::bind`]): each particle's and
+    /// triangle's box, the grid, the pairs.
+    fn search(&self, pass: &mut wgpu::ComputePass<'_>) {
         if self.together {
             return self.run(pass, Kernel::SearchTogether);
         }
@@ -568,11 +567,11 @@ impl SelfPass {
         start: Start,
         obstacles: bool,
     ) {
+        self.bind(pass, start);
         if obstacles {
             // Pushed into a table top by the layer above and put back by the obstacles'
             // pass after the pushes, the lowest layer of a stack was pressed into the next
             // one, as on a sphere (below).
-            self.bind(pass, start);
             self.run(pass, Kernel::ObstaclesMoved);
         }
         let solids = self.params.passes[0] > 0;
@@ -587,11 +586,10 @@ impl SelfPass {
             // down by the layer above, the lowest layer of a stack on a sphere was lifted
             // back into it after the pushes, substep after substep, and the cuts held
             // the two pressed together.
-            self.bind(pass, start);
             self.run(pass, Kernel::Faces);
             self.run(pass, Kernel::FacesLift);
         }
-        self.search(pass, start);
+        self.search(pass);
         if self.together {
             self.run(pass, Kernel::PushesTogether);
             if solids {
@@ -619,7 +617,8 @@ impl SelfPass {
     /// Records a substep's cuts, where `start` says its start and end are: the pairs of the
     /// motion as pushed, checked along it.
     pub(super) fn encode_cuts(&self, pass: &mut wgpu::ComputePass<'_>, start: Start) {
-        self.search(pass, start);
+        self.bind(pass, start);
+        self.search(pass);
         if self.together {
             return self.run(pass, Kernel::CutsTogether);
         }
