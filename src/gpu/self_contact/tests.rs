@@ -16,7 +16,8 @@ use crate::sim::{FrameOutcome, StepBackend};
 /// The host's copies of the shader's counter layout are the shader's: where the buckets
 /// start and where the most entries and pairs a submission asked for are read from; each
 /// round of cuts has its two counters, clear of those; the pair kernels' indirect
-/// dispatches are sized by the workgroup they run in.
+/// dispatches are sized by the workgroup they run in; a particle has as many push words,
+/// and the number of every push round of a substep fits above a key's depth and hash.
 #[test]
 fn the_host_and_the_shader_agree_on_the_counters() {
     let c = |name: &str| shader_const(super::SOURCE, name);
@@ -34,6 +35,11 @@ fn the_host_and_the_shader_agree_on_the_counters() {
     );
     assert_eq!(c("WIDTH"), WORKGROUP);
     assert_eq!(u64::from(c("PUSH_WORDS")), super::PUSH_WORDS);
+    let round_bits = 32 - c("KEY_DEPTH_BITS") - c("KEY_HASH_BITS");
+    assert!(
+        super::PUSH_SWEEPS * super::PUSH_ROUNDS < 1 << round_bits,
+        "every push round's number fits the top of its keys"
+    );
 }
 
 /// A GPU stepper for `scene` on its own headless device; with `pushes` false its
@@ -226,14 +232,14 @@ fn the_cuts_alone_keep_a_pressed_strip_from_passing_through_itself_on_the_gpu() 
 /// layers land on each other: the stack never passes through itself, nor through the
 /// sphere (its triangles' interiors kept out as well as its particles, and what the pushes
 /// press into the sphere put back out), and the pushes hold its layers apart. Measured:
-/// they come no nearer than 4.7 mm (the CPU's 4.9 mm; the thickness is 6 mm).
+/// they come no nearer than 4.8 mm (the CPU's 4.9 mm; the thickness is 6 mm).
 /// - The triangles are kept out of the sphere before the pushes as well as after, and what
 ///   that lifts is held as resting on the sphere, as the CPU holds what its solids moved:
 ///   left free, the lowest layer was pushed down into the sphere by the layer above,
 ///   lifted back into it after the pushes, and held pressed there by the cuts, substep
-///   after substep: 64 µm apart (3 µm with the triangles kept out only after the pushes).
+///   after substep: 21 µm apart (3 µm with the triangles kept out only after the pushes).
 /// - The deepest pairs claim their particles first in each round of pushes: with the
-///   claims in an order that ignores depth, 0.92 mm.
+///   claims in an order that ignores depth (its bits in the key zero), 2.4 mm.
 #[test]
 fn a_stack_of_cloths_on_a_sphere_never_passes_through_on_the_gpu() {
     let (_, closest) = never_passes_through(stack(6, None), (13, 19), true);
@@ -271,10 +277,10 @@ fn stack(quads: u32, solid: Option<&str>) -> Scene {
 /// apart. What the table's pass moved before the pushes is held as resting on it, as the
 /// CPU holds what its solids moved: left free, it was pushed down into the table by the
 /// layer above and put back into that layer by the table's pass after the pushes (the
-/// CPU's recheck runs every solid again), and the layers came within 2.65 mm; with that
+/// CPU's recheck runs every solid again), and the layers came within 3.2 mm; with that
 /// second pass left out as well, the lowest layer was pressed 3 mm into the table's 10 mm.
-/// With the pushes' claims in an order that ignores depth, 3.65 mm. Measured: the lowest
-/// particle 10 mm above the table top to 0.1 µm, the layers no nearer than 5.1 mm (the
+/// With the pushes' claims in an order that ignores depth, 3.8 mm. Measured: the lowest
+/// particle 10 mm above the table top to 0.1 µm, the layers no nearer than 5.0 mm (the
 /// CPU's 5.6 mm).
 #[test]
 fn a_stack_of_cloths_on_a_table_never_passes_through_it_on_the_gpu() {
