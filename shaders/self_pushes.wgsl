@@ -172,6 +172,11 @@ fn done_at(p: u32) -> u32 {
     return scales_at() + sp.counts.x + p;
 }
 
+// Where pair `p` keeps its key of the round it claimed in, 0 in a round it did not.
+fn key_at(p: u32) -> u32 {
+    return done_at(sp.more.x) + p;
+}
+
 // Whether pair `p` was pushed in sweep `sweep`.
 fn pushed_in(p: u32, sweep: u32) -> bool {
     return lists[done_at(p)] == sweep + 1u;
@@ -186,9 +191,11 @@ fn claim_one(p: u32, round: u32, sweep: u32) -> bool {
     let pair = pair_at(p);
     let push = push_of(pair);
     if (!push.pushed) {
+        lists[key_at(p)] = 0u;
         return false;
     }
     let key = key_of(pair, round, push.depth);
+    lists[key_at(p)] = key;
     var claimed = false;
     for (var k = 0u; k < 4u; k++) {
         let i = pair.ids[k];
@@ -205,14 +212,17 @@ fn claim(@builtin(global_invocation_id) id: vec3<u32>) {
     _ = claim_one(id.x, this_round.x, this_round.y);
 }
 
-// Pair `p` pushes its particles where it holds all its claims of the round.
-fn push_alone_one(p: u32, round: u32, sweep: u32) {
+// Pair `p` pushes its particles where it holds all the claims it made this round (its
+// push is worked out again only then: most pairs of a round lose a claim).
+fn push_alone_one(p: u32, sweep: u32) {
     if (p >= pairs_kept() || pushed_in(p, sweep)) {
         return;
     }
+    let key = lists[key_at(p)];
+    if (key == 0u) {
+        return;
+    }
     let pair = pair_at(p);
-    let push = push_of(pair);
-    let key = key_of(pair, round, push.depth);
     for (var k = 0u; k < 4u; k++) {
         let i = pair.ids[k];
         if (start[i].x.w > 0.0 && atomicLoad(&atomics[owner_at(i)]) != key) {
@@ -220,6 +230,7 @@ fn push_alone_one(p: u32, round: u32, sweep: u32) {
         }
     }
     lists[done_at(p)] = sweep + 1u;
+    let push = push_of(pair);
     if (!push.pushed) {
         return;
     }
@@ -238,7 +249,7 @@ fn push_alone_one(p: u32, round: u32, sweep: u32) {
 
 @compute @workgroup_size(64)
 fn push_alone(@builtin(global_invocation_id) id: vec3<u32>) {
-    push_alone_one(id.x, this_round.x, this_round.y);
+    push_alone_one(id.x, this_round.y);
 }
 
 // The pairs the rounds left, side by side: each particle moves by half the sum of their

@@ -85,7 +85,7 @@ fn pushes_together(@builtin(local_invocation_index) l: u32) {
                 break;
             }
             for (var p = l; p < n; p += WIDTH) {
-                push_alone_one(p, round, sweep);
+                push_alone_one(p, sweep);
             }
             storageBarrier();
         }

@@ -319,7 +319,8 @@ impl SelfPass {
         let pairs = u64::from(params.more[0]);
         // Per particle: its cut, its pushes' words and its owner in a push round.
         let atomic_words = u64::from(COUNTERS) + buckets + (2 + PUSH_WORDS) * count;
-        let list_words = 5 * entries + triangles + 5 * pairs + count;
+        // Per pair: its particles, whether it was pushed this sweep, its key this round.
+        let list_words = 5 * entries + triangles + 6 * pairs + count;
         let need = [
             (4 * atomic_words, "self-contact buckets"),
             (4 * list_words, "self-contact pairs"),
