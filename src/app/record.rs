@@ -62,11 +62,6 @@ impl ClothApp {
         self.recording.gif.is_some()
     }
 
-    /// Images queued for writing.
-    pub fn pending_writes(&self) -> usize {
-        self.recording.writer.pending()
-    }
-
     /// Blocks until queued files are written, then reports them (tests, shutdown).
     pub fn finish_writes(&mut self) {
         if let Some((path, _)) = self.recording.gif.take() {
