@@ -499,6 +499,22 @@ fn a_cloth_landing_on_another_pushed_side_by_side_rests_on_it_a_thickness_apart_
     lands_a_thickness_apart("xpbd", 8, 0);
 }
 
+/// The knob the test above turns takes effect: the two cloths of [`lands_a_thickness_apart`]
+/// landing under XPBD (frames 26 to 28 on the GPU) end elsewhere with no rounds of pushes
+/// than with the rounds (where it left the rounds in, both runs would give the same bits).
+#[test]
+fn no_rounds_of_pushes_lands_the_cloths_otherwise_than_the_rounds_do_on_the_gpu() {
+    let [none, rounds] = [0, super::PUSH_ROUNDS]
+        .map(|rounds| clean_frames(two_cloths("xpbd", 8), (26, 28), rounds, |_| {}));
+    let moved = (none.state().pos.iter().zip(&rounds.state().pos))
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(
+        moved > 0,
+        "no rounds, and the same end: the knob did nothing"
+    );
+}
+
 /// Self-contact's room for grid entries and pairs running out: the two cloths of
 /// [`lands_a_thickness_apart`] (on the GPU from frame 24 to 31) with room for 64 entries
 /// and 8 pairs to start with, where they need about 100–220 entries from the first frame
