@@ -7,10 +7,10 @@
 // Each particle's motion over the substep, grown by half the thickness, is its box; each
 // triangle's box (its corners' together) goes into a hashed grid of cells (a list per
 // bucket, linked through an atomic exchange); each triangle then walks the cells its box
-// covers and keeps, with every other triangle whose box overlaps its own in the first cell
-// both cover, their vertex–triangle and edge–edge pairs (each vertex and edge owned by one
-// triangle, as on the CPU) whose sides' boxes overlap. A triangle whose box covers too
-// many cells is checked against every triangle instead.
+// covers and keeps every other triangle whose box overlaps its own in the first cell both
+// cover; then each such pair of triangles keeps its vertex–triangle and edge–edge pairs
+// (each vertex and edge owned by one triangle, as on the CPU) whose sides' boxes overlap.
+// A triangle whose box covers too many cells is checked against every triangle instead.
 // The pairs closer than the thickness at the substep's end are pushed a thickness apart
 // (shaders/self_pushes.wgsl), a particle resting on a sphere or plane moving only where
 // nothing else in its pair can (the CPU's `held`); the colliders then act again on what
@@ -56,21 +56,24 @@ struct SelfParams {
 @group(0) @binding(5) var<storage, read_write> atomics: array<atomic<u32>>;
 // Each grid entry's next in its bucket, then the entries (triangle and cell, four words),
 // then the triangles checked against all, then the pairs (four words), then each
-// particle's share of its motion as the last round left it.
+// particle's share of its motion as the last round left it, each pair's marks in the push
+// rounds (two words), and the pairs of triangles whose boxes overlap (two words).
 @group(0) @binding(6) var<storage, read_write> lists: array<u32>;
 // The solver's words the contacts tell of what they moved (see the obstacles' shader).
 @group(0) @binding(7) var<storage, read_write> solver: array<u32>;
 // The round this dispatch takes (x).
 @group(1) @binding(0) var<uniform> this_round: vec4<u32>;
-// The pair kernels' workgroup counts (x, y, z), read by their indirect dispatches (bound to
-// `size_pairs` alone).
+// The pair kernels' workgroup counts (x, y, z), then `pairs_of_triangles`', read by their
+// indirect dispatches (bound to `size_pairs` and `size_triangle_pairs` alone).
 @group(2) @binding(0) var<storage, read_write> pair_groups: array<u32>;
 
-// Counters in `atomics`: grid entries, pairs, triangles checked against all, and per round
-// the pairs it found could meet and those of them it could not cut.
+// Counters in `atomics`: grid entries, pairs, triangles checked against all, pairs of
+// triangles whose boxes overlap, and per round the pairs it found could meet and those of
+// them it could not cut.
 const ENTRIES: u32 = 0u;
 const PAIRS: u32 = 1u;
 const BIG: u32 = 2u;
+const TRIANGLE_PAIRS: u32 = 3u;
 const IMPACTS: u32 = 4u;
 const STUCK: u32 = 20u;
 // The most grid entries and pairs any substep of the submission asked for (zeroed by the
@@ -126,6 +129,12 @@ fn pairs_at() -> u32 {
 
 fn scales_at() -> u32 {
     return pairs_at() + 4u * sp.more.x;
+}
+
+// The pairs of triangles (room for as many as for pairs: a substep that finds more has
+// run out of room, as one that keeps more pairs has).
+fn triangle_pairs_at() -> u32 {
+    return scales_at() + sp.counts.x + 2u * sp.more.x;
 }
 
 fn cell_of(p: vec3<f32>) -> vec3<i32> {
@@ -369,9 +378,27 @@ fn pairs_of(a: u32, b: u32) {
     }
 }
 
-// Each triangle keeps its pairs with every triangle whose box meets its own: from the
-// grid, each two once (from the lower-numbered, in the first cell both cover); a triangle
-// on the list of those checked against all, with every triangle.
+// Keeps triangles `a` and `b`, whose boxes overlap, for `pairs_of_triangles`.
+fn keep_triangles(a: u32, b: u32) {
+    let at = atomicAdd(&atomics[TRIANGLE_PAIRS], 1u);
+    if (at < sp.more.x) {
+        lists[triangle_pairs_at() + 2u * at] = a;
+        lists[triangle_pairs_at() + 2u * at + 1u] = b;
+    }
+}
+
+// The pairs of triangles kept this substep (those that had room).
+fn triangle_pairs_kept() -> u32 {
+    return min(atomicLoad(&atomics[TRIANGLE_PAIRS]), sp.more.x);
+}
+
+// Each triangle keeps every triangle whose box meets its own: from the grid, each two
+// once (from the lower-numbered, in the first cell both cover); a triangle on the list of
+// those checked against all, with every triangle. Their vertex–triangle and edge–edge
+// pairs are kept in a dispatch of their own (`pairs_of_triangles`), one pair of triangles
+// an invocation: tested here as each walk met them, each invocation's walk of a different
+// length, the invocations run side by side waited on each other, and on the software
+// adapter the search took four times as long.
 fn find_one(a: u32) {
     if (a >= sp.counts.y) {
         return;
@@ -386,7 +413,7 @@ fn find_one(a: u32) {
                 continue;
             }
             if (boxes_meet(lo, hi, box_b.xyz, boxes[triangle_box_at(b) + 1u].xyz)) {
-                pairs_of(a, b);
+                keep_triangles(a, b);
             }
         }
         return;
@@ -412,7 +439,7 @@ fn find_one(a: u32) {
                     if (!boxes_meet(lo, hi, blo, bhi) || any(cell_of(max(lo, blo)) != c)) {
                         continue;
                     }
-                    pairs_of(a, b);
+                    keep_triangles(a, b);
                 }
             }
         }
@@ -424,16 +451,54 @@ fn find(@builtin(global_invocation_id) id: vec3<u32>) {
     find_one(id.x);
 }
 
+// The pairs of the `q`th pair of triangles kept.
+fn pairs_of_one(q: u32) {
+    if (q < triangle_pairs_kept()) {
+        let at = triangle_pairs_at() + 2u * q;
+        pairs_of(lists[at], lists[at + 1u]);
+    }
+}
+
+@compute @workgroup_size(64)
+fn pairs_of_triangles(@builtin(global_invocation_id) id: vec3<u32>) {
+    pairs_of_one(id.x);
+}
+
 // Invocations a workgroup has (the host's `WORKGROUP`, every `@workgroup_size` here).
 const WIDTH: u32 = 64u;
 
 // The workgroups the pair kernels dispatch: as many as the pairs the search kept need (the
 // room for pairs is far more, and a workgroup past them would do nothing).
+// The grid entries and the room for pairs the search just made asked for (a pair of
+// triangles takes as much room as a pair).
+fn room_asked() -> vec2<u32> {
+    let pairs = max(atomicLoad(&atomics[PAIRS]), atomicLoad(&atomics[TRIANGLE_PAIRS]));
+    return vec2<u32>(atomicLoad(&atomics[ENTRIES]), pairs);
+}
+
+// Records what the search asked for among the most of the submission, after each search:
+// the pushes' as well as the cuts', so that a frame whose pushes' search ran out of room
+// (and dropped pairs from its pushes) is redone with more, as one whose cuts' did.
+fn record_room_asked() {
+    let asked = room_asked();
+    atomicMax(&atomics[MOST_ENTRIES], asked.x);
+    atomicMax(&atomics[MOST_PAIRS], asked.y);
+}
+
 @compute @workgroup_size(1)
 fn size_pairs() {
+    record_room_asked();
     pair_groups[0] = (pairs_kept() + WIDTH - 1u) / WIDTH;
     pair_groups[1] = 1u;
     pair_groups[2] = 1u;
+}
+
+// The same for `pairs_of_triangles`, after `find` (the next four words).
+@compute @workgroup_size(1)
+fn size_triangle_pairs() {
+    pair_groups[4] = (triangle_pairs_kept() + WIDTH - 1u) / WIDTH;
+    pair_groups[5] = 1u;
+    pair_groups[6] = 1u;
 }
 
 // Where particle i is with `share` of its motion over the substep (the one expression both
@@ -641,13 +706,8 @@ fn finish_one(i: u32) {
     }
     let last = sp.more.w - 1u;
     let unfinished = cut_something(last);
-    let entries = atomicLoad(&atomics[ENTRIES]);
-    let pairs = atomicLoad(&atomics[PAIRS]);
-    let overflow = entries > sp.counts.w || pairs > sp.more.x;
-    if (i == 0u) {
-        atomicMax(&atomics[MOST_ENTRIES], entries);
-        atomicMax(&atomics[MOST_PAIRS], pairs);
-    }
+    let asked = room_asked();
+    let overflow = asked.x > sp.counts.w || asked.y > sp.more.x;
     atomicAnd(&atomics[pushes_at() + PUSH_WORDS * i + HELD], ~MOVED);
     var s = share_of(i);
     if ((unfinished || overflow) && start[i].x.w > 0.0) {

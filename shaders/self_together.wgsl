@@ -33,8 +33,17 @@ fn pairs_for_team(l: u32) -> u32 {
     return workgroupUniformLoad(&team_count);
 }
 
+// The same for the pairs of triangles.
+fn triangle_pairs_for_team(l: u32) -> u32 {
+    if (l == 0u) {
+        team_count = triangle_pairs_kept();
+    }
+    return workgroupUniformLoad(&team_count);
+}
+
 // The substep's pairs: the counters cleared, the particles' and triangles' boxes, the grid,
-// the pairs (the wide path's `clear`, `particle_boxes`, `insert` and `find`).
+// the pairs of triangles, their pairs (the wide path's `clear`, `particle_boxes`, `insert`,
+// `find` and `pairs_of_triangles`).
 @compute @workgroup_size(WIDTH)
 fn search_together(@builtin(local_invocation_index) l: u32) {
     for (var i = l; i < COUNTERS + sp.counts.z; i += WIDTH) {
@@ -51,6 +60,15 @@ fn search_together(@builtin(local_invocation_index) l: u32) {
     storageBarrier();
     for (var t = l; t < sp.counts.y; t += WIDTH) {
         find_one(t);
+    }
+    storageBarrier();
+    let n = triangle_pairs_for_team(l);
+    for (var q = l; q < n; q += WIDTH) {
+        pairs_of_one(q);
+    }
+    storageBarrier();
+    if (l == 0u) {
+        record_room_asked();
     }
 }
 

@@ -75,6 +75,10 @@ struct SelfParams {
     colliders: [GpuCollider; MAX_COLLIDERS],
 }
 
+/// Where the workgroup counts of `pairs_of_triangles` start in the pair kernels' (bytes:
+/// the shader's `size_triangle_pairs` writes from word 4).
+const TRIANGLE_PAIR_GROUPS: u64 = 16;
+
 /// Room in the grid and for pairs, per triangle, to start with.
 const ENTRIES_PER_TRIANGLE: u32 = 16;
 const PAIRS_PER_TRIANGLE: u32 = 16;
@@ -105,9 +109,11 @@ enum Kernel {
     SolidsTogether,
     CutsTogether,
     SizePairs,
+    PairsOfTriangles,
+    SizeTrianglePairs,
 }
 
-const KERNELS: usize = Kernel::SizePairs as usize + 1;
+const KERNELS: usize = Kernel::SizeTrianglePairs as usize + 1;
 
 const ENTRY_POINTS: [&str; KERNELS] = [
     "clear",
@@ -133,6 +139,8 @@ const ENTRY_POINTS: [&str; KERNELS] = [
     "solids_together",
     "cuts_together",
     "size_pairs",
+    "pairs_of_triangles",
+    "size_triangle_pairs",
 ];
 
 /// The most triangles, and pairs the last submission found in a substep, for which one
@@ -165,7 +173,8 @@ pub(super) struct SelfPass {
     groups: [wgpu::BindGroup; 6],
     rounds: wgpu::BindGroup,
     /// The pair kernels' workgroup counts (x, y, z), which `size_pairs` writes after each
-    /// search and their indirect dispatches read, and its group (2).
+    /// search and their indirect dispatches read, then the same for the pairs of
+    /// triangles (`size_triangle_pairs`), and its group (2).
     pair_groups: wgpu::Buffer,
     pair_groups_group: wgpu::BindGroup,
     /// What the groups bind: the uniform, the triangles, the boxes, the counters and
@@ -272,11 +281,20 @@ impl SelfPass {
             device,
             "self-contact",
             &format!("{LAYOUT}{CONTACT}{GEOMETRY}{SOURCE}"),
-            ENTRY_POINTS.map(|entry| (entry, if entry == "size_pairs" { sizing } else { all })),
+            ENTRY_POINTS.map(|entry| {
+                (
+                    entry,
+                    if entry.starts_with("size_") {
+                        sizing
+                    } else {
+                        all
+                    },
+                )
+            }),
         );
         let pair_groups = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("self-contact pair groups"),
-            size: 16,
+            size: 2 * TRIANGLE_PAIR_GROUPS,
             usage: U::STORAGE | U::INDIRECT,
             mapped_at_creation: false,
         });
@@ -319,8 +337,9 @@ impl SelfPass {
         let pairs = u64::from(params.more[0]);
         // Per particle: its cut, its pushes' words and its owner in a push round.
         let atomic_words = u64::from(COUNTERS) + buckets + (2 + PUSH_WORDS) * count;
-        // Per pair: its particles, whether it was pushed this sweep, its key this round.
-        let list_words = 5 * entries + triangles + 6 * pairs + count;
+        // Per pair: its particles, whether it was pushed this sweep, its key this round;
+        // and as much room for pairs of triangles (two words each).
+        let list_words = 5 * entries + triangles + 8 * pairs + count;
         let need = [
             (4 * atomic_words, "self-contact buckets"),
             (4 * list_words, "self-contact pairs"),
@@ -507,8 +526,9 @@ impl SelfPass {
     }
 
     /// Dispatches `kernel` over what it runs on: a particle, a triangle, a pair (as many
-    /// workgroups as the search's pairs need, which `size_pairs` wrote) or a counter or
-    /// bucket each invocation; or the one workgroup that runs all.
+    /// workgroups as the search's pairs need, which `size_pairs` wrote), a pair of triangles
+    /// (the same, from `size_triangle_pairs`) or a counter or bucket each invocation; or the
+    /// one workgroup that runs all.
     fn run(&self, pass: &mut wgpu::ComputePass<'_>, kernel: Kernel) {
         use Kernel::*;
         let [count, triangles, buckets, _] = self.params.counts;
@@ -519,16 +539,21 @@ impl SelfPass {
                 pass.set_pipeline(&self.kernels[kernel as usize]);
                 return pass.dispatch_workgroups_indirect(&self.pair_groups, 0);
             }
+            PairsOfTriangles => {
+                pass.set_pipeline(&self.kernels[kernel as usize]);
+                return pass.dispatch_workgroups_indirect(&self.pair_groups, TRIANGLE_PAIR_GROUPS);
+            }
             Boxes | CutApply | Finish | KeepStart | PushApply | Solids | FacesApply | FacesLift
             | BeforeObstacles | ObstaclesMoved => count,
-            SearchTogether | PushesTogether | SolidsTogether | CutsTogether | SizePairs => 1,
+            SearchTogether | PushesTogether | SolidsTogether | CutsTogether | SizePairs
+            | SizeTrianglePairs => 1,
         };
         pass.set_pipeline(&self.kernels[kernel as usize]);
         pass.dispatch_workgroups(n.div_ceil(WORKGROUP), 1, 1);
     }
 
     /// Searches the pairs of the substep bound ([`SelfPass::bind`]): each particle's and
-    /// triangle's box, the grid, the pairs.
+    /// triangle's box, the grid, the pairs of triangles whose boxes overlap, their pairs.
     fn search(&self, pass: &mut wgpu::ComputePass<'_>) {
         if self.together {
             return self.run(pass, Kernel::SearchTogether);
@@ -537,6 +562,8 @@ impl SelfPass {
             self.run(pass, kernel);
         }
         pass.set_bind_group(2, &self.pair_groups_group, &[]);
+        self.run(pass, Kernel::SizeTrianglePairs);
+        self.run(pass, Kernel::PairsOfTriangles);
         self.run(pass, Kernel::SizePairs);
     }
 
