@@ -311,7 +311,7 @@ mod tests {
     /// A replay (the guard's redo from its rollback point after a broken limit) in which a
     /// frame runs out of self-contact's room starts again from the rollback point with the
     /// room grown, and ends where the same replay with room enough ends, to the bit.
-    /// `layers` at 4 quads under XPBD at 8 substeps, on the GPU from frame 13 to 15, as its
+    /// `layers` at 4 quads under XPBD at 8 substeps, on the GPU for frame 14, as its
     /// five cloths reach the sphere; then replayed from the checkpoint to there at 16
     /// substeps, once as it was and once with the room shrunk to 8 pairs and 64 grid entries
     /// just before (the cloths alone need more than that).
@@ -324,7 +324,7 @@ mod tests {
         scene.params.step.substeps = 8;
         scene.params.guard.enabled = true;
         let mut cpu = crate::scene::Simulation::new(scene.clone());
-        for _ in 0..13 {
+        for _ in 0..14 {
             cpu.step_frame().expect("a frame");
         }
         scene.initial = cpu.state().clone();
@@ -332,7 +332,7 @@ mod tests {
         let replayed = |room: Option<[u32; 2]>| {
             let mut stepper = stepper_on(&gpu, &scene);
             let mut state = scene.initial.clone();
-            for frame in 13..15 {
+            for frame in 14..15 {
                 let outcome = stepper.frame(model, &mut state).expect("a frame");
                 assert_eq!(outcome, crate::sim::FrameOutcome::Stepped, "frame {frame}");
             }
