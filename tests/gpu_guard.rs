@@ -135,9 +135,7 @@ fn without_the_guard_the_gpu_cloth_blows_up() {
 
 /// With XPBD as the fallback, a frame that more substeps cannot save is redone by XPBD at
 /// the requested substeps, on the GPU as on the CPU; XPBD then stays, and the two cloths
-/// go on together (here to the bit: XPBD's arithmetic is the same on both). The default
-/// fallback, implicit Euler, runs on the GPU too: both fall back to it at the same frame, and
-/// their cloths agree to the solve's tolerance.
+/// go on together (here to the bit: XPBD's arithmetic is the same on both).
 #[test]
 fn the_gpu_falls_back_to_xpbd_as_the_cpu_does() {
     let policy = GuardPolicy {
@@ -162,6 +160,12 @@ fn the_gpu_falls_back_to_xpbd_as_the_cpu_does() {
     let worst = farthest(&cpu.state().pos, &gpu.state().pos);
     eprintln!("after the fallback the backends are {worst:e} m apart");
     assert!(worst < 1e-5, "GPU and CPU differ by {worst} m");
+}
+
+/// The default fallback, implicit Euler, runs on the GPU too: both fall back to it at the
+/// same frame, and their cloths agree to the solve's tolerance.
+#[test]
+fn the_gpu_falls_back_to_implicit_euler_by_default_as_the_cpu_does() {
     let policy = GuardPolicy {
         max_refinements: 1,
         ..GuardPolicy::default()
