@@ -170,8 +170,8 @@ fn newton_iterations_are_refused_on_the_gpu_with_the_reason() {
 /// Handles carry the cloth under implicit Euler on the GPU as on the CPU: `fast-fold`'s back
 /// edge flung over at 10 m/s (without its self-collision, whose pushes the two backends order differently), the carried
 /// particles' velocities entering the springs' damping and `∂f/∂x·v` as on the CPU
-/// (measured: 0.5 µm apart after the cloth moved 0.48 m). Solved to 10⁻⁵ but at most 20
-/// iterations, at 4 substeps, the two ended 2.5 mm apart after 24 frames: the flung cloth's
+/// (measured: 0.4 µm apart after the cloth moved 0.48 m). Solved to 10⁻⁵ but at most 20
+/// iterations, at 4 substeps, the two ended 0.7 mm apart after 24 frames: the flung cloth's
 /// solves stop at the cap, where rounding in other orders leaves other iterates, and the
 /// fling amplifies it.
 #[test]
