@@ -398,7 +398,7 @@ fn triangle_pairs_kept() -> u32 {
 // pairs are kept in a dispatch of their own (`pairs_of_triangles`), one pair of triangles
 // an invocation: tested here as each walk met them, each invocation's walk of a different
 // length, the invocations run side by side waited on each other, and on the software
-// adapter the search took four times as long.
+// adapter the search took twice as long (`layers` at 6 quads: 6.7 ms against 3).
 fn find_one(a: u32) {
     if (a >= sp.counts.y) {
         return;
