@@ -314,7 +314,8 @@ mod tests {
     /// `layers` at 4 quads under XPBD at 8 substeps, on the GPU for frame 14, as its
     /// five cloths reach the sphere; then replayed from the checkpoint to there at 16
     /// substeps, once as it was and once with the room shrunk to 8 pairs and 64 grid entries
-    /// just before (the cloths alone need more than that).
+    /// just before (the cloths alone need more than that). The replays run the wide path:
+    /// without `size_pairs` recording what each search asked for, the positions differ.
     #[test]
     fn a_replay_that_runs_out_of_room_starts_again_with_more() {
         let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
@@ -338,7 +339,8 @@ mod tests {
             }
             assert!(stepper.guard.checkpoint.is_some(), "a rollback point");
             let own = stepper.contacts.own.as_mut().expect("self-contact");
-            own.room = room;
+            // The wide path (the room test in `gpu::self_contact` runs one workgroup).
+            (own.room, own.forced) = (room, Some(false));
             stepper.set_substeps(16);
             let before = stepper.stats.steps;
             let end = state.time;

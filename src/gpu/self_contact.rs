@@ -143,15 +143,16 @@ const ENTRY_POINTS: [&str; KERNELS] = [
     "size_triangle_pairs",
 ];
 
-/// The most triangles, and pairs the last submission found in a substep, for which one
-/// workgroup runs each phase of a substep (`shaders/self_together.wgsl`): five dispatches
-/// where the wide path has about a hundred. Measured on the software adapter (two
-/// threads), where the wide path's dispatches cost about 8 ms a substep: with a few
-/// hundred pairs (`twist` at 12 quads) one workgroup steps 2.8 times faster; with 1 400
-/// (`layers` at 6 quads before it lands) 1.6 times slower, its one thread doing all the
-/// work.
+/// The most triangles, and pairs (or pairs of triangles, where those are more) the last
+/// submission found in a substep, for which one workgroup runs each phase of a substep
+/// (`shaders/self_together.wgsl`): five dispatches where the wide path has about a
+/// hundred. Measured on the software adapter (2026-11-27, the 2-vCPU machine, its two
+/// threads), a frame of `layers` at 6 quads under XPBD at 8 substeps: with 2 380 (before it
+/// lands) one workgroup steps it 2.5–3 times faster; with 3 200 as fast; with 4 700 half as
+/// fast, its one thread doing all the work. (Before the search's pairs of triangles had a
+/// dispatch of their own, one workgroup was 1.6 times slower already at 1 400 pairs.)
 const TOGETHER_TRIANGLES: u32 = 1024;
-const TOGETHER_PAIRS: u32 = 768;
+const TOGETHER_PAIRS: u32 = 3072;
 
 /// Whether one workgroup runs the substeps of a cloth of `triangles` whose last submission
 /// found at most `pairs` in a substep.
