@@ -467,8 +467,6 @@ fn pairs_of_triangles(@builtin(global_invocation_id) id: vec3<u32>) {
 // Invocations a workgroup has (the host's `WORKGROUP`, every `@workgroup_size` here).
 const WIDTH: u32 = 64u;
 
-// The workgroups the pair kernels dispatch: as many as the pairs the search kept need (the
-// room for pairs is far more, and a workgroup past them would do nothing).
 // The grid entries and the room for pairs the search just made asked for (a pair of
 // triangles takes as much room as a pair).
 fn room_asked() -> vec2<u32> {
@@ -485,6 +483,9 @@ fn record_room_asked() {
     atomicMax(&atomics[MOST_PAIRS], asked.y);
 }
 
+// The workgroups the pair kernels dispatch: as many as the pairs the search kept need (the
+// room for pairs is far more, and a workgroup past them would do nothing); and what the
+// search asked for, recorded.
 @compute @workgroup_size(1)
 fn size_pairs() {
     record_room_asked();
