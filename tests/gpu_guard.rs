@@ -133,55 +133,49 @@ fn without_the_guard_the_gpu_cloth_blows_up() {
     assert!(blown.count() > 0, "every particle slower than 1 km/s");
 }
 
-/// With XPBD as the fallback, a frame that more substeps cannot save is redone by XPBD at
-/// the requested substeps, on the GPU as on the CPU; XPBD then stays, and the two cloths
-/// go on together (here to the bit: XPBD's arithmetic is the same on both).
-#[test]
-fn the_gpu_falls_back_to_xpbd_as_the_cpu_does() {
+/// A frame that more substeps cannot save (the stiff cloth, at most one refinement) is redone
+/// by `fallback` at the requested substeps, on the GPU as on the CPU, in the same frame;
+/// `fallback` then stays, and the two cloths go on together, to `tolerance` metres.
+fn falls_back_as_the_cpu_does(fallback: IntegratorKind, tolerance: f32) {
     let policy = GuardPolicy {
         max_refinements: 1,
-        fallback: Some(IntegratorKind::Xpbd),
+        fallback: Some(fallback),
         ..GuardPolicy::default()
     };
     let start = stiff_cloth(8, policy.clone()).initial.pos;
     let (mut cpu, mut gpu, on_cpu, on_gpu) = both(stiff_cloth(8, policy), 12);
     let fell_back = GuardAction::FellBack {
-        integrator: IntegratorKind::Xpbd,
+        integrator: fallback,
     };
     let expected = [("0.0167".to_string(), fell_back, 8, 8)];
     assert_eq!(actions(&on_cpu), expected);
     assert_eq!(actions(&on_gpu), expected);
     for sim in [&cpu, &gpu] {
-        assert_eq!(sim.integrator_in_effect(), IntegratorKind::Xpbd);
+        assert_eq!(sim.integrator_in_effect(), fallback);
     }
     cpu.sync_state().expect("cpu");
     gpu.sync_state().expect("read back");
-    assert!(farthest(&gpu.state().pos, &start) > 1e-3, "the cloth moved");
+    // Moved far more than the backends may differ by, or the comparison says nothing.
+    let moved = farthest(&gpu.state().pos, &start);
+    assert!(moved > 10.0 * tolerance, "the cloth moved {moved} m");
     let worst = farthest(&cpu.state().pos, &gpu.state().pos);
-    eprintln!("after the fallback the backends are {worst:e} m apart");
-    assert!(worst < 1e-5, "GPU and CPU differ by {worst} m");
+    eprintln!("after falling back to {fallback:?} the backends are {worst:e} m apart");
+    assert!(worst < tolerance, "GPU and CPU differ by {worst} m");
 }
 
-/// The default fallback, implicit Euler, runs on the GPU too: both fall back to it at the
-/// same frame, and their cloths agree to the solve's tolerance.
+/// XPBD as the fallback: the two cloths agree to the bit (XPBD's arithmetic is the same on
+/// both).
+#[test]
+fn the_gpu_falls_back_to_xpbd_as_the_cpu_does() {
+    falls_back_as_the_cpu_does(IntegratorKind::Xpbd, 1e-5);
+}
+
+/// The default fallback, implicit Euler, runs on the GPU too; the cloths agree to the
+/// solve's tolerance (measured: 0.13 µm apart, the cloth having moved 0.3 mm; without the
+/// GPU solve's `h·(∂f/∂x)·v`, 96 µm, which the bound of 0.1 mm it had let pass).
 #[test]
 fn the_gpu_falls_back_to_implicit_euler_by_default_as_the_cpu_does() {
-    let policy = GuardPolicy {
-        max_refinements: 1,
-        ..GuardPolicy::default()
-    };
-    assert_eq!(policy.fallback, Some(IntegratorKind::ImplicitEuler));
-    let (mut cpu, mut gpu, on_cpu, on_gpu) = both(stiff_cloth(8, policy), 12);
-    let fell_back = GuardAction::FellBack {
-        integrator: IntegratorKind::ImplicitEuler,
-    };
-    let expected = [("0.0167".to_string(), fell_back, 8, 8)];
-    assert_eq!(actions(&on_cpu), expected);
-    assert_eq!(actions(&on_gpu), expected);
-    assert_eq!(gpu.integrator_in_effect(), IntegratorKind::ImplicitEuler);
-    cpu.sync_state().expect("cpu");
-    gpu.sync_state().expect("read back");
-    let worst = farthest(&cpu.state().pos, &gpu.state().pos);
-    eprintln!("after falling back to implicit Euler the backends are {worst:e} m apart");
-    assert!(worst < 1e-4, "GPU and CPU differ by {worst} m");
+    let default = GuardPolicy::default().fallback;
+    assert_eq!(default, Some(IntegratorKind::ImplicitEuler));
+    falls_back_as_the_cpu_does(IntegratorKind::ImplicitEuler, 1e-6);
 }
