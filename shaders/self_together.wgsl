@@ -25,18 +25,11 @@ fn any_in_team(l: u32, mine: bool) -> bool {
     return workgroupUniformLoad(&team_flag) != 0u;
 }
 
-// The pairs the search kept, the same for every invocation of the team.
-fn pairs_for_team(l: u32) -> u32 {
+// `count` as invocation 0 reads it, the same for every invocation of the team (a count
+// the search kept: its pairs, or its pairs of triangles).
+fn for_team(l: u32, count: u32) -> u32 {
     if (l == 0u) {
-        team_count = pairs_kept();
-    }
-    return workgroupUniformLoad(&team_count);
-}
-
-// The same for the pairs of triangles.
-fn triangle_pairs_for_team(l: u32) -> u32 {
-    if (l == 0u) {
-        team_count = triangle_pairs_kept();
+        team_count = count;
     }
     return workgroupUniformLoad(&team_count);
 }
@@ -62,7 +55,7 @@ fn search_together(@builtin(local_invocation_index) l: u32) {
         find_one(t);
     }
     storageBarrier();
-    let n = triangle_pairs_for_team(l);
+    let n = for_team(l, triangle_pairs_kept());
     for (var q = l; q < n; q += WIDTH) {
         pairs_of_one(q);
     }
@@ -82,7 +75,7 @@ fn take_pushes_together(l: u32, share: f32) {
 // The sweeps of push rounds, each with what its rounds leave pushed side by side.
 @compute @workgroup_size(WIDTH)
 fn pushes_together(@builtin(local_invocation_index) l: u32) {
-    let n = pairs_for_team(l);
+    let n = for_team(l, pairs_kept());
     for (var sweep = 0u; sweep < sp.passes.y; sweep++) {
         for (var r = 0u; r < sp.passes.z; r++) {
             let round = sweep * sp.passes.z + r;
@@ -133,7 +126,7 @@ fn solids_together(@builtin(local_invocation_index) l: u32) {
 // The rounds of cuts on the motion as pushed, then each particle's end.
 @compute @workgroup_size(WIDTH)
 fn cuts_together(@builtin(local_invocation_index) l: u32) {
-    let n = pairs_for_team(l);
+    let n = for_team(l, pairs_kept());
     for (var r = 0u; r < sp.more.w; r++) {
         // A round runs only after one that cut something (`cut_one`); the rounds not run
         // leave their counters cleared, as the wide path's rounds that return at once do.
