@@ -110,6 +110,11 @@ fn closest_layers(triangles: &[[u32; 3]], pos: &[Vec3]) -> f32 {
     best
 }
 
+/// The height of the lowest particle, m.
+fn lowest_of(pos: &[Vec3]) -> f32 {
+    pos.iter().fold(f32::INFINITY, |m, p| m.min(p.y))
+}
+
 /// The point of triangle (a, b, c) nearest to `p`.
 fn closest_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
     let n = (b - a).cross(c - a);
@@ -170,16 +175,14 @@ fn never_passes_through(scene: Scene, frames: (usize, usize), pushes: bool) -> (
 /// Euler at 4 substeps (it meets the sphere at frame 36; on the GPU for frames 38 and 39,
 /// from 14 cm above the ground), with the pass after every substep, it comes down to the
 /// ground (a pass that held the cloth where each substep started fails here) and never
-/// passes through itself. At this size it does not fold onto itself (its layers come no nearer than 10 cm
-/// in 60 frames, and with the pass left out nothing crosses either): the guarantee itself
-/// is tested by the twisting strip.
+/// passes through itself. At this size it does not fold onto itself (its layers come no
+/// nearer than 10 cm in 60 frames, and with the pass left out nothing crosses either):
+/// the guarantee itself is tested by the twisting strip.
 #[test]
 fn a_crumpling_cloth_comes_down_and_never_passes_through_itself_on_the_gpu() {
     let scene = Scene::open_resized("crumple", None, &Default::default(), Some(12)).unwrap();
     let (gpu, closest) = never_passes_through(scene, (38, 40), true);
-    let lowest = (gpu.state().pos.iter())
-        .map(|p| p.y)
-        .fold(f32::INFINITY, f32::min);
+    let lowest = lowest_of(&gpu.state().pos);
     eprintln!("crumple: lowest {lowest}, closest layers {closest}");
     assert!(
         lowest < 0.02,
@@ -301,7 +304,7 @@ fn a_stack_of_cloths_on_a_table_never_passes_through_it_on_the_gpu() {
     cpu_then_gpu(scene, gpu, (10, 15), |frame, _, sim| {
         let pos = &sim.state().pos;
         closest = closest.min(closest_layers(&sim.model().triangles, pos));
-        let low = pos.iter().fold(f32::INFINITY, |m, p| m.min(p.y));
+        let low = lowest_of(pos);
         if frame >= 11 {
             lowest = lowest.min(low);
         }
@@ -329,16 +332,7 @@ fn a_stack_of_cloths_on_a_table_never_passes_through_it_on_the_gpu() {
 /// other in 16. Returns how near they came. (Measured too: `crumple` at 32 quads, the same
 /// bits for 60 frames.)
 fn same_bits(pushes: bool) -> f32 {
-    let scene = || {
-        edited(
-            include_str!("../../../assets/scenes/layers.toml"),
-            &[
-                ("integrator = \"implicit-euler\"", "integrator = \"xpbd\""),
-                ("substeps = 4", "substeps = 8"),
-            ],
-            4,
-        )
-    };
+    let scene = || stack(4, None);
     let mut cpu = Simulation::new(scene());
     for _ in 0..15 {
         cpu.step_frame().expect("cpu frame");
@@ -421,7 +415,7 @@ fn lands_a_thickness_apart(integrator: &str, substeps: u32, push_rounds: u32) {
         let speed = (sim.state().vel.iter()).fold(0.0f32, |m, v| m.max(v.length()));
         fastest = fastest.max(speed);
     });
-    let lowest = (sim.state().pos.iter()).fold(f32::INFINITY, |m, p| m.min(p.y));
+    let lowest = lowest_of(&sim.state().pos);
     let closest = closest_layers(&sim.model().triangles, &sim.state().pos);
     eprintln!("{integrator}: lowest {lowest}, closest layers {closest}, fastest {fastest} m/s");
     assert!(
@@ -555,7 +549,7 @@ fn a_frame_whose_room_for_pairs_ran_out_is_redone_with_more_on_the_gpu() {
         });
         (states, sim.take_stats().steps)
     });
-    let lowest = (roomy[27].0.iter()).fold(f32::INFINITY, |m, p| m.min(p.y));
+    let lowest = lowest_of(&roomy[27].0);
     assert!(lowest < 0.011, "the cloths have landed: {lowest}");
     for (frame, (a, b)) in roomy.iter().zip(&tight).enumerate() {
         assert!(
