@@ -33,21 +33,26 @@ fn compare(scene: Scene, frames: usize) -> (f32, Simulation) {
     compare_checking(scene, (0, frames), |_, _| {})
 }
 
-/// [`compare`] from frame `from` on: the CPU steps the frames before alone (the cloth
-/// falling free, as both backends step it alike), and the GPU starts where it left the
-/// cloth; `check` is run on the GPU's simulation after each of its frames (by number).
+/// `scene` stepped `from` frames on the CPU (the cloth falling free, as both backends step
+/// it alike), and a GPU simulation of it starting where the CPU left it.
+fn on_the_gpu_from(mut scene: Scene, from: usize) -> (Simulation, Simulation) {
+    let mut cpu = Simulation::new(scene.clone());
+    for _ in 0..from {
+        cpu.step_frame().expect("cpu frame");
+    }
+    scene.initial = cpu.state().clone();
+    let (gpu, _) = gpu_simulation(scene, true).expect("GPU backend on the software adapter");
+    (cpu, gpu)
+}
+
+/// [`compare`] from frame `from` on ([`on_the_gpu_from`]); `check` is run on the GPU's
+/// simulation after each of its frames (by number).
 fn compare_checking(
     scene: Scene,
     (from, frames): (usize, usize),
     check: impl Fn(usize, &Simulation),
 ) -> (f32, Simulation) {
-    let mut cpu = Simulation::new(scene.clone());
-    for _ in 0..from {
-        cpu.step_frame().expect("cpu frame");
-    }
-    let mut scene = scene;
-    scene.initial = cpu.state().clone();
-    let (mut gpu, _) = gpu_simulation(scene, true).expect("GPU backend on the software adapter");
+    let (mut cpu, mut gpu) = on_the_gpu_from(scene, from);
     for frame in from..frames {
         cpu.step_frame().expect("cpu frame");
         gpu.step_frame().expect("gpu frame");
@@ -156,13 +161,7 @@ fn a_tablecloth_under_vbd_meets_the_table_as_on_the_cpu() {
 /// rim.
 #[test]
 fn a_tablecloth_on_the_gpu_never_passes_through_the_table() {
-    let mut cpu = Simulation::new(scene("tablecloth", 8));
-    for _ in 0..12 {
-        cpu.step_frame().expect("cpu frame");
-    }
-    let mut from_there = scene("tablecloth", 8);
-    from_there.initial = cpu.state().clone();
-    let (mut gpu, _) = gpu_simulation(from_there, true).expect("GPU backend");
+    let (_, mut gpu) = on_the_gpu_from(scene("tablecloth", 8), 12);
     for frame in 12..21 {
         gpu.step_frame().expect("gpu frame");
         passes_through_nothing(frame, &gpu);
