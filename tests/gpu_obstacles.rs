@@ -79,8 +79,8 @@ fn passes_through_nothing(frame: usize, sim: &Simulation) {
 /// `carousel`'s drum, turning at 1 rad/s: the cloth lands on it and is carried round by
 /// friction with the drum's surface, and kept off the drum's rim (on the GPU from frame 8,
 /// two before it lands). Measured: 4.2 µm apart after 15 frames, when the cloth has lain
-/// on the turning drum for five; without the surface's velocity in the response, 5 cm;
-/// without the edge pass, 14 cm; with every sweep of it run, 5 mm.
+/// on the turning drum for five; without the surface's velocity in the catch's response,
+/// 6.4 mm; without the edge pass, 14 cm; with every sweep of it run, 5 mm.
 #[test]
 fn a_turning_drum_carries_the_cloth_as_on_the_cpu() {
     let (apart, cpu) = compare_checking(scene("carousel", 8), (8, 15), |_, _| {});
