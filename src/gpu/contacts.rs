@@ -108,10 +108,10 @@ impl Contacts {
 
     /// Records substep `k`'s contacts, where `start` says its start and end are.
     pub(super) fn encode(&self, pass: &mut wgpu::ComputePass<'_>, k: u32, start: Start) {
-        if let (Some(own), Some(_)) = (&self.own, &self.obstacles) {
-            own.before_obstacles(pass, start);
-        }
         if let Some(obstacles) = &self.obstacles {
+            if let Some(own) = &self.own {
+                own.before_obstacles(pass, start);
+            }
             obstacles.encode(pass, k, start);
         }
         if let Some(own) = &self.own {
