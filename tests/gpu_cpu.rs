@@ -4,12 +4,13 @@
 //! descended, colour by colour in the same order, so the two agree to rounding. And
 //! friction between layers of the cloth, against Coulomb's law on an incline.
 
-use clothsim::gpu::gpu_simulation;
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::{BendingModel, Effect, IntegratorKind, Wind};
 
 mod common;
-use common::{apart_after_a_push, farthest, incline, slope_acceleration, slope_speed};
+use common::{
+    apart_after_a_push, farthest, gpu_simulation, incline, slope_acceleration, slope_speed,
+};
 
 /// The built-in scene `name` with its grid at 16 quads.
 fn small(name: &str) -> Scene {

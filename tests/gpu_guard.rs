@@ -2,12 +2,11 @@
 //! blow-up, rolls back to a checkpoint kept on the device, refines and recovers as the CPU
 //! guard does, and says why when nothing saves a frame.
 
-use clothsim::gpu::gpu_simulation;
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::{GuardAction, GuardEvent, GuardPolicy, IntegratorKind};
 
 mod common;
-use common::farthest;
+use common::{farthest, gpu_simulation};
 
 /// The 16 × 16 bench cloth with semi-implicit Euler at `substeps` a frame, springs 30×
 /// stiffer, under the guard with `policy`.

@@ -3,12 +3,11 @@
 //! guess and stopping rule, so the two agree to the solve's tolerance, and to rounding when
 //! both stop after the same few iterations.
 
-use clothsim::gpu::gpu_simulation;
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::IntegratorKind;
 
 mod common;
-use common::{apart_after_a_push, farthest};
+use common::{apart_after_a_push, farthest, gpu_simulation};
 
 /// The built-in scene `name` at 16 quads, stepped by implicit Euler at `substeps` a frame
 /// with the solve's `tolerance` and iteration cap.

@@ -7,12 +7,11 @@
 //! (then which side an edge is on turns on rounding, and they part by tenths of a
 //! millimetre); and the catch agrees to rounding even where the obstacle flings the cloth.
 
-use clothsim::gpu::gpu_simulation;
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::IntegratorKind;
 
 mod common;
-use common::farthest;
+use common::{farthest, gpu_simulation};
 
 /// The built-in scene `name` at `quads` quads.
 fn scene(name: &str, quads: u32) -> Scene {

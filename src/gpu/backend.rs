@@ -31,9 +31,24 @@ pub fn gpu_simulation(
     scene: Scene,
     read_every_frame: bool,
 ) -> Result<(Simulation, String), GpuError> {
+    gpu_simulation_on(scene, read_every_frame, AdapterPreference::Any)
+}
+
+/// [`gpu_simulation`] on the adapter `preference` picks: the tests ask for the software
+/// one, as their golden images do, so that the same rasteriser's compiler runs them
+/// whatever else the machine has (through Vulkan's lavapipe a contact decision at its
+/// threshold went the other way in one comparison with the CPU).
+///
+/// # Errors
+/// As [`gpu_simulation`].
+pub fn gpu_simulation_on(
+    scene: Scene,
+    read_every_frame: bool,
+    preference: AdapterPreference,
+) -> Result<(Simulation, String), GpuError> {
     let params = &scene.params;
     gpu_support(&params.step, params.solver.precision, &scene.effects)?;
-    let gpu = HeadlessDevice::open(AdapterPreference::Any)?;
+    let gpu = HeadlessDevice::open(preference)?;
     let stepper = GpuStepper::new(
         &gpu.device,
         &gpu.queue,

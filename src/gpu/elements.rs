@@ -323,7 +323,7 @@ mod tests {
     /// gives the CPU's wind and dihedral forces on every particle, to f32 rounding.
     #[test]
     fn the_element_forces_summed_per_particle_are_the_cpus() {
-        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let gpu = HeadlessDevice::open(AdapterPreference::Software).expect("an adapter");
         let scene = Scene::builtin("flag").expect("scene");
         let model = &scene.model;
         let mut state = scene.initial.clone();

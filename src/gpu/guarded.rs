@@ -282,7 +282,7 @@ mod tests {
     /// the state read back after the frame it names.
     #[test]
     fn the_devices_checkpoint_is_an_earlier_frames_state_to_the_bit() {
-        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let gpu = HeadlessDevice::open(AdapterPreference::Software).expect("an adapter");
         let scene = guarded_bench();
         let model = &scene.model;
         let mut stepper = stepper_on(&gpu, &scene);
@@ -318,7 +318,7 @@ mod tests {
     /// without `size_pairs` recording what each search asked for, the positions differ.
     #[test]
     fn a_replay_that_runs_out_of_room_starts_again_with_more() {
-        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let gpu = HeadlessDevice::open(AdapterPreference::Software).expect("an adapter");
         let options = Default::default();
         let mut scene = Scene::open_resized("layers", None, &options, Some(4)).expect("scene");
         scene.params.step.integrator = IntegratorKind::Xpbd;
@@ -376,7 +376,7 @@ mod tests {
     /// stretch, to f32 rounding; a NaN velocity or an infinite position anywhere is seen.
     #[test]
     fn the_devices_measure_of_a_state_is_the_cpus() {
-        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let gpu = HeadlessDevice::open(AdapterPreference::Software).expect("an adapter");
         let scene = Scene::builtin("sphere-drop").expect("scene");
         let (model, params) = (&scene.model, &scene.params);
         let mut state = scene.initial.clone();
@@ -435,7 +435,7 @@ mod tests {
     /// one's rest length it ends 2.2 m away.
     #[test]
     fn the_grid_gather_steps_the_cloth_the_general_one_does() {
-        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let gpu = HeadlessDevice::open(AdapterPreference::Software).expect("an adapter");
         let scene =
             crate::bench::bench_scene(16, IntegratorKind::SemiImplicitEuler).expect("scene");
         let (model, params) = (&scene.model, &scene.params);
@@ -476,7 +476,7 @@ mod tests {
     #[test]
     fn the_spring_ends_are_sent_again_only_when_their_classes_change() {
         use crate::device::{AdapterPreference, HeadlessDevice};
-        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let gpu = HeadlessDevice::open(AdapterPreference::Software).expect("an adapter");
         // The bench scene: one stiffness and damping for every kind of spring.
         let scene = crate::scene::Scene::builtin("hanging-bench").expect("scene");
         let (model, effects) = (&scene.model, &scene.effects);
@@ -530,7 +530,7 @@ mod tests {
 
     /// A device of the first adapter with its compute limits changed by `limit`.
     fn limited_device(limit: impl FnOnce(&mut wgpu::Limits)) -> (wgpu::Device, wgpu::Queue) {
-        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let gpu = HeadlessDevice::open(AdapterPreference::Software).expect("an adapter");
         let mut limits = crate::device::compute_limits(&gpu.adapter);
         limit(&mut limits);
         pollster::block_on(gpu.adapter.request_device(&wgpu::DeviceDescriptor {
@@ -610,7 +610,7 @@ mod tests {
     /// keeps the last state the caller had; every later frame says the same.
     #[test]
     fn a_lost_device_stops_the_run_and_keeps_the_last_state() {
-        let gpu = HeadlessDevice::open(AdapterPreference::Any).expect("an adapter");
+        let gpu = HeadlessDevice::open(AdapterPreference::Software).expect("an adapter");
         let scene = guarded_bench();
         let model = &scene.model;
         let mut stepper = stepper_on(&gpu, &scene);

@@ -30,7 +30,7 @@ mod support;
 mod vbd;
 mod xpbd;
 
-pub use backend::{Backend, gpu_simulation};
+pub use backend::{Backend, gpu_simulation, gpu_simulation_on};
 pub use error::GpuError;
 pub use stepper::GpuStepper;
 pub use support::{GPU_INTEGRATOR, GPU_INTEGRATORS, gpu_support};

@@ -1,5 +1,16 @@
 //! What the test files share (the GPU's, and the contact tests).
 
+/// [`clothsim::gpu::gpu_simulation`] on the software adapter (Mesa's llvmpipe through GL
+/// where there is one), as the golden images: the tests' bounds are its rounding.
+#[allow(dead_code)] // Not every test file steps on the GPU.
+pub fn gpu_simulation(
+    scene: clothsim::scene::Scene,
+    read_every_frame: bool,
+) -> Result<(clothsim::scene::Simulation, String), clothsim::gpu::GpuError> {
+    let software = clothsim::device::AdapterPreference::Software;
+    clothsim::gpu::gpu_simulation_on(scene, read_every_frame, software)
+}
+
 /// The largest distance between the same particle in `a` and `b`, metres.
 pub fn farthest(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
     (a.iter().zip(b))
@@ -13,7 +24,7 @@ pub fn farthest(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
 #[allow(dead_code)] // Not every GPU test file pushes.
 pub fn apart_after_a_push(scene: clothsim::scene::Scene, frames: usize) -> f32 {
     let mut cpu = clothsim::scene::Simulation::new(scene.clone());
-    let (mut gpu, _) = clothsim::gpu::gpu_simulation(scene, true).expect("GPU backend");
+    let (mut gpu, _) = gpu_simulation(scene, true).expect("GPU backend");
     for sim in [&mut cpu, &mut gpu] {
         for _ in 0..frames {
             sim.step_frame().expect("frame");
