@@ -48,8 +48,8 @@ struct SelfParams {
 // Each triangle's corners, and which of its corners (bits 0–2) and edges (bits 3–5, edge
 // k from corner k to the next) it owns.
 @group(0) @binding(3) var<storage, read> triangles: array<vec4<u32>>;
-// Each particle's box (lo, hi), then each triangle's (lo, hi; lo.w 1 where it is checked
-// against every triangle).
+// Each particle's box (lo, hi; lo.w 1 where it is held, see `held`), then each triangle's
+// (lo, hi; lo.w 1 where it is checked against every triangle).
 @group(0) @binding(4) var<storage, read_write> boxes: array<vec4<f32>>;
 // Counters (see below), then each bucket's first entry, then each particle's cut (the
 // bits of its share of the motion).
@@ -169,17 +169,19 @@ fn particle_boxes_one(i: u32) {
     let a = start[i].x.xyz;
     let b = state[i].x.xyz;
     let g = vec3<f32>(0.5 * sp.lengths.x);
-    boxes[2u * i] = vec4<f32>(min(a, b) - g, 0.0);
+    let word = pushes_at() + PUSH_WORDS * i + HELD;
+    let moved = atomicLoad(&atomics[word]) & MOVED;
+    let now_held = moved | select(0u, 1u, on_solid(b));
+    boxes[2u * i] = vec4<f32>(min(a, b) - g, select(0.0, 1.0, now_held != 0u));
     boxes[2u * i + 1u] = vec4<f32>(max(a, b) + g, 0.0);
     lists[scales_at() + i] = bitcast<u32>(1.0);
     atomicStore(&atomics[cuts_at() + i], bitcast<u32>(1.0));
     for (var k = 0u; k < HELD; k++) {
         atomicStore(&atomics[pushes_at() + PUSH_WORDS * i + k], 0u);
     }
-    // Held: on a sphere or plane, or moved by a solid this substep (`MOVED`).
-    let word = pushes_at() + PUSH_WORDS * i + HELD;
-    let moved = atomicLoad(&atomics[word]) & MOVED;
-    atomicStore(&atomics[word], moved | select(0u, 1u, on_solid(b)));
+    // Held: on a sphere or plane, or moved by a solid this substep (`MOVED`); the box
+    // keeps a copy (`held`).
+    atomicStore(&atomics[word], now_held);
     atomicStore(&atomics[pushes_at() + PUSH_WORDS * i + LONGEST], 0u);
     atomicStore(&atomics[owner_at(i)], 0u);
 }
@@ -215,8 +217,13 @@ fn on_solid(x: vec3<f32>) -> bool {
     return false;
 }
 
+// Whether particle `i` is held (its held word not 0), as the search copied the word into
+// its box: the word changes only before a search (`obstacles_moved`, `faces_lift`), in it
+// and after the cuts (`finish`), so the copy is the word wherever the pushes and cuts read
+// it; read so, not by an atomic load, which some backends make a read-modify-write (GL's
+// `atomicOr(x, 0)`), and every pair's push reads four of them.
 fn held(i: u32) -> bool {
-    return atomicLoad(&atomics[pushes_at() + PUSH_WORDS * i + HELD]) != 0u;
+    return boxes[2u * i].w != 0.0;
 }
 
 // The colliders act again on the substep's end, as pushed (a stack pressed its lowest
@@ -307,9 +314,20 @@ struct Pair {
     ids: vec4<u32>,
 }
 
-// The pairs kept this substep (those that had room).
-fn pairs_kept() -> u32 {
+// The pairs the search kept (those that had room), counted as it adds them.
+fn pairs_found() -> u32 {
     return min(atomicLoad(&atomics[PAIRS]), sp.more.x);
+}
+
+// Where the search's count of pairs kept is written once it is done.
+fn kept_at() -> u32 {
+    return triangle_pairs_at() + 2u * sp.more.x;
+}
+
+// The pairs kept this substep, as the search's end wrote them: a plain read (see `held`),
+// as every pair's invocation makes.
+fn pairs_kept() -> u32 {
+    return lists[kept_at()];
 }
 
 // Pair `p` (stored with EDGES set in its first particle for an edge–edge pair).
@@ -489,7 +507,9 @@ fn record_room_asked() {
 @compute @workgroup_size(1)
 fn size_pairs() {
     record_room_asked();
-    pair_groups[0] = (pairs_kept() + WIDTH - 1u) / WIDTH;
+    let kept = pairs_found();
+    lists[kept_at()] = kept;
+    pair_groups[0] = (kept + WIDTH - 1u) / WIDTH;
     pair_groups[1] = 1u;
     pair_groups[2] = 1u;
 }

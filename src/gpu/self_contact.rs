@@ -83,6 +83,14 @@ const TRIANGLE_PAIR_GROUPS: u64 = 16;
 const ENTRIES_PER_TRIANGLE: u32 = 16;
 const PAIRS_PER_TRIANGLE: u32 = 16;
 
+/// The least room for pairs to start with, whatever the cloth's size (1 MiB of lists): a
+/// submission that runs out is stepped again with more, and a small cloth that lands in
+/// layers asks for many more pairs than its triangles. `layers` at 6 quads (360 triangles,
+/// room for 5 760 pairs) asked for 9 800 pressed on a table, and each frame in which the
+/// count outgrew the room was stepped twice: a third of the landing's time on the software
+/// adapter.
+const LEAST_PAIRS: u32 = 1 << 15;
+
 /// The shader's entry points (`ENTRY_POINTS` names them in this order).
 #[derive(Clone, Copy)]
 enum Kernel {
@@ -229,7 +237,7 @@ impl SelfPass {
                 (2 * n).next_power_of_two().max(64),
                 ENTRIES_PER_TRIANGLE * n,
             ],
-            more: [PAIRS_PER_TRIANGLE * n, 0, 0, ROUNDS],
+            more: [(PAIRS_PER_TRIANGLE * n).max(LEAST_PAIRS), 0, 0, ROUNDS],
             lengths: [
                 own.thickness,
                 0.1 * own.thickness,
@@ -339,8 +347,8 @@ impl SelfPass {
         // Per particle: its cut, its pushes' words and its owner in a push round.
         let atomic_words = u64::from(COUNTERS) + buckets + (2 + PUSH_WORDS) * count;
         // Per pair: its particles, whether it was pushed this sweep, its key this round;
-        // and as much room for pairs of triangles (two words each).
-        let list_words = 5 * entries + triangles + 8 * pairs + count;
+        // as much room for pairs of triangles (two words each); and the pairs kept.
+        let list_words = 5 * entries + triangles + 8 * pairs + count + 1;
         let need = [
             (4 * atomic_words, "self-contact buckets"),
             (4 * list_words, "self-contact pairs"),
