@@ -13,7 +13,8 @@ use crate::sim::{IntegratorKind, Precision};
 /// The bench scene's name.
 pub const BENCH_SCENE: &str = "hanging-bench";
 
-/// Simulated seconds of every bench run (the sag is read at its end).
+/// Simulated seconds of a bench run unless told otherwise (the sag is read at its end, and
+/// [`REFERENCE_SAG`] is for this time).
 pub const BENCH_SECONDS: f64 = 2.0;
 
 /// Sag after 2 s of the reference solution (semi-implicit Euler at `dt = 1/(60 N)`, from
@@ -109,6 +110,8 @@ pub struct BenchRow {
 pub enum BenchError {
     #[error("the bench cloth needs at least 3 × 3 particles, got {0}")]
     TooSmall(u32),
+    #[error("a bench run lasts from two frames (1/30 s) to an hour, got {0} s")]
+    Seconds(f64),
     #[error(transparent)]
     Scene(#[from] SceneError),
     /// No device, or a scene the GPU backend cannot run.
@@ -160,32 +163,34 @@ fn central(sim: &Simulation) -> Vec<usize> {
 /// # Errors
 /// [`BenchError`] for a bad `n`.
 pub fn bench_one(n: u32, integrator: IntegratorKind) -> Result<BenchRow, BenchError> {
-    bench_in(n, integrator, Precision::F32)
+    bench_in(n, integrator, Precision::F32, BENCH_SECONDS)
 }
 
-/// As [`bench_one`], computing in `precision`.
+/// As [`bench_one`], computing in `precision`, for `seconds` of simulated time (the sag is
+/// held against its reference only at [`BENCH_SECONDS`], the time the reference is for).
 ///
 /// # Errors
-/// [`BenchError`] for a bad `n`.
+/// [`BenchError`] for a bad `n` or `seconds`.
 pub fn bench_in(
     n: u32,
     integrator: IntegratorKind,
     precision: Precision,
+    seconds: f64,
 ) -> Result<BenchRow, BenchError> {
-    bench_with(n, integrator, |mut scene| {
+    bench_for(n, integrator, seconds, |mut scene| {
         scene.params.solver.precision = precision;
         Ok(Simulation::new(scene))
     })
 }
 
-/// As [`bench_one`] on the GPU backend, on a headless device of its own
+/// As [`bench_in`] on the GPU backend, on a headless device of its own
 /// ([`crate::gpu::gpu_simulation`]; its state read back at the end only).
 ///
 /// # Errors
-/// [`BenchError`] for a bad `n`; [`BenchError::Gpu`] with the reason when there is no
-/// device or the GPU backend cannot run the scene.
-pub fn bench_gpu(n: u32, integrator: IntegratorKind) -> Result<BenchRow, BenchError> {
-    bench_with(n, integrator, |scene| {
+/// [`BenchError`] for a bad `n` or `seconds`; [`BenchError::Gpu`] with the reason when
+/// there is no device or the GPU backend cannot run the scene.
+pub fn bench_gpu(n: u32, integrator: IntegratorKind, seconds: f64) -> Result<BenchRow, BenchError> {
+    bench_for(n, integrator, seconds, |scene| {
         Ok(crate::gpu::gpu_simulation(scene, false).map(|(sim, _)| sim)?)
     })
 }
@@ -199,6 +204,34 @@ pub fn bench_with(
     integrator: IntegratorKind,
     make: impl FnOnce(Scene) -> Result<Simulation, BenchError>,
 ) -> Result<BenchRow, BenchError> {
+    bench_for(n, integrator, BENCH_SECONDS, make)
+}
+
+/// Frames of a bench run `seconds` long: at least two (the first is not timed), at most an
+/// hour's (each frame's time is kept).
+///
+/// # Errors
+/// [`BenchError::Seconds`] for a time outside that (or not a number).
+pub fn bench_frames(seconds: f64) -> Result<u64, BenchError> {
+    let frames = (seconds * 60.0).round();
+    if (2.0..=60.0 * 3600.0).contains(&frames) {
+        Ok(frames as u64)
+    } else {
+        Err(BenchError::Seconds(seconds))
+    }
+}
+
+/// As [`bench_with`], for `seconds` of simulated time (see [`bench_in`]).
+///
+/// # Errors
+/// [`BenchError`] for a bad `n` or `seconds`, or what `make` returns.
+pub fn bench_for(
+    n: u32,
+    integrator: IntegratorKind,
+    seconds: f64,
+    make: impl FnOnce(Scene) -> Result<Simulation, BenchError>,
+) -> Result<BenchRow, BenchError> {
+    let frames = bench_frames(seconds)?;
     let start = Instant::now();
     let mut sim = make(bench_scene(n, integrator)?)?;
     let mut finite = sim.substep().is_ok();
@@ -210,7 +243,6 @@ pub fn bench_with(
         .sum::<f64>()
         / 4.0;
     let substeps = sim.params().step.substeps;
-    let frames = (BENCH_SECONDS * 60.0).round() as u64;
     let total = frames * substeps as u64;
     let timer = Instant::now();
     // The first substep is done: the rest of the first frame, then whole frames (one
@@ -241,7 +273,9 @@ pub fn bench_with(
         .sum::<f64>()
         / 4.0;
     let sag = y0 - y;
-    let reference = REFERENCE_SAG.iter().find(|(m, _)| *m == n).map(|(_, s)| *s);
+    let reference = (REFERENCE_SAG.iter())
+        .find(|(m, _)| *m == n && seconds == BENCH_SECONDS)
+        .map(|(_, s)| *s);
     let error = reference.map(|r| (sag - r).abs() / r);
     let us = wall * 1e6 / (total - 1).max(1) as f64;
     let spread = frame_spread(&mut frame_us).filter(|_| frames_finished);

@@ -3,9 +3,10 @@
 
 use std::process::Command;
 
-use clothsim::bench::{FrameSpread, REFERENCE_SAG, bench_one, bench_scene, frame_spread};
+use clothsim::bench::{FrameSpread, REFERENCE_SAG, bench_in, bench_one, bench_scene, frame_spread};
 use clothsim::mesh::SpringKind;
-use clothsim::sim::IntegratorKind;
+use clothsim::scene::Simulation;
+use clothsim::sim::{IntegratorKind, Precision};
 
 #[test]
 fn bench_scene_has_the_peers_particles_springs_masses_and_pins() {
@@ -296,4 +297,37 @@ fn bench_cli_refuses_bad_thread_counts_and_gpu_integrators_in_one_line() {
     );
     let err = run(&["bench", "--sizes", "8", "--backend", "tpu"]);
     assert!(err.contains("--backend"), "{err}");
+    for seconds in ["0.01", "NaN", "-1", "1e9"] {
+        let err = run(&["bench", "--sizes", "8", "--seconds", seconds]);
+        assert!(
+            err.contains("--seconds") && err.contains("two frames (1/30 s) to an hour"),
+            "{seconds}: {err}"
+        );
+    }
+}
+
+/// A run of `seconds` lasts that long: the sag it reports is the cloth's after that many
+/// frames, stepped plainly; it is held against the reference only at the reference's 2 s.
+#[test]
+fn a_bench_run_lasts_the_seconds_asked_for() {
+    let (n, kind) = (32, IntegratorKind::SemiImplicitEuler);
+    let row = bench_in(n, kind, Precision::F32, 0.5).expect("runs");
+    let mut sim = Simulation::new(bench_scene(n, kind).expect("builds"));
+    let rest = sim.model().rest_positions.clone();
+    let (lo, hi) = clothsim::mesh::bounds(&rest);
+    let mid = 0.5 * (lo + hi);
+    let mut central: Vec<usize> = (0..rest.len()).collect();
+    central.sort_by(|&a, &b| rest[a].distance(mid).total_cmp(&rest[b].distance(mid)));
+    central.truncate(4);
+    let height =
+        |pos: &[glam::Vec3]| central.iter().map(|&p| f64::from(pos[p].y)).sum::<f64>() / 4.0;
+    let start = height(&sim.state().pos);
+    for _ in 0..30 {
+        sim.step_frame().expect("a frame");
+    }
+    let sag = start - height(&sim.state().pos);
+    assert_eq!(row.sag_m, sag, "the sag after 30 frames");
+    assert_eq!((row.reference_sag_m, row.sag_ok), (None, None));
+    let full = bench_one(n, kind).expect("runs");
+    assert!(full.reference_sag_m.is_some() && full.sag_m != row.sag_m);
 }

@@ -1,6 +1,7 @@
 //! The GPU backend (wgpu compute, run here on the software adapter) against the CPU solver:
 //! the same scene after the same simulated time.
 
+use clothsim::bench::BENCH_SECONDS;
 use clothsim::device::{AdapterPreference, HeadlessDevice};
 use clothsim::gpu::{Backend, gpu_support};
 use clothsim::scene::{Scene, Simulation};
@@ -281,7 +282,7 @@ fn gpu_bench_row_has_the_run_mean_but_no_frame_spread() {
         .build()
         .expect("a pool of 3");
     let (gpu, cpu) = pool.install(|| {
-        let gpu = clothsim::bench::bench_gpu(16, IntegratorKind::SemiImplicitEuler)
+        let gpu = clothsim::bench::bench_gpu(16, IntegratorKind::SemiImplicitEuler, BENCH_SECONDS)
             .expect("GPU bench on the software adapter");
         let cpu = clothsim::bench::bench_one(16, IntegratorKind::SemiImplicitEuler).expect("cpu");
         (gpu, cpu)
@@ -300,11 +301,20 @@ fn gpu_bench_row_has_the_run_mean_but_no_frame_spread() {
 }
 
 /// Without `--integrators`, `bench --backend gpu` has a row for every integrator the GPU
-/// runs.
+/// runs (each a quarter second: two seconds took 0.6 s on the software adapter).
 #[test]
 fn gpu_bench_cli_defaults_to_the_integrators_it_runs() {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_clothsim"))
-        .args(["bench", "--backend", "gpu", "--sizes", "8", "--json"])
+        .args([
+            "bench",
+            "--backend",
+            "gpu",
+            "--sizes",
+            "8",
+            "--seconds",
+            "0.25",
+        ])
+        .arg("--json")
         .output()
         .expect("runs");
     let stderr = String::from_utf8_lossy(&out.stderr);

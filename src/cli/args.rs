@@ -152,14 +152,18 @@ pub enum Command {
         /// What the CPU computes in: f32 or f64 (the GPU refuses f64).
         #[arg(long, default_value_t = Precision::F32)]
         precision: Precision,
+        /// Simulated seconds of each row (the sag is held against its reference only at
+        /// 2, the time the reference is for).
+        #[arg(long, default_value_t = clothsim::bench::BENCH_SECONDS, allow_negative_numbers = true)]
+        seconds: f64,
         /// Instead: a 64 × 64 cloth resting on a mesh sphere of about 1 000 and 100 000
         /// triangles, the obstacle phase against the springs' (per --threads).
-        #[arg(long, conflicts_with_all = ["sizes", "integrators", "backend"])]
+        #[arg(long, conflicts_with_all = ["sizes", "integrators", "backend", "seconds"])]
         obstacles: bool,
         /// Instead: the `crumple` scene's first simulated second at --quads (its own
         /// integrator, or each of --integrators), the contact phases per substep
         /// against the springs' and the pairs per particle (per --threads).
-        #[arg(long, conflicts_with_all = ["sizes", "backend", "obstacles"])]
+        #[arg(long, conflicts_with_all = ["sizes", "backend", "obstacles", "seconds"])]
         crumple: bool,
         /// Comma-separated grid sizes (quads a side) for --crumple.
         #[arg(

@@ -5,18 +5,31 @@ use anyhow::{Context, Result, bail};
 use clothsim::gpu::{Backend, GPU_INTEGRATORS};
 use clothsim::sim::{IntegratorKind, Precision};
 
-/// Runs and prints one row per thread count × size × integrator (JSON with `json`).
+/// The bench's rows: each thread count × size × integrator, for `seconds` of simulated time.
+pub struct BenchRuns<'a> {
+    pub sizes: &'a [u32],
+    pub integrators: &'a [IntegratorKind],
+    pub threads: &'a [usize],
+    pub seconds: f64,
+}
+
+/// Runs and prints `runs`' rows (JSON with `json`).
 pub fn bench(
-    sizes: &[u32],
-    integrators: &[IntegratorKind],
-    threads: &[usize],
+    runs: &BenchRuns<'_>,
     json: bool,
     backend: Backend,
     precision: Precision,
 ) -> Result<()> {
+    let BenchRuns {
+        sizes,
+        integrators,
+        threads,
+        seconds,
+    } = *runs;
     if let Some(&n) = sizes.iter().find(|&&n| !(3..=2048).contains(&n)) {
         bail!("--sizes: {n} particles per side is outside 3..=2048");
     }
+    clothsim::bench::bench_frames(seconds).context("--seconds")?;
     check_threads(threads)?;
     if backend == Backend::Gpu && precision != Precision::F32 {
         bail!("--backend gpu computes in f32 only, not {precision}");
@@ -57,12 +70,14 @@ pub fn bench(
         for &n in sizes {
             for &k in integrators {
                 let row = match backend {
-                    Backend::Cpu => pool.install(|| clothsim::bench::bench_in(n, k, precision))?,
+                    Backend::Cpu => {
+                        pool.install(|| clothsim::bench::bench_in(n, k, precision, seconds))?
+                    }
                     // On this thread, not the pool's: a GL device (llvmpipe through EGL) is
                     // current on the thread that made it, and a pool's thread still tearing
                     // that down while the process exits corrupts the heap (a crash at exit
                     // in a few runs in a hundred).
-                    Backend::Gpu => clothsim::bench::bench_gpu(n, k)?,
+                    Backend::Gpu => clothsim::bench::bench_gpu(n, k, seconds)?,
                 };
                 if json {
                     println!("{}", serde_json::to_string(&row)?);
@@ -79,6 +94,9 @@ pub fn bench(
                                     " (too far: the speed does not count)"
                                 }
                             )
+                        }
+                        _ if seconds != clothsim::bench::BENCH_SECONDS => {
+                            "no reference at this time (2 s)".to_string()
                         }
                         _ => "no reference".to_string(),
                     };

@@ -6,7 +6,7 @@ use clothsim::gpu::{Backend, GPU_INTEGRATORS};
 
 use super::accuracy::accuracy;
 use super::args::{Cli, Command};
-use super::bench::{bench, contact_bench, crumple_bench};
+use super::bench::{BenchRuns, bench, contact_bench, crumple_bench};
 use super::grid::grid;
 use super::info::info;
 use super::render::{Output, render};
@@ -122,6 +122,7 @@ pub fn run(cli: Cli) -> Result<()> {
             json,
             backend,
             precision,
+            seconds,
             obstacles: false,
             crumple: false,
             ..
@@ -130,7 +131,13 @@ pub fn run(cli: Cli) -> Result<()> {
                 Backend::Cpu => clothsim::bench::BENCH_INTEGRATORS.to_vec(),
                 Backend::Gpu => GPU_INTEGRATORS.to_vec(),
             });
-            bench(&sizes, &integrators, &threads, json, backend, precision)
+            let runs = BenchRuns {
+                sizes: &sizes,
+                integrators: &integrators,
+                threads: &threads,
+                seconds,
+            };
+            bench(&runs, json, backend, precision)
         }
     }
 }
