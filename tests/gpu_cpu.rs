@@ -82,9 +82,11 @@ fn gpu_xpbd_swings_the_hanging_cloth_as_the_cpu_does() {
     solver_agrees(IntegratorKind::Xpbd, "hanging", 1, 30, 1e-5);
 }
 
+/// At two sweeps for 20 frames (0.57 m swung; 2.6 µm apart, and 17 µm with the seam's
+/// colours projected before the halves').
 #[test]
 fn gpu_xpbd_swings_the_hanging_cloth_as_the_cpu_does_at_two_sweeps() {
-    solver_agrees(IntegratorKind::Xpbd, "hanging", 2, 30, 1e-5);
+    solver_agrees(IntegratorKind::Xpbd, "hanging", 2, 20, 1e-5);
 }
 
 #[test]
