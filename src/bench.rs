@@ -29,6 +29,14 @@ pub const REFERENCE_SAG: [(u32, f64); 6] = [
     (700, 0.015759),
 ];
 
+/// The reference sag of the bench cloth at `n` particles a side after `seconds`: only at
+/// [`BENCH_SECONDS`], the time [`REFERENCE_SAG`] is for, and only at its sizes.
+pub fn reference_sag(n: u32, seconds: f64) -> Option<f64> {
+    (REFERENCE_SAG.iter())
+        .find(|(m, _)| *m == n && seconds == BENCH_SECONDS)
+        .map(|(_, s)| *s)
+}
+
 /// How close the sag must be for a speed to count: 1 %, 5 % for implicit Euler, XPBD and VBD
 /// (which trade accuracy for their large steps).
 pub fn sag_tolerance(integrator: IntegratorKind) -> f64 {
@@ -146,8 +154,8 @@ pub fn bench_scene(n: u32, integrator: IntegratorKind) -> Result<Scene, BenchErr
     Ok(Scene::from_file(file, None)?)
 }
 
-/// The 4 particles nearest the middle of the cloth's rest shape.
-fn central(sim: &Simulation) -> Vec<usize> {
+/// The 4 particles nearest the middle of the cloth's rest shape: the sag is theirs.
+pub fn central(sim: &Simulation) -> Vec<usize> {
     let rest = &sim.model().rest_positions;
     let (lo, hi) = crate::mesh::bounds(rest);
     let mid = 0.5 * (lo + hi);
@@ -273,9 +281,7 @@ pub fn bench_for(
         .sum::<f64>()
         / 4.0;
     let sag = y0 - y;
-    let reference = (REFERENCE_SAG.iter())
-        .find(|(m, _)| *m == n && seconds == BENCH_SECONDS)
-        .map(|(_, s)| *s);
+    let reference = reference_sag(n, seconds);
     let error = reference.map(|r| (sag - r).abs() / r);
     let us = wall * 1e6 / (total - 1).max(1) as f64;
     let spread = frame_spread(&mut frame_us).filter(|_| frames_finished);

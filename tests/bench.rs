@@ -3,7 +3,9 @@
 
 use std::process::Command;
 
-use clothsim::bench::{FrameSpread, REFERENCE_SAG, bench_in, bench_one, bench_scene, frame_spread};
+use clothsim::bench::{
+    FrameSpread, REFERENCE_SAG, bench_in, bench_one, bench_scene, central, frame_spread,
+};
 use clothsim::mesh::SpringKind;
 use clothsim::scene::Simulation;
 use clothsim::sim::{IntegratorKind, Precision};
@@ -313,12 +315,7 @@ fn a_bench_run_lasts_the_seconds_asked_for() {
     let (n, kind) = (32, IntegratorKind::SemiImplicitEuler);
     let row = bench_in(n, kind, Precision::F32, 0.5).expect("runs");
     let mut sim = Simulation::new(bench_scene(n, kind).expect("builds"));
-    let rest = sim.model().rest_positions.clone();
-    let (lo, hi) = clothsim::mesh::bounds(&rest);
-    let mid = 0.5 * (lo + hi);
-    let mut central: Vec<usize> = (0..rest.len()).collect();
-    central.sort_by(|&a, &b| rest[a].distance(mid).total_cmp(&rest[b].distance(mid)));
-    central.truncate(4);
+    let central = central(&sim);
     let height =
         |pos: &[glam::Vec3]| central.iter().map(|&p| f64::from(pos[p].y)).sum::<f64>() / 4.0;
     let start = height(&sim.state().pos);
@@ -330,4 +327,38 @@ fn a_bench_run_lasts_the_seconds_asked_for() {
     assert_eq!((row.reference_sag_m, row.sag_ok), (None, None));
     let full = bench_one(n, kind).expect("runs");
     assert!(full.reference_sag_m.is_some() && full.sag_m != row.sag_m);
+}
+
+/// The table says why a row has no reference: at another time than the reference's 2 s
+/// for a size that has one, and plainly for a size that has none.
+#[test]
+fn the_bench_table_says_why_a_row_has_no_reference() {
+    let out = Command::new(env!("CARGO_BIN_EXE_clothsim"))
+        .args([
+            "bench",
+            "--sizes",
+            "8,32",
+            "--integrators",
+            "semi-implicit-euler",
+        ])
+        .args(["--threads", "1", "--seconds", "0.5"])
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let row = |n: &str| {
+        (text.lines())
+            .find(|l| l.split_whitespace().next() == Some(n))
+            .unwrap_or_else(|| panic!("no row for {n} in {text}"))
+            .to_string()
+    };
+    assert!(
+        row("32").ends_with("no reference at this time (2 s)"),
+        "{text}"
+    );
+    assert!(row("8").ends_with("  no reference"), "{text}");
 }

@@ -305,16 +305,8 @@ fn gpu_bench_row_has_the_run_mean_but_no_frame_spread() {
 #[test]
 fn gpu_bench_cli_defaults_to_the_integrators_it_runs() {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_clothsim"))
-        .args([
-            "bench",
-            "--backend",
-            "gpu",
-            "--sizes",
-            "8",
-            "--seconds",
-            "0.25",
-        ])
-        .arg("--json")
+        .args(["bench", "--backend", "gpu", "--sizes", "8"])
+        .args(["--seconds", "0.25", "--json"])
         .output()
         .expect("runs");
     let stderr = String::from_utf8_lossy(&out.stderr);

@@ -2,6 +2,7 @@
 
 use anyhow::{Context, Result, bail};
 
+use clothsim::bench::{BENCH_SECONDS, reference_sag};
 use clothsim::gpu::{Backend, GPU_INTEGRATORS};
 use clothsim::sim::{IntegratorKind, Precision};
 
@@ -95,7 +96,7 @@ pub fn bench(
                                 }
                             )
                         }
-                        _ if seconds != clothsim::bench::BENCH_SECONDS => {
+                        _ if reference_sag(n, BENCH_SECONDS).is_some() => {
                             "no reference at this time (2 s)".to_string()
                         }
                         _ => "no reference".to_string(),
