@@ -319,13 +319,18 @@ fn pairs_found() -> u32 {
     return min(atomicLoad(&atomics[PAIRS]), sp.more.x);
 }
 
-// Where the search's count of pairs kept is written once it is done.
-fn kept_at() -> u32 {
+// Where a search's counts are written once the step that counts them is done, for the
+// kernels after to read plainly (see `held`: every invocation of theirs reads one): its
+// pairs of triangles, then its pairs.
+fn triangle_pairs_kept_at() -> u32 {
     return triangle_pairs_at() + 2u * sp.more.x;
 }
 
-// The pairs kept this substep, as the search's end wrote them: a plain read (see `held`),
-// as every pair's invocation makes.
+fn kept_at() -> u32 {
+    return triangle_pairs_kept_at() + 1u;
+}
+
+// The pairs kept this substep, as the search's end wrote them.
 fn pairs_kept() -> u32 {
     return lists[kept_at()];
 }
@@ -405,9 +410,14 @@ fn keep_triangles(a: u32, b: u32) {
     }
 }
 
-// The pairs of triangles kept this substep (those that had room).
-fn triangle_pairs_kept() -> u32 {
+// The pairs of triangles the search kept (those that had room), counted as it adds them.
+fn triangle_pairs_found() -> u32 {
     return min(atomicLoad(&atomics[TRIANGLE_PAIRS]), sp.more.x);
+}
+
+// The pairs of triangles kept this substep, as `size_triangle_pairs` wrote them.
+fn triangle_pairs_kept() -> u32 {
+    return lists[triangle_pairs_kept_at()];
 }
 
 // Each triangle keeps every triangle whose box meets its own: from the grid, each two
@@ -471,15 +481,15 @@ fn find(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // The pairs of the `q`th pair of triangles kept.
 fn pairs_of_one(q: u32) {
-    if (q < triangle_pairs_kept()) {
-        let at = triangle_pairs_at() + 2u * q;
-        pairs_of(lists[at], lists[at + 1u]);
-    }
+    let at = triangle_pairs_at() + 2u * q;
+    pairs_of(lists[at], lists[at + 1u]);
 }
 
 @compute @workgroup_size(64)
 fn pairs_of_triangles(@builtin(global_invocation_id) id: vec3<u32>) {
-    pairs_of_one(id.x);
+    if (id.x < triangle_pairs_kept()) {
+        pairs_of_one(id.x);
+    }
 }
 
 // Invocations a workgroup has (the host's `WORKGROUP`, every `@workgroup_size` here).
@@ -501,25 +511,35 @@ fn record_room_asked() {
     atomicMax(&atomics[MOST_PAIRS], asked.y);
 }
 
-// The workgroups the pair kernels dispatch: as many as the pairs the search kept need (the
-// room for pairs is far more, and a workgroup past them would do nothing); and what the
-// search asked for, recorded.
-@compute @workgroup_size(1)
-fn size_pairs() {
+// What ends a search: what it asked for recorded, and the count of the pairs it kept
+// written (and returned).
+fn end_search() -> u32 {
     record_room_asked();
     let kept = pairs_found();
     lists[kept_at()] = kept;
-    pair_groups[0] = (kept + WIDTH - 1u) / WIDTH;
-    pair_groups[1] = 1u;
-    pair_groups[2] = 1u;
+    return kept;
 }
 
-// The same for `pairs_of_triangles`, after `find` (the next four words).
+// The indirect dispatch at word `at` of `pair_groups` runs as many workgroups as `count`
+// invocations need (the room is far more, and a workgroup past them would do nothing).
+fn dispatch_for(at: u32, count: u32) {
+    pair_groups[at] = (count + WIDTH - 1u) / WIDTH;
+    pair_groups[at + 1u] = 1u;
+    pair_groups[at + 2u] = 1u;
+}
+
+// The workgroups the pair kernels dispatch, at the search's end.
+@compute @workgroup_size(1)
+fn size_pairs() {
+    dispatch_for(0u, end_search());
+}
+
+// The same for `pairs_of_triangles`, after `find` (the next four words), its count written.
 @compute @workgroup_size(1)
 fn size_triangle_pairs() {
-    pair_groups[4] = (triangle_pairs_kept() + WIDTH - 1u) / WIDTH;
-    pair_groups[5] = 1u;
-    pair_groups[6] = 1u;
+    let kept = triangle_pairs_found();
+    lists[triangle_pairs_kept_at()] = kept;
+    dispatch_for(4u, kept);
 }
 
 // Where particle i is with `share` of its motion over the substep (the one expression both

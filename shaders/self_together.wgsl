@@ -55,14 +55,13 @@ fn search_together(@builtin(local_invocation_index) l: u32) {
         find_one(t);
     }
     storageBarrier();
-    let n = for_team(l, triangle_pairs_kept());
+    let n = for_team(l, triangle_pairs_found());
     for (var q = l; q < n; q += WIDTH) {
         pairs_of_one(q);
     }
     storageBarrier();
     if (l == 0u) {
-        record_room_asked();
-        lists[kept_at()] = pairs_found();
+        _ = end_search();
     }
 }
 

@@ -347,8 +347,8 @@ impl SelfPass {
         // Per particle: its cut, its pushes' words and its owner in a push round.
         let atomic_words = u64::from(COUNTERS) + buckets + (2 + PUSH_WORDS) * count;
         // Per pair: its particles, whether it was pushed this sweep, its key this round;
-        // as much room for pairs of triangles (two words each); and the pairs kept.
-        let list_words = 5 * entries + triangles + 8 * pairs + count + 1;
+        // as much room for pairs of triangles (two words each); and the two counts kept.
+        let list_words = 5 * entries + triangles + 8 * pairs + count + 2;
         let need = [
             (4 * atomic_words, "self-contact buckets"),
             (4 * list_words, "self-contact pairs"),
