@@ -557,7 +557,7 @@ fn a_frame_whose_room_for_pairs_ran_out_is_redone_with_more_on_the_gpu() {
             assert_eq!(outcome, FrameOutcome::Stepped, "frame {frame}");
             states.push((sim.state().pos.clone(), sim.state().vel.clone()));
         });
-        // The CPU's frames before are the same substeps in both runs.
+        // The GPU's substeps: its stats start when it takes over.
         (states, sim.take_stats().steps)
     });
     let lowest = lowest_of(&roomy[1].0);
@@ -568,6 +568,8 @@ fn a_frame_whose_room_for_pairs_ran_out_is_redone_with_more_on_the_gpu() {
             "frame {frame}: the run with too little room differs"
         );
     }
+    // With room enough, each of the two frames is stepped once (8 substeps).
+    assert_eq!(plain, 16, "the roomy run redid a frame");
     assert!(
         redone > plain,
         "frames were redone: {redone} substeps against {plain}"
