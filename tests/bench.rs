@@ -162,9 +162,8 @@ fn bench_rows_name_the_teams_threads_not_a_larger_pools() {
     assert_eq!(threads_in(17), 16);
 }
 
-/// Runs `clothsim` with `args` (a `--json` bench), which must succeed, and reads one JSON
-/// row per line of its output.
-fn json_rows(args: &[&str]) -> Vec<serde_json::Value> {
+/// Runs `clothsim` with `args`, which must succeed; its output.
+fn output_of(args: &[&str]) -> String {
     let out = Command::new(env!("CARGO_BIN_EXE_clothsim"))
         .args(args)
         .output()
@@ -174,8 +173,13 @@ fn json_rows(args: &[&str]) -> Vec<serde_json::Value> {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    String::from_utf8_lossy(&out.stdout)
-        .lines()
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Runs `clothsim` with `args` (a `--json` bench), which must succeed, and reads one JSON
+/// row per line of its output.
+fn json_rows(args: &[&str]) -> Vec<serde_json::Value> {
+    (output_of(args).lines())
         .map(|l| serde_json::from_str(l).expect("one JSON object per line"))
         .collect()
 }
@@ -333,23 +337,17 @@ fn a_bench_run_lasts_the_seconds_asked_for() {
 /// for a size that has one, and plainly for a size that has none.
 #[test]
 fn the_bench_table_says_why_a_row_has_no_reference() {
-    let out = Command::new(env!("CARGO_BIN_EXE_clothsim"))
-        .args([
-            "bench",
-            "--sizes",
-            "8,32",
-            "--integrators",
-            "semi-implicit-euler",
-        ])
-        .args(["--threads", "1", "--seconds", "0.5"])
-        .output()
-        .expect("runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8_lossy(&out.stdout);
+    let text = output_of(&[
+        "bench",
+        "--sizes",
+        "8,32",
+        "--integrators",
+        "semi-implicit-euler",
+        "--threads",
+        "1",
+        "--seconds",
+        "0.5",
+    ]);
     let row = |n: &str| {
         (text.lines())
             .find(|l| l.split_whitespace().next() == Some(n))
