@@ -12,10 +12,12 @@
 //! counted ([`SelfWork::forced`]).
 
 mod ccd;
+mod certify;
 mod error;
 mod found;
 mod hash;
 mod primitives;
+mod rings;
 mod search;
 mod solver;
 

@@ -8,6 +8,7 @@ use rustc_hash::FxHashMap;
 use super::ccd::closing_bound;
 use super::found::Found;
 use super::primitives::{Pair, StoredPair, distance};
+use super::rings::Rings;
 use crate::cloth::ClothModel;
 use crate::mesh::triangles_around;
 
@@ -28,11 +29,17 @@ pub(super) struct Owners {
     pub(super) edges: Vec<[[u32; 2]; 3]>,
     /// Each particle's owning triangle ([`NONE`] for a particle in none).
     pub(super) vertex_owner: Vec<u32>,
-    /// The vertex–triangle and edge–edge pairs of every two triangles that share a corner.
-    /// Their boxes always overlap (both hold the corner's), so every search has them: they
-    /// are tested from this list, and the hash's search passes such triangles by. On a
-    /// grid they are four in five of the overlapping triangles a search meets.
+    /// The vertex–triangle and edge–edge pairs of every two triangles that share a corner,
+    /// by the corner they were taken at (`corner_start`, as rows). Their boxes always
+    /// overlap (both hold the corner's), so every search has them: they are tested from
+    /// this list, and the hash's search passes such triangles by. On a grid they are four
+    /// in five of the overlapping triangles a search meets.
     pub(super) neighbours: Vec<StoredPair>,
+    corner_start: Vec<u32>,
+    /// The corners each piece of a search's neighbours starts at (and the last's end).
+    piece_start: Vec<u32>,
+    /// Each particle's ring, for the certificates ([`super::certify`]).
+    pub(super) rings: Rings,
 }
 
 pub(super) const NONE: u32 = u32::MAX;
@@ -72,8 +79,14 @@ impl Owners {
 
     pub(super) fn build(model: &ClothModel) -> Owners {
         let mut owners = Self::owned(model);
-        owners.neighbours = owners.neighbour_pairs(&model.triangles, model.particle_count());
+        owners.neighbour_pairs(&model.triangles, model.particle_count());
+        owners.rings = Rings::build(model.particle_count(), &model.triangles);
         owners
+    }
+
+    /// The pairs taken at corner `c` (see [`Owners::neighbours`]).
+    pub(super) fn corner_pairs(&self, c: usize) -> &[StoredPair] {
+        &self.neighbours[self.corner_start[c] as usize..self.corner_start[c + 1] as usize]
     }
 
     /// Which vertices and edges each triangle owns, without the neighbours' pairs.
@@ -88,6 +101,9 @@ impl Owners {
             edges: Vec::with_capacity(model.triangles.len()),
             vertex_owner: vec![NONE; model.particle_count()],
             neighbours: Vec::new(),
+            corner_start: Vec::new(),
+            piece_start: Vec::new(),
+            rings: Rings::default(),
         };
         for (n, t) in model.triangles.iter().enumerate() {
             let mut v = [NONE; 3];
@@ -111,26 +127,43 @@ impl Owners {
         owners
     }
 
-    /// The pairs that [`Owners::neighbours`] holds: those of every two triangles sharing a
-    /// corner, each pair of triangles taken once (from the lower-numbered, at the first
-    /// corner they share).
-    fn neighbour_pairs(&self, triangles: &[[u32; 3]], particles: usize) -> Vec<StoredPair> {
+    /// Fills [`Owners::neighbours`]: the pairs of every two triangles sharing a corner, each
+    /// pair of triangles taken once (from the lower-numbered, at the first corner they
+    /// share), by that corner; and the pieces a search cuts them into.
+    fn neighbour_pairs(&mut self, triangles: &[[u32; 3]], particles: usize) {
         let (start, around) = triangles_around(particles, triangles);
-        let mut out = Vec::new();
+        let mut taken = Vec::new();
         for (a, ta) in triangles.iter().enumerate() {
             for (k, &corner) in ta.iter().enumerate() {
-                let corner = corner as usize;
-                let (from, to) = (start[corner] as usize, start[corner + 1] as usize);
-                for &b in &around[from..to] {
+                let (from, to) = (start[corner as usize], start[corner as usize + 1]);
+                for &b in &around[from as usize..to as usize] {
                     let b = b as usize;
                     if b > a && !ta[..k].iter().any(|i| triangles[b].contains(i)) {
-                        self.each_pair(triangles, a, b, |_, stored| out.push(stored));
+                        self.each_pair(triangles, a, b, |_, stored| taken.push((corner, stored)));
                     }
                 }
             }
         }
-        out.shrink_to_fit();
-        out
+        // Stable: a corner's pairs keep the order they were taken in.
+        taken.sort_by_key(|&(corner, _)| corner);
+        self.neighbours = taken.iter().map(|&(_, stored)| stored).collect();
+        self.corner_start = vec![0; particles + 1];
+        for &(corner, _) in &taken {
+            self.corner_start[corner as usize + 1] += 1;
+        }
+        for c in 0..particles {
+            self.corner_start[c + 1] += self.corner_start[c];
+        }
+        self.piece_start = vec![0];
+        for c in 0..particles {
+            let first = self.corner_start[*self.piece_start.last().unwrap_or(&0) as usize];
+            if (self.corner_start[c + 1] - first) as usize >= NEIGHBOURS_PER_PIECE {
+                self.piece_start.push(c as u32 + 1);
+            }
+        }
+        if *self.piece_start.last().unwrap_or(&0) as usize != particles {
+            self.piece_start.push(particles as u32);
+        }
     }
 
     /// Calls `visit` with each vertex–triangle and edge–edge pair that triangles `a` and
@@ -177,7 +210,8 @@ pub fn owned_parts(model: &ClothModel) -> Vec<u32> {
         .collect()
 }
 
-/// Pairs of [`Owners::neighbours`] tested in one piece of a search.
+/// Pairs of [`Owners::neighbours`] tested in one piece of a search (at least: a corner's
+/// pairs are not split).
 pub(super) const NEIGHBOURS_PER_PIECE: usize = 4096;
 
 /// The boxes a search bins and reads.
@@ -203,6 +237,8 @@ pub(super) struct Search<'a> {
     pub(super) triangles: &'a [[u32; 3]],
     pub(super) boxes: &'a Boxes,
     pub(super) thickness: f32,
+    /// Which corners' pairs are tested (see [`super::certify`]); `None`: every corner's.
+    pub(super) open: Option<&'a [bool]>,
 }
 
 impl Search<'_> {
@@ -222,30 +258,35 @@ impl Search<'_> {
     }
 
     /// Adds to `out` the pairs of piece `piece` of [`Owners::neighbours`] that could come
-    /// within the thickness; with `dirty`, only those of a triangle it flags.
+    /// within the thickness; with `dirty`, only those of a triangle it flags. The pairs of
+    /// a corner the certificates closed are passed by.
     pub(super) fn neighbours(
         &self,
         piece: usize,
         dirty: Option<&[bool]>,
         out: &mut Vec<StoredPair>,
     ) {
-        let all = &self.owners.neighbours;
-        let first = piece * NEIGHBOURS_PER_PIECE;
+        let starts = &self.owners.piece_start;
         let owner = &self.owners.vertex_owner;
-        for &stored in &all[first..(first + NEIGHBOURS_PER_PIECE).min(all.len())] {
-            if dirty.is_some_and(|d| !stored.triangles(owner).iter().any(|&t| d[t as usize])) {
+        for c in starts[piece] as usize..starts[piece + 1] as usize {
+            if self.open.is_some_and(|open| !open[c]) {
                 continue;
             }
-            let pair = stored.expand(self.triangles, &self.owners.edges);
-            if self.sides_meet(&pair) {
-                self.keep(pair, stored, out);
+            for &stored in self.owners.corner_pairs(c) {
+                if dirty.is_some_and(|d| !stored.triangles(owner).iter().any(|&t| d[t as usize])) {
+                    continue;
+                }
+                let pair = stored.expand(self.triangles, &self.owners.edges);
+                if self.sides_meet(&pair) {
+                    self.keep(pair, stored, out);
+                }
             }
         }
     }
 
     /// Pieces [`Search::neighbours`] is cut into.
     pub(super) fn neighbour_pieces(&self) -> usize {
-        self.owners.neighbours.len().div_ceil(NEIGHBOURS_PER_PIECE)
+        self.owners.piece_start.len().saturating_sub(1)
     }
 
     /// Whether the boxes of the pair's two sides (each its particles' boxes together)

@@ -8,6 +8,7 @@ use glam::Vec3;
 use crate::cloth::{ClothModel, ClothState};
 
 use super::ccd::safe_fraction;
+use super::certify::Certificates;
 use super::error::ContactError;
 use super::found::Found;
 use super::hash::BoxHash;
@@ -30,6 +31,9 @@ pub struct SelfWork {
     pub refreshes: u64,
     /// Triangles those searched again.
     pub refreshed: u64,
+    /// Corners whose pairs' reference distances were measured again, their certificate
+    /// having failed (see the module's notes).
+    pub retaken: u64,
     /// Pairs whose motion was cut short because their sides could otherwise have met.
     pub impacts: u64,
     /// Pairs that prescribed motion (pins, handles) drove together, so no cut could keep
@@ -110,6 +114,9 @@ pub struct SelfContacts {
     /// The pairs found: for every two triangles whose boxes overlap, their pairs whose
     /// particles' boxes could come within the thickness.
     found: Found,
+    /// Which corners' pairs the cloth's relative motion keeps apart, where the pairs are
+    /// judged by the motion.
+    certificates: Certificates,
     /// Particles whose motion left their boxes, and the triangles they are corners of
     /// (as flags and as a list), for a refresh.
     left: Vec<bool>,
@@ -162,6 +169,7 @@ impl SelfContacts {
         }
         if self.owners.update(model) {
             self.found_for = None;
+            self.certificates.forget();
         }
         // Only the running total outlives a resolve.
         self.work = SelfWork {
@@ -346,11 +354,18 @@ impl SelfContacts {
         }
         let (dirty, owner) = (&self.dirty, &self.owners.vertex_owner);
         (self.found).retain(|p| p.triangles(owner).iter().all(|&t| !dirty[t as usize]));
+        if self.boxes.swept {
+            let motion = [&self.boxes.from[..], &self.boxes.to[..]];
+            let left = Some(&self.left[..]);
+            self.work.retaken +=
+                (self.certificates).decide(&self.owners, &model.triangles, motion, thickness, left);
+        }
         let search = Search {
             owners: &self.owners,
             triangles: &model.triangles,
             boxes: &self.boxes,
             thickness,
+            open: self.boxes.swept.then_some(&self.certificates.open[..]),
         };
         let list = &self.dirty_list;
         let pieces = list.len().div_ceil(REFRESHED_PER_PIECE);
@@ -424,11 +439,17 @@ impl SelfContacts {
         let cell = (2.0 * self.owners.longest).max(2.0 * thickness).max(1e-6);
         self.hash.bin(&self.boxes.lo, &self.boxes.hi, cell)?;
         self.found.clear();
+        if self.boxes.swept {
+            let motion = [&self.boxes.from[..], &self.boxes.to[..]];
+            self.work.retaken +=
+                (self.certificates).decide(&self.owners, &model.triangles, motion, thickness, None);
+        }
         let search = Search {
             owners: &self.owners,
             triangles: &model.triangles,
             boxes: &self.boxes,
             thickness,
+            open: self.boxes.swept.then_some(&self.certificates.open[..]),
         };
         let hash = &self.hash;
         let work = |piece: usize, out: &mut Vec<StoredPair>| {

@@ -81,8 +81,10 @@ fn sorted(pairs: Vec<StoredPair>) -> Vec<StoredPair> {
 
 /// A search finds exactly the pairs that testing every two triangles whose boxes overlap
 /// finds — those of triangles sharing a corner from the owners' list, the others from the
-/// hash — with the cloth still and moving fast; and many of them are of triangles that
-/// share a corner (the crumpled cloth folds its neighbours close).
+/// hash — with the cloth still and moving fast, less, moving fast, the pairs of the
+/// corners the certificates closed (17 856 of the 45 886 pairs of triangles sharing a
+/// corner); and many of them are of triangles that share a corner (the crumpled cloth
+/// folds its neighbours close).
 #[test]
 fn a_search_finds_what_testing_every_two_triangles_finds() {
     let (model, start) = crumpled();
@@ -95,6 +97,7 @@ fn a_search_finds_what_testing_every_two_triangles_finds() {
             triangles,
             boxes: &contacts.boxes,
             thickness: THICKNESS,
+            open: None,
         };
         let (lo, hi) = (&contacts.boxes.lo, &contacts.boxes.hi);
         let mut every = Vec::new();
@@ -109,6 +112,21 @@ fn a_search_finds_what_testing_every_two_triangles_finds() {
                 }
             }
         }
+        // Moving fast, the pairs of the corners the certificates closed are left out.
+        let mut closed = Vec::new();
+        if contacts.boxes.swept {
+            let open = &contacts.certificates.open;
+            for c in (0..start.len()).filter(|&c| !open[c]) {
+                closed.extend_from_slice(contacts.owners.corner_pairs(c));
+            }
+        }
+        let closed = sorted(closed);
+        eprintln!(
+            "closed {} of {}",
+            closed.len(),
+            contacts.owners.neighbours.len()
+        );
+        every.retain(|p| closed.binary_search(&p.canonical()).is_err());
         let every = sorted(every);
         let owner = &contacts.owners.vertex_owner;
         let neighbours = (every.iter())
