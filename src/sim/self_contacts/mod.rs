@@ -2,7 +2,8 @@
 //! it is not a corner of, an edge against an edge it shares no particle with — are found
 //! by a hierarchical spatial hash of the triangles' boxes over the substep's motion
 //! ([`hash`]; which pairs of two overlapping triangles are kept, [`search`]; where they are
-//! kept, [`found`]), pushed a thickness apart at the substep's end with friction, and then
+//! kept, [`found`]; the pairs of triangles sharing a corner, passed by while the corner's
+//! ring keeps its shape, [`certify`]), pushed a thickness apart at the substep's end with friction, and then
 //! checked along the whole motion by conservative continuous collision detection
 //! ([`ccd`]): a pair whose sides could meet has its free particles' motion cut short where
 //! they are still apart, round after round, until no pair can meet (after a few rounds
