@@ -132,28 +132,36 @@ impl Owners {
     /// share), by that corner; and the pieces a search cuts them into.
     fn neighbour_pairs(&mut self, triangles: &[[u32; 3]], particles: usize) {
         let (start, around) = triangles_around(particles, triangles);
-        let mut taken = Vec::new();
-        for (a, ta) in triangles.iter().enumerate() {
-            for (k, &corner) in ta.iter().enumerate() {
-                let (from, to) = (start[corner as usize], start[corner as usize + 1]);
-                for &b in &around[from as usize..to as usize] {
-                    let b = b as usize;
-                    if b > a && !ta[..k].iter().any(|i| triangles[b].contains(i)) {
-                        self.each_pair(triangles, a, b, |_, stored| taken.push((corner, stored)));
+        // Each pair of triangles sharing a corner, with the corner it is taken at.
+        let each = |visit: &mut dyn FnMut(u32, StoredPair)| {
+            for (a, ta) in triangles.iter().enumerate() {
+                for (k, &corner) in ta.iter().enumerate() {
+                    let (from, to) = (start[corner as usize], start[corner as usize + 1]);
+                    for &b in &around[from as usize..to as usize] {
+                        let b = b as usize;
+                        if b > a && !ta[..k].iter().any(|i| triangles[b].contains(i)) {
+                            self.each_pair(triangles, a, b, |_, stored| visit(corner, stored));
+                        }
                     }
                 }
             }
-        }
-        // Stable: a corner's pairs keep the order they were taken in.
-        taken.sort_by_key(|&(corner, _)| corner);
-        self.neighbours = taken.iter().map(|&(_, stored)| stored).collect();
-        self.corner_start = vec![0; particles + 1];
-        for &(corner, _) in &taken {
-            self.corner_start[corner as usize + 1] += 1;
-        }
+        };
+        // Counted, then placed (a corner's in the order they are met): no list of pairs
+        // and their corners beside the result (16 MB at 256²).
+        let mut corner_start = vec![0u32; particles + 1];
+        each(&mut |corner, _| corner_start[corner as usize + 1] += 1);
         for c in 0..particles {
-            self.corner_start[c + 1] += self.corner_start[c];
+            corner_start[c + 1] += corner_start[c];
         }
+        let mut next = corner_start.clone();
+        let mut neighbours =
+            vec![StoredPair::vertex_triangle(0, 0); corner_start[particles] as usize];
+        each(&mut |corner, stored| {
+            let slot = &mut next[corner as usize];
+            neighbours[*slot as usize] = stored;
+            *slot += 1;
+        });
+        (self.neighbours, self.corner_start) = (neighbours, corner_start);
         self.piece_start = vec![0];
         for c in 0..particles {
             let first = self.corner_start[*self.piece_start.last().unwrap_or(&0) as usize];
