@@ -354,6 +354,9 @@ impl SelfContacts {
         }
         let (dirty, owner) = (&self.dirty, &self.owners.vertex_owner);
         (self.found).retain(|p| p.triangles(owner).iter().all(|&t| !dirty[t as usize]));
+        // Only the corners with a triangle searched again are decided again. One that was
+        // closed and is open now still leaves out the pairs of its triangles that stayed:
+        // it held for their motion, which has not changed.
         if self.boxes.swept {
             let motion = [&self.boxes.from[..], &self.boxes.to[..]];
             let left = Some(&self.left[..]);
