@@ -3,7 +3,7 @@
 //! along each axis, so the table holds at most eight entries a triangle however the cloth
 //! is stretched, and two boxes that overlap share a cell at the coarser one's level.
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 use super::error::ContactError;
 
@@ -196,7 +196,7 @@ impl BoxHash {
         if piece < run_pieces {
             let first = piece * RUNS_PER_PIECE;
             let last = (first + RUNS_PER_PIECE).min(self.runs.len());
-            let mut local = [(Vec3::ZERO, Vec3::ZERO, [0; 3], 0, 0); LOCAL];
+            let mut local = [(Vec3A::ZERO, Vec3A::ZERO, [0; 3], 0, 0); LOCAL];
             for r in first..last {
                 let start = self.runs[r] as usize;
                 let end = self
@@ -206,20 +206,18 @@ impl BoxHash {
                 let cell = &self.bins[start..end];
                 let key = entry_key(cell[0]);
                 // The cell's boxes read once into `local` (most cells hold a few dozen),
-                // not once per pair.
+                // not once per pair, as 16-byte vectors whose tests are one instruction
+                // each (with `Vec3`'s 12 bytes, `crumple`'s contact at 64² took 10 % longer).
                 let n = cell.len().min(LOCAL);
-                for (slot, &e) in local.iter_mut().zip(&cell[..n]) {
+                let boxed = |e: u64| {
                     let b = entry_box(e);
-                    *slot = (lo[b], hi[b], self.first[b], self.level[b], b as u32);
-                }
-                let read = |i: usize| {
-                    if i < n {
-                        local[i]
-                    } else {
-                        let b = entry_box(cell[i]);
-                        (lo[b], hi[b], self.first[b], self.level[b], b as u32)
-                    }
+                    let (l, h) = (Vec3A::from(lo[b]), Vec3A::from(hi[b]));
+                    (l, h, self.first[b], self.level[b], b as u32)
                 };
+                for (slot, &e) in local.iter_mut().zip(&cell[..n]) {
+                    *slot = boxed(e);
+                }
+                let read = |i: usize| if i < n { local[i] } else { boxed(cell[i]) };
                 for i in 0..cell.len() {
                     let (alo, ahi, first, level, a) = read(i);
                     for j in i + 1..cell.len() {
