@@ -241,8 +241,28 @@ impl Team {
         pieces: usize,
         work: &(dyn Fn(usize, usize) + Sync),
     ) {
+        self.pieces_if(parallel, pieces, work, Paced::Yes);
+    }
+
+    /// [`Team::run_pieces_if`] for [`Team::run_large_pieces`]' work.
+    pub fn run_large_pieces_if(
+        &self,
+        parallel: bool,
+        pieces: usize,
+        work: &(dyn Fn(usize, usize) + Sync),
+    ) {
+        self.pieces_if(parallel, pieces, work, Paced::No);
+    }
+
+    fn pieces_if(
+        &self,
+        parallel: bool,
+        pieces: usize,
+        work: &(dyn Fn(usize, usize) + Sync),
+        paced: Paced,
+    ) {
         if parallel && self.members() > 1 {
-            self.run_pieces(pieces, work);
+            self.pieces_as(pieces, work, paced);
         } else {
             (0..pieces).for_each(|piece| work(0, piece));
         }

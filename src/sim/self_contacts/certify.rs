@@ -11,14 +11,14 @@
 //! nothing. Along the substep's straight-line motion each ring particle's offset from that
 //! place is linear in time, so its largest is at the substep's start or end: a corner is
 //! certified for the whole substep from those two. Where the certificate fails, the
-//! reference is taken again at the substep's start, and the corner's pairs are tested one
-//! by one only if it fails still.
+//! reference is taken again at the substep's end (where the next one starts), and the
+//! corner's pairs are tested one by one only if it fails still.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{Mat3, Vec3};
 
-use super::primitives::{StoredPair, distance};
+use super::primitives::distance;
 use super::search::Owners;
 use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
 
@@ -86,24 +86,16 @@ impl Certificates {
                 }
                 // SAFETY: each corner is one piece's, and its ring's entries its own.
                 let corner = unsafe { (reference.part(range), apart.at(c), open.at(c)) };
-                let pairs = owners.corner_pairs(c);
-                taken += u64::from(decide_one(
-                    c,
-                    (ring, pairs),
-                    corner,
-                    (owners, triangles),
-                    [from, to],
-                    least,
-                ));
+                let motion = [from, to];
+                taken += u64::from(decide_one(c, corner, (owners, triangles), motion, least));
             }
             retaken.fetch_add(taken, Ordering::Relaxed);
         };
-        let pieces = corners.div_ceil(CORNERS_PER_PIECE);
-        if corners >= PARALLEL_ELEMENTS {
-            Team::current().run_large_pieces(pieces, &work);
-        } else {
-            (0..pieces).for_each(|piece| work(0, piece));
-        }
+        let (parallel, pieces) = (
+            corners >= PARALLEL_ELEMENTS,
+            corners.div_ceil(CORNERS_PER_PIECE),
+        );
+        Team::current().run_large_pieces_if(parallel, pieces, &work);
         retaken.into_inner()
     }
 }
@@ -111,16 +103,19 @@ impl Certificates {
 /// Corners decided in one piece of [`Certificates::decide`].
 const CORNERS_PER_PIECE: usize = 256;
 
-/// Decides corner `c` (its `ring` and its `pairs`), with its reference, least distance and
-/// whether it is open; returns whether the reference was taken again.
+/// Decides corner `c`, with its reference, least distance and whether it is open;
+/// returns whether the reference was taken again.
 fn decide_one(
     c: usize,
-    (ring, pairs): (&[u32], &[StoredPair]),
     (reference, apart, open): (&mut [Vec3], &mut f32, &mut bool),
     (owners, triangles): (&Owners, &[[u32; 3]]),
     [from, to]: [&[Vec3]; 2],
     least: f32,
 ) -> bool {
+    let (ring, pairs) = (
+        &owners.rings.ring[owners.rings.range(c)],
+        owners.corner_pairs(c),
+    );
     if pairs.is_empty() {
         *open = false;
         return false;

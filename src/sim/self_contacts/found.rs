@@ -70,11 +70,7 @@ impl Found {
                 end: out.len() as u32,
             };
         };
-        if parallel {
-            team.run_large_pieces(pieces, &work);
-        } else {
-            (0..pieces).for_each(|piece| work(0, piece));
-        }
+        team.run_large_pieces_if(parallel, pieces, &work);
         self.segments.retain(|s| s.start != s.end);
     }
 
@@ -104,12 +100,8 @@ impl Found {
     /// Calls `visit` with each piece's pairs, shared with the team's helpers when
     /// `parallel` (in no set order then: for work whose result does not depend on it).
     pub(super) fn share(&self, parallel: bool, visit: &(dyn Fn(&[StoredPair]) + Sync)) {
-        let piece = |piece: usize| visit(self.segment(self.segments[piece]));
-        if parallel {
-            Team::current().run_large_pieces(self.segments.len(), &|_, p| piece(p));
-        } else {
-            (0..self.segments.len()).for_each(piece);
-        }
+        let piece = |_: usize, piece: usize| visit(self.segment(self.segments[piece]));
+        Team::current().run_large_pieces_if(parallel, self.segments.len(), &piece);
     }
 
     /// Keeps only the pairs for which `keep` is true, in their order.

@@ -245,8 +245,9 @@ pub(super) struct Search<'a> {
     pub(super) triangles: &'a [[u32; 3]],
     pub(super) boxes: &'a Boxes,
     pub(super) thickness: f32,
-    /// Which corners' pairs are tested (see [`super::certify`]); `None`: every corner's.
-    pub(super) open: Option<&'a [bool]>,
+    /// Which corners' pairs are tested where the pairs are judged by the motion (see
+    /// [`super::certify`]); judged by the boxes alone, every corner's are.
+    pub(super) open: &'a [bool],
 }
 
 impl Search<'_> {
@@ -277,7 +278,7 @@ impl Search<'_> {
         let starts = &self.owners.piece_start;
         let owner = &self.owners.vertex_owner;
         for c in starts[piece] as usize..starts[piece + 1] as usize {
-            if self.open.is_some_and(|open| !open[c]) {
+            if self.boxes.swept && !self.open[c] {
                 continue;
             }
             for &stored in self.owners.corner_pairs(c) {

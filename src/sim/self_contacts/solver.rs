@@ -308,6 +308,19 @@ impl SelfContacts {
         self.find_pairs(model, thickness)
     }
 
+    /// Where the pairs are judged by the motion, decides which corners' pairs the search
+    /// tests ([`Certificates::decide`], for the motion the boxes were made for); after a
+    /// refresh (`refreshed`), only the corners of the triangles searched again.
+    fn decide_corners(&mut self, triangles: &[[u32; 3]], thickness: f32, refreshed: bool) {
+        if self.boxes.swept {
+            let motion = [&self.boxes.from[..], &self.boxes.to[..]];
+            let only = refreshed.then_some(&self.left[..]);
+            let certificates = &mut self.certificates;
+            self.work.retaken +=
+                certificates.decide(&self.owners, triangles, motion, thickness, only);
+        }
+    }
+
     /// The box that holds a particle's motion from `s` to `p`, grown by `grow` each way.
     fn vertex_box(s: Vec3, p: Vec3, grow: f32) -> (Vec3, Vec3) {
         (s.min(p) - Vec3::splat(grow), s.max(p) + Vec3::splat(grow))
@@ -352,23 +365,18 @@ impl SelfContacts {
         if (self.dirty_list.iter()).any(|&a| hash.levels_below(a as usize) > REFRESH_LEVELS) {
             return Ok(false);
         }
-        let (dirty, owner) = (&self.dirty, &self.owners.vertex_owner);
-        (self.found).retain(|p| p.triangles(owner).iter().all(|&t| !dirty[t as usize]));
         // Only the corners with a triangle searched again are decided again. One that was
         // closed and is open now still leaves out the pairs of its triangles that stayed:
         // it held for their motion, which has not changed.
-        if self.boxes.swept {
-            let motion = [&self.boxes.from[..], &self.boxes.to[..]];
-            let left = Some(&self.left[..]);
-            self.work.retaken +=
-                (self.certificates).decide(&self.owners, &model.triangles, motion, thickness, left);
-        }
+        self.decide_corners(&model.triangles, thickness, true);
+        let (hash, dirty, owner) = (&self.hash, &self.dirty, &self.owners.vertex_owner);
+        (self.found).retain(|p| p.triangles(owner).iter().all(|&t| !dirty[t as usize]));
         let search = Search {
             owners: &self.owners,
             triangles: &model.triangles,
             boxes: &self.boxes,
             thickness,
-            open: self.boxes.swept.then_some(&self.certificates.open[..]),
+            open: &self.certificates.open,
         };
         let list = &self.dirty_list;
         let pieces = list.len().div_ceil(REFRESHED_PER_PIECE);
@@ -442,17 +450,13 @@ impl SelfContacts {
         let cell = (2.0 * self.owners.longest).max(2.0 * thickness).max(1e-6);
         self.hash.bin(&self.boxes.lo, &self.boxes.hi, cell)?;
         self.found.clear();
-        if self.boxes.swept {
-            let motion = [&self.boxes.from[..], &self.boxes.to[..]];
-            self.work.retaken +=
-                (self.certificates).decide(&self.owners, &model.triangles, motion, thickness, None);
-        }
+        self.decide_corners(&model.triangles, thickness, false);
         let search = Search {
             owners: &self.owners,
             triangles: &model.triangles,
             boxes: &self.boxes,
             thickness,
-            open: self.boxes.swept.then_some(&self.certificates.open[..]),
+            open: &self.certificates.open,
         };
         let hash = &self.hash;
         let work = |piece: usize, out: &mut Vec<StoredPair>| {

@@ -97,7 +97,7 @@ fn a_search_finds_what_testing_every_two_triangles_finds() {
             triangles,
             boxes: &contacts.boxes,
             thickness: THICKNESS,
-            open: None,
+            open: &contacts.certificates.open,
         };
         let (lo, hi) = (&contacts.boxes.lo, &contacts.boxes.hi);
         let mut every = Vec::new();
