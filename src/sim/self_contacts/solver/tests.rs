@@ -253,26 +253,40 @@ fn the_checks_cut_the_same_bits_on_two_threads_as_on_one() {
 }
 
 /// A solver that served one cloth and is handed another with as many particles and
-/// triangles (the same triangles in reverse order: each pair's stored triangle numbers
-/// now name others) rebuilds what it derived from the triangles and drops its pairs: it
-/// resolves the new cloth to the same bits as a fresh solver.
+/// triangles rebuilds what it derived from the triangles and drops its pairs and its
+/// corners' references. The same triangles in reverse order (each pair's stored triangle
+/// numbers now name others), the cloth still: it resolves the new cloth to the same bits
+/// as a fresh solver. Each triangle's corners turned round (the same rings and frames,
+/// but other owners, so other pairs at each corner), its halves moving apart fast (where
+/// the corners are decided): it takes every corner's reference afresh, as a fresh solver
+/// does (its frame has moved with the first cloth, so the bits may differ).
 #[test]
 fn a_solver_handed_another_cloth_forgets_the_first() {
     let (model, start) = crumpled();
-    let mut other = model.clone();
-    other.triangles.reverse();
-    let step = |solver: &mut SelfContacts, model: &ClothModel| {
-        let mut state = ClothState::at_rest(model);
-        state.pos.clone_from(&start);
-        solver
-            .resolve([THICKNESS, 0.3, 0.01], model, &start, &mut state)
-            .unwrap();
-        state
-    };
-    let mut reused = SelfContacts::default();
-    step(&mut reused, &model);
-    let again = step(&mut reused, &other);
-    let fresh = step(&mut SelfContacts::default(), &other);
-    assert!(fresh.pos != start, "the pushes moved something");
-    assert!(again.pos == fresh.pos && again.vel == fresh.vel);
+    let mut reversed = model.clone();
+    reversed.triangles.reverse();
+    let mut turned = model.clone();
+    turned.triangles.iter_mut().for_each(|t| t.rotate_left(1));
+    for (motion, other) in [(Vec3::ZERO, reversed), (FAST, turned)] {
+        let step = |solver: &mut SelfContacts, model: &ClothModel| {
+            let mut state = ClothState::at_rest(model);
+            // The halves moving apart: in the frame of the mean motion too.
+            let side = |p: Vec3| if p.x < 0.0 { -1.0 } else { 1.0 };
+            state.pos = start.iter().map(|&p| p + side(p) * motion).collect();
+            solver
+                .resolve([THICKNESS, 0.3, 0.01], model, &start, &mut state)
+                .unwrap();
+            (state, solver.work)
+        };
+        let mut reused = SelfContacts::default();
+        step(&mut reused, &model);
+        let (again, again_work) = step(&mut reused, &other);
+        let (fresh, fresh_work) = step(&mut SelfContacts::default(), &other);
+        assert!(fresh.pos != start, "the pushes moved something");
+        if motion == Vec3::ZERO {
+            assert!(again.pos == fresh.pos && again.vel == fresh.vel);
+        }
+        assert_eq!(again_work.retaken, fresh_work.retaken, "{motion}");
+        assert_eq!(fresh_work.retaken > 1000, motion == FAST, "{fresh_work:?}");
+    }
 }
