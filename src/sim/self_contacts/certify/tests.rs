@@ -140,29 +140,11 @@ fn a_cloth_that_only_turns_keeps_its_references() {
 /// first's far edge. The flaps' nearest pairs (the upper flap's far edge and corners
 /// against the lower flap, and the lower's corners against the upper) are 5.75–6 mm apart.
 fn flaps() -> (ClothModel, Owners, Vec<Vec3>) {
-    let (r, h) = (0.02, 0.006);
-    let positions = vec![
-        Vec3::ZERO,
-        Vec3::new(-r, 0.0, -r / 2.0),
-        Vec3::new(-r, 0.0, r / 2.0),
-        Vec3::new(r, h, -r / 2.0),
-        Vec3::new(r, h, r / 2.0),
-        Vec3::new(r, 0.0, -r / 2.0),
-        Vec3::new(r, 0.0, r / 2.0),
-    ];
-    let triangles = vec![[0, 1, 2], [0, 3, 4], [0, 5, 6]];
-    let mut edges: Vec<[u32; 2]> = (triangles.iter())
-        .flat_map(|t| (0..3).map(move |k| [t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])]))
-        .collect();
-    edges.sort_unstable();
-    let mesh = crate::mesh::ClothMesh {
-        uvs: vec![glam::Vec2::ZERO; positions.len()],
-        edge_kinds: vec![crate::mesh::SpringKind::Structural; edges.len()],
-        positions,
-        triangles,
-        edges,
-        ..Default::default()
-    };
+    // r = 2 cm, h = 6 mm.
+    let obj = "v 0 0 0\nv -0.02 0 -0.01\nv -0.02 0 0.01\nv 0.02 0.006 -0.01\n\
+               v 0.02 0.006 0.01\nv 0.02 0 -0.01\nv 0.02 0 0.01\nf 1 2 3\nf 1 4 5\nf 1 6 7\n";
+    let mesh = crate::mesh::obj_from_str(obj, "flaps.obj").unwrap().mesh;
+    assert_eq!(mesh.triangles, [[0, 1, 2], [0, 3, 4], [0, 5, 6]]);
     let model = ClothModel::new(&mesh, 0.2, &[]);
     let owners = Owners::build(&model);
     (model, owners, mesh.positions)
