@@ -69,20 +69,9 @@ pub(super) fn pack_elements(model: &ClothModel, forces: &ForceSet, wind: bool) -
         packed.hinges = model.hinges.len() as u32;
     }
     // A counting sort by particle keeps each particle's slots in slot order.
-    let count = model.particle_count();
-    let mut offsets = vec![0u32; count + 1];
-    for &(p, _) in &touches {
-        offsets[p as usize + 1] += 1;
-    }
-    for p in 0..count {
-        offsets[p + 1] += offsets[p];
-    }
-    let mut slots = vec![0u32; touches.len()];
-    let mut next = offsets.clone();
-    for &(p, slot) in &touches {
-        slots[next[p as usize] as usize] = slot;
-        next[p as usize] += 1;
-    }
+    let (offsets, slots) = crate::mesh::grouped(model.particle_count(), |visit| {
+        touches.iter().for_each(|&(p, slot)| visit(p, slot));
+    });
     packed.incidence = offsets;
     packed.incidence.extend(slots);
     packed

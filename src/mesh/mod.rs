@@ -22,7 +22,7 @@ pub use bounds::{bbox_diagonal, bounds, thinnest_axis};
 pub use error::ObjError;
 pub use grid::{GridBends, GridOrientation, GridSpec};
 pub use import::{load_obj, load_obj_with, obj_from_str, obj_from_str_with};
-pub use incidence::triangles_around;
+pub use incidence::{grouped, triangles_around};
 pub use limits::{MAX_COORDINATE, MAX_FILE_BYTES, MAX_TRIANGLES, MAX_VERTICES};
 pub use normals::vertex_normals;
 pub use obj::{parse_obj, write_obj};

@@ -20,7 +20,7 @@ const EDGES: u32 = 1 << 31;
 /// `1`, or the edges numbered `0` and `1` (an edge's number is three times its triangle's
 /// plus its side in it), the kind in the top bit of the first. Half a [`Pair`]'s size:
 /// where a cloth lands fast its pairs are counted in millions.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord)]
 pub struct StoredPair([u32; 2]);
 
 impl StoredPair {

@@ -10,7 +10,7 @@ use super::found::Found;
 use super::primitives::{Pair, StoredPair, distance};
 use super::rings::Rings;
 use crate::cloth::ClothModel;
-use crate::mesh::triangles_around;
+use crate::mesh::{grouped, triangles_around};
 
 /// Which vertices and edges each triangle owns: each vertex and each edge belongs to the
 /// first triangle that has it, so a pair of triangles yields each vertex–triangle and
@@ -148,20 +148,7 @@ impl Owners {
         };
         // Counted, then placed (a corner's in the order they are met): no list of pairs
         // and their corners beside the result (16 MB at 256²).
-        let mut corner_start = vec![0u32; particles + 1];
-        each(&mut |corner, _| corner_start[corner as usize + 1] += 1);
-        for c in 0..particles {
-            corner_start[c + 1] += corner_start[c];
-        }
-        let mut next = corner_start.clone();
-        let mut neighbours =
-            vec![StoredPair::vertex_triangle(0, 0); corner_start[particles] as usize];
-        each(&mut |corner, stored| {
-            let slot = &mut next[corner as usize];
-            neighbours[*slot as usize] = stored;
-            *slot += 1;
-        });
-        (self.neighbours, self.corner_start) = (neighbours, corner_start);
+        (self.corner_start, self.neighbours) = grouped(particles, each);
         self.piece_start = vec![0];
         for c in 0..particles {
             let first = self.corner_start[*self.piece_start.last().unwrap_or(&0) as usize];
