@@ -203,18 +203,6 @@ pub fn bench_gpu(n: u32, integrator: IntegratorKind, seconds: f64) -> Result<Ben
     })
 }
 
-/// As [`bench_one`], with the simulation built by `make` (another backend).
-///
-/// # Errors
-/// [`BenchError`] for a bad `n`, or what `make` returns.
-pub fn bench_with(
-    n: u32,
-    integrator: IntegratorKind,
-    make: impl FnOnce(Scene) -> Result<Simulation, BenchError>,
-) -> Result<BenchRow, BenchError> {
-    bench_for(n, integrator, BENCH_SECONDS, make)
-}
-
 /// Frames of a bench run `seconds` long: at least two (the first is not timed), at most an
 /// hour's (each frame's time is kept).
 ///
@@ -229,7 +217,7 @@ pub fn bench_frames(seconds: f64) -> Result<u64, BenchError> {
     }
 }
 
-/// As [`bench_with`], for `seconds` of simulated time (see [`bench_in`]).
+/// As [`bench_in`], with the simulation built by `make` (another backend, other settings).
 ///
 /// # Errors
 /// [`BenchError`] for a bad `n` or `seconds`, or what `make` returns.

@@ -4,7 +4,8 @@
 use std::process::Command;
 
 use clothsim::bench::{
-    FrameSpread, REFERENCE_SAG, bench_in, bench_one, bench_scene, central, frame_spread,
+    BENCH_SECONDS, FrameSpread, REFERENCE_SAG, bench_in, bench_one, bench_scene, central,
+    frame_spread,
 };
 use clothsim::mesh::SpringKind;
 use clothsim::scene::Simulation;
@@ -136,11 +137,12 @@ fn bench_gives_xpbd_the_sweeps_its_sag_needs() {
         "sag {} with the bench's sweeps",
         row.sag_m
     );
-    let one_sweep = clothsim::bench::bench_with(32, IntegratorKind::Xpbd, |mut scene| {
-        scene.params.solver.xpbd_iterations = 1;
-        Ok(clothsim::scene::Simulation::new(scene))
-    })
-    .expect("runs");
+    let one_sweep =
+        clothsim::bench::bench_for(32, IntegratorKind::Xpbd, BENCH_SECONDS, |mut scene| {
+            scene.params.solver.xpbd_iterations = 1;
+            Ok(clothsim::scene::Simulation::new(scene))
+        })
+        .expect("runs");
     assert_eq!(one_sweep.sag_ok, Some(false), "sag {}", one_sweep.sag_m);
     assert!(one_sweep.sag_m > row.sag_m, "one sweep is softer");
 }
