@@ -36,7 +36,7 @@ pub struct CrumpleRow {
     pub springs_us: f64,
     /// Pairs the search kept per particle, averaged over the last substep of each frame.
     pub pairs_per_particle: f64,
-    /// Searches of the whole hash per substep (sampled as the pairs are).
+    /// Searches of the whole tree per substep (sampled as the pairs are).
     pub searches_per_substep: f64,
     /// Searches of only the triangles whose particles left their boxes, per substep
     /// (sampled as the pairs are); substeps with neither reused the pairs found before.

@@ -254,15 +254,14 @@ fn builtin(name: &str, configure: impl FnOnce(&mut Scene)) -> Simulation {
 /// about 54 × 54) aborted on an 8 GB allocation: the state grew by orders of magnitude
 /// within one frame, and self-collision binned every substep's triangles into every cell of
 /// their boxes, billions of them, before the guard looked at the frame's end. Now each
-/// substep meets the guard's speed and energy limits before contacts read it, and the table
-/// holds at most eight entries a triangle. The same failure, made small: `self-fold` at 8 ×
-/// the stiffness (ωh ≈ 2.6 at 48 substeps).
+/// substep meets the guard's speed and energy limits before contacts read it, and the
+/// search walks a tree as large whatever the positions. The same failure, made small:
+/// `self-fold` at 8 × the stiffness (ωh ≈ 2.6 at 48 substeps).
 #[test]
 fn a_cloth_diverging_with_self_collision_is_rolled_back_not_aborted() {
     let mut sim = builtin("self-fold", |s| {
         s.params.material.stiffness = s.params.material.stiffness.map(|k| k * 8.0)
     });
-    let triangles = sim.model().triangles.len() as u64;
     let outcome = sim.step_frame().expect("refining saves the frame");
     assert_eq!(outcome, FrameOutcome::Refined { from: 48, to: 96 });
     assert!(sim.state().is_finite());
@@ -276,29 +275,24 @@ fn a_cloth_diverging_with_self_collision_is_rolled_back_not_aborted() {
     // self-collision passes, then the 96 of the frame redone.
     let passes = sim.take_timings().get("self-collision").unwrap().calls;
     assert!(passes > 96 && passes < 48 + 96, "{passes} passes");
-    let work = sim.self_collision_work().unwrap();
-    assert!(work.binned <= 8 * triangles, "{} entries", work.binned);
 }
 
 /// With the guard off nothing checks the substeps, and the diverging state reaches
-/// self-contact, which never allocates for it: the table stays bounded every frame, and
-/// the run either ends with contact detection's refusal (a non-finite or absurdly spread
-/// state) or stays finite, its motion cut wherever the cloth would cross itself.
+/// self-contact: the run either ends with contact detection's refusal (a non-finite or
+/// absurdly spread state) or stays finite, its motion cut wherever the cloth would cross
+/// itself.
 #[test]
-fn with_the_guard_off_self_collision_stays_bounded_on_a_diverging_state() {
+fn with_the_guard_off_self_collision_refuses_or_resolves_a_diverging_state() {
     let mut sim = builtin("self-fold", |s| {
         s.params.material.stiffness = s.params.material.stiffness.map(|k| k * 8.0);
         s.params.guard.enabled = false;
     });
-    let triangles = sim.model().triangles.len() as u64;
     for _ in 0..4 {
         if let Err(e) = sim.step_frame() {
             let err = e.to_string();
             assert!(err.contains("contact detection refused"), "{err}");
             return;
         }
-        let work = sim.self_collision_work().unwrap();
-        assert!(work.binned <= 8 * triangles, "{} entries", work.binned);
         assert!(sim.state().is_finite());
     }
 }

@@ -44,21 +44,30 @@ impl TriangleTree {
     /// The tree over `triangles` (corners); degenerate triangles are kept (they are found
     /// by nothing they do not touch).
     pub fn new(triangles: &[[Vec3; 3]]) -> Self {
-        let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
-        let centre = |t: u32| {
+        let (splits, order) = split_at_medians(triangles.len(), LEAF, |t| {
             let [a, b, c] = triangles[t as usize];
             (a + b + c) / 3.0
-        };
-        let mut nodes = Vec::with_capacity(2 * triangles.len().div_ceil(LEAF));
-        if !triangles.is_empty() {
-            build(&mut nodes, &mut order, 0, triangles, &centre);
-        }
+        });
+        let nodes = (splits.iter())
+            .map(|s| Node {
+                lo: Vec3::ZERO,
+                hi: Vec3::ZERO,
+                first: if s.count as usize > LEAF {
+                    s.second
+                } else {
+                    s.first
+                },
+                count: if s.count as usize > LEAF { 0 } else { s.count },
+            })
+            .collect();
         let corners = order.iter().map(|&t| triangles[t as usize]).collect();
-        Self {
+        let mut tree = Self {
             nodes,
             corners,
             index: order,
-        }
+        };
+        tree.fit();
+        tree
     }
 
     /// Moves each triangle to `triangle(number)` (the same triangles, numbered as when it
@@ -69,6 +78,11 @@ impl TriangleTree {
         for (corners, &t) in self.corners.iter_mut().zip(&self.index) {
             *corners = triangle(t as usize);
         }
+        self.fit();
+    }
+
+    /// Fits every box around the triangles' corners as they are.
+    fn fit(&mut self) {
         // Children come after their parent, so boxes fill in from the last node back.
         for at in (0..self.nodes.len()).rev() {
             let node = self.nodes[at];
@@ -262,52 +276,66 @@ impl TriangleTree {
     }
 }
 
-/// Builds the subtree over `order` (whose places start at `offset` in the final order) and
-/// returns its node's index.
-fn build(
-    nodes: &mut Vec<Node>,
-    order: &mut [u32],
-    offset: usize,
-    triangles: &[[Vec3; 3]],
-    centre: &impl Fn(u32) -> Vec3,
-) -> usize {
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for &t in order.iter() {
-        for c in triangles[t as usize] {
-            lo = lo.min(c);
-            hi = hi.max(c);
-        }
-    }
-    let at = nodes.len();
-    nodes.push(Node {
-        lo,
-        hi,
-        first: offset as u32,
-        count: order.len() as u32,
-    });
-    if order.len() <= LEAF {
-        return at;
-    }
-    // Split at the median centre along the widest spread of centres.
-    let (mut clo, mut chi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for &t in order.iter() {
-        clo = clo.min(centre(t));
-        chi = chi.max(centre(t));
-    }
-    let spread = chi - clo;
-    let axis = if spread.x >= spread.y && spread.x >= spread.z {
-        0
-    } else if spread.y >= spread.z {
-        1
+/// A node of a tree over places `0..n` split at medians ([`split_at_medians`]): it holds
+/// `count` places from `first` in the tree's order; one of more than the leaf's size has
+/// its children right after it and at `second`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Split {
+    pub first: u32,
+    pub count: u32,
+    pub second: u32,
+}
+
+/// A balanced tree over `n` places, each at `centre(place)`: every node of more than
+/// `leaf` places is halved at the median of their centres along the axis of their widest
+/// spread. Returns the nodes, each parent before its children (so that a pass from the
+/// last back meets children first), and the places in the tree's order.
+pub(crate) fn split_at_medians(
+    n: usize,
+    leaf: usize,
+    centre: impl Fn(u32) -> Vec3,
+) -> (Vec<Split>, Vec<u32>) {
+    let mut order: Vec<u32> = (0..n as u32).collect();
+    let mut nodes = Vec::with_capacity(2 * n.div_ceil(leaf.max(1)));
+    // Depth first: the second child is set aside until the first's subtree is built.
+    let mut pending = if n == 0 {
+        vec![]
     } else {
-        2
+        vec![(0u32, n as u32, None)]
     };
-    let mid = order.len() / 2;
-    order.select_nth_unstable_by(mid, |&a, &b| centre(a)[axis].total_cmp(&centre(b)[axis]));
-    let (left, right) = order.split_at_mut(mid);
-    build(nodes, left, offset, triangles, centre);
-    let second = build(nodes, right, offset + mid, triangles, centre);
-    nodes[at].first = second as u32;
-    nodes[at].count = 0;
-    at
+    while let Some((first, count, parent)) = pending.pop() {
+        if let Some(parent) = parent {
+            let at = nodes.len() as u32;
+            let node: &mut Split = &mut nodes[parent as usize];
+            node.second = at;
+        }
+        let at = nodes.len() as u32;
+        nodes.push(Split {
+            first,
+            count,
+            second: 0,
+        });
+        if count as usize <= leaf.max(1) {
+            continue;
+        }
+        let held = &mut order[first as usize..(first + count) as usize];
+        let (lo, hi) = (held.iter()).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &t| {
+            (lo.min(centre(t)), hi.max(centre(t)))
+        });
+        let spread = hi - lo;
+        let axis = if spread.x >= spread.y && spread.x >= spread.z {
+            0
+        } else if spread.y >= spread.z {
+            1
+        } else {
+            2
+        };
+        let mid = count / 2;
+        held.select_nth_unstable_by(mid as usize, |&a, &b| {
+            centre(a)[axis].total_cmp(&centre(b)[axis])
+        });
+        pending.push((first + mid, count - mid, Some(at)));
+        pending.push((first, mid, None));
+    }
+    (nodes, order)
 }

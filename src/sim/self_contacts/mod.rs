@@ -1,9 +1,10 @@
 //! Self-contact: the cloth kept off itself. Two kinds of pair — a vertex against a triangle
 //! it is not a corner of, an edge against an edge it shares no particle with — are found
-//! by a hierarchical spatial hash of the triangles' boxes over the substep's motion
-//! ([`hash`]; which pairs of two overlapping triangles are kept, [`search`]; where they are
-//! kept, [`found`]; the pairs of triangles sharing a corner, passed by while the corner's
-//! ring keeps its shape, [`certify`]), pushed a thickness apart at the substep's end with friction, and then
+//! by walking a tree of the triangles' boxes against itself, told apart by the substep's
+//! motion ([`tree`]; which pairs of two triangles not told apart are kept, [`search`];
+//! where they are kept, [`found`]; the pairs of triangles sharing a corner, passed by
+//! while the corner's ring keeps its shape, [`certify`]), pushed a thickness apart at the
+//! substep's end with friction, and then
 //! checked along the whole motion by conservative continuous collision detection
 //! ([`ccd`]): a pair whose sides could meet has its free particles' motion cut short where
 //! they are still apart, round after round, until no pair can meet (after a few rounds
@@ -16,14 +17,13 @@ mod ccd;
 mod certify;
 mod error;
 mod found;
-mod hash;
 mod primitives;
 mod rings;
 mod search;
 mod solver;
+mod tree;
 
 pub use error::ContactError;
-pub use hash::CELLS_PER_TRIANGLE;
 pub(crate) use primitives::point_triangle_distance;
 pub use search::owned_parts;
 pub use solver::{SelfContacts, SelfWork};

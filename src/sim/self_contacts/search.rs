@@ -2,7 +2,7 @@
 //! the boxes, and the test that keeps a vertex–triangle or edge–edge pair of two triangles
 //! whose boxes overlap.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use rustc_hash::FxHashMap;
 
 use super::ccd::closing_bound;
@@ -23,7 +23,7 @@ pub(super) struct Owners {
     identity: (usize, usize, usize),
     /// What it was built for: triangle count, particle count and a hash of the triangles.
     key: (usize, usize, u64),
-    /// The model's longest mesh edge at rest, m (the hash's base cell is twice it).
+    /// The model's longest mesh edge at rest, m.
     pub(super) longest: f32,
     pub(super) vertices: Vec<[u32; 3]>,
     pub(super) edges: Vec<[[u32; 2]; 3]>,
@@ -32,7 +32,7 @@ pub(super) struct Owners {
     /// The vertex–triangle and edge–edge pairs of every two triangles that share a corner,
     /// by the corner they were taken at (`corner_start`, as rows). Their boxes always
     /// overlap (both hold the corner's), so every search has them: they are tested from
-    /// this list, and the hash's search passes such triangles by. On a grid they are four
+    /// this list, and the tree's search passes such triangles by. On a grid they are four
     /// in five of the overlapping triangles a search meets.
     pub(super) neighbours: Vec<StoredPair>,
     corner_start: Vec<u32>,
@@ -82,6 +82,13 @@ impl Owners {
         owners.neighbour_pairs(&model.triangles, model.particle_count());
         owners.rings = Rings::build(model.particle_count(), &model.triangles);
         owners
+    }
+
+    /// The cloth's cell, m: twice its longest mesh edge at rest, or twice `thickness`
+    /// where that is more (a scale against which a triangle's box tells a state that has
+    /// blown up).
+    pub(super) fn cell(&self, thickness: f32) -> f32 {
+        (2.0 * self.longest).max(2.0 * thickness).max(1e-6)
     }
 
     /// The pairs taken at corner `c` (see [`Owners::neighbours`]).
@@ -305,25 +312,18 @@ impl Search<'_> {
         meet(first, second)
     }
 
-    /// Keeps `pair` (as `stored`) if, with each particle anywhere in its box, its sides
-    /// could come within the thickness, and (where the boxes are `swept`) if they could
-    /// along the motion the boxes were made for.
+    /// Keeps `pair` (as `stored`) if its sides could come within the thickness: where the
+    /// boxes are `swept`, along the motion they were made for (the pairs then hold for
+    /// that motion alone, so the boxes need not be asked); otherwise with each particle
+    /// anywhere in its box.
     pub(super) fn keep(&self, pair: Pair, stored: StoredPair, out: &mut Vec<StoredPair>) {
-        let ids = pair.ids();
-        // The smallest ball around each particle's box: in its box, a particle is at most
-        // half the box's diagonal from the box's centre.
-        let (lo, hi) = (
-            ids.map(|i| self.boxes.vertex_lo[i]),
-            ids.map(|i| self.boxes.vertex_hi[i]),
-        );
-        let x = std::array::from_fn(|j| (0.5 * (lo[j] + hi[j])).as_dvec3());
-        let radius = |j: usize| 0.5 * f64::from((hi[j] - lo[j]).length());
-        let most = |r: std::ops::Range<usize>| r.map(radius).fold(0.0f64, f64::max);
-        let k = pair.first_side();
         let thickness = f64::from(self.thickness);
-        if distance(&pair, x) - most(0..k) - most(k..4) < thickness
-            && (!self.boxes.swept || self.swept_apart(&pair) < thickness)
-        {
+        let near = if self.boxes.swept {
+            self.swept_apart(&pair) < thickness
+        } else {
+            self.boxed_apart(&pair) < thickness
+        };
+        if near {
             // Grown by a quarter, not doubled: where a cloth lands fast the pairs run to
             // millions, and a doubled buffer can hold as much again unused (a large
             // buffer grows in place: the allocator remaps its pages).
@@ -334,17 +334,49 @@ impl Search<'_> {
         }
     }
 
+    /// A lower bound on how close the pair's sides come with each particle anywhere in its
+    /// box: in its box, a particle is at most half the box's diagonal from the box's
+    /// centre (the smallest ball around the box).
+    fn boxed_apart(&self, pair: &Pair) -> f64 {
+        let ids = pair.ids();
+        let (lo, hi) = (
+            ids.map(|i| self.boxes.vertex_lo[i]),
+            ids.map(|i| self.boxes.vertex_hi[i]),
+        );
+        let x = std::array::from_fn(|j| (0.5 * (lo[j] + hi[j])).as_dvec3());
+        let radius = |j: usize| 0.5 * f64::from((hi[j] - lo[j]).length());
+        let most = |r: std::ops::Range<usize>| r.map(radius).fold(0.0f64, f64::max);
+        let k = pair.first_side();
+        distance(pair, x) - most(0..k) - most(k..4)
+    }
+
     /// A lower bound on how close the pair's sides come along the particles' straight
-    /// motion the boxes were made for: its distance changes along the motion no faster
-    /// than the sides' largest displacements relative to the pair's mean motion add up to
-    /// (`L`), so it stays above both `d₀ − τL` and `d₁ − (1 − τ)L`, whose larger is least,
-    /// `(d₀ + d₁ − L)/2`, where they cross.
+    /// motion the boxes were made for. First the sides' boxes in the frame that moves with
+    /// the pair's mean motion (each side stays in the box of its particles' starts and
+    /// ends less that motion; a translation changes no distance): most pairs that move
+    /// together end there, their gap along an axis. Then the distance: it changes along the
+    /// motion no faster than the sides' largest displacements relative to the pair's mean
+    /// motion add up to (`L`), so it stays above both `d₀ − τL` and `d₁ − (1 − τ)L`, whose
+    /// larger is least, `(d₀ + d₁ − L)/2`, where they cross.
     fn swept_apart(&self, pair: &Pair) -> f64 {
         let ids = pair.ids();
         let (from, to) = (&self.boxes.from, &self.boxes.to);
         let x0 = ids.map(|i| from[i].as_dvec3());
         let x1 = ids.map(|i| to[i].as_dvec3());
-        let moves = std::array::from_fn(|j| x1[j] - x0[j]);
+        let moves: [DVec3; 4] = std::array::from_fn(|j| x1[j] - x0[j]);
+        let mean = moves.iter().copied().sum::<DVec3>() / 4.0;
+        let side = |r: std::ops::Range<usize>| {
+            r.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), j| {
+                let e = x1[j] - mean;
+                (lo.min(x0[j]).min(e), hi.max(x0[j]).max(e))
+            })
+        };
+        let k = pair.first_side();
+        let ((alo, ahi), (blo, bhi)) = (side(0..k), side(k..4));
+        let gap = (blo - ahi).max(alo - bhi).max_element();
+        if gap >= f64::from(self.thickness) {
+            return gap;
+        }
         0.5 * (distance(pair, x0) + distance(pair, x1) - closing_bound(pair, moves))
     }
 }

@@ -11,9 +11,9 @@ use super::ccd::safe_fraction;
 use super::certify::Certificates;
 use super::error::ContactError;
 use super::found::Found;
-use super::hash::BoxHash;
 use super::primitives::{StoredPair, closer_than, push_apart};
 use super::search::{Boxes, Owners, Search, pairs};
+use super::tree::TriangleTree;
 
 /// Work done by the last resolve: for cost checks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -22,9 +22,9 @@ pub struct SelfWork {
     pub candidates: u64,
     /// Pushes that kept a pair a thickness apart at the substep's end.
     pub contacts: u64,
-    /// Entries in the spatial hash's table (at most [`CELLS_PER_TRIANGLE`](super::CELLS_PER_TRIANGLE) per triangle).
-    pub binned: u64,
-    /// Searches of the whole hash (0 when the pairs found before still held, or only
+    /// Nodes of the tree the search walks (one less than twice the triangles).
+    pub nodes: u64,
+    /// Searches of the whole tree (0 when the pairs found before still held, or only
     /// some triangles were searched again).
     pub searches: u64,
     /// Searches of only the triangles whose particles left their boxes.
@@ -53,16 +53,29 @@ const KEEP: f64 = 0.1;
 /// 64² against a few hundred, and cost more than the searches it saved.
 const REUSE_BELOW: f32 = 0.5;
 
+/// Where the pairs are judged by the motion, each whole search judges them along the
+/// particles' motion carried on at its velocity for a window of up to this many substeps,
+/// so that they hold for the substeps after while each particle stays within
+/// [`ALLOWANCE`] of that path (see [`Window`]).
+const LONGEST_WINDOW: u32 = 2;
+
+/// How far, as a share of the thickness, a particle may stray from the path a window
+/// foresaw for it before its triangles are searched again (the pairs are kept for twice
+/// as much more than the thickness).
+const ALLOWANCE: f32 = 0.2;
+
 /// Only the triangles whose particles left their boxes are searched again while those
-/// particles are fewer than one in this many; more, and the whole hash is.
+/// particles are fewer than one in this many; more, and the whole tree is.
 const REFRESH_BELOW: usize = 4;
 
-/// Triangles searched again in one piece of a refresh.
-const REFRESHED_PER_PIECE: usize = 64;
+/// A triangle's box may be at most this many times the cloth's cell (twice its longest
+/// edge, or twice the thickness): wider, the state has blown up, and is refused rather
+/// than searched (every pair of the cloth could be near).
+const WIDEST: f32 = 1e6;
 
-/// A refresh looks a triangle up at every level of the hash: where the finest is more than
-/// this many levels below the triangle's, the whole hash is searched instead.
-const REFRESH_LEVELS: u32 = 2;
+/// The most triangles self-contact takes: a stored edge–edge pair numbers each edge as
+/// three times its triangle's number and its side, below the bit that marks its kind.
+const MOST_TRIANGLES: usize = (1 << 31) / 3;
 
 /// The distance, as a share of the thickness, within which the continuous check needs
 /// its pairs: twice what it keeps, for margin (pairs farther apart along the whole motion
@@ -97,10 +110,32 @@ impl Clone for Cuts {
     }
 }
 
+/// How long the pairs judged by the motion hold. A search judges them along each
+/// particle's path over a window of `len` substeps: its motion in the substep searched,
+/// carried on at the same velocity (in the frame that moves with the cloth's mean motion,
+/// where the cloth's own deceleration moves no particle). They hold at the window's
+/// substep `at` while each particle's start and end lie within the allowance (and the
+/// slack of what the pairs are needed for) of where the path puts them then: along the
+/// substep a particle is then within as much of its path, so a pair's distance falls
+/// short of its foreseen one by at most twice that. A window that ran out before the
+/// whole tree had to be searched again is followed by one twice as long (up to
+/// [`LONGEST_WINDOW`]); one cut short by a search, by one half as long.
+#[derive(Clone, Copy, Debug)]
+struct Window {
+    len: u32,
+    at: u32,
+}
+
+impl Default for Window {
+    fn default() -> Self {
+        Window { len: 1, at: 0 }
+    }
+}
+
 /// Reusable buffers of self-contact: nothing is allocated per substep once warm.
 #[derive(Clone, Debug, Default)]
 pub struct SelfContacts {
-    hash: BoxHash,
+    tree: TriangleTree,
     owners: Owners,
     /// The particles' and triangles' boxes the pairs were found with.
     boxes: Boxes,
@@ -118,12 +153,17 @@ pub struct SelfContacts {
     /// judged by the motion.
     certificates: Certificates,
     /// Particles whose motion left their boxes, and the triangles they are corners of
-    /// (as flags and as a list), for a refresh.
+    /// (as flags), for a refresh.
     left: Vec<bool>,
     dirty: Vec<bool>,
-    dirty_list: Vec<u32>,
     /// How much the boxes were grown by around each particle's motion.
     grow: f32,
+    /// The window the pairs judged by the motion were found for, and how far into it the
+    /// substep resolved is.
+    window: Window,
+    /// How far a particle may stray from its path in the window, m (0 for a window of one
+    /// substep, whose paths are the motion itself).
+    allowance: f32,
     /// Particles resting on a solid this substep (set by the stepper before
     /// [`SelfContacts::resolve`]): pushes move them only where nothing else can.
     pub held: Vec<bool>,
@@ -168,8 +208,12 @@ impl SelfContacts {
             return Err(ContactError::NonFinite { particle });
         }
         if self.owners.update(model) {
+            // Nothing found for the old cloth holds: not its pairs, its corners'
+            // references, its tree, nor how long its windows ran.
             self.found_for = None;
             self.certificates.forget();
+            self.tree = TriangleTree::default();
+            (self.window, self.boxes.swept) = (Window::default(), false);
         }
         // Only the running total outlives a resolve.
         self.work = SelfWork {
@@ -184,10 +228,12 @@ impl SelfContacts {
             .fold(glam::DVec3::ZERO, |m, (s, p)| m + (*p - *s).as_dvec3())
             / n;
         let mean = mean.as_vec3();
+        // A substep further into the window.
+        self.window.at += 1;
         self.relative(start, &state.pos, self.shift, mean);
         self.update_pairs(model, thickness, thickness)?;
         self.work.candidates = self.found.len() as u64;
-        self.work.binned = self.hash.len() as u64;
+        self.work.nodes = self.tree.len() as u64;
         // The sweeps go through the pairs whose sides are near enough to come into
         // contact, picked out first (by the team, where they are many).
         let (triangles, edges, pos) = (&model.triangles, &self.owners.edges, &state.pos);
@@ -251,12 +297,6 @@ impl SelfContacts {
         Ok((self.work.impacts - impacts) as usize)
     }
 
-    /// Entries in the hash's table now: at most [`CELLS_PER_TRIANGLE`](super::CELLS_PER_TRIANGLE) per triangle,
-    /// whatever the positions.
-    pub fn table_len(&self) -> usize {
-        self.hash.len()
-    }
-
     /// Fills the substep's start and end in the moving frame: less `shift`, how far the
     /// frame had moved by the substep's start, and the end less the substep's `mean` motion
     /// too.
@@ -272,38 +312,60 @@ impl SelfContacts {
     /// particle's motion lies in its box less half of `within` (two boxes that far apart
     /// keep their particles `within` apart). Particles whose motion left theirs get new
     /// boxes, and their triangles are searched again ([`SelfContacts::refresh`]); where
-    /// many left, the whole hash is ([`SelfContacts::find_pairs`]).
+    /// many left, the whole tree is ([`SelfContacts::find_pairs`]).
+    /// Where the pairs are judged by the motion, also while the window they were found for
+    /// lasts ([`Window`]).
     fn update_pairs(
         &mut self,
         model: &ClothModel,
         thickness: f32,
         within: f32,
     ) -> Result<(), ContactError> {
-        if self.found_for != Some(thickness) || self.boxes.vertex_lo.len() != self.to.len() {
+        let swept = self.boxes.swept;
+        if self.found_for != Some(thickness)
+            || self.boxes.vertex_lo.len() != self.to.len()
+            || swept && self.window.at >= self.window.len
+        {
             return self.find_pairs(model, thickness);
         }
         let g = Vec3::splat(0.5 * within);
-        // Pairs judged by the motion hold while each particle starts where it did and ends
-        // within half of what `within` leaves of the thickness from where it did: a pair
-        // that stayed a thickness apart then stays `within` apart.
-        let (swept, slack) = (self.boxes.swept, 0.5 * (thickness - within));
-        let boxes = &self.boxes;
+        // Pairs judged by the motion hold while each particle starts and ends within the
+        // allowance and half of what `within` leaves of the thickness of where its path in
+        // the window puts it (see `Window`): a pair kept apart by the thickness and twice
+        // the allowance along the paths then stays `within` apart. A window of one
+        // substep has no allowance: each particle starts where it did.
+        let slack = 0.5 * (thickness - within);
+        let (boxes, window) = (&self.boxes, self.window);
+        let (strays, off) = (self.allowance > 0.0, f64::from(self.allowance + slack));
+        let strayed = |i: usize, s: Vec3, p: Vec3| {
+            let (from, to) = (boxes.from[i], boxes.to[i]);
+            if !strays {
+                return s != from || p.distance(to) > slack;
+            }
+            // In f64: the path's points are not rounded on the way.
+            let along = |step: u32| {
+                let t = f64::from(step) / f64::from(window.len);
+                from.as_dvec3() + (to - from).as_dvec3() * t
+            };
+            s.as_dvec3().distance(along(window.at)) > off
+                || p.as_dvec3().distance(along(window.at + 1)) > off
+        };
         self.left.clear();
         self.left.extend(
             (self.from.iter().zip(&self.to))
                 .enumerate()
-                .map(|(i, (s, p))| {
+                .map(|(i, (&s, &p))| {
                     let (lo, hi) = (boxes.vertex_lo[i], boxes.vertex_hi[i]);
-                    !((s.min(*p) - g).cmpge(lo).all() && (s.max(*p) + g).cmple(hi).all())
-                        || swept && (*s != boxes.from[i] || p.distance(boxes.to[i]) > slack)
+                    !((s.min(p) - g).cmpge(lo).all() && (s.max(p) + g).cmple(hi).all())
+                        || swept && strayed(i, s, p)
                 }),
         );
         let left = self.left.iter().filter(|&&l| l).count();
         if left == 0 {
             return Ok(());
         }
-        if left * REFRESH_BELOW < self.left.len() && self.refresh(model, thickness)? {
-            return Ok(());
+        if left * REFRESH_BELOW < self.left.len() {
+            return self.refresh(model, thickness);
         }
         self.find_pairs(model, thickness)
     }
@@ -316,8 +378,8 @@ impl SelfContacts {
             let motion = [&self.boxes.from[..], &self.boxes.to[..]];
             let only = refreshed.then_some(&self.left[..]);
             let certificates = &mut self.certificates;
-            self.work.retaken +=
-                certificates.decide(&self.owners, triangles, motion, thickness, only);
+            let reach = thickness + 2.0 * self.allowance;
+            self.work.retaken += certificates.decide(&self.owners, triangles, motion, reach, only);
         }
     }
 
@@ -326,84 +388,108 @@ impl SelfContacts {
         (s.min(p) - Vec3::splat(grow), s.max(p) + Vec3::splat(grow))
     }
 
-    /// Triangle `t`'s box: its corners' boxes together.
-    fn triangle_box(&self, t: [u32; 3]) -> (Vec3, Vec3) {
+    /// Triangle `n`'s box (its corners `t`): its corners' boxes together.
+    ///
+    /// # Errors
+    /// [`ContactError::Extent`] for a box wider than [`WIDEST`] times the cloth's cell
+    /// (twice its longest edge, or twice the thickness): a state that has blown up.
+    fn triangle_box(
+        &self,
+        n: usize,
+        t: [u32; 3],
+        thickness: f32,
+    ) -> Result<(Vec3, Vec3), ContactError> {
         let [a, b, c] = t.map(|i| i as usize);
         let (lo, hi) = (&self.boxes.vertex_lo, &self.boxes.vertex_hi);
-        (lo[a].min(lo[b]).min(lo[c]), hi[a].max(hi[b]).max(hi[c]))
+        let (lo, hi) = (lo[a].min(lo[b]).min(lo[c]), hi[a].max(hi[b]).max(hi[c]));
+        let (extent, cell) = ((hi - lo).max_element(), self.owners.cell(thickness));
+        if extent > WIDEST * cell {
+            return Err(ContactError::Extent {
+                triangle: n,
+                extent,
+                cell,
+            });
+        }
+        Ok((lo, hi))
     }
 
     /// The particles that [`SelfContacts::update_pairs`] found out of their boxes get new
     /// ones; the pairs of every triangle they are corners of are dropped and searched
-    /// again against the whole hash, binned anew. The pairs of two triangles neither of
-    /// which moved out stand: their boxes are the same. Returns false, having changed no
-    /// pair, where a triangle would be looked up too many levels down (a search of the
-    /// whole hash then follows).
-    fn refresh(&mut self, model: &ClothModel, thickness: f32) -> Result<bool, ContactError> {
+    /// again against the whole tree, fitted anew. The pairs of two triangles neither of
+    /// which moved out stand: their boxes are the same.
+    fn refresh(&mut self, model: &ClothModel, thickness: f32) -> Result<(), ContactError> {
         // Until the pairs are whole again (an error on the way leaves them not).
         self.found_for = None;
+        let window = self.window;
         for (i, _) in self.left.iter().enumerate().filter(|(_, l)| **l) {
-            (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) =
-                Self::vertex_box(self.from[i], self.to[i], self.grow);
+            let (mut s, mut p) = (self.from[i], self.to[i]);
             if self.boxes.swept {
-                (self.boxes.from[i], self.boxes.to[i]) = (self.from[i], self.to[i]);
+                // The particle's path in the window from its motion now, carried on both
+                // ways at its velocity.
+                if window.len > 1 {
+                    let v = p - s;
+                    (s, p) = (
+                        s - v * window.at as f32,
+                        s + v * (window.len - window.at) as f32,
+                    );
+                }
+                (self.boxes.from[i], self.boxes.to[i]) = (s, p);
             }
+            (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) = Self::vertex_box(s, p, self.grow);
         }
         self.dirty.clear();
-        self.dirty_list.clear();
+        let mut refreshed = 0;
         for (n, &t) in model.triangles.iter().enumerate() {
             let dirty = t.iter().any(|&i| self.left[i as usize]);
             self.dirty.push(dirty);
             if dirty {
-                self.dirty_list.push(n as u32);
-                (self.boxes.lo[n], self.boxes.hi[n]) = self.triangle_box(t);
+                refreshed += 1;
+                (self.boxes.lo[n], self.boxes.hi[n]) = self.triangle_box(n, t, thickness)?;
             }
         }
-        self.hash
-            .bin(&self.boxes.lo, &self.boxes.hi, self.hash.cell())?;
-        let hash = &self.hash;
-        if (self.dirty_list.iter()).any(|&a| hash.levels_below(a as usize) > REFRESH_LEVELS) {
-            return Ok(false);
-        }
+        self.fit_tree(model, thickness);
+        self.tree.mark(&self.dirty);
         // Only the corners with a triangle searched again are decided again. One that was
         // closed and is open now still leaves out the pairs of its triangles that stayed:
         // it held for their motion, which has not changed.
         self.decide_corners(&model.triangles, thickness, true);
-        let (hash, dirty, owner) = (&self.hash, &self.dirty, &self.owners.vertex_owner);
+        let (tree, dirty, owner) = (&self.tree, &self.dirty, &self.owners.vertex_owner);
         (self.found).retain(|p| p.triangles(owner).iter().all(|&t| !dirty[t as usize]));
         let search = Search {
             owners: &self.owners,
             triangles: &model.triangles,
             boxes: &self.boxes,
-            thickness,
+            thickness: thickness + 2.0 * self.allowance,
             open: &self.certificates.open,
         };
-        let list = &self.dirty_list;
-        let pieces = list.len().div_ceil(REFRESHED_PER_PIECE);
+        let pieces = tree.pieces();
         let work = |piece: usize, out: &mut Vec<StoredPair>| {
             if piece >= pieces {
                 // The pairs of triangles sharing a corner, where either is one of those.
                 return search.neighbours(piece - pieces, Some(dirty), out);
             }
-            let first = piece * REFRESHED_PER_PIECE;
-            for &a in &list[first..(first + REFRESHED_PER_PIECE).min(list.len())] {
-                let a = a as usize;
-                hash.overlapping(a, &search.boxes.lo, &search.boxes.hi, |b| {
-                    // Two triangles moved out: their pairs are searched from the first.
-                    let b = b as usize;
-                    if !dirty[b] || a < b {
-                        search.pairs_of(a, b, out);
-                    }
-                });
-            }
+            tree.piece_pairs(piece, true, |a, b| {
+                search.pairs_of(a as usize, b as usize, out)
+            });
         };
-        // A triangle looked up costs about what one searched with the whole hash does.
-        let parallel = list.len() >= PARALLEL_TRIANGLES / 4;
+        let parallel = refreshed >= PARALLEL_TRIANGLES / 4;
         (self.found).extend(pieces + search.neighbour_pieces(), parallel, &work);
         self.work.refreshes += 1;
-        self.work.refreshed += list.len() as u64;
+        self.work.refreshed += refreshed as u64;
         self.found_for = Some(thickness);
-        Ok(true)
+        Ok(())
+    }
+
+    /// Fits the tree to the boxes, or where the pairs are judged by the motion, to the
+    /// motion the boxes were made for (told apart by the thickness).
+    fn fit_tree(&mut self, model: &ClothModel, thickness: f32) {
+        if self.boxes.swept {
+            let motion = [&self.boxes.from[..], &self.boxes.to[..]];
+            let reach = thickness + 2.0 * self.allowance;
+            self.tree.fit_motion(&model.triangles, motion, reach);
+        } else {
+            self.tree.fit_boxes(&self.boxes.lo, &self.boxes.hi);
+        }
     }
 
     /// The pairs of every two triangles whose boxes overlap, each particle's box its
@@ -421,17 +507,48 @@ impl SelfContacts {
             .fold(0.0f32, f32::max)
             .sqrt();
         let slow = fastest < REUSE_BELOW * thickness;
-        self.grow = if slow { 0.75 } else { 0.5 } * thickness;
-        for (s, p) in self.from.iter().zip(&self.to) {
-            let (lo, hi) = Self::vertex_box(*s, *p, self.grow);
-            self.boxes.vertex_lo.push(lo);
-            self.boxes.vertex_hi.push(hi);
-        }
-        // Fast, the pairs are judged by this motion too (see `Boxes::swept`).
+        // Fast, the pairs are judged by the motion too (see `Boxes::swept`), carried on
+        // for a window: twice as long as the last where it ran out, half where it did
+        // not.
+        let (was_swept, window) = (self.boxes.swept, self.window);
+        self.window = Window {
+            len: match (slow, was_swept) {
+                (false, true) if window.at >= window.len => (2 * window.len).min(LONGEST_WINDOW),
+                (false, true) => (window.len / 2).max(1),
+                _ => 1,
+            },
+            at: 0,
+        };
+        self.allowance = if self.window.len > 1 {
+            ALLOWANCE * thickness
+        } else {
+            0.0
+        };
+        self.grow = if slow {
+            0.75 * thickness
+        } else {
+            0.5 * thickness + self.allowance
+        };
         self.boxes.swept = !slow;
         if self.boxes.swept {
             self.boxes.from.clone_from(&self.from);
             self.boxes.to.clone_from(&self.to);
+            if self.window.len > 1 {
+                let len = self.window.len as f32;
+                for (to, &s) in self.boxes.to.iter_mut().zip(&self.from) {
+                    *to = s + (*to - s) * len;
+                }
+            }
+        }
+        let (from, to) = if self.boxes.swept {
+            (&self.boxes.from, &self.boxes.to)
+        } else {
+            (&self.from, &self.to)
+        };
+        for (s, p) in from.iter().zip(to) {
+            let (lo, hi) = Self::vertex_box(*s, *p, self.grow);
+            self.boxes.vertex_lo.push(lo);
+            self.boxes.vertex_hi.push(hi);
         }
         self.search_all(model, thickness)
     }
@@ -442,33 +559,41 @@ impl SelfContacts {
         self.found_for = None;
         self.boxes.lo.clear();
         self.boxes.hi.clear();
-        for &t in &model.triangles {
-            let (lo, hi) = self.triangle_box(t);
+        if model.triangles.len() > MOST_TRIANGLES {
+            return Err(ContactError::TooMany {
+                triangles: model.triangles.len(),
+                most: MOST_TRIANGLES,
+            });
+        }
+        if self.tree.triangles() != model.triangles.len() {
+            self.tree = TriangleTree::build(&model.triangles, &model.rest_positions);
+        }
+        for (n, &t) in model.triangles.iter().enumerate() {
+            let (lo, hi) = self.triangle_box(n, t, thickness)?;
             self.boxes.lo.push(lo);
             self.boxes.hi.push(hi);
         }
-        let cell = (2.0 * self.owners.longest).max(2.0 * thickness).max(1e-6);
-        self.hash.bin(&self.boxes.lo, &self.boxes.hi, cell)?;
+        self.fit_tree(model, thickness);
         self.found.clear();
         self.decide_corners(&model.triangles, thickness, false);
         let search = Search {
             owners: &self.owners,
             triangles: &model.triangles,
             boxes: &self.boxes,
-            thickness,
+            thickness: thickness + 2.0 * self.allowance,
             open: &self.certificates.open,
         };
-        let hash = &self.hash;
+        let tree = &self.tree;
         let work = |piece: usize, out: &mut Vec<StoredPair>| {
-            if piece >= hash.pieces() {
-                return search.neighbours(piece - hash.pieces(), None, out);
+            if piece >= tree.pieces() {
+                return search.neighbours(piece - tree.pieces(), None, out);
             }
-            hash.piece_pairs(piece, &search.boxes.lo, &search.boxes.hi, |a, b| {
-                search.pairs_of(a as usize, b as usize, out);
+            tree.piece_pairs(piece, false, |a, b| {
+                search.pairs_of(a as usize, b as usize, out)
             });
         };
         let parallel = model.triangles.len() >= PARALLEL_TRIANGLES;
-        let pieces = hash.pieces() + search.neighbour_pieces();
+        let pieces = tree.pieces() + search.neighbour_pieces();
         self.found.extend(pieces, parallel, &work);
         self.work.searches += 1;
         self.found_for = Some(thickness);

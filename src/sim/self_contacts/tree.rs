@@ -1,0 +1,338 @@
+//! The broad phase: a bounding-volume tree over the cloth's triangles, built once per
+//! cloth from where its triangles lie at rest (halved at the median of their centres,
+//! level by level: [`split_at_medians`]), so that each node holds a patch of the cloth
+//! that stays together however it folds. Every search fits the boxes to the positions as
+//! they are (the tree's shape never changes) and walks the tree against itself: two nodes
+//! that keep apart are passed by with everything under them.
+//!
+//! Where the pairs are judged by the motion, a node holds two boxes — its particles'
+//! starts and ends — and their mean motion, and two nodes are told apart in the frame that
+//! moves with their mean motion: there each node stays in the box of its starts and its
+//! ends less that motion (each particle's path runs between them), and a translation
+//! changes no distance. Where the cloth lands, its parts move fast against the cloth's
+//! mean but hardly against each other: in their own frame, two patches' boxes are hardly
+//! larger than the patches.
+
+use glam::{Vec3, Vec3A};
+
+use crate::sim::obstacle::{Split, split_at_medians};
+
+/// Triangles in a leaf at most: two leaves are tested triangle by triangle.
+const LEAF: usize = 4;
+
+/// A walk of the tree in one piece of a search: a node against itself (both the same) or
+/// two nodes against each other.
+type Task = (u32, u32);
+
+/// A node of this many triangles or fewer is walked against itself in one piece of a
+/// search.
+const TRIANGLES_PER_PIECE: u32 = 256;
+
+/// The deepest walk: a balanced tree of 2³¹ triangles is 30 levels deep; a walk of two
+/// nodes holds at most one task more for each level it goes down either, one of a node
+/// against itself two more a level.
+const STACK: usize = 128;
+
+/// How a search tells two nodes, or two triangles, apart.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Fit {
+    /// By their boxes: apart where they do not overlap.
+    Boxes,
+    /// By their particles' motion: apart where, in the frame of their mean motion, the
+    /// boxes of their starts and ends less that motion are `reach` apart along an axis.
+    Motion { reach: f32 },
+}
+
+/// The tree and the boxes its last fit gave it. Its boxes are numbered nodes first, then
+/// triangles in the tree's order.
+#[derive(Clone, Debug, Default)]
+pub(super) struct TriangleTree {
+    nodes: Vec<Split>,
+    /// The triangles in the tree's order.
+    order: Vec<u32>,
+    /// The pieces a search is cut into.
+    tasks: Vec<Task>,
+    /// Each box (by boxes), or the box of its starts (by motion).
+    lo: Vec<Vec3A>,
+    hi: Vec<Vec3A>,
+    /// The box of each one's ends, and its mean motion (by motion).
+    end_lo: Vec<Vec3A>,
+    end_hi: Vec<Vec3A>,
+    mean: Vec<Vec3A>,
+    fit: Option<Fit>,
+    /// Whether each box holds a triangle a refresh searches again ([`TriangleTree::mark`]).
+    marked: Vec<bool>,
+}
+
+impl TriangleTree {
+    /// The tree over `triangles`, from the particles' `rest` positions (balanced: its
+    /// depth is that of a complete tree).
+    pub(super) fn build(triangles: &[[u32; 3]], rest: &[Vec3]) -> TriangleTree {
+        let (nodes, order) = split_at_medians(triangles.len(), LEAF, |t| {
+            let corner = |i: u32| rest.get(i as usize).copied().unwrap_or(Vec3::ZERO);
+            triangles[t as usize]
+                .iter()
+                .map(|&i| corner(i))
+                .sum::<Vec3>()
+                / 3.0
+        });
+        let mut tree = TriangleTree {
+            nodes,
+            order,
+            ..TriangleTree::default()
+        };
+        if !tree.nodes.is_empty() {
+            tree.cut(0);
+        }
+        tree
+    }
+
+    /// Adds the pieces of a walk of node `a` against itself to the tasks.
+    fn cut(&mut self, a: u32) {
+        let node = self.nodes[a as usize];
+        if node.count <= TRIANGLES_PER_PIECE {
+            self.tasks.push((a, a));
+            return;
+        }
+        let (first, second) = (a + 1, node.second);
+        self.cut(first);
+        self.cut(second);
+        self.tasks.push((first, second));
+    }
+
+    /// Triangles the tree was built for.
+    pub(super) fn triangles(&self) -> usize {
+        self.order.len()
+    }
+
+    /// Nodes in the tree.
+    pub(super) fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    fn is_leaf(node: Split) -> bool {
+        node.count as usize <= LEAF
+    }
+
+    /// The box number of the triangle at `place` in the tree's order.
+    fn place(&self, place: u32) -> usize {
+        self.nodes.len() + place as usize
+    }
+
+    /// The boxes node `i` is fitted around: its children's, or its triangles'.
+    fn parts(&self, i: usize) -> ([usize; LEAF], usize) {
+        let node = self.nodes[i];
+        let mut parts = [0; LEAF];
+        if Self::is_leaf(node) {
+            let first = self.place(node.first);
+            for (k, part) in parts.iter_mut().enumerate().take(node.count as usize) {
+                *part = first + k;
+            }
+            (parts, node.count as usize)
+        } else {
+            (parts[0], parts[1]) = (i + 1, node.second as usize);
+            (parts, 2)
+        }
+    }
+
+    /// Sizes the boxes for nodes and triangles (and by motion, the ends and means).
+    fn size(&mut self, moving: bool) {
+        let n = self.nodes.len() + self.order.len();
+        for v in [&mut self.lo, &mut self.hi] {
+            v.resize(n, Vec3A::ZERO);
+        }
+        if moving {
+            for v in [&mut self.end_lo, &mut self.end_hi, &mut self.mean] {
+                v.resize(n, Vec3A::ZERO);
+            }
+        }
+    }
+
+    /// Fits the nodes' boxes around their parts', from the last node back (children come
+    /// after their parents).
+    fn fit_nodes(&mut self, moving: bool) {
+        for i in (0..self.nodes.len()).rev() {
+            let (parts, n) = self.parts(i);
+            let parts = &parts[..n];
+            let around = |v: &[Vec3A]| {
+                (parts.iter()).fold((Vec3A::INFINITY, Vec3A::NEG_INFINITY), |(lo, hi), &k| {
+                    (lo.min(v[k]), hi.max(v[k]))
+                })
+            };
+            (self.lo[i], self.hi[i]) = (around(&self.lo).0, around(&self.hi).1);
+            if moving {
+                (self.end_lo[i], self.end_hi[i]) = (around(&self.end_lo).0, around(&self.end_hi).1);
+                // Weighted by the triangles each part holds.
+                let weight = |k: usize| self.nodes.get(k).map_or(1.0, |n| n.count as f32);
+                let (sum, total) = (parts.iter()).fold((Vec3A::ZERO, 0.0), |(s, w), &k| {
+                    (s + self.mean[k] * weight(k), w + weight(k))
+                });
+                self.mean[i] = sum / total;
+            }
+        }
+    }
+
+    /// Fits the tree to the triangles' boxes `lo..hi`.
+    pub(super) fn fit_boxes(&mut self, lo: &[Vec3], hi: &[Vec3]) {
+        self.size(false);
+        let first = self.nodes.len();
+        for (place, &t) in self.order.iter().enumerate() {
+            (self.lo[first + place], self.hi[first + place]) =
+                (lo[t as usize].into(), hi[t as usize].into());
+        }
+        self.fit_nodes(false);
+        self.fit = Some(Fit::Boxes);
+    }
+
+    /// Fits the tree to the motion of the particles of `triangles` from `from` to `to`,
+    /// told apart by `reach` (see [`Fit::Motion`]).
+    pub(super) fn fit_motion(
+        &mut self,
+        triangles: &[[u32; 3]],
+        [from, to]: [&[Vec3]; 2],
+        reach: f32,
+    ) {
+        self.size(true);
+        let first = self.nodes.len();
+        for (place, &t) in self.order.iter().enumerate() {
+            let corners = triangles[t as usize];
+            let [a, b, c] = corners.map(|k| Vec3A::from(from[k as usize]));
+            let [d, e, f] = corners.map(|k| Vec3A::from(to[k as usize]));
+            let i = first + place;
+            (self.lo[i], self.hi[i]) = (a.min(b).min(c), a.max(b).max(c));
+            (self.end_lo[i], self.end_hi[i]) = (d.min(e).min(f), d.max(e).max(f));
+            self.mean[i] = ((d - a) + (e - b) + (f - c)) / 3.0;
+        }
+        self.fit_nodes(true);
+        self.fit = Some(Fit::Motion { reach });
+    }
+
+    /// Marks the boxes that hold a triangle `dirty` flags, for a walk of only theirs.
+    pub(super) fn mark(&mut self, dirty: &[bool]) {
+        let first = self.nodes.len();
+        self.marked.resize(first + self.order.len(), false);
+        for (place, &t) in self.order.iter().enumerate() {
+            self.marked[first + place] = dirty[t as usize];
+        }
+        for i in (0..first).rev() {
+            let (parts, n) = self.parts(i);
+            self.marked[i] = parts[..n].iter().any(|&k| self.marked[k]);
+        }
+    }
+
+    /// Whether boxes `a` and `b` do not overlap.
+    #[inline(always)]
+    fn boxes_apart(&self, a: usize, b: usize) -> bool {
+        !(self.lo[a].cmple(self.hi[b]).all() && self.lo[b].cmple(self.hi[a]).all())
+    }
+
+    /// Whether `a` and `b` keep `reach` apart along their motion, told in the frame of
+    /// their mean motion.
+    #[inline(always)]
+    fn moving_apart(&self, a: usize, b: usize, reach: f32) -> bool {
+        let m = 0.5 * (self.mean[a] + self.mean[b]);
+        let (alo, ahi) = (
+            self.lo[a].min(self.end_lo[a] - m),
+            self.hi[a].max(self.end_hi[a] - m),
+        );
+        let (blo, bhi) = (
+            self.lo[b].min(self.end_lo[b] - m),
+            self.hi[b].max(self.end_hi[b] - m),
+        );
+        (blo - ahi).max(alo - bhi).max_element() >= reach
+    }
+
+    /// Pieces a search of the whole tree is cut into, for a team to share.
+    pub(super) fn pieces(&self) -> usize {
+        self.tasks.len()
+    }
+
+    /// Calls `pair(a, b)` for each two triangles the walk of piece `piece` does not tell
+    /// apart (as the last fit tells them); the pieces together call it once for every
+    /// such two. With `marked`, only for those two of which one at least is marked
+    /// ([`TriangleTree::mark`]): the walk passes by two unmarked sides, and so tells every
+    /// other two apart, or not, exactly as the whole walk does.
+    pub(super) fn piece_pairs(&self, piece: usize, marked: bool, pair: impl FnMut(u32, u32)) {
+        // One walk for each fit, each with its test inlined.
+        match self.fit {
+            Some(Fit::Motion { reach }) => {
+                self.walk(piece, marked, |a, b| self.moving_apart(a, b, reach), pair);
+            }
+            _ => self.walk(piece, marked, |a, b| self.boxes_apart(a, b), pair),
+        }
+    }
+
+    #[inline(always)]
+    fn walk(
+        &self,
+        piece: usize,
+        marked: bool,
+        apart: impl Fn(usize, usize) -> bool,
+        mut pair: impl FnMut(u32, u32),
+    ) {
+        let unmarked = |a: usize| marked && !self.marked[a];
+        let first = self.nodes.len();
+        // Two triangles, at places `p` and `q`.
+        let mut places = |p: usize, q: usize| {
+            let (a, b) = (first + p, first + q);
+            let passed = unmarked(a) && unmarked(b) || apart(a, b);
+            if !passed {
+                pair(self.order[p], self.order[q]);
+            }
+        };
+        let mut stack = [(0u32, 0u32); STACK];
+        stack[0] = self.tasks[piece];
+        let mut depth = 1;
+        while depth > 0 {
+            depth -= 1;
+            let (a, b) = stack[depth];
+            if unmarked(a as usize) && unmarked(b as usize) {
+                continue;
+            }
+            let (na, nb) = (self.nodes[a as usize], self.nodes[b as usize]);
+            if a == b {
+                if Self::is_leaf(na) {
+                    let held = na.first as usize..(na.first + na.count) as usize;
+                    for p in held.clone() {
+                        for q in p + 1..held.end {
+                            places(p, q);
+                        }
+                    }
+                } else {
+                    let (first, second) = (a + 1, na.second);
+                    stack[depth..depth + 3].copy_from_slice(&[
+                        (first, second),
+                        (second, second),
+                        (first, first),
+                    ]);
+                    depth += 3;
+                }
+                continue;
+            }
+            if apart(a as usize, b as usize) {
+                continue;
+            }
+            match (Self::is_leaf(na), Self::is_leaf(nb)) {
+                (true, true) => {
+                    for p in na.first..na.first + na.count {
+                        for q in nb.first..nb.first + nb.count {
+                            places(p as usize, q as usize);
+                        }
+                    }
+                }
+                // The larger is split.
+                (false, _) if na.count >= nb.count || Self::is_leaf(nb) => {
+                    stack[depth..depth + 2].copy_from_slice(&[(na.second, b), (a + 1, b)]);
+                    depth += 2;
+                }
+                _ => {
+                    stack[depth..depth + 2].copy_from_slice(&[(a, nb.second), (a, b + 1)]);
+                    depth += 2;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
