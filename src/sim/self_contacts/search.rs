@@ -250,7 +250,9 @@ impl Search<'_> {
     /// share a corner are left to [`Search::neighbours`].
     pub(super) fn pairs_of(&self, a: usize, b: usize, out: &mut Vec<StoredPair>) {
         let tb = self.triangles[b];
-        if self.triangles[a].iter().any(|i| tb.contains(i)) {
+        if self.triangles[a].iter().any(|i| tb.contains(i))
+            || self.boxes.swept && self.apart_across(a, b)
+        {
             return;
         }
         (self.owners).each_pair(self.triangles, a, b, |pair, stored| {
@@ -258,6 +260,38 @@ impl Search<'_> {
                 self.keep(pair, stored, out);
             }
         });
+    }
+
+    /// Whether triangles `a` and `b` stay a thickness apart along the motion the boxes were
+    /// made for, told along the line between their centres: in the frame of the two
+    /// triangles' mean motion each stays in the hull of its corners' starts and ends (less
+    /// that motion), and two hulls whose extents along any line are a thickness apart are
+    /// at least that far apart. Two triangles of a smooth patch that share no corner
+    /// overlap in their boxes wherever the patch runs across the axes, but lie apart along
+    /// the line between them. In f64, so that no rounding keeps apart what touches.
+    fn apart_across(&self, a: usize, b: usize) -> bool {
+        let (from, to) = (&self.boxes.from, &self.boxes.to);
+        let ends = |t: [u32; 3]| {
+            let s = t.map(|i| from[i as usize].as_dvec3());
+            let e = t.map(|i| to[i as usize].as_dvec3());
+            (s, e)
+        };
+        let ((sa, ea), (sb, eb)) = (ends(self.triangles[a]), ends(self.triangles[b]));
+        let sum = |x: [DVec3; 3]| x[0] + x[1] + x[2];
+        let mean = (sum(ea) - sum(sa) + sum(eb) - sum(sb)) / 6.0;
+        let axis = (sum(sb) + sum(eb) - sum(sa) - sum(ea)) / 6.0;
+        let length = axis.length();
+        if length == 0.0 {
+            return false;
+        }
+        let span = |s: [DVec3; 3], e: [DVec3; 3]| {
+            (0..3).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), k| {
+                let (p, q) = (axis.dot(s[k]), axis.dot(e[k] - mean));
+                (lo.min(p).min(q), hi.max(p).max(q))
+            })
+        };
+        let ((alo, ahi), (blo, bhi)) = (span(sa, ea), span(sb, eb));
+        (blo - ahi).max(alo - bhi) >= f64::from(self.thickness) * length
     }
 
     /// Adds to `out` the pairs of piece `piece` of [`Owners::neighbours`] that could come
