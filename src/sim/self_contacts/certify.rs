@@ -11,7 +11,8 @@
 //! nothing. Along the substep's straight-line motion each ring particle's offset from that
 //! place is linear in time, so its largest is at the substep's start or end: a corner is
 //! certified for the whole substep from those two. Where the certificate fails, the
-//! reference is taken again at the substep's end (where the next one starts), and the
+//! reference is taken again at the motion's end (the substep's, where the next one starts,
+//! or the end of the window the pairs are judged over: any shape will do), and the
 //! corner's pairs are tested one by one only if it fails still.
 
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -140,7 +141,7 @@ fn decide_one(
         *open = false;
         return false;
     }
-    // Taken again at the substep's end (where the next substep starts), in its frame
+    // Taken again at the motion's end (where the next substep starts), in its frame
     // there; the distances are exact for the rounded positions, and rounded down to f32.
     let back = frame(to[c], to[a], to[b]).transpose();
     for (&j, r) in ring.iter().zip(reference.iter_mut()) {

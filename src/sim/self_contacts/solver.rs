@@ -22,7 +22,8 @@ pub struct SelfWork {
     pub candidates: u64,
     /// Pushes that kept a pair a thickness apart at the substep's end.
     pub contacts: u64,
-    /// Nodes of the tree the search walks (one less than twice the triangles).
+    /// Nodes of the tree the search walks (about half as many as the triangles: a leaf
+    /// holds up to four).
     pub nodes: u64,
     /// Searches of the whole tree (0 when the pairs found before still held, or only
     /// some triangles were searched again).
@@ -229,7 +230,7 @@ impl SelfContacts {
             / n;
         let mean = mean.as_vec3();
         // A substep further into the window.
-        self.window.at += 1;
+        self.window.at = self.window.at.saturating_add(1);
         self.relative(start, &state.pos, self.shift, mean);
         self.update_pairs(model, thickness, thickness)?;
         self.work.candidates = self.found.len() as u64;
@@ -377,10 +378,16 @@ impl SelfContacts {
         if self.boxes.swept {
             let motion = [&self.boxes.from[..], &self.boxes.to[..]];
             let only = refreshed.then_some(&self.left[..]);
+            let reach = self.reach(thickness);
             let certificates = &mut self.certificates;
-            let reach = thickness + 2.0 * self.allowance;
             self.work.retaken += certificates.decide(&self.owners, triangles, motion, reach, only);
         }
+    }
+
+    /// How near along their paths the pairs judged by the motion are kept, m: the
+    /// thickness and twice the allowance.
+    fn reach(&self, thickness: f32) -> f32 {
+        thickness + 2.0 * self.allowance
     }
 
     /// The box that holds a particle's motion from `s` to `p`, grown by `grow` each way.
@@ -459,7 +466,7 @@ impl SelfContacts {
             owners: &self.owners,
             triangles: &model.triangles,
             boxes: &self.boxes,
-            thickness: thickness + 2.0 * self.allowance,
+            thickness: self.reach(thickness),
             open: &self.certificates.open,
         };
         let pieces = tree.pieces();
@@ -485,7 +492,7 @@ impl SelfContacts {
     fn fit_tree(&mut self, model: &ClothModel, thickness: f32) {
         if self.boxes.swept {
             let motion = [&self.boxes.from[..], &self.boxes.to[..]];
-            let reach = thickness + 2.0 * self.allowance;
+            let reach = self.reach(thickness);
             self.tree.fit_motion(&model.triangles, motion, reach);
         } else {
             self.tree.fit_boxes(&self.boxes.lo, &self.boxes.hi);
@@ -580,7 +587,7 @@ impl SelfContacts {
             owners: &self.owners,
             triangles: &model.triangles,
             boxes: &self.boxes,
-            thickness: thickness + 2.0 * self.allowance,
+            thickness: self.reach(thickness),
             open: &self.certificates.open,
         };
         let tree = &self.tree;
