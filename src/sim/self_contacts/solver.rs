@@ -22,9 +22,6 @@ pub struct SelfWork {
     pub candidates: u64,
     /// Pushes that kept a pair a thickness apart at the substep's end.
     pub contacts: u64,
-    /// Nodes of the tree the search walks (about half as many as the triangles: a leaf
-    /// holds up to four).
-    pub nodes: u64,
     /// Searches of the whole tree (0 when the pairs found before still held, or only
     /// some triangles were searched again).
     pub searches: u64,
@@ -234,7 +231,6 @@ impl SelfContacts {
         self.relative(start, &state.pos, self.shift, mean);
         self.update_pairs(model, thickness, thickness)?;
         self.work.candidates = self.found.len() as u64;
-        self.work.nodes = self.tree.len() as u64;
         // The sweeps go through the pairs whose sides are near enough to come into
         // contact, picked out first (by the team, where they are many).
         let (triangles, edges, pos) = (&model.triangles, &self.owners.edges, &state.pos);

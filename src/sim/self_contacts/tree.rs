@@ -33,10 +33,11 @@ const TRIANGLES_PER_PIECE: u32 = 256;
 /// against itself two more a level.
 const STACK: usize = 128;
 
-/// How a search tells two nodes, or two triangles, apart.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum Fit {
+/// How a search tells two nodes, or two triangles, apart: as the last fit made them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+enum Fit {
     /// By their boxes: apart where they do not overlap.
+    #[default]
     Boxes,
     /// By their particles' motion: apart where, in the frame of their mean motion, the
     /// boxes of their starts and ends less that motion are `reach` apart along an axis.
@@ -59,7 +60,7 @@ pub(super) struct TriangleTree {
     end_lo: Vec<Vec3A>,
     end_hi: Vec<Vec3A>,
     mean: Vec<Vec3A>,
-    fit: Option<Fit>,
+    fit: Fit,
     /// Whether each box holds a triangle a refresh searches again ([`TriangleTree::mark`]).
     marked: Vec<bool>,
 }
@@ -103,11 +104,6 @@ impl TriangleTree {
     /// Triangles the tree was built for.
     pub(super) fn triangles(&self) -> usize {
         self.order.len()
-    }
-
-    /// Nodes in the tree.
-    pub(super) fn len(&self) -> usize {
-        self.nodes.len()
     }
 
     fn is_leaf(node: Split) -> bool {
@@ -181,7 +177,7 @@ impl TriangleTree {
                 (lo[t as usize].into(), hi[t as usize].into());
         }
         self.fit_nodes(false);
-        self.fit = Some(Fit::Boxes);
+        self.fit = Fit::Boxes;
     }
 
     /// Fits the tree to the motion of the particles of `triangles` from `from` to `to`,
@@ -204,7 +200,7 @@ impl TriangleTree {
             self.mean[i] = ((d - a) + (e - b) + (f - c)) / 3.0;
         }
         self.fit_nodes(true);
-        self.fit = Some(Fit::Motion { reach });
+        self.fit = Fit::Motion { reach };
     }
 
     /// Marks the boxes that hold a triangle `dirty` flags, for a walk of only theirs.
@@ -255,10 +251,10 @@ impl TriangleTree {
     pub(super) fn piece_pairs(&self, piece: usize, marked: bool, pair: impl FnMut(u32, u32)) {
         // One walk for each fit, each with its test inlined.
         match self.fit {
-            Some(Fit::Motion { reach }) => {
+            Fit::Motion { reach } => {
                 self.walk(piece, marked, |a, b| self.moving_apart(a, b, reach), pair);
             }
-            _ => self.walk(piece, marked, |a, b| self.boxes_apart(a, b), pair),
+            Fit::Boxes => self.walk(piece, marked, |a, b| self.boxes_apart(a, b), pair),
         }
     }
 
