@@ -154,14 +154,9 @@ pub struct SelfContacts {
     /// (as flags), for a refresh.
     left: Vec<bool>,
     dirty: Vec<bool>,
-    /// How much the boxes were grown by around each particle's motion.
-    grow: f32,
     /// The window the pairs judged by the motion were found for, and how far into it the
     /// substep resolved is.
     window: Window,
-    /// How far a particle may stray from its path in the window, m (0 for a window of one
-    /// substep, whose paths are the motion itself).
-    allowance: f32,
     /// Particles resting on a solid this substep (set by the stepper before
     /// [`SelfContacts::resolve`]): pushes move them only where nothing else can.
     pub held: Vec<bool>,
@@ -333,7 +328,8 @@ impl SelfContacts {
         // substep has no allowance: each particle starts where it did.
         let slack = 0.5 * (thickness - within);
         let (boxes, window) = (&self.boxes, self.window);
-        let (strays, off) = (self.allowance > 0.0, f64::from(self.allowance + slack));
+        let allowance = self.allowance(thickness);
+        let (strays, off) = (allowance > 0.0, f64::from(allowance + slack));
         let strayed = |i: usize, s: Vec3, p: Vec3| {
             let (from, to) = (boxes.from[i], boxes.to[i]);
             if !strays {
@@ -380,10 +376,31 @@ impl SelfContacts {
         }
     }
 
+    /// How far a particle may stray from its path in the window, m: none in a window of
+    /// one substep, whose paths are the motion itself.
+    fn allowance(&self, thickness: f32) -> f32 {
+        if self.window.len > 1 {
+            ALLOWANCE * thickness
+        } else {
+            0.0
+        }
+    }
+
     /// How near along their paths the pairs judged by the motion are kept, m: the
     /// thickness and twice the allowance.
     fn reach(&self, thickness: f32) -> f32 {
-        thickness + 2.0 * self.allowance
+        thickness + 2.0 * self.allowance(thickness)
+    }
+
+    /// How much each particle's box is grown around its motion, m: half the thickness and
+    /// the allowance where the pairs are judged by the motion, three quarters of the
+    /// thickness where by the boxes (room to reuse them).
+    fn grow(&self, thickness: f32) -> f32 {
+        if self.boxes.swept {
+            0.5 * thickness + self.allowance(thickness)
+        } else {
+            0.75 * thickness
+        }
     }
 
     /// The box that holds a particle's motion from `s` to `p`, grown by `grow` each way.
@@ -423,7 +440,7 @@ impl SelfContacts {
     fn refresh(&mut self, model: &ClothModel, thickness: f32) -> Result<(), ContactError> {
         // Until the pairs are whole again (an error on the way leaves them not).
         self.found_for = None;
-        let window = self.window;
+        let (window, grow) = (self.window, self.grow(thickness));
         for (i, _) in self.left.iter().enumerate().filter(|(_, l)| **l) {
             let (mut s, mut p) = (self.from[i], self.to[i]);
             if self.boxes.swept {
@@ -438,7 +455,7 @@ impl SelfContacts {
                 }
                 (self.boxes.from[i], self.boxes.to[i]) = (s, p);
             }
-            (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) = Self::vertex_box(s, p, self.grow);
+            (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) = Self::vertex_box(s, p, grow);
         }
         self.dirty.clear();
         let mut refreshed = 0;
@@ -522,16 +539,6 @@ impl SelfContacts {
             },
             at: 0,
         };
-        self.allowance = if self.window.len > 1 {
-            ALLOWANCE * thickness
-        } else {
-            0.0
-        };
-        self.grow = if slow {
-            0.75 * thickness
-        } else {
-            0.5 * thickness + self.allowance
-        };
         self.boxes.swept = !slow;
         if self.boxes.swept {
             self.boxes.from.clone_from(&self.from);
@@ -548,8 +555,9 @@ impl SelfContacts {
         } else {
             (&self.from, &self.to)
         };
+        let grow = self.grow(thickness);
         for (s, p) in from.iter().zip(to) {
-            let (lo, hi) = Self::vertex_box(*s, *p, self.grow);
+            let (lo, hi) = Self::vertex_box(*s, *p, grow);
             self.boxes.vertex_lo.push(lo);
             self.boxes.vertex_hi.push(hi);
         }
