@@ -48,16 +48,21 @@ impl TriangleTree {
             let [a, b, c] = triangles[t as usize];
             (a + b + c) / 3.0
         });
+        // An inner node keeps its second child where a leaf keeps its first place.
         let nodes = (splits.iter())
-            .map(|s| Node {
-                lo: Vec3::ZERO,
-                hi: Vec3::ZERO,
-                first: if s.count as usize > LEAF {
-                    s.second
+            .map(|s| {
+                let (first, count) = if s.count as usize > LEAF {
+                    (s.second, 0)
                 } else {
-                    s.first
-                },
-                count: if s.count as usize > LEAF { 0 } else { s.count },
+                    (s.first, s.count)
+                };
+                let (lo, hi) = (Vec3::ZERO, Vec3::ZERO);
+                Node {
+                    lo,
+                    hi,
+                    first,
+                    count,
+                }
             })
             .collect();
         let corners = order.iter().map(|&t| triangles[t as usize]).collect();
@@ -296,7 +301,7 @@ pub(crate) fn split_at_medians(
     centre: impl Fn(u32) -> Vec3,
 ) -> (Vec<Split>, Vec<u32>) {
     let mut order: Vec<u32> = (0..n as u32).collect();
-    let mut nodes = Vec::with_capacity(2 * n.div_ceil(leaf.max(1)));
+    let mut nodes: Vec<Split> = Vec::with_capacity(2 * n.div_ceil(leaf.max(1)));
     // Depth first: the second child is set aside until the first's subtree is built.
     let mut pending = if n == 0 {
         vec![]
@@ -304,12 +309,10 @@ pub(crate) fn split_at_medians(
         vec![(0u32, n as u32, None)]
     };
     while let Some((first, count, parent)) = pending.pop() {
-        if let Some(parent) = parent {
-            let at = nodes.len() as u32;
-            let node: &mut Split = &mut nodes[parent as usize];
-            node.second = at;
-        }
         let at = nodes.len() as u32;
+        if let Some(parent) = parent {
+            nodes[parent as usize].second = at;
+        }
         nodes.push(Split {
             first,
             count,
