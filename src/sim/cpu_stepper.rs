@@ -9,7 +9,7 @@ use crate::cloth::{ClothModel, ClothState, Real};
 use super::backend::StepBackend;
 use super::diagnosis::Cause;
 use super::effects::{
-    ContactPass, Effect, SelfCollision, air_damping_of, gravity_of, shortest_edge,
+    ContactPass, Effect, FacePatches, SelfCollision, air_damping_of, gravity_of, shortest_edge,
 };
 use super::forces::ForceSet;
 use super::guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check};
@@ -60,6 +60,8 @@ pub struct CpuStepper<R: Real = f32> {
     /// Positions before the solids act (first, and again after self-contact): what they
     /// moved is what changed since.
     before_solids: Vec<glam::Vec3>,
+    /// The cloth's triangles in patches, for the solids' face passes.
+    faces: FacePatches,
     /// Air damping in effect, 1/s (0 without the effect; for the guard's diagnosis).
     air_damping: f32,
     /// The state stepped, in a precision other than `f32`.
@@ -112,6 +114,7 @@ impl<R: Real> CpuStepper<R> {
             self_collision: None,
             self_contacts: SelfContacts::default(),
             before_solids: Vec::new(),
+            faces: FacePatches::default(),
             air_damping: 0.0,
             precise: PreciseState::default(),
             view: ClothState::default(),
@@ -188,7 +191,7 @@ impl<R: Real> CpuStepper<R> {
             state,
             offset: self.offset,
             self_contacts: &mut self.self_contacts,
-            faces: self.self_collision.is_some(),
+            faces: (self.self_collision.is_some()).then_some(&mut self.faces),
         };
         if self.self_collision.is_some() {
             self.before_solids.clone_from(&pass.state.pos);
@@ -199,14 +202,18 @@ impl<R: Real> CpuStepper<R> {
                 let held = &mut pass.self_contacts.held;
                 held.clear();
                 held.extend((self.before_solids.iter().zip(&pass.state.pos)).map(|(a, b)| a != b));
+                // Where self-contact starts from (it comes last).
+                self.before_solids.clone_from(&pass.state.pos);
             }
             contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
         }
         // Self-contact may have pushed cloth into a solid (a stack pressing its lowest
-        // layer): the solids act once more, and the cloth's motion since self-contact is
-        // checked again, cut where a pair of the cloth could meet.
+        // layer): where it moved anything, the solids act once more, and the cloth's
+        // motion since self-contact is checked again, cut where a pair of the cloth could
+        // meet.
         if let Some(own) = self.self_collision
             && self.contacts.len() > 1
+            && self.before_solids != pass.state.pos
         {
             for _ in 0..RECHECKS {
                 self.before_solids.clone_from(&pass.state.pos);

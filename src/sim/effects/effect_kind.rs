@@ -4,6 +4,7 @@
 
 use glam::Vec3;
 
+use super::faces::FacePatches;
 use crate::cloth::{ClothModel, ClothState, Real};
 use crate::sim::forces::Force;
 use crate::sim::param_error::ParamError;
@@ -22,9 +23,10 @@ pub struct ContactPass<'a> {
     pub offset: f32,
     /// Self-collision's buffers, kept between substeps.
     pub self_contacts: &'a mut SelfContacts,
-    /// Whether solids keep the cloth's triangles out too, not only its particles (with
-    /// self-contact, whose guarantee covers the surface).
-    pub faces: bool,
+    /// Where solids keep the cloth's triangles out too, not only its particles (with
+    /// self-contact, whose guarantee covers the surface): the triangles in patches, so a
+    /// solid tests the triangles of the patches near it only.
+    pub faces: Option<&'a mut FacePatches>,
 }
 
 /// What an effect adds to the stability guard's limits.

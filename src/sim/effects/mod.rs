@@ -5,6 +5,7 @@ mod air_damping;
 mod bending;
 mod cloth_springs;
 mod effect_kind;
+mod faces;
 mod gravity;
 mod handle;
 mod list;
@@ -20,6 +21,7 @@ pub use air_damping::AirDamping;
 pub use bending::{BendingModel, DEFAULT_DIHEDRAL_STIFFNESS};
 pub use cloth_springs::ClothSprings;
 pub use effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
+pub use faces::FacePatches;
 pub use gravity::Gravity;
 pub use handle::Handle;
 pub use list::{

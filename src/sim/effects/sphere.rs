@@ -75,23 +75,18 @@ impl Sphere {
     fn keep_faces_out(&self, pass: &mut ContactPass<'_>) -> usize {
         let reach = self.radius + pass.offset;
         let (model, state) = (pass.model, &mut *pass.state);
+        let Some(patches) = pass.faces.as_deref_mut() else {
+            return 0;
+        };
+        // Only the triangles of the patches whose box comes within the reach.
+        let center = self.center;
+        let near =
+            |lo: Vec3, hi: Vec3| center.clamp(lo, hi).distance_squared(center) < reach * reach;
         let inv = &model.inv_mass;
         let mut pushed = 0;
-        for t in &model.triangles {
-            let ids = t.map(|i| i as usize);
+        for &t in patches.near(model, &state.pos, near) {
+            let ids = model.triangles[t as usize].map(|i| i as usize);
             let x = ids.map(|i| state.pos[i]);
-            // One root each: the root of the least square is the least root.
-            let near = (x.iter())
-                .map(|p| p.distance_squared(self.center))
-                .fold(f32::INFINITY, f32::min)
-                .sqrt();
-            let longest = (x[0].distance_squared(x[1]))
-                .max(x[1].distance_squared(x[2]))
-                .max(x[2].distance_squared(x[0]))
-                .sqrt();
-            if near > reach + longest {
-                continue;
-            }
             let w = closest_weights(self.center, x);
             let q = w[0] * x[0] + w[1] * x[1] + w[2] * x[2];
             let gap = q - self.center;
@@ -162,12 +157,7 @@ impl EffectKind for Sphere {
 
     fn resolve(&self, pass: &mut ContactPass<'_>) -> Result<usize, ContactError> {
         let particles = resolve(self, pass);
-        let faces = if pass.faces {
-            self.keep_faces_out(pass)
-        } else {
-            0
-        };
-        Ok(particles + faces)
+        Ok(particles + self.keep_faces_out(pass))
     }
 
     fn surface(&self, p: Vec3) -> Option<(f32, Vec3, Vec3)> {

@@ -1,0 +1,101 @@
+//! The cloth's triangles in patches, for the solids' face passes: a pass that keeps the
+//! triangles' interiors out of a solid tests each patch's box first, and only the
+//! triangles of the patches near the solid one by one. The patches are cut once per cloth
+//! from where its triangles lie at rest (halved at the medians of their centres, as the
+//! trees are), so each is a piece of cloth that stays together however it folds and its
+//! box stays small.
+
+use glam::Vec3;
+
+use crate::cloth::ClothModel;
+use crate::sim::obstacle::split_at_medians;
+
+/// Triangles in a patch at most (at least half as many, but for a cloth with fewer).
+const PATCH: usize = 32;
+
+/// The patches and the triangles a face pass takes (scratch: nothing is allocated once
+/// warm).
+#[derive(Clone, Debug, Default)]
+pub struct FacePatches {
+    /// The triangles, patch by patch; patch `k`'s are `triangles[starts[k]..starts[k + 1]]`.
+    triangles: Vec<u32>,
+    starts: Vec<usize>,
+    /// The particles of each patch's triangles, each once a patch, cut as the triangles.
+    particles: Vec<u32>,
+    particle_starts: Vec<usize>,
+    /// The cloth they were cut for: its triangles and particles.
+    cut_for: (usize, usize),
+    /// The triangles of the patches the last call found near, in the cloth's order.
+    near: Vec<u32>,
+}
+
+impl FacePatches {
+    /// Cuts the patches for `model` if they were cut for another cloth (a stepper serves
+    /// one cloth: its size tells a new one apart).
+    fn fit(&mut self, model: &ClothModel) {
+        let size = (model.triangles.len(), model.particle_count());
+        if size == self.cut_for && !self.starts.is_empty() {
+            return;
+        }
+        let (triangles, rest) = (&model.triangles, &model.rest_positions);
+        let (nodes, order) = split_at_medians(triangles.len(), PATCH, |t| {
+            let corner = |i: u32| rest.get(i as usize).copied().unwrap_or(Vec3::ZERO);
+            triangles[t as usize]
+                .iter()
+                .map(|&i| corner(i))
+                .sum::<Vec3>()
+                / 3.0
+        });
+        *self = FacePatches {
+            cut_for: size,
+            ..FacePatches::default()
+        };
+        let mut seen = vec![usize::MAX; model.particle_count()];
+        self.starts.push(0);
+        self.particle_starts.push(0);
+        for (k, node) in (nodes.iter().filter(|n| n.count as usize <= PATCH)).enumerate() {
+            let held = &order[node.first as usize..(node.first + node.count) as usize];
+            for &t in held {
+                self.triangles.push(t);
+                for i in triangles[t as usize] {
+                    if let Some(mark) = seen.get_mut(i as usize).filter(|m| **m != k) {
+                        *mark = k;
+                        self.particles.push(i);
+                    }
+                }
+            }
+            self.starts.push(self.triangles.len());
+            self.particle_starts.push(self.particles.len());
+        }
+    }
+
+    /// The triangles, in the cloth's order, of every patch whose particles at `pos` lie in
+    /// a box for which `near(lo, hi)` holds: a triangle lies in the box of its corners, so
+    /// one that a solid could touch is among them when `near` holds for every box the
+    /// solid comes within its reach of.
+    pub fn near(
+        &mut self,
+        model: &ClothModel,
+        pos: &[Vec3],
+        near: impl Fn(Vec3, Vec3) -> bool,
+    ) -> &[u32] {
+        self.fit(model);
+        self.near.clear();
+        for k in 0..self.starts.len() - 1 {
+            let ids = &self.particles[self.particle_starts[k]..self.particle_starts[k + 1]];
+            let (lo, hi) =
+                (ids.iter()).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &i| {
+                    let p = pos[i as usize];
+                    (lo.min(p), hi.max(p))
+                });
+            if near(lo, hi) {
+                (self.near).extend_from_slice(&self.triangles[self.starts[k]..self.starts[k + 1]]);
+            }
+        }
+        self.near.sort_unstable();
+        &self.near
+    }
+}
+
+#[cfg(test)]
+mod tests;
