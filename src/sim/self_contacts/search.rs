@@ -388,7 +388,9 @@ impl Search<'_> {
     /// motion the boxes were made for. First the sides' boxes in the frame that moves with
     /// the pair's mean motion (each side stays in the box of its particles' starts and
     /// ends less that motion; a translation changes no distance): most pairs that move
-    /// together end there, their gap along an axis. Then the distance: it changes along the
+    /// together end there, their gap along an axis. Then, in the same frame, the gap along
+    /// the line between the sides' middles (two sides a cell apart on a patch that runs
+    /// across the axes end there). Then the distance: it changes along the
     /// motion no faster than the sides' largest displacements relative to the pair's mean
     /// motion add up to (`L`), so it stays above both `d₀ − τL` and `d₁ − (1 − τ)L`, whose
     /// larger is least, `(d₀ + d₁ − L)/2`, where they cross.
@@ -408,8 +410,28 @@ impl Search<'_> {
         let k = pair.first_side();
         let ((alo, ahi), (blo, bhi)) = (side(0..k), side(k..4));
         let gap = (blo - ahi).max(alo - bhi).max_element();
-        if gap >= f64::from(self.thickness) {
+        let thickness = f64::from(self.thickness);
+        if gap >= thickness {
             return gap;
+        }
+        // Then along the line between the sides' middles (in the same frame): where a
+        // smooth patch runs across the axes, two sides a cell apart are apart along it.
+        let ends: [DVec3; 4] = std::array::from_fn(|j| x1[j] - mean);
+        let middle = |r: std::ops::Range<usize>| {
+            let n = r.len() as f64;
+            r.map(|j| x0[j] + ends[j]).sum::<DVec3>() / (2.0 * n)
+        };
+        let axis = middle(k..4) - middle(0..k);
+        let span = |r: std::ops::Range<usize>| {
+            r.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), j| {
+                let (p, q) = (axis.dot(x0[j]), axis.dot(ends[j]));
+                (lo.min(p).min(q), hi.max(p).max(q))
+            })
+        };
+        let ((_, ahi), (blo, _)) = (span(0..k), span(k..4));
+        let length = axis.length();
+        if blo - ahi >= thickness * length && length > 0.0 {
+            return (blo - ahi) / length;
         }
         0.5 * (distance(pair, x0) + distance(pair, x1) - closing_bound(pair, moves))
     }
