@@ -25,7 +25,7 @@ use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
 
 /// The share of the thickness by which a certificate must clear it: for the rounding of
 /// the positions in the frame the search works in (the pairs' own tests keep none).
-const MARGIN: f32 = 0.01;
+pub(super) const MARGIN: f32 = 0.01;
 
 /// The references and what they certify.
 #[derive(Clone, Debug, Default)]
@@ -49,15 +49,16 @@ impl Certificates {
     /// Decides, for the motion of each particle from `from` to `to`, which corners' pairs
     /// could come within `thickness` (those it leaves [`Certificates::open`]); with `only`,
     /// only the corners that are, or have in their ring, a particle it flags (the others'
-    /// motion is as when they were last decided). Returns how many references it took
-    /// again.
+    /// motion is as when they were last decided); with `covered`, the corners it flags are
+    /// closed as they are (their pairs are certified apart otherwise:
+    /// [`super::patches`]). Returns how many references it took again.
     pub(super) fn decide(
         &mut self,
         owners: &Owners,
         triangles: &[[u32; 3]],
         [from, to]: [&[Vec3]; 2],
         thickness: f32,
-        only: Option<&[bool]>,
+        [only, covered]: [Option<&[bool]>; 2],
     ) -> u64 {
         let rings = &owners.rings;
         let corners = from.len();
@@ -83,6 +84,11 @@ impl Certificates {
                 let range = rings.range(c);
                 let ring = &rings.ring[range.clone()];
                 if only.is_some_and(|o| !o[c] && ring.iter().all(|&j| !o[j as usize])) {
+                    continue;
+                }
+                if covered.is_some_and(|k| k[c]) {
+                    // SAFETY: each corner is one piece's.
+                    *unsafe { open.at(c) } = false;
                     continue;
                 }
                 // SAFETY: each corner is one piece's, and its ring's entries its own.
@@ -173,7 +179,7 @@ fn certified(apart: f32, strayed: f32, least: f32) -> bool {
 /// An orthonormal frame of the triangle (`c`, `a`, `b`): along `a − c`, across it in the
 /// triangle's plane, and along the normal; where the triangle has no area, no turn at all
 /// (any turn keeps the bound, this one only keeps it tight).
-fn frame(c: Vec3, a: Vec3, b: Vec3) -> Mat3 {
+pub(super) fn frame(c: Vec3, a: Vec3, b: Vec3) -> Mat3 {
     let along = (a - c).normalize_or_zero();
     let normal = (a - c).cross(b - c).normalize_or_zero();
     if along == Vec3::ZERO || normal == Vec3::ZERO {
@@ -183,7 +189,7 @@ fn frame(c: Vec3, a: Vec3, b: Vec3) -> Mat3 {
 }
 
 /// `d` rounded down to an `f32`.
-fn shave(d: f64) -> f32 {
+pub(super) fn shave(d: f64) -> f32 {
     let f = d as f32;
     if f64::from(f) > d { f.next_down() } else { f }
 }

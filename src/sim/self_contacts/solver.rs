@@ -11,6 +11,7 @@ use super::ccd::safe_fraction;
 use super::certify::Certificates;
 use super::error::ContactError;
 use super::found::Found;
+use super::patches::Patches;
 use super::primitives::{StoredPair, closer_than, push_apart};
 use super::search::{Boxes, Owners, Search, pairs};
 use super::tree::TriangleTree;
@@ -134,6 +135,8 @@ impl Default for Window {
 #[derive(Clone, Debug, Default)]
 pub struct SelfContacts {
     tree: TriangleTree,
+    /// The tree's patches certified apart by the rest shape.
+    patches: Patches,
     owners: Owners,
     /// The particles' and triangles' boxes the pairs were found with.
     boxes: Boxes,
@@ -369,10 +372,17 @@ impl SelfContacts {
     fn decide_corners(&mut self, triangles: &[[u32; 3]], thickness: f32, refreshed: bool) {
         if self.boxes.swept {
             let motion = [&self.boxes.from[..], &self.boxes.to[..]];
-            let only = refreshed.then_some(&self.left[..]);
+            // A whole search leaves the corners the patches cover closed; a refresh decides
+            // those whose motion changed, covered or not.
+            let (only, covered) = if refreshed {
+                (Some(&self.left[..]), None)
+            } else {
+                (None, Some(&self.patches.corners[..]))
+            };
             let reach = self.reach(thickness);
             let certificates = &mut self.certificates;
-            self.work.retaken += certificates.decide(&self.owners, triangles, motion, reach, only);
+            self.work.retaken +=
+                certificates.decide(&self.owners, triangles, motion, reach, [only, covered]);
         }
     }
 
@@ -577,7 +587,9 @@ impl SelfContacts {
             });
         }
         if self.tree.triangles() != model.triangles.len() {
-            self.tree = TriangleTree::build(&model.triangles, &model.rest_positions);
+            let (triangles, rest) = (&model.triangles, &model.rest_positions);
+            self.tree = TriangleTree::build(triangles, rest);
+            self.patches = Patches::build(&mut self.tree, triangles, rest, &self.owners);
         }
         for (n, &t) in model.triangles.iter().enumerate() {
             let (lo, hi) = self.triangle_box(n, t, thickness)?;
@@ -586,6 +598,15 @@ impl SelfContacts {
         }
         self.fit_tree(model, thickness);
         self.found.clear();
+        if self.boxes.swept {
+            let (motion, reach) = (
+                [&self.boxes.from[..], &self.boxes.to[..]],
+                self.reach(thickness),
+            );
+            (self.patches).decide(&mut self.tree, motion, reach);
+        } else {
+            self.patches.uncover(&mut self.tree);
+        }
         self.decide_corners(&model.triangles, thickness, false);
         let search = Search {
             owners: &self.owners,

@@ -26,7 +26,7 @@ type Task = (u32, u32);
 
 /// A node of this many triangles or fewer is walked against itself in one piece of a
 /// search.
-const TRIANGLES_PER_PIECE: u32 = 256;
+pub(super) const TRIANGLES_PER_PIECE: u32 = 256;
 
 /// The deepest walk: a balanced tree of 2³¹ triangles is 30 levels deep; a walk of two
 /// nodes holds at most one task more for each level it goes down either, one of a node
@@ -63,6 +63,9 @@ pub(super) struct TriangleTree {
     fit: Fit,
     /// Whether each box holds a triangle a refresh searches again ([`TriangleTree::mark`]).
     marked: Vec<bool>,
+    /// Whether each node's own pairs are certified apart for the motion of the last fit
+    /// (see [`super::patches`]): a whole walk passes by a node against itself then.
+    pub(super) covered: Vec<bool>,
 }
 
 impl TriangleTree {
@@ -104,6 +107,17 @@ impl TriangleTree {
     /// Triangles the tree was built for.
     pub(super) fn triangles(&self) -> usize {
         self.order.len()
+    }
+
+    /// The nodes, each parent before its children (the first right after it).
+    pub(super) fn nodes(&self) -> &[Split] {
+        &self.nodes
+    }
+
+    /// The triangles node `i` holds.
+    pub(super) fn held(&self, i: usize) -> &[u32] {
+        let node = self.nodes[i];
+        &self.order[node.first as usize..(node.first + node.count) as usize]
     }
 
     fn is_leaf(node: Split) -> bool {
@@ -244,10 +258,11 @@ impl TriangleTree {
     }
 
     /// Calls `pair(a, b)` for each two triangles the walk of piece `piece` does not tell
-    /// apart (as the last fit tells them); the pieces together call it once for every
-    /// such two. With `marked`, only for those two of which one at least is marked
-    /// ([`TriangleTree::mark`]): the walk passes by two unmarked sides, and so tells every
-    /// other two apart, or not, exactly as the whole walk does.
+    /// apart (as the last fit tells them) and no covered node holds both of; the pieces
+    /// together call it once for every such two. With `marked`, only for those two of
+    /// which one at least is marked ([`TriangleTree::mark`]), covered or not: the walk
+    /// passes by two unmarked sides, and so tells every other two apart, or not, exactly
+    /// as the whole walk does.
     pub(super) fn piece_pairs(&self, piece: usize, marked: bool, pair: impl FnMut(u32, u32)) {
         // One walk for each fit, each with its test inlined.
         match self.fit {
@@ -287,6 +302,9 @@ impl TriangleTree {
             }
             let (na, nb) = (self.nodes[a as usize], self.nodes[b as usize]);
             if a == b {
+                if !marked && self.covered.get(a as usize).copied().unwrap_or(false) {
+                    continue;
+                }
                 if Self::is_leaf(na) {
                     let held = na.first as usize..(na.first + na.count) as usize;
                     for p in held.clone() {

@@ -83,7 +83,7 @@ fn a_corner_left_closed_keeps_its_pairs_a_thickness_apart() {
         let fold = |s: usize| (5.0 * s as f32).to_radians();
         let from = folded(&rest, fold(step), step);
         let to = folded(&rest, fold(step + 1), step + 1);
-        certificates.decide(&owners, triangles, [&from, &to], THICKNESS, None);
+        certificates.decide(&owners, triangles, [&from, &to], THICKNESS, [None; 2]);
         for c in 0..rest.len() {
             if owners.corner_pairs(c).is_empty() {
                 continue;
@@ -127,7 +127,13 @@ fn a_cloth_that_only_turns_keeps_its_references() {
     let mut certificates = Certificates::default();
     for step in 0..4 {
         let (from, to) = (moved(step), moved(step + 1));
-        let retaken = certificates.decide(&owners, &model.triangles, [&from, &to], THICKNESS, None);
+        let retaken = certificates.decide(
+            &owners,
+            &model.triangles,
+            [&from, &to],
+            THICKNESS,
+            [None; 2],
+        );
         let expected = if step == 0 { with_pairs as u64 } else { 0 };
         assert_eq!(retaken, expected, "substep {step}");
         assert!(certificates.open.iter().all(|&o| !o), "substep {step}");
@@ -176,7 +182,7 @@ fn flaps_pressed_together_open_their_corner_before_they_come_within_the_thicknes
         for motion in [[&rest, &pressed], [&pressed, &rest]] {
             let mut certificates = Certificates::default();
             let still = [&rest[..], &rest[..]];
-            certificates.decide(&owners, &model.triangles, still, thickness, None);
+            certificates.decide(&owners, &model.triangles, still, thickness, [None; 2]);
             assert!(!certificates.open[0]);
             // The substep, then one that stays where it ended (on the reference taken
             // there, if it was).
@@ -185,7 +191,7 @@ fn flaps_pressed_together_open_their_corner_before_they_come_within_the_thicknes
                 .enumerate()
             {
                 let retaken =
-                    certificates.decide(&owners, &model.triangles, motion, thickness, None);
+                    certificates.decide(&owners, &model.triangles, motion, thickness, [None; 2]);
                 let least = closest_along(&owners, &model.triangles, 0, motion);
                 if certificates.open[0] {
                     assert!(

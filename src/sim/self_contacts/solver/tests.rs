@@ -443,6 +443,74 @@ fn particles_that_leave_a_window_get_paths_of_their_own() {
     assert!(near_total > 5000, "{near_total} pairs came near");
 }
 
+/// A particle that strays inside a patch the rest shape certified has its triangles
+/// searched again against that patch too: the cloth of
+/// [`pairs_found_for_a_window_hold_through_it`], four particles of its upper half (whose
+/// patches keep their rest shape, mirrored, and are covered) pushed 5.2 cm along the plane
+/// in the window's second substep, each along another diagonal, towards triangles of
+/// their own patch (5.9 cm away at rest), which the refresh of that substep must find.
+/// Every pair that comes near is held throughout, the pushed ones' too.
+#[test]
+fn a_particle_that_strays_inside_a_covered_patch_is_searched_against_it() {
+    let pushed = [
+        (41, [1.0, 1.0]),
+        (43, [1.0, -1.0]),
+        (119, [-1.0, 1.0]),
+        (121, [-1.0, -1.0]),
+    ];
+    let push = |i: usize, k: usize| {
+        let along = pushed
+            .iter()
+            .find(|p| p.0 == i)
+            .map_or(Vec3::ZERO, |p| Vec3::new(p.1[0], 0.0, p.1[1]).normalize());
+        along * 0.052 * k.saturating_sub(2).min(1) as f32
+    };
+    let (mesh, model, path) = folded_and_sinking(push);
+    let mut contacts = SelfContacts {
+        owners: Owners::build(&model),
+        ..SelfContacts::default()
+    };
+    let mut covered = 0;
+    for k in 0..path.len() - 1 {
+        let motion = [&path[k][..], &path[k + 1][..]];
+        hold_through(&mut contacts, &mesh, &model, motion);
+        if k == 1 {
+            // The window's whole search: the pushed particles' patches are covered.
+            let nodes = contacts.tree.nodes().len();
+            covered = (0..nodes)
+                .filter(|&n| contacts.tree.covered[n])
+                .filter(|&n| {
+                    let held = contacts.tree.held(n);
+                    held.iter().any(|&t| {
+                        pushed
+                            .iter()
+                            .any(|p| model.triangles[t as usize].contains(&(p.0 as u32)))
+                    })
+                })
+                .count();
+        }
+        if k == 2 {
+            assert_eq!((contacts.window.len, contacts.window.at), (2, 1));
+            assert_eq!(contacts.work.refreshes, 1, "{:?}", contacts.work);
+        }
+    }
+    assert!(
+        covered >= 4,
+        "{covered} covered nodes hold a pushed particle"
+    );
+    // The pushed particles came near triangles of their own patches.
+    let near = |i: usize| {
+        let end = &path[3];
+        (model.triangles.iter())
+            .filter(|t| !t.contains(&(i as u32)))
+            .any(|t| {
+                let x = [i, t[0] as usize, t[1] as usize, t[2] as usize].map(|j| end[j].as_dvec3());
+                distance(&Pair::vertex_triangle(i as u32, *t), x) < f64::from(THICKNESS)
+            })
+    };
+    assert!(pushed.iter().any(|p| near(p.0)));
+}
+
 /// A 12 × 12-quad cloth folded in two, its upper half 1.5 thicknesses above the lower and
 /// sinking onto it by 0.1 of the thickness a substep, one row of the lower half sliding
 /// away at a thickness a substep, every particle wobbling off its path by up to 0.035 of

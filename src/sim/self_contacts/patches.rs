@@ -1,0 +1,342 @@
+//! Patches certified apart by the cloth's shape at rest. Where the cloth lands, a search
+//! spends most of its time proving what is plain to see: that a smooth patch does not
+//! touch itself. The tree's nodes of [`SMALLEST`]–[`TRIANGLES_PER_PIECE`] triangles are
+//! patches that stay together however the cloth folds; at rest no two sides of a pair of
+//! the cloth are closer than its rest gap (measured once per cloth, up to its longest
+//! edge), and a pair's distance changes by at most twice the farthest its particles stray
+//! from a rigid motion of the rest shape. So while every particle of a patch stays within
+//! half of what the gap leaves over the reach of where its rest shape, turned with the
+//! patch's frame and carried with its first particle, puts it, no pair of two of its
+//! triangles comes within the reach — those that share a corner included. As for the
+//! corners' certificates ([`super::certify`]), the frame is the patch's in the middle of
+//! the motion, each particle's offset from its place is then linear along the motion, and
+//! a patch is certified for the whole motion from its start and end.
+//!
+//! A certified node is covered, and so is every node under it: a whole search walks past a
+//! covered node against itself and leaves the corners whose ring a covered node holds
+//! closed. The certificates need no reference taken again: the rest shape is the
+//! reference.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use glam::Vec3;
+
+use super::certify::{MARGIN, frame, shave};
+use super::primitives::{Pair, distance};
+use super::search::{NONE, Owners};
+use super::tree::{TRIANGLES_PER_PIECE, TriangleTree};
+use crate::parallel::{PARALLEL_ELEMENTS, Team};
+
+/// Triangles in the smallest node certified on its own (smaller ones are covered only
+/// with a node above them: their walk is short, and their frames would turn on a few
+/// particles).
+const SMALLEST: u32 = 4;
+
+/// The patches of one cloth, from its rest shape.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Patches {
+    /// Each node's parent (the root its own).
+    parent: Vec<u32>,
+    /// Each node's entries, `start[i]..start[i + 1]` (none: it is not certified on its
+    /// own).
+    start: Vec<u32>,
+    /// Each entry's particle; its offset at rest from the node's middle, in the node's
+    /// frame at rest; and its weights in the node's turn (see [`Patches::turn`]).
+    particle: Vec<u32>,
+    reference: Vec<Vec3>,
+    weights: Vec<[f32; 2]>,
+    /// Each corner's smallest node holding every triangle around it ([`NONE`]: none of at
+    /// most [`TRIANGLES_PER_PIECE`] triangles).
+    home: Vec<u32>,
+    /// The least distance at rest between the sides of a pair of the cloth, up to its
+    /// longest edge, rounded down, m.
+    gap: f32,
+    /// Whether each corner's ring is held by a node covered for the motion last decided.
+    pub(super) corners: Vec<bool>,
+}
+
+impl Patches {
+    /// The patches of the cloth of `triangles` whose `tree` is built from its `rest`
+    /// positions. Leaves the tree fitted to the rest shape and uncovered.
+    pub(super) fn build(
+        tree: &mut TriangleTree,
+        triangles: &[[u32; 3]],
+        rest: &[Vec3],
+        owners: &Owners,
+    ) -> Patches {
+        let nodes = tree.nodes().to_vec();
+        let mut patches = Patches {
+            parent: vec![0; nodes.len()],
+            start: vec![0],
+            gap: rest_gap(tree, triangles, rest, owners),
+            ..Patches::default()
+        };
+        for (i, node) in nodes.iter().enumerate() {
+            if node.second != 0 {
+                patches.parent[i + 1] = i as u32;
+                patches.parent[node.second as usize] = i as u32;
+            }
+        }
+        // Each node's particles, each once: the stamp is the node that took it last.
+        let mut stamp = vec![NONE; rest.len()];
+        let mut held = Vec::new();
+        for (i, node) in nodes.iter().enumerate() {
+            held.clear();
+            if (SMALLEST..=TRIANGLES_PER_PIECE).contains(&node.count) {
+                for &t in tree.held(i) {
+                    for j in triangles[t as usize] {
+                        if std::mem::replace(&mut stamp[j as usize], i as u32) != i as u32 {
+                            held.push(j);
+                        }
+                    }
+                }
+            }
+            patches.add(&held, rest);
+            patches.start.push(patches.particle.len() as u32);
+        }
+        patches.home = homes(tree, &nodes, &patches.parent, triangles, rest.len());
+        tree.covered.clear();
+        patches
+    }
+
+    /// Covers the tree's nodes certified for the motion of each particle from `from` to
+    /// `to`, with `reach` (see the module's notes), and the corners whose ring they hold.
+    pub(super) fn decide(&mut self, tree: &mut TriangleTree, [from, to]: [&[Vec3]; 2], reach: f32) {
+        let least = reach * (1.0 + MARGIN);
+        let covered = &mut tree.covered;
+        covered.clear();
+        for i in 0..self.parent.len() {
+            let above = i > 0 && covered[self.parent[i] as usize];
+            covered.push(above || self.certified(i, [from, to], least));
+        }
+        self.corners.clear();
+        (self.corners).extend(self.home.iter().map(|&h| h != NONE && covered[h as usize]));
+    }
+
+    /// Covers nothing (the pairs are judged by the boxes, not by the motion).
+    pub(super) fn uncover(&mut self, tree: &mut TriangleTree) {
+        tree.covered.clear();
+        self.corners.clear();
+        self.corners.resize(self.home.len(), false);
+    }
+
+    /// Whether every particle of node `i` starts and ends within `√limit` of where its
+    /// rest shape, turned with the node's frame in the middle of the motion and carried
+    /// with its first anchor, puts it (never for a node with no entries, nor where a
+    /// distance is NaN).
+    fn certified(&self, i: usize, [from, to]: [&[Vec3]; 2], least: f32) -> bool {
+        let range = self.start[i] as usize..self.start[i + 1] as usize;
+        if range.is_empty() {
+            return false;
+        }
+        let (particle, weights) = (&self.particle[range.clone()], &self.weights[range.clone()]);
+        let n = range.len() as f32;
+        // The middles of the starts and of the ends, and the map fitted in the middle.
+        let (mut first, mut last, mut p, mut q) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+        for (&j, &[a, b]) in particle.iter().zip(weights) {
+            let (s, e) = (from[j as usize], to[j as usize]);
+            (first, last) = (first + s, last + e);
+            let middle = 0.5 * (s + e);
+            (p, q) = (p + a * middle, q + b * middle);
+        }
+        let (first, last) = (first / n, last / n);
+        let Some((map, shrink)) = fitted(p, q) else {
+            return false;
+        };
+        let most = 0.5 * (shrink * self.gap - least);
+        if most.is_nan() || most <= 0.0 {
+            return false;
+        }
+        let limit = most * most;
+        (particle.iter().zip(&self.reference[range])).all(|(&j, &r)| {
+            let (j, r) = (j as usize, map * r);
+            let start = (from[j] - first - r).length_squared();
+            let end = (to[j] - last - r).length_squared();
+            start <= limit && end <= limit
+        })
+    }
+
+    /// Adds a node's entries for its particles `held` at `rest` (none: not certified).
+    fn add(&mut self, held: &[u32], rest: &[Vec3]) {
+        if held.is_empty() {
+            return;
+        }
+        let at = |j: u32| rest[j as usize];
+        let middle = held.iter().map(|&j| at(j)).sum::<Vec3>() / held.len() as f32;
+        let [a, b, c] = anchor(held, rest).map(at);
+        let back = frame(a, b, c).transpose();
+        let start = self.reference.len();
+        (self.reference).extend(held.iter().map(|&j| back * (at(j) - middle)));
+        // The least-squares fit of the motion's middles by a linear map of the rest
+        // shape's offsets in the frame's first two axes: `p` and `q` are the map's
+        // columns, each a sum over the particles weighted by the inverse of the offsets'
+        // second moments. A rigid motion is fitted exactly (its turn, found again).
+        let r = &self.reference[start..];
+        let (uu, uv, vv) = r.iter().fold((0.0, 0.0, 0.0), |(uu, uv, vv), o| {
+            (uu + o.x * o.x, uv + o.x * o.y, vv + o.y * o.y)
+        });
+        let det = uu * vv - uv * uv;
+        let inverse = if det.abs() > f32::EPSILON * (uu * vv).max(f32::MIN_POSITIVE) {
+            [vv / det, -uv / det, uu / det]
+        } else {
+            [0.0; 3]
+        };
+        (self.weights).extend(r.iter().map(|o| {
+            [
+                inverse[0] * o.x + inverse[1] * o.y,
+                inverse[1] * o.x + inverse[2] * o.y,
+            ]
+        }));
+        self.particle.extend_from_slice(held);
+    }
+}
+
+/// The linear map whose first two columns are `p` and `q` and whose third is their
+/// normal scaled by the least the two stretch any direction between them, and that least
+/// (`None` where they are parallel): it shrinks no distance by more than that least.
+fn fitted(p: Vec3, q: Vec3) -> Option<(glam::Mat3, f32)> {
+    let (a, b, c) = (p.dot(p), p.dot(q), q.dot(q));
+    let least = 0.5 * (a + c) - (0.25 * (a - c) * (a - c) + b * b).sqrt();
+    let normal = p.cross(q).normalize_or_zero();
+    if least.is_nan() || least <= 0.0 || normal == Vec3::ZERO {
+        return None;
+    }
+    let shrink = least.sqrt();
+    Some((glam::Mat3::from_cols(p, q, shrink * normal), shrink))
+}
+
+/// Three of `held` (at `rest`) whose frame turns a node: the one nearest their middle,
+/// the one farthest from it, and the one farthest from the line through those two.
+fn anchor(held: &[u32], rest: &[Vec3]) -> [u32; 3] {
+    let Some(&first) = held.first() else {
+        return [0; 3];
+    };
+    let at = |j: u32| rest[j as usize];
+    let middle = held.iter().map(|&j| at(j)).sum::<Vec3>() / held.len() as f32;
+    let most = |key: &dyn Fn(Vec3) -> f32| {
+        (held.iter().copied()).fold((first, f32::NEG_INFINITY), |(best, k), j| {
+            let v = key(at(j));
+            if v > k { (j, v) } else { (best, k) }
+        })
+    };
+    let (a, _) = most(&|p| -p.distance_squared(middle));
+    let (b, _) = most(&|p| p.distance_squared(at(a)));
+    let (c, _) = most(&|p| (p - at(a)).cross(at(b) - at(a)).length_squared());
+    [a, b, c]
+}
+
+/// Each corner's smallest node of at most [`TRIANGLES_PER_PIECE`] triangles holding
+/// every triangle around it ([`NONE`]: none).
+fn homes(
+    tree: &TriangleTree,
+    nodes: &[crate::sim::obstacle::Split],
+    parent: &[u32],
+    triangles: &[[u32; 3]],
+    particles: usize,
+) -> Vec<u32> {
+    let mut leaf = vec![0u32; triangles.len()];
+    let mut depth = vec![0u32; nodes.len()];
+    for (i, node) in nodes.iter().enumerate() {
+        if i > 0 {
+            depth[i] = depth[parent[i] as usize] + 1;
+        }
+        if node.second == 0 {
+            for &t in tree.held(i) {
+                leaf[t as usize] = i as u32;
+            }
+        }
+    }
+    let common = |mut a: u32, mut b: u32| {
+        while a != b {
+            if depth[a as usize] >= depth[b as usize] {
+                a = parent[a as usize];
+            } else {
+                b = parent[b as usize];
+            }
+        }
+        a
+    };
+    let (start, around) = crate::mesh::triangles_around(particles, triangles);
+    (0..particles)
+        .map(|c| {
+            let ring = &around[start[c] as usize..start[c + 1] as usize];
+            let first = ring.first().map(|&t| leaf[t as usize]);
+            let home = ring
+                .iter()
+                .fold(first, |h, &t| h.map(|h| common(h, leaf[t as usize])));
+            home.filter(|&h| nodes[h as usize].count <= TRIANGLES_PER_PIECE)
+                .unwrap_or(NONE)
+        })
+        .collect()
+}
+
+/// The least distance at `rest` between the sides of any pair of the cloth (a vertex and a
+/// triangle it is not a corner of, two edges that share no particle), up to the longest
+/// rest edge, rounded down: the pairs of two triangles that share a corner, and those of
+/// two that do not whose rest boxes, grown by half that edge, overlap (found by a walk of
+/// the `tree`, fitted to them). Shared with the team; a pair whose sides' boxes lie
+/// farther apart than the least yet is passed by.
+fn rest_gap(
+    tree: &mut TriangleTree,
+    triangles: &[[u32; 3]],
+    rest: &[Vec3],
+    owners: &Owners,
+) -> f32 {
+    let cap = owners.longest;
+    let grow = Vec3::splat(0.5 * cap);
+    let (lo, hi): (Vec<Vec3>, Vec<Vec3>) = (triangles.iter())
+        .map(|t| {
+            let [a, b, c] = t.map(|i| rest[i as usize]);
+            (a.min(b).min(c) - grow, a.max(b).max(c) + grow)
+        })
+        .unzip();
+    tree.covered.clear();
+    tree.fit_boxes(&lo, &hi);
+    // The least yet, as the bits of a positive `f64` (which order as the numbers do).
+    let least = AtomicU64::new(f64::from(cap).to_bits());
+    let measure = |pair: Pair, mine: &mut f64| {
+        let ids = pair.ids();
+        let k = pair.first_side();
+        let side = |r: std::ops::Range<usize>| {
+            (ids[r].iter()).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &i| {
+                (lo.min(rest[i]), hi.max(rest[i]))
+            })
+        };
+        let ((alo, ahi), (blo, bhi)) = (side(0..k), side(k..4));
+        // Apart by their boxes by more than the least yet (less a rounding's worth).
+        let gap = f64::from((blo - ahi).max(alo - bhi).max(Vec3::ZERO).length());
+        if gap * (1.0 - 1e-6) < *mine {
+            *mine = mine.min(distance(&pair, ids.map(|i| rest[i].as_dvec3())));
+        }
+    };
+    let (pieces, corners) = (tree.pieces(), rest.len().div_ceil(CORNERS_PER_PIECE));
+    let tree = &*tree;
+    let work = |_: usize, piece: usize| {
+        let mut mine = f64::from_bits(least.load(Ordering::Relaxed));
+        if piece < pieces {
+            tree.piece_pairs(piece, false, |a, b| {
+                let (a, b) = (a as usize, b as usize);
+                if !triangles[a].iter().any(|i| triangles[b].contains(i)) {
+                    owners.each_pair(triangles, a, b, |pair, _| measure(pair, &mut mine));
+                }
+            });
+        } else {
+            let first = (piece - pieces) * CORNERS_PER_PIECE;
+            for c in first..(first + CORNERS_PER_PIECE).min(rest.len()) {
+                for stored in owners.corner_pairs(c) {
+                    measure(stored.expand(triangles, &owners.edges), &mut mine);
+                }
+            }
+        }
+        least.fetch_min(mine.to_bits(), Ordering::Relaxed);
+    };
+    let parallel = triangles.len() >= PARALLEL_ELEMENTS;
+    Team::current().run_large_pieces_if(parallel, pieces + corners, &work);
+    shave(f64::from_bits(least.into_inner()))
+}
+
+/// Corners whose pairs [`rest_gap`] measures in one piece.
+const CORNERS_PER_PIECE: usize = 512;
+
+#[cfg(test)]
+mod tests;

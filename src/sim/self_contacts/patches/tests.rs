@@ -1,0 +1,265 @@
+//! The patches: a covered node keeps every pair of two of its triangles the reach apart
+//! along the whole motion, a covered corner's ring lies in one, and the rest gap is the
+//! least distance at rest.
+
+use glam::{Quat, Vec3};
+
+use super::*;
+use crate::cloth::ClothModel;
+use crate::mesh::{GridOrientation, GridSpec};
+
+const REACH: f32 = 0.004;
+
+/// A `quads`² cloth 2 cm between particles, flat in the xz plane (rest gap 1.41 cm,
+/// half the diagonal), with its particles moved by `shape` from rest; its triangles,
+/// owners, tree and patches, and those particles.
+struct Cloth {
+    model: ClothModel,
+    owners: Owners,
+    tree: TriangleTree,
+    patches: Patches,
+    rest: Vec<Vec3>,
+}
+
+fn cloth(quads: u32, mut shape: impl FnMut(Vec3) -> Vec3) -> Cloth {
+    let size = 0.02 * quads as f32;
+    let mesh = GridSpec::square(quads, size, GridOrientation::Horizontal, Vec3::ZERO)
+        .build()
+        .unwrap();
+    let mut mesh = mesh;
+    for p in &mut mesh.positions {
+        *p = shape(*p);
+    }
+    let model = ClothModel::new(&mesh, 0.2, &[]);
+    let owners = Owners::build(&model);
+    let rest = model.rest_positions.clone();
+    let mut tree = TriangleTree::build(&model.triangles, &rest);
+    let patches = Patches::build(&mut tree, &model.triangles, &rest, &owners);
+    Cloth {
+        model,
+        owners,
+        tree,
+        patches,
+        rest,
+    }
+}
+
+/// Calls `visit` with every pair of triangles `s` and `t`: each vertex of one against the
+/// other, if not its corner; each edge of one against each of the other sharing no
+/// particle.
+fn each_pair(s: [u32; 3], t: [u32; 3], mut visit: impl FnMut(Pair)) {
+    for (v, other) in [(s, t), (t, s)] {
+        for &i in v.iter().filter(|i| !other.contains(i)) {
+            visit(Pair::vertex_triangle(i, other));
+        }
+    }
+    for k in 0..3 {
+        for j in 0..3 {
+            let (e, f) = ([s[k], s[(k + 1) % 3]], [t[j], t[(j + 1) % 3]]);
+            if !e.iter().any(|i| f.contains(i)) {
+                visit(Pair::edge_edge(e, f));
+            }
+        }
+    }
+}
+
+/// The least distance, at 17 points along the motion from `from` to `to`, between the
+/// sides of any pair of two triangles (or one) in `held` (pairs whose sides' boxes over
+/// the motion lie `REACH` apart are passed by: they keep that far apart).
+fn closest_within(triangles: &[[u32; 3]], held: &[u32], [from, to]: [&[Vec3]; 2]) -> f64 {
+    let mut least = f64::INFINITY;
+    for (k, &a) in held.iter().enumerate() {
+        for &b in &held[k + 1..] {
+            each_pair(triangles[a as usize], triangles[b as usize], |pair| {
+                let ids = pair.ids();
+                let side = |r: std::ops::Range<usize>| {
+                    (ids[r].iter()).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &i| {
+                        (lo.min(from[i]).min(to[i]), hi.max(from[i]).max(to[i]))
+                    })
+                };
+                let s = pair.first_side();
+                let ((alo, ahi), (blo, bhi)) = (side(0..s), side(s..4));
+                if (blo - ahi).max(alo - bhi).max_element() >= REACH {
+                    return;
+                }
+                for step in 0..=16 {
+                    let t = f64::from(step) / 16.0;
+                    let x = ids.map(|i| from[i].as_dvec3().lerp(to[i].as_dvec3(), t));
+                    least = least.min(distance(&pair, x));
+                }
+            });
+        }
+    }
+    least
+}
+
+/// Decides the motion and checks every node covered below an uncovered one (the others
+/// are held by those) and every corner flagged: no pair of theirs comes within the reach.
+/// Returns the triangles covered and the least distance of a covered pair.
+fn decide_and_check(c: &mut Cloth, motion: [&[Vec3]; 2], what: &str) -> (usize, f64) {
+    c.patches.decide(&mut c.tree, motion, REACH);
+    let triangles = &c.model.triangles;
+    let (mut covered, mut least) = (0, f64::INFINITY);
+    for (i, _) in c.tree.nodes().iter().enumerate() {
+        let parent = c.patches.parent[i] as usize;
+        if c.tree.covered[i] && (i == 0 || !c.tree.covered[parent]) {
+            let held = c.tree.held(i);
+            covered += held.len();
+            least = least.min(closest_within(triangles, held, motion));
+        }
+    }
+    assert!(
+        least >= f64::from(REACH),
+        "{what}: a covered pair at {least}"
+    );
+    let (start, around) = crate::mesh::triangles_around(c.rest.len(), triangles);
+    for (corner, _) in c.patches.corners.iter().enumerate().filter(|(_, f)| **f) {
+        let ring = &around[start[corner] as usize..start[corner + 1] as usize];
+        let near = closest_within(triangles, ring, motion);
+        assert!(
+            near >= f64::from(REACH),
+            "{what}: corner {corner}'s pair at {near}"
+        );
+    }
+    (covered, least)
+}
+
+/// The cloth folds over a line as the corners' test folds it (5° a substep, to 175°),
+/// wobbling by up to 3 mm and turned and carried as a whole; then it is squeezed along x,
+/// and jittered, more the farther along x: each time, no covered pair comes within the
+/// reach, while most of the cloth is covered where it stays near its rest shape and the
+/// covered pairs come near the reach where it does not; and four particles are pushed
+/// along the plane towards their neighbours by the motion's end alone.
+#[test]
+fn a_covered_patch_keeps_its_pairs_the_reach_apart() {
+    let mut c = cloth(12, |p| p);
+    assert!(
+        (c.patches.gap - 0.01 * 2f32.sqrt()).abs() < 1e-6,
+        "{}",
+        c.patches.gap
+    );
+    let rest = c.rest.clone();
+    let folded = |fold: f32, step: usize| -> Vec<Vec3> {
+        let k = step as f32;
+        let turn = Quat::from_axis_angle(Vec3::new(0.3, 1.0, 0.2).normalize(), 0.07 * k);
+        (rest.iter())
+            .map(|&p| {
+                let p = if p.x > 0.0 {
+                    Vec3::new(p.x * fold.cos(), p.x * fold.sin(), p.z)
+                } else {
+                    p
+                };
+                let wobble = 0.003
+                    * Vec3::new(
+                        (0.7 * k + 90.0 * p.x).sin(),
+                        (1.3 * k + 70.0 * p.z).sin(),
+                        (0.9 * k + 60.0 * (p.x + p.z)).cos(),
+                    );
+                turn * (p + wobble) + k * Vec3::new(0.01, -0.03, 0.02)
+            })
+            .collect()
+    };
+    let triangles = c.model.triangles.len();
+    let mut least = f64::INFINITY;
+    let (mut most, mut fewest) = (0, usize::MAX);
+    for step in 0..35 {
+        let fold = |s: usize| (s as f32 * 5.0).to_radians();
+        let (from, to) = (folded(fold(step), step), folded(fold(step + 1), step + 1));
+        let (covered, near) = decide_and_check(&mut c, [&from, &to], "fold");
+        (most, fewest, least) = (most.max(covered), fewest.min(covered), least.min(near));
+    }
+    // Flat, nearly all of it; folded, the nodes across the fold are not.
+    assert!(most * 10 >= triangles * 9, "{most} of {triangles}");
+    assert!(fewest * 10 <= triangles * 8, "{fewest} of {triangles}");
+    // Squeezed along x and falling: a patch squeezed less than its rest gap allows over
+    // the reach is covered (by the least it stretches any direction), one squeezed more
+    // is not.
+    for squeeze in [0.6, 0.3, 0.2, 0.1] {
+        let from: Vec<Vec3> = rest
+            .iter()
+            .map(|p| Vec3::new(squeeze * p.x, p.y, p.z))
+            .collect();
+        let to: Vec<Vec3> = from
+            .iter()
+            .map(|&p| p + Vec3::new(0.0, -0.02, 0.01))
+            .collect();
+        let (covered, near) = decide_and_check(&mut c, [&from, &to], "squeezed");
+        let allowed = squeeze * 0.01 * 2f32.sqrt() >= REACH * (1.0 + MARGIN);
+        assert_eq!(covered > 0, allowed, "squeezed to {squeeze}: {covered}");
+        least = least.min(near);
+    }
+    // Jittered by up to 0 mm at x = −12 cm and 12 mm at 12 cm, at the start and end.
+    let mut rnd = crate::test_rng::uniform(9);
+    let mut jitter = |p: Vec3| {
+        let amount = 0.05 * (p.x + 0.12);
+        p + amount * Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5)
+    };
+    let from: Vec<Vec3> = rest.iter().map(|&p| jitter(p)).collect();
+    let to: Vec<Vec3> = rest.iter().map(|&p| jitter(p)).collect();
+    let (covered, near) = decide_and_check(&mut c, [&from, &to], "jittered");
+    assert!(covered > 0 && covered < triangles, "{covered}");
+    least = least.min(near);
+    // Four particles, far apart, pushed 11 mm along the plane by the motion's end, each
+    // along another diagonal (one at least towards an edge of a triangle it is not a
+    // corner of, 14 mm away at rest): the start is the rest shape, which the nodes around
+    // them fit at the start but not at the end.
+    let pushed = [
+        (40, Vec3::new(1.0, 0.0, 1.0)),
+        (46, Vec3::new(1.0, 0.0, -1.0)),
+    ]
+    .into_iter()
+    .chain([
+        (118, Vec3::new(-1.0, 0.0, 1.0)),
+        (124, Vec3::new(-1.0, 0.0, -1.0)),
+    ]);
+    let mut to = rest.clone();
+    for (i, along) in pushed {
+        to[i] += 0.011 * along.normalize();
+    }
+    let (covered, near) = decide_and_check(&mut c, [&rest, &to], "pushed");
+    assert!(covered > triangles / 2, "{covered}");
+    least = least.min(near);
+    // The certificates are used towards their limit.
+    assert!(least < 2.0 * f64::from(REACH), "{least}");
+}
+
+/// The rest gap is the least distance between the sides of any pair at rest, found by
+/// testing every two triangles: the cloth jittered at rest (so that it is not the grid's),
+/// and with its four corner particles moved 12 mm inwards along the diagonal, towards
+/// triangles of their ring (pairs the walk leaves to the corners' own).
+#[test]
+fn the_rest_gap_is_the_least_distance_at_rest() {
+    let mut rnd = crate::test_rng::uniform(4);
+    let jittered = cloth(8, |p| {
+        p + 0.008 * Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5)
+    });
+    let moves = [
+        (0, [1.0, 1.0]),
+        (8, [-1.0, 1.0]),
+        (72, [1.0, -1.0]),
+        (80, [-1.0, -1.0]),
+    ];
+    let mut i = 0;
+    let moved = cloth(8, |p| {
+        let along = moves.iter().find(|m| m.0 == i).map_or(Vec3::ZERO, |m| {
+            Vec3::new(m.1[0], 0.0, m.1[1]).normalize() * 0.012
+        });
+        i += 1;
+        p + along
+    });
+    for c in [jittered, moved] {
+        let (triangles, x) = (&c.model.triangles, &c.rest);
+        let mut least = f64::from(c.owners.longest);
+        for a in 0..triangles.len() {
+            for b in a..triangles.len() {
+                each_pair(triangles[a], triangles[b], |pair| {
+                    let at = pair.ids().map(|i| x[i].as_dvec3());
+                    least = least.min(distance(&pair, at));
+                });
+            }
+        }
+        assert!(least < 0.01, "{least}");
+        let gap = f64::from(c.patches.gap);
+        assert!(gap <= least && gap > least - 1e-9, "{gap} against {least}");
+    }
+}
