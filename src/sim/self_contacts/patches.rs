@@ -25,7 +25,7 @@ use super::certify::{MARGIN, frame, shave};
 use super::primitives::{Pair, distance};
 use super::search::{NONE, Owners};
 use super::tree::{TRIANGLES_PER_PIECE, TriangleTree};
-use crate::parallel::{PARALLEL_ELEMENTS, Team};
+use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
 
 /// Triangles in the smallest node certified on its own (smaller ones are covered only
 /// with a node above them: their walk is short, and their frames would turn on a few
@@ -37,6 +37,10 @@ const SMALLEST: u32 = 4;
 pub(super) struct Patches {
     /// Each node's parent (the root its own).
     parent: Vec<u32>,
+    /// The nodes of each subtree whose root holds at most [`TRIANGLES_PER_PIECE`]
+    /// triangles and its parent more (the nodes a certificate can cover), as a range:
+    /// decided in pieces shared with the team.
+    subtrees: Vec<std::ops::Range<usize>>,
     /// Each node's entries, `start[i]..start[i + 1]` (none: it is not certified on its
     /// own).
     start: Vec<u32>,
@@ -95,6 +99,21 @@ impl Patches {
             patches.start.push(patches.particle.len() as u32);
         }
         patches.home = homes(tree, &nodes, &patches.parent, triangles, rest.len());
+        // In the tree's order a subtree's nodes follow its root, up to the next node that
+        // is not under it.
+        let mut i = 0;
+        while i < nodes.len() {
+            if nodes[i].count > TRIANGLES_PER_PIECE {
+                i += 1;
+                continue;
+            }
+            let mut end = i + 1;
+            while end < nodes.len() && under(&patches.parent, end, i) {
+                end += 1;
+            }
+            patches.subtrees.push(i..end);
+            i = end;
+        }
         tree.covered.clear();
         patches
     }
@@ -105,10 +124,21 @@ impl Patches {
         let least = reach * (1.0 + MARGIN);
         let covered = &mut tree.covered;
         covered.clear();
-        for i in 0..self.parent.len() {
-            let above = i > 0 && covered[self.parent[i] as usize];
-            covered.push(above || self.certified(i, [from, to], least));
-        }
+        covered.resize(self.parent.len(), false);
+        // Each subtree from its root down: a node under a certified one is covered with it.
+        let flags = Disjoint::new(covered);
+        let work = |_: usize, piece: usize| {
+            let range = self.subtrees[piece].clone();
+            // SAFETY: the subtrees' ranges are disjoint.
+            let flags = unsafe { flags.part(range.clone()) };
+            for i in range.clone() {
+                let parent = self.parent[i] as usize;
+                let above = i != range.start && flags[parent - range.start];
+                flags[i - range.start] = above || self.certified(i, [from, to], least);
+            }
+        };
+        let parallel = self.particle.len() >= PARALLEL_ELEMENTS;
+        Team::current().run_large_pieces_if(parallel, self.subtrees.len(), &work);
         self.corners.clear();
         (self.corners).extend(self.home.iter().map(|&h| h != NONE && covered[h as usize]));
     }
@@ -120,10 +150,12 @@ impl Patches {
         self.corners.resize(self.home.len(), false);
     }
 
-    /// Whether every particle of node `i` starts and ends within `√limit` of where its
-    /// rest shape, turned with the node's frame in the middle of the motion and carried
-    /// with its first anchor, puts it (never for a node with no entries, nor where a
-    /// distance is NaN).
+    /// Whether no pair of node `i` comes within `least` along the motion: every particle
+    /// starts and ends within half of what the rest gap, shrunk by the node's fitted map,
+    /// leaves over `least` of where that map of its rest offset, carried with the middle of
+    /// the node's starts or ends, puts it. The map is the least-squares fit of the motion's
+    /// middles; any map would do. Never for a node with no entries, nor where a distance is
+    /// NaN.
     fn certified(&self, i: usize, [from, to]: [&[Vec3]; 2], least: f32) -> bool {
         let range = self.start[i] as usize..self.start[i + 1] as usize;
         if range.is_empty() {
@@ -203,6 +235,15 @@ fn fitted(p: Vec3, q: Vec3) -> Option<(glam::Mat3, f32)> {
     }
     let shrink = least.sqrt();
     Some((glam::Mat3::from_cols(p, q, shrink * normal), shrink))
+}
+
+/// Whether node `i` is under node `root` (`parent` each node's parent; a parent comes
+/// before its children).
+fn under(parent: &[u32], mut i: usize, root: usize) -> bool {
+    while i > root {
+        i = parent[i] as usize;
+    }
+    i == root
 }
 
 /// Three of `held` (at `rest`) whose frame turns a node: the one nearest their middle,
