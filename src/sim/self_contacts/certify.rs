@@ -49,8 +49,8 @@ impl Certificates {
     /// Decides, for the motion of each particle from `from` to `to`, which corners' pairs
     /// could come within `thickness` (those it leaves [`Certificates::open`]); with `only`,
     /// only the corners that are, or have in their ring, a particle it flags (the others'
-    /// motion is as when they were last decided); with `covered`, the corners it flags are
-    /// closed as they are (their pairs are certified apart otherwise:
+    /// motion is as when they were last decided); the corners for which `settled` holds are
+    /// closed as they are (their pairs are certified apart otherwise, for this motion:
     /// [`super::patches`]). Returns how many references it took again.
     pub(super) fn decide(
         &mut self,
@@ -58,7 +58,8 @@ impl Certificates {
         triangles: &[[u32; 3]],
         [from, to]: [&[Vec3]; 2],
         thickness: f32,
-        [only, covered]: [Option<&[bool]>; 2],
+        only: Option<&[bool]>,
+        settled: &(dyn Fn(usize) -> bool + Sync),
     ) -> u64 {
         let rings = &owners.rings;
         let corners = from.len();
@@ -86,7 +87,7 @@ impl Certificates {
                 if only.is_some_and(|o| !o[c] && ring.iter().all(|&j| !o[j as usize])) {
                     continue;
                 }
-                if covered.is_some_and(|k| k[c]) {
+                if settled(c) {
                     // SAFETY: each corner is one piece's.
                     *unsafe { open.at(c) } = false;
                     continue;

@@ -44,6 +44,9 @@ pub(super) struct Patches {
     /// Each node's entries, `start[i]..start[i + 1]` (none: it is not certified on its
     /// own).
     start: Vec<u32>,
+    /// Each corner's ring's entries (the corner and its ring), `rings[c]..rings[c + 1]`
+    /// (none: it has no pairs).
+    rings: Vec<u32>,
     /// Each entry's particle; its offset at rest from the node's middle, in the node's
     /// frame at rest; and its weights in the node's turn (see [`Patches::turn`]).
     particle: Vec<u32>,
@@ -97,6 +100,16 @@ impl Patches {
             }
             patches.add(&held, rest);
             patches.start.push(patches.particle.len() as u32);
+        }
+        patches.rings.push(patches.particle.len() as u32);
+        for c in 0..rest.len() {
+            held.clear();
+            if !owners.corner_pairs(c).is_empty() {
+                held.push(c as u32);
+                held.extend_from_slice(&owners.rings.ring[owners.rings.range(c)]);
+            }
+            patches.add(&held, rest);
+            patches.rings.push(patches.particle.len() as u32);
         }
         patches.home = homes(tree, &nodes, &patches.parent, triangles, rest.len());
         // In the tree's order a subtree's nodes follow its root, up to the next node that
@@ -156,8 +169,24 @@ impl Patches {
     /// the node's starts or ends, puts it. The map is the least-squares fit of the motion's
     /// middles; any map would do. Never for a node with no entries, nor where a distance is
     /// NaN.
-    fn certified(&self, i: usize, [from, to]: [&[Vec3]; 2], least: f32) -> bool {
-        let range = self.start[i] as usize..self.start[i + 1] as usize;
+    fn certified(&self, i: usize, motion: [&[Vec3]; 2], least: f32) -> bool {
+        self.holds(
+            self.start[i] as usize..self.start[i + 1] as usize,
+            motion,
+            least,
+        )
+    }
+
+    /// Whether corner `c`'s ring keeps so near its rest shape along the motion from
+    /// `from` to `to` that none of the corner's pairs comes within `reach` (as for a node:
+    /// a ring is a patch too).
+    pub(super) fn ring_holds(&self, c: usize, motion: [&[Vec3]; 2], reach: f32) -> bool {
+        let range = self.rings[c] as usize..self.rings[c + 1] as usize;
+        self.holds(range, motion, reach * (1.0 + MARGIN))
+    }
+
+    /// [`Patches::certified`] for the entries in `range`.
+    fn holds(&self, range: std::ops::Range<usize>, [from, to]: [&[Vec3]; 2], least: f32) -> bool {
         if range.is_empty() {
             return false;
         }

@@ -372,17 +372,16 @@ impl SelfContacts {
     fn decide_corners(&mut self, triangles: &[[u32; 3]], thickness: f32, refreshed: bool) {
         if self.boxes.swept {
             let motion = [&self.boxes.from[..], &self.boxes.to[..]];
-            // A whole search leaves the corners the patches cover closed; a refresh decides
-            // those whose motion changed, covered or not.
-            let (only, covered) = if refreshed {
-                (Some(&self.left[..]), None)
-            } else {
-                (None, Some(&self.patches.corners[..]))
-            };
-            let reach = self.reach(thickness);
+            // Closed as they are: the corners whose ring keeps near its rest shape, and in a
+            // whole search those the patches cover (a refresh decides those whose motion
+            // changed, covered or not).
+            let (patches, reach) = (&self.patches, self.reach(thickness));
+            let only = refreshed.then_some(&self.left[..]);
+            let apart =
+                |c: usize| !refreshed && patches.corners[c] || patches.ring_holds(c, motion, reach);
             let certificates = &mut self.certificates;
             self.work.retaken +=
-                certificates.decide(&self.owners, triangles, motion, reach, [only, covered]);
+                certificates.decide(&self.owners, triangles, motion, reach, only, &apart);
         }
     }
 

@@ -83,7 +83,9 @@ fn a_corner_left_closed_keeps_its_pairs_a_thickness_apart() {
         let fold = |s: usize| (5.0 * s as f32).to_radians();
         let from = folded(&rest, fold(step), step);
         let to = folded(&rest, fold(step + 1), step + 1);
-        certificates.decide(&owners, triangles, [&from, &to], THICKNESS, [None; 2]);
+        certificates.decide(&owners, triangles, [&from, &to], THICKNESS, None, &|_| {
+            false
+        });
         for c in 0..rest.len() {
             if owners.corner_pairs(c).is_empty() {
                 continue;
@@ -132,7 +134,8 @@ fn a_cloth_that_only_turns_keeps_its_references() {
             &model.triangles,
             [&from, &to],
             THICKNESS,
-            [None; 2],
+            None,
+            &|_| false,
         );
         let expected = if step == 0 { with_pairs as u64 } else { 0 };
         assert_eq!(retaken, expected, "substep {step}");
@@ -182,7 +185,9 @@ fn flaps_pressed_together_open_their_corner_before_they_come_within_the_thicknes
         for motion in [[&rest, &pressed], [&pressed, &rest]] {
             let mut certificates = Certificates::default();
             let still = [&rest[..], &rest[..]];
-            certificates.decide(&owners, &model.triangles, still, thickness, [None; 2]);
+            certificates.decide(&owners, &model.triangles, still, thickness, None, &|_| {
+                false
+            });
             assert!(!certificates.open[0]);
             // The substep, then one that stays where it ended (on the reference taken
             // there, if it was).
@@ -190,8 +195,14 @@ fn flaps_pressed_together_open_their_corner_before_they_come_within_the_thicknes
                 .into_iter()
                 .enumerate()
             {
-                let retaken =
-                    certificates.decide(&owners, &model.triangles, motion, thickness, [None; 2]);
+                let retaken = certificates.decide(
+                    &owners,
+                    &model.triangles,
+                    motion,
+                    thickness,
+                    None,
+                    &|_| false,
+                );
                 let least = closest_along(&owners, &model.triangles, 0, motion);
                 if certificates.open[0] {
                     assert!(

@@ -94,9 +94,10 @@ fn closest_within(triangles: &[[u32; 3]], held: &[u32], [from, to]: [&[Vec3]; 2]
 }
 
 /// Decides the motion and checks every node covered below an uncovered one (the others
-/// are held by those) and every corner flagged: no pair of theirs comes within the reach.
-/// Returns the triangles covered and the least distance of a covered pair.
-fn decide_and_check(c: &mut Cloth, motion: [&[Vec3]; 2], what: &str) -> (usize, f64) {
+/// are held by those), every corner flagged and every corner whose ring holds: no pair of
+/// theirs comes within the reach. Returns the triangles covered, the least distance of a
+/// covered pair, and the corners whose ring holds.
+fn decide_and_check(c: &mut Cloth, motion: [&[Vec3]; 2], what: &str) -> (usize, f64, usize) {
     c.patches.decide(&mut c.tree, motion, REACH);
     let triangles = &c.model.triangles;
     let (mut covered, mut least) = (0, f64::INFINITY);
@@ -112,16 +113,23 @@ fn decide_and_check(c: &mut Cloth, motion: [&[Vec3]; 2], what: &str) -> (usize, 
         least >= f64::from(REACH),
         "{what}: a covered pair at {least}"
     );
+    // Corners covered by a node, or whose ring keeps near its rest shape.
     let (start, around) = crate::mesh::triangles_around(c.rest.len(), triangles);
-    for (corner, _) in c.patches.corners.iter().enumerate().filter(|(_, f)| **f) {
-        let ring = &around[start[corner] as usize..start[corner + 1] as usize];
-        let near = closest_within(triangles, ring, motion);
-        assert!(
-            near >= f64::from(REACH),
-            "{what}: corner {corner}'s pair at {near}"
-        );
+    let mut rings = 0;
+    for corner in 0..c.rest.len() {
+        let held = c.patches.ring_holds(corner, motion, REACH);
+        if c.patches.corners[corner] || held {
+            let ring = &around[start[corner] as usize..start[corner + 1] as usize];
+            let near = closest_within(triangles, ring, motion);
+            assert!(
+                near >= f64::from(REACH),
+                "{what}: corner {corner}'s pair at {near}"
+            );
+            least = least.min(near);
+            rings += usize::from(held);
+        }
     }
-    (covered, least)
+    (covered, least, rings)
 }
 
 /// The cloth folds over a line as the corners' test folds it (5° a substep, to 175°),
@@ -162,15 +170,23 @@ fn a_covered_patch_keeps_its_pairs_the_reach_apart() {
     let triangles = c.model.triangles.len();
     let mut least = f64::INFINITY;
     let (mut most, mut fewest) = (0, usize::MAX);
+    let (mut rings_most, mut rings_fewest) = (0, usize::MAX);
     for step in 0..35 {
         let fold = |s: usize| (s as f32 * 5.0).to_radians();
         let (from, to) = (folded(fold(step), step), folded(fold(step + 1), step + 1));
-        let (covered, near) = decide_and_check(&mut c, [&from, &to], "fold");
+        let (covered, near, held) = decide_and_check(&mut c, [&from, &to], "fold");
         (most, fewest, least) = (most.max(covered), fewest.min(covered), least.min(near));
+        (rings_most, rings_fewest) = (rings_most.max(held), rings_fewest.min(held));
     }
     // Flat, nearly all of it; folded, the nodes across the fold are not.
     assert!(most * 10 >= triangles * 9, "{most} of {triangles}");
     assert!(fewest * 10 <= triangles * 8, "{fewest} of {triangles}");
+    // And most corners' rings, fewer folded.
+    let corners = c.rest.len();
+    assert!(
+        rings_most * 10 >= corners * 7 && rings_fewest < rings_most,
+        "{rings_fewest}–{rings_most} of {corners}"
+    );
     // Squeezed along x and falling: a patch squeezed less than its rest gap allows over
     // the reach is covered (by the least it stretches any direction), one squeezed more
     // is not.
@@ -183,7 +199,7 @@ fn a_covered_patch_keeps_its_pairs_the_reach_apart() {
             .iter()
             .map(|&p| p + Vec3::new(0.0, -0.02, 0.01))
             .collect();
-        let (covered, near) = decide_and_check(&mut c, [&from, &to], "squeezed");
+        let (covered, near, _) = decide_and_check(&mut c, [&from, &to], "squeezed");
         let allowed = squeeze * 0.01 * 2f32.sqrt() >= REACH * (1.0 + MARGIN);
         assert_eq!(covered > 0, allowed, "squeezed to {squeeze}: {covered}");
         least = least.min(near);
@@ -196,7 +212,7 @@ fn a_covered_patch_keeps_its_pairs_the_reach_apart() {
     };
     let from: Vec<Vec3> = rest.iter().map(|&p| jitter(p)).collect();
     let to: Vec<Vec3> = rest.iter().map(|&p| jitter(p)).collect();
-    let (covered, near) = decide_and_check(&mut c, [&from, &to], "jittered");
+    let (covered, near, _) = decide_and_check(&mut c, [&from, &to], "jittered");
     assert!(covered > 0 && covered < triangles, "{covered}");
     least = least.min(near);
     // Four particles, far apart, pushed 11 mm along the plane by the motion's end, each
@@ -216,7 +232,7 @@ fn a_covered_patch_keeps_its_pairs_the_reach_apart() {
     for (i, along) in pushed {
         to[i] += 0.011 * along.normalize();
     }
-    let (covered, near) = decide_and_check(&mut c, [&rest, &to], "pushed");
+    let (covered, near, _) = decide_and_check(&mut c, [&rest, &to], "pushed");
     assert!(covered > triangles / 2, "{covered}");
     least = least.min(near);
     // The certificates are used towards their limit.
