@@ -49,9 +49,10 @@ impl Certificates {
     /// Decides, for the motion of each particle from `from` to `to`, which corners' pairs
     /// could come within `thickness` (those it leaves [`Certificates::open`]); with `only`,
     /// only the corners that are, or have in their ring, a particle it flags (the others'
-    /// motion is as when they were last decided); the corners for which `settled` holds are
-    /// closed as they are (their pairs are certified apart otherwise, for this motion:
-    /// [`super::patches`]). Returns how many references it took again.
+    /// motion is as when they were last decided). The corners `covered` flags are closed as
+    /// they are, and so are those whose reference fails where `near_rest` holds (their
+    /// pairs are certified apart otherwise, for this motion: [`super::patches`]), before
+    /// their reference is taken again. Returns how many references it took again.
     pub(super) fn decide(
         &mut self,
         owners: &Owners,
@@ -59,7 +60,7 @@ impl Certificates {
         [from, to]: [&[Vec3]; 2],
         thickness: f32,
         only: Option<&[bool]>,
-        settled: &(dyn Fn(usize) -> bool + Sync),
+        [covered, near_rest]: [&(dyn Fn(usize) -> bool + Sync); 2],
     ) -> u64 {
         let rings = &owners.rings;
         let corners = from.len();
@@ -87,7 +88,7 @@ impl Certificates {
                 if only.is_some_and(|o| !o[c] && ring.iter().all(|&j| !o[j as usize])) {
                     continue;
                 }
-                if settled(c) {
+                if covered(c) {
                     // SAFETY: each corner is one piece's.
                     *unsafe { open.at(c) } = false;
                     continue;
@@ -95,7 +96,15 @@ impl Certificates {
                 // SAFETY: each corner is one piece's, and its ring's entries its own.
                 let corner = unsafe { (reference.part(range), apart.at(c), open.at(c)) };
                 let motion = [from, to];
-                taken += u64::from(decide_one(c, corner, (owners, triangles), motion, least));
+                let settled = || near_rest(c);
+                taken += u64::from(decide_one(
+                    c,
+                    corner,
+                    (owners, triangles),
+                    motion,
+                    least,
+                    settled,
+                ));
             }
             retaken.fetch_add(taken, Ordering::Relaxed);
         };
@@ -111,14 +120,16 @@ impl Certificates {
 /// Corners decided in one piece of [`Certificates::decide`].
 const CORNERS_PER_PIECE: usize = 256;
 
-/// Decides corner `c`, with its reference, least distance and whether it is open;
-/// returns whether the reference was taken again.
+/// Decides corner `c`, with its reference, least distance and whether it is open (closed
+/// without a new reference where its reference fails but `settled` holds); returns
+/// whether the reference was taken again.
 fn decide_one(
     c: usize,
     (reference, apart, open): (&mut [Vec3], &mut f32, &mut bool),
     (owners, triangles): (&Owners, &[[u32; 3]]),
     [from, to]: [&[Vec3]; 2],
     least: f32,
+    settled: impl Fn() -> bool,
 ) -> bool {
     let (ring, pairs) = (
         &owners.rings.ring[owners.rings.range(c)],
@@ -144,7 +155,7 @@ fn decide_one(
         }
         most.sqrt()
     };
-    if certified(*apart, strayed(reference), least) {
+    if certified(*apart, strayed(reference), least) || settled() {
         *open = false;
         return false;
     }

@@ -372,16 +372,17 @@ impl SelfContacts {
     fn decide_corners(&mut self, triangles: &[[u32; 3]], thickness: f32, refreshed: bool) {
         if self.boxes.swept {
             let motion = [&self.boxes.from[..], &self.boxes.to[..]];
-            // Closed as they are: the corners whose ring keeps near its rest shape, and in a
-            // whole search those the patches cover (a refresh decides those whose motion
-            // changed, covered or not).
+            // Closed as they are: in a whole search the corners the patches cover (a
+            // refresh decides those whose motion changed, covered or not), and those whose
+            // reference fails but whose ring keeps near its rest shape.
             let (patches, reach) = (&self.patches, self.reach(thickness));
             let only = refreshed.then_some(&self.left[..]);
-            let apart =
-                |c: usize| !refreshed && patches.corners[c] || patches.ring_holds(c, motion, reach);
+            let covered = |c: usize| !refreshed && patches.corners[c];
+            let near_rest = |c: usize| patches.ring_holds(c, motion, reach);
+            let settled: [&(dyn Fn(usize) -> bool + Sync); 2] = [&covered, &near_rest];
             let certificates = &mut self.certificates;
             self.work.retaken +=
-                certificates.decide(&self.owners, triangles, motion, reach, only, &apart);
+                certificates.decide(&self.owners, triangles, motion, reach, only, settled);
         }
     }
 

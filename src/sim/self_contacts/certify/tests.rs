@@ -83,9 +83,14 @@ fn a_corner_left_closed_keeps_its_pairs_a_thickness_apart() {
         let fold = |s: usize| (5.0 * s as f32).to_radians();
         let from = folded(&rest, fold(step), step);
         let to = folded(&rest, fold(step + 1), step + 1);
-        certificates.decide(&owners, triangles, [&from, &to], THICKNESS, None, &|_| {
-            false
-        });
+        certificates.decide(
+            &owners,
+            triangles,
+            [&from, &to],
+            THICKNESS,
+            None,
+            [&|_| false; 2],
+        );
         for c in 0..rest.len() {
             if owners.corner_pairs(c).is_empty() {
                 continue;
@@ -135,7 +140,7 @@ fn a_cloth_that_only_turns_keeps_its_references() {
             [&from, &to],
             THICKNESS,
             None,
-            &|_| false,
+            [&|_| false; 2],
         );
         let expected = if step == 0 { with_pairs as u64 } else { 0 };
         assert_eq!(retaken, expected, "substep {step}");
@@ -185,9 +190,14 @@ fn flaps_pressed_together_open_their_corner_before_they_come_within_the_thicknes
         for motion in [[&rest, &pressed], [&pressed, &rest]] {
             let mut certificates = Certificates::default();
             let still = [&rest[..], &rest[..]];
-            certificates.decide(&owners, &model.triangles, still, thickness, None, &|_| {
-                false
-            });
+            certificates.decide(
+                &owners,
+                &model.triangles,
+                still,
+                thickness,
+                None,
+                [&|_| false; 2],
+            );
             assert!(!certificates.open[0]);
             // The substep, then one that stays where it ended (on the reference taken
             // there, if it was).
@@ -201,7 +211,7 @@ fn flaps_pressed_together_open_their_corner_before_they_come_within_the_thicknes
                     motion,
                     thickness,
                     None,
-                    &|_| false,
+                    [&|_| false; 2],
                 );
                 let least = closest_along(&owners, &model.triangles, 0, motion);
                 if certificates.open[0] {
