@@ -47,11 +47,14 @@ pub(super) struct Patches {
     /// Each corner's ring's entries (the corner and its ring), `rings[c]..rings[c + 1]`
     /// (none: it has no pairs).
     rings: Vec<u32>,
-    /// Each entry's particle; its offset at rest from the node's middle, in the node's
-    /// frame at rest; and its weights in the node's turn (see [`Patches::turn`]).
+    /// Each entry's particle, and its offset at rest from its patch's middle, in the
+    /// patch's frame at rest.
     particle: Vec<u32>,
     reference: Vec<Vec3>,
-    weights: Vec<[f32; 2]>,
+    /// Each node's and each corner's ring's inverse second moments of its offsets in the
+    /// frame's first two axes (`[xx, xy, yy]` of the inverse), which weigh the fit.
+    inverse: Vec<[f32; 3]>,
+    ring_inverse: Vec<[f32; 3]>,
     /// Each corner's smallest node holding every triangle around it ([`NONE`]: none of at
     /// most [`TRIANGLES_PER_PIECE`] triangles).
     home: Vec<u32>,
@@ -98,7 +101,8 @@ impl Patches {
                     }
                 }
             }
-            patches.add(&held, rest);
+            let inverse = patches.add(&held, rest);
+            patches.inverse.push(inverse);
             patches.start.push(patches.particle.len() as u32);
         }
         patches.rings.push(patches.particle.len() as u32);
@@ -108,7 +112,8 @@ impl Patches {
                 held.push(c as u32);
                 held.extend_from_slice(&owners.rings.ring[owners.rings.range(c)]);
             }
-            patches.add(&held, rest);
+            let inverse = patches.add(&held, rest);
+            patches.ring_inverse.push(inverse);
             patches.rings.push(patches.particle.len() as u32);
         }
         patches.home = homes(tree, &nodes, &patches.parent, triangles, rest.len());
@@ -128,6 +133,10 @@ impl Patches {
             i = end;
         }
         tree.covered.clear();
+        // Grown entry by entry: kept at their size (about 15 MB at 256², up to twice that
+        // with the room a growing vector leaves).
+        patches.particle.shrink_to_fit();
+        patches.reference.shrink_to_fit();
         patches
     }
 
@@ -170,11 +179,8 @@ impl Patches {
     /// middles; any map would do. Never for a node with no entries, nor where a distance is
     /// NaN.
     fn certified(&self, i: usize, motion: [&[Vec3]; 2], least: f32) -> bool {
-        self.holds(
-            self.start[i] as usize..self.start[i + 1] as usize,
-            motion,
-            least,
-        )
+        let range = self.start[i] as usize..self.start[i + 1] as usize;
+        self.holds(range, self.inverse[i], motion, least)
     }
 
     /// Whether corner `c`'s ring keeps so near its rest shape along the motion from
@@ -182,22 +188,31 @@ impl Patches {
     /// a ring is a patch too).
     pub(super) fn ring_holds(&self, c: usize, motion: [&[Vec3]; 2], reach: f32) -> bool {
         let range = self.rings[c] as usize..self.rings[c + 1] as usize;
-        self.holds(range, motion, reach * (1.0 + MARGIN))
+        self.holds(range, self.ring_inverse[c], motion, reach * (1.0 + MARGIN))
     }
 
-    /// [`Patches::certified`] for the entries in `range`.
-    fn holds(&self, range: std::ops::Range<usize>, [from, to]: [&[Vec3]; 2], least: f32) -> bool {
+    /// [`Patches::certified`] for the entries in `range`, whose inverse second moments
+    /// are `inverse`.
+    fn holds(
+        &self,
+        range: std::ops::Range<usize>,
+        [xx, xy, yy]: [f32; 3],
+        [from, to]: [&[Vec3]; 2],
+        least: f32,
+    ) -> bool {
         if range.is_empty() {
             return false;
         }
-        let (particle, weights) = (&self.particle[range.clone()], &self.weights[range.clone()]);
-        let n = range.len() as f32;
-        // The middles of the starts and of the ends, and the map fitted in the middle.
+        let (particle, reference) = (&self.particle[range.clone()], &self.reference[range]);
+        let n = particle.len() as f32;
+        // The middles of the starts and of the ends, and the map fitted in the middle:
+        // its columns are sums over the particles weighed by the inverse second moments.
         let (mut first, mut last, mut p, mut q) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
-        for (&j, &[a, b]) in particle.iter().zip(weights) {
+        for (&j, r) in particle.iter().zip(reference) {
             let (s, e) = (from[j as usize], to[j as usize]);
             (first, last) = (first + s, last + e);
             let middle = 0.5 * (s + e);
+            let (a, b) = (xx * r.x + xy * r.y, xy * r.x + yy * r.y);
             (p, q) = (p + a * middle, q + b * middle);
         }
         let (first, last) = (first / n, last / n);
@@ -209,7 +224,7 @@ impl Patches {
             return false;
         }
         let limit = most * most;
-        (particle.iter().zip(&self.reference[range])).all(|(&j, &r)| {
+        (particle.iter().zip(reference)).all(|(&j, &r)| {
             let (j, r) = (j as usize, map * r);
             let start = (from[j] - first - r).length_squared();
             let end = (to[j] - last - r).length_squared();
@@ -217,10 +232,11 @@ impl Patches {
         })
     }
 
-    /// Adds a node's entries for its particles `held` at `rest` (none: not certified).
-    fn add(&mut self, held: &[u32], rest: &[Vec3]) {
+    /// Adds a patch's entries for its particles `held` at `rest` (none: not certified);
+    /// returns their inverse second moments.
+    fn add(&mut self, held: &[u32], rest: &[Vec3]) -> [f32; 3] {
         if held.is_empty() {
-            return;
+            return [0.0; 3];
         }
         let at = |j: u32| rest[j as usize];
         let middle = held.iter().map(|&j| at(j)).sum::<Vec3>() / held.len() as f32;
@@ -228,27 +244,21 @@ impl Patches {
         let back = frame(a, b, c).transpose();
         let start = self.reference.len();
         (self.reference).extend(held.iter().map(|&j| back * (at(j) - middle)));
+        self.particle.extend_from_slice(held);
         // The least-squares fit of the motion's middles by a linear map of the rest
-        // shape's offsets in the frame's first two axes: `p` and `q` are the map's
-        // columns, each a sum over the particles weighted by the inverse of the offsets'
-        // second moments. A rigid motion is fitted exactly (its turn, found again).
+        // shape's offsets in the frame's first two axes: the map's columns are sums over
+        // the particles weighed by the inverse of the offsets' second moments. A rigid
+        // motion is fitted exactly (its turn, found again).
         let r = &self.reference[start..];
         let (uu, uv, vv) = r.iter().fold((0.0, 0.0, 0.0), |(uu, uv, vv), o| {
             (uu + o.x * o.x, uv + o.x * o.y, vv + o.y * o.y)
         });
         let det = uu * vv - uv * uv;
-        let inverse = if det.abs() > f32::EPSILON * (uu * vv).max(f32::MIN_POSITIVE) {
+        if det.abs() > f32::EPSILON * (uu * vv).max(f32::MIN_POSITIVE) {
             [vv / det, -uv / det, uu / det]
         } else {
             [0.0; 3]
-        };
-        (self.weights).extend(r.iter().map(|o| {
-            [
-                inverse[0] * o.x + inverse[1] * o.y,
-                inverse[1] * o.x + inverse[2] * o.y,
-            ]
-        }));
-        self.particle.extend_from_slice(held);
+        }
     }
 }
 
