@@ -3,6 +3,8 @@
 use glam::Vec3;
 
 use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
+#[cfg(doc)]
+use super::faces::FacePatches;
 use super::solid::{Solid, default_friction, resolve};
 use crate::sim::obstacle::closest_weights;
 use crate::sim::param_error::ParamError;
@@ -68,10 +70,11 @@ impl Solid for Sphere {
 impl Sphere {
     /// Keeps each triangle's interior out of the sphere too (with self-contact, whose
     /// guarantee covers the surface): a flat triangle over a small sphere dips in between
-    /// its corners however far out they are. A triangle whose point
-    /// nearest the centre is within the radius and half the offset is pushed out along the
-    /// line from the centre, its corners by their weights and inverse masses, and their
-    /// velocities lose what points in. Returns the triangles pushed.
+    /// its corners however far out they are. A triangle whose point nearest the centre is
+    /// within the radius and the offset is pushed out along the line from the centre, its
+    /// corners by their weights and inverse masses, and their velocities lose what points
+    /// in; only the triangles of the patches whose box comes that near are tested
+    /// ([`FacePatches`]). Returns the triangles pushed.
     fn keep_faces_out(&self, pass: &mut ContactPass<'_>) -> usize {
         let reach = self.radius + pass.offset;
         let (model, state) = (pass.model, &mut *pass.state);

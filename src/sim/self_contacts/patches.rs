@@ -3,19 +3,21 @@
 //! touch itself. The tree's nodes of [`SMALLEST`]–[`TRIANGLES_PER_PIECE`] triangles are
 //! patches that stay together however the cloth folds; at rest no two sides of a pair of
 //! the cloth are closer than its rest gap (measured once per cloth, up to its longest
-//! edge), and a pair's distance changes by at most twice the farthest its particles stray
-//! from a rigid motion of the rest shape. So while every particle of a patch stays within
-//! half of what the gap leaves over the reach of where its rest shape, turned with the
-//! patch's frame and carried with its first particle, puts it, no pair of two of its
-//! triangles comes within the reach — those that share a corner included. As for the
-//! corners' certificates ([`super::certify`]), the frame is the patch's in the middle of
-//! the motion, each particle's offset from its place is then linear along the motion, and
-//! a patch is certified for the whole motion from its start and end.
+//! edge). A linear map of the rest shape, carried anywhere, shrinks no distance by more
+//! than the least it stretches any direction (`σ`), and a pair's distance differs from its
+//! distance so mapped by at most twice the farthest its particles are from where the map
+//! puts them. So while every particle of a patch stays within `(σ·gap − reach)/2` of where
+//! such a map of its rest offset, carried with the middle of the patch, puts it, no pair of
+//! two of its triangles comes within the reach — those that share a corner included. The
+//! map is fitted to the middles of the motion by least squares (any map keeps the bound;
+//! the fitted one keeps it tight); held fixed along the motion, each particle's offset
+//! from its place is linear in time, so a patch is certified for the whole motion from its
+//! start and end, as the corners' certificates are ([`super::certify`]).
 //!
 //! A certified node is covered, and so is every node under it: a whole search walks past a
 //! covered node against itself and leaves the corners whose ring a covered node holds
-//! closed. The certificates need no reference taken again: the rest shape is the
-//! reference.
+//! closed. A corner's ring is such a patch too. The certificates need no reference taken
+//! again: the rest shape is the reference.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
