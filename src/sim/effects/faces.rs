@@ -8,7 +8,7 @@
 use glam::Vec3;
 
 use crate::cloth::ClothModel;
-use crate::sim::obstacle::split_at_medians;
+use crate::sim::obstacle::split_triangles_at_medians;
 
 /// Triangles in a patch at most (at least half as many, but for a cloth with fewer).
 const PATCH: usize = 32;
@@ -38,14 +38,7 @@ impl FacePatches {
             return;
         }
         let (triangles, rest) = (&model.triangles, &model.rest_positions);
-        let (nodes, order) = split_at_medians(triangles.len(), PATCH, |t| {
-            let corner = |i: u32| rest.get(i as usize).copied().unwrap_or(Vec3::ZERO);
-            triangles[t as usize]
-                .iter()
-                .map(|&i| corner(i))
-                .sum::<Vec3>()
-                / 3.0
-        });
+        let (nodes, order) = split_triangles_at_medians(triangles, rest, PATCH);
         *self = FacePatches {
             cut_for: size,
             ..FacePatches::default()

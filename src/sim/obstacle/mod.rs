@@ -12,4 +12,4 @@ pub(crate) use geometry::{closest_weights, segments_closest};
 pub use sequence::{Moment, Sequence};
 pub use surface::{Caught, Gathered, Surface};
 pub use tree::{Nearest, TriangleTree};
-pub(crate) use tree::{Split, split_at_medians};
+pub(crate) use tree::{Split, split_triangles_at_medians};

@@ -291,6 +291,23 @@ pub(crate) struct Split {
     pub second: u32,
 }
 
+/// [`split_at_medians`] over the triangles of a cloth, each at the centre of its corners'
+/// `rest` positions (a corner past them at the origin).
+pub(crate) fn split_triangles_at_medians(
+    triangles: &[[u32; 3]],
+    rest: &[Vec3],
+    leaf: usize,
+) -> (Vec<Split>, Vec<u32>) {
+    split_at_medians(triangles.len(), leaf, |t| {
+        let corner = |i: u32| rest.get(i as usize).copied().unwrap_or(Vec3::ZERO);
+        triangles[t as usize]
+            .iter()
+            .map(|&i| corner(i))
+            .sum::<Vec3>()
+            / 3.0
+    })
+}
+
 /// A balanced tree over `n` places, each at `centre(place)`: every node of more than
 /// `leaf` places is halved at the median of their centres along the axis of their widest
 /// spread. Returns the nodes, each parent before its children (so that a pass from the

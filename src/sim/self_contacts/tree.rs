@@ -1,6 +1,6 @@
 //! The broad phase: a bounding-volume tree over the cloth's triangles, built once per
 //! cloth from where its triangles lie at rest (halved at the median of their centres,
-//! level by level: [`split_at_medians`]), so that each node holds a patch of the cloth
+//! level by level: [`split_triangles_at_medians`]), so that each node holds a patch of the cloth
 //! that stays together however it folds. Every search fits the boxes to the positions as
 //! they are (the tree's shape never changes) and walks the tree against itself: two nodes
 //! that keep apart are passed by with everything under them.
@@ -15,7 +15,7 @@
 
 use glam::{Vec3, Vec3A};
 
-use crate::sim::obstacle::{Split, split_at_medians};
+use crate::sim::obstacle::{Split, split_triangles_at_medians};
 
 /// Triangles in a leaf at most: two leaves are tested triangle by triangle.
 const LEAF: usize = 4;
@@ -72,14 +72,7 @@ impl TriangleTree {
     /// The tree over `triangles`, from the particles' `rest` positions (balanced: its
     /// depth is that of a complete tree).
     pub(super) fn build(triangles: &[[u32; 3]], rest: &[Vec3]) -> TriangleTree {
-        let (nodes, order) = split_at_medians(triangles.len(), LEAF, |t| {
-            let corner = |i: u32| rest.get(i as usize).copied().unwrap_or(Vec3::ZERO);
-            triangles[t as usize]
-                .iter()
-                .map(|&i| corner(i))
-                .sum::<Vec3>()
-                / 3.0
-        });
+        let (nodes, order) = split_triangles_at_medians(triangles, rest, LEAF);
         let mut tree = TriangleTree {
             nodes,
             order,
