@@ -57,8 +57,8 @@ pub struct CpuStepper<R: Real = f32> {
     substep_start: Vec<glam::Vec3>,
     self_collision: Option<SelfCollision>,
     self_contacts: SelfContacts,
-    /// Positions before the solids act (first, and again after self-contact): what they
-    /// moved is what changed since.
+    /// Positions before the solids act (first, and again after self-contact), and before
+    /// self-contact: what they, or it, moved is what changed since.
     before_solids: Vec<glam::Vec3>,
     /// The cloth's triangles in patches, for the solids' face passes.
     faces: FacePatches,

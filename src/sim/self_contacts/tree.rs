@@ -1,7 +1,7 @@
 //! The broad phase: a bounding-volume tree over the cloth's triangles, built once per
 //! cloth from where its triangles lie at rest (halved at the median of their centres,
-//! level by level: [`split_triangles_at_medians`]), so that each node holds a patch of the cloth
-//! that stays together however it folds. Every search fits the boxes to the positions as
+//! level by level: [`split_triangles_at_medians`]), so that each node holds a patch of
+//! the cloth that stays together however it folds. Every search fits the boxes to the positions as
 //! they are (the tree's shape never changes) and walks the tree against itself: two nodes
 //! that keep apart are passed by with everything under them.
 //!
