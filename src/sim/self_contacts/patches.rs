@@ -8,11 +8,14 @@
 //! distance so mapped by at most twice the farthest its particles are from where the map
 //! puts them. So while every particle of a patch stays within `(σ·gap − reach)/2` of where
 //! such a map of its rest offset, carried with the middle of the patch, puts it, no pair of
-//! two of its triangles comes within the reach — those that share a corner included. The
-//! map is fitted to the middles of the motion by least squares (any map keeps the bound;
-//! the fitted one keeps it tight); held fixed along the motion, each particle's offset
-//! from its place is linear in time, so a patch is certified for the whole motion from its
-//! start and end, as the corners' certificates are ([`super::certify`]).
+//! two of its triangles comes within the reach — those that share a corner included. Maps
+//! are fitted to the starts and to the ends by least squares (any maps keep the bound;
+//! fitted ones keep it tight), and along the motion the map runs from one to the other:
+//! each particle's offset from its place is then linear in time, so a patch is certified
+//! for the whole motion from its start and end, as the corners' certificates are
+//! ([`super::certify`]); the map in between shrinks no distance by more than the middle
+//! map's least stretch less half how far the map moves (Weyl's inequality), so a patch
+//! that turns as a whole stays certified.
 //!
 //! A certified node is covered, and so is every node under it: a whole search walks past a
 //! covered node against itself and leaves the corners whose ring a covered node holds
@@ -175,11 +178,11 @@ impl Patches {
     }
 
     /// Whether no pair of node `i` comes within `least` along the motion: every particle
-    /// starts and ends within half of what the rest gap, shrunk by the node's fitted map,
-    /// leaves over `least` of where that map of its rest offset, carried with the middle of
-    /// the node's starts or ends, puts it. The map is the least-squares fit of the motion's
-    /// middles; any map would do. Never for a node with no entries, nor where a distance is
-    /// NaN.
+    /// starts (ends) within half of what the rest gap, shrunk by the least the maps along
+    /// the motion stretch, leaves over `least` of where the map fitted to the starts (ends)
+    /// puts its rest offset, carried with the middle of the starts (ends). The maps are
+    /// least-squares fits; any maps would do. Never for a node with no entries, nor where a
+    /// distance is NaN.
     fn certified(&self, i: usize, motion: [&[Vec3]; 2], least: f32) -> bool {
         let range = self.start[i] as usize..self.start[i + 1] as usize;
         self.holds(range, self.inverse[i], motion, least)
@@ -207,29 +210,38 @@ impl Patches {
         }
         let (particle, reference) = (&self.particle[range.clone()], &self.reference[range]);
         let n = particle.len() as f32;
-        // The middles of the starts and of the ends, and the map fitted in the middle:
-        // its columns are sums over the particles weighed by the inverse second moments.
-        let (mut first, mut last, mut p, mut q) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+        // The middles of the starts and of the ends, and the maps fitted to each: their
+        // columns are sums over the particles weighed by the inverse second moments.
+        let (mut first, mut last) = (Vec3::ZERO, Vec3::ZERO);
+        let [mut p0, mut q0, mut p1, mut q1] = [Vec3::ZERO; 4];
         for (&j, r) in particle.iter().zip(reference) {
             let (s, e) = (from[j as usize], to[j as usize]);
             (first, last) = (first + s, last + e);
-            let middle = 0.5 * (s + e);
             let (a, b) = (xx * r.x + xy * r.y, xy * r.x + yy * r.y);
-            (p, q) = (p + a * middle, q + b * middle);
+            (p0, q0, p1, q1) = (p0 + a * s, q0 + b * s, p1 + a * e, q1 + b * e);
         }
         let (first, last) = (first / n, last / n);
-        let Some((map, shrink)) = fitted(p, q) else {
+        // Along the motion the map runs from the starts' to the ends' (its third column,
+        // the normal, held at the middle's): it shrinks no distance by more than the
+        // middle's least stretch less half how far the map moves (Weyl).
+        let Some((middle, shrink)) = fitted(0.5 * (p0 + p1), 0.5 * (q0 + q1)) else {
             return false;
         };
-        let most = 0.5 * (shrink * self.gap - least);
+        let moved = 0.5 * ((p1 - p0).length_squared() + (q1 - q0).length_squared()).sqrt();
+        let most = 0.5 * ((shrink - moved) * self.gap - least);
         if most.is_nan() || most <= 0.0 {
             return false;
         }
         let limit = most * most;
+        let normal = middle.z_axis;
+        let (start_map, end_map) = (
+            glam::Mat3::from_cols(p0, q0, normal),
+            glam::Mat3::from_cols(p1, q1, normal),
+        );
         (particle.iter().zip(reference)).all(|(&j, &r)| {
-            let (j, r) = (j as usize, map * r);
-            let start = (from[j] - first - r).length_squared();
-            let end = (to[j] - last - r).length_squared();
+            let j = j as usize;
+            let start = (from[j] - first - start_map * r).length_squared();
+            let end = (to[j] - last - end_map * r).length_squared();
             start <= limit && end <= limit
         })
     }

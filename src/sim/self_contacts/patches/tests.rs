@@ -132,12 +132,14 @@ fn decide_and_check(c: &mut Cloth, motion: [&[Vec3]; 2], what: &str) -> (usize, 
     (covered, least, rings)
 }
 
-/// The cloth folds over a line as the corners' test folds it (5° a substep, to 175°),
-/// wobbling by up to 3 mm and turned and carried as a whole; then it is squeezed along x,
-/// and jittered, more the farther along x: each time, no covered pair comes within the
-/// reach, while most of the cloth is covered where it stays near its rest shape and the
-/// covered pairs come near the reach where it does not; and four particles are pushed
-/// along the plane towards their neighbours by the motion's end alone.
+/// The cloth folds over the line x = 3 cm (through the middle of a row of its nodes)
+/// as the corners' test folds it (5° a substep, to 175°), wobbling by up to 3 mm and
+/// turned and carried as a whole; then it is squeezed along x, then along z instead of
+/// x as it moves, and jittered, more the farther along x: each time, no covered pair
+/// comes within the reach, while most of the cloth is covered where it stays near its
+/// rest shape and the covered pairs come near the reach where it does not; and four
+/// particles are pushed along the plane towards their neighbours by the motion's end
+/// alone.
 #[test]
 fn a_covered_patch_keeps_its_pairs_the_reach_apart() {
     let mut c = cloth(12, |p| p);
@@ -152,8 +154,9 @@ fn a_covered_patch_keeps_its_pairs_the_reach_apart() {
         let turn = Quat::from_axis_angle(Vec3::new(0.3, 1.0, 0.2).normalize(), 0.07 * k);
         (rest.iter())
             .map(|&p| {
-                let p = if p.x > 0.0 {
-                    Vec3::new(p.x * fold.cos(), p.x * fold.sin(), p.z)
+                let (line, x) = (0.03, p.x - 0.03);
+                let p = if x > 0.0 {
+                    Vec3::new(line + x * fold.cos(), x * fold.sin(), p.z)
                 } else {
                     p
                 };
@@ -204,6 +207,19 @@ fn a_covered_patch_keeps_its_pairs_the_reach_apart() {
         assert_eq!(covered > 0, allowed, "squeezed to {squeeze}: {covered}");
         least = least.min(near);
     }
+    // Squeezed to 0.15 along x at the start and along z at the end: in the middle the
+    // map shrinks nothing by more than 0.575, but at the ends the pairs are within the
+    // reach.
+    let from: Vec<Vec3> = rest
+        .iter()
+        .map(|p| Vec3::new(0.15 * p.x, p.y, p.z))
+        .collect();
+    let to: Vec<Vec3> = rest
+        .iter()
+        .map(|p| Vec3::new(p.x, p.y, 0.15 * p.z))
+        .collect();
+    let (covered, _, _) = decide_and_check(&mut c, [&from, &to], "squeezed across");
+    assert_eq!(covered, 0);
     // Jittered by up to 0 mm at x = −12 cm and 12 mm at 12 cm, at the start and end.
     let mut rnd = crate::test_rng::uniform(9);
     let mut jitter = |p: Vec3| {
