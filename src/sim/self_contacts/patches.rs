@@ -66,8 +66,6 @@ pub(super) struct Patches {
     /// The least distance at rest between the sides of a pair of the cloth, up to its
     /// longest edge, rounded down, m.
     gap: f32,
-    /// Whether each corner's ring is held by a node covered for the motion last decided.
-    pub(super) corners: Vec<bool>,
 }
 
 impl Patches {
@@ -122,20 +120,20 @@ impl Patches {
             patches.rings.push(patches.particle.len() as u32);
         }
         patches.home = homes(tree, &nodes, &patches.parent, triangles, rest.len());
-        // In the tree's order a subtree's nodes follow its root, up to the next node that
-        // is not under it.
+        // In the tree's order a subtree's nodes follow its root, up to its last leaf, the
+        // end of the chain of second children.
         let mut i = 0;
         while i < nodes.len() {
             if nodes[i].count > TRIANGLES_PER_PIECE {
                 i += 1;
                 continue;
             }
-            let mut end = i + 1;
-            while end < nodes.len() && under(&patches.parent, end, i) {
-                end += 1;
+            let mut last = i;
+            while nodes[last].second != 0 {
+                last = nodes[last].second as usize;
             }
-            patches.subtrees.push(i..end);
-            i = end;
+            patches.subtrees.push(i..last + 1);
+            i = last + 1;
         }
         tree.covered.clear();
         // Grown entry by entry: kept at their size (about 15 MB at 256², up to twice that
@@ -146,8 +144,8 @@ impl Patches {
     }
 
     /// Covers the tree's nodes certified for the motion of each particle from `from` to
-    /// `to`, with `reach` (see the module's notes), and the corners whose ring they hold.
-    pub(super) fn decide(&mut self, tree: &mut TriangleTree, [from, to]: [&[Vec3]; 2], reach: f32) {
+    /// `to`, with `reach` (see the module's notes).
+    pub(super) fn decide(&self, tree: &mut TriangleTree, [from, to]: [&[Vec3]; 2], reach: f32) {
         let least = reach * (1.0 + MARGIN);
         let covered = &mut tree.covered;
         covered.clear();
@@ -166,15 +164,13 @@ impl Patches {
         };
         let parallel = self.particle.len() >= PARALLEL_ELEMENTS;
         Team::current().run_large_pieces_if(parallel, self.subtrees.len(), &work);
-        self.corners.clear();
-        (self.corners).extend(self.home.iter().map(|&h| h != NONE && covered[h as usize]));
     }
 
-    /// Covers nothing (the pairs are judged by the boxes, not by the motion).
-    pub(super) fn uncover(&mut self, tree: &mut TriangleTree) {
-        tree.covered.clear();
-        self.corners.clear();
-        self.corners.resize(self.home.len(), false);
+    /// Whether corner `c`'s ring is held by a node of `tree` covered for the motion last
+    /// decided.
+    pub(super) fn covers(&self, tree: &TriangleTree, c: usize) -> bool {
+        let home = self.home[c];
+        home != NONE && tree.covered.get(home as usize).copied().unwrap_or(false)
     }
 
     /// Whether no pair of node `i` comes within `least` along the motion: every particle
@@ -288,15 +284,6 @@ fn fitted(p: Vec3, q: Vec3) -> Option<(glam::Mat3, f32)> {
     }
     let shrink = least.sqrt();
     Some((glam::Mat3::from_cols(p, q, shrink * normal), shrink))
-}
-
-/// Whether node `i` is under node `root` (`parent` each node's parent; a parent comes
-/// before its children).
-fn under(parent: &[u32], mut i: usize, root: usize) -> bool {
-    while i > root {
-        i = parent[i] as usize;
-    }
-    i == root
 }
 
 /// Three of `held` (at `rest`) whose frame turns a node: the one nearest their middle,

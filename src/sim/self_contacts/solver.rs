@@ -375,9 +375,9 @@ impl SelfContacts {
             // Closed as they are: in a whole search the corners the patches cover (a
             // refresh decides those whose motion changed, covered or not), and those whose
             // reference fails but whose ring keeps near its rest shape.
-            let (patches, reach) = (&self.patches, self.reach(thickness));
+            let (patches, tree, reach) = (&self.patches, &self.tree, self.reach(thickness));
             let only = refreshed.then_some(&self.left[..]);
-            let covered = |c: usize| !refreshed && patches.corners[c];
+            let covered = |c: usize| !refreshed && patches.covers(tree, c);
             let near_rest = |c: usize| patches.ring_holds(c, motion, reach);
             let settled: [&(dyn Fn(usize) -> bool + Sync); 2] = [&covered, &near_rest];
             let certificates = &mut self.certificates;
@@ -605,7 +605,8 @@ impl SelfContacts {
             );
             (self.patches).decide(&mut self.tree, motion, reach);
         } else {
-            self.patches.uncover(&mut self.tree);
+            // The pairs are judged by the boxes: nothing is covered.
+            self.tree.covered.clear();
         }
         self.decide_corners(&model.triangles, thickness, false);
         let search = Search {

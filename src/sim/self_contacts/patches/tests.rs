@@ -118,7 +118,7 @@ fn decide_and_check(c: &mut Cloth, motion: [&[Vec3]; 2], what: &str) -> (usize, 
     let mut rings = 0;
     for corner in 0..c.rest.len() {
         let held = c.patches.ring_holds(corner, motion, REACH);
-        if c.patches.corners[corner] || held {
+        if c.patches.covers(&c.tree, corner) || held {
             let ring = &around[start[corner] as usize..start[corner + 1] as usize];
             let near = closest_within(triangles, ring, motion);
             assert!(
