@@ -392,14 +392,7 @@ fn pair_key(pair: &Pair) -> [u32; 5] {
 /// past them (refreshed only where the sliding row leaves its boxes).
 #[test]
 fn pairs_found_for_a_window_hold_through_it() {
-    let (mesh, model, path) = folded_and_sinking(|_, _| Vec3::ZERO);
-    let mut contacts = SelfContacts {
-        owners: Owners::build(&model),
-        ..SelfContacts::default()
-    };
-    let near_total = (0..path.len() - 1)
-        .map(|k| hold_through(&mut contacts, &mesh, &model, [&path[k], &path[k + 1]]))
-        .sum::<usize>();
+    let (contacts, _, _, near_total) = held_along(|_, _| Vec3::ZERO, |_, _, _| {});
     let work = contacts.work;
     assert!(near_total > 5000, "{near_total} pairs came near");
     assert_eq!((work.searches, work.refreshes), (5, 0), "{work:?}");
@@ -423,23 +416,15 @@ fn particles_that_leave_a_window_get_paths_of_their_own() {
             Vec3::ZERO
         }
     };
-    let (mesh, model, path) = folded_and_sinking(band);
-    let mut contacts = SelfContacts {
-        owners: Owners::build(&model),
-        ..SelfContacts::default()
-    };
-    let mut near_total = 0;
-    for k in 0..path.len() - 1 {
-        let motion = [&path[k][..], &path[k + 1][..]];
-        near_total += hold_through(&mut contacts, &mesh, &model, motion);
+    let (_, _, _, near_total) = held_along(band, |k, contacts, model| {
         if k == 2 {
             assert_eq!((contacts.window.len, contacts.window.at), (2, 1));
             assert_eq!(contacts.work.refreshes, 1, "{:?}", contacts.work);
             let work = contacts.work;
-            contacts.update_pairs(&model, THICKNESS, THICKNESS).unwrap();
+            contacts.update_pairs(model, THICKNESS, THICKNESS).unwrap();
             assert_eq!(contacts.work, work, "checked again");
         }
-    }
+    });
     assert!(near_total > 5000, "{near_total} pairs came near");
 }
 
@@ -465,15 +450,8 @@ fn a_particle_that_strays_inside_a_covered_patch_is_searched_against_it() {
             .map_or(Vec3::ZERO, |p| Vec3::new(p.1[0], 0.0, p.1[1]).normalize());
         along * 0.052 * k.saturating_sub(2).min(1) as f32
     };
-    let (mesh, model, path) = folded_and_sinking(push);
-    let mut contacts = SelfContacts {
-        owners: Owners::build(&model),
-        ..SelfContacts::default()
-    };
     let mut covered = 0;
-    for k in 0..path.len() - 1 {
-        let motion = [&path[k][..], &path[k + 1][..]];
-        hold_through(&mut contacts, &mesh, &model, motion);
+    let (_, model, path, _) = held_along(push, |k, contacts, model| {
         if k == 1 {
             // The window's whole search: the pushed particles' patches are covered.
             let nodes = contacts.tree.nodes().len();
@@ -493,7 +471,7 @@ fn a_particle_that_strays_inside_a_covered_patch_is_searched_against_it() {
             assert_eq!((contacts.window.len, contacts.window.at), (2, 1));
             assert_eq!(contacts.work.refreshes, 1, "{:?}", contacts.work);
         }
-    }
+    });
     assert!(
         covered >= 4,
         "{covered} covered nodes hold a pushed particle"
@@ -509,6 +487,26 @@ fn a_particle_that_strays_inside_a_covered_patch_is_searched_against_it() {
             })
     };
     assert!(pushed.iter().any(|p| near(p.0)));
+}
+
+/// The cloth of [`folded_and_sinking`] (with `more`) through its eight substeps, each
+/// brought up to date and checked by [`hold_through`], `after(k, …)` called after substep
+/// `k`: the solver, the model, the path, and how many pairs came near.
+fn held_along(
+    more: impl Fn(usize, usize) -> Vec3,
+    mut after: impl FnMut(usize, &mut SelfContacts, &ClothModel),
+) -> (SelfContacts, ClothModel, Vec<Vec<Vec3>>, usize) {
+    let (mesh, model, path) = folded_and_sinking(more);
+    let mut contacts = SelfContacts {
+        owners: Owners::build(&model),
+        ..SelfContacts::default()
+    };
+    let mut near = 0;
+    for k in 0..path.len() - 1 {
+        near += hold_through(&mut contacts, &mesh, &model, [&path[k], &path[k + 1]]);
+        after(k, &mut contacts, &model);
+    }
+    (contacts, model, path, near)
 }
 
 /// A 12 × 12-quad cloth folded in two, its upper half 1.5 thicknesses above the lower and
