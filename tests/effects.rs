@@ -859,8 +859,9 @@ fn a_scene_without_self_collision_does_no_self_collision_work() {
     let mut sim = Simulation::new(Scene::builtin("hanging").unwrap());
     sim.run(0.1);
     assert_eq!(sim.self_collision_work(), None);
+    // Once the fold has come within reach of itself.
     let mut sim = Simulation::new(Scene::builtin("self-fold").unwrap());
-    sim.run(0.1);
+    sim.run(0.5);
     let work = sim
         .self_collision_work()
         .expect("self-fold has self-collision");

@@ -23,6 +23,7 @@ mod rings;
 mod search;
 mod solver;
 mod tree;
+mod window;
 
 pub use error::ContactError;
 pub(crate) use primitives::point_triangle_distance;

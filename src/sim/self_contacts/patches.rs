@@ -395,7 +395,7 @@ fn rest_gap(
     let work = |_: usize, piece: usize| {
         let mut mine = f64::from_bits(least.load(Ordering::Relaxed));
         if piece < pieces {
-            tree.piece_pairs(piece, false, |a, b| {
+            tree.piece_pairs(piece, |a, b| {
                 let (a, b) = (a as usize, b as usize);
                 if !triangles[a].iter().any(|i| triangles[b].contains(i)) {
                     owners.each_pair(triangles, a, b, |pair, _| measure(pair, &mut mine));

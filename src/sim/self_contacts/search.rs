@@ -295,20 +295,32 @@ impl Search<'_> {
     }
 
     /// Adds to `out` the pairs of piece `piece` of [`Owners::neighbours`] that could come
-    /// within the thickness; with `dirty`, only those of a triangle it flags. The pairs of
-    /// a corner the certificates closed are passed by.
+    /// within the thickness; with `dirty` (triangles and the particles that made them so),
+    /// only those of a triangle it flags. The pairs of a corner the certificates closed
+    /// are passed by.
     pub(super) fn neighbours(
         &self,
         piece: usize,
-        dirty: Option<&[bool]>,
+        dirty: Option<[&[bool]; 2]>,
         out: &mut Vec<StoredPair>,
     ) {
         let starts = &self.owners.piece_start;
-        let owner = &self.owners.vertex_owner;
+        let (owner, rings) = (&self.owners.vertex_owner, &self.owners.rings);
         for c in starts[piece] as usize..starts[piece + 1] as usize {
             if self.boxes.swept && !self.open[c] {
                 continue;
             }
+            // A corner's pairs lie on the triangles around it, whose particles are its
+            // ring's: none of those left, none of its triangles is dirty.
+            if let Some([_, left]) = dirty
+                && !left[c]
+                && rings.ring[rings.range(c)]
+                    .iter()
+                    .all(|&j| !left[j as usize])
+            {
+                continue;
+            }
+            let dirty = dirty.map(|[triangles, _]| triangles);
             for &stored in self.owners.corner_pairs(c) {
                 if dirty.is_some_and(|d| !stored.triangles(owner).iter().any(|&t| d[t as usize])) {
                     continue;
@@ -369,8 +381,9 @@ impl Search<'_> {
     }
 
     /// A lower bound on how close the pair's sides come with each particle anywhere in its
-    /// box: in its box, a particle is at most half the box's diagonal from the box's
-    /// centre (the smallest ball around the box).
+    /// box less half the thickness each way (judged by the boxes, the pairs hold while
+    /// each particle's motion lies there): there, a particle is at most half that box's
+    /// diagonal from its centre (the smallest ball around the box).
     fn boxed_apart(&self, pair: &Pair) -> f64 {
         let ids = pair.ids();
         let (lo, hi) = (
@@ -378,7 +391,8 @@ impl Search<'_> {
             ids.map(|i| self.boxes.vertex_hi[i]),
         );
         let x = std::array::from_fn(|j| (0.5 * (lo[j] + hi[j])).as_dvec3());
-        let radius = |j: usize| 0.5 * f64::from((hi[j] - lo[j]).length());
+        let t = self.thickness;
+        let radius = |j: usize| 0.5 * f64::from((hi[j] - lo[j] - t).max(Vec3::ZERO).length());
         let most = |r: std::ops::Range<usize>| r.map(radius).fold(0.0f64, f64::max);
         let k = pair.first_side();
         distance(pair, x) - most(0..k) - most(k..4)

@@ -15,6 +15,7 @@ use super::patches::Patches;
 use super::primitives::{StoredPair, closer_than, push_apart};
 use super::search::{Boxes, Owners, Search, pairs};
 use super::tree::TriangleTree;
+use super::window::Window;
 
 /// Work done by the last resolve: for cost checks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -52,12 +53,6 @@ const KEEP: f64 = 0.1;
 /// 64² against a few hundred, and cost more than the searches it saved.
 const REUSE_BELOW: f32 = 0.5;
 
-/// Where the pairs are judged by the motion, each whole search judges them along the
-/// particles' motion carried on at its velocity for a window of up to this many substeps,
-/// so that they hold for the substeps after while each particle stays within
-/// [`ALLOWANCE`] of that path (see [`Window`]).
-const LONGEST_WINDOW: u32 = 2;
-
 /// How far, as a share of the thickness, a particle may stray from the path a window
 /// foresaw for it before its triangles are searched again (the pairs are kept for twice
 /// as much more than the thickness).
@@ -80,6 +75,12 @@ const MOST_TRIANGLES: usize = (1 << 31) / 3;
 /// its pairs: twice what it keeps, for margin (pairs farther apart along the whole motion
 /// cannot come within [`KEEP`]). The pushes need the whole thickness.
 const CHECKED: f32 = 2.0 * KEEP as f32;
+
+/// Judged by the boxes alone (the cloth slow in the moving frame), each particle's box
+/// holds its motion carried on at the same velocity for this many substeps more: a
+/// particle that creeps (cloth sliding slowly off a sphere) stays in it that much longer
+/// before its triangles are searched again.
+const AHEAD: f32 = 12.0;
 
 /// Gauss–Seidel sweeps of the pushes over the pairs.
 const PUSH_SWEEPS: usize = 4;
@@ -109,28 +110,6 @@ impl Clone for Cuts {
     }
 }
 
-/// How long the pairs judged by the motion hold. A search judges them along each
-/// particle's path over a window of `len` substeps: its motion in the substep searched,
-/// carried on at the same velocity (in the frame that moves with the cloth's mean motion,
-/// where the cloth's own deceleration moves no particle). They hold at the window's
-/// substep `at` while each particle's start and end lie within the allowance (and the
-/// slack of what the pairs are needed for) of where the path puts them then: along the
-/// substep a particle is then within as much of its path, so a pair's distance falls
-/// short of its foreseen one by at most twice that. A window that ran out before the
-/// whole tree had to be searched again is followed by one twice as long (up to
-/// [`LONGEST_WINDOW`]); one cut short by a search, by one half as long.
-#[derive(Clone, Copy, Debug)]
-struct Window {
-    len: u32,
-    at: u32,
-}
-
-impl Default for Window {
-    fn default() -> Self {
-        Window { len: 1, at: 0 }
-    }
-}
-
 /// Reusable buffers of self-contact: nothing is allocated per substep once warm.
 #[derive(Clone, Debug, Default)]
 pub struct SelfContacts {
@@ -157,6 +136,8 @@ pub struct SelfContacts {
     /// (as flags), for a refresh.
     left: Vec<bool>,
     dirty: Vec<bool>,
+    /// The triangles a refresh searches again, in order.
+    searched: Vec<u32>,
     /// The window the pairs judged by the motion were found for, and how far into it the
     /// substep resolved is.
     window: Window,
@@ -177,6 +158,9 @@ pub struct SelfContacts {
     changed: Vec<bool>,
     pub work: SelfWork,
 }
+
+/// Triangles searched again in one piece of a refresh.
+const REFRESHED_PER_PIECE: usize = 64;
 
 /// Triangles from which the search shares its work out between the team's members.
 const PARALLEL_TRIANGLES: usize = 2048;
@@ -305,7 +289,9 @@ impl SelfContacts {
     /// Makes the pairs hold every pair that can come within `within` along the motion from
     /// `from` to `to`: they do while they were found for this thickness and every
     /// particle's motion lies in its box less half of `within` (two boxes that far apart
-    /// keep their particles `within` apart). Particles whose motion left theirs get new
+    /// keep their particles `within` apart), or judged by the boxes alone, less half the
+    /// thickness, whatever `within` (the pairs kept are only those that could come within
+    /// the thickness from there: [`Search::keep`]). Particles whose motion left theirs get new
     /// boxes, and their triangles are searched again ([`SelfContacts::refresh`]); where
     /// many left, the whole tree is ([`SelfContacts::find_pairs`]).
     /// Where the pairs are judged by the motion, also while the window they were found for
@@ -323,7 +309,7 @@ impl SelfContacts {
         {
             return self.find_pairs(model, thickness);
         }
-        let g = Vec3::splat(0.5 * within);
+        let g = Vec3::splat(0.5 * if swept { within } else { thickness });
         // Pairs judged by the motion hold while each particle starts and ends within the
         // allowance and half of what `within` leaves of the thickness of where its path in
         // the window puts it (see `Window`): a pair kept apart by the thickness and twice
@@ -413,6 +399,12 @@ impl SelfContacts {
         }
     }
 
+    /// Substeps more of each particle's motion its box holds: [`AHEAD`] where the pairs are
+    /// judged by the boxes alone, none where by the motion (the window carries it on).
+    fn ahead(&self) -> f32 {
+        if self.boxes.swept { 0.0 } else { AHEAD }
+    }
+
     /// The box that holds a particle's motion from `s` to `p`, grown by `grow` each way.
     fn vertex_box(s: Vec3, p: Vec3, grow: f32) -> (Vec3, Vec3) {
         (s.min(p) - Vec3::splat(grow), s.max(p) + Vec3::splat(grow))
@@ -465,7 +457,8 @@ impl SelfContacts {
                 }
                 (self.boxes.from[i], self.boxes.to[i]) = (s, p);
             }
-            (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) = Self::vertex_box(s, p, grow);
+            let ahead = p + (p - s) * self.ahead();
+            (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) = Self::vertex_box(s, ahead, grow);
         }
         self.dirty.clear();
         let mut refreshed = 0;
@@ -478,12 +471,12 @@ impl SelfContacts {
             }
         }
         self.fit_tree(model, thickness);
-        self.tree.mark(&self.dirty);
         // Only the corners with a triangle searched again are decided again. One that was
         // closed and is open now still leaves out the pairs of its triangles that stayed:
         // it held for their motion, which has not changed.
         self.decide_corners(&model.triangles, thickness, true);
-        let (tree, dirty, owner) = (&self.tree, &self.dirty, &self.owners.vertex_owner);
+        let (tree, dirty, left) = (&self.tree, &self.dirty, &self.left);
+        let owner = &self.owners.vertex_owner;
         (self.found).retain(|p| p.triangles(owner).iter().all(|&t| !dirty[t as usize]));
         let search = Search {
             owners: &self.owners,
@@ -492,15 +485,21 @@ impl SelfContacts {
             thickness: self.reach(thickness),
             open: &self.certificates.open,
         };
-        let pieces = tree.pieces();
+        self.searched.clear();
+        (self.searched).extend((0..model.triangles.len() as u32).filter(|&t| dirty[t as usize]));
+        let searched = &self.searched;
+        let pieces = searched.len().div_ceil(REFRESHED_PER_PIECE);
         let work = |piece: usize, out: &mut Vec<StoredPair>| {
             if piece >= pieces {
                 // The pairs of triangles sharing a corner, where either is one of those.
-                return search.neighbours(piece - pieces, Some(dirty), out);
+                return search.neighbours(piece - pieces, Some([dirty, left]), out);
             }
-            tree.piece_pairs(piece, true, |a, b| {
-                search.pairs_of(a as usize, b as usize, out)
-            });
+            let first = piece * REFRESHED_PER_PIECE;
+            for &t in &searched[first..(first + REFRESHED_PER_PIECE).min(searched.len())] {
+                tree.triangle_pairs(t, dirty, |a, b| {
+                    search.pairs_of(a as usize, b as usize, out)
+                });
+            }
         };
         let parallel = refreshed >= PARALLEL_TRIANGLES / 4;
         (self.found).extend(pieces + search.neighbour_pieces(), parallel, &work);
@@ -540,15 +539,7 @@ impl SelfContacts {
         // Fast, the pairs are judged by the motion too (see `Boxes::swept`), carried on
         // for a window: twice as long as the last where it ran out, half where it did
         // not.
-        let (was_swept, window) = (self.boxes.swept, self.window);
-        self.window = Window {
-            len: match (slow, was_swept) {
-                (false, true) if window.at >= window.len => (2 * window.len).min(LONGEST_WINDOW),
-                (false, true) => (window.len / 2).max(1),
-                _ => 1,
-            },
-            at: 0,
-        };
+        self.window = self.window.next(slow, self.boxes.swept);
         self.boxes.swept = !slow;
         if self.boxes.swept {
             self.boxes.from.clone_from(&self.from);
@@ -565,9 +556,9 @@ impl SelfContacts {
         } else {
             (&self.from, &self.to)
         };
-        let grow = self.grow(thickness);
+        let (grow, ahead) = (self.grow(thickness), self.ahead());
         for (s, p) in from.iter().zip(to) {
-            let (lo, hi) = Self::vertex_box(*s, *p, grow);
+            let (lo, hi) = Self::vertex_box(*s, *p + (*p - *s) * ahead, grow);
             self.boxes.vertex_lo.push(lo);
             self.boxes.vertex_hi.push(hi);
         }
@@ -621,9 +612,7 @@ impl SelfContacts {
             if piece >= tree.pieces() {
                 return search.neighbours(piece - tree.pieces(), None, out);
             }
-            tree.piece_pairs(piece, false, |a, b| {
-                search.pairs_of(a as usize, b as usize, out)
-            });
+            tree.piece_pairs(piece, |a, b| search.pairs_of(a as usize, b as usize, out));
         };
         let parallel = model.triangles.len() >= PARALLEL_TRIANGLES;
         let pieces = tree.pieces() + search.neighbour_pieces();

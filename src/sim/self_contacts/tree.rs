@@ -49,8 +49,9 @@ enum Fit {
 #[derive(Clone, Debug, Default)]
 pub(super) struct TriangleTree {
     nodes: Vec<Split>,
-    /// The triangles in the tree's order.
+    /// The triangles in the tree's order, and each triangle's place in it.
     order: Vec<u32>,
+    place_of: Vec<u32>,
     /// The pieces a search is cut into.
     tasks: Vec<Task>,
     /// Each box (by boxes), or the box of its starts (by motion).
@@ -61,8 +62,6 @@ pub(super) struct TriangleTree {
     end_hi: Vec<Vec3A>,
     mean: Vec<Vec3A>,
     fit: Fit,
-    /// Whether each box holds a triangle a refresh searches again ([`TriangleTree::mark`]).
-    marked: Vec<bool>,
     /// Whether each node's own pairs are certified apart for the motion of the last fit
     /// (see [`super::patches`]): a whole walk passes by a node against itself then.
     pub(super) covered: Vec<bool>,
@@ -73,9 +72,14 @@ impl TriangleTree {
     /// depth is that of a complete tree).
     pub(super) fn build(triangles: &[[u32; 3]], rest: &[Vec3]) -> TriangleTree {
         let (nodes, order) = split_triangles_at_medians(triangles, rest, LEAF);
+        let mut place_of = vec![0; order.len()];
+        for (place, &t) in order.iter().enumerate() {
+            place_of[t as usize] = place as u32;
+        }
         let mut tree = TriangleTree {
             nodes,
             order,
+            place_of,
             ..TriangleTree::default()
         };
         if !tree.nodes.is_empty() {
@@ -210,19 +214,6 @@ impl TriangleTree {
         self.fit = Fit::Motion { reach };
     }
 
-    /// Marks the boxes that hold a triangle `dirty` flags, for a walk of only theirs.
-    pub(super) fn mark(&mut self, dirty: &[bool]) {
-        let first = self.nodes.len();
-        self.marked.resize(first + self.order.len(), false);
-        for (place, &t) in self.order.iter().enumerate() {
-            self.marked[first + place] = dirty[t as usize];
-        }
-        for i in (0..first).rev() {
-            let (parts, n) = self.parts(i);
-            self.marked[i] = parts[..n].iter().any(|&k| self.marked[k]);
-        }
-    }
-
     /// Whether boxes `a` and `b` do not overlap.
     #[inline(always)]
     fn boxes_apart(&self, a: usize, b: usize) -> bool {
@@ -252,17 +243,64 @@ impl TriangleTree {
 
     /// Calls `pair(a, b)` for each two triangles the walk of piece `piece` does not tell
     /// apart (as the last fit tells them) and no covered node holds both of; the pieces
-    /// together call it once for every such two. With `marked`, only for those two of
-    /// which one at least is marked ([`TriangleTree::mark`]), covered or not: the walk
-    /// passes by two unmarked sides, and so tells every other two apart, or not, exactly
-    /// as the whole walk does.
-    pub(super) fn piece_pairs(&self, piece: usize, marked: bool, pair: impl FnMut(u32, u32)) {
+    /// together call it once for every such two.
+    pub(super) fn piece_pairs(&self, piece: usize, pair: impl FnMut(u32, u32)) {
         // One walk for each fit, each with its test inlined.
         match self.fit {
             Fit::Motion { reach } => {
-                self.walk(piece, marked, |a, b| self.moving_apart(a, b, reach), pair);
+                self.walk(piece, |a, b| self.moving_apart(a, b, reach), pair);
             }
-            Fit::Boxes => self.walk(piece, marked, |a, b| self.boxes_apart(a, b), pair),
+            Fit::Boxes => self.walk(piece, |a, b| self.boxes_apart(a, b), pair),
+        }
+    }
+
+    /// Calls `pair(t, b)` for each triangle `b` that triangle `t`'s box is not told apart
+    /// from (as the last fit tells them), other than `t`, and not flagged by `searched`
+    /// where `b < t` (a search of each flagged triangle so calls it once for each two of
+    /// which one at least is flagged, as [`TriangleTree::piece_pairs`] with `marked` does:
+    /// the tests are the same, against each of `t`'s ancestors' nodes instead of theirs).
+    pub(super) fn triangle_pairs(&self, t: u32, searched: &[bool], pair: impl FnMut(u32, u32)) {
+        match self.fit {
+            Fit::Motion { reach } => {
+                self.query(t, searched, |a, b| self.moving_apart(a, b, reach), pair);
+            }
+            Fit::Boxes => self.query(t, searched, |a, b| self.boxes_apart(a, b), pair),
+        }
+    }
+
+    #[inline(always)]
+    fn query(
+        &self,
+        t: u32,
+        searched: &[bool],
+        apart: impl Fn(usize, usize) -> bool,
+        mut pair: impl FnMut(u32, u32),
+    ) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let x = self.place(self.place_of[t as usize]);
+        let mut stack = [0u32; STACK];
+        let mut depth = 1;
+        while depth > 0 {
+            depth -= 1;
+            let a = stack[depth];
+            if apart(a as usize, x) {
+                continue;
+            }
+            let node = self.nodes[a as usize];
+            if Self::is_leaf(node) {
+                for q in node.first..node.first + node.count {
+                    let b = self.order[q as usize];
+                    let once = b != t && !(b < t && searched[b as usize]);
+                    if once && !apart(self.place(q), x) {
+                        pair(t, b);
+                    }
+                }
+            } else {
+                stack[depth..depth + 2].copy_from_slice(&[node.second, a + 1]);
+                depth += 2;
+            }
         }
     }
 
@@ -270,17 +308,13 @@ impl TriangleTree {
     fn walk(
         &self,
         piece: usize,
-        marked: bool,
         apart: impl Fn(usize, usize) -> bool,
         mut pair: impl FnMut(u32, u32),
     ) {
-        let unmarked = |a: usize| marked && !self.marked[a];
         let first = self.nodes.len();
         // Two triangles, at places `p` and `q`.
         let mut places = |p: usize, q: usize| {
-            let (a, b) = (first + p, first + q);
-            let passed = unmarked(a) && unmarked(b) || apart(a, b);
-            if !passed {
+            if !apart(first + p, first + q) {
                 pair(self.order[p], self.order[q]);
             }
         };
@@ -290,12 +324,9 @@ impl TriangleTree {
         while depth > 0 {
             depth -= 1;
             let (a, b) = stack[depth];
-            if unmarked(a as usize) && unmarked(b as usize) {
-                continue;
-            }
             let (na, nb) = (self.nodes[a as usize], self.nodes[b as usize]);
             if a == b {
-                if !marked && self.covered.get(a as usize).copied().unwrap_or(false) {
+                if self.covered.get(a as usize).copied().unwrap_or(false) {
                     continue;
                 }
                 if Self::is_leaf(na) {

@@ -216,11 +216,87 @@ fn a_search_finds_what_testing_every_two_triangles_finds() {
     }
 }
 
+/// Judged by the boxes (the cloth still), the pairs hold wherever each particle lies in its
+/// box less half the thickness: with the crumpled cloth's particles at the corners of
+/// that room, and at random points in it, every vertex–triangle and edge–edge pair that
+/// comes within the thickness is among the pairs found.
+#[test]
+fn pairs_judged_by_the_boxes_hold_anywhere_in_them() {
+    let (model, start) = crumpled();
+    let contacts = searched(&model, &start, Vec3::ZERO);
+    assert!(!contacts.boxes.swept);
+    let found = pairs(&contacts.found, &model.triangles, &contacts.owners);
+    let held: std::collections::HashSet<[u32; 5]> = found.map(|p| pair_key(&p)).collect();
+    let (lo, hi) = (&contacts.boxes.vertex_lo, &contacts.boxes.vertex_hi);
+    let room = Vec3::splat(0.5 * THICKNESS);
+    let mut rnd = crate::test_rng::uniform(9);
+    for corners in [true, false] {
+        let pos: Vec<Vec3> = (lo.iter().zip(hi))
+            .map(|(&l, &h)| {
+                let u = Vec3::new(rnd(), rnd(), rnd());
+                l + room + (h - l - 2.0 * room) * if corners { u.round() } else { u }
+            })
+            .collect();
+        let near = near_pairs(&model.triangles, &pos, THICKNESS);
+        let missed = near.iter().filter(|k| !held.contains(*k)).count();
+        assert!(near.len() > 1000, "{} near", near.len());
+        assert_eq!(missed, 0, "of {} near", near.len());
+    }
+}
+
+/// Every vertex–triangle and edge–edge pair of `triangles` closer than `within` at `pos`,
+/// by [`pair_key`] (triangles swept along x for those whose boxes come that near).
+fn near_pairs(triangles: &[[u32; 3]], pos: &[Vec3], within: f32) -> Vec<[u32; 5]> {
+    let boxes: Vec<(Vec3, Vec3)> = (triangles.iter())
+        .map(|t| {
+            let [a, b, c] = t.map(|i| pos[i as usize]);
+            (a.min(b).min(c), a.max(b).max(c) + within)
+        })
+        .collect();
+    let mut by_x: Vec<usize> = (0..triangles.len()).collect();
+    by_x.sort_by(|&a, &b| boxes[a].0.x.total_cmp(&boxes[b].0.x));
+    let mut near = Vec::new();
+    for (k, &a) in by_x.iter().enumerate() {
+        for &b in by_x[k + 1..]
+            .iter()
+            .take_while(|&&b| boxes[b].0.x <= boxes[a].1.x)
+        {
+            if !meet(boxes[a], boxes[b]) {
+                continue;
+            }
+            let (ta, tb) = (triangles[a], triangles[b]);
+            let mut each = vec![];
+            for (s, t) in [(ta, tb), (tb, ta)] {
+                each.extend(
+                    s.iter()
+                        .filter(|v| !t.contains(v))
+                        .map(|&v| Pair::vertex_triangle(v, t)),
+                );
+            }
+            for j in 0..3 {
+                for k in 0..3 {
+                    let (e, f) = ([ta[j], ta[(j + 1) % 3]], [tb[k], tb[(k + 1) % 3]]);
+                    if !e.iter().any(|i| f.contains(i)) {
+                        each.push(Pair::edge_edge(e, f));
+                    }
+                }
+            }
+            let close =
+                |p: &Pair| distance(p, p.ids().map(|i| pos[i].as_dvec3())) < f64::from(within);
+            near.extend(each.iter().filter(|p| close(p)).map(pair_key));
+        }
+    }
+    near.sort_unstable();
+    near.dedup();
+    near
+}
+
 /// A band of a fifth of the cloth moved 4 cm sideways: only its triangles are searched
-/// again (one refresh, no second search of the whole tree), and the pairs are exactly
-/// those a search of the whole tree finds with the boxes as they now are — the band's
-/// new pairs found, its old ones gone, the rest kept — whether the pairs were judged by
-/// their boxes (the cloth still) or by the motion too (the cloth moving fast).
+/// again (one refresh, no second search of the whole tree), and the pairs are those a
+/// search of the whole tree finds with the boxes as they now are — the band's new pairs
+/// found, its old ones gone, the rest kept: exactly, where the pairs were judged by their
+/// boxes (the cloth still); less a few pairs that stay apart, where by the motion too
+/// (the cloth moving fast).
 #[test]
 fn a_refresh_finds_what_a_whole_search_finds() {
     let model = crumpled().0;
@@ -252,8 +328,28 @@ fn a_refresh_finds_what_a_whole_search_finds() {
         let missing: Vec<_> = (whole.iter())
             .filter(|p| after.binary_search(p).is_err())
             .collect();
+        // By the motion, a refresh tells its triangles apart from the whole tree's nodes,
+        // not from those the whole walk pairs them with: it may pass by a few pairs more,
+        // each of which stays the reach apart along the motion (at every one of 33
+        // points); by the boxes, the tests are the same.
+        let (from, to, reach) = (
+            &contacts.boxes.from,
+            &contacts.boxes.to,
+            contacts.reach(THICKNESS),
+        );
+        let passed = |stored: &&StoredPair| {
+            let pair = stored.expand(&model.triangles, &contacts.owners.edges);
+            (0..=32).all(|k| {
+                let t = f64::from(k) / 32.0;
+                let x = (pair.ids()).map(|i| (from[i] + (to[i] - from[i]) * t as f32).as_dvec3());
+                distance(&pair, x) >= f64::from(reach)
+            })
+        };
+        let unexplained = missing
+            .iter()
+            .filter(|p| motion == Vec3::ZERO || !passed(p));
         assert!(
-            extra.is_empty() && missing.is_empty() && after.len() == whole.len(),
+            extra.is_empty() && unexplained.count() == 0 && missing.len() < whole.len() / 100,
             "{} pairs not in the whole search's {}, {} of its missing: {:?} {:?}",
             extra.len(),
             whole.len(),
@@ -268,11 +364,19 @@ fn a_refresh_finds_what_a_whole_search_finds() {
 /// while every particle ends within the slack of where it did (half of what `within`
 /// leaves of the thickness): a particle moved 0.45 of the thickness (0.26 along each axis,
 /// inside its box) is searched again for the checks (0.2 × thickness), one moved 0.35 is
-/// not; judged by the boxes alone, neither is.
+/// not. Judged by the boxes alone, the pairs hold while each particle lies in its box less
+/// half the thickness (a room of a quarter of it each way, whatever the checks need): the
+/// particle moved 0.45 is searched again, one moved 0.4 (0.23 along each axis) is not.
 #[test]
 fn pairs_judged_by_the_motion_hold_within_the_slack() {
     let nudge = |by: f32| (-0.49, Vec3::splat(by * THICKNESS / 3f32.sqrt()));
-    for (motion, by, searched) in [(FAST, 0.45, 1), (FAST, 0.35, 0), (Vec3::ZERO, 0.45, 0)] {
+    let cases = [
+        (FAST, 0.45, 1),
+        (FAST, 0.35, 0),
+        (Vec3::ZERO, 0.45, 1),
+        (Vec3::ZERO, 0.4, 0),
+    ];
+    for (motion, by, searched) in cases {
         let (contacts, _, _) = refreshed(motion, nudge(by), CHECKED * THICKNESS);
         let work = contacts.work;
         assert_eq!(
@@ -358,7 +462,9 @@ fn a_solver_handed_another_cloth_forgets_the_first() {
             assert!(again.pos == fresh.pos && again.vel == fresh.vel);
         }
         assert_eq!(again_work.retaken, fresh_work.retaken, "{motion}");
-        assert_eq!(fresh_work.retaken > 1000, motion == FAST, "{fresh_work:?}");
+        if motion == FAST {
+            assert!(fresh_work.retaken > 1000, "{fresh_work:?}");
+        }
     }
 }
 
