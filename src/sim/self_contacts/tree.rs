@@ -254,11 +254,12 @@ impl TriangleTree {
         }
     }
 
-    /// Calls `pair(t, b)` for each triangle `b` that triangle `t`'s box is not told apart
-    /// from (as the last fit tells them), other than `t`, and not flagged by `searched`
-    /// where `b < t` (a search of each flagged triangle so calls it once for each two of
-    /// which one at least is flagged, as [`TriangleTree::piece_pairs`] with `marked` does:
-    /// the tests are the same, against each of `t`'s ancestors' nodes instead of theirs).
+    /// Calls `pair(t, b)` for each triangle `b` other than `t` that `t`'s box is not told
+    /// apart from (as the last fit tells them), not flagged by `searched` where `b < t`: a
+    /// search of each flagged triangle so calls it once for each two of which one at least
+    /// is flagged. By the boxes, the whole walk's tests of theirs and these tell the same
+    /// two apart; by the motion, `t` is told apart from each node in their own frame
+    /// rather than from the node the whole walk pairs with it.
     pub(super) fn triangle_pairs(&self, t: u32, searched: &[bool], pair: impl FnMut(u32, u32)) {
         match self.fit {
             Fit::Motion { reach } => {
