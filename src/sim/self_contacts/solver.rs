@@ -162,6 +162,12 @@ pub struct SelfContacts {
 /// Triangles searched again in one piece of a refresh.
 const REFRESHED_PER_PIECE: usize = 64;
 
+/// Triangles searched again from which a refresh is shared out between the team's
+/// members (two pieces): where `crumple` settles at 64² a refresh searches 300–400, and
+/// sharing those cut its second and third seconds' self-contact by a sixth on two threads
+/// (from 512 on, it ran them alone).
+const PARALLEL_REFRESHED: usize = 2 * REFRESHED_PER_PIECE;
+
 /// Triangles from which the search shares its work out between the team's members.
 const PARALLEL_TRIANGLES: usize = 2048;
 
@@ -501,7 +507,7 @@ impl SelfContacts {
                 });
             }
         };
-        let parallel = refreshed >= PARALLEL_TRIANGLES / 4;
+        let parallel = refreshed >= PARALLEL_REFRESHED;
         (self.found).extend(pieces + search.neighbour_pieces(), parallel, &work);
         self.work.refreshes += 1;
         self.work.refreshed += refreshed as u64;

@@ -399,7 +399,7 @@ fn many_particles_out_of_their_boxes_search_the_whole_tree() {
 fn a_refresh_stores_the_same_order_on_two_threads_as_on_one() {
     let run = |threads: usize| on_threads(threads, || refreshed(Vec3::ZERO, BAND, THICKNESS));
     let ((one, _, a), (two, _, b)) = (run(1), run(2));
-    assert!(one.work.refreshed as usize >= PARALLEL_TRIANGLES / 4);
+    assert!(one.work.refreshed as usize >= PARALLEL_REFRESHED);
     assert_eq!(two.work.refreshes, 1);
     assert_eq!(a, b);
 }
