@@ -82,6 +82,12 @@ const CHECKED: f32 = 2.0 * KEEP as f32;
 /// before its triangles are searched again.
 const AHEAD: f32 = 12.0;
 
+/// How far, as a share of the thickness, a particle's box reaches at most beyond its
+/// motion ([`AHEAD`]): no more than the room the box gives that motion, so that a particle
+/// pushed about every substep (a stack of cloths pressed together in `layers`) does not
+/// get a box as long as twelve of its pushes.
+const AHEAD_MOST: f32 = 0.25;
+
 /// Gauss–Seidel sweeps of the pushes over the pairs.
 const PUSH_SWEEPS: usize = 4;
 
@@ -405,10 +411,15 @@ impl SelfContacts {
         }
     }
 
-    /// Substeps more of each particle's motion its box holds: [`AHEAD`] where the pairs are
-    /// judged by the boxes alone, none where by the motion (the window carries it on).
-    fn ahead(&self) -> f32 {
-        if self.boxes.swept { 0.0 } else { AHEAD }
+    /// Where a particle's box reaches to beyond its motion from `s` to `p`: where the pairs
+    /// are judged by the boxes alone, that motion carried on for [`AHEAD`] substeps more,
+    /// [`AHEAD_MOST`] of the thickness at most; where by the motion, `p` (the window
+    /// carries it on).
+    fn ahead(&self, s: Vec3, p: Vec3, thickness: f32) -> Vec3 {
+        if self.boxes.swept {
+            return p;
+        }
+        p + ((p - s) * AHEAD).clamp_length_max(AHEAD_MOST * thickness)
     }
 
     /// The box that holds a particle's motion from `s` to `p`, grown by `grow` each way.
@@ -463,7 +474,7 @@ impl SelfContacts {
                 }
                 (self.boxes.from[i], self.boxes.to[i]) = (s, p);
             }
-            let ahead = p + (p - s) * self.ahead();
+            let ahead = self.ahead(s, p, thickness);
             (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) = Self::vertex_box(s, ahead, grow);
         }
         self.dirty.clear();
@@ -562,9 +573,9 @@ impl SelfContacts {
         } else {
             (&self.from, &self.to)
         };
-        let (grow, ahead) = (self.grow(thickness), self.ahead());
-        for (s, p) in from.iter().zip(to) {
-            let (lo, hi) = Self::vertex_box(*s, *p + (*p - *s) * ahead, grow);
+        let grow = self.grow(thickness);
+        for (&s, &p) in from.iter().zip(to) {
+            let (lo, hi) = Self::vertex_box(s, self.ahead(s, p, thickness), grow);
             self.boxes.vertex_lo.push(lo);
             self.boxes.vertex_hi.push(hi);
         }
