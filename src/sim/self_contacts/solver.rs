@@ -478,12 +478,12 @@ impl SelfContacts {
             (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) = Self::vertex_box(s, ahead, grow);
         }
         self.dirty.clear();
-        let mut refreshed = 0;
+        self.searched.clear();
         for (n, &t) in model.triangles.iter().enumerate() {
             let dirty = t.iter().any(|&i| self.left[i as usize]);
             self.dirty.push(dirty);
             if dirty {
-                refreshed += 1;
+                self.searched.push(n as u32);
                 (self.boxes.lo[n], self.boxes.hi[n]) = self.triangle_box(n, t, thickness)?;
             }
         }
@@ -502,8 +502,6 @@ impl SelfContacts {
             thickness: self.reach(thickness),
             open: &self.certificates.open,
         };
-        self.searched.clear();
-        (self.searched).extend((0..model.triangles.len() as u32).filter(|&t| dirty[t as usize]));
         let searched = &self.searched;
         let pieces = searched.len().div_ceil(REFRESHED_PER_PIECE);
         let work = |piece: usize, out: &mut Vec<StoredPair>| {
@@ -518,6 +516,7 @@ impl SelfContacts {
                 });
             }
         };
+        let refreshed = searched.len();
         let parallel = refreshed >= PARALLEL_REFRESHED;
         (self.found).extend(pieces + search.neighbour_pieces(), parallel, &work);
         self.work.refreshes += 1;
