@@ -237,20 +237,32 @@ fn pairs_judged_by_the_boxes_hold_anywhere_in_them() {
                 l + room + (h - l - 2.0 * room) * if corners { u.round() } else { u }
             })
             .collect();
-        let near = near_pairs(&model.triangles, &pos, THICKNESS);
+        let close =
+            |p: &Pair| distance(p, p.ids().map(|i| pos[i].as_dvec3())) < f64::from(THICKNESS);
+        let near = pairs_near(&model.triangles, [&pos, &pos], THICKNESS, close);
         let missed = near.iter().filter(|k| !held.contains(*k)).count();
         assert!(near.len() > 1000, "{} near", near.len());
         assert_eq!(missed, 0, "of {} near", near.len());
     }
 }
 
-/// Every vertex–triangle and edge–edge pair of `triangles` closer than `within` at `pos`,
-/// by [`pair_key`] (triangles swept along x for those whose boxes come that near).
-fn near_pairs(triangles: &[[u32; 3]], pos: &[Vec3], within: f32) -> Vec<[u32; 5]> {
+/// Every vertex–triangle and edge–edge pair of `triangles` for which `close` holds, by
+/// [`pair_key`], of those whose particles' boxes over the motion from `start` to `end`
+/// come within `within` of each other (by brute force over the triangles, swept along x):
+/// the pairs the checks hold the solver's against.
+fn pairs_near(
+    triangles: &[[u32; 3]],
+    [start, end]: [&[Vec3]; 2],
+    within: f32,
+    close: impl Fn(&Pair) -> bool,
+) -> Vec<[u32; 5]> {
     let boxes: Vec<(Vec3, Vec3)> = (triangles.iter())
         .map(|t| {
-            let [a, b, c] = t.map(|i| pos[i as usize]);
-            (a.min(b).min(c), a.max(b).max(c) + within)
+            let (lo, hi) = (t.iter()).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &i| {
+                let (s, e) = (start[i as usize], end[i as usize]);
+                (lo.min(s).min(e), hi.max(s).max(e))
+            });
+            (lo, hi + within)
         })
         .collect();
     let mut by_x: Vec<usize> = (0..triangles.len()).collect();
@@ -281,8 +293,6 @@ fn near_pairs(triangles: &[[u32; 3]], pos: &[Vec3], within: f32) -> Vec<[u32; 5]
                     }
                 }
             }
-            let close =
-                |p: &Pair| distance(p, p.ids().map(|i| pos[i].as_dvec3())) < f64::from(within);
             near.extend(each.iter().filter(|p| close(p)).map(pair_key));
         }
     }
@@ -602,14 +612,14 @@ fn held_along(
     more: impl Fn(usize, usize) -> Vec3,
     mut after: impl FnMut(usize, &mut SelfContacts, &ClothModel),
 ) -> (SelfContacts, ClothModel, Vec<Vec<Vec3>>, usize) {
-    let (mesh, model, path) = folded_and_sinking(more);
+    let (model, path) = folded_and_sinking(more);
     let mut contacts = SelfContacts {
         owners: Owners::build(&model),
         ..SelfContacts::default()
     };
     let mut near = 0;
     for k in 0..path.len() - 1 {
-        near += hold_through(&mut contacts, &mesh, &model, [&path[k], &path[k + 1]]);
+        near += hold_through(&mut contacts, &model, [&path[k], &path[k + 1]]);
         after(k, &mut contacts, &model);
     }
     (contacts, model, path, near)
@@ -620,9 +630,7 @@ fn held_along(
 /// away at a thickness a substep, every particle wobbling off its path by up to 0.035 of
 /// the thickness; particle `i` moved `more(i, k)` besides at substep boundary `k`. Nine
 /// boundaries, for eight substeps.
-fn folded_and_sinking(
-    more: impl Fn(usize, usize) -> Vec3,
-) -> (crate::mesh::ClothMesh, ClothModel, Vec<Vec<Vec3>>) {
+fn folded_and_sinking(more: impl Fn(usize, usize) -> Vec3) -> (ClothModel, Vec<Vec<Vec3>>) {
     let mesh = GridSpec::square(12, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
         .build()
         .unwrap();
@@ -653,16 +661,15 @@ fn folded_and_sinking(
                 .collect()
         })
         .collect();
-    (mesh, model, path)
+    (model, path)
 }
 
 /// Brings the pairs up to date for a substep's `[start, end]` as a resolve does, and
-/// checks that each pair that could be a contact (by brute force) and comes within the
+/// checks that each pair that could be a contact ([`pairs_near`]) and comes within the
 /// thickness at one of nine points along the substep's motion is held. Returns how many
 /// came that near.
 fn hold_through(
     contacts: &mut SelfContacts,
-    mesh: &crate::mesh::ClothMesh,
     model: &ClothModel,
     [start, end]: [&[Vec3]; 2],
 ) -> usize {
@@ -673,40 +680,27 @@ fn hold_through(
     let held: std::collections::HashSet<[u32; 5]> = (contacts.found.stored())
         .map(|p| pair_key(&p.expand(&model.triangles, &contacts.owners.edges)))
         .collect();
-    let mut candidates = Vec::new();
-    for v in 0..mesh.positions.len() as u32 {
-        for t in model.triangles.iter().filter(|t| !t.contains(&v)) {
-            candidates.push(Pair::vertex_triangle(v, *t));
-        }
-    }
-    for (n, e) in mesh.edges.iter().enumerate() {
-        for f in mesh.edges[n + 1..]
-            .iter()
-            .filter(|f| !e.iter().any(|i| f.contains(i)))
-        {
-            candidates.push(Pair::edge_edge(*e, *f));
-        }
-    }
-    let mut near = 0;
-    for pair in &candidates {
-        let ids = pair.ids();
-        let least = (0..=8)
+    // The least distance at nine points along the substep's motion.
+    let least = |pair: &Pair| {
+        (0..=8)
             .map(|s| {
                 let t = f64::from(s) / 8.0;
-                let x = ids.map(|i| {
+                let x = pair.ids().map(|i| {
                     let (a, b) = (start[i].as_dvec3(), end[i].as_dvec3());
                     a + t * (b - a)
                 });
                 distance(pair, x)
             })
-            .fold(f64::INFINITY, f64::min);
-        if least < f64::from(THICKNESS) {
-            near += 1;
-            assert!(
-                held.contains(&pair_key(pair)),
-                "{pair:?} comes within {least} m, not held"
-            );
-        }
+            .fold(f64::INFINITY, f64::min)
+    };
+    let near = pairs_near(&model.triangles, [start, end], THICKNESS, |pair| {
+        least(pair) < f64::from(THICKNESS)
+    });
+    for key in &near {
+        assert!(
+            held.contains(key),
+            "{key:?} comes within the thickness, not held"
+        );
     }
-    near
+    near.len()
 }
