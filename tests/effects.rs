@@ -8,7 +8,7 @@ use clothsim::mesh::{GridOrientation, GridSpec};
 use clothsim::scene::{Scene, SceneFile, Simulation};
 use clothsim::sim::forces::{DihedralBending, hinge_angle};
 use clothsim::sim::{
-    BendingModel, ContactError, Effect, ForceTerm, SelfCollision, SelfContacts, Wind,
+    BendingModel, ContactError, Effect, ForceTerm, SELF_SETUP, SelfCollision, SelfContacts, Wind,
 };
 use glam::{Quat, Vec3};
 
@@ -866,6 +866,21 @@ fn a_scene_without_self_collision_does_no_self_collision_work() {
         .self_collision_work()
         .expect("self-fold has self-collision");
     assert!(work.candidates > 0);
+}
+
+/// Self-contact's setup for the cloth is made with the simulation, once, and a run lists
+/// it beside its own phases; a scene without self-collision has none.
+#[test]
+fn self_contact_is_set_up_once_when_the_simulation_is_made() {
+    let setups = |name: &str| {
+        let mut sim = Simulation::new(Scene::builtin(name).unwrap());
+        let first = sim.run(0.05);
+        let second = sim.run(0.05);
+        let calls = |s: &clothsim::scene::RunSummary| s.phases.get(SELF_SETUP).map(|p| p.calls);
+        (calls(&first), calls(&second))
+    };
+    assert_eq!(setups("self-fold"), (Some(1), None));
+    assert_eq!(setups("hanging"), (None, None));
 }
 
 #[test]

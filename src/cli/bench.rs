@@ -196,13 +196,14 @@ pub fn crumple_bench(
         integrators.map_or(vec![None], |ks| ks.iter().copied().map(Some).collect());
     if !json {
         println!(
-            "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11} {:>13} {:>13} {:>9} {:>11} {:>9} {:>9}",
+            "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11} {:>9} {:>13} {:>13} {:>9} {:>11} {:>9} {:>9}",
             "quads",
             "particles",
             "integrator",
             "threads",
             "substeps",
             "wall/sim s",
+            "setup ms",
             "contact µs/ss",
             "springs µs/ss",
             "× springs",
@@ -222,13 +223,14 @@ pub fn crumple_bench(
                 println!("{}", serde_json::to_string(&row)?);
             } else {
                 println!(
-                    "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11.2} {:>13.1} {:>13.1} {:>9} {:>11.4} {:>9.2} {:>9.2}",
+                    "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11.2} {:>9.1} {:>13.1} {:>13.1} {:>9} {:>11.4} {:>9.2} {:>9.2}",
                     row.quads,
                     row.particles,
                     row.integrator,
                     row.threads,
                     row.substeps,
                     row.wall_per_second,
+                    row.setup_ms,
                     row.contact_us,
                     row.springs_us,
                     ratio(row.contact_us, row.springs_us),

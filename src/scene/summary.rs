@@ -45,7 +45,10 @@ pub struct RunSummary {
     pub integrator_in_effect: String,
     /// Everything the stability guard did, in order.
     pub guard_events: Vec<GuardEvent>,
-    /// Wall time and calls of every phase that ran during the run (only those).
+    /// Wall time and calls of every phase that ran during the run (only those), and
+    /// self-contact's setup for the cloth ([`crate::sim::SELF_SETUP`]) where it was made
+    /// since the last run (with the simulation, or for a new cloth): not in the run's wall
+    /// time.
     pub phases: BTreeMap<String, PhaseSummary>,
     /// Linear-solver (conjugate-gradient) iterations per step during the run: 0 for
     /// integrators without a linear solve.
@@ -88,8 +91,9 @@ impl Simulation {
         mut observe: impl FnMut(&Simulation, u64) -> Result<(), E>,
     ) -> Result<RunSummary, E> {
         let frames = (seconds / self.params().step.dt as f64).round().max(0.0) as u64;
-        // Timings and counts gathered before the run are not the run's.
-        self.take_timings();
+        // Timings and counts gathered before the run are not the run's, but for
+        // self-contact's setup (made with the simulation), listed beside them.
+        let before = self.take_timings();
         self.take_stats();
         let start = Instant::now();
         let mut refined = 0;
@@ -112,8 +116,11 @@ impl Simulation {
             }
         }
         let mut summary = self.summary(start.elapsed().as_secs_f64());
-        summary.phases = self
-            .take_timings()
+        let mut timings = self.take_timings();
+        if let Some(setup) = before.get(crate::sim::SELF_SETUP) {
+            timings.add_calls(setup.name, setup.time, setup.calls);
+        }
+        summary.phases = timings
             .phases()
             .iter()
             .map(|p| {

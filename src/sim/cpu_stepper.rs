@@ -553,6 +553,12 @@ impl<R: Real> StepBackend for CpuStepper<R> {
                 _ => None,
             });
             self.effects = effects.to_vec();
+            if self.self_collision.is_some() {
+                // Built now, not in the first substep; timed as its own phase. A cloth
+                // too large for it is refused by the first substep, with its error.
+                let (contacts, timings) = (&mut self.self_contacts, &mut self.timings);
+                let _ = timings.time(super::SELF_SETUP, || contacts.prepare(model));
+            }
             self.air_damping = air_damping_of(effects);
             self.gravity = gravity_of(effects);
         }

@@ -375,6 +375,17 @@ fn rest_gap(
     tree.fit_boxes(&lo, &hi);
     // The least yet, as the bits of a positive `f64` (which order as the numbers do).
     let least = AtomicU64::new(f64::from(cap).to_bits());
+    let box_of = |t: [u32; 3]| {
+        let [a, b, c] = t.map(|i| rest[i as usize]);
+        (a.min(b).min(c), a.max(b).max(c))
+    };
+    // Whether the boxes of triangles `a` and `b` lie more than `least` apart (less a
+    // rounding's worth).
+    let apart_by = |a: [u32; 3], b: [u32; 3], least: f64| {
+        let ((alo, ahi), (blo, bhi)) = (box_of(a), box_of(b));
+        let gap = f64::from((blo - ahi).max(alo - bhi).max(Vec3::ZERO).length());
+        gap * (1.0 - 1e-6) >= least
+    };
     let measure = |pair: Pair, mine: &mut f64| {
         let ids = pair.ids();
         let k = pair.first_side();
@@ -397,9 +408,13 @@ fn rest_gap(
         if piece < pieces {
             tree.piece_pairs(piece, |a, b| {
                 let (a, b) = (a as usize, b as usize);
-                if !triangles[a].iter().any(|i| triangles[b].contains(i)) {
-                    owners.each_pair(triangles, a, b, |pair, _| measure(pair, &mut mine));
+                // Two triangles whose own boxes lie farther apart than the least yet have
+                // no pair nearer (most of those the grown boxes meet).
+                let (ta, tb) = (triangles[a], triangles[b]);
+                if ta.iter().any(|i| tb.contains(i)) || apart_by(ta, tb, mine) {
+                    return;
                 }
+                owners.each_pair(triangles, a, b, |pair, _| measure(pair, &mut mine));
             });
         } else {
             let first = (piece - pieces) * CORNERS_PER_PIECE;

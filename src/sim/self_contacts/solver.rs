@@ -199,14 +199,6 @@ impl SelfContacts {
         if let Some(particle) = state.pos.iter().position(|p| !p.is_finite()) {
             return Err(ContactError::NonFinite { particle });
         }
-        if self.owners.update(model) {
-            // Nothing found for the old cloth holds: not its pairs, its corners'
-            // references, its tree, nor how long its windows ran.
-            self.found_for = None;
-            self.certificates.forget();
-            self.tree = TriangleTree::default();
-            (self.window, self.boxes.swept) = (Window::default(), false);
-        }
         // Only the running total outlives a resolve.
         self.work = SelfWork {
             forced_total: self.work.forced_total,
@@ -256,6 +248,38 @@ impl SelfContacts {
         self.fixed.clear();
         self.keep_apart(model, start, state, thickness, substep)?;
         Ok(contacts)
+    }
+
+    /// Builds what self-contact keeps for `model` alone, from its triangles and rest
+    /// shape: which triangle owns each vertex and edge and the pairs of the triangles
+    /// that share a corner ([`Owners`]), the tree over the triangles and its patches with
+    /// the cloth's rest gap. Once per cloth (a stepper calls it when self-collision is
+    /// turned on, so that the first substep does not wait for it); each resolve checks
+    /// that they are the model's, and builds them again only for another cloth.
+    ///
+    /// # Errors
+    /// [`ContactError::TooMany`] for more triangles than a stored pair can number.
+    pub fn prepare(&mut self, model: &ClothModel) -> Result<(), ContactError> {
+        if model.triangles.len() > MOST_TRIANGLES {
+            return Err(ContactError::TooMany {
+                triangles: model.triangles.len(),
+                most: MOST_TRIANGLES,
+            });
+        }
+        if self.owners.update(model) {
+            // Nothing found for the old cloth holds: not its pairs, its corners'
+            // references, its tree, nor how long its windows ran.
+            self.found_for = None;
+            self.certificates.forget();
+            self.tree = TriangleTree::default();
+            (self.window, self.boxes.swept) = (Window::default(), false);
+        }
+        if self.tree.triangles() != model.triangles.len() {
+            let (triangles, rest) = (&model.triangles, &model.rest_positions);
+            self.tree = TriangleTree::build(triangles, rest);
+            self.patches = Patches::build(&mut self.tree, triangles, rest, &self.owners);
+        }
+        Ok(())
     }
 
     /// Checks the substep's motion again after [`SelfContacts::resolve`] and a move of the
@@ -314,6 +338,8 @@ impl SelfContacts {
         thickness: f32,
         within: f32,
     ) -> Result<(), ContactError> {
+        // Nothing to build where it was prepared for this cloth.
+        self.prepare(model)?;
         let swept = self.boxes.swept;
         if self.found_for != Some(thickness)
             || self.boxes.vertex_lo.len() != self.to.len()
@@ -587,17 +613,6 @@ impl SelfContacts {
         self.found_for = None;
         self.boxes.lo.clear();
         self.boxes.hi.clear();
-        if model.triangles.len() > MOST_TRIANGLES {
-            return Err(ContactError::TooMany {
-                triangles: model.triangles.len(),
-                most: MOST_TRIANGLES,
-            });
-        }
-        if self.tree.triangles() != model.triangles.len() {
-            let (triangles, rest) = (&model.triangles, &model.rest_positions);
-            self.tree = TriangleTree::build(triangles, rest);
-            self.patches = Patches::build(&mut self.tree, triangles, rest, &self.owners);
-        }
         for (n, &t) in model.triangles.iter().enumerate() {
             let (lo, hi) = self.triangle_box(n, t, thickness)?;
             self.boxes.lo.push(lo);

@@ -37,10 +37,8 @@ fn searched(model: &ClothModel, start: &[Vec3], motion: Vec3) -> SelfContacts {
 /// A solver for `model` with the pairs found for the particles moving from `start` to
 /// `end`.
 fn searched_to(model: &ClothModel, start: &[Vec3], end: &[Vec3]) -> SelfContacts {
-    let mut contacts = SelfContacts {
-        owners: Owners::build(model),
-        ..SelfContacts::default()
-    };
+    let mut contacts = SelfContacts::default();
+    contacts.prepare(model).unwrap();
     contacts.relative(start, end, Vec3::ZERO, Vec3::ZERO);
     contacts.update_pairs(model, THICKNESS, THICKNESS).unwrap();
     contacts
@@ -613,10 +611,7 @@ fn held_along(
     mut after: impl FnMut(usize, &mut SelfContacts, &ClothModel),
 ) -> (SelfContacts, ClothModel, Vec<Vec<Vec3>>, usize) {
     let (model, path) = folded_and_sinking(more);
-    let mut contacts = SelfContacts {
-        owners: Owners::build(&model),
-        ..SelfContacts::default()
-    };
+    let mut contacts = SelfContacts::default();
     let mut near = 0;
     for k in 0..path.len() - 1 {
         near += hold_through(&mut contacts, &model, [&path[k], &path[k + 1]]);
