@@ -410,8 +410,7 @@ fn rest_gap(
                 let (a, b) = (a as usize, b as usize);
                 // Two triangles whose own boxes lie farther apart than the least yet have
                 // no pair nearer (most of those the grown boxes meet).
-                let (ta, tb) = (triangles[a], triangles[b]);
-                if ta.iter().any(|i| tb.contains(i)) || apart_by(ta, tb, mine) {
+                if apart_by(triangles[a], triangles[b], mine) {
                     return;
                 }
                 owners.each_pair(triangles, a, b, |pair, _| measure(pair, &mut mine));

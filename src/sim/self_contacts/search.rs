@@ -246,13 +246,10 @@ pub(super) struct Search<'a> {
 
 impl Search<'_> {
     /// Adds to `out` the vertex–triangle and edge–edge pairs that triangles `a` and `b`
-    /// (whose boxes overlap) own and that could come within the thickness. Triangles that
-    /// share a corner are left to [`Search::neighbours`].
+    /// (whose boxes overlap, and that share no corner: those are left to
+    /// [`Search::neighbours`]) own and that could come within the thickness.
     pub(super) fn pairs_of(&self, a: usize, b: usize, out: &mut Vec<StoredPair>) {
-        let tb = self.triangles[b];
-        if self.triangles[a].iter().any(|i| tb.contains(i))
-            || self.boxes.swept && self.apart_across(a, b)
-        {
+        if self.boxes.swept && self.apart_across(a, b) {
             return;
         }
         (self.owners).each_pair(self.triangles, a, b, |pair, stored| {

@@ -52,6 +52,9 @@ pub(super) struct TriangleTree {
     /// The triangles in the tree's order, and each triangle's place in it.
     order: Vec<u32>,
     place_of: Vec<u32>,
+    /// Each place's triangle's corners: two that share one are passed by without a test
+    /// of their boxes (read in the tree's order, where a walk reads them).
+    corners: Vec<[u32; 3]>,
     /// The pieces a search is cut into.
     tasks: Vec<Task>,
     /// Each box (by boxes), or the box of its starts (by motion).
@@ -76,10 +79,12 @@ impl TriangleTree {
         for (place, &t) in order.iter().enumerate() {
             place_of[t as usize] = place as u32;
         }
+        let corners = order.iter().map(|&t| triangles[t as usize]).collect();
         let mut tree = TriangleTree {
             nodes,
             order,
             place_of,
+            corners,
             ..TriangleTree::default()
         };
         if !tree.nodes.is_empty() {
@@ -241,9 +246,9 @@ impl TriangleTree {
         self.tasks.len()
     }
 
-    /// Calls `pair(a, b)` for each two triangles the walk of piece `piece` does not tell
-    /// apart (as the last fit tells them) and no covered node holds both of; the pieces
-    /// together call it once for every such two.
+    /// Calls `pair(a, b)` for each two triangles that share no corner, that the walk of
+    /// piece `piece` does not tell apart (as the last fit tells them) and that no covered
+    /// node holds both of; the pieces together call it once for every such two.
     pub(super) fn piece_pairs(&self, piece: usize, pair: impl FnMut(u32, u32)) {
         // One walk for each fit, each with its test inlined.
         match self.fit {
@@ -254,8 +259,8 @@ impl TriangleTree {
         }
     }
 
-    /// Calls `pair(t, b)` for each triangle `b` other than `t` that `t`'s box is not told
-    /// apart from (as the last fit tells them), not flagged by `searched` where `b < t`: a
+    /// Calls `pair(t, b)` for each triangle `b` sharing no corner with `t` that `t`'s box
+    /// is not told apart from (as the last fit tells them), not flagged by `searched` where `b < t`: a
     /// search of each flagged triangle so calls it once for each two of which one at least
     /// is flagged. By the boxes, the whole walk's tests of theirs and these tell the same
     /// two apart; by the motion, `t` is told apart from each node in their own frame
@@ -281,6 +286,7 @@ impl TriangleTree {
             return;
         }
         let x = self.place(self.place_of[t as usize]);
+        let corners = self.corners[self.place_of[t as usize] as usize];
         let mut stack = [0u32; STACK];
         let mut depth = 1;
         while depth > 0 {
@@ -294,7 +300,8 @@ impl TriangleTree {
                 for q in node.first..node.first + node.count {
                     let b = self.order[q as usize];
                     let once = b != t && !(b < t && searched[b as usize]);
-                    if once && !apart(self.place(q), x) {
+                    let near = !share_a_corner(self.corners[q as usize], corners);
+                    if once && near && !apart(self.place(q), x) {
                         pair(t, b);
                     }
                 }
@@ -315,7 +322,7 @@ impl TriangleTree {
         let first = self.nodes.len();
         // Two triangles, at places `p` and `q`.
         let mut places = |p: usize, q: usize| {
-            if !apart(first + p, first + q) {
+            if !share_a_corner(self.corners[p], self.corners[q]) && !apart(first + p, first + q) {
                 pair(self.order[p], self.order[q]);
             }
         };
@@ -371,6 +378,12 @@ impl TriangleTree {
             }
         }
     }
+}
+
+/// Whether two triangles share a corner.
+#[inline(always)]
+fn share_a_corner(a: [u32; 3], b: [u32; 3]) -> bool {
+    a.iter().any(|i| b.contains(i))
 }
 
 #[cfg(test)]

@@ -1,4 +1,4 @@
-//! The tree's walks: every two triangles whose boxes overlap, once; by the motion, no two
+//! The tree's walks: every two triangles that share no corner and whose boxes overlap, once; by the motion, no two
 //! passed by that come within the reach anywhere along it; and a search of some triangles
 //! finds what the whole walk finds of theirs.
 
@@ -39,8 +39,8 @@ fn sorted(mut pairs: Vec<(u32, u32)>) -> (Vec<(u32, u32)>, bool) {
     (pairs, twice)
 }
 
-/// Fitted to boxes, the walk finds exactly the two triangles whose boxes overlap, each
-/// once, over pieces of several hundred triangles.
+/// Fitted to boxes, the walk finds exactly the two triangles that share no corner and whose
+/// boxes overlap, each once, over pieces of several hundred triangles.
 #[test]
 fn a_walk_finds_every_two_triangles_whose_boxes_overlap_once() {
     let (triangles, rest, pos) = cloth();
@@ -59,12 +59,13 @@ fn a_walk_finds_every_two_triangles_whose_boxes_overlap_once() {
     let mut every = Vec::new();
     for a in 0..triangles.len() {
         for b in a + 1..triangles.len() {
-            if lo[a].cmple(hi[b]).all() && lo[b].cmple(hi[a]).all() {
+            let overlap = lo[a].cmple(hi[b]).all() && lo[b].cmple(hi[a]).all();
+            if overlap && !share_a_corner(triangles[a], triangles[b]) {
                 every.push((a as u32, b as u32));
             }
         }
     }
-    assert!(every.len() > 5 * triangles.len(), "{}", every.len());
+    assert!(every.len() > 3 * triangles.len(), "{}", every.len());
     assert_eq!(found, every);
 }
 
@@ -164,7 +165,7 @@ fn a_search_of_some_triangles_finds_what_the_whole_walk_finds_of_theirs() {
         .map(|&p| p + Vec3::new(0.0, if p.x < 0.0 { -0.05 } else { 0.0 }, 0.0))
         .collect();
     let mut rnd = crate::test_rng::uniform(3);
-    let dirty: Vec<bool> = triangles.iter().map(|_| rnd() < 0.1).collect();
+    let dirty: Vec<bool> = triangles.iter().map(|_| rnd() < 0.2).collect();
     let marked = |p: &(u32, u32)| dirty[p.0 as usize] || dirty[p.1 as usize];
     for by_motion in [false, true] {
         if by_motion {
@@ -186,7 +187,7 @@ fn a_search_of_some_triangles_finds_what_the_whole_walk_finds_of_theirs() {
         let (only, twice) = sorted(pairs);
         assert!(!twice);
         let theirs: Vec<_> = whole.iter().copied().filter(marked).collect();
-        assert!(theirs.len() > 200, "{}", theirs.len());
+        assert!(theirs.len() > 100, "{}", theirs.len());
         assert!(
             only.len() < whole.len() / 2,
             "{} of {}",
