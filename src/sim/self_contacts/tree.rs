@@ -57,13 +57,10 @@ pub(super) struct TriangleTree {
     corners: Vec<[u32; 3]>,
     /// The pieces a search is cut into.
     tasks: Vec<Task>,
-    /// Each box (by boxes), or the box of its starts (by motion).
-    lo: Vec<Vec3A>,
-    hi: Vec<Vec3A>,
-    /// The box of each one's ends, and its mean motion (by motion).
-    end_lo: Vec<Vec3A>,
-    end_hi: Vec<Vec3A>,
-    mean: Vec<Vec3A>,
+    /// Each one's box (by boxes), or the box of its starts (by motion), as `[lo, hi]`.
+    boxes: Vec<[Vec3A; 2]>,
+    /// By motion, each one's box of its ends and its mean motion, as `[lo, hi, mean]`.
+    motion: Vec<[Vec3A; 3]>,
     fit: Fit,
     /// Whether each node's own pairs are certified apart for the motion of the last fit
     /// (see [`super::patches`]): a whole walk passes by a node against itself then.
@@ -147,17 +144,11 @@ impl TriangleTree {
         }
     }
 
-    /// Sizes the boxes for nodes and triangles (and by motion, the ends and means).
-    fn size(&mut self, moving: bool) {
+    /// Sizes the boxes for nodes and triangles.
+    fn size(&mut self) {
         let n = self.nodes.len() + self.order.len();
-        for v in [&mut self.lo, &mut self.hi] {
-            v.resize(n, Vec3A::ZERO);
-        }
-        if moving {
-            for v in [&mut self.end_lo, &mut self.end_hi, &mut self.mean] {
-                v.resize(n, Vec3A::ZERO);
-            }
-        }
+        self.boxes.resize(n, [Vec3A::ZERO; 2]);
+        self.motion.resize(n, [Vec3A::ZERO; 3]);
     }
 
     /// Fits the nodes' boxes around their parts', from the last node back (children come
@@ -166,31 +157,33 @@ impl TriangleTree {
         for i in (0..self.nodes.len()).rev() {
             let (parts, n) = self.parts(i);
             let parts = &parts[..n];
-            let around = |v: &[Vec3A]| {
-                (parts.iter()).fold((Vec3A::INFINITY, Vec3A::NEG_INFINITY), |(lo, hi), &k| {
-                    (lo.min(v[k]), hi.max(v[k]))
-                })
-            };
-            (self.lo[i], self.hi[i]) = (around(&self.lo).0, around(&self.hi).1);
+            let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+            for &k in parts {
+                let [l, h] = self.boxes[k];
+                (lo, hi) = (lo.min(l), hi.max(h));
+            }
+            self.boxes[i] = [lo, hi];
             if moving {
-                (self.end_lo[i], self.end_hi[i]) = (around(&self.end_lo).0, around(&self.end_hi).1);
-                // Weighted by the triangles each part holds.
-                let weight = |k: usize| self.nodes.get(k).map_or(1.0, |n| n.count as f32);
-                let (sum, total) = (parts.iter()).fold((Vec3A::ZERO, 0.0), |(s, w), &k| {
-                    (s + self.mean[k] * weight(k), w + weight(k))
-                });
-                self.mean[i] = sum / total;
+                let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+                // The mean weighted by the triangles each part holds.
+                let (mut sum, mut total) = (Vec3A::ZERO, 0.0);
+                for &k in parts {
+                    let [l, h, mean] = self.motion[k];
+                    (lo, hi) = (lo.min(l), hi.max(h));
+                    let weight = self.nodes.get(k).map_or(1.0, |n| n.count as f32);
+                    (sum, total) = (sum + mean * weight, total + weight);
+                }
+                self.motion[i] = [lo, hi, sum / total];
             }
         }
     }
 
     /// Fits the tree to the triangles' boxes `lo..hi`.
     pub(super) fn fit_boxes(&mut self, lo: &[Vec3], hi: &[Vec3]) {
-        self.size(false);
+        self.size();
         let first = self.nodes.len();
         for (place, &t) in self.order.iter().enumerate() {
-            (self.lo[first + place], self.hi[first + place]) =
-                (lo[t as usize].into(), hi[t as usize].into());
+            self.boxes[first + place] = [lo[t as usize].into(), hi[t as usize].into()];
         }
         self.fit_nodes(false);
         self.fit = Fit::Boxes;
@@ -204,16 +197,16 @@ impl TriangleTree {
         [from, to]: [&[Vec3]; 2],
         reach: f32,
     ) {
-        self.size(true);
+        self.size();
         let first = self.nodes.len();
         for (place, &t) in self.order.iter().enumerate() {
             let corners = triangles[t as usize];
             let [a, b, c] = corners.map(|k| Vec3A::from(from[k as usize]));
             let [d, e, f] = corners.map(|k| Vec3A::from(to[k as usize]));
             let i = first + place;
-            (self.lo[i], self.hi[i]) = (a.min(b).min(c), a.max(b).max(c));
-            (self.end_lo[i], self.end_hi[i]) = (d.min(e).min(f), d.max(e).max(f));
-            self.mean[i] = ((d - a) + (e - b) + (f - c)) / 3.0;
+            self.boxes[i] = [a.min(b).min(c), a.max(b).max(c)];
+            let mean = ((d - a) + (e - b) + (f - c)) / 3.0;
+            self.motion[i] = [d.min(e).min(f), d.max(e).max(f), mean];
         }
         self.fit_nodes(true);
         self.fit = Fit::Motion { reach };
@@ -222,22 +215,19 @@ impl TriangleTree {
     /// Whether boxes `a` and `b` do not overlap.
     #[inline(always)]
     fn boxes_apart(&self, a: usize, b: usize) -> bool {
-        !(self.lo[a].cmple(self.hi[b]).all() && self.lo[b].cmple(self.hi[a]).all())
+        let ([alo, ahi], [blo, bhi]) = (self.boxes[a], self.boxes[b]);
+        !(alo.cmple(bhi).all() && blo.cmple(ahi).all())
     }
 
     /// Whether `a` and `b` keep `reach` apart along their motion, told in the frame of
     /// their mean motion.
     #[inline(always)]
     fn moving_apart(&self, a: usize, b: usize, reach: f32) -> bool {
-        let m = 0.5 * (self.mean[a] + self.mean[b]);
-        let (alo, ahi) = (
-            self.lo[a].min(self.end_lo[a] - m),
-            self.hi[a].max(self.end_hi[a] - m),
-        );
-        let (blo, bhi) = (
-            self.lo[b].min(self.end_lo[b] - m),
-            self.hi[b].max(self.end_hi[b] - m),
-        );
+        let ([alo, ahi], [aend_lo, aend_hi, amean]) = (self.boxes[a], self.motion[a]);
+        let ([blo, bhi], [bend_lo, bend_hi, bmean]) = (self.boxes[b], self.motion[b]);
+        let m = 0.5 * (amean + bmean);
+        let (alo, ahi) = (alo.min(aend_lo - m), ahi.max(aend_hi - m));
+        let (blo, bhi) = (blo.min(bend_lo - m), bhi.max(bend_hi - m));
         (blo - ahi).max(alo - bhi).max_element() >= reach
     }
 
