@@ -10,10 +10,13 @@
 //! first triangle in the middle of the substep, so that turning with the cloth costs
 //! nothing. Along the substep's straight-line motion each ring particle's offset from that
 //! place is linear in time, so its largest is at the substep's start or end: a corner is
-//! certified for the whole substep from those two. Where the certificate fails, the
-//! reference is taken again at the motion's end (the substep's, where the next one starts,
-//! or the end of the window the pairs are judged over: any shape will do), and the
-//! corner's pairs are tested one by one only if it fails still.
+//! certified for the whole substep from those two. Every corner's first reference is its
+//! rest shape (measured once per cloth, with the rest gap). Where the certificate fails
+//! but the ring keeps near its rest shape ([`super::patches`]), the corner is closed and
+//! goes back to its rest shape as its reference; where both fail, the reference is taken
+//! again at the motion's end (the substep's, where the next one starts, or the end of the
+//! window the pairs are judged over: any shape will do), and the corner's pairs are tested
+//! one by one only if it fails still.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -38,10 +41,55 @@ pub(super) struct Certificates {
     apart: Vec<f32>,
     /// Whether each corner's pairs must be tested one by one (its certificate failed).
     pub(super) open: Vec<bool>,
+    /// The rest shape as a reference: each ring entry's particle less its corner at rest,
+    /// in the corner's frame there, and each corner's least distance between the sides of
+    /// its pairs at rest (rounded down; `+∞` for a corner without pairs). Every corner
+    /// starts from it, and goes back to it where its ring keeps near its rest shape.
+    rest: Vec<Vec3>,
+    rest_apart: Vec<f32>,
 }
 
 impl Certificates {
-    /// Forgets every reference (the model changed).
+    /// The certificates of the cloth of `triangles` with `owners`, each corner's reference
+    /// its rest shape `rest` (measured by the team).
+    pub(super) fn build(owners: &Owners, triangles: &[[u32; 3]], rest: &[Vec3]) -> Certificates {
+        let rings = &owners.rings;
+        let corners = rest.len();
+        let mut certificates = Certificates {
+            rest: vec![Vec3::ZERO; rings.ring.len()],
+            rest_apart: vec![f32::INFINITY; corners],
+            ..Certificates::default()
+        };
+        let (reference, apart) = (
+            Disjoint::new(&mut certificates.rest),
+            Disjoint::new(&mut certificates.rest_apart),
+        );
+        let work = |_: usize, piece: usize| {
+            let first = piece * CORNERS_PER_PIECE;
+            for c in first..(first + CORNERS_PER_PIECE).min(corners) {
+                let range = rings.range(c);
+                // SAFETY: each corner is one piece's, and its ring's entries its own.
+                let (reference, apart) = unsafe { (reference.part(range), apart.at(c)) };
+                if !owners.corner_pairs(c).is_empty() {
+                    *apart = take(c, reference, (owners, triangles), rest);
+                }
+            }
+        };
+        let pieces = corners.div_ceil(CORNERS_PER_PIECE);
+        Team::current().run_large_pieces_if(corners >= PARALLEL_ELEMENTS, pieces, &work);
+        certificates
+    }
+
+    /// The least distance at rest between the sides of any pair of two triangles that
+    /// share a corner, rounded down (`+∞`: none).
+    pub(super) fn least_at_rest(&self) -> f32 {
+        self.rest_apart
+            .iter()
+            .copied()
+            .fold(f32::INFINITY, f32::min)
+    }
+
+    /// Forgets every reference taken since the rest shape (the motion starts anew).
     pub(super) fn forget(&mut self) {
         self.apart.clear();
     }
@@ -65,13 +113,21 @@ impl Certificates {
         let rings = &owners.rings;
         let corners = from.len();
         if self.apart.len() != corners || self.reference.len() != rings.ring.len() {
-            self.apart.clear();
-            self.apart.resize(corners, f32::NEG_INFINITY);
-            self.reference.clear();
-            self.reference.resize(rings.ring.len(), Vec3::ZERO);
+            // From the rest shape, where it was measured for this cloth; from none (`-∞`)
+            // otherwise.
+            if self.rest_apart.len() == corners && self.rest.len() == rings.ring.len() {
+                self.apart.clone_from(&self.rest_apart);
+                self.reference.clone_from(&self.rest);
+            } else {
+                self.apart.clear();
+                self.apart.resize(corners, f32::NEG_INFINITY);
+                self.reference.clear();
+                self.reference.resize(rings.ring.len(), Vec3::ZERO);
+            }
             self.open.clear();
             self.open.resize(corners, true);
         }
+        let at_rest = (self.rest_apart.len() == corners).then_some((&self.rest, &self.rest_apart));
         let least = thickness * (1.0 + MARGIN);
         let retaken = AtomicU64::new(0);
         let (reference, apart, open) = (
@@ -93,6 +149,7 @@ impl Certificates {
                     *unsafe { open.at(c) } = false;
                     continue;
                 }
+                let rest = at_rest.map(|(r, a)| (&r[range.clone()], a[c]));
                 // SAFETY: each corner is one piece's, and its ring's entries its own.
                 let corner = unsafe { (reference.part(range), apart.at(c), open.at(c)) };
                 let motion = [from, to];
@@ -103,7 +160,7 @@ impl Certificates {
                     (owners, triangles),
                     motion,
                     least,
-                    settled,
+                    (settled, rest),
                 ));
             }
             retaken.fetch_add(taken, Ordering::Relaxed);
@@ -121,15 +178,16 @@ impl Certificates {
 const CORNERS_PER_PIECE: usize = 256;
 
 /// Decides corner `c`, with its reference, least distance and whether it is open (closed
-/// without a new reference where its reference fails but `settled` holds); returns
-/// whether the reference was taken again.
+/// without a new reference where its reference fails but `settled` holds: its reference
+/// is then its rest shape, where that was measured, `rest`); returns whether the
+/// reference was taken again.
 fn decide_one(
     c: usize,
     (reference, apart, open): (&mut [Vec3], &mut f32, &mut bool),
     (owners, triangles): (&Owners, &[[u32; 3]]),
     [from, to]: [&[Vec3]; 2],
     least: f32,
-    settled: impl Fn() -> bool,
+    (settled, rest): (impl Fn() -> bool, Option<(&[Vec3], f32)>),
 ) -> bool {
     let (ring, pairs) = (
         &owners.rings.ring[owners.rings.range(c)],
@@ -155,31 +213,53 @@ fn decide_one(
         }
         most.sqrt()
     };
-    if certified(*apart, strayed(reference), least) || settled() {
+    if certified(*apart, strayed(reference), least) {
         *open = false;
         return false;
     }
-    // Taken again at the motion's end (where the next substep starts), in its frame
-    // there; the distances are exact for the rounded positions, and rounded down to f32.
-    let back = frame(to[c], to[a], to[b]).transpose();
-    for (&j, r) in ring.iter().zip(reference.iter_mut()) {
-        *r = back * (to[j as usize] - to[c]);
+    if settled() {
+        // Its ring keeps near its rest shape: so will its rest shape fit the next
+        // substeps (rather than a reference that failed, tried again every time).
+        if let Some((rest, rest_apart)) = rest {
+            reference.copy_from_slice(rest);
+            *apart = rest_apart;
+        }
+        *open = false;
+        return false;
     }
-    let nearest = (pairs.iter())
+    // Taken again at the motion's end (where the next substep starts).
+    *apart = take(c, reference, (owners, triangles), to);
+    *open = !certified(*apart, strayed(reference), least);
+    true
+}
+
+/// Takes corner `c`'s reference with its particles at `x`, in the frame of its first
+/// triangle there; returns the least distance between the sides of its pairs (exact for
+/// the rounded positions, rounded down to f32; `-∞` where the reference overflowed: it
+/// certifies nothing).
+fn take(
+    c: usize,
+    reference: &mut [Vec3],
+    (owners, triangles): (&Owners, &[[u32; 3]]),
+    x: &[Vec3],
+) -> f32 {
+    let ring = &owners.rings.ring[owners.rings.range(c)];
+    let [a, b] = owners.rings.first[c].map(|i| i as usize);
+    let back = frame(x[c], x[a], x[b]).transpose();
+    for (&j, r) in ring.iter().zip(reference.iter_mut()) {
+        *r = back * (x[j as usize] - x[c]);
+    }
+    let nearest = (owners.corner_pairs(c).iter())
         .map(|p| {
             let pair = p.expand(triangles, &owners.edges);
-            distance(&pair, pair.ids().map(|i| to[i].as_dvec3()))
+            distance(&pair, pair.ids().map(|i| x[i].as_dvec3()))
         })
         .fold(f64::INFINITY, f64::min);
-    // A reference that overflowed certifies nothing.
-    let finite = reference.iter().all(|r| r.is_finite());
-    *apart = if finite {
+    if reference.iter().all(|r| r.is_finite()) {
         shave(nearest)
     } else {
         f32::NEG_INFINITY
-    };
-    *open = !certified(*apart, strayed(reference), least);
-    true
+    }
 }
 
 /// Whether pairs `apart` at the reference, their particles `strayed` from it, stay at

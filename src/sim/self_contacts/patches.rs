@@ -70,18 +70,20 @@ pub(super) struct Patches {
 
 impl Patches {
     /// The patches of the cloth of `triangles` whose `tree` is built from its `rest`
-    /// positions. Leaves the tree fitted to the rest shape and uncovered.
+    /// positions, with its `owners` and the least distance at rest between the sides of
+    /// the pairs of two triangles that share a corner (`corners`, measured with their
+    /// certificates). Leaves the tree fitted to the rest shape and uncovered.
     pub(super) fn build(
         tree: &mut TriangleTree,
         triangles: &[[u32; 3]],
         rest: &[Vec3],
-        owners: &Owners,
+        (owners, corners): (&Owners, f32),
     ) -> Patches {
         let nodes = tree.nodes().to_vec();
         let mut patches = Patches {
             parent: vec![0; nodes.len()],
             start: vec![0],
-            gap: rest_gap(tree, triangles, rest, owners),
+            gap: rest_gap(tree, triangles, rest, (owners, corners)),
             ..Patches::default()
         };
         for (i, node) in nodes.iter().enumerate() {
@@ -353,15 +355,15 @@ fn homes(
 
 /// The least distance at `rest` between the sides of any pair of the cloth (a vertex and a
 /// triangle it is not a corner of, two edges that share no particle), up to the longest
-/// rest edge, rounded down: the pairs of two triangles that share a corner, and those of
-/// two that do not whose rest boxes, grown by half that edge, overlap (found by a walk of
-/// the `tree`, fitted to them). Shared with the team; a pair whose sides' boxes lie
-/// farther apart than the least yet is passed by.
+/// rest edge, rounded down: `corners` for the pairs of two triangles that share a corner,
+/// and those of two that do not whose rest boxes, grown by half that edge, overlap (found
+/// by a walk of the `tree`, fitted to them). Shared with the team; a pair whose sides'
+/// boxes lie farther apart than the least yet is passed by.
 fn rest_gap(
     tree: &mut TriangleTree,
     triangles: &[[u32; 3]],
     rest: &[Vec3],
-    owners: &Owners,
+    (owners, corners): (&Owners, f32),
 ) -> f32 {
     let cap = owners.longest;
     let grow = Vec3::splat(0.5 * cap);
@@ -374,7 +376,7 @@ fn rest_gap(
     tree.covered.clear();
     tree.fit_boxes(&lo, &hi);
     // The least yet, as the bits of a positive `f64` (which order as the numbers do).
-    let least = AtomicU64::new(f64::from(cap).to_bits());
+    let least = AtomicU64::new(f64::from(cap.min(corners)).to_bits());
     let box_of = |t: [u32; 3]| {
         let [a, b, c] = t.map(|i| rest[i as usize]);
         (a.min(b).min(c), a.max(b).max(c))
@@ -401,37 +403,24 @@ fn rest_gap(
             *mine = mine.min(distance(&pair, ids.map(|i| rest[i].as_dvec3())));
         }
     };
-    let (pieces, corners) = (tree.pieces(), rest.len().div_ceil(CORNERS_PER_PIECE));
     let tree = &*tree;
     let work = |_: usize, piece: usize| {
         let mut mine = f64::from_bits(least.load(Ordering::Relaxed));
-        if piece < pieces {
-            tree.piece_pairs(piece, |a, b| {
-                let (a, b) = (a as usize, b as usize);
-                // Two triangles whose own boxes lie farther apart than the least yet have
-                // no pair nearer (most of those the grown boxes meet).
-                if apart_by(triangles[a], triangles[b], mine) {
-                    return;
-                }
-                owners.each_pair(triangles, a, b, |pair, _| measure(pair, &mut mine));
-            });
-        } else {
-            let first = (piece - pieces) * CORNERS_PER_PIECE;
-            for c in first..(first + CORNERS_PER_PIECE).min(rest.len()) {
-                for stored in owners.corner_pairs(c) {
-                    measure(stored.expand(triangles, &owners.edges), &mut mine);
-                }
+        tree.piece_pairs(piece, |a, b| {
+            let (a, b) = (a as usize, b as usize);
+            // Two triangles whose own boxes lie farther apart than the least yet have no
+            // pair nearer (most of those the grown boxes meet).
+            if apart_by(triangles[a], triangles[b], mine) {
+                return;
             }
-        }
+            owners.each_pair(triangles, a, b, |pair, _| measure(pair, &mut mine));
+        });
         least.fetch_min(mine.to_bits(), Ordering::Relaxed);
     };
     let parallel = triangles.len() >= PARALLEL_ELEMENTS;
-    Team::current().run_large_pieces_if(parallel, pieces + corners, &work);
+    Team::current().run_large_pieces_if(parallel, tree.pieces(), &work);
     shave(f64::from_bits(least.into_inner()))
 }
-
-/// Corners whose pairs [`rest_gap`] measures in one piece.
-const CORNERS_PER_PIECE: usize = 512;
 
 #[cfg(test)]
 mod tests;

@@ -252,8 +252,8 @@ impl SelfContacts {
 
     /// Builds what self-contact keeps for `model` alone, from its triangles and rest
     /// shape: which triangle owns each vertex and edge and the pairs of the triangles
-    /// that share a corner ([`Owners`]), the tree over the triangles and its patches with
-    /// the cloth's rest gap. Once per cloth (a stepper calls it when self-collision is
+    /// that share a corner, each corner's rest shape as its first reference, the tree
+    /// over the triangles and its patches with the cloth's rest gap. Once per cloth (a stepper calls it when self-collision is
     /// turned on, so that the first substep does not wait for it); each resolve checks
     /// that they are the model's, and builds them again only for another cloth.
     ///
@@ -276,8 +276,10 @@ impl SelfContacts {
         }
         if self.tree.triangles() != model.triangles.len() {
             let (triangles, rest) = (&model.triangles, &model.rest_positions);
+            self.certificates = Certificates::build(&self.owners, triangles, rest);
             self.tree = TriangleTree::build(triangles, rest);
-            self.patches = Patches::build(&mut self.tree, triangles, rest, &self.owners);
+            let corners = self.certificates.least_at_rest();
+            self.patches = Patches::build(&mut self.tree, triangles, rest, (&self.owners, corners));
         }
         Ok(())
     }

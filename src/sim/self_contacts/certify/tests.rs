@@ -148,6 +148,37 @@ fn a_cloth_that_only_turns_keeps_its_references() {
     }
 }
 
+/// Every corner starts from its rest shape: a cloth that only turns and moves from rest
+/// takes no reference at all. One folded in two takes the references of the corners along
+/// the fold; laid flat again and turning, where their rings keep near their rest shape (as
+/// the patches tell), those corners go back to their rest shape, so that turning and
+/// moving on takes none again.
+#[test]
+fn corners_start_from_their_rest_shape_and_go_back_to_it() {
+    let (model, owners, rest) = flat();
+    let triangles = &model.triangles;
+    let moved = |s: usize| -> Vec<Vec3> {
+        let turn = Quat::from_rotation_y((10.0 * s as f32).to_radians());
+        let carry = s as f32 * Vec3::new(0.05, 0.0, -0.02);
+        rest.iter().map(|&p| turn * p + carry).collect()
+    };
+    let mut certificates = Certificates::build(&owners, triangles, &rest);
+    let mut decide = |motion: [&[Vec3]; 2], near_rest: bool| {
+        let settled: [&(dyn Fn(usize) -> bool + Sync); 2] = [&|_| false, &|_| near_rest];
+        let retaken = certificates.decide(&owners, triangles, motion, THICKNESS, None, settled);
+        (retaken, certificates.open.iter().filter(|&&o| o).count())
+    };
+    assert_eq!(decide([&moved(0), &moved(1)], false), (0, 0));
+    let fold = folded(&rest, 90f32.to_radians(), 0);
+    let (retaken, _) = decide([&fold, &fold], false);
+    assert!(retaken > 10, "{retaken} taken along the fold");
+    assert_eq!(decide([&moved(0), &moved(1)], true), (0, 0));
+    for step in 1..4 {
+        let (from, to) = (moved(step), moved(step + 1));
+        assert_eq!(decide([&from, &to], false), (0, 0), "substep {step}");
+    }
+}
+
 /// Three triangles meeting only at corner 0, which is therefore their one corner with
 /// pairs: a flat one pointing along −x (the corner's first triangle, whose frame turns
 /// the references), a flat flap along +x, and above it a flap that rises to 6 mm over the

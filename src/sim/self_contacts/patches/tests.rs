@@ -7,6 +7,7 @@ use glam::{Quat, Vec3};
 use super::*;
 use crate::cloth::ClothModel;
 use crate::mesh::{GridOrientation, GridSpec};
+use crate::sim::self_contacts::certify::Certificates;
 
 const REACH: f32 = 0.004;
 
@@ -34,7 +35,8 @@ fn cloth(quads: u32, mut shape: impl FnMut(Vec3) -> Vec3) -> Cloth {
     let owners = Owners::build(&model);
     let rest = model.rest_positions.clone();
     let mut tree = TriangleTree::build(&model.triangles, &rest);
-    let patches = Patches::build(&mut tree, &model.triangles, &rest, &owners);
+    let corners = Certificates::build(&owners, &model.triangles, &rest).least_at_rest();
+    let patches = Patches::build(&mut tree, &model.triangles, &rest, (&owners, corners));
     Cloth {
         model,
         owners,
