@@ -22,7 +22,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{Mat3, Vec3};
 
-use super::primitives::distance;
+use super::primitives::nearer;
 use super::search::Owners;
 use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
 
@@ -249,12 +249,9 @@ fn take(
     for (&j, r) in ring.iter().zip(reference.iter_mut()) {
         *r = back * (x[j as usize] - x[c]);
     }
-    let nearest = (owners.corner_pairs(c).iter())
-        .map(|p| {
-            let pair = p.expand(triangles, &owners.edges);
-            distance(&pair, pair.ids().map(|i| x[i].as_dvec3()))
-        })
-        .fold(f64::INFINITY, f64::min);
+    let nearest = (owners.corner_pairs(c).iter()).fold(f64::INFINITY, |least, p| {
+        nearer(&p.expand(triangles, &owners.edges), x, least)
+    });
     if reference.iter().all(|r| r.is_finite()) {
         shave(nearest)
     } else {

@@ -27,7 +27,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use glam::Vec3;
 
 use super::certify::{MARGIN, frame, shave};
-use super::primitives::{Pair, distance};
+use super::primitives::{Pair, nearer};
 use super::search::{NONE, Owners};
 use super::tree::{TRIANGLES_PER_PIECE, TriangleTree};
 use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
@@ -388,21 +388,7 @@ fn rest_gap(
         let gap = f64::from((blo - ahi).max(alo - bhi).max(Vec3::ZERO).length());
         gap * (1.0 - 1e-6) >= least
     };
-    let measure = |pair: Pair, mine: &mut f64| {
-        let ids = pair.ids();
-        let k = pair.first_side();
-        let side = |r: std::ops::Range<usize>| {
-            (ids[r].iter()).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &i| {
-                (lo.min(rest[i]), hi.max(rest[i]))
-            })
-        };
-        let ((alo, ahi), (blo, bhi)) = (side(0..k), side(k..4));
-        // Apart by their boxes by more than the least yet (less a rounding's worth).
-        let gap = f64::from((blo - ahi).max(alo - bhi).max(Vec3::ZERO).length());
-        if gap * (1.0 - 1e-6) < *mine {
-            *mine = mine.min(distance(&pair, ids.map(|i| rest[i].as_dvec3())));
-        }
-    };
+    let measure = |pair: Pair, mine: &mut f64| *mine = nearer(&pair, rest, *mine);
     let tree = &*tree;
     let work = |_: usize, piece: usize| {
         let mut mine = f64::from_bits(least.load(Ordering::Relaxed));

@@ -116,6 +116,27 @@ impl Pair {
     }
 }
 
+/// The least of `least` and the pair's distance with its particles at `x`, measured (in
+/// f64) only where the boxes of its two sides lie nearer than `least`: a running least
+/// over many pairs, most of which their boxes pass by.
+pub(super) fn nearer(pair: &Pair, x: &[Vec3], least: f64) -> f64 {
+    let ids = pair.ids();
+    let k = pair.first_side();
+    let side = |r: std::ops::Range<usize>| {
+        (ids[r].iter()).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &i| {
+            (lo.min(x[i]), hi.max(x[i]))
+        })
+    };
+    let ((alo, ahi), (blo, bhi)) = (side(0..k), side(k..4));
+    // Apart by their boxes by more than the least yet (less a rounding's worth).
+    let gap = f64::from((blo - ahi).max(alo - bhi).max(Vec3::ZERO).length());
+    if gap * (1.0 - 1e-6) < least {
+        least.min(distance(pair, ids.map(|i| x[i].as_dvec3())))
+    } else {
+        least
+    }
+}
+
 /// The distance between the pair's two sides with its particles at `x`, in f64.
 pub fn distance(pair: &Pair, x: [DVec3; 4]) -> f64 {
     if pair.edges() {

@@ -6,6 +6,7 @@ use glam::{Quat, Vec3};
 use super::*;
 use crate::cloth::ClothModel;
 use crate::mesh::{GridOrientation, GridSpec};
+use crate::sim::self_contacts::primitives::distance;
 
 const THICKNESS: f32 = 0.006;
 

@@ -8,6 +8,7 @@ use super::*;
 use crate::cloth::ClothModel;
 use crate::mesh::{GridOrientation, GridSpec};
 use crate::sim::self_contacts::certify::Certificates;
+use crate::sim::self_contacts::primitives::distance;
 
 const REACH: f32 = 0.004;
 
