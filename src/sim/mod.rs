@@ -47,10 +47,6 @@ pub use motion::{AxisAngle, Ease, Keyframe, MotionError, Pose, RigidMotion};
 pub use param_error::ParamError;
 pub use params::{Changes, ContactConfig, Material, SimParams, SolverConfig, StepConfig};
 pub use precision::Precision;
-pub use self_contacts::{ContactError, SelfContacts, SelfWork, owned_parts};
-
-/// The phase that times self-contact's setup for a cloth ([`SelfContacts::prepare`]),
-/// when a stepper takes self-collision on: once, before the substeps.
-pub const SELF_SETUP: &str = "self-setup";
+pub use self_contacts::{ContactError, SELF_SETUP, SelfContacts, SelfWork, owned_parts};
 pub use stats::StepStats;
 pub use timings::{Phase, PhaseTimings};

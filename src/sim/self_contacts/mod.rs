@@ -24,8 +24,10 @@ mod search;
 mod solver;
 mod tree;
 mod window;
+mod work;
 
 pub use error::ContactError;
 pub(crate) use primitives::point_triangle_distance;
 pub use search::owned_parts;
-pub use solver::{SelfContacts, SelfWork};
+pub use solver::SelfContacts;
+pub use work::{SELF_SETUP, SelfWork};

@@ -16,32 +16,7 @@ use super::primitives::{StoredPair, closer_than, push_apart};
 use super::search::{Boxes, Owners, Search, pairs};
 use super::tree::TriangleTree;
 use super::window::Window;
-
-/// Work done by the last resolve: for cost checks.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
-pub struct SelfWork {
-    /// Vertex–triangle and edge–edge pairs whose boxes over the substep overlap.
-    pub candidates: u64,
-    /// Pushes that kept a pair a thickness apart at the substep's end.
-    pub contacts: u64,
-    /// Searches of the whole tree (0 when the pairs found before still held, or only
-    /// some triangles were searched again).
-    pub searches: u64,
-    /// Searches of only the triangles whose particles left their boxes.
-    pub refreshes: u64,
-    /// Triangles those searched again.
-    pub refreshed: u64,
-    /// Corners whose pairs' reference distances were measured again, their certificate
-    /// having failed (see the module's notes).
-    pub retaken: u64,
-    /// Pairs whose motion was cut short because their sides could otherwise have met.
-    pub impacts: u64,
-    /// Pairs that prescribed motion (pins, handles) drove together, so no cut could keep
-    /// them apart.
-    pub forced: u64,
-    /// [`SelfWork::forced`] added up since the solver was made.
-    pub forced_total: u64,
-}
+use super::work::SelfWork;
 
 /// The separation the continuous check keeps, as a share of the thickness (pairs that
 /// start closer keep half of what they start at).
