@@ -554,10 +554,13 @@ impl<R: Real> StepBackend for CpuStepper<R> {
             });
             self.effects = effects.to_vec();
             if self.self_collision.is_some() {
-                // Built now, not in the first substep; timed as its own phase. A cloth
-                // too large for it is refused by the first substep, with its error.
-                let (contacts, timings) = (&mut self.self_contacts, &mut self.timings);
-                let _ = timings.time(super::SELF_SETUP, || contacts.prepare(model));
+                // Built now, not in the first substep; timed as its own phase where it
+                // was built (not where it was this cloth's already). A cloth too large
+                // for it is refused by the first substep, with its error.
+                let start = std::time::Instant::now();
+                if let Ok(true) = self.self_contacts.prepare(model) {
+                    self.timings.add(super::SELF_SETUP, start.elapsed());
+                }
             }
             self.air_damping = air_damping_of(effects);
             self.gravity = gravity_of(effects);

@@ -228,13 +228,14 @@ impl SelfContacts {
     /// Builds what self-contact keeps for `model` alone, from its triangles and rest
     /// shape: which triangle owns each vertex and edge and the pairs of the triangles
     /// that share a corner, each corner's rest shape as its first reference, the tree
-    /// over the triangles and its patches with the cloth's rest gap. Once per cloth (a stepper calls it when self-collision is
-    /// turned on, so that the first substep does not wait for it); each resolve checks
-    /// that they are the model's, and builds them again only for another cloth.
+    /// over the triangles and its patches with the cloth's rest gap. Once per cloth (a
+    /// stepper calls it when self-collision is turned on, so that the first substep does
+    /// not wait for it); each resolve checks that they are the model's, and builds them
+    /// again only for another cloth. Returns whether it built them.
     ///
     /// # Errors
     /// [`ContactError::TooMany`] for more triangles than a stored pair can number.
-    pub fn prepare(&mut self, model: &ClothModel) -> Result<(), ContactError> {
+    pub fn prepare(&mut self, model: &ClothModel) -> Result<bool, ContactError> {
         if model.triangles.len() > MOST_TRIANGLES {
             return Err(ContactError::TooMany {
                 triangles: model.triangles.len(),
@@ -249,14 +250,15 @@ impl SelfContacts {
             self.tree = TriangleTree::default();
             (self.window, self.boxes.swept) = (Window::default(), false);
         }
-        if self.tree.triangles() != model.triangles.len() {
-            let (triangles, rest) = (&model.triangles, &model.rest_positions);
-            self.certificates = Certificates::build(&self.owners, triangles, rest);
-            self.tree = TriangleTree::build(triangles, rest);
-            let corners = self.certificates.least_at_rest();
-            self.patches = Patches::build(&mut self.tree, triangles, rest, (&self.owners, corners));
+        if self.tree.triangles() == model.triangles.len() {
+            return Ok(false);
         }
-        Ok(())
+        let (triangles, rest) = (&model.triangles, &model.rest_positions);
+        self.certificates = Certificates::build(&self.owners, triangles, rest);
+        self.tree = TriangleTree::build(triangles, rest);
+        let corners = self.certificates.least_at_rest();
+        self.patches = Patches::build(&mut self.tree, triangles, rest, (&self.owners, corners));
+        Ok(true)
     }
 
     /// Checks the substep's motion again after [`SelfContacts::resolve`] and a move of the
