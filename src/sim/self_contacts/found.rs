@@ -82,21 +82,6 @@ impl Found {
             .sum()
     }
 
-    /// Makes `out` the pairs for which `keep` is true, in their order: a piece per segment,
-    /// shared with the team's helpers when `parallel`.
-    pub(super) fn select_into(
-        &self,
-        out: &mut Found,
-        parallel: bool,
-        keep: &(dyn Fn(StoredPair) -> bool + Sync),
-    ) {
-        out.clear();
-        out.extend(self.segments.len(), parallel, &|piece, buffer| {
-            let pairs = self.segment(self.segments[piece]);
-            buffer.extend(pairs.iter().copied().filter(|&p| keep(p)));
-        });
-    }
-
     /// Calls `visit` with each piece's pairs, shared with the team's helpers when
     /// `parallel` (in no set order then: for work whose result does not depend on it).
     pub(super) fn share(&self, parallel: bool, visit: &(dyn Fn(&[StoredPair]) + Sync)) {

@@ -22,6 +22,7 @@ mod primitives;
 mod rings;
 mod search;
 mod solver;
+mod sweeps;
 mod tree;
 mod window;
 mod work;

@@ -168,10 +168,11 @@ pub fn point_triangle_distance(p: DVec3, [a, b, c]: [DVec3; 3]) -> f64 {
     to_segment(a, b).min(to_segment(b, c)).min(to_segment(c, a))
 }
 
-/// Whether the pair's sides are closer than `d` with its particles at `pos`: then the
-/// weights of their closest points ([`Pair::weights`]) and the offset between them (first
-/// side less the other).
-pub fn closer_than(pair: &Pair, pos: &[Vec3], d: f32) -> Option<([f32; 4], Vec3)> {
+/// Where the pair's sides are closer than `d` with its particles at `pos`, the weights of
+/// their closest points ([`Pair::weights`]) and the offset between them (first side less
+/// the other); where they are not, how far apart they are at least (the gap between their
+/// boxes along an axis, or their closest points' distance, as rounded).
+fn separation(pair: &Pair, pos: &[Vec3], d: f32) -> Result<([f32; 4], Vec3), f32> {
     let x = pair.ids().map(|i| pos[i]);
     let k = pair.first_side();
     // Sides whose boxes are `d` apart are not closer.
@@ -181,34 +182,43 @@ pub fn closer_than(pair: &Pair, pos: &[Vec3], d: f32) -> Option<([f32; 4], Vec3)
         })
     };
     let ((alo, ahi), (blo, bhi)) = (side_box(0..k), side_box(k..4));
-    if (blo - ahi).max(alo - bhi).max_element() >= d {
-        return None;
+    let apart = (blo - ahi).max(alo - bhi).max_element();
+    if apart >= d {
+        return Err(apart);
     }
     let w = pair.weights(x);
     let sign = |i: usize| if i < k { 1.0 } else { -1.0 };
     let gap: Vec3 = (0..4).map(|i| sign(i) * w[i] * x[i]).sum();
-    (gap.length() < d).then_some((w, gap))
+    let length = gap.length();
+    if length < d {
+        Ok((w, gap))
+    } else {
+        Err(length)
+    }
 }
 
 /// Keeps the pair's sides `thickness` apart, on the side they were on at the substep's
 /// start (`start`): each particle moves by its share of the push (its weight times its
 /// inverse mass); the approaching relative velocity is removed and Coulomb `friction`
 /// applied to the sliding part. Particles `held` (resting on a solid) move only where
-/// nothing else in the pair can. Returns whether it pushed.
+/// nothing else in the pair can. Returns whether it pushed, or (`Err`) how far apart its
+/// sides were at least where they were not closer than the thickness: measured where
+/// they are closer than `within` (at least the thickness), and where not, at least that.
 pub fn push_apart(
     pair: &Pair,
-    [thickness, friction]: [f32; 2],
+    [thickness, friction, within]: [f32; 3],
     model: &ClothModel,
     start: &[Vec3],
     state: &mut ClothState,
     held: &[bool],
-) -> bool {
+) -> Result<bool, f32> {
     let ids = pair.ids();
     let k = pair.first_side();
-    let Some((w, gap)) = closer_than(pair, &state.pos, thickness) else {
-        return false;
-    };
+    let (w, gap) = separation(pair, &state.pos, within.max(thickness))?;
     let dist = gap.length();
+    if dist >= thickness {
+        return Err(dist);
+    }
     // Signed weights: the first side counts positively, the other negatively.
     let sign = |i: usize| if i < k { 1.0 } else { -1.0 };
     // Which side: the sides' offset at the start, at the same weights.
@@ -220,11 +230,11 @@ pub fn push_apart(
     } else if let Some(n) = gap.try_normalize() {
         n
     } else {
-        return false;
+        return Ok(false);
     };
     let depth = thickness - gap.dot(direction);
     if depth <= 0.0 {
-        return false;
+        return Ok(false);
     }
     let held = |i: usize| held.get(i).copied().unwrap_or(false);
     let mut inv = ids.map(|i| if held(i) { 0.0 } else { model.inv_mass[i] });
@@ -234,7 +244,7 @@ pub fn push_apart(
         weight = (0..4).map(|i| w[i] * w[i] * inv[i]).sum();
     }
     if weight <= 0.0 {
-        return false;
+        return Ok(false);
     }
     // No particle moves farther than the depth: a pair whose only free particle barely
     // weighs in its side (a small weight) is pushed partly, not flung.
@@ -259,5 +269,5 @@ pub fn push_apart(
             state.vel[ids[i]] += (sign(i) * w[i] * inv[i]) * impulse;
         }
     }
-    true
+    Ok(true)
 }

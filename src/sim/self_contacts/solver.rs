@@ -12,8 +12,9 @@ use super::certify::Certificates;
 use super::error::ContactError;
 use super::found::Found;
 use super::patches::Patches;
-use super::primitives::{StoredPair, closer_than, push_apart};
-use super::search::{Boxes, Owners, Search, pairs};
+use super::primitives::StoredPair;
+use super::search::{Boxes, Owners, Search};
+use super::sweeps::Sweeps;
 use super::tree::TriangleTree;
 use super::window::Window;
 use super::work::SelfWork;
@@ -66,14 +67,11 @@ const AHEAD_MOST: f32 = 0.25;
 /// Gauss–Seidel sweeps of the pushes over the pairs.
 const PUSH_SWEEPS: usize = 4;
 
-/// The pushes go through only the pairs whose sides are closer than this many
-/// thicknesses before their first sweep: one farther apart comes into contact within the
-/// sweeps only where pushes elsewhere move its particles a thickness (the next substep
-/// pushes it then; the continuous check, not the pushes, keeps the guarantee).
+/// The pushes' sweeps after the first go through only the pairs whose sides were closer
+/// than this many thicknesses when the first came to them (see [`Sweeps`]).
 const NEAR: f32 = 2.0;
 
-/// Pairs from which picking out the near ones, and the continuous check's rounds, are
-/// shared with the team.
+/// Pairs from which the continuous check's rounds are shared with the team.
 const PARALLEL_PAIRS: usize = 16_384;
 
 /// Rounds of cuts by the safe fraction; after them, a pair that can still meet has its
@@ -132,8 +130,8 @@ pub struct SelfContacts {
     found_for: Option<f32>,
     /// How much of its motion each particle keeps, and whether that changed last round.
     scale: Vec<f64>,
-    /// The pairs the pushes go through.
-    near: Found,
+    /// What the pushes' sweeps keep.
+    sweeps: Sweeps,
     /// This round's cuts: each particle's smallest scale yet, as the bits of an `f64`.
     cut: Cuts,
     changed: Vec<bool>,
@@ -192,27 +190,15 @@ impl SelfContacts {
         self.relative(start, &state.pos, self.shift, mean);
         self.update_pairs(model, thickness, thickness)?;
         self.work.candidates = self.found.len() as u64;
-        // The sweeps go through the pairs whose sides are near enough to come into
-        // contact, picked out first (by the team, where they are many).
-        let (triangles, edges, pos) = (&model.triangles, &self.owners.edges, &state.pos);
-        let near = |p: StoredPair| {
-            closer_than(&p.expand(triangles, edges), pos, NEAR * thickness).is_some()
-        };
-        let parallel = self.work.candidates as usize >= PARALLEL_PAIRS;
-        self.found.select_into(&mut self.near, parallel, &near);
-        let mut contacts = 0;
-        for _ in 0..PUSH_SWEEPS {
-            for pair in pairs(&self.near, &model.triangles, &self.owners) {
-                contacts += usize::from(push_apart(
-                    &pair,
-                    [thickness, friction],
-                    model,
-                    start,
-                    state,
-                    &self.held,
-                ));
-            }
-        }
+        let contacts = self.sweeps.push(
+            PUSH_SWEEPS,
+            (&self.found, &self.owners),
+            [thickness, friction, NEAR * thickness],
+            model,
+            start,
+            state,
+            &self.held,
+        );
         self.work.contacts = contacts as u64;
         // The pushes may have taken a particle out of the box its pairs were found in; the
         // check needs only the pairs that can come within what it keeps.
