@@ -743,3 +743,50 @@ fn the_sweeps_pass_by_only_pairs_their_test_would_leave() {
     assert_eq!(pushes, every_pushes);
     assert!(swept.pos == every.pos && swept.vel == every.vel);
 }
+
+/// Judged by the boxes, a pair is kept exactly where the smallest balls around its
+/// particles' boxes less half the thickness come within the thickness (the distance
+/// between the boxes' centres less the largest radius of each side), however near two
+/// of its particles' centres are.
+#[test]
+fn pairs_judged_by_the_boxes_are_kept_exactly_where_their_balls_come_near() {
+    let (model, start) = crumpled();
+    let triangles = &model.triangles;
+    let contacts = searched_to(&model, &start, &start);
+    assert!(!contacts.boxes.swept);
+    let search = Search {
+        owners: &contacts.owners,
+        triangles,
+        boxes: &contacts.boxes,
+        thickness: THICKNESS,
+        open: &contacts.certificates.open,
+    };
+    let (lo, hi) = (&contacts.boxes.vertex_lo, &contacts.boxes.vertex_hi);
+    let centre = |i: usize| (0.5 * (lo[i] + hi[i])).as_dvec3();
+    let radius = |i: usize| 0.5 * f64::from((hi[i] - lo[i] - THICKNESS).max(Vec3::ZERO).length());
+    let (mut kept, mut passed) = (0, 0);
+    for a in 0..triangles.len() {
+        for b in a + 1..triangles.len() {
+            let (ta, tb) = (triangles[a], triangles[b]);
+            let (alo, ahi) = (contacts.boxes.lo[a], contacts.boxes.hi[a]);
+            let (blo, bhi) = (contacts.boxes.lo[b], contacts.boxes.hi[b]);
+            if !meet((alo, ahi), (blo, bhi)) || ta.iter().any(|i| tb.contains(i)) {
+                continue;
+            }
+            (search.owners).each_pair(triangles, a, b, |pair, stored| {
+                let (ids, k) = (pair.ids(), pair.first_side());
+                let most =
+                    |r: std::ops::Range<usize>| r.map(|j| radius(ids[j])).fold(0.0, f64::max);
+                let apart = distance(&pair, ids.map(centre)) - most(0..k) - most(k..4);
+                let mut out = Vec::new();
+                search.keep(pair, stored, &mut out);
+                assert_eq!(!out.is_empty(), apart < f64::from(THICKNESS), "{apart}");
+                (kept, passed) = (kept + out.len(), passed + 1 - out.len());
+            });
+        }
+    }
+    assert!(
+        kept > 1000 && passed > 1000,
+        "{kept} kept, {passed} passed by"
+    );
+}
