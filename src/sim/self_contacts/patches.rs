@@ -376,7 +376,9 @@ fn rest_gap(
     tree.covered.clear();
     tree.fit_boxes(&lo, &hi);
     // The least yet, as the bits of a positive `f64` (which order as the numbers do).
-    let least = AtomicU64::new(f64::from(cap.min(corners)).to_bits());
+    // Not below 0 (a corner's reference that overflowed reads -∞), where the bits would
+    // not order as the numbers do.
+    let least = AtomicU64::new(f64::from(cap.min(corners).max(0.0)).to_bits());
     let box_of = |t: [u32; 3]| {
         let [a, b, c] = t.map(|i| rest[i as usize]);
         (a.min(b).min(c), a.max(b).max(c))
