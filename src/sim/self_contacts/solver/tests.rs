@@ -46,6 +46,35 @@ fn searched_to(model: &ClothModel, start: &[Vec3], end: &[Vec3]) -> SelfContacts
     contacts
 }
 
+/// The search `contacts` made for the cloth of `triangles`, with its boxes and corners.
+fn search_of<'a>(contacts: &'a SelfContacts, triangles: &'a [[u32; 3]]) -> Search<'a> {
+    Search {
+        owners: &contacts.owners,
+        triangles,
+        boxes: &contacts.boxes,
+        thickness: THICKNESS,
+        open: &contacts.certificates.open,
+    }
+}
+
+/// Calls `visit` with each vertex–triangle and edge–edge pair of every two triangles whose
+/// boxes (as `search` has them) overlap, whose sides' boxes overlap too: by testing every
+/// two triangles.
+fn each_overlapping_pair(search: &Search, mut visit: impl FnMut(Pair, StoredPair)) {
+    let (lo, hi, triangles) = (&search.boxes.lo, &search.boxes.hi, search.triangles);
+    for a in 0..triangles.len() {
+        for b in a + 1..triangles.len() {
+            if meet((lo[a], hi[a]), (lo[b], hi[b])) {
+                (search.owners).each_pair(triangles, a, b, |pair, stored| {
+                    if search.sides_meet(&pair) {
+                        visit(pair, stored);
+                    }
+                });
+            }
+        }
+    }
+}
+
 /// Pairs found for every particle moving by `motion` (none: the boxes get room, and the
 /// pairs are judged by them alone; a fast one: by the motion too), then the particles in
 /// the band `x < band` moved by `shift` more, which takes them out of their boxes, and the
@@ -123,26 +152,11 @@ fn a_search_finds_what_testing_every_two_triangles_finds() {
             .collect();
         let contacts = searched_to(&model, &start, &end);
         let found = sorted(contacts.found.stored().copied().collect());
-        let search = Search {
-            owners: &contacts.owners,
-            triangles,
-            boxes: &contacts.boxes,
-            thickness: THICKNESS,
-            open: &contacts.certificates.open,
-        };
-        let (lo, hi) = (&contacts.boxes.lo, &contacts.boxes.hi);
+        let search = search_of(&contacts, triangles);
         let mut every = Vec::new();
-        for a in 0..triangles.len() {
-            for b in a + 1..triangles.len() {
-                if meet((lo[a], hi[a]), (lo[b], hi[b])) {
-                    (search.owners).each_pair(triangles, a, b, |pair, stored| {
-                        if search.sides_meet(&pair) {
-                            search.keep(pair, stored, &mut every);
-                        }
-                    });
-                }
-            }
-        }
+        each_overlapping_pair(&search, |pair, stored| {
+            search.keep(pair, stored, &mut every)
+        });
         // Moving fast, the pairs of the corners the certificates closed are left out.
         let mut closed = Vec::new();
         if contacts.boxes.swept {
@@ -751,40 +765,22 @@ fn the_sweeps_pass_by_only_pairs_their_test_would_leave() {
 #[test]
 fn pairs_judged_by_the_boxes_are_kept_exactly_where_their_balls_come_near() {
     let (model, start) = crumpled();
-    let triangles = &model.triangles;
     let contacts = searched_to(&model, &start, &start);
     assert!(!contacts.boxes.swept);
-    let search = Search {
-        owners: &contacts.owners,
-        triangles,
-        boxes: &contacts.boxes,
-        thickness: THICKNESS,
-        open: &contacts.certificates.open,
-    };
+    let search = search_of(&contacts, &model.triangles);
     let (lo, hi) = (&contacts.boxes.vertex_lo, &contacts.boxes.vertex_hi);
     let centre = |i: usize| (0.5 * (lo[i] + hi[i])).as_dvec3();
     let radius = |i: usize| 0.5 * f64::from((hi[i] - lo[i] - THICKNESS).max(Vec3::ZERO).length());
     let (mut kept, mut passed) = (0, 0);
-    for a in 0..triangles.len() {
-        for b in a + 1..triangles.len() {
-            let (ta, tb) = (triangles[a], triangles[b]);
-            let (alo, ahi) = (contacts.boxes.lo[a], contacts.boxes.hi[a]);
-            let (blo, bhi) = (contacts.boxes.lo[b], contacts.boxes.hi[b]);
-            if !meet((alo, ahi), (blo, bhi)) || ta.iter().any(|i| tb.contains(i)) {
-                continue;
-            }
-            (search.owners).each_pair(triangles, a, b, |pair, stored| {
-                let (ids, k) = (pair.ids(), pair.first_side());
-                let most =
-                    |r: std::ops::Range<usize>| r.map(|j| radius(ids[j])).fold(0.0, f64::max);
-                let apart = distance(&pair, ids.map(centre)) - most(0..k) - most(k..4);
-                let mut out = Vec::new();
-                search.keep(pair, stored, &mut out);
-                assert_eq!(!out.is_empty(), apart < f64::from(THICKNESS), "{apart}");
-                (kept, passed) = (kept + out.len(), passed + 1 - out.len());
-            });
-        }
-    }
+    each_overlapping_pair(&search, |pair, stored| {
+        let (ids, k) = (pair.ids(), pair.first_side());
+        let most = |r: std::ops::Range<usize>| r.map(|j| radius(ids[j])).fold(0.0, f64::max);
+        let apart = distance(&pair, ids.map(centre)) - most(0..k) - most(k..4);
+        let mut out = Vec::new();
+        search.keep(pair, stored, &mut out);
+        assert_eq!(!out.is_empty(), apart < f64::from(THICKNESS), "{apart}");
+        (kept, passed) = (kept + out.len(), passed + 1 - out.len());
+    });
     assert!(
         kept > 1000 && passed > 1000,
         "{kept} kept, {passed} passed by"
