@@ -27,7 +27,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use glam::Vec3;
 
 use super::certify::{MARGIN, frame, shave};
-use super::primitives::{Pair, nearer};
+use super::primitives::{Pair, boxes_apart_by, nearer};
 use super::search::{NONE, Owners};
 use super::tree::{TRIANGLES_PER_PIECE, TriangleTree};
 use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
@@ -367,29 +367,19 @@ fn rest_gap(
 ) -> f32 {
     let cap = owners.longest;
     let grow = Vec3::splat(0.5 * cap);
-    let (lo, hi): (Vec<Vec3>, Vec<Vec3>) = (triangles.iter())
+    let boxes: Vec<(Vec3, Vec3)> = (triangles.iter())
         .map(|t| {
             let [a, b, c] = t.map(|i| rest[i as usize]);
-            (a.min(b).min(c) - grow, a.max(b).max(c) + grow)
+            (a.min(b).min(c), a.max(b).max(c))
         })
-        .unzip();
+        .collect();
+    let (lo, hi): (Vec<Vec3>, Vec<Vec3>) = boxes.iter().map(|&(l, h)| (l - grow, h + grow)).unzip();
     tree.covered.clear();
     tree.fit_boxes(&lo, &hi);
     // The least yet, as the bits of a positive `f64` (which order as the numbers do).
     // Not below 0 (a corner's reference that overflowed reads -∞), where the bits would
     // not order as the numbers do.
     let least = AtomicU64::new(f64::from(cap.min(corners).max(0.0)).to_bits());
-    let box_of = |t: [u32; 3]| {
-        let [a, b, c] = t.map(|i| rest[i as usize]);
-        (a.min(b).min(c), a.max(b).max(c))
-    };
-    // Whether the boxes of triangles `a` and `b` lie more than `least` apart (less a
-    // rounding's worth).
-    let apart_by = |a: [u32; 3], b: [u32; 3], least: f64| {
-        let ((alo, ahi), (blo, bhi)) = (box_of(a), box_of(b));
-        let gap = f64::from((blo - ahi).max(alo - bhi).max(Vec3::ZERO).length());
-        gap * (1.0 - 1e-6) >= least
-    };
     let measure = |pair: Pair, mine: &mut f64| *mine = nearer(&pair, rest, *mine);
     let tree = &*tree;
     let work = |_: usize, piece: usize| {
@@ -398,7 +388,7 @@ fn rest_gap(
             let (a, b) = (a as usize, b as usize);
             // Two triangles whose own boxes lie farther apart than the least yet have no
             // pair nearer (most of those the grown boxes meet).
-            if apart_by(triangles[a], triangles[b], mine) {
+            if boxes_apart_by(boxes[a], boxes[b], mine) {
                 return;
             }
             owners.each_pair(triangles, a, b, |pair, _| measure(pair, &mut mine));
