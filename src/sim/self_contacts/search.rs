@@ -364,7 +364,7 @@ impl Search<'_> {
         let near = if self.boxes.swept {
             self.swept_apart(&pair) < thickness
         } else {
-            self.boxed_near(&pair, thickness)
+            self.boxed_near(&pair)
         };
         if near {
             // Grown by a quarter, not doubled: where a cloth lands fast the pairs run to
@@ -377,13 +377,13 @@ impl Search<'_> {
         }
     }
 
-    /// Whether the pair's sides could come within `thickness` with each particle anywhere
+    /// Whether the pair's sides could come within the thickness with each particle anywhere
     /// in its box less half the thickness each way (judged by the boxes, the pairs hold
     /// while each particle's motion lies there): there, a particle is at most half that
     /// box's diagonal from its centre (the smallest ball around the box). Where two of
     /// the sides' particles' centres are that near already, the sides are (a side holds
     /// its particles): stacked cloths keep most of their pairs so, without their distance.
-    fn boxed_near(&self, pair: &Pair, thickness: f64) -> bool {
+    fn boxed_near(&self, pair: &Pair) -> bool {
         let ids = pair.ids();
         let (lo, hi) = (
             ids.map(|i| self.boxes.vertex_lo[i]),
@@ -394,7 +394,7 @@ impl Search<'_> {
         let radius = |j: usize| 0.5 * f64::from((hi[j] - lo[j] - t).max(Vec3::ZERO).length());
         let most = |r: std::ops::Range<usize>| r.map(radius).fold(0.0f64, f64::max);
         let k = pair.first_side();
-        let reach = thickness + most(0..k) + most(k..4);
+        let reach = f64::from(t) + most(0..k) + most(k..4);
         let nearest = (0..k)
             .flat_map(|i| (k..4).map(move |j| (i, j)))
             .map(|(i, j)| x[i].distance_squared(x[j]))

@@ -478,7 +478,7 @@ impl SelfContacts {
                 (self.boxes.lo[n], self.boxes.hi[n]) = self.triangle_box(n, t, thickness)?;
             }
         }
-        self.fit_tree(model, thickness);
+        self.fit_tree(thickness);
         // Only the corners with a triangle searched again are decided again. One that was
         // closed and is open now still leaves out the pairs of its triangles that stayed:
         // it held for their motion, which has not changed.
@@ -518,11 +518,11 @@ impl SelfContacts {
 
     /// Fits the tree to the boxes, or where the pairs are judged by the motion, to the
     /// motion the boxes were made for (told apart by the thickness).
-    fn fit_tree(&mut self, model: &ClothModel, thickness: f32) {
+    fn fit_tree(&mut self, thickness: f32) {
         if self.boxes.swept {
             let motion = [&self.boxes.from[..], &self.boxes.to[..]];
             let reach = self.reach(thickness);
-            self.tree.fit_motion(&model.triangles, motion, reach);
+            self.tree.fit_motion(motion, reach);
         } else {
             self.tree.fit_boxes(&self.boxes.lo, &self.boxes.hi);
         }
@@ -583,7 +583,7 @@ impl SelfContacts {
             self.boxes.lo.push(lo);
             self.boxes.hi.push(hi);
         }
-        self.fit_tree(model, thickness);
+        self.fit_tree(thickness);
         self.found.clear();
         if self.boxes.swept {
             let (motion, reach) = (

@@ -189,18 +189,12 @@ impl TriangleTree {
         self.fit = Fit::Boxes;
     }
 
-    /// Fits the tree to the motion of the particles of `triangles` from `from` to `to`,
-    /// told apart by `reach` (see [`Fit::Motion`]).
-    pub(super) fn fit_motion(
-        &mut self,
-        triangles: &[[u32; 3]],
-        [from, to]: [&[Vec3]; 2],
-        reach: f32,
-    ) {
+    /// Fits the tree to the motion of its triangles' particles from `from` to `to`, told
+    /// apart by `reach` (see [`Fit::Motion`]).
+    pub(super) fn fit_motion(&mut self, [from, to]: [&[Vec3]; 2], reach: f32) {
         self.size();
         let first = self.nodes.len();
-        for (place, &t) in self.order.iter().enumerate() {
-            let corners = triangles[t as usize];
+        for (place, &corners) in self.corners.iter().enumerate() {
             let [a, b, c] = corners.map(|k| Vec3A::from(from[k as usize]));
             let [d, e, f] = corners.map(|k| Vec3A::from(to[k as usize]));
             let i = first + place;
@@ -250,9 +244,9 @@ impl TriangleTree {
     }
 
     /// Calls `pair(t, b)` for each triangle `b` sharing no corner with `t` that `t`'s box
-    /// is not told apart from (as the last fit tells them), not flagged by `searched` where `b < t`: a
-    /// search of each flagged triangle so calls it once for each two of which one at least
-    /// is flagged. By the boxes, the whole walk's tests of theirs and these tell the same
+    /// is not told apart from (as the last fit tells them), not flagged by `searched`
+    /// where `b < t`: a search of each flagged triangle so calls it once for each two of
+    /// which one at least is flagged. By the boxes, the whole walk's tests of theirs and these tell the same
     /// two apart; by the motion, `t` is told apart from each node in their own frame
     /// rather than from the node the whole walk pairs with it.
     pub(super) fn triangle_pairs(&self, t: u32, searched: &[bool], pair: impl FnMut(u32, u32)) {

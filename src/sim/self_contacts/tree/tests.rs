@@ -122,7 +122,7 @@ fn a_walk_by_the_motion_passes_by_nothing_that_comes_within_reach() {
         })
         .collect();
     let reach = 0.01;
-    tree.fit_motion(&triangles, [&from, &to], reach);
+    tree.fit_motion([&from, &to], reach);
     let (found, twice) = walked(&tree);
     assert!(!twice, "a pair found twice");
     let at = |s: f64| -> Vec<DVec3> {
@@ -169,7 +169,7 @@ fn a_search_of_some_triangles_finds_what_the_whole_walk_finds_of_theirs() {
     let marked = |p: &(u32, u32)| dirty[p.0 as usize] || dirty[p.1 as usize];
     for by_motion in [false, true] {
         if by_motion {
-            tree.fit_motion(&triangles, [&from, &to], 0.01);
+            tree.fit_motion([&from, &to], 0.01);
         } else {
             let (lo, hi): (Vec<Vec3>, Vec<Vec3>) = (triangles.iter())
                 .map(|t| {
