@@ -89,11 +89,6 @@ impl Certificates {
             .fold(f32::INFINITY, f32::min)
     }
 
-    /// Forgets every reference taken since the rest shape (the motion starts anew).
-    pub(super) fn forget(&mut self) {
-        self.apart.clear();
-    }
-
     /// Decides, for the motion of each particle from `from` to `to`, which corners' pairs
     /// could come within `thickness` (those it leaves [`Certificates::open`]); with `only`,
     /// only the corners that are, or have in their ring, a particle it flags (the others'

@@ -172,6 +172,8 @@ impl SelfContacts {
         if let Some(particle) = state.pos.iter().position(|p| !p.is_finite()) {
             return Err(ContactError::NonFinite { particle });
         }
+        // Nothing to build where it was prepared for this cloth.
+        self.prepare(model)?;
         // Only the running total outlives a resolve.
         self.work = SelfWork {
             forced_total: self.work.forced_total,
@@ -229,10 +231,10 @@ impl SelfContacts {
             });
         }
         if self.owners.update(model) {
-            // Nothing found for the old cloth holds: not its pairs, its corners'
-            // references, its tree, nor how long its windows ran.
+            // Nothing found for the old cloth holds: not its pairs, its tree (nor, built
+            // with it, its corners' references and its patches), nor how long its windows
+            // ran.
             self.found_for = None;
-            self.certificates.forget();
             self.tree = TriangleTree::default();
             (self.window, self.boxes.swept) = (Window::default(), false);
         }
@@ -266,6 +268,7 @@ impl SelfContacts {
         if thickness <= 0.0 || model.triangles.is_empty() {
             return Ok(0);
         }
+        self.prepare(model)?;
         // The substep in the frame it was resolved in (whose shift already has its mean).
         self.relative(start, &state.pos, self.shift - self.mean, self.mean);
         self.update_pairs(model, thickness, CHECKED * thickness)?;
@@ -303,8 +306,6 @@ impl SelfContacts {
         thickness: f32,
         within: f32,
     ) -> Result<(), ContactError> {
-        // Nothing to build where it was prepared for this cloth.
-        self.prepare(model)?;
         let swept = self.boxes.swept;
         if self.found_for != Some(thickness)
             || self.boxes.vertex_lo.len() != self.to.len()

@@ -628,6 +628,7 @@ fn held_along(
 ) -> (SelfContacts, ClothModel, Vec<Vec<Vec3>>, usize) {
     let (model, path) = folded_and_sinking(more);
     let mut contacts = SelfContacts::default();
+    contacts.prepare(&model).unwrap();
     let mut near = 0;
     for k in 0..path.len() - 1 {
         near += hold_through(&mut contacts, &model, [&path[k], &path[k + 1]]);
