@@ -41,6 +41,10 @@ pub(super) struct Certificates {
     apart: Vec<f32>,
     /// Whether each corner's pairs must be tested one by one (its certificate failed).
     pub(super) open: Vec<bool>,
+    /// Whether each corner was last closed by its ring keeping near its rest shape: its
+    /// ring is tested first then (its rest shape as a reference, turned with the corner,
+    /// mostly fails where the ring bends along with the cloth).
+    ringed: Vec<bool>,
     /// The rest shape as a reference: each ring entry's particle less its corner at rest,
     /// in the corner's frame there, and each corner's least distance between the sides of
     /// its pairs at rest (rounded down; `+∞` for a corner without pairs). Every corner
@@ -121,14 +125,17 @@ impl Certificates {
             }
             self.open.clear();
             self.open.resize(corners, true);
+            self.ringed.clear();
+            self.ringed.resize(corners, false);
         }
         let at_rest = (self.rest_apart.len() == corners).then_some((&self.rest, &self.rest_apart));
         let least = thickness * (1.0 + MARGIN);
         let retaken = AtomicU64::new(0);
-        let (reference, apart, open) = (
+        let (reference, apart, open, ringed) = (
             Disjoint::new(&mut self.reference),
             Disjoint::new(&mut self.apart),
             Disjoint::new(&mut self.open),
+            Disjoint::new(&mut self.ringed),
         );
         let work = |_: usize, piece: usize| {
             let first = piece * CORNERS_PER_PIECE;
@@ -146,7 +153,10 @@ impl Certificates {
                 }
                 let rest = at_rest.map(|(r, a)| (&r[range.clone()], a[c]));
                 // SAFETY: each corner is one piece's, and its ring's entries its own.
-                let corner = unsafe { (reference.part(range), apart.at(c), open.at(c)) };
+                let corner = unsafe {
+                    let flags = (open.at(c), ringed.at(c));
+                    (reference.part(range), apart.at(c), flags)
+                };
                 let motion = [from, to];
                 let settled = || near_rest(c);
                 taken += u64::from(decide_one(
@@ -174,11 +184,11 @@ const CORNERS_PER_PIECE: usize = 256;
 
 /// Decides corner `c`, with its reference, least distance and whether it is open (closed
 /// without a new reference where its reference fails but `settled` holds: its reference
-/// is then its rest shape, where that was measured, `rest`); returns whether the
-/// reference was taken again.
+/// is then its rest shape, where that was measured, `rest`; and where it was last closed
+/// so, `ringed`, `settled` is tried first); returns whether the reference was taken again.
 fn decide_one(
     c: usize,
-    (reference, apart, open): (&mut [Vec3], &mut f32, &mut bool),
+    (reference, apart, (open, ringed)): (&mut [Vec3], &mut f32, (&mut bool, &mut bool)),
     (owners, triangles): (&Owners, &[[u32; 3]]),
     [from, to]: [&[Vec3]; 2],
     least: f32,
@@ -192,6 +202,13 @@ fn decide_one(
         *open = false;
         return false;
     }
+    // Closed by its ring last time, and again: its reference (the rest shape) stands.
+    let ring_first = *ringed;
+    if ring_first && settled() {
+        *open = false;
+        return false;
+    }
+    *ringed = false;
     let [a, b] = owners.rings.first[c].map(|i| i as usize);
     let middle = |i: usize| 0.5 * (from[i] + to[i]);
     let turn = frame(middle(c), middle(a), middle(b));
@@ -212,7 +229,8 @@ fn decide_one(
         *open = false;
         return false;
     }
-    if settled() {
+    if !ring_first && settled() {
+        *ringed = true;
         // Its ring keeps near its rest shape: so will its rest shape fit the next
         // substeps (rather than a reference that failed, tried again every time).
         if let Some((rest, rest_apart)) = rest {

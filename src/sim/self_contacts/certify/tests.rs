@@ -180,6 +180,40 @@ fn corners_start_from_their_rest_shape_and_go_back_to_it() {
     }
 }
 
+/// A corner last closed by its ring is tried by its ring first, and decided by its
+/// reference where the ring no longer holds: folded at a right angle, the corners along
+/// the fold take references; laid flat, their rings close them; folded nearly flat, their
+/// rings fail, their references are taken again, and some open: no corner left closed
+/// has a pair within the thickness.
+#[test]
+fn a_corner_closed_by_its_ring_is_decided_again_where_its_ring_fails() {
+    let (model, owners, rest) = flat();
+    let triangles = &model.triangles;
+    let mut certificates = Certificates::build(&owners, triangles, &rest);
+    let mut decide = |motion: [&[Vec3]; 2], near_rest: bool| {
+        let settled: [&(dyn Fn(usize) -> bool + Sync); 2] = [&|_| false, &|_| near_rest];
+        let retaken = certificates.decide(&owners, triangles, motion, THICKNESS, None, settled);
+        let open = certificates.open.clone();
+        (retaken, open)
+    };
+    let fold = folded(&rest, 90f32.to_radians(), 0);
+    let (retaken, _) = decide([&fold, &fold], false);
+    assert!(retaken > 10, "{retaken} taken along the fold");
+    let (retaken, open) = decide([&rest, &rest], true);
+    assert_eq!((retaken, open.iter().filter(|&&o| o).count()), (0, 0));
+    let sharp = folded(&rest, 175f32.to_radians(), 1);
+    let (retaken, open) = decide([&sharp, &sharp], false);
+    let opened = open.iter().filter(|&&o| o).count();
+    assert!(retaken > 10 && opened > 0, "{retaken} taken, {opened} open");
+    for c in (0..rest.len()).filter(|&c| !open[c]) {
+        let least = closest_along(&owners, triangles, c, [&sharp, &sharp]);
+        assert!(
+            least >= f64::from(THICKNESS),
+            "corner {c} closed at {least}"
+        );
+    }
+}
+
 /// Three triangles meeting only at corner 0, which is therefore their one corner with
 /// pairs: a flat one pointing along −x (the corner's first triangle, whose frame turns
 /// the references), a flat flap along +x, and above it a flap that rises to 6 mm over the
