@@ -37,6 +37,10 @@ use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
 /// particles).
 const SMALLEST: u32 = 4;
 
+/// A node's count of searches still to leave it out of ([`Patches::decide`]), in the low
+/// bits of its backoff (the failures in a row above them).
+const WAITING: u8 = 0x0f;
+
 /// The patches of one cloth, from its rest shape.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Patches {
@@ -146,22 +150,39 @@ impl Patches {
     }
 
     /// Covers the tree's nodes certified for the motion of each particle from `from` to
-    /// `to`, with `reach` (see the module's notes).
-    pub(super) fn decide(&self, tree: &mut TriangleTree, [from, to]: [&[Vec3]; 2], reach: f32) {
+    /// `to`, with `reach` (see the module's notes). A node whose certificate failed is
+    /// left uncovered, untested, for the next searches that `backoff` (one count a node,
+    /// kept from search to search; zeros: test every node) counts out.
+    pub(super) fn decide(
+        &self,
+        tree: &mut TriangleTree,
+        [from, to]: [&[Vec3]; 2],
+        reach: f32,
+        backoff: &mut Vec<u8>,
+    ) {
         let least = reach * (1.0 + MARGIN);
         let covered = &mut tree.covered;
         covered.clear();
         covered.resize(self.parent.len(), false);
+        if backoff.len() != self.parent.len() {
+            backoff.clear();
+            backoff.resize(self.parent.len(), 0);
+        }
         // Each subtree from its root down: a node under a certified one is covered with it.
-        let flags = Disjoint::new(covered);
+        let (flags, counts) = (Disjoint::new(covered), Disjoint::new(backoff));
         let work = |_: usize, piece: usize| {
             let range = self.subtrees[piece].clone();
             // SAFETY: the subtrees' ranges are disjoint.
-            let flags = unsafe { flags.part(range.clone()) };
+            let (flags, counts) =
+                unsafe { (flags.part(range.clone()), counts.part(range.clone())) };
             for i in range.clone() {
                 let parent = self.parent[i] as usize;
-                let above = i != range.start && flags[parent - range.start];
-                flags[i - range.start] = above || self.certified(i, [from, to], least);
+                let (at, above) = (
+                    i - range.start,
+                    i != range.start && flags[parent - range.start],
+                );
+                flags[at] =
+                    above || tried(&mut counts[at], || self.certified(i, [from, to], least));
             }
         };
         let parallel = self.particle.len() >= PARALLEL_ELEMENTS;
@@ -271,6 +292,24 @@ impl Patches {
         } else {
             [0.0; 3]
         }
+    }
+}
+
+/// Whether a node with backoff `count` is certified: not tested (`false`) while its count
+/// waits, then `certified`; a failure leaves it out of the next 1, 3 or 7 searches after
+/// one, two, or three or more in a row.
+fn tried(count: &mut u8, certified: impl FnOnce() -> bool) -> bool {
+    let (wait, failed) = (*count & WAITING, *count >> 4);
+    if wait > 0 {
+        *count -= 1;
+        false
+    } else if certified() {
+        *count = 0;
+        true
+    } else {
+        let failed = (failed + 1).min(3);
+        *count = failed << 4 | ((1 << failed) - 1);
+        false
     }
 }
 

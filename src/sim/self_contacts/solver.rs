@@ -95,6 +95,8 @@ pub struct SelfContacts {
     tree: TriangleTree,
     /// The tree's patches certified apart by the rest shape.
     patches: Patches,
+    /// How many searches each node's certificate is left out of (see [`Patches::decide`]).
+    backoff: Vec<u8>,
     owners: Owners,
     /// The particles' and triangles' boxes the pairs were found with.
     boxes: Boxes,
@@ -246,6 +248,7 @@ impl SelfContacts {
         self.tree = TriangleTree::build(triangles, rest);
         let corners = self.certificates.least_at_rest();
         self.patches = Patches::build(&mut self.tree, triangles, rest, (&self.owners, corners));
+        self.backoff.clear();
         Ok(true)
     }
 
@@ -591,7 +594,7 @@ impl SelfContacts {
                 [&self.boxes.from[..], &self.boxes.to[..]],
                 self.reach(thickness),
             );
-            (self.patches).decide(&mut self.tree, motion, reach);
+            (self.patches).decide(&mut self.tree, motion, reach, &mut self.backoff);
         } else {
             // The pairs are judged by the boxes: nothing is covered.
             self.tree.covered.clear();

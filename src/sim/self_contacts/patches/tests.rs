@@ -101,7 +101,8 @@ fn closest_within(triangles: &[[u32; 3]], held: &[u32], [from, to]: [&[Vec3]; 2]
 /// theirs comes within the reach. Returns the triangles covered, the least distance of a
 /// covered pair, and the corners whose ring holds.
 fn decide_and_check(c: &mut Cloth, motion: [&[Vec3]; 2], what: &str) -> (usize, f64, usize) {
-    c.patches.decide(&mut c.tree, motion, REACH);
+    c.patches
+        .decide(&mut c.tree, motion, REACH, &mut Vec::new());
     let triangles = &c.model.triangles;
     let (mut covered, mut least) = (0, f64::INFINITY);
     for (i, _) in c.tree.nodes().iter().enumerate() {
@@ -265,6 +266,57 @@ fn a_covered_patch_keeps_its_pairs_the_reach_apart() {
     least = least.min(near);
     // The certificates are used towards their limit.
     assert!(least < 2.0 * f64::from(REACH), "{least}");
+}
+
+/// A node whose certificate failed is left uncovered, untested, for the next search; after
+/// two failures in a row for the next three, after three or more for the next seven; and
+/// tested again after. The cloth folded at a right angle (the nodes across the fold fail),
+/// then laid flat: the next search leaves those nodes uncovered, the one after covers what
+/// a search with no backoff covers. Folded at every search where they are tested again,
+/// three times in a row, they stay uncovered for seven flat searches and are covered at
+/// the eighth.
+#[test]
+fn a_node_that_failed_is_tried_again_after_a_few_searches() {
+    let mut c = cloth(12, |p| p);
+    let rest = c.rest.clone();
+    let fold: Vec<Vec3> = (rest.iter())
+        .map(|&p| {
+            let a = 90f32.to_radians();
+            if p.x > 0.0 {
+                Vec3::new(p.x * a.cos(), p.x * a.sin(), p.z)
+            } else {
+                p
+            }
+        })
+        .collect();
+    let mut covered = |motion: &[Vec3], backoff: &mut Vec<u8>| {
+        c.patches
+            .decide(&mut c.tree, [motion, motion], REACH, backoff);
+        c.tree.covered.clone()
+    };
+    let (folded, flat) = (
+        covered(&fold, &mut Vec::new()),
+        covered(&rest, &mut Vec::new()),
+    );
+    let fewer = |some: &[bool]| {
+        let n = |v: &[bool]| v.iter().filter(|&&c| c).count();
+        // Only nodes that the fold leaves uncovered are left out.
+        let subset = (some.iter().zip(&flat).zip(&folded)).all(|((&s, &f), &o)| s == f || !s && !o);
+        subset && n(some) < n(&flat)
+    };
+    assert!(fewer(&folded), "the fold uncovers some nodes");
+    let mut backoff = Vec::new();
+    assert_eq!(covered(&fold, &mut backoff), folded);
+    assert!(fewer(&covered(&rest, &mut backoff)));
+    assert_eq!(covered(&rest, &mut backoff), flat);
+    // Failures at the searches where they are tested again: the 1st, 3rd and 7th.
+    for search in 1..=7 {
+        assert!(fewer(&covered(&fold, &mut backoff)), "search {search}");
+    }
+    for search in 1..=7 {
+        assert!(fewer(&covered(&rest, &mut backoff)), "flat search {search}");
+    }
+    assert_eq!(covered(&rest, &mut backoff), flat);
 }
 
 /// The rest gap is the least distance between the sides of any pair at rest, found by
