@@ -15,7 +15,10 @@
 
 use glam::{Vec3, Vec3A};
 
+use self::lanes::{Corners, Lanes, One, share_none};
 use crate::sim::obstacle::{Split, split_triangles_at_medians};
+
+mod lanes;
 
 /// Triangles in a leaf at most: two leaves are tested triangle by triangle.
 const LEAF: usize = 4;
@@ -44,11 +47,18 @@ enum Fit {
     Motion { reach: f32 },
 }
 
-/// The tree and the boxes its last fit gave it. Its boxes are numbered nodes first, then
-/// triangles in the tree's order.
+/// The tree and the boxes its last fit gave it: the nodes', and the triangles' side by side
+/// in their leaves.
 #[derive(Clone, Debug, Default)]
 pub(super) struct TriangleTree {
     nodes: Vec<Split>,
+    /// Each leaf's node, and each node's leaf ([`NOT_A_LEAF`] for the others); the leaf of
+    /// each place in the tree's order.
+    leaves: Vec<u32>,
+    leaf_of: Vec<u32>,
+    leaf_at: Vec<u32>,
+    /// Each leaf's triangles' corners, side by side.
+    leaf_corners: Vec<Corners>,
     /// The triangles in the tree's order, and each triangle's place in it.
     order: Vec<u32>,
     place_of: Vec<u32>,
@@ -57,10 +67,12 @@ pub(super) struct TriangleTree {
     corners: Vec<[u32; 3]>,
     /// The pieces a search is cut into.
     tasks: Vec<Task>,
-    /// Each one's box (by boxes), or the box of its starts (by motion), as `[lo, hi]`.
+    /// Each node's box (by boxes), or the box of its starts (by motion), as `[lo, hi]`.
     boxes: Vec<[Vec3A; 2]>,
-    /// By motion, each one's box of its ends and its mean motion, as `[lo, hi, mean]`.
+    /// By motion, each node's box of its ends and its mean motion, as `[lo, hi, mean]`.
     motion: Vec<[Vec3A; 3]>,
+    /// Each leaf's triangles' boxes.
+    lanes: Vec<Lanes>,
     fit: Fit,
     /// Whether each node's own pairs are certified apart for the motion of the last fit
     /// (see [`super::patches`]): a whole walk passes by a node against itself then.
@@ -76,9 +88,30 @@ impl TriangleTree {
         for (place, &t) in order.iter().enumerate() {
             place_of[t as usize] = place as u32;
         }
-        let corners = order.iter().map(|&t| triangles[t as usize]).collect();
+        let corners: Vec<[u32; 3]> = order.iter().map(|&t| triangles[t as usize]).collect();
+        let (mut leaves, mut leaf_of) = (Vec::new(), vec![NOT_A_LEAF; nodes.len()]);
+        let (mut leaf_at, mut leaf_corners) = (vec![0; order.len()], Vec::new());
+        for (i, &node) in nodes.iter().enumerate() {
+            if Self::is_leaf(node) {
+                leaf_of[i] = leaves.len() as u32;
+                // Lanes past the leaf's triangles hold no particle's number.
+                let mut lanes = [[u32::MAX; 4]; 3];
+                for (k, place) in (node.first..node.first + node.count).enumerate() {
+                    leaf_at[place as usize] = leaves.len() as u32;
+                    for (lane, corner) in lanes.iter_mut().zip(corners[place as usize]) {
+                        lane[k] = corner;
+                    }
+                }
+                leaves.push(i as u32);
+                leaf_corners.push(lanes);
+            }
+        }
         let mut tree = TriangleTree {
             nodes,
+            leaves,
+            leaf_of,
+            leaf_at,
+            leaf_corners,
             order,
             place_of,
             corners,
@@ -123,42 +156,32 @@ impl TriangleTree {
         node.count as usize <= LEAF
     }
 
-    /// The box number of the triangle at `place` in the tree's order.
-    fn place(&self, place: u32) -> usize {
-        self.nodes.len() + place as usize
-    }
-
-    /// The boxes node `i` is fitted around: its children's, or its triangles'.
-    fn parts(&self, i: usize) -> ([usize; LEAF], usize) {
-        let node = self.nodes[i];
-        let mut parts = [0; LEAF];
-        if Self::is_leaf(node) {
-            let first = self.place(node.first);
-            for (k, part) in parts.iter_mut().enumerate().take(node.count as usize) {
-                *part = first + k;
-            }
-            (parts, node.count as usize)
-        } else {
-            (parts[0], parts[1]) = (i + 1, node.second as usize);
-            (parts, 2)
-        }
-    }
-
-    /// Sizes the boxes for nodes and triangles.
+    /// Sizes the boxes for nodes and leaves.
     fn size(&mut self) {
-        let n = self.nodes.len() + self.order.len();
+        let n = self.nodes.len();
         self.boxes.resize(n, [Vec3A::ZERO; 2]);
         self.motion.resize(n, [Vec3A::ZERO; 3]);
+        self.lanes.resize(self.leaves.len(), Lanes::default());
     }
 
     /// Fits the nodes' boxes around their parts', from the last node back (children come
-    /// after their parents).
+    /// after their parents): a leaf's around its triangles', another's around its two
+    /// children's.
     fn fit_nodes(&mut self, moving: bool) {
         for i in (0..self.nodes.len()).rev() {
-            let (parts, n) = self.parts(i);
-            let parts = &parts[..n];
+            let node = self.nodes[i];
+            if Self::is_leaf(node) {
+                let leaf = &self.lanes[self.leaf_of[i] as usize];
+                let (boxes, motion) = leaf.bounds(node.count as usize, moving);
+                self.boxes[i] = boxes;
+                if moving {
+                    self.motion[i] = motion;
+                }
+                continue;
+            }
+            let parts = [i + 1, node.second as usize];
             let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-            for &k in parts {
+            for &k in &parts {
                 let [l, h] = self.boxes[k];
                 (lo, hi) = (lo.min(l), hi.max(h));
             }
@@ -167,10 +190,10 @@ impl TriangleTree {
                 let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
                 // The mean weighted by the triangles each part holds.
                 let (mut sum, mut total) = (Vec3A::ZERO, 0.0);
-                for &k in parts {
+                for &k in &parts {
                     let [l, h, mean] = self.motion[k];
                     (lo, hi) = (lo.min(l), hi.max(h));
-                    let weight = self.nodes.get(k).map_or(1.0, |n| n.count as f32);
+                    let weight = self.nodes[k].count as f32;
                     (sum, total) = (sum + mean * weight, total + weight);
                 }
                 self.motion[i] = [lo, hi, sum / total];
@@ -178,13 +201,26 @@ impl TriangleTree {
         }
     }
 
+    /// Sets each leaf's lanes by `set(lanes, lane, place)`, for each of its triangles'
+    /// places in the tree's order.
+    fn set_lanes(&mut self, mut set: impl FnMut(&mut Lanes, usize, usize)) {
+        for (lanes, &i) in self.lanes.iter_mut().zip(&self.leaves) {
+            let node = self.nodes[i as usize];
+            for lane in 0..node.count as usize {
+                set(lanes, lane, node.first as usize + lane);
+            }
+        }
+    }
+
     /// Fits the tree to the triangles' boxes `lo..hi`.
     pub(super) fn fit_boxes(&mut self, lo: &[Vec3], hi: &[Vec3]) {
         self.size();
-        let first = self.nodes.len();
-        for (place, &t) in self.order.iter().enumerate() {
-            self.boxes[first + place] = [lo[t as usize].into(), hi[t as usize].into()];
-        }
+        let order = std::mem::take(&mut self.order);
+        self.set_lanes(|lanes, lane, place| {
+            let t = order[place] as usize;
+            lanes.set_box(lane, [lo[t].into(), hi[t].into()]);
+        });
+        self.order = order;
         self.fit_nodes(false);
         self.fit = Fit::Boxes;
     }
@@ -193,36 +229,47 @@ impl TriangleTree {
     /// apart by `reach` (see [`Fit::Motion`]).
     pub(super) fn fit_motion(&mut self, [from, to]: [&[Vec3]; 2], reach: f32) {
         self.size();
-        let first = self.nodes.len();
-        for (place, &corners) in self.corners.iter().enumerate() {
+        let corners = std::mem::take(&mut self.corners);
+        self.set_lanes(|lanes, lane, place| {
+            let corners = corners[place];
             let [a, b, c] = corners.map(|k| Vec3A::from(from[k as usize]));
             let [d, e, f] = corners.map(|k| Vec3A::from(to[k as usize]));
-            let i = first + place;
-            self.boxes[i] = [a.min(b).min(c), a.max(b).max(c)];
-            let mean = ((d - a) + (e - b) + (f - c)) / 3.0;
-            self.motion[i] = [d.min(e).min(f), d.max(e).max(f), mean];
-        }
+            let one = One {
+                lo: a.min(b).min(c),
+                hi: a.max(b).max(c),
+                end_lo: d.min(e).min(f),
+                end_hi: d.max(e).max(f),
+                mean: ((d - a) + (e - b) + (f - c)) / 3.0,
+            };
+            lanes.set(lane, one);
+        });
+        self.corners = corners;
         self.fit_nodes(true);
         self.fit = Fit::Motion { reach };
     }
 
-    /// Whether boxes `a` and `b` do not overlap.
+    /// Whether nodes `a` and `b`'s boxes do not overlap.
     #[inline(always)]
     fn boxes_apart(&self, a: usize, b: usize) -> bool {
-        let ([alo, ahi], [blo, bhi]) = (self.boxes[a], self.boxes[b]);
-        !(alo.cmple(bhi).all() && blo.cmple(ahi).all())
+        boxes_apart(self.boxes[a], self.boxes[b])
     }
 
-    /// Whether `a` and `b` keep `reach` apart along their motion, told in the frame of
-    /// their mean motion.
+    /// Whether nodes `a` and `b` keep `reach` apart along their motion, told in the frame
+    /// of their mean motion.
     #[inline(always)]
     fn moving_apart(&self, a: usize, b: usize, reach: f32) -> bool {
-        let ([alo, ahi], [aend_lo, aend_hi, amean]) = (self.boxes[a], self.motion[a]);
-        let ([blo, bhi], [bend_lo, bend_hi, bmean]) = (self.boxes[b], self.motion[b]);
-        let m = 0.5 * (amean + bmean);
-        let (alo, ahi) = (alo.min(aend_lo - m), ahi.max(aend_hi - m));
-        let (blo, bhi) = (blo.min(bend_lo - m), bhi.max(bend_hi - m));
-        (blo - ahi).max(alo - bhi).max_element() >= reach
+        let (a, b) = (
+            (self.boxes[a], self.motion[a]),
+            (self.boxes[b], self.motion[b]),
+        );
+        moving_apart(a, b, reach)
+    }
+
+    /// The leaf and lane of the triangle at `place` in the tree's order.
+    fn lane(&self, place: usize) -> (&Lanes, usize) {
+        let leaf = self.leaf_at[place] as usize;
+        let first = self.nodes[self.leaves[leaf] as usize].first as usize;
+        (&self.lanes[leaf], place - first)
     }
 
     /// Pieces a search of the whole tree is cut into, for a team to share.
@@ -234,12 +281,20 @@ impl TriangleTree {
     /// piece `piece` does not tell apart (as the last fit tells them) and that no covered
     /// node holds both of; the pieces together call it once for every such two.
     pub(super) fn piece_pairs(&self, piece: usize, pair: impl FnMut(u32, u32)) {
-        // One walk for each fit, each with its test inlined.
+        // One walk for each fit, each with its tests inlined.
         match self.fit {
-            Fit::Motion { reach } => {
-                self.walk(piece, |a, b| self.moving_apart(a, b, reach), pair);
-            }
-            Fit::Boxes => self.walk(piece, |a, b| self.boxes_apart(a, b), pair),
+            Fit::Motion { reach } => self.walk(
+                piece,
+                |a, b| self.moving_apart(a, b, reach),
+                |lanes, one| lanes.moving_near(one, reach),
+                pair,
+            ),
+            Fit::Boxes => self.walk(
+                piece,
+                |a, b| self.boxes_apart(a, b),
+                |lanes, one| lanes.boxes_meet(one),
+                pair,
+            ),
         }
     }
 
@@ -251,10 +306,23 @@ impl TriangleTree {
     /// rather than from the node the whole walk pairs with it.
     pub(super) fn triangle_pairs(&self, t: u32, searched: &[bool], pair: impl FnMut(u32, u32)) {
         match self.fit {
-            Fit::Motion { reach } => {
-                self.query(t, searched, |a, b| self.moving_apart(a, b, reach), pair);
-            }
-            Fit::Boxes => self.query(t, searched, |a, b| self.boxes_apart(a, b), pair),
+            Fit::Motion { reach } => self.query(
+                t,
+                searched,
+                |a, one| {
+                    let own = ([one.lo, one.hi], [one.end_lo, one.end_hi, one.mean]);
+                    moving_apart((self.boxes[a], self.motion[a]), own, reach)
+                },
+                |lanes, one| lanes.moving_near(one, reach),
+                pair,
+            ),
+            Fit::Boxes => self.query(
+                t,
+                searched,
+                |a, one| boxes_apart(self.boxes[a], [one.lo, one.hi]),
+                |lanes, one| lanes.boxes_meet(one),
+                pair,
+            ),
         }
     }
 
@@ -263,29 +331,32 @@ impl TriangleTree {
         &self,
         t: u32,
         searched: &[bool],
-        apart: impl Fn(usize, usize) -> bool,
+        apart: impl Fn(usize, &One) -> bool,
+        lanes_near: impl Fn(&Lanes, (&Lanes, usize)) -> u32,
         mut pair: impl FnMut(u32, u32),
     ) {
         if self.nodes.is_empty() {
             return;
         }
-        let x = self.place(self.place_of[t as usize]);
-        let corners = self.corners[self.place_of[t as usize] as usize];
+        let place = self.place_of[t as usize] as usize;
+        let (lane, corners) = (self.lane(place), self.corners[place]);
+        let one = lane.0.one(lane.1);
         let mut stack = [0u32; STACK];
         let mut depth = 1;
         while depth > 0 {
             depth -= 1;
             let a = stack[depth];
-            if apart(a as usize, x) {
+            if apart(a as usize, &one) {
                 continue;
             }
             let node = self.nodes[a as usize];
             if Self::is_leaf(node) {
-                for q in node.first..node.first + node.count {
-                    let b = self.order[q as usize];
-                    let once = b != t && !(b < t && searched[b as usize]);
-                    let near = !share_a_corner(self.corners[q as usize], corners);
-                    if once && near && !apart(self.place(q), x) {
+                let leaf = self.leaf_of[a as usize] as usize;
+                let near = lanes_near(&self.lanes[leaf], lane)
+                    & share_none(corners, &self.leaf_corners[leaf]);
+                for k in flagged(near, 0, node.count) {
+                    let b = self.order[node.first as usize + k];
+                    if b != t && !(b < t && searched[b as usize]) {
                         pair(t, b);
                     }
                 }
@@ -301,13 +372,23 @@ impl TriangleTree {
         &self,
         piece: usize,
         apart: impl Fn(usize, usize) -> bool,
+        lanes_near: impl Fn(&Lanes, (&Lanes, usize)) -> u32,
         mut pair: impl FnMut(u32, u32),
     ) {
-        let first = self.nodes.len();
-        // Two triangles, at places `p` and `q`.
-        let mut places = |p: usize, q: usize| {
-            if !share_a_corner(self.corners[p], self.corners[q]) && !apart(first + p, first + q) {
-                pair(self.order[p], self.order[q]);
+        // Each triangle of leaf node `a` against those of leaf node `b` (past its own,
+        // where they are the same).
+        let mut leaves = |a: usize, b: usize| {
+            let (na, nb) = (self.nodes[a], self.nodes[b]);
+            let (la, lb) = (self.leaf_of[a] as usize, self.leaf_of[b] as usize);
+            let (lanes, corners) = (&self.lanes[lb], &self.leaf_corners[lb]);
+            for k in 0..na.count as usize {
+                let p = na.first as usize + k;
+                let near =
+                    share_none(self.corners[p], corners) & lanes_near(lanes, (&self.lanes[la], k));
+                let from = if a == b { k + 1 } else { 0 };
+                for q in flagged(near, from, nb.count) {
+                    pair(self.order[p], self.order[nb.first as usize + q]);
+                }
             }
         };
         let mut stack = [(0u32, 0u32); STACK];
@@ -322,12 +403,7 @@ impl TriangleTree {
                     continue;
                 }
                 if Self::is_leaf(na) {
-                    let held = na.first as usize..(na.first + na.count) as usize;
-                    for p in held.clone() {
-                        for q in p + 1..held.end {
-                            places(p, q);
-                        }
-                    }
+                    leaves(a as usize, a as usize);
                 } else {
                     let (first, second) = (a + 1, na.second);
                     stack[depth..depth + 3].copy_from_slice(&[
@@ -343,13 +419,7 @@ impl TriangleTree {
                 continue;
             }
             match (Self::is_leaf(na), Self::is_leaf(nb)) {
-                (true, true) => {
-                    for p in na.first..na.first + na.count {
-                        for q in nb.first..nb.first + nb.count {
-                            places(p as usize, q as usize);
-                        }
-                    }
-                }
+                (true, true) => leaves(a as usize, b as usize),
                 // The larger is split.
                 (false, _) if na.count >= nb.count || Self::is_leaf(nb) => {
                     stack[depth..depth + 2].copy_from_slice(&[(na.second, b), (a + 1, b)]);
@@ -364,10 +434,39 @@ impl TriangleTree {
     }
 }
 
-/// Whether two triangles share a corner.
+/// The lanes flagged in the bits of `flags`, from lane `from` up to lane `count`, in order.
 #[inline(always)]
-fn share_a_corner(a: [u32; 3], b: [u32; 3]) -> bool {
-    a.iter().any(|i| b.contains(i))
+fn flagged(flags: u32, from: usize, count: u32) -> impl Iterator<Item = usize> {
+    let mut left = flags & ((1 << count) - 1) & !((1 << from) - 1);
+    std::iter::from_fn(move || {
+        let lane = left.trailing_zeros() as usize;
+        left &= left.wrapping_sub(1);
+        (lane < 32).then_some(lane)
+    })
+}
+
+/// A node that is not a leaf, in [`TriangleTree`]'s `leaf_of`.
+const NOT_A_LEAF: u32 = u32::MAX;
+
+/// Whether two boxes `[lo, hi]` do not overlap.
+#[inline(always)]
+fn boxes_apart([alo, ahi]: [Vec3A; 2], [blo, bhi]: [Vec3A; 2]) -> bool {
+    !(alo.cmple(bhi).all() && blo.cmple(ahi).all())
+}
+
+/// Whether two boxes by motion (`[lo, hi]` of the starts, `[lo, hi, mean]` of the ends
+/// and the mean motion) keep `reach` apart along their motion, told in the frame of their
+/// mean motion.
+#[inline(always)]
+fn moving_apart(
+    ([alo, ahi], [aend_lo, aend_hi, amean]): ([Vec3A; 2], [Vec3A; 3]),
+    ([blo, bhi], [bend_lo, bend_hi, bmean]): ([Vec3A; 2], [Vec3A; 3]),
+    reach: f32,
+) -> bool {
+    let m = 0.5 * (amean + bmean);
+    let (alo, ahi) = (alo.min(aend_lo - m), ahi.max(aend_hi - m));
+    let (blo, bhi) = (blo.min(bend_lo - m), bhi.max(bend_hi - m));
+    (blo - ahi).max(alo - bhi).max_element() >= reach
 }
 
 #[cfg(test)]

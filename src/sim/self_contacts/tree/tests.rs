@@ -20,6 +20,11 @@ fn cloth() -> (Vec<[u32; 3]>, Vec<Vec3>, Vec<Vec3>) {
     (mesh.triangles.clone(), mesh.positions.clone(), pos)
 }
 
+/// Whether two triangles share a corner.
+fn share_a_corner(a: [u32; 3], b: [u32; 3]) -> bool {
+    a.iter().any(|i| b.contains(i))
+}
+
 /// The pairs of every piece's walk, each as (lower, higher), sorted; and whether any came
 /// twice.
 fn walked(tree: &TriangleTree) -> (Vec<(u32, u32)>, bool) {

@@ -1,0 +1,140 @@
+//! A leaf's triangles side by side: each of their boxes' bounds in a lane of its own, so
+//! that one triangle is told apart from a whole leaf's at once (four lanes: one SSE
+//! register an axis), where two leaves are tested triangle by triangle.
+
+use glam::{BVec4A, Vec3A, Vec4};
+
+/// One triangle's boxes: by boxes its box `[lo, hi]`; by motion also the box of its ends
+/// and its mean motion (`lo` and `hi` then bound its starts).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct One {
+    pub(super) lo: Vec3A,
+    pub(super) hi: Vec3A,
+    pub(super) end_lo: Vec3A,
+    pub(super) end_hi: Vec3A,
+    pub(super) mean: Vec3A,
+}
+
+/// A leaf's triangles' boxes (as [`One`]), one lane each in the tree's order, a vector an
+/// axis; lanes past the leaf's triangles are never read.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Lanes {
+    lo: [Vec4; 3],
+    hi: [Vec4; 3],
+    end_lo: [Vec4; 3],
+    end_hi: [Vec4; 3],
+    mean: [Vec4; 3],
+}
+
+impl Lanes {
+    /// Sets lane `lane` to a triangle's box.
+    pub(super) fn set_box(&mut self, lane: usize, [lo, hi]: [Vec3A; 2]) {
+        for x in 0..3 {
+            (self.lo[x][lane], self.hi[x][lane]) = (lo[x], hi[x]);
+        }
+    }
+
+    /// Sets lane `lane` to a triangle's boxes by motion.
+    pub(super) fn set(&mut self, lane: usize, one: One) {
+        self.set_box(lane, [one.lo, one.hi]);
+        for x in 0..3 {
+            self.end_lo[x][lane] = one.end_lo[x];
+            self.end_hi[x][lane] = one.end_hi[x];
+            self.mean[x][lane] = one.mean[x];
+        }
+    }
+
+    /// Lane `lane`'s triangle.
+    #[inline(always)]
+    pub(super) fn one(&self, lane: usize) -> One {
+        let at = |v: &[Vec4; 3]| Vec3A::new(v[0][lane], v[1][lane], v[2][lane]);
+        One {
+            lo: at(&self.lo),
+            hi: at(&self.hi),
+            end_lo: at(&self.end_lo),
+            end_hi: at(&self.end_hi),
+            mean: at(&self.mean),
+        }
+    }
+
+    /// The lanes (as bits) whose box overlaps that of lane `k` of `one`.
+    #[inline(always)]
+    pub(super) fn boxes_meet(&self, (one, k): (&Lanes, usize)) -> u32 {
+        let mut meet = BVec4A::splat(true);
+        for x in 0..3 {
+            let (lo, hi) = (Vec4::splat(one.lo[x][k]), Vec4::splat(one.hi[x][k]));
+            meet &= lo.cmple(self.hi[x]) & self.lo[x].cmple(hi);
+        }
+        meet.bitmask()
+    }
+
+    /// The lanes (as bits) whose triangle the triangle of lane `k` of `one` is not told
+    /// `reach` apart from along their motion, in the frame of their mean motion: the
+    /// tree's test of two nodes (that one first), four at a time, to the bit.
+    #[inline(always)]
+    pub(super) fn moving_near(&self, (one, k): (&Lanes, usize), reach: f32) -> u32 {
+        let mut gap = Vec4::NEG_INFINITY;
+        for x in 0..3 {
+            let m = 0.5 * (Vec4::splat(one.mean[x][k]) + self.mean[x]);
+            let alo = Vec4::splat(one.lo[x][k]).min(Vec4::splat(one.end_lo[x][k]) - m);
+            let ahi = Vec4::splat(one.hi[x][k]).max(Vec4::splat(one.end_hi[x][k]) - m);
+            let blo = self.lo[x].min(self.end_lo[x] - m);
+            let bhi = self.hi[x].max(self.end_hi[x] - m);
+            gap = gap.max((blo - ahi).max(alo - bhi));
+        }
+        (!gap.cmpge(Vec4::splat(reach))).bitmask()
+    }
+
+    /// The box of the first `count` lanes' boxes, and by motion the box of their ends and
+    /// the mean of their mean motions.
+    pub(super) fn bounds(&self, count: usize, moving: bool) -> ([Vec3A; 2], [Vec3A; 3]) {
+        let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+        let (mut end_lo, mut end_hi, mut sum) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY, Vec3A::ZERO);
+        for l in 0..count {
+            let one = self.one(l);
+            (lo, hi) = (lo.min(one.lo), hi.max(one.hi));
+            if moving {
+                (end_lo, end_hi) = (end_lo.min(one.end_lo), end_hi.max(one.end_hi));
+                sum += one.mean;
+            }
+        }
+        ([lo, hi], [end_lo, end_hi, sum / count as f32])
+    }
+}
+
+/// A leaf's triangles' corners, one lane each, an array a corner.
+pub(super) type Corners = [[u32; 4]; 3];
+
+/// The lanes (as bits) whose triangle shares no corner with one with `corners`.
+#[inline(always)]
+pub(super) fn share_none(corners: [u32; 3], lanes: &Corners) -> u32 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{
+            __m128i, _mm_castsi128_ps, _mm_cmpeq_epi32, _mm_loadu_si128, _mm_movemask_ps,
+            _mm_or_si128, _mm_set1_epi32, _mm_setzero_si128,
+        };
+        // SAFETY: SSE2 is part of every x86-64 CPU; the loads read whole `[u32; 4]`s.
+        unsafe {
+            let mut any = _mm_setzero_si128();
+            for lane in lanes {
+                let lane = _mm_loadu_si128(lane.as_ptr().cast::<__m128i>());
+                for c in corners {
+                    any = _mm_or_si128(any, _mm_cmpeq_epi32(lane, _mm_set1_epi32(c as i32)));
+                }
+            }
+            !(_mm_movemask_ps(_mm_castsi128_ps(any)) as u32) & 0xf
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let mut none = 0;
+        for l in 0..4 {
+            let shared = corners
+                .iter()
+                .any(|&c| lanes.iter().any(|lane| lane[l] == c));
+            none |= u32::from(!shared) << l;
+        }
+        none
+    }
+}
