@@ -790,6 +790,30 @@ fn a_cloth_flung_farther_keeps_fewer_pairs() {
     assert_eq!(err, ContactError::NonFinite { particle: 7 });
     let err = refused(1e9);
     assert!(matches!(err, ContactError::Extent { .. }), "{err}");
+    // Sent there over the substep from rest (the pairs judged by the motion, where the
+    // triangles' boxes are not kept): refused too, nothing moved.
+    let mut state = rest.clone();
+    state.pos[7].y = 1e9;
+    let end = state.pos.clone();
+    let thickness = params.thickness;
+    let err = (solver.resolve(
+        [thickness, params.friction, 1.0 / 240.0],
+        &model,
+        &rest.pos,
+        &mut state,
+    ))
+    .unwrap_err();
+    // In the frame of the cloth's mean motion every particle moves by 1/289 of 10⁹ m:
+    // the first triangle already spans more than a million cells.
+    let ContactError::Extent {
+        triangle, extent, ..
+    } = err
+    else {
+        panic!("{err}");
+    };
+    assert_eq!(triangle, 0, "{err}");
+    assert!((extent - 1e9 / 289.0).abs() < 1e3, "{err}");
+    assert_eq!(state.pos, end, "nothing moved");
 }
 
 fn point_triangle_distance(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {

@@ -222,7 +222,8 @@ pub(super) struct Boxes {
     /// Each particle's: its motion grown by half the thickness or more.
     pub(super) vertex_lo: Vec<Vec3>,
     pub(super) vertex_hi: Vec<Vec3>,
-    /// Each triangle's: its corners' boxes together.
+    /// Each triangle's: its corners' boxes together (kept only where the pairs are judged
+    /// by the boxes alone; by the motion the tree's fit stands in for them).
     pub(super) lo: Vec<Vec3>,
     pub(super) hi: Vec<Vec3>,
     /// Whether the pairs were also judged by each particle's motion, from `from` to `to`

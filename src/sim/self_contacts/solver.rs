@@ -479,10 +479,12 @@ impl SelfContacts {
             self.dirty.push(dirty);
             if dirty {
                 self.searched.push(n as u32);
-                (self.boxes.lo[n], self.boxes.hi[n]) = self.triangle_box(n, t, thickness)?;
+                if !self.boxes.swept {
+                    (self.boxes.lo[n], self.boxes.hi[n]) = self.triangle_box(n, t, thickness)?;
+                }
             }
         }
-        self.fit_tree(thickness);
+        self.fit_tree(model, thickness)?;
         // Only the corners with a triangle searched again are decided again. One that was
         // closed and is open now still leaves out the pairs of its triangles that stayed:
         // it held for their motion, which has not changed.
@@ -522,14 +524,25 @@ impl SelfContacts {
 
     /// Fits the tree to the boxes, or where the pairs are judged by the motion, to the
     /// motion the boxes were made for (told apart by the thickness).
-    fn fit_tree(&mut self, thickness: f32) {
+    ///
+    /// # Errors
+    /// As [`SelfContacts::triangle_box`], where the pairs are judged by the motion (the
+    /// triangles' boxes are not kept then: the fit tells how wide the widest is, and only
+    /// where that comes near the limit are they all measured).
+    fn fit_tree(&mut self, model: &ClothModel, thickness: f32) -> Result<(), ContactError> {
         if self.boxes.swept {
             let motion = [&self.boxes.from[..], &self.boxes.to[..]];
             let reach = self.reach(thickness);
-            self.tree.fit_motion(motion, reach);
+            let widest = self.tree.fit_motion(motion, reach) + 2.0 * self.grow(thickness);
+            if widest >= 0.999 * WIDEST * self.owners.cell(thickness) {
+                for (n, &t) in model.triangles.iter().enumerate() {
+                    self.triangle_box(n, t, thickness)?;
+                }
+            }
         } else {
             self.tree.fit_boxes(&self.boxes.lo, &self.boxes.hi);
         }
+        Ok(())
     }
 
     /// The pairs of every two triangles whose boxes overlap, each particle's box its
@@ -582,12 +595,14 @@ impl SelfContacts {
         self.found_for = None;
         self.boxes.lo.clear();
         self.boxes.hi.clear();
-        for (n, &t) in model.triangles.iter().enumerate() {
-            let (lo, hi) = self.triangle_box(n, t, thickness)?;
-            self.boxes.lo.push(lo);
-            self.boxes.hi.push(hi);
+        if !self.boxes.swept {
+            for (n, &t) in model.triangles.iter().enumerate() {
+                let (lo, hi) = self.triangle_box(n, t, thickness)?;
+                self.boxes.lo.push(lo);
+                self.boxes.hi.push(hi);
+            }
         }
-        self.fit_tree(thickness);
+        self.fit_tree(model, thickness)?;
         self.found.clear();
         if self.boxes.swept {
             let (motion, reach) = (

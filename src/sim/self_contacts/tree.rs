@@ -226,10 +226,12 @@ impl TriangleTree {
     }
 
     /// Fits the tree to the motion of its triangles' particles from `from` to `to`, told
-    /// apart by `reach` (see [`Fit::Motion`]).
-    pub(super) fn fit_motion(&mut self, [from, to]: [&[Vec3]; 2], reach: f32) {
+    /// apart by `reach` (see [`Fit::Motion`]). Returns the widest any triangle's particles
+    /// span along an axis over the motion.
+    pub(super) fn fit_motion(&mut self, [from, to]: [&[Vec3]; 2], reach: f32) -> f32 {
         self.size();
         let corners = std::mem::take(&mut self.corners);
+        let mut widest = Vec3A::ZERO;
         self.set_lanes(|lanes, lane, place| {
             let corners = corners[place];
             let [a, b, c] = corners.map(|k| Vec3A::from(from[k as usize]));
@@ -241,11 +243,13 @@ impl TriangleTree {
                 end_hi: d.max(e).max(f),
                 mean: ((d - a) + (e - b) + (f - c)) / 3.0,
             };
+            widest = widest.max(one.hi.max(one.end_hi) - one.lo.min(one.end_lo));
             lanes.set(lane, one);
         });
         self.corners = corners;
         self.fit_nodes(true);
         self.fit = Fit::Motion { reach };
+        widest.max_element()
     }
 
     /// Whether nodes `a` and `b`'s boxes do not overlap.
