@@ -6,6 +6,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use glam::Vec3;
 
 use crate::cloth::{ClothModel, ClothState};
+use crate::parallel::{each_part, within};
 
 use super::ccd::safe_fraction;
 use super::certify::Certificates;
@@ -18,6 +19,14 @@ use super::sweeps::Sweeps;
 use super::tree::TriangleTree;
 use super::window::Window;
 use super::work::SelfWork;
+
+/// [`SelfContacts::ahead`], `swept` where the pairs are judged by the motion.
+fn ahead(swept: bool, s: Vec3, p: Vec3, thickness: f32) -> Vec3 {
+    if swept {
+        return p;
+    }
+    p + ((p - s) * AHEAD).clamp_length_max(AHEAD_MOST * thickness)
+}
 
 /// The separation the continuous check keeps, as a share of the thickness (pairs that
 /// start closer keep half of what they start at).
@@ -287,10 +296,16 @@ impl SelfContacts {
     /// frame had moved by the substep's start, and the end less the substep's `mean` motion
     /// too.
     fn relative(&mut self, start: &[Vec3], pos: &[Vec3], shift: Vec3, mean: Vec3) {
-        self.from.clear();
-        self.from.extend(start.iter().map(|&s| s - shift));
-        self.to.clear();
-        self.to.extend(pos.iter().map(|&p| p - shift - mean));
+        self.from.resize(start.len(), Vec3::ZERO);
+        self.to.resize(pos.len(), Vec3::ZERO);
+        each_part([&mut self.from, &mut self.to], |range, [from, to]| {
+            for (f, &s) in from.iter_mut().zip(within(start, range.clone())) {
+                *f = s - shift;
+            }
+            for (t, &p) in to.iter_mut().zip(within(pos, range)) {
+                *t = p - shift - mean;
+            }
+        });
     }
 
     /// Makes the pairs hold every pair that can come within `within` along the motion from
@@ -339,16 +354,16 @@ impl SelfContacts {
             s.as_dvec3().distance(along(window.at)) > off
                 || p.as_dvec3().distance(along(window.at + 1)) > off
         };
-        self.left.clear();
-        self.left.extend(
-            (self.from.iter().zip(&self.to))
-                .enumerate()
-                .map(|(i, (&s, &p))| {
-                    let (lo, hi) = (boxes.vertex_lo[i], boxes.vertex_hi[i]);
-                    !((s.min(p) - g).cmpge(lo).all() && (s.max(p) + g).cmple(hi).all())
-                        || swept && strayed(i, s, p)
-                }),
-        );
+        self.left.resize(self.to.len(), false);
+        let (from, to) = (&self.from, &self.to);
+        each_part([&mut self.left], |range, [left]| {
+            for (l, i) in left.iter_mut().zip(range) {
+                let (s, p) = (from[i], to[i]);
+                let (lo, hi) = (boxes.vertex_lo[i], boxes.vertex_hi[i]);
+                *l = !((s.min(p) - g).cmpge(lo).all() && (s.max(p) + g).cmple(hi).all())
+                    || swept && strayed(i, s, p);
+            }
+        });
         let left = self.left.iter().filter(|&&l| l).count();
         if left == 0 {
             return Ok(());
@@ -411,10 +426,7 @@ impl SelfContacts {
     /// [`AHEAD_MOST`] of the thickness at most; where by the motion, `p` (the window
     /// carries it on).
     fn ahead(&self, s: Vec3, p: Vec3, thickness: f32) -> Vec3 {
-        if self.boxes.swept {
-            return p;
-        }
-        p + ((p - s) * AHEAD).clamp_length_max(AHEAD_MOST * thickness)
+        ahead(self.boxes.swept, s, p, thickness)
     }
 
     /// The box that holds a particle's motion from `s` to `p`, grown by `grow` each way.
@@ -551,8 +563,6 @@ impl SelfContacts {
     /// while each particle's motion stays in its box less half the thickness.
     fn find_pairs(&mut self, model: &ClothModel, thickness: f32) -> Result<(), ContactError> {
         self.found_for = None;
-        self.boxes.vertex_lo.clear();
-        self.boxes.vertex_hi.clear();
         // Room to reuse the pairs only where the cloth moves slowly in the moving frame; a
         // fast substep would leave its boxes at once, and the room would only add pairs.
         let fastest = (self.from.iter().zip(&self.to))
@@ -575,17 +585,21 @@ impl SelfContacts {
                 }
             }
         }
-        let (from, to) = if self.boxes.swept {
+        let (grow, swept) = (self.grow(thickness), self.boxes.swept);
+        let (from, to) = if swept {
             (&self.boxes.from, &self.boxes.to)
         } else {
             (&self.from, &self.to)
         };
-        let grow = self.grow(thickness);
-        for (&s, &p) in from.iter().zip(to) {
-            let (lo, hi) = Self::vertex_box(s, self.ahead(s, p, thickness), grow);
-            self.boxes.vertex_lo.push(lo);
-            self.boxes.vertex_hi.push(hi);
-        }
+        self.boxes.vertex_lo.resize(from.len(), Vec3::ZERO);
+        self.boxes.vertex_hi.resize(from.len(), Vec3::ZERO);
+        let boxes = [&mut self.boxes.vertex_lo[..], &mut self.boxes.vertex_hi[..]];
+        each_part(boxes, |range, [lo, hi]| {
+            for ((lo, hi), i) in lo.iter_mut().zip(hi).zip(range) {
+                let (s, p) = (from[i], to[i]);
+                (*lo, *hi) = Self::vertex_box(s, ahead(swept, s, p, thickness), grow);
+            }
+        });
         self.search_all(model, thickness)
     }
 
