@@ -4,6 +4,9 @@
 
 use glam::{BVec4A, Vec3A, Vec4};
 
+// A leaf's triangles fill one vector of four lanes.
+const _: () = assert!(super::LEAF == 4);
+
 /// One triangle's boxes: by boxes its box `[lo, hi]`; by motion also the box of its ends
 /// and its mean motion (`lo` and `hi` then bound its starts).
 #[derive(Clone, Copy, Debug, Default)]
