@@ -130,14 +130,53 @@ pub(super) fn share_none(corners: [u32; 3], lanes: &Corners) -> u32 {
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
-    {
-        let mut none = 0;
-        for l in 0..4 {
-            let shared = corners
-                .iter()
-                .any(|&c| lanes.iter().any(|lane| lane[l] == c));
-            none |= u32::from(!shared) << l;
+    share_none_plainly(corners, lanes)
+}
+
+/// [`share_none`] without SIMD.
+#[cfg(any(test, not(target_arch = "x86_64")))]
+fn share_none_plainly(corners: [u32; 3], lanes: &Corners) -> u32 {
+    let mut none = 0;
+    for l in 0..4 {
+        let shared = corners
+            .iter()
+            .any(|&c| lanes.iter().any(|lane| lane[l] == c));
+        none |= u32::from(!shared) << l;
+    }
+    none
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The SIMD compare and the plain one flag the same lanes, for corners drawn from a
+    /// few particles (so that many share one, in every lane and every corner's place), and
+    /// from numbers past `i32::MAX` (compared as signed lanes).
+    #[test]
+    fn the_corner_compare_flags_what_the_plain_one_flags() {
+        let mut rnd = crate::test_rng::uniform(5);
+        let mut pick = |few: bool| {
+            let r = (rnd() * 6.0) as u32;
+            if few { r } else { u32::MAX - r }
+        };
+        let (mut apart, mut shared) = (0, 0);
+        for k in 0..2000 {
+            let few = k % 2 == 0;
+            let corners = [pick(few), pick(few), pick(few)];
+            let lanes: Corners = std::array::from_fn(|_| std::array::from_fn(|_| pick(few)));
+            let flags = share_none(corners, &lanes);
+            assert_eq!(
+                flags,
+                share_none_plainly(corners, &lanes),
+                "{corners:?} {lanes:?}"
+            );
+            apart += u32::from(flags != 0);
+            shared += u32::from(flags != 0xf);
         }
-        none
+        assert!(
+            apart > 100 && shared > 100,
+            "{apart} with a lane apart, {shared} shared"
+        );
     }
 }
