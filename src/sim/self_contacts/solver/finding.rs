@@ -1,0 +1,346 @@
+//! How the pairs are found: each particle's box and path, the whole search of the tree
+//! (fitted to the boxes or to the motion, with the patches and the corners decided for
+//! it), and the refresh of the triangles whose particles left their boxes.
+
+use glam::Vec3;
+
+use super::*;
+
+/// The particles' boxes are given room for later substeps only while none moves more
+/// than this share of the thickness in a substep in the moving frame. Room for the slow
+/// particles alone was tried: where `crumple` piles up, it kept 15 000–20 000 pairs at
+/// 64² against a few hundred, and cost more than the searches it saved.
+const REUSE_BELOW: f32 = 0.5;
+
+/// How far, as a share of the thickness, a particle may stray from the path a window
+/// foresaw for it before its triangles are searched again (the pairs are kept for twice
+/// as much more than the thickness).
+const ALLOWANCE: f32 = 0.2;
+
+/// A triangle's box may be at most this many times the cloth's cell (twice its longest
+/// edge, or twice the thickness): wider, the state has blown up, and is refused rather
+/// than searched (every pair of the cloth could be near).
+const WIDEST: f32 = 1e6;
+
+/// Judged by the boxes alone (the cloth slow in the moving frame), each particle's box
+/// holds its motion carried on at the same velocity for this many substeps more: a
+/// particle that creeps (cloth sliding slowly off a sphere) stays in it that much longer
+/// before its triangles are searched again.
+const AHEAD: f32 = 12.0;
+
+/// How far, as a share of the thickness, a particle's box reaches at most beyond its
+/// motion ([`AHEAD`]): no more than the room the box gives that motion, so that a particle
+/// pushed about every substep (a stack of cloths pressed together in `layers`) does not
+/// get a box as long as twelve of its pushes.
+const AHEAD_MOST: f32 = 0.25;
+
+/// Triangles from which the search shares its work out between the team's members.
+const PARALLEL_TRIANGLES: usize = 2048;
+
+impl SelfContacts {
+    /// Where the pairs are judged by the motion, decides which corners' pairs the search
+    /// tests ([`Certificates::decide`], for the motion the boxes were made for); after a
+    /// refresh (`refreshed`), only the corners of the triangles searched again.
+    pub(super) fn decide_corners(
+        &mut self,
+        triangles: &[[u32; 3]],
+        thickness: f32,
+        refreshed: bool,
+    ) {
+        if self.boxes.swept {
+            let motion = [&self.boxes.from[..], &self.boxes.to[..]];
+            // Closed as they are: in a whole search the corners the patches cover (a
+            // refresh decides those whose motion changed, covered or not), and those whose
+            // reference fails but whose ring keeps near its rest shape.
+            let (patches, tree, reach) = (&self.patches, &self.tree, self.reach(thickness));
+            let only = refreshed.then_some(&self.left[..]);
+            let covered = |c: usize| !refreshed && patches.covers(tree, c);
+            let near_rest = |c: usize| patches.ring_holds(c, motion, reach);
+            let settled: [&(dyn Fn(usize) -> bool + Sync); 2] = [&covered, &near_rest];
+            let certificates = &mut self.certificates;
+            self.work.retaken +=
+                certificates.decide(&self.owners, triangles, motion, reach, only, settled);
+        }
+    }
+
+    /// How far a particle may stray from its path in the window, m: none in a window of
+    /// one substep, whose paths are the motion itself.
+    pub(super) fn allowance(&self, thickness: f32) -> f32 {
+        if self.window.len > 1 {
+            ALLOWANCE * thickness
+        } else {
+            0.0
+        }
+    }
+
+    /// How near along their paths the pairs judged by the motion are kept, m: the
+    /// thickness and twice the allowance.
+    pub(super) fn reach(&self, thickness: f32) -> f32 {
+        thickness + 2.0 * self.allowance(thickness)
+    }
+
+    /// How much each particle's box is grown around its motion, m: half the thickness and
+    /// the allowance where the pairs are judged by the motion, three quarters of the
+    /// thickness where by the boxes (room to reuse them).
+    pub(super) fn grow(&self, thickness: f32) -> f32 {
+        if self.boxes.swept {
+            0.5 * thickness + self.allowance(thickness)
+        } else {
+            0.75 * thickness
+        }
+    }
+
+    /// Where a particle's box reaches to beyond its motion from `s` to `p`: where the pairs
+    /// are judged by the boxes alone, that motion carried on for [`AHEAD`] substeps more,
+    /// [`AHEAD_MOST`] of the thickness at most; where by the motion, `p` (the window
+    /// carries it on).
+    pub(super) fn ahead(&self, s: Vec3, p: Vec3, thickness: f32) -> Vec3 {
+        ahead(self.boxes.swept, s, p, thickness)
+    }
+
+    /// The box that holds a particle's motion from `s` to `p`, grown by `grow` each way.
+    pub(super) fn vertex_box(s: Vec3, p: Vec3, grow: f32) -> (Vec3, Vec3) {
+        (s.min(p) - Vec3::splat(grow), s.max(p) + Vec3::splat(grow))
+    }
+
+    /// Triangle `n`'s box (its corners `t`): its corners' boxes together.
+    ///
+    /// # Errors
+    /// [`ContactError::Extent`] for a box wider than [`WIDEST`] times the cloth's cell
+    /// (twice its longest edge, or twice the thickness): a state that has blown up.
+    pub(super) fn triangle_box(
+        &self,
+        n: usize,
+        t: [u32; 3],
+        thickness: f32,
+    ) -> Result<(Vec3, Vec3), ContactError> {
+        let [a, b, c] = t.map(|i| i as usize);
+        let (lo, hi) = (&self.boxes.vertex_lo, &self.boxes.vertex_hi);
+        let (lo, hi) = (lo[a].min(lo[b]).min(lo[c]), hi[a].max(hi[b]).max(hi[c]));
+        let (extent, cell) = ((hi - lo).max_element(), self.owners.cell(thickness));
+        if extent > WIDEST * cell {
+            return Err(ContactError::Extent {
+                triangle: n,
+                extent,
+                cell,
+            });
+        }
+        Ok((lo, hi))
+    }
+
+    /// The particles that [`SelfContacts::update_pairs`] found out of their boxes get new
+    /// ones; the pairs of every triangle they are corners of are dropped and searched
+    /// again against the whole tree, fitted anew. The pairs of two triangles neither of
+    /// which moved out stand: their boxes are the same.
+    pub(super) fn refresh(
+        &mut self,
+        model: &ClothModel,
+        thickness: f32,
+    ) -> Result<(), ContactError> {
+        // Until the pairs are whole again (an error on the way leaves them not).
+        self.found_for = None;
+        let (window, grow) = (self.window, self.grow(thickness));
+        for (i, _) in self.left.iter().enumerate().filter(|(_, l)| **l) {
+            let (mut s, mut p) = (self.from[i], self.to[i]);
+            if self.boxes.swept {
+                // The particle's path in the window from its motion now, carried on both
+                // ways at its velocity.
+                if window.len > 1 {
+                    let v = p - s;
+                    (s, p) = (
+                        s - v * window.at as f32,
+                        s + v * (window.len - window.at) as f32,
+                    );
+                }
+                (self.boxes.from[i], self.boxes.to[i]) = (s, p);
+            }
+            let ahead = self.ahead(s, p, thickness);
+            (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) = Self::vertex_box(s, ahead, grow);
+        }
+        self.dirty.clear();
+        self.searched.clear();
+        for (n, &t) in model.triangles.iter().enumerate() {
+            let dirty = t.iter().any(|&i| self.left[i as usize]);
+            self.dirty.push(dirty);
+            if dirty {
+                self.searched.push(n as u32);
+                if !self.boxes.swept {
+                    (self.boxes.lo[n], self.boxes.hi[n]) = self.triangle_box(n, t, thickness)?;
+                }
+            }
+        }
+        self.fit_tree(model, thickness)?;
+        // Only the corners with a triangle searched again are decided again. One that was
+        // closed and is open now still leaves out the pairs of its triangles that stayed:
+        // it held for their motion, which has not changed.
+        self.decide_corners(&model.triangles, thickness, true);
+        let (tree, dirty, left) = (&self.tree, &self.dirty, &self.left);
+        let owner = &self.owners.vertex_owner;
+        (self.found).retain(|p| p.triangles(owner).iter().all(|&t| !dirty[t as usize]));
+        let search = Search {
+            owners: &self.owners,
+            triangles: &model.triangles,
+            boxes: &self.boxes,
+            thickness: self.reach(thickness),
+            open: &self.certificates.open,
+        };
+        let searched = &self.searched;
+        let pieces = searched.len().div_ceil(REFRESHED_PER_PIECE);
+        let work = |piece: usize, out: &mut Vec<StoredPair>| {
+            if piece >= pieces {
+                // The pairs of triangles sharing a corner, where either is one of those.
+                return search.neighbours(piece - pieces, Some([dirty, left]), out);
+            }
+            let first = piece * REFRESHED_PER_PIECE;
+            for &t in &searched[first..(first + REFRESHED_PER_PIECE).min(searched.len())] {
+                tree.triangle_pairs(t, dirty, |a, b| {
+                    search.pairs_of(a as usize, b as usize, out)
+                });
+            }
+        };
+        let refreshed = searched.len();
+        let parallel = refreshed >= PARALLEL_REFRESHED;
+        (self.found).extend(pieces + search.neighbour_pieces(), parallel, &work);
+        self.work.refreshes += 1;
+        self.work.refreshed += refreshed as u64;
+        self.found_for = Some(thickness);
+        Ok(())
+    }
+
+    /// Fits the tree to the boxes, or where the pairs are judged by the motion, to the
+    /// motion the boxes were made for (told apart by the thickness).
+    ///
+    /// # Errors
+    /// As [`SelfContacts::triangle_box`], where the pairs are judged by the motion (the
+    /// triangles' boxes are not kept then: the fit tells how wide the widest is, and only
+    /// where that comes near the limit are they all measured).
+    pub(super) fn fit_tree(
+        &mut self,
+        model: &ClothModel,
+        thickness: f32,
+    ) -> Result<(), ContactError> {
+        if self.boxes.swept {
+            let motion = [&self.boxes.from[..], &self.boxes.to[..]];
+            let reach = self.reach(thickness);
+            let widest = self.tree.fit_motion(motion, reach) + 2.0 * self.grow(thickness);
+            if widest >= 0.999 * WIDEST * self.owners.cell(thickness) {
+                for (n, &t) in model.triangles.iter().enumerate() {
+                    self.triangle_box(n, t, thickness)?;
+                }
+            }
+        } else {
+            self.tree.fit_boxes(&self.boxes.lo, &self.boxes.hi);
+        }
+        Ok(())
+    }
+
+    /// The pairs of every two triangles whose boxes overlap, each particle's box its
+    /// motion grown by half the thickness, or (where the whole cloth moves slowly in the
+    /// moving frame) three quarters of it, so that the pairs hold for the substeps after
+    /// while each particle's motion stays in its box less half the thickness.
+    pub(super) fn find_pairs(
+        &mut self,
+        model: &ClothModel,
+        thickness: f32,
+    ) -> Result<(), ContactError> {
+        self.found_for = None;
+        // Room to reuse the pairs only where the cloth moves slowly in the moving frame; a
+        // fast substep would leave its boxes at once, and the room would only add pairs.
+        let fastest = (self.from.iter().zip(&self.to))
+            .map(|(s, p)| s.distance_squared(*p))
+            .fold(0.0f32, f32::max)
+            .sqrt();
+        let slow = fastest < REUSE_BELOW * thickness;
+        // Fast, the pairs are judged by the motion too (see `Boxes::swept`), carried on
+        // for a window: twice as long as the last where it ran out, half where it did
+        // not.
+        self.window = self.window.next(slow, self.boxes.swept);
+        self.boxes.swept = !slow;
+        if self.boxes.swept {
+            self.boxes.from.clone_from(&self.from);
+            self.boxes.to.clone_from(&self.to);
+            if self.window.len > 1 {
+                let len = self.window.len as f32;
+                for (to, &s) in self.boxes.to.iter_mut().zip(&self.from) {
+                    *to = s + (*to - s) * len;
+                }
+            }
+        }
+        let (grow, swept) = (self.grow(thickness), self.boxes.swept);
+        let (from, to) = if swept {
+            (&self.boxes.from, &self.boxes.to)
+        } else {
+            (&self.from, &self.to)
+        };
+        self.boxes.vertex_lo.resize(from.len(), Vec3::ZERO);
+        self.boxes.vertex_hi.resize(from.len(), Vec3::ZERO);
+        let boxes = [&mut self.boxes.vertex_lo[..], &mut self.boxes.vertex_hi[..]];
+        each_part(boxes, |range, [lo, hi]| {
+            for ((lo, hi), i) in lo.iter_mut().zip(hi).zip(range) {
+                let (s, p) = (from[i], to[i]);
+                (*lo, *hi) = Self::vertex_box(s, ahead(swept, s, p, thickness), grow);
+            }
+        });
+        self.search_all(model, thickness)
+    }
+
+    /// The pairs of every two triangles whose boxes overlap, from the particles' boxes as
+    /// they are.
+    pub(super) fn search_all(
+        &mut self,
+        model: &ClothModel,
+        thickness: f32,
+    ) -> Result<(), ContactError> {
+        self.found_for = None;
+        self.boxes.lo.clear();
+        self.boxes.hi.clear();
+        if !self.boxes.swept {
+            for (n, &t) in model.triangles.iter().enumerate() {
+                let (lo, hi) = self.triangle_box(n, t, thickness)?;
+                self.boxes.lo.push(lo);
+                self.boxes.hi.push(hi);
+            }
+        }
+        self.fit_tree(model, thickness)?;
+        self.found.clear();
+        if self.boxes.swept {
+            let (motion, reach) = (
+                [&self.boxes.from[..], &self.boxes.to[..]],
+                self.reach(thickness),
+            );
+            (self.patches).decide(&mut self.tree, motion, reach, &mut self.backoff);
+        } else {
+            // The pairs are judged by the boxes: nothing is covered.
+            self.tree.covered.clear();
+        }
+        self.decide_corners(&model.triangles, thickness, false);
+        let search = Search {
+            owners: &self.owners,
+            triangles: &model.triangles,
+            boxes: &self.boxes,
+            thickness: self.reach(thickness),
+            open: &self.certificates.open,
+        };
+        let tree = &self.tree;
+        let work = |piece: usize, out: &mut Vec<StoredPair>| {
+            if piece >= tree.pieces() {
+                return search.neighbours(piece - tree.pieces(), None, out);
+            }
+            tree.piece_pairs(piece, |a, b| search.pairs_of(a as usize, b as usize, out));
+        };
+        let parallel = model.triangles.len() >= PARALLEL_TRIANGLES;
+        let pieces = tree.pieces() + search.neighbour_pieces();
+        self.found.extend(pieces, parallel, &work);
+        self.work.searches += 1;
+        self.found_for = Some(thickness);
+        Ok(())
+    }
+}
+
+/// [`SelfContacts::ahead`], `swept` where the pairs are judged by the motion.
+fn ahead(swept: bool, s: Vec3, p: Vec3, thickness: f32) -> Vec3 {
+    if swept {
+        return p;
+    }
+    p + ((p - s) * AHEAD).clamp_length_max(AHEAD_MOST * thickness)
+}
