@@ -57,14 +57,12 @@ pub(super) struct TriangleTree {
     leaves: Vec<u32>,
     leaf_of: Vec<u32>,
     leaf_at: Vec<u32>,
-    /// Each leaf's triangles' corners, side by side.
+    /// Each leaf's triangles' corners, side by side: two triangles that share one are
+    /// passed by without a test of their boxes.
     leaf_corners: Vec<Corners>,
     /// The triangles in the tree's order, and each triangle's place in it.
     order: Vec<u32>,
     place_of: Vec<u32>,
-    /// Each place's triangle's corners: two that share one are passed by without a test
-    /// of their boxes (read in the tree's order, where a walk reads them).
-    corners: Vec<[u32; 3]>,
     /// The pieces a search is cut into.
     tasks: Vec<Task>,
     /// Each node's box (by boxes), or the box of its starts (by motion), as `[lo, hi]`.
@@ -88,7 +86,6 @@ impl TriangleTree {
         for (place, &t) in order.iter().enumerate() {
             place_of[t as usize] = place as u32;
         }
-        let corners: Vec<[u32; 3]> = order.iter().map(|&t| triangles[t as usize]).collect();
         let (mut leaves, mut leaf_of) = (Vec::new(), vec![NOT_A_LEAF; nodes.len()]);
         let (mut leaf_at, mut leaf_corners) = (vec![0; order.len()], Vec::new());
         for (i, &node) in nodes.iter().enumerate() {
@@ -98,7 +95,8 @@ impl TriangleTree {
                 let mut lanes = [[u32::MAX; 4]; 3];
                 for (k, place) in (node.first..node.first + node.count).enumerate() {
                     leaf_at[place as usize] = leaves.len() as u32;
-                    for (lane, corner) in lanes.iter_mut().zip(corners[place as usize]) {
+                    let corners = triangles[order[place as usize] as usize];
+                    for (lane, corner) in lanes.iter_mut().zip(corners) {
                         lane[k] = corner;
                     }
                 }
@@ -114,7 +112,6 @@ impl TriangleTree {
             leaf_corners,
             order,
             place_of,
-            corners,
             ..TriangleTree::default()
         };
         if !tree.nodes.is_empty() {
@@ -201,13 +198,19 @@ impl TriangleTree {
         }
     }
 
-    /// Sets each leaf's lanes by `set(lanes, lane, place)`, for each of its triangles'
-    /// places in the tree's order.
-    fn set_lanes(&mut self, mut set: impl FnMut(&mut Lanes, usize, usize)) {
-        for (lanes, &i) in self.lanes.iter_mut().zip(&self.leaves) {
+    /// Sets each leaf's lanes by `set(lanes, lane, triangle, corners)`, for each of its
+    /// triangles.
+    fn set_lanes(&mut self, mut set: impl FnMut(&mut Lanes, usize, usize, [u32; 3])) {
+        let leaves = self
+            .lanes
+            .iter_mut()
+            .zip(&self.leaves)
+            .zip(&self.leaf_corners);
+        for ((lanes, &i), corners) in leaves {
             let node = self.nodes[i as usize];
             for lane in 0..node.count as usize {
-                set(lanes, lane, node.first as usize + lane);
+                let t = self.order[node.first as usize + lane] as usize;
+                set(lanes, lane, t, corners.map(|c| c[lane]));
             }
         }
     }
@@ -215,12 +218,7 @@ impl TriangleTree {
     /// Fits the tree to the triangles' boxes `lo..hi`.
     pub(super) fn fit_boxes(&mut self, lo: &[Vec3], hi: &[Vec3]) {
         self.size();
-        let order = std::mem::take(&mut self.order);
-        self.set_lanes(|lanes, lane, place| {
-            let t = order[place] as usize;
-            lanes.set_box(lane, [lo[t].into(), hi[t].into()]);
-        });
-        self.order = order;
+        self.set_lanes(|lanes, lane, t, _| lanes.set_box(lane, [lo[t].into(), hi[t].into()]));
         self.fit_nodes(false);
         self.fit = Fit::Boxes;
     }
@@ -230,10 +228,8 @@ impl TriangleTree {
     /// span along an axis over the motion.
     pub(super) fn fit_motion(&mut self, [from, to]: [&[Vec3]; 2], reach: f32) -> f32 {
         self.size();
-        let corners = std::mem::take(&mut self.corners);
         let mut widest = Vec3A::ZERO;
-        self.set_lanes(|lanes, lane, place| {
-            let corners = corners[place];
+        self.set_lanes(|lanes, lane, _, corners| {
             let [a, b, c] = corners.map(|k| Vec3A::from(from[k as usize]));
             let [d, e, f] = corners.map(|k| Vec3A::from(to[k as usize]));
             let one = One {
@@ -246,7 +242,6 @@ impl TriangleTree {
             widest = widest.max(one.hi.max(one.end_hi) - one.lo.min(one.end_lo));
             lanes.set(lane, one);
         });
-        self.corners = corners;
         self.fit_nodes(true);
         self.fit = Fit::Motion { reach };
         widest.max_element()
@@ -270,10 +265,17 @@ impl TriangleTree {
     }
 
     /// The leaf and lane of the triangle at `place` in the tree's order.
-    fn lane(&self, place: usize) -> (&Lanes, usize) {
+    fn lane(&self, place: usize) -> (usize, usize) {
         let leaf = self.leaf_at[place] as usize;
-        let first = self.nodes[self.leaves[leaf] as usize].first as usize;
-        (&self.lanes[leaf], place - first)
+        (
+            leaf,
+            place - self.nodes[self.leaves[leaf] as usize].first as usize,
+        )
+    }
+
+    /// The corners of lane `lane`'s triangle of leaf `leaf`.
+    fn corners(&self, leaf: usize, lane: usize) -> [u32; 3] {
+        self.leaf_corners[leaf].map(|c| c[lane])
     }
 
     /// Pieces a search of the whole tree is cut into, for a team to share.
@@ -343,8 +345,9 @@ impl TriangleTree {
             return;
         }
         let place = self.place_of[t as usize] as usize;
-        let (lane, corners) = (self.lane(place), self.corners[place]);
-        let one = lane.0.one(lane.1);
+        let (leaf, k) = self.lane(place);
+        let (lane, corners) = ((&self.lanes[leaf], k), self.corners(leaf, k));
+        let one = self.lanes[leaf].one(k);
         let mut stack = [0u32; STACK];
         let mut depth = 1;
         while depth > 0 {
@@ -387,8 +390,8 @@ impl TriangleTree {
             let (lanes, corners) = (&self.lanes[lb], &self.leaf_corners[lb]);
             for k in 0..na.count as usize {
                 let p = na.first as usize + k;
-                let near =
-                    share_none(self.corners[p], corners) & lanes_near(lanes, (&self.lanes[la], k));
+                let near = share_none(self.corners(la, k), corners)
+                    & lanes_near(lanes, (&self.lanes[la], k));
                 let from = if a == b { k + 1 } else { 0 };
                 for q in flagged(near, from, nb.count) {
                     pair(self.order[p], self.order[nb.first as usize + q]);
