@@ -16,7 +16,12 @@ const THICKNESS: f32 = 0.01;
 /// A 48 × 48-quad cloth (4 608 triangles, so the search is shared out) 1 m wide, crumpled
 /// by random offsets of up to 1.5 cm, so that its particles have many pairs.
 fn crumpled() -> (ClothModel, Vec<Vec3>) {
-    let mesh = GridSpec::square(48, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
+    crumpled_of(48)
+}
+
+/// [`crumpled`] with `quads`² quads.
+fn crumpled_of(quads: u32) -> (ClothModel, Vec<Vec3>) {
+    let mesh = GridSpec::square(quads, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
         .build()
         .unwrap();
     let model = ClothModel::new(&mesh, 0.2, &[]);
@@ -457,6 +462,38 @@ fn the_checks_cut_the_same_bits_on_two_threads_as_on_one() {
     assert!(work.candidates as usize >= PARALLEL_PAIRS, "{work:?}");
     assert!(work.impacts > 500, "{work:?}");
     assert!(one.pos == two.pos && one.vel == two.vel);
+}
+
+/// The per-particle loops shared out between two threads (the moving frame, the
+/// particles' checks against their boxes and paths, a whole search's boxes) on a cloth
+/// large enough to share them: three substeps of a crumpled 64 × 64-quad cloth falling and
+/// rippling (its pairs judged by the motion, found for windows and checked along them)
+/// end in the same bits, with the same pairs, as on one thread.
+#[test]
+fn a_cloth_large_enough_to_share_its_particles_resolves_the_same_on_two_threads() {
+    let run = |threads: usize| {
+        on_threads(threads, || {
+            let (model, start) = crumpled_of(64);
+            assert!(start.len() >= crate::parallel::PARALLEL_ELEMENTS);
+            let mut contacts = SelfContacts::default();
+            let (mut from, mut ends) = (start, Vec::new());
+            for k in 0..3 {
+                let mut state = ClothState::at_rest(&model);
+                let ripple = |p: Vec3| 0.006 * (10.0 * p.x + 7.0 * p.z + k as f32).sin();
+                state.pos = (from.iter())
+                    .map(|&p| p + Vec3::new(0.0, -0.02 + ripple(p), 0.0))
+                    .collect();
+                (contacts.resolve([THICKNESS, 0.3, 0.01], &model, &from, &mut state)).unwrap();
+                from.clone_from(&state.pos);
+                ends.push(state.pos);
+            }
+            assert!(contacts.boxes.swept && contacts.work.searches + contacts.work.refreshes > 0);
+            (ends, sorted(contacts.found.stored().copied().collect()))
+        })
+    };
+    let ((one, found), (two, found_two)) = (run(1), run(2));
+    assert!(found.len() > 1000, "{} pairs", found.len());
+    assert!(one == two && found == found_two);
 }
 
 /// A solver that served one cloth and is handed another with as many particles and
