@@ -25,14 +25,16 @@ const WIDEST: f32 = 1e6;
 /// Judged by the boxes alone (the cloth slow in the moving frame), each particle's box
 /// holds its motion carried on at the same velocity for this many substeps more: a
 /// particle that creeps (cloth sliding slowly off a sphere) stays in it that much longer
-/// before its triangles are searched again.
-const AHEAD: f32 = 12.0;
+/// before its triangles are searched again. Where `crumple` creeps over the sphere at 64²,
+/// 24 substeps up to a whole thickness left half as many particles out a substep as 12 up
+/// to a quarter (167 → 88); 48 up to two thicknesses kept ten times the pairs.
+const AHEAD: f32 = 24.0;
 
 /// How far, as a share of the thickness, a particle's box reaches at most beyond its
-/// motion ([`AHEAD`]): no more than the room the box gives that motion, so that a particle
-/// pushed about every substep (a stack of cloths pressed together in `layers`) does not
-/// get a box as long as twelve of its pushes.
-const AHEAD_MOST: f32 = 0.25;
+/// motion ([`AHEAD`]): a particle pushed about every substep (a stack of cloths pressed
+/// together in `layers`) gets a box no longer than this, not as long as its pushes
+/// carried on; and a box reaching farther would keep pairs of the triangles around it.
+const AHEAD_MOST: f32 = 1.0;
 
 /// Triangles from which the search shares its work out between the team's members.
 const PARALLEL_TRIANGLES: usize = 2048;
