@@ -95,8 +95,9 @@ impl Certificates {
 
     /// Decides, for the motion of each particle from `from` to `to`, which corners' pairs
     /// could come within `thickness` (those it leaves [`Certificates::open`]); with `only`,
-    /// only the corners that are, or have in their ring, a particle it flags (the others'
-    /// motion is as when they were last decided). The corners `covered` flags are closed as
+    /// only the corners it flags (the caller flags every corner that is, or has in its
+    /// ring, a particle whose motion changed: the others' is as when they were last
+    /// decided). The corners `covered` flags are closed as
     /// they are, and so are those whose reference fails where `near_rest` holds (their
     /// pairs are certified apart otherwise, for this motion: [`super::patches`]), before
     /// their reference is taken again. Returns how many references it took again.
@@ -141,11 +142,10 @@ impl Certificates {
             let first = piece * CORNERS_PER_PIECE;
             let mut taken = 0;
             for c in first..(first + CORNERS_PER_PIECE).min(corners) {
-                let range = rings.range(c);
-                let ring = &rings.ring[range.clone()];
-                if only.is_some_and(|o| !o[c] && ring.iter().all(|&j| !o[j as usize])) {
+                if only.is_some_and(|o| !o[c]) {
                     continue;
                 }
+                let range = rings.range(c);
                 if covered(c) {
                     // SAFETY: each corner is one piece's.
                     *unsafe { open.at(c) } = false;

@@ -1,13 +1,16 @@
 //! Each particle's ring, for the certificates ([`super::certify`]).
 
 /// Each particle's ring: the other particles of the triangles it is a corner of,
-/// `ring[start[i]..start[i + 1]]`, each once, in increasing order; and the other two
-/// corners of its first triangle, whose frame turns the reference.
+/// `ring[start[i]..start[i + 1]]`, each once, in increasing order; the other two corners
+/// of its first triangle, whose frame turns the reference; and the triangles it is a
+/// corner of, in increasing order.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Rings {
     pub(super) start: Vec<u32>,
     pub(super) ring: Vec<u32>,
     pub(super) first: Vec<[u32; 2]>,
+    around_start: Vec<u32>,
+    around: Vec<u32>,
 }
 
 impl Rings {
@@ -17,6 +20,8 @@ impl Rings {
             start: Vec::with_capacity(particles + 1),
             ring: Vec::new(),
             first: Vec::with_capacity(particles),
+            around_start: Vec::new(),
+            around: Vec::new(),
         };
         rings.start.push(0);
         let mut one = Vec::new();
@@ -37,7 +42,13 @@ impl Rings {
             rings.ring.extend_from_slice(&one);
             rings.start.push(rings.ring.len() as u32);
         }
+        (rings.around_start, rings.around) = (around_start, around);
         rings
+    }
+
+    /// The triangles particle `i` is a corner of.
+    pub(super) fn triangles_of(&self, i: usize) -> &[u32] {
+        &self.around[self.around_start[i] as usize..self.around_start[i + 1] as usize]
     }
 
     /// Particle `i`'s ring, as the range of entries it takes.

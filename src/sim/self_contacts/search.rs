@@ -293,9 +293,9 @@ impl Search<'_> {
     }
 
     /// Adds to `out` the pairs of piece `piece` of [`Owners::neighbours`] that could come
-    /// within the thickness; with `dirty` (triangles and the particles that made them so),
-    /// only those of a triangle it flags. The pairs of a corner the certificates closed
-    /// are passed by.
+    /// within the thickness; with `dirty` (triangles, and the corners whose pairs lie on
+    /// them), only those of a triangle it flags. The pairs of a corner the certificates
+    /// closed are passed by.
     pub(super) fn neighbours(
         &self,
         piece: usize,
@@ -303,19 +303,12 @@ impl Search<'_> {
         out: &mut Vec<StoredPair>,
     ) {
         let starts = &self.owners.piece_start;
-        let (owner, rings) = (&self.owners.vertex_owner, &self.owners.rings);
+        let owner = &self.owners.vertex_owner;
         for c in starts[piece] as usize..starts[piece + 1] as usize {
             if self.boxes.swept && !self.open[c] {
                 continue;
             }
-            // A corner's pairs lie on the triangles around it, whose particles are its
-            // ring's: none of those left, none of its triangles is dirty.
-            if let Some([_, left]) = dirty
-                && !left[c]
-                && rings.ring[rings.range(c)]
-                    .iter()
-                    .all(|&j| !left[j as usize])
-            {
+            if dirty.is_some_and(|[_, corners]| !corners[c]) {
                 continue;
             }
             let dirty = dirty.map(|[triangles, _]| triangles);

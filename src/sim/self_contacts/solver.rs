@@ -87,9 +87,11 @@ pub struct SelfContacts {
     /// judged by the motion.
     certificates: Certificates,
     /// Particles whose motion left their boxes, and the triangles they are corners of
-    /// (as flags), for a refresh.
+    /// (as flags), for a refresh; and the corners whose pairs lie on those triangles (the
+    /// particles that left and their rings).
     left: Vec<bool>,
     dirty: Vec<bool>,
+    touched: Vec<bool>,
     /// The triangles a refresh searches again, in order.
     searched: Vec<u32>,
     /// The window the pairs judged by the motion were found for, and how far into it the

@@ -75,6 +75,8 @@ pub(super) struct TriangleTree {
     /// Whether each node's own pairs are certified apart for the motion of the last fit
     /// (see [`super::patches`]): a whole walk passes by a node against itself then.
     pub(super) covered: Vec<bool>,
+    /// Scratch of a fit of some triangles: the nodes that hold one.
+    stale: Vec<bool>,
 }
 
 impl TriangleTree {
@@ -163,10 +165,19 @@ impl TriangleTree {
 
     /// Fits the nodes' boxes around their parts', from the last node back (children come
     /// after their parents): a leaf's around its triangles', another's around its two
-    /// children's.
-    fn fit_nodes(&mut self, moving: bool) {
+    /// children's. With `some`, only the nodes [`TriangleTree::stale`] flags, and their
+    /// parents (flagged on the way).
+    fn fit_nodes(&mut self, moving: bool, some: bool) {
         for i in (0..self.nodes.len()).rev() {
             let node = self.nodes[i];
+            if some {
+                if !Self::is_leaf(node) {
+                    self.stale[i] = self.stale[i + 1] || self.stale[node.second as usize];
+                }
+                if !self.stale[i] {
+                    continue;
+                }
+            }
             if Self::is_leaf(node) {
                 let leaf = &self.lanes[self.leaf_of[i] as usize];
                 let (boxes, motion) = leaf.bounds(node.count as usize, moving);
@@ -219,8 +230,20 @@ impl TriangleTree {
     pub(super) fn fit_boxes(&mut self, lo: &[Vec3], hi: &[Vec3]) {
         self.size();
         self.set_lanes(|lanes, lane, t, _| lanes.set_box(lane, [lo[t].into(), hi[t].into()]));
-        self.fit_nodes(false);
+        self.fit_nodes(false, false);
         self.fit = Fit::Boxes;
+    }
+
+    /// [`TriangleTree::fit_boxes`] where only the boxes of the triangles `changed` differ
+    /// from the last fit's: only those and the nodes above them are fitted again (the whole
+    /// tree where the last fit was not by boxes).
+    pub(super) fn refit_boxes(&mut self, changed: &[u32], lo: &[Vec3], hi: &[Vec3]) {
+        if self.fit != Fit::Boxes || self.boxes.len() != self.nodes.len() {
+            return self.fit_boxes(lo, hi);
+        }
+        self.fit_some(changed, false, |lanes, lane, t, _| {
+            lanes.set_box(lane, [lo[t].into(), hi[t].into()]);
+        });
     }
 
     /// Fits the tree to the motion of its triangles' particles from `from` to `to`, told
@@ -230,21 +253,54 @@ impl TriangleTree {
         self.size();
         let mut widest = Vec3A::ZERO;
         self.set_lanes(|lanes, lane, _, corners| {
-            let [a, b, c] = corners.map(|k| Vec3A::from(from[k as usize]));
-            let [d, e, f] = corners.map(|k| Vec3A::from(to[k as usize]));
-            let one = One {
-                lo: a.min(b).min(c),
-                hi: a.max(b).max(c),
-                end_lo: d.min(e).min(f),
-                end_hi: d.max(e).max(f),
-                mean: ((d - a) + (e - b) + (f - c)) / 3.0,
-            };
+            let one = One::of(corners, [from, to]);
             widest = widest.max(one.hi.max(one.end_hi) - one.lo.min(one.end_lo));
             lanes.set(lane, one);
         });
-        self.fit_nodes(true);
+        self.fit_nodes(true, false);
         self.fit = Fit::Motion { reach };
         widest.max_element()
+    }
+
+    /// [`TriangleTree::fit_motion`] where only the motion of the triangles `changed`
+    /// differs from the last fit's: only those and the nodes above them are fitted again
+    /// (the whole tree where the last fit was not by the motion for `reach`). Returns the
+    /// widest those triangles' particles span along an axis over the motion.
+    pub(super) fn refit_motion(
+        &mut self,
+        changed: &[u32],
+        [from, to]: [&[Vec3]; 2],
+        reach: f32,
+    ) -> f32 {
+        if self.fit != (Fit::Motion { reach }) || self.motion.len() != self.nodes.len() {
+            return self.fit_motion([from, to], reach);
+        }
+        let mut widest = Vec3A::ZERO;
+        self.fit_some(changed, true, |lanes, lane, _, corners| {
+            let one = One::of(corners, [from, to]);
+            widest = widest.max(one.hi.max(one.end_hi) - one.lo.min(one.end_lo));
+            lanes.set(lane, one);
+        });
+        widest.max_element()
+    }
+
+    /// Sets the lanes of the triangles `changed` by `set` (as [`TriangleTree::set_lanes`])
+    /// and fits the nodes that hold them.
+    fn fit_some(
+        &mut self,
+        changed: &[u32],
+        moving: bool,
+        mut set: impl FnMut(&mut Lanes, usize, usize, [u32; 3]),
+    ) {
+        self.stale.clear();
+        self.stale.resize(self.nodes.len(), false);
+        for &t in changed {
+            let (leaf, lane) = self.lane(self.place_of[t as usize] as usize);
+            let corners = self.corners(leaf, lane);
+            set(&mut self.lanes[leaf], lane, t as usize, corners);
+            self.stale[self.leaves[leaf] as usize] = true;
+        }
+        self.fit_nodes(moving, true);
     }
 
     /// Whether nodes `a` and `b`'s boxes do not overlap.

@@ -55,7 +55,7 @@ impl SelfContacts {
             // refresh decides those whose motion changed, covered or not), and those whose
             // reference fails but whose ring keeps near its rest shape.
             let (patches, tree, reach) = (&self.patches, &self.tree, self.reach(thickness));
-            let only = refreshed.then_some(&self.left[..]);
+            let only = refreshed.then_some(&self.touched[..]);
             let covered = |c: usize| !refreshed && patches.covers(tree, c);
             let near_rest = |c: usize| patches.ring_holds(c, motion, reach);
             let settled: [&(dyn Fn(usize) -> bool + Sync); 2] = [&covered, &near_rest];
@@ -159,24 +159,38 @@ impl SelfContacts {
             let ahead = self.ahead(s, p, thickness);
             (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) = Self::vertex_box(s, ahead, grow);
         }
+        // The triangles searched again: those a particle that left is a corner of, in
+        // order; and the corners whose pairs lie on them: those particles and their rings.
+        let (n, rings) = (model.triangles.len(), &self.owners.rings);
         self.dirty.clear();
+        self.dirty.resize(n, false);
+        self.touched.clear();
+        self.touched.resize(self.left.len(), false);
         self.searched.clear();
-        for (n, &t) in model.triangles.iter().enumerate() {
-            let dirty = t.iter().any(|&i| self.left[i as usize]);
-            self.dirty.push(dirty);
-            if dirty {
-                self.searched.push(n as u32);
-                if !self.boxes.swept {
-                    (self.boxes.lo[n], self.boxes.hi[n]) = self.triangle_box(n, t, thickness)?;
+        for (i, _) in self.left.iter().enumerate().filter(|(_, l)| **l) {
+            self.touched[i] = true;
+            for &j in &rings.ring[rings.range(i)] {
+                self.touched[j as usize] = true;
+            }
+            for &t in rings.triangles_of(i) {
+                if !std::mem::replace(&mut self.dirty[t as usize], true) {
+                    self.searched.push(t);
                 }
             }
         }
-        self.fit_tree(model, thickness)?;
+        self.searched.sort_unstable();
+        if !self.boxes.swept {
+            for &t in &self.searched {
+                let (t, corners) = (t as usize, model.triangles[t as usize]);
+                (self.boxes.lo[t], self.boxes.hi[t]) = self.triangle_box(t, corners, thickness)?;
+            }
+        }
+        self.fit_tree(model, thickness, true)?;
         // Only the corners with a triangle searched again are decided again. One that was
         // closed and is open now still leaves out the pairs of its triangles that stayed:
         // it held for their motion, which has not changed.
         self.decide_corners(&model.triangles, thickness, true);
-        let (tree, dirty, left) = (&self.tree, &self.dirty, &self.left);
+        let (tree, dirty, touched) = (&self.tree, &self.dirty, &self.touched);
         let owner = &self.owners.vertex_owner;
         (self.found).retain(|p| p.triangles(owner).iter().all(|&t| !dirty[t as usize]));
         let search = Search {
@@ -191,7 +205,7 @@ impl SelfContacts {
         let work = |piece: usize, out: &mut Vec<StoredPair>| {
             if piece >= pieces {
                 // The pairs of triangles sharing a corner, where either is one of those.
-                return search.neighbours(piece - pieces, Some([dirty, left]), out);
+                return search.neighbours(piece - pieces, Some([dirty, touched]), out);
             }
             let first = piece * REFRESHED_PER_PIECE;
             for &t in &searched[first..(first + REFRESHED_PER_PIECE).min(searched.len())] {
@@ -210,7 +224,8 @@ impl SelfContacts {
     }
 
     /// Fits the tree to the boxes, or where the pairs are judged by the motion, to the
-    /// motion the boxes were made for (told apart by the thickness).
+    /// motion the boxes were made for (told apart by the thickness); `refreshed`, only the
+    /// triangles searched again (the others' stand as the last fit left them).
     ///
     /// # Errors
     /// As [`SelfContacts::triangle_box`], where the pairs are judged by the motion (the
@@ -220,16 +235,26 @@ impl SelfContacts {
         &mut self,
         model: &ClothModel,
         thickness: f32,
+        refreshed: bool,
     ) -> Result<(), ContactError> {
+        let changed = &self.searched[..];
         if self.boxes.swept {
             let motion = [&self.boxes.from[..], &self.boxes.to[..]];
             let reach = self.reach(thickness);
-            let widest = self.tree.fit_motion(motion, reach) + 2.0 * self.grow(thickness);
+            let widest = if refreshed {
+                self.tree.refit_motion(changed, motion, reach)
+            } else {
+                self.tree.fit_motion(motion, reach)
+            };
+            let widest = widest + 2.0 * self.grow(thickness);
             if widest >= 0.999 * WIDEST * self.owners.cell(thickness) {
                 for (n, &t) in model.triangles.iter().enumerate() {
                     self.triangle_box(n, t, thickness)?;
                 }
             }
+        } else if refreshed {
+            self.tree
+                .refit_boxes(changed, &self.boxes.lo, &self.boxes.hi);
         } else {
             self.tree.fit_boxes(&self.boxes.lo, &self.boxes.hi);
         }
@@ -303,7 +328,7 @@ impl SelfContacts {
                 self.boxes.hi.push(hi);
             }
         }
-        self.fit_tree(model, thickness)?;
+        self.fit_tree(model, thickness, false)?;
         self.found.clear();
         if self.boxes.swept {
             let (motion, reach) = (

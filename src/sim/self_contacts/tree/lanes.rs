@@ -2,7 +2,7 @@
 //! that one triangle is told apart from a whole leaf's at once (four lanes: one SSE
 //! register an axis), where two leaves are tested triangle by triangle.
 
-use glam::{BVec4A, Vec3A, Vec4};
+use glam::{BVec4A, Vec3, Vec3A, Vec4};
 
 // A leaf's triangles fill one vector of four lanes.
 const _: () = assert!(super::LEAF == 4);
@@ -16,6 +16,21 @@ pub(super) struct One {
     pub(super) end_lo: Vec3A,
     pub(super) end_hi: Vec3A,
     pub(super) mean: Vec3A,
+}
+
+impl One {
+    /// The boxes by motion of a triangle with `corners`, moving from `from` to `to`.
+    pub(super) fn of(corners: [u32; 3], [from, to]: [&[Vec3]; 2]) -> One {
+        let [a, b, c] = corners.map(|k| Vec3A::from(from[k as usize]));
+        let [d, e, f] = corners.map(|k| Vec3A::from(to[k as usize]));
+        One {
+            lo: a.min(b).min(c),
+            hi: a.max(b).max(c),
+            end_lo: d.min(e).min(f),
+            end_hi: d.max(e).max(f),
+            mean: ((d - a) + (e - b) + (f - c)) / 3.0,
+        }
+    }
 }
 
 /// A leaf's triangles' boxes (as [`One`]), one lane each in the tree's order, a vector an
