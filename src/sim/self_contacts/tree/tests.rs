@@ -1,6 +1,7 @@
 //! The tree's walks: every two triangles that share no corner and whose boxes overlap, once; by the motion, no two
-//! passed by that come within the reach anywhere along it; and a search of some triangles
-//! finds what the whole walk finds of theirs.
+//! passed by that come within the reach anywhere along it; a search of some triangles
+//! finds what the whole walk finds of theirs; and a fit of some triangles leaves the tree
+//! as a whole fit does.
 
 use glam::{DVec3, Quat, Vec3};
 
@@ -201,4 +202,59 @@ fn a_search_of_some_triangles_finds_what_the_whole_walk_finds_of_theirs() {
         );
         assert_eq!(only, theirs, "by the motion: {by_motion}");
     }
+}
+
+/// Fitting again only the triangles whose particles moved (a refresh) leaves every node as
+/// a fit of the whole tree does, by boxes and by the motion: a moved particle's triangles
+/// sit in leaves far apart in the tree, so the fit must carry each change up to the root;
+/// and after a fit of the other kind, the whole tree is fitted.
+#[test]
+fn fitting_the_moved_triangles_again_leaves_the_tree_as_a_whole_fit_does() {
+    let (triangles, rest, pos) = cloth();
+    // A corner of the cloth and a particle in its middle move 5 cm up.
+    let moved = |i: usize| i < 20 || i == 150;
+    let lifted: Vec<Vec3> = (pos.iter().enumerate())
+        .map(|(i, &p)| if moved(i) { p + 0.05 * Vec3::Y } else { p })
+        .collect();
+    let changed: Vec<u32> = (0..triangles.len() as u32)
+        .filter(|&t| triangles[t as usize].iter().any(|&i| moved(i as usize)))
+        .collect();
+    let boxes_of = |x: &[Vec3]| -> (Vec<Vec3>, Vec<Vec3>) {
+        (triangles.iter())
+            .map(|t| {
+                let [a, b, c] = t.map(|i| x[i as usize]);
+                (a.min(b).min(c), a.max(b).max(c))
+            })
+            .unzip()
+    };
+    let whole = |fit: &dyn Fn(&mut TriangleTree)| {
+        let mut tree = TriangleTree::build(&triangles, &rest);
+        fit(&mut tree);
+        tree
+    };
+    let same = |a: &TriangleTree, b: &TriangleTree, moving: bool| {
+        assert!(a.boxes == b.boxes, "the nodes' boxes differ");
+        assert!(!moving || a.motion == b.motion, "the nodes' motion differs");
+        assert_eq!(walked(a), walked(b));
+    };
+    let ((lo, hi), (lo2, hi2)) = (boxes_of(&pos), boxes_of(&lifted));
+    let mut tree = whole(&|t| t.fit_boxes(&lo, &hi));
+    tree.refit_boxes(&changed, &lo2, &hi2);
+    same(&tree, &whole(&|t| t.fit_boxes(&lo2, &hi2)), false);
+    // By the motion: first rest → pos, then rest → lifted for the moved triangles.
+    let reach = 0.01;
+    let mut tree = whole(&|t| {
+        t.fit_motion([&rest, &pos], reach);
+    });
+    let widest = tree.refit_motion(&changed, [&rest, &lifted], reach);
+    let mut fresh = whole(&|t| {
+        t.fit_motion([&rest, &lifted], reach);
+    });
+    same(&tree, &fresh, true);
+    // The moved triangles are the widest over the motion: 5 cm up and more.
+    assert!(widest > 0.05, "{widest}");
+    // Fitted by boxes last, a fit by the motion of some triangles fits them all.
+    fresh.fit_boxes(&lo, &hi);
+    fresh.refit_motion(&changed, [&rest, &lifted], reach);
+    same(&fresh, &tree, true);
 }
