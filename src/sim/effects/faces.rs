@@ -13,6 +13,10 @@ use crate::sim::obstacle::split_triangles_at_medians;
 /// Triangles in a patch at most (at least half as many, but for a cloth with fewer).
 const PATCH: usize = 32;
 
+/// The triangles near are sorted into the cloth's order while they are fewer than one in
+/// this many of the cloth's; more, and every triangle is looked at in order.
+const SORTED_BELOW: usize = 16;
+
 /// The patches and the triangles a face pass takes (scratch: nothing is allocated once
 /// warm).
 #[derive(Clone, Debug, Default)]
@@ -23,6 +27,10 @@ pub struct FacePatches {
     /// The particles of each patch's triangles, each once a patch, cut as the triangles.
     particles: Vec<u32>,
     particle_starts: Vec<usize>,
+    /// Each triangle's patch.
+    patch_of: Vec<u32>,
+    /// Whether each patch was near in the last call.
+    flagged: Vec<bool>,
     /// The cloth they were cut for: its triangles and particles.
     cut_for: (usize, usize),
     /// The triangles of the patches the last call found near, in the cloth's order.
@@ -41,6 +49,7 @@ impl FacePatches {
         let (nodes, order) = split_triangles_at_medians(triangles, rest, PATCH);
         *self = FacePatches {
             cut_for: size,
+            patch_of: vec![0; triangles.len()],
             ..FacePatches::default()
         };
         let mut seen = vec![usize::MAX; model.particle_count()];
@@ -50,6 +59,7 @@ impl FacePatches {
             let held = &order[node.first as usize..(node.first + node.count) as usize];
             for &t in held {
                 self.triangles.push(t);
+                self.patch_of[t as usize] = k as u32;
                 for i in triangles[t as usize] {
                     if let Some(mark) = seen.get_mut(i as usize).filter(|m| **m != k) {
                         *mark = k;
@@ -74,6 +84,8 @@ impl FacePatches {
     ) -> &[u32] {
         self.fit(model);
         self.near.clear();
+        self.flagged.clear();
+        let mut held = 0;
         for k in 0..self.starts.len() - 1 {
             let ids = &self.particles[self.particle_starts[k]..self.particle_starts[k + 1]];
             let (lo, hi) =
@@ -81,11 +93,28 @@ impl FacePatches {
                     let p = pos[i as usize];
                     (lo.min(p), hi.max(p))
                 });
-            if near(lo, hi) {
+            let flagged = near(lo, hi);
+            self.flagged.push(flagged);
+            held += if flagged {
+                self.starts[k + 1] - self.starts[k]
+            } else {
+                0
+            };
+        }
+        // In the cloth's order: sorted where they are few, picked out of every triangle
+        // where they are many (a cloth draped over a sphere: 2 000 of 8 192 at 64², whose
+        // sort took a fifth of the pass).
+        if held * SORTED_BELOW < self.patch_of.len() {
+            for (k, _) in self.flagged.iter().enumerate().filter(|(_, f)| **f) {
                 (self.near).extend_from_slice(&self.triangles[self.starts[k]..self.starts[k + 1]]);
             }
+            self.near.sort_unstable();
+        } else {
+            let (flagged, patch_of) = (&self.flagged, &self.patch_of);
+            (self.near).extend(
+                (0..patch_of.len() as u32).filter(|&t| flagged[patch_of[t as usize] as usize]),
+            );
         }
-        self.near.sort_unstable();
         &self.near
     }
 }
