@@ -23,18 +23,20 @@ const ALLOWANCE: f32 = 0.2;
 const WIDEST: f32 = 1e6;
 
 /// Judged by the boxes alone (the cloth slow in the moving frame), each particle's box
-/// holds its motion carried on at the same velocity for this many substeps more: a
-/// particle that creeps (cloth sliding slowly off a sphere) stays in it that much longer
-/// before its triangles are searched again. Where `crumple` creeps over the sphere at 64²,
-/// 24 substeps up to a whole thickness left half as many particles out a substep as 12 up
-/// to a quarter (167 → 88); 48 up to two thicknesses kept ten times the pairs.
-const AHEAD: f32 = 24.0;
+/// holds its motion carried on at the same velocity for some substeps more, up to some
+/// share of the thickness, as `(substeps, share)`: a particle that creeps (cloth sliding
+/// slowly off a sphere) stays in it that much longer before its triangles are searched
+/// again. These where the pairs are few (fewer than one a particle: a cloth creeping on
+/// its own): where `crumple` creeps over the sphere at 64², they left half as many
+/// particles out of their boxes a substep as [`AHEAD_MANY`] (167 → 88); 48 substeps up to
+/// two thicknesses kept ten times the pairs.
+const AHEAD_FEW: (f32, f32) = (24.0, 1.0);
 
-/// How far, as a share of the thickness, a particle's box reaches at most beyond its
-/// motion ([`AHEAD`]): a particle pushed about every substep (a stack of cloths pressed
-/// together in `layers`) gets a box no longer than this, not as long as its pushes
-/// carried on; and a box reaching farther would keep pairs of the triangles around it.
-const AHEAD_MOST: f32 = 1.0;
+/// [`AHEAD_FEW`] where the pairs are many: a particle pushed about every substep (a stack
+/// of cloths pressed together in `layers`, 46 pairs a particle) gets a box no longer than
+/// a quarter of the thickness, not as long as its pushes carried on (with [`AHEAD_FEW`]
+/// there, `layers` ran 4–5 % slower).
+const AHEAD_MANY: (f32, f32) = (12.0, 0.25);
 
 /// Triangles from which the search shares its work out between the team's members.
 const PARALLEL_TRIANGLES: usize = 2048;
@@ -92,12 +94,19 @@ impl SelfContacts {
         }
     }
 
-    /// Where a particle's box reaches to beyond its motion from `s` to `p`: where the pairs
-    /// are judged by the boxes alone, that motion carried on for [`AHEAD`] substeps more,
-    /// [`AHEAD_MOST`] of the thickness at most; where by the motion, `p` (the window
-    /// carries it on).
-    pub(super) fn ahead(&self, s: Vec3, p: Vec3, thickness: f32) -> Vec3 {
-        ahead(self.boxes.swept, s, p, thickness)
+    /// How far each particle's box reaches beyond its motion, as `(substeps, share of the
+    /// thickness at most)`: [`AHEAD_FEW`] or [`AHEAD_MANY`] by the pairs found last, where
+    /// the pairs are judged by the boxes alone; none (`None`) where by the motion (the
+    /// window carries it on).
+    pub(super) fn look_ahead(&self) -> Option<(f32, f32)> {
+        if self.boxes.swept {
+            return None;
+        }
+        Some(if self.found.len() < self.from.len() {
+            AHEAD_FEW
+        } else {
+            AHEAD_MANY
+        })
     }
 
     /// The box that holds a particle's motion from `s` to `p`, grown by `grow` each way.
@@ -141,7 +150,7 @@ impl SelfContacts {
     ) -> Result<(), ContactError> {
         // Until the pairs are whole again (an error on the way leaves them not).
         self.found_for = None;
-        let (window, grow) = (self.window, self.grow(thickness));
+        let (window, grow, look) = (self.window, self.grow(thickness), self.look_ahead());
         for (i, _) in self.left.iter().enumerate().filter(|(_, l)| **l) {
             let (mut s, mut p) = (self.from[i], self.to[i]);
             if self.boxes.swept {
@@ -156,7 +165,7 @@ impl SelfContacts {
                 }
                 (self.boxes.from[i], self.boxes.to[i]) = (s, p);
             }
-            let ahead = self.ahead(s, p, thickness);
+            let ahead = ahead(look, s, p, thickness);
             (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) = Self::vertex_box(s, ahead, grow);
         }
         // The triangles searched again: those a particle that left is a corner of, in
@@ -293,7 +302,7 @@ impl SelfContacts {
                 }
             }
         }
-        let (grow, swept) = (self.grow(thickness), self.boxes.swept);
+        let (grow, swept, look) = (self.grow(thickness), self.boxes.swept, self.look_ahead());
         let (from, to) = if swept {
             (&self.boxes.from, &self.boxes.to)
         } else {
@@ -305,7 +314,7 @@ impl SelfContacts {
         each_part(boxes, |range, [lo, hi]| {
             for ((lo, hi), i) in lo.iter_mut().zip(hi).zip(range) {
                 let (s, p) = (from[i], to[i]);
-                (*lo, *hi) = Self::vertex_box(s, ahead(swept, s, p, thickness), grow);
+                (*lo, *hi) = Self::vertex_box(s, ahead(look, s, p, thickness), grow);
             }
         });
         self.search_all(model, thickness)
@@ -364,10 +373,11 @@ impl SelfContacts {
     }
 }
 
-/// [`SelfContacts::ahead`], `swept` where the pairs are judged by the motion.
-fn ahead(swept: bool, s: Vec3, p: Vec3, thickness: f32) -> Vec3 {
-    if swept {
+/// Where a particle's box reaches to beyond its motion from `s` to `p`: that motion carried
+/// on as `look` says ([`SelfContacts::look_ahead`]); `p` with none.
+fn ahead(look: Option<(f32, f32)>, s: Vec3, p: Vec3, thickness: f32) -> Vec3 {
+    let Some((substeps, most)) = look else {
         return p;
-    }
-    p + ((p - s) * AHEAD).clamp_length_max(AHEAD_MOST * thickness)
+    };
+    p + ((p - s) * substeps).clamp_length_max(most * thickness)
 }
