@@ -124,7 +124,7 @@ impl Sphere {
 /// square less the largest square of a corner's distance from the centroid (the weighted
 /// spread about `q` is at most that about any other point). A margin of a thousandth
 /// covers the rounding; a triangle it leaves undecided is measured. Of the 2 000
-/// triangles near the sphere where `crumple` drapes over it at 64², 1 500 are told clear
+/// triangles near the sphere where `crumple` drapes over it at 64², 1 300 are told clear
 /// so.
 #[inline]
 fn clear_of(center: Vec3, reach: f32, x: [Vec3; 3]) -> bool {
