@@ -126,21 +126,7 @@ impl Patches {
             patches.rings.push(patches.particle.len() as u32);
         }
         patches.home = homes(tree, &nodes, &patches.parent, triangles, rest.len());
-        // In the tree's order a subtree's nodes follow its root, up to its last leaf, the
-        // end of the chain of second children.
-        let mut i = 0;
-        while i < nodes.len() {
-            if nodes[i].count > TRIANGLES_PER_PIECE {
-                i += 1;
-                continue;
-            }
-            let mut last = i;
-            while nodes[last].second != 0 {
-                last = nodes[last].second as usize;
-            }
-            patches.subtrees.push(i..last + 1);
-            i = last + 1;
-        }
+        patches.subtrees = tree.subtrees().collect();
         tree.covered.clear();
         // Grown entry by entry: kept at their size (about 15 MB at 256², up to twice that
         // with the room a growing vector leaves).

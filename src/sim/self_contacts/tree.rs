@@ -13,9 +13,12 @@
 //! mean but hardly against each other: in their own frame, two patches' boxes are hardly
 //! larger than the patches.
 
+use std::sync::atomic::{AtomicU32, Ordering};
+
 use glam::{Vec3, Vec3A};
 
 use self::lanes::{Corners, Lanes, One, share_none};
+use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
 use crate::sim::obstacle::{Split, split_triangles_at_medians};
 
 mod lanes;
@@ -65,6 +68,10 @@ pub(super) struct TriangleTree {
     place_of: Vec<u32>,
     /// The pieces a search is cut into.
     tasks: Vec<Task>,
+    /// The nodes and the leaves of each subtree whose root holds at most
+    /// [`TRIANGLES_PER_PIECE`] triangles and its parent more, as ranges: fitted in pieces
+    /// shared with the team.
+    subtrees: Vec<(std::ops::Range<usize>, std::ops::Range<usize>)>,
     /// Each node's box (by boxes), or the box of its starts (by motion), as `[lo, hi]`.
     boxes: Vec<[Vec3A; 2]>,
     /// By motion, each node's box of its ends and its mean motion, as `[lo, hi, mean]`.
@@ -119,7 +126,29 @@ impl TriangleTree {
         if !tree.nodes.is_empty() {
             tree.cut(0);
         }
+        // In the tree's order a subtree's nodes follow its root, up to its last leaf, the
+        // end of the chain of second children; its leaves are numbered in that order too.
+        let mut i = 0;
+        while i < tree.nodes.len() {
+            if tree.nodes[i].count > TRIANGLES_PER_PIECE {
+                i += 1;
+                continue;
+            }
+            let mut last = i;
+            while !Self::is_leaf(tree.nodes[last]) {
+                last = tree.nodes[last].second as usize;
+            }
+            let below = |end: usize| tree.leaves.partition_point(|&n| (n as usize) < end);
+            tree.subtrees.push((i..last + 1, below(i)..below(last + 1)));
+            i = last + 1;
+        }
         tree
+    }
+
+    /// The nodes of each subtree whose root holds at most [`TRIANGLES_PER_PIECE`]
+    /// triangles and its parent more, as ranges in the tree's order.
+    pub(super) fn subtrees(&self) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+        self.subtrees.iter().map(|(nodes, _)| nodes.clone())
     }
 
     /// Adds the pieces of a walk of node `a` against itself to the tasks.
@@ -163,74 +192,83 @@ impl TriangleTree {
         self.lanes.resize(self.leaves.len(), Lanes::default());
     }
 
-    /// Fits the nodes' boxes around their parts', from the last node back (children come
-    /// after their parents): a leaf's around its triangles', another's around its two
-    /// children's. With `some`, only the nodes [`TriangleTree::stale`] flags, and their
-    /// parents (flagged on the way).
-    fn fit_nodes(&mut self, moving: bool, some: bool) {
+    /// Fits the nodes [`TriangleTree::stale`] flags and their parents (flagged on the
+    /// way), from the last node back (children come after their parents).
+    fn fit_stale(&mut self, moving: bool) {
+        let fitting = Fitting {
+            nodes: &self.nodes,
+            leaf_of: &self.leaf_of,
+            moving,
+        };
         for i in (0..self.nodes.len()).rev() {
             let node = self.nodes[i];
-            if some {
-                if !Self::is_leaf(node) {
-                    self.stale[i] = self.stale[i + 1] || self.stale[node.second as usize];
-                }
-                if !self.stale[i] {
-                    continue;
-                }
+            if !Self::is_leaf(node) {
+                self.stale[i] = self.stale[i + 1] || self.stale[node.second as usize];
             }
-            if Self::is_leaf(node) {
-                let leaf = &self.lanes[self.leaf_of[i] as usize];
-                let (boxes, motion) = leaf.bounds(node.count as usize, moving);
-                self.boxes[i] = boxes;
-                if moving {
-                    self.motion[i] = motion;
-                }
-                continue;
-            }
-            let parts = [i + 1, node.second as usize];
-            let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-            for &k in &parts {
-                let [l, h] = self.boxes[k];
-                (lo, hi) = (lo.min(l), hi.max(h));
-            }
-            self.boxes[i] = [lo, hi];
-            if moving {
-                let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-                // The mean weighted by the triangles each part holds.
-                let (mut sum, mut total) = (Vec3A::ZERO, 0.0);
-                for &k in &parts {
-                    let [l, h, mean] = self.motion[k];
-                    (lo, hi) = (lo.min(l), hi.max(h));
-                    let weight = self.nodes[k].count as f32;
-                    (sum, total) = (sum + mean * weight, total + weight);
-                }
-                self.motion[i] = [lo, hi, sum / total];
+            if self.stale[i] {
+                fitting.node(i, (&mut self.boxes, &mut self.motion, 0), (&self.lanes, 0));
             }
         }
     }
 
-    /// Sets each leaf's lanes by `set(lanes, lane, triangle, corners)`, for each of its
-    /// triangles.
-    fn set_lanes(&mut self, mut set: impl FnMut(&mut Lanes, usize, usize, [u32; 3])) {
-        let leaves = self
-            .lanes
-            .iter_mut()
-            .zip(&self.leaves)
-            .zip(&self.leaf_corners);
-        for ((lanes, &i), corners) in leaves {
-            let node = self.nodes[i as usize];
-            for lane in 0..node.count as usize {
-                let t = self.order[node.first as usize + lane] as usize;
-                set(lanes, lane, t, corners.map(|c| c[lane]));
+    /// Sets every leaf's lanes by `set(lanes, lane, triangle, corners)`, for each of its
+    /// triangles, and fits every node's boxes around its parts', subtree by subtree
+    /// (shared with the team for a large cloth), then the nodes above them. Returns the
+    /// largest `set` returned.
+    fn fit_all(&mut self, moving: bool, set: &SetLane<'_>) -> f32 {
+        self.size();
+        // The largest as bits: non-negative floats order as their bits do.
+        let largest = AtomicU32::new(0);
+        let fitting = Fitting {
+            nodes: &self.nodes,
+            leaf_of: &self.leaf_of,
+            moving,
+        };
+        let (lanes, boxes, motion) = (
+            Disjoint::new(&mut self.lanes),
+            Disjoint::new(&mut self.boxes),
+            Disjoint::new(&mut self.motion),
+        );
+        let (leaves, corners, order) = (&self.leaves, &self.leaf_corners, &self.order);
+        let subtrees = &self.subtrees;
+        let work = |_: usize, piece: usize| {
+            let (at, held) = subtrees[piece].clone();
+            // SAFETY: the subtrees' nodes, and their leaves, are disjoint.
+            let (lanes, boxes, motion) = unsafe {
+                (
+                    lanes.part(held.clone()),
+                    boxes.part(at.clone()),
+                    motion.part(at.clone()),
+                )
+            };
+            let mut most = 0.0f32;
+            for (leaf, lanes) in held.clone().zip(lanes.iter_mut()) {
+                let node = fitting.nodes[leaves[leaf] as usize];
+                for lane in 0..node.count as usize {
+                    let t = order[node.first as usize + lane] as usize;
+                    most = most.max(set(lanes, lane, t, corners[leaf].map(|c| c[lane])));
+                }
             }
+            for i in at.clone().rev() {
+                fitting.node(i, (boxes, motion, at.start), (lanes, held.start));
+            }
+            largest.fetch_max(most.to_bits(), Ordering::Relaxed);
+        };
+        let parallel = order.len() >= PARALLEL_ELEMENTS;
+        Team::current().run_large_pieces_if(parallel, subtrees.len(), &work);
+        let above = (0..fitting.nodes.len()).rev();
+        for i in above.filter(|&i| fitting.nodes[i].count > TRIANGLES_PER_PIECE) {
+            fitting.node(i, (&mut self.boxes, &mut self.motion, 0), (&self.lanes, 0));
         }
+        f32::from_bits(largest.into_inner())
     }
 
     /// Fits the tree to the triangles' boxes `lo..hi`.
     pub(super) fn fit_boxes(&mut self, lo: &[Vec3], hi: &[Vec3]) {
-        self.size();
-        self.set_lanes(|lanes, lane, t, _| lanes.set_box(lane, [lo[t].into(), hi[t].into()]));
-        self.fit_nodes(false, false);
+        self.fit_all(false, &|lanes, lane, t, _| {
+            lanes.set_box(lane, [lo[t].into(), hi[t].into()]);
+            0.0
+        });
         self.fit = Fit::Boxes;
     }
 
@@ -243,6 +281,7 @@ impl TriangleTree {
         }
         self.fit_some(changed, false, |lanes, lane, t, _| {
             lanes.set_box(lane, [lo[t].into(), hi[t].into()]);
+            0.0
         });
     }
 
@@ -250,16 +289,11 @@ impl TriangleTree {
     /// apart by `reach` (see [`Fit::Motion`]). Returns the widest any triangle's particles
     /// span along an axis over the motion.
     pub(super) fn fit_motion(&mut self, [from, to]: [&[Vec3]; 2], reach: f32) -> f32 {
-        self.size();
-        let mut widest = Vec3A::ZERO;
-        self.set_lanes(|lanes, lane, _, corners| {
-            let one = One::of(corners, [from, to]);
-            widest = widest.max(one.hi.max(one.end_hi) - one.lo.min(one.end_lo));
-            lanes.set(lane, one);
+        let widest = self.fit_all(true, &|lanes, lane, _, corners| {
+            set_motion(lanes, lane, One::of(corners, [from, to]))
         });
-        self.fit_nodes(true, false);
         self.fit = Fit::Motion { reach };
-        widest.max_element()
+        widest
     }
 
     /// [`TriangleTree::fit_motion`] where only the motion of the triangles `changed`
@@ -275,13 +309,9 @@ impl TriangleTree {
         if self.fit != (Fit::Motion { reach }) || self.motion.len() != self.nodes.len() {
             return self.fit_motion([from, to], reach);
         }
-        let mut widest = Vec3A::ZERO;
         self.fit_some(changed, true, |lanes, lane, _, corners| {
-            let one = One::of(corners, [from, to]);
-            widest = widest.max(one.hi.max(one.end_hi) - one.lo.min(one.end_lo));
-            lanes.set(lane, one);
-        });
-        widest.max_element()
+            set_motion(lanes, lane, One::of(corners, [from, to]))
+        })
     }
 
     /// Sets the lanes of the triangles `changed` by `set` (as [`TriangleTree::set_lanes`])
@@ -290,17 +320,19 @@ impl TriangleTree {
         &mut self,
         changed: &[u32],
         moving: bool,
-        mut set: impl FnMut(&mut Lanes, usize, usize, [u32; 3]),
-    ) {
+        set: impl Fn(&mut Lanes, usize, usize, [u32; 3]) -> f32,
+    ) -> f32 {
         self.stale.clear();
         self.stale.resize(self.nodes.len(), false);
+        let mut most = 0.0f32;
         for &t in changed {
             let (leaf, lane) = self.lane(self.place_of[t as usize] as usize);
             let corners = self.corners(leaf, lane);
-            set(&mut self.lanes[leaf], lane, t as usize, corners);
+            most = most.max(set(&mut self.lanes[leaf], lane, t as usize, corners));
             self.stale[self.leaves[leaf] as usize] = true;
         }
-        self.fit_nodes(moving, true);
+        self.fit_stale(moving);
+        most
     }
 
     /// Whether nodes `a` and `b`'s boxes do not overlap.
@@ -506,6 +538,67 @@ fn flagged(flags: u32, from: usize, count: u32) -> impl Iterator<Item = usize> {
         left &= left.wrapping_sub(1);
         (lane < 32).then_some(lane)
     })
+}
+
+/// Sets lane `lane` of a leaf's lanes to triangle `t`'s boxes (its corners given); returns
+/// what the fit keeps the largest of (the widest triangle by motion).
+type SetLane<'a> = dyn Fn(&mut Lanes, usize, usize, [u32; 3]) -> f32 + Sync + 'a;
+
+/// Sets lane `lane` to a triangle's boxes by motion `one`; returns the widest its particles
+/// span along an axis over the motion.
+fn set_motion(lanes: &mut Lanes, lane: usize, one: One) -> f32 {
+    lanes.set(lane, one);
+    (one.hi.max(one.end_hi) - one.lo.min(one.end_lo)).max_element()
+}
+
+/// What fitting a node reads: the tree's nodes, each node's leaf, and whether by motion.
+struct Fitting<'a> {
+    nodes: &'a [Split],
+    leaf_of: &'a [u32],
+    moving: bool,
+}
+
+impl Fitting<'_> {
+    /// Fits node `i`'s boxes around its parts': a leaf's around its triangles', another's
+    /// around its two children's (fitted before). `boxes` and `motion` hold the nodes from
+    /// node `base` on, `lanes` the leaves from leaf `first` on.
+    #[inline]
+    fn node(
+        &self,
+        i: usize,
+        (boxes, motion, base): (&mut [[Vec3A; 2]], &mut [[Vec3A; 3]], usize),
+        (lanes, first): (&[Lanes], usize),
+    ) {
+        let node = self.nodes[i];
+        if TriangleTree::is_leaf(node) {
+            let leaf = &lanes[self.leaf_of[i] as usize - first];
+            let (fitted, moved) = leaf.bounds(node.count as usize, self.moving);
+            boxes[i - base] = fitted;
+            if self.moving {
+                motion[i - base] = moved;
+            }
+            return;
+        }
+        let parts = [i + 1, node.second as usize];
+        let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+        for &k in &parts {
+            let [l, h] = boxes[k - base];
+            (lo, hi) = (lo.min(l), hi.max(h));
+        }
+        boxes[i - base] = [lo, hi];
+        if self.moving {
+            let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+            // The mean weighted by the triangles each part holds.
+            let (mut sum, mut total) = (Vec3A::ZERO, 0.0);
+            for &k in &parts {
+                let [l, h, mean] = motion[k - base];
+                (lo, hi) = (lo.min(l), hi.max(h));
+                let weight = self.nodes[k].count as f32;
+                (sum, total) = (sum + mean * weight, total + weight);
+            }
+            motion[i - base] = [lo, hi, sum / total];
+        }
+    }
 }
 
 /// A node that is not a leaf, in [`TriangleTree`]'s `leaf_of`.
