@@ -314,8 +314,9 @@ impl TriangleTree {
         })
     }
 
-    /// Sets the lanes of the triangles `changed` by `set` (as [`TriangleTree::set_lanes`])
-    /// and fits the nodes that hold them.
+    /// Sets the lanes of the triangles `changed` by `set` (as [`TriangleTree::fit_all`]
+    /// sets every triangle's) and fits the nodes that hold them. Returns the largest `set`
+    /// returned.
     fn fit_some(
         &mut self,
         changed: &[u32],

@@ -26,10 +26,10 @@ const WIDEST: f32 = 1e6;
 /// holds its motion carried on at the same velocity for some substeps more, up to some
 /// share of the thickness, as `(substeps, share)`: a particle that creeps (cloth sliding
 /// slowly off a sphere) stays in it that much longer before its triangles are searched
-/// again. These where the pairs are few (fewer than one a particle: a cloth creeping on
-/// its own): where `crumple` creeps over the sphere at 64², they left half as many
-/// particles out of their boxes a substep as [`AHEAD_MANY`] (167 → 88); 48 substeps up to
-/// two thicknesses kept ten times the pairs.
+/// again. This one where the pairs last found are few (fewer than one a particle: a cloth
+/// creeping on its own): where `crumple` creeps over the sphere at 64², it left half as
+/// many particles out of their boxes a substep as [`AHEAD_MANY`] (167 → 88); 48 substeps
+/// up to two thicknesses kept ten times the pairs.
 const AHEAD_FEW: (f32, f32) = (24.0, 1.0);
 
 /// [`AHEAD_FEW`] where the pairs are many: a particle pushed about every substep (a stack
