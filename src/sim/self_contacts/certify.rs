@@ -97,10 +97,10 @@ impl Certificates {
     /// could come within `thickness` (those it leaves [`Certificates::open`]); with `only`,
     /// only the corners it flags (the caller flags every corner that is, or has in its
     /// ring, a particle whose motion changed: the others' is as when they were last
-    /// decided). The corners `covered` flags are closed as
-    /// they are, and so are those whose reference fails where `near_rest` holds (their
-    /// pairs are certified apart otherwise, for this motion: [`super::patches`]), before
-    /// their reference is taken again. Returns how many references it took again.
+    /// decided). The corners `covered` flags are closed as they are, and so are those
+    /// whose reference fails where `near_rest` holds (their pairs are certified apart
+    /// otherwise, for this motion: [`super::patches`]), before their reference is taken
+    /// again. Returns how many references it took again.
     pub(super) fn decide(
         &mut self,
         owners: &Owners,

@@ -1,4 +1,5 @@
-//! Each particle's ring, for the certificates ([`super::certify`]).
+//! Each particle's ring, for the certificates ([`super::certify`]), and its triangles, for
+//! the refresh's search of the triangles around the particles that left their boxes.
 
 /// Each particle's ring: the other particles of the triangles it is a corner of,
 /// `ring[start[i]..start[i + 1]]`, each once, in increasing order; the other two corners
