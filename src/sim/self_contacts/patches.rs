@@ -46,10 +46,6 @@ const WAITING: u8 = 0x0f;
 pub(super) struct Patches {
     /// Each node's parent (the root its own).
     parent: Vec<u32>,
-    /// The nodes of each subtree whose root holds at most [`TRIANGLES_PER_PIECE`]
-    /// triangles and its parent more (the nodes a certificate can cover), as a range:
-    /// decided in pieces shared with the team.
-    subtrees: Vec<std::ops::Range<usize>>,
     /// Each node's entries, `start[i]..start[i + 1]` (none: it is not certified on its
     /// own).
     start: Vec<u32>,
@@ -126,7 +122,6 @@ impl Patches {
             patches.rings.push(patches.particle.len() as u32);
         }
         patches.home = homes(tree, &nodes, &patches.parent, triangles, rest.len());
-        patches.subtrees = tree.subtrees().collect();
         tree.covered.clear();
         // Grown entry by entry: kept at their size (about 15 MB at 256², up to twice that
         // with the room a growing vector leaves).
@@ -147,7 +142,8 @@ impl Patches {
         backoff: &mut Vec<u8>,
     ) {
         let least = reach * (1.0 + MARGIN);
-        let covered = &mut tree.covered;
+        // Each of the tree's subtrees (the nodes a certificate can cover) is one piece.
+        let (subtrees, covered) = (&tree.subtrees, &mut tree.covered);
         covered.clear();
         covered.resize(self.parent.len(), false);
         if backoff.len() != self.parent.len() {
@@ -157,7 +153,7 @@ impl Patches {
         // Each subtree from its root down: a node under a certified one is covered with it.
         let (flags, counts) = (Disjoint::new(covered), Disjoint::new(backoff));
         let work = |_: usize, piece: usize| {
-            let range = self.subtrees[piece].clone();
+            let range = subtrees[piece].0.clone();
             // SAFETY: the subtrees' ranges are disjoint.
             let (flags, counts) =
                 unsafe { (flags.part(range.clone()), counts.part(range.clone())) };
@@ -172,7 +168,7 @@ impl Patches {
             }
         };
         let parallel = self.particle.len() >= PARALLEL_ELEMENTS;
-        Team::current().run_large_pieces_if(parallel, self.subtrees.len(), &work);
+        Team::current().run_large_pieces_if(parallel, subtrees.len(), &work);
     }
 
     /// Whether corner `c`'s ring is held by a node of `tree` covered for the motion last

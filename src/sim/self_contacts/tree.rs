@@ -69,9 +69,10 @@ pub(super) struct TriangleTree {
     /// The pieces a search is cut into.
     tasks: Vec<Task>,
     /// The nodes and the leaves of each subtree whose root holds at most
-    /// [`TRIANGLES_PER_PIECE`] triangles and its parent more, as ranges: fitted in pieces
-    /// shared with the team.
-    subtrees: Vec<(std::ops::Range<usize>, std::ops::Range<usize>)>,
+    /// [`TRIANGLES_PER_PIECE`] triangles and its parent more, as ranges in the tree's
+    /// order: fitted, and its patches decided ([`super::patches`]), in pieces shared with
+    /// the team.
+    pub(super) subtrees: Vec<(std::ops::Range<usize>, std::ops::Range<usize>)>,
     /// Each node's box (by boxes), or the box of its starts (by motion), as `[lo, hi]`.
     boxes: Vec<[Vec3A; 2]>,
     /// By motion, each node's box of its ends and its mean motion, as `[lo, hi, mean]`.
@@ -143,12 +144,6 @@ impl TriangleTree {
             i = last + 1;
         }
         tree
-    }
-
-    /// The nodes of each subtree whose root holds at most [`TRIANGLES_PER_PIECE`]
-    /// triangles and its parent more, as ranges in the tree's order.
-    pub(super) fn subtrees(&self) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
-        self.subtrees.iter().map(|(nodes, _)| nodes.clone())
     }
 
     /// Adds the pieces of a walk of node `a` against itself to the tasks.
