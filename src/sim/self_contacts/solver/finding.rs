@@ -151,6 +151,14 @@ impl SelfContacts {
         // Until the pairs are whole again (an error on the way leaves them not).
         self.found_for = None;
         let (window, grow, look) = (self.window, self.grow(thickness), self.look_ahead());
+        // The triangles searched again: those a particle that left is a corner of, in
+        // order; and the corners whose pairs lie on them: those particles and their rings.
+        let (n, rings) = (model.triangles.len(), &self.owners.rings);
+        self.dirty.clear();
+        self.dirty.resize(n, false);
+        self.touched.clear();
+        self.touched.resize(self.left.len(), false);
+        self.searched.clear();
         for (i, _) in self.left.iter().enumerate().filter(|(_, l)| **l) {
             let (mut s, mut p) = (self.from[i], self.to[i]);
             if self.boxes.swept {
@@ -167,16 +175,6 @@ impl SelfContacts {
             }
             let ahead = ahead(look, s, p, thickness);
             (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) = Self::vertex_box(s, ahead, grow);
-        }
-        // The triangles searched again: those a particle that left is a corner of, in
-        // order; and the corners whose pairs lie on them: those particles and their rings.
-        let (n, rings) = (model.triangles.len(), &self.owners.rings);
-        self.dirty.clear();
-        self.dirty.resize(n, false);
-        self.touched.clear();
-        self.touched.resize(self.left.len(), false);
-        self.searched.clear();
-        for (i, _) in self.left.iter().enumerate().filter(|(_, l)| **l) {
             self.touched[i] = true;
             for &j in &rings.ring[rings.range(i)] {
                 self.touched[j as usize] = true;
