@@ -83,6 +83,19 @@ impl SelfContacts {
         thickness + 2.0 * self.allowance(thickness)
     }
 
+    /// What a search of the cloth of `triangles` for `thickness` reads: the owners, the
+    /// boxes, the reach, and which corners the certificates left open. (The pairs it
+    /// finds are taken out of the solver meanwhile, to be filled while this is read.)
+    pub(super) fn search<'a>(&'a self, triangles: &'a [[u32; 3]], thickness: f32) -> Search<'a> {
+        Search {
+            owners: &self.owners,
+            triangles,
+            boxes: &self.boxes,
+            thickness: self.reach(thickness),
+            open: &self.certificates.open,
+        }
+    }
+
     /// How much each particle's box is grown around its motion, m: half the thickness and
     /// the allowance where the pairs are judged by the motion, three quarters of the
     /// thickness where by the boxes (room to reuse them).
@@ -199,14 +212,9 @@ impl SelfContacts {
         self.decide_corners(&model.triangles, thickness, true);
         let (tree, dirty, touched) = (&self.tree, &self.dirty, &self.touched);
         let owner = &self.owners.vertex_owner;
-        (self.found).retain(|p| p.triangles(owner).iter().all(|&t| !dirty[t as usize]));
-        let search = Search {
-            owners: &self.owners,
-            triangles: &model.triangles,
-            boxes: &self.boxes,
-            thickness: self.reach(thickness),
-            open: &self.certificates.open,
-        };
+        let mut found = std::mem::take(&mut self.found);
+        found.retain(|p| p.triangles(owner).iter().all(|&t| !dirty[t as usize]));
+        let search = self.search(&model.triangles, thickness);
         let searched = &self.searched;
         let pieces = searched.len().div_ceil(REFRESHED_PER_PIECE);
         let work = |piece: usize, out: &mut Vec<StoredPair>| {
@@ -223,7 +231,8 @@ impl SelfContacts {
         };
         let refreshed = searched.len();
         let parallel = refreshed >= PARALLEL_REFRESHED;
-        (self.found).extend(pieces + search.neighbour_pieces(), parallel, &work);
+        found.extend(pieces + search.neighbour_pieces(), parallel, &work);
+        self.found = found;
         self.work.refreshes += 1;
         self.work.refreshed += refreshed as u64;
         self.found_for = Some(thickness);
@@ -348,13 +357,8 @@ impl SelfContacts {
             self.tree.covered.clear();
         }
         self.decide_corners(&model.triangles, thickness, false);
-        let search = Search {
-            owners: &self.owners,
-            triangles: &model.triangles,
-            boxes: &self.boxes,
-            thickness: self.reach(thickness),
-            open: &self.certificates.open,
-        };
+        let mut found = std::mem::take(&mut self.found);
+        let search = self.search(&model.triangles, thickness);
         let tree = &self.tree;
         let work = |piece: usize, out: &mut Vec<StoredPair>| {
             if piece >= tree.pieces() {
@@ -364,7 +368,8 @@ impl SelfContacts {
         };
         let parallel = model.triangles.len() >= PARALLEL_TRIANGLES;
         let pieces = tree.pieces() + search.neighbour_pieces();
-        self.found.extend(pieces, parallel, &work);
+        found.extend(pieces, parallel, &work);
+        self.found = found;
         self.work.searches += 1;
         self.found_for = Some(thickness);
         Ok(())

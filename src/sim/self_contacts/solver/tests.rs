@@ -51,17 +51,6 @@ fn searched_to(model: &ClothModel, start: &[Vec3], end: &[Vec3]) -> SelfContacts
     contacts
 }
 
-/// The search `contacts` made for the cloth of `triangles`, with its boxes and corners.
-fn search_of<'a>(contacts: &'a SelfContacts, triangles: &'a [[u32; 3]]) -> Search<'a> {
-    Search {
-        owners: &contacts.owners,
-        triangles,
-        boxes: &contacts.boxes,
-        thickness: THICKNESS,
-        open: &contacts.certificates.open,
-    }
-}
-
 /// Calls `visit` with each vertex–triangle and edge–edge pair of every two triangles whose
 /// boxes (their particles' boxes, as `search` has them) overlap, whose sides' boxes
 /// overlap too: by testing every two triangles.
@@ -165,7 +154,7 @@ fn a_search_finds_what_testing_every_two_triangles_finds() {
             .collect();
         let contacts = searched_to(&model, &start, &end);
         let found = sorted(contacts.found.stored().copied().collect());
-        let search = search_of(&contacts, triangles);
+        let search = contacts.search(triangles, THICKNESS);
         let mut every = Vec::new();
         each_overlapping_pair(&search, |pair, stored| {
             search.keep(pair, stored, &mut every)
@@ -604,7 +593,7 @@ fn pairs_judged_by_the_boxes_are_kept_exactly_where_their_balls_come_near() {
     let (model, start) = crumpled();
     let contacts = searched_to(&model, &start, &start);
     assert!(!contacts.boxes.swept);
-    let search = search_of(&contacts, &model.triangles);
+    let search = contacts.search(&model.triangles, THICKNESS);
     let (lo, hi) = (&contacts.boxes.vertex_lo, &contacts.boxes.vertex_hi);
     let centre = |i: usize| (0.5 * (lo[i] + hi[i])).as_dvec3();
     let radius = |i: usize| 0.5 * f64::from((hi[i] - lo[i] - THICKNESS).max(Vec3::ZERO).length());
