@@ -154,8 +154,8 @@ impl SelfContacts {
 
     /// The particles that [`SelfContacts::update_pairs`] found out of their boxes get new
     /// ones; the pairs of every triangle they are corners of are dropped and searched
-    /// again against the whole tree, fitted anew. The pairs of two triangles neither of
-    /// which moved out stand: their boxes are the same.
+    /// again against the whole tree, fitted again where those triangles lie. The pairs of
+    /// two triangles neither of which moved out stand: their boxes are the same.
     pub(super) fn refresh(
         &mut self,
         model: &ClothModel,
