@@ -1,7 +1,7 @@
 //! The tree's walks: every two triangles that share no corner and whose boxes overlap, once; by the motion, no two
 //! passed by that come within the reach anywhere along it; a search of some triangles
-//! finds what the whole walk finds of theirs; and a fit of some triangles leaves the tree
-//! as a whole fit does.
+//! finds what the whole walk finds of theirs; a fit of some triangles leaves the tree as
+//! a whole fit does; and a fit by the motion tells the widest triangle.
 
 use glam::{DVec3, Quat, Vec3};
 
@@ -257,4 +257,37 @@ fn fitting_the_moved_triangles_again_leaves_the_tree_as_a_whole_fit_does() {
     fresh.fit_boxes(&lo, &hi);
     fresh.refit_motion(&changed, [&rest, &lifted], reach);
     same(&fresh, &tree, true);
+}
+
+/// A fit by the motion tells the widest any triangle's particles span along an axis over
+/// the motion, wherever in the tree that triangle lies: in the first subtree fitted, the
+/// last, or one between (the fit runs subtree by subtree).
+#[test]
+fn a_fit_by_the_motion_tells_the_widest_triangle_wherever_it_lies() {
+    let (triangles, rest, pos) = cloth();
+    let mut tree = TriangleTree::build(&triangles, &rest);
+    assert!(tree.subtrees.len() >= 2, "{} subtrees", tree.subtrees.len());
+    let widest = |to: &[Vec3]| {
+        (triangles.iter())
+            .map(|t| {
+                let (s, e) = (t.map(|i| rest[i as usize]), t.map(|i| to[i as usize]));
+                let lo = s.iter().chain(&e).fold(Vec3::INFINITY, |m, &p| m.min(p));
+                let hi = s
+                    .iter()
+                    .chain(&e)
+                    .fold(Vec3::NEG_INFINITY, |m, &p| m.max(p));
+                (hi - lo).max_element()
+            })
+            .fold(0.0f32, f32::max)
+    };
+    let places = [0, tree.order.len() / 2, tree.order.len() - 1];
+    for place in places {
+        // A corner of the triangle at that place in the tree's order flung 3 m.
+        let flung = triangles[tree.order[place] as usize][0] as usize;
+        let mut to = pos.clone();
+        to[flung] += Vec3::new(3.0, 0.0, 0.0);
+        let told = tree.fit_motion([&rest, &to], 0.01);
+        assert!(told >= 3.0, "place {place}: {told}");
+        assert_eq!(told, widest(&to), "place {place}");
+    }
 }
