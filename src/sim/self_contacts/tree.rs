@@ -376,13 +376,16 @@ impl TriangleTree {
             Fit::Motion { reach } => self.walk(
                 piece,
                 |a, b| self.moving_apart(a, b, reach),
-                |lanes, one| lanes.moving_near(one, reach),
+                |[a, b], [la, lb]| {
+                    let m = 0.5 * (self.motion[a][2] + self.motion[b][2]);
+                    self.lanes[lb].moving_near_rows(&self.lanes[la], m, reach)
+                },
                 pair,
             ),
             Fit::Boxes => self.walk(
                 piece,
                 |a, b| self.boxes_apart(a, b),
-                |lanes, one| lanes.boxes_meet(one),
+                |_, [la, lb]| self.lanes[lb].boxes_meet_rows(&self.lanes[la]),
                 pair,
             ),
         }
@@ -403,14 +406,17 @@ impl TriangleTree {
                     let own = ([one.lo, one.hi], [one.end_lo, one.end_hi, one.mean]);
                     moving_apart((self.boxes[a], self.motion[a]), own, reach)
                 },
-                |lanes, one| lanes.moving_near(one, reach),
+                |[a, b], lanes, one| {
+                    let m = 0.5 * (self.motion[a][2] + self.motion[b][2]);
+                    lanes.moving_near(one, m, reach)
+                },
                 pair,
             ),
             Fit::Boxes => self.query(
                 t,
                 searched,
                 |a, one| boxes_apart(self.boxes[a], [one.lo, one.hi]),
-                |lanes, one| lanes.boxes_meet(one),
+                |_, lanes, one| lanes.boxes_meet(one),
                 pair,
             ),
         }
@@ -422,7 +428,7 @@ impl TriangleTree {
         t: u32,
         searched: &[bool],
         apart: impl Fn(usize, &One) -> bool,
-        lanes_near: impl Fn(&Lanes, (&Lanes, usize)) -> u32,
+        lanes_near: impl Fn([usize; 2], &Lanes, (&Lanes, usize)) -> u32,
         mut pair: impl FnMut(u32, u32),
     ) {
         if self.nodes.is_empty() {
@@ -431,7 +437,7 @@ impl TriangleTree {
         let place = self.place_of[t as usize] as usize;
         let (leaf, k) = self.lane(place);
         let (lane, corners) = ((&self.lanes[leaf], k), self.corners(leaf, k));
-        let one = self.lanes[leaf].one(k);
+        let (one, own) = (self.lanes[leaf].one(k), self.leaves[leaf] as usize);
         let mut stack = [0u32; STACK];
         let mut depth = 1;
         while depth > 0 {
@@ -443,7 +449,7 @@ impl TriangleTree {
             let node = self.nodes[a as usize];
             if Self::is_leaf(node) {
                 let leaf = self.leaf_of[a as usize] as usize;
-                let near = lanes_near(&self.lanes[leaf], lane)
+                let near = lanes_near([own, a as usize], &self.lanes[leaf], lane)
                     & share_none(corners, &self.leaf_corners[leaf]);
                 for k in flagged(near, 0, node.count) {
                     let b = self.order[node.first as usize + k];
@@ -463,7 +469,7 @@ impl TriangleTree {
         &self,
         piece: usize,
         apart: impl Fn(usize, usize) -> bool,
-        lanes_near: impl Fn(&Lanes, (&Lanes, usize)) -> u32,
+        lanes_near: impl Fn([usize; 2], [usize; 2]) -> [u32; 4],
         mut pair: impl FnMut(u32, u32),
     ) {
         // Each triangle of leaf node `a` against those of leaf node `b` (past its own,
@@ -471,13 +477,18 @@ impl TriangleTree {
         let mut leaves = |a: usize, b: usize| {
             let (na, nb) = (self.nodes[a], self.nodes[b]);
             let (la, lb) = (self.leaf_of[a] as usize, self.leaf_of[b] as usize);
-            let (lanes, corners) = (&self.lanes[lb], &self.leaf_corners[lb]);
-            for k in 0..na.count as usize {
+            let corners = &self.leaf_corners[lb];
+            let rows = lanes_near([a, b], [la, lb]);
+            let lanes = (1u32 << nb.count) - 1;
+            for (k, &row) in rows.iter().enumerate().take(na.count as usize) {
+                // Past its own, where the leaves are the same.
+                let row = if a == b { row & !((2 << k) - 1) } else { row } & lanes;
+                if row == 0 {
+                    continue;
+                }
                 let p = na.first as usize + k;
-                let near = share_none(self.corners(la, k), corners)
-                    & lanes_near(lanes, (&self.lanes[la], k));
-                let from = if a == b { k + 1 } else { 0 };
-                for q in flagged(near, from, nb.count) {
+                let near = share_none(self.corners(la, k), corners) & row;
+                for q in flagged(near, 0, nb.count) {
                     pair(self.order[p], self.order[nb.first as usize + q]);
                 }
             }

@@ -86,21 +86,40 @@ impl Lanes {
         meet.bitmask()
     }
 
-    /// The lanes (as bits) whose triangle the triangle of lane `k` of `one` is not told
-    /// `reach` apart from along their motion, in the frame of their mean motion: the
-    /// tree's test of two nodes (that one first), four at a time, to the bit.
+    /// Each lane's box of its starts and its ends less `m`, an axis each: in the frame
+    /// that moves by `m` along the motion, its triangle stays in it (each particle's path
+    /// runs between its start and its end less `m`).
     #[inline(always)]
-    pub(super) fn moving_near(&self, (one, k): (&Lanes, usize), reach: f32) -> u32 {
-        let mut gap = Vec4::NEG_INFINITY;
-        for x in 0..3 {
-            let m = 0.5 * (Vec4::splat(one.mean[x][k]) + self.mean[x]);
-            let alo = Vec4::splat(one.lo[x][k]).min(Vec4::splat(one.end_lo[x][k]) - m);
-            let ahi = Vec4::splat(one.hi[x][k]).max(Vec4::splat(one.end_hi[x][k]) - m);
-            let blo = self.lo[x].min(self.end_lo[x] - m);
-            let bhi = self.hi[x].max(self.end_hi[x] - m);
-            gap = gap.max((blo - ahi).max(alo - bhi));
-        }
-        (!gap.cmpge(Vec4::splat(reach))).bitmask()
+    fn hulls(&self, m: Vec3A) -> [[Vec4; 2]; 3] {
+        std::array::from_fn(|x| {
+            let mx = Vec4::splat(m[x]);
+            [
+                self.lo[x].min(self.end_lo[x] - mx),
+                self.hi[x].max(self.end_hi[x] - mx),
+            ]
+        })
+    }
+
+    /// The lanes (as bits) whose triangle the triangle of lane `k` of `one` is not told
+    /// `reach` apart from along their motion, in the frame that moves by `m` (any frame
+    /// keeps the test; the two leaves' mean motion keeps it tight): the tree's test of
+    /// two nodes, four at a time.
+    #[inline(always)]
+    pub(super) fn moving_near(&self, (one, k): (&Lanes, usize), m: Vec3A, reach: f32) -> u32 {
+        near_row(&self.hulls(m), &one.hulls(m), k, reach)
+    }
+
+    /// [`Lanes::moving_near`] for each lane of `other`, as a row of bits each.
+    #[inline(always)]
+    pub(super) fn moving_near_rows(&self, other: &Lanes, m: Vec3A, reach: f32) -> [u32; 4] {
+        let (b, a) = (self.hulls(m), other.hulls(m));
+        std::array::from_fn(|k| near_row(&b, &a, k, reach))
+    }
+
+    /// [`Lanes::boxes_meet`] for each lane of `other`, as a row of bits each.
+    #[inline(always)]
+    pub(super) fn boxes_meet_rows(&self, other: &Lanes) -> [u32; 4] {
+        std::array::from_fn(|k| self.boxes_meet((other, k)))
     }
 
     /// The box of the first `count` lanes' boxes, and by motion the box of their ends and
@@ -118,6 +137,18 @@ impl Lanes {
         }
         ([lo, hi], [end_lo, end_hi, sum / count as f32])
     }
+}
+
+/// The lanes (as bits) of hulls `b` ([`Lanes::hulls`]) not told `reach` apart from lane
+/// `k` of hulls `a` along any axis.
+#[inline(always)]
+fn near_row(b: &[[Vec4; 2]; 3], a: &[[Vec4; 2]; 3], k: usize, reach: f32) -> u32 {
+    let mut gap = Vec4::NEG_INFINITY;
+    for ([blo, bhi], [alo, ahi]) in b.iter().zip(a) {
+        let (alo, ahi) = (Vec4::splat(alo[k]), Vec4::splat(ahi[k]));
+        gap = gap.max((*blo - ahi).max(alo - *bhi));
+    }
+    (!gap.cmpge(Vec4::splat(reach))).bitmask()
 }
 
 /// A leaf's triangles' corners, one lane each, an array a corner.
