@@ -196,6 +196,70 @@ fn share_none_plainly(corners: [u32; 3], lanes: &Corners) -> u32 {
 mod tests {
     use super::*;
 
+    /// Two leaves of four triangles each, moving 2–20 cm toward, past or along each other
+    /// (each triangle a few cm wide and 1–10 cm from the other leaf): the pairs their rows
+    /// tell apart in the frame of the leaves' mean motion, of none, or of any motion, keep
+    /// the reach apart all along it (at each of 33 points their boxes lie that far apart
+    /// along an axis), and a row is what one lane's test tells.
+    #[test]
+    fn triangles_told_apart_by_their_motion_keep_apart_along_it() {
+        let mut rnd = crate::test_rng::uniform(17);
+        let mut vector = |scale: f32| Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * scale;
+        let reach = 0.01;
+        let (mut apart, mut near) = (0, 0);
+        for trial in 0..600 {
+            let (ca, cb) = (vector(0.1), vector(0.1));
+            let (ma, mb) = (vector(0.2), vector(0.2));
+            let mut leaf = |centre: Vec3, motion: Vec3| {
+                let from: Vec<Vec3> = (0..12).map(|_| centre + vector(0.04)).collect();
+                let to: Vec<Vec3> = from.iter().map(|&p| p + motion + vector(0.01)).collect();
+                let mut lanes = Lanes::default();
+                for lane in 0..4 {
+                    let corners = [0, 1, 2].map(|c| (3 * lane + c) as u32);
+                    lanes.set(lane, One::of(corners, [&from, &to]));
+                }
+                (lanes, from, to)
+            };
+            let ((a, a_from, a_to), (b, b_from, b_to)) = (leaf(ca, ma), leaf(cb, mb));
+            let m = match trial % 3 {
+                0 => Vec3A::from(0.5 * (ma + mb)),
+                1 => Vec3A::ZERO,
+                _ => Vec3A::from(vector(0.4)),
+            };
+            let rows = b.moving_near_rows(&a, m, reach);
+            for (k, &row) in rows.iter().enumerate() {
+                assert_eq!(row, b.moving_near((&a, k), m, reach));
+                for j in 0..4 {
+                    if row & (1 << j) != 0 {
+                        near += 1;
+                        continue;
+                    }
+                    apart += 1;
+                    for step in 0..=32 {
+                        let t = step as f32 / 32.0;
+                        let at = |from: &[Vec3], to: &[Vec3], lane: usize| {
+                            (3 * lane..3 * lane + 3).fold(
+                                (Vec3::INFINITY, Vec3::NEG_INFINITY),
+                                |(lo, hi), i| {
+                                    let p = from[i] + (to[i] - from[i]) * t;
+                                    (lo.min(p), hi.max(p))
+                                },
+                            )
+                        };
+                        let ((alo, ahi), (blo, bhi)) =
+                            (at(&a_from, &a_to, k), at(&b_from, &b_to, j));
+                        let gap = (blo - ahi).max(alo - bhi).max_element();
+                        assert!(
+                            gap >= reach * (1.0 - 1e-4),
+                            "trial {trial}: {k} and {j} {gap} m apart at {t}"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(apart > 1000 && near > 1000, "{apart} apart, {near} near");
+    }
+
     /// The SIMD compare and the plain one flag the same lanes, for corners drawn from a
     /// few particles (so that many share one, in every lane and every corner's place), and
     /// from numbers past `i32::MAX` (compared as signed lanes).
