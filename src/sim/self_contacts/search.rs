@@ -354,9 +354,8 @@ impl Search<'_> {
     /// that motion alone, so the boxes need not be asked); otherwise with each particle
     /// anywhere in its box.
     pub(super) fn keep(&self, pair: Pair, stored: StoredPair, out: &mut Vec<StoredPair>) {
-        let thickness = f64::from(self.thickness);
         let near = if self.boxes.swept {
-            self.swept_apart(&pair) < thickness
+            self.swept_near(&pair)
         } else {
             self.boxed_near(&pair)
         };
@@ -396,17 +395,19 @@ impl Search<'_> {
         nearest < reach * reach || distance(pair, x) < reach
     }
 
-    /// A lower bound on how close the pair's sides come along the particles' straight
-    /// motion the boxes were made for. First the sides' boxes in the frame that moves with
-    /// the pair's mean motion (each side stays in the box of its particles' starts and
-    /// ends less that motion; a translation changes no distance): most pairs that move
-    /// together end there, their gap along an axis. Then, in the same frame, the gap along
-    /// the line between the sides' middles (two sides a cell apart on a patch that runs
-    /// across the axes end there). Then the distance: it changes along the
-    /// motion no faster than the sides' largest displacements relative to the pair's mean
-    /// motion add up to (`L`), so it stays above both `d₀ − τL` and `d₁ − (1 − τ)L`, whose
-    /// larger is least, `(d₀ + d₁ − L)/2`, where they cross.
-    fn swept_apart(&self, pair: &Pair) -> f64 {
+    /// Whether the pair's sides could come within the thickness along the particles'
+    /// straight motion the boxes were made for. First the sides' boxes in the frame that
+    /// moves with the pair's mean motion (each side stays in the box of its particles'
+    /// starts and ends less that motion; a translation changes no distance): most pairs
+    /// that move together are told apart there, by their gap along an axis. Then, in the
+    /// same frame, the gap along the line between the sides' middles (two sides a cell
+    /// apart on a patch that runs across the axes are told apart there). Then the
+    /// distances at the start and the end (`d₀`, `d₁`): either within the thickness keeps
+    /// the pair (as most of a stack's do); otherwise the distance changes along the motion
+    /// no faster than the sides' largest displacements relative to the pair's mean motion
+    /// add up to (`L`), so it stays above both `d₀ − τL` and `d₁ − (1 − τ)L`, whose larger
+    /// is least, `(d₀ + d₁ − L)/2`, where they cross.
+    fn swept_near(&self, pair: &Pair) -> bool {
         let ids = pair.ids();
         let (from, to) = (&self.boxes.from, &self.boxes.to);
         let x0 = ids.map(|i| from[i].as_dvec3());
@@ -424,7 +425,7 @@ impl Search<'_> {
         let gap = (blo - ahi).max(alo - bhi).max_element();
         let thickness = f64::from(self.thickness);
         if gap >= thickness {
-            return gap;
+            return false;
         }
         // Then along the line between the sides' middles (in the same frame): where a
         // smooth patch runs across the axes, two sides a cell apart are apart along it.
@@ -443,9 +444,14 @@ impl Search<'_> {
         let ((_, ahi), (blo, _)) = (span(0..k), span(k..4));
         let length = axis.length();
         if blo - ahi >= thickness * length && length > 0.0 {
-            return (blo - ahi) / length;
+            return false;
         }
-        0.5 * (distance(pair, x0) + distance(pair, x1) - closing_bound(pair, moves))
+        let first = distance(pair, x0);
+        if first < thickness {
+            return true;
+        }
+        let last = distance(pair, x1);
+        last < thickness || 0.5 * (first + last - closing_bound(pair, moves)) < thickness
     }
 }
 
