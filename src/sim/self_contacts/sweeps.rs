@@ -13,7 +13,7 @@
 use glam::Vec3;
 
 use super::found::Found;
-use super::primitives::push_apart;
+use super::primitives::{Pair, push_apart};
 use super::search::{Owners, pairs};
 use crate::cloth::{ClothModel, ClothState};
 
@@ -22,11 +22,10 @@ use crate::cloth::{ClothModel, ClothState};
 pub(super) struct Sweeps {
     /// Each particle's running sum of how far the pushes of this pass moved it, m.
     moved: Vec<f32>,
-    /// Each pair's (in the list's order) least distance over the thickness when last
-    /// found apart, m (negative: test it; `+∞`: left out), and its four particles' sums
-    /// then.
-    slack: Vec<f32>,
-    since: Vec<[f32; 4]>,
+    /// The pairs the first sweep did not leave out, each with its least distance over the
+    /// thickness when last found apart, m (negative: test it), and its four particles'
+    /// sums then.
+    near: Vec<(Pair, f32, [f32; 4])>,
 }
 
 /// A pair's slack is kept short of what its test measured by this share of it: the
@@ -51,42 +50,57 @@ impl Sweeps {
     ) -> usize {
         self.moved.clear();
         self.moved.resize(state.pos.len(), 0.0);
-        self.slack.clear();
-        self.slack.resize(found.len(), -1.0);
-        self.since.resize(found.len(), [0.0; 4]);
+        self.near.clear();
         let mut pushes = 0;
-        for sweep in 0..count {
-            // The first sweep measures out to `within`, the others to the thickness.
-            let reach = if sweep == 0 { within } else { thickness };
-            let listed = pairs(found, &model.triangles, owners);
-            for ((pair, slack), since) in listed.zip(&mut self.slack).zip(&mut self.since) {
-                let ids = pair.ids();
-                let k = pair.first_side();
-                let moved = &self.moved;
+        let mut push = |moved: &mut [f32], pair: &Pair, reach: f32| {
+            let ids = pair.ids();
+            let before = ids.map(|i| state.pos[i]);
+            let outcome = push_apart(
+                pair,
+                [thickness, friction, reach],
+                model,
+                start,
+                state,
+                held,
+            );
+            if outcome == Ok(true) {
+                pushes += 1;
+                for (j, &i) in ids.iter().enumerate() {
+                    moved[i] += state.pos[i].distance(before[j]);
+                }
+            }
+            outcome
+        };
+        // A pair's slack after a push's `outcome`: how far apart over the thickness it
+        // was found, and its particles' sums then; none where it was within it.
+        let slack_after = |outcome: Result<bool, f32>, ids: [usize; 4], moved: &[f32]| match outcome
+        {
+            Err(apart) => (
+                (apart - thickness) - ROUNDING * apart,
+                ids.map(|i| moved[i]),
+            ),
+            Ok(_) => (-1.0, [0.0; 4]),
+        };
+        // The first sweep measures out to `within`; the others, to the thickness, go
+        // through only the pairs it found nearer.
+        for pair in pairs(found, &model.triangles, owners) {
+            let outcome = push(&mut self.moved, &pair, within);
+            if !matches!(outcome, Err(apart) if apart >= within) {
+                let (slack, since) = slack_after(outcome, pair.ids(), &self.moved);
+                self.near.push((pair, slack, since));
+            }
+        }
+        for _ in 1..count {
+            for (pair, slack, since) in &mut self.near {
+                let (ids, k, moved) = (pair.ids(), pair.first_side(), &self.moved);
                 let drift = |r: std::ops::Range<usize>| {
                     r.map(|j| moved[ids[j]] - since[j]).fold(0.0f32, f32::max)
                 };
                 if *slack > drift(0..k) + drift(k..4) {
                     continue;
                 }
-                let before = ids.map(|i| state.pos[i]);
-                let pair_at = [thickness, friction, reach];
-                match push_apart(&pair, pair_at, model, start, state, held) {
-                    Err(apart) if sweep == 0 && apart >= within => *slack = f32::INFINITY,
-                    Err(apart) => {
-                        *slack = (apart - thickness) - ROUNDING * apart;
-                        *since = ids.map(|i| self.moved[i]);
-                    }
-                    Ok(pushed) => {
-                        *slack = -1.0;
-                        if pushed {
-                            pushes += 1;
-                            for (j, &i) in ids.iter().enumerate() {
-                                self.moved[i] += state.pos[i].distance(before[j]);
-                            }
-                        }
-                    }
-                }
+                let outcome = push(&mut self.moved, pair, thickness);
+                (*slack, *since) = slack_after(outcome, ids, &self.moved);
             }
         }
         pushes
