@@ -2,7 +2,9 @@
 //! meet an obstacle, decided by the signs of orientation tests computed exactly (Shewchuk's
 //! adaptive predicates, the `robust` crate; an f32 coordinate is exact in f64). Plain f64
 //! is not enough: a flat cloth's triangles are exactly coplanar, and rounding gives their
-//! volumes signs that make neighbours cross. It judges a state; it moves nothing.
+//! volumes signs that make neighbours cross. Plain f64 only tells apart, first, two
+//! triangles that lie apart along the line between their middles by more than rounding
+//! could close. It judges a state; it moves nothing.
 //!
 //! Two triangles of the cloth that share an edge always touch along it and are not
 //! counted; two that share one vertex are tested on the edge each has opposite it; the

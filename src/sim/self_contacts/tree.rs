@@ -394,9 +394,10 @@ impl TriangleTree {
     /// Calls `pair(t, b)` for each triangle `b` sharing no corner with `t` that `t`'s box
     /// is not told apart from (as the last fit tells them), not flagged by `searched`
     /// where `b < t`: a search of each flagged triangle so calls it once for each two of
-    /// which one at least is flagged. By the boxes, the whole walk's tests of theirs and these tell the same
-    /// two apart; by the motion, `t` is told apart from each node in their own frame
-    /// rather than from the node the whole walk pairs with it.
+    /// which one at least is flagged. By the boxes, the whole walk's tests of theirs and
+    /// these tell the same two apart; by the motion, `t` is told apart from each node in
+    /// their own frame rather than from the node the whole walk pairs with it (at a leaf,
+    /// in the frame of the two leaves, as the whole walk tells them).
     pub(super) fn triangle_pairs(&self, t: u32, searched: &[bool], pair: impl FnMut(u32, u32)) {
         match self.fit {
             Fit::Motion { reach } => self.query(
