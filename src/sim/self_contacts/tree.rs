@@ -452,7 +452,7 @@ impl TriangleTree {
                 let leaf = self.leaf_of[a as usize] as usize;
                 let near = lanes_near([own, a as usize], &self.lanes[leaf], lane)
                     & share_none(corners, &self.leaf_corners[leaf]);
-                for k in flagged(near, 0, node.count) {
+                for k in flagged(near & lanes_of(node)) {
                     let b = self.order[node.first as usize + k];
                     if b != t && !(b < t && searched[b as usize]) {
                         pair(t, b);
@@ -480,7 +480,7 @@ impl TriangleTree {
             let (la, lb) = (self.leaf_of[a] as usize, self.leaf_of[b] as usize);
             let corners = &self.leaf_corners[lb];
             let rows = lanes_near([a, b], [la, lb]);
-            let lanes = (1u32 << nb.count) - 1;
+            let lanes = lanes_of(nb);
             for (k, &row) in rows.iter().enumerate().take(na.count as usize) {
                 // Past its own, where the leaves are the same.
                 let row = if a == b { row & !((2 << k) - 1) } else { row } & lanes;
@@ -489,7 +489,7 @@ impl TriangleTree {
                 }
                 let p = na.first as usize + k;
                 let near = share_none(self.corners(la, k), corners) & row;
-                for q in flagged(near, 0, nb.count) {
+                for q in flagged(near) {
                     pair(self.order[p], self.order[nb.first as usize + q]);
                 }
             }
@@ -537,15 +537,21 @@ impl TriangleTree {
     }
 }
 
-/// The lanes flagged in the bits of `flags`, from lane `from` up to lane `count`, in order.
+/// The lanes flagged in the bits of `flags`, in order.
 #[inline(always)]
-fn flagged(flags: u32, from: usize, count: u32) -> impl Iterator<Item = usize> {
-    let mut left = flags & ((1 << count) - 1) & !((1 << from) - 1);
+fn flagged(flags: u32) -> impl Iterator<Item = usize> {
+    let mut left = flags;
     std::iter::from_fn(move || {
         let lane = left.trailing_zeros() as usize;
         left &= left.wrapping_sub(1);
         (lane < 32).then_some(lane)
     })
+}
+
+/// The lanes (as bits) that hold leaf `node`'s triangles.
+#[inline(always)]
+fn lanes_of(node: Split) -> u32 {
+    (1 << node.count) - 1
 }
 
 /// Sets lane `lane` of a leaf's lanes to triangle `t`'s boxes (its corners given); returns
