@@ -9,16 +9,34 @@ use super::*;
 use crate::mesh::{GridOrientation, GridSpec};
 use crate::sim::self_contacts::primitives::{Pair, distance};
 
-/// A 16 × 16-quad cloth 1 m wide (512 triangles: several pieces of a walk), its particles
-/// jittered by up to 2 cm about the plane: its triangles and rest and jittered positions.
+/// A 15 × 15-quad cloth 1 m wide (450 triangles: several pieces of a walk, and leaves of
+/// three triangles as well as of four), its particles jittered by up to 2 cm about the
+/// plane: its triangles and rest and jittered positions.
 fn cloth() -> (Vec<[u32; 3]>, Vec<Vec3>, Vec<Vec3>) {
-    let mesh = GridSpec::square(16, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
+    let mesh = GridSpec::square(15, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
         .build()
         .unwrap();
     let mut rnd = crate::test_rng::uniform(11);
     let mut jitter = || Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.04;
     let pos = mesh.positions.iter().map(|&p| p + jitter()).collect();
     (mesh.triangles.clone(), mesh.positions.clone(), pos)
+}
+
+/// Fills the lanes past each leaf's triangles with boxes that meet everything, by boxes
+/// and by motion: a walk or a search must never take them (they hold no triangle).
+fn poison_empty_lanes(tree: &mut TriangleTree) {
+    let everywhere = One {
+        lo: Vec3A::NEG_INFINITY,
+        hi: Vec3A::INFINITY,
+        end_lo: Vec3A::NEG_INFINITY,
+        end_hi: Vec3A::INFINITY,
+        mean: Vec3A::ZERO,
+    };
+    for (lanes, &node) in tree.lanes.iter_mut().zip(&tree.leaves) {
+        for lane in tree.nodes[node as usize].count as usize..LEAF {
+            lanes.set(lane, everywhere);
+        }
+    }
 }
 
 /// Whether two triangles share a corner.
@@ -46,12 +64,18 @@ fn sorted(mut pairs: Vec<(u32, u32)>) -> (Vec<(u32, u32)>, bool) {
 }
 
 /// Fitted to boxes, the walk finds exactly the two triangles that share no corner and whose
-/// boxes overlap, each once, over pieces of several hundred triangles.
+/// boxes overlap, each once, over pieces of several hundred triangles and leaves short of
+/// four (whose empty lanes hold no triangle).
 #[test]
 fn a_walk_finds_every_two_triangles_whose_boxes_overlap_once() {
     let (triangles, rest, pos) = cloth();
     let mut tree = TriangleTree::build(&triangles, &rest);
     assert!(tree.pieces() >= 3, "{} pieces", tree.pieces());
+    let short = |n: &Split| TriangleTree::is_leaf(*n) && (n.count as usize) < LEAF;
+    assert!(
+        tree.nodes().iter().any(short),
+        "no leaf short of four triangles"
+    );
     // Each triangle's box, grown by 2 cm.
     let grow = Vec3::splat(0.02);
     let boxed = |t: [u32; 3]| {
@@ -60,6 +84,7 @@ fn a_walk_finds_every_two_triangles_whose_boxes_overlap_once() {
     };
     let (lo, hi): (Vec<Vec3>, Vec<Vec3>) = triangles.iter().map(|&t| boxed(t)).unzip();
     tree.fit_boxes(&lo, &hi);
+    poison_empty_lanes(&mut tree);
     let (found, twice) = walked(&tree);
     assert!(!twice, "a pair found twice");
     let mut every = Vec::new();
@@ -129,6 +154,7 @@ fn a_walk_by_the_motion_passes_by_nothing_that_comes_within_reach() {
         .collect();
     let reach = 0.01;
     tree.fit_motion([&from, &to], reach);
+    poison_empty_lanes(&mut tree);
     let (found, twice) = walked(&tree);
     assert!(!twice, "a pair found twice");
     let at = |s: f64| -> Vec<DVec3> {
@@ -185,6 +211,7 @@ fn a_search_of_some_triangles_finds_what_the_whole_walk_finds_of_theirs() {
                 .unzip();
             tree.fit_boxes(&lo, &hi);
         }
+        poison_empty_lanes(&mut tree);
         let (whole, _) = walked(&tree);
         let mut pairs = Vec::new();
         for t in (0..triangles.len() as u32).filter(|&t| dirty[t as usize]) {
