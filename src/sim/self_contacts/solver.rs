@@ -109,6 +109,15 @@ pub struct SelfContacts {
     scale: Vec<f64>,
     /// What the pushes' sweeps keep.
     sweeps: Sweeps,
+    /// Particles whose motion changed since [`SelfContacts::update_pairs`] last checked it
+    /// against its box and path in this substep; every particle where `all_unchecked`
+    /// (at a substep's start, whose window has moved on, or where a check asks more than
+    /// the last). The others' hold, for a check that asks as much or less, where they were
+    /// found or left again.
+    unchecked: Vec<u32>,
+    all_unchecked: bool,
+    /// What the last check asked for: its `within`.
+    checked_within: f32,
     /// This round's cuts: each particle's smallest scale yet, as the bits of an `f64`.
     cut: Cuts,
     changed: Vec<bool>,
@@ -161,7 +170,7 @@ impl SelfContacts {
             .fold(glam::DVec3::ZERO, |m, (s, p)| m + (*p - *s).as_dvec3())
             / n;
         let mean = mean.as_vec3();
-        // A substep further into the window.
+        // A substep further into the window: every particle's motion is checked again.
         self.window.at = self.window.at.saturating_add(1);
         self.relative(start, &state.pos, self.shift, mean);
         self.update_pairs(model, thickness, thickness)?;
@@ -177,8 +186,12 @@ impl SelfContacts {
         );
         self.work.contacts = contacts as u64;
         // The pushes may have taken a particle out of the box its pairs were found in; the
-        // check needs only the pairs that can come within what it keeps.
-        self.relative(start, &state.pos, self.shift, mean);
+        // check needs only the pairs that can come within what it keeps. Only the pushed
+        // particles' ends changed.
+        for &i in self.sweeps.pushed() {
+            self.to[i as usize] = state.pos[i as usize] - self.shift - mean;
+        }
+        self.unchecked.extend_from_slice(self.sweeps.pushed());
         self.update_pairs(model, thickness, CHECKED * thickness)?;
         self.shift += mean;
         self.mean = mean;
@@ -257,8 +270,9 @@ impl SelfContacts {
 
     /// Fills the substep's start and end in the moving frame: less `shift`, how far the
     /// frame had moved by the substep's start, and the end less the substep's `mean` motion
-    /// too.
+    /// too; every particle's is to be checked.
     fn relative(&mut self, start: &[Vec3], pos: &[Vec3], shift: Vec3, mean: Vec3) {
+        self.all_unchecked = true;
         self.from.resize(start.len(), Vec3::ZERO);
         self.to.resize(pos.len(), Vec3::ZERO);
         each_part([&mut self.from, &mut self.to], |range, [from, to]| {
@@ -288,10 +302,16 @@ impl SelfContacts {
         within: f32,
     ) -> Result<(), ContactError> {
         let swept = self.boxes.swept;
+        // Less room to come within (more to stray) holds wherever more did.
+        self.all_unchecked |= within > self.checked_within;
+        self.checked_within = within;
         if self.found_for != Some(thickness)
             || self.boxes.vertex_lo.len() != self.to.len()
             || swept && self.window.at >= self.window.len
         {
+            // Every particle gets a box and a path for its motion now.
+            self.all_unchecked = false;
+            self.unchecked.clear();
             return self.find_pairs(model, thickness);
         }
         let g = Vec3::splat(0.5 * if swept { within } else { thickness });
@@ -304,30 +324,49 @@ impl SelfContacts {
         let (boxes, window) = (&self.boxes, self.window);
         let allowance = self.allowance(thickness);
         let (strays, off) = (allowance > 0.0, f64::from(allowance + slack));
-        let strayed = |i: usize, s: Vec3, p: Vec3| {
-            let (from, to) = (boxes.from[i], boxes.to[i]);
+        // In f64: the path's points are not rounded on the way.
+        let len = f64::from(window.len);
+        let at = [window.at, window.at + 1].map(|step| f64::from(step) / len);
+        let strayed = |(s, p): (Vec3, Vec3), (from, to): (Vec3, Vec3)| {
             if !strays {
                 return s != from || p.distance(to) > slack;
             }
-            // In f64: the path's points are not rounded on the way.
-            let along = |step: u32| {
-                let t = f64::from(step) / f64::from(window.len);
-                from.as_dvec3() + (to - from).as_dvec3() * t
-            };
-            s.as_dvec3().distance(along(window.at)) > off
-                || p.as_dvec3().distance(along(window.at + 1)) > off
+            let (from, along) = (from.as_dvec3(), (to - from).as_dvec3());
+            let gap = |x: Vec3, t: f64| x.as_dvec3().distance_squared(from + along * t);
+            gap(s, at[0]) > off * off || gap(p, at[1]) > off * off
+        };
+        // A particle without a path (none can be: the search sets them all) has left.
+        let left_box = |(s, p): (Vec3, Vec3), (lo, hi): (Vec3, Vec3), path: Option<_>| {
+            !((s.min(p) - g).cmpge(lo).all() && (s.max(p) + g).cmple(hi).all())
+                || swept && path.is_none_or(|path| strayed((s, p), path))
         };
         self.left.resize(self.to.len(), false);
         let (from, to) = (&self.from, &self.to);
-        each_part([&mut self.left], |range, [left]| {
-            for (l, i) in left.iter_mut().zip(range) {
-                let (s, p) = (from[i], to[i]);
-                let (lo, hi) = (boxes.vertex_lo[i], boxes.vertex_hi[i]);
-                *l = !((s.min(p) - g).cmpge(lo).all() && (s.max(p) + g).cmple(hi).all())
-                    || swept && strayed(i, s, p);
+        let left = if self.all_unchecked {
+            each_part([&mut self.left], |range, [left]| {
+                let part = |v| crate::parallel::within(v, range.clone()).iter().copied();
+                let (motion, room) = (
+                    part(from).zip(part(to)),
+                    part(&boxes.vertex_lo).zip(part(&boxes.vertex_hi)),
+                );
+                let mut paths = part(&boxes.from).zip(part(&boxes.to));
+                for ((l, motion), room) in left.iter_mut().zip(motion).zip(room) {
+                    *l = left_box(motion, room, if swept { paths.next() } else { None });
+                }
+            });
+            self.left.iter().filter(|&&l| l).count()
+        } else {
+            self.left.fill(false);
+            let path = |i: usize| Some((*boxes.from.get(i)?, *boxes.to.get(i)?));
+            let room = |i: usize| (boxes.vertex_lo[i], boxes.vertex_hi[i]);
+            for &i in &self.unchecked {
+                let i = i as usize;
+                self.left[i] = left_box((from[i], to[i]), room(i), path(i));
             }
-        });
-        let left = self.left.iter().filter(|&&l| l).count();
+            self.left.iter().filter(|&&l| l).count()
+        };
+        self.all_unchecked = false;
+        self.unchecked.clear();
         if left == 0 {
             return Ok(());
         }
@@ -466,10 +505,11 @@ impl SelfContacts {
                 // particles end within the slack of where they did: the others' pairs are
                 // searched again, and the next round checks every pair.
                 let cuts = (self.to.iter_mut().zip(&self.scale)).zip(start.iter().zip(end));
-                for ((to, &s), (&a, &b)) in cuts {
+                for (i, ((to, &s), (&a, &b))) in cuts.enumerate() {
                     if s < 1.0 {
                         let end = a.as_dvec3() + s * (b.as_dvec3() - a.as_dvec3());
                         *to = end.as_vec3() - self.shift;
+                        self.unchecked.push(i as u32);
                     }
                 }
                 let searches = self.work.searches + self.work.refreshes;

@@ -26,6 +26,10 @@ pub(super) struct Sweeps {
     /// thickness when last found apart, m (negative: test it), and its four particles'
     /// sums then.
     near: Vec<(Pair, f32, [f32; 4])>,
+    /// The particles the pushes of this pass moved, each once, and whether each is among
+    /// them.
+    pushed: Vec<u32>,
+    is_pushed: Vec<bool>,
 }
 
 /// A pair's slack is kept short of what its test measured by this share of it: the
@@ -51,6 +55,12 @@ impl Sweeps {
         self.moved.clear();
         self.moved.resize(state.pos.len(), 0.0);
         self.near.clear();
+        for &i in &self.pushed {
+            self.is_pushed[i as usize] = false;
+        }
+        self.pushed.clear();
+        self.is_pushed.resize(state.pos.len(), false);
+        let (pushed, is_pushed) = (&mut self.pushed, &mut self.is_pushed);
         let mut pushes = 0;
         let mut push = |moved: &mut [f32], pair: &Pair, reach: f32| {
             let ids = pair.ids();
@@ -67,6 +77,9 @@ impl Sweeps {
                 pushes += 1;
                 for (j, &i) in ids.iter().enumerate() {
                     moved[i] += state.pos[i].distance(before[j]);
+                    if !std::mem::replace(&mut is_pushed[i], true) {
+                        pushed.push(i as u32);
+                    }
                 }
             }
             outcome
@@ -104,5 +117,11 @@ impl Sweeps {
             }
         }
         pushes
+    }
+
+    /// The particles the last pass's pushes moved, each once (the others are where it
+    /// found them).
+    pub(super) fn pushed(&self) -> &[u32] {
+        &self.pushed
     }
 }
