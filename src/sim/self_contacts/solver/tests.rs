@@ -444,14 +444,7 @@ fn a_refresh_stores_the_same_order_on_two_threads_as_on_one() {
 fn the_checks_cut_the_same_bits_on_two_threads_as_on_one() {
     let run = |threads: usize| {
         on_threads(threads, || {
-            let (model, start) = crumpled();
-            let mut rnd = crate::test_rng::uniform(9);
-            let mut state = ClothState::at_rest(&model);
-            for (p, s) in state.pos.iter_mut().zip(&start) {
-                *p = *s + Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.04;
-            }
-            let mut contacts = SelfContacts::default();
-            (contacts.resolve([THICKNESS, 0.3, 0.01], &model, &start, &mut state)).unwrap();
+            let (_, _, state, contacts) = resolved_once(9, Vec3::ZERO, 0.04);
             (state, contacts.work)
         })
     };
@@ -680,23 +673,36 @@ fn a_creeping_particle_keeps_its_box_longer_where_the_pairs_are_few() {
     assert_eq!([first, second - first], [28, 28]);
 }
 
+/// A [`crumpled`] cloth's start, and a solver and the state after it resolved one substep
+/// that moved every particle by `motion` and up to half of `jitter` more along each axis
+/// (at random from `seed`).
+fn resolved_once(
+    seed: u64,
+    motion: Vec3,
+    jitter: f32,
+) -> (ClothModel, Vec<Vec3>, ClothState, SelfContacts) {
+    let (model, start) = crumpled();
+    let mut rnd = crate::test_rng::uniform(seed);
+    let mut state = ClothState::at_rest(&model);
+    for (p, s) in state.pos.iter_mut().zip(&start) {
+        *p = *s + motion + Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * jitter;
+    }
+    let mut contacts = SelfContacts::default();
+    (contacts.resolve([THICKNESS, 0.3, 0.01], &model, &start, &mut state)).unwrap();
+    (model, start, state, contacts)
+}
+
 /// After a substep whose pushes moved many particles (a crumpled cloth, still or moving
-/// fast, each particle jittered by up to 2 or 4 mm more along each axis), every particle's motion as pushed and
-/// cut still lies in its box less what the continuous check needs and, judged by the
-/// motion, near its path: a check of every particle again finds none out, so the pairs the
-/// check went through hold for that motion. (Only the pushed particles are checked after
-/// the pushes: the others' motion is as checked before them.)
+/// fast, each particle jittered by up to 2 or 4 mm more along each axis), every
+/// particle's motion as pushed and cut still lies in its box less what the continuous
+/// check needs and, judged by the motion, near its path: a check of every particle again
+/// finds none out, so the pairs the check went through hold for that motion. (Only the
+/// pushed particles are checked after the pushes: the others' motion is as checked before
+/// them.)
 #[test]
 fn the_pairs_hold_for_the_motion_as_pushed_and_cut() {
     for (motion, jitter) in [(Vec3::ZERO, 0.004), (FAST, 0.008)] {
-        let (model, start) = crumpled();
-        let mut rnd = crate::test_rng::uniform(11);
-        let mut state = ClothState::at_rest(&model);
-        for (p, s) in state.pos.iter_mut().zip(&start) {
-            *p = *s + motion + Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * jitter;
-        }
-        let mut contacts = SelfContacts::default();
-        (contacts.resolve([THICKNESS, 0.3, 0.01], &model, &start, &mut state)).unwrap();
+        let (model, start, state, mut contacts) = resolved_once(11, motion, jitter);
         let work = contacts.work;
         assert!(work.contacts > 100, "{work:?}");
         // Every particle checked again for the motion as it ended, in the frame it was
