@@ -112,8 +112,8 @@ pub struct SelfContacts {
     /// Particles whose motion changed since [`SelfContacts::update_pairs`] last checked it
     /// against its box and path in this substep; every particle where `all_unchecked`
     /// (at a substep's start, whose window has moved on, or where a check asks more than
-    /// the last). The others' hold, for a check that asks as much or less, where they were
-    /// found or left again.
+    /// the last). Each other particle's motion passed the last check, or got a box and a
+    /// path since, so it passes a check that asks as much or less.
     unchecked: Vec<u32>,
     all_unchecked: bool,
     /// What the last check asked for: its `within`.
@@ -336,7 +336,7 @@ impl SelfContacts {
             gap(s, at[0]) > off * off || gap(p, at[1]) > off * off
         };
         // A particle without a path (none can be: the search sets them all) has left.
-        let left_box = |(s, p): (Vec3, Vec3), (lo, hi): (Vec3, Vec3), path: Option<_>| {
+        let has_left = |(s, p): (Vec3, Vec3), (lo, hi): (Vec3, Vec3), path: Option<_>| {
             !((s.min(p) - g).cmpge(lo).all() && (s.max(p) + g).cmple(hi).all())
                 || swept && path.is_none_or(|path| strayed((s, p), path))
         };
@@ -351,7 +351,7 @@ impl SelfContacts {
                 );
                 let mut paths = part(&boxes.from).zip(part(&boxes.to));
                 for ((l, motion), room) in left.iter_mut().zip(motion).zip(room) {
-                    *l = left_box(motion, room, if swept { paths.next() } else { None });
+                    *l = has_left(motion, room, if swept { paths.next() } else { None });
                 }
             });
             self.left.iter().filter(|&&l| l).count()
@@ -361,7 +361,7 @@ impl SelfContacts {
             let room = |i: usize| (boxes.vertex_lo[i], boxes.vertex_hi[i]);
             for &i in &self.unchecked {
                 let i = i as usize;
-                self.left[i] = left_box((from[i], to[i]), room(i), path(i));
+                self.left[i] = has_left((from[i], to[i]), room(i), path(i));
             }
             self.left.iter().filter(|&&l| l).count()
         };
