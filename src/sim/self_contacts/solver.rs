@@ -342,7 +342,7 @@ impl SelfContacts {
         };
         self.left.resize(self.to.len(), false);
         let (from, to) = (&self.from, &self.to);
-        let left = if self.all_unchecked {
+        if self.all_unchecked {
             each_part([&mut self.left], |range, [left]| {
                 let part = |v| crate::parallel::within(v, range.clone()).iter().copied();
                 let (motion, room) = (
@@ -354,7 +354,6 @@ impl SelfContacts {
                     *l = has_left(motion, room, if swept { paths.next() } else { None });
                 }
             });
-            self.left.iter().filter(|&&l| l).count()
         } else {
             self.left.fill(false);
             let path = |i: usize| Some((*boxes.from.get(i)?, *boxes.to.get(i)?));
@@ -363,8 +362,8 @@ impl SelfContacts {
                 let i = i as usize;
                 self.left[i] = has_left((from[i], to[i]), room(i), path(i));
             }
-            self.left.iter().filter(|&&l| l).count()
-        };
+        }
+        let left = self.left.iter().filter(|&&l| l).count();
         self.all_unchecked = false;
         self.unchecked.clear();
         if left == 0 {
