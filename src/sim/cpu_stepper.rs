@@ -554,11 +554,14 @@ impl<R: Real> StepBackend for CpuStepper<R> {
             });
             self.effects = effects.to_vec();
             if self.self_collision.is_some() {
-                // Built now, not in the first substep; timed as its own phase where it
-                // was built (not where it was this cloth's already). A cloth too large
-                // for it is refused by the first substep, with its error.
+                // Built now, not in the first substep, with the patches the solids' face
+                // passes take (they run only beside self-collision); timed as its own
+                // phase where either was built (not where they were this cloth's
+                // already). A cloth too large for it is refused by the first substep,
+                // with its error.
                 let start = std::time::Instant::now();
-                if let Ok(true) = self.self_contacts.prepare(model) {
+                let built = matches!(self.self_contacts.prepare(model), Ok(true));
+                if self.faces.prepare(model) || built {
                     self.timings.add(super::SELF_SETUP, start.elapsed());
                 }
             }

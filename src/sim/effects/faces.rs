@@ -39,11 +39,11 @@ pub struct FacePatches {
 
 impl FacePatches {
     /// Cuts the patches for `model` if they were cut for another cloth (a stepper serves
-    /// one cloth: its size tells a new one apart).
-    fn fit(&mut self, model: &ClothModel) {
+    /// one cloth: its size tells a new one apart); returns whether it cut them.
+    pub fn prepare(&mut self, model: &ClothModel) -> bool {
         let size = (model.triangles.len(), model.particle_count());
         if size == self.cut_for && !self.starts.is_empty() {
-            return;
+            return false;
         }
         let (triangles, rest) = (&model.triangles, &model.rest_positions);
         let (nodes, order) = split_triangles_at_medians(triangles, rest, PATCH);
@@ -70,6 +70,7 @@ impl FacePatches {
             self.starts.push(self.triangles.len());
             self.particle_starts.push(self.particles.len());
         }
+        true
     }
 
     /// The triangles, in the cloth's order, of every patch whose particles at `pos` lie in
@@ -82,7 +83,7 @@ impl FacePatches {
         pos: &[Vec3],
         near: impl Fn(Vec3, Vec3) -> bool,
     ) -> &[u32] {
-        self.fit(model);
+        self.prepare(model);
         self.near.clear();
         self.flagged.clear();
         let mut held = 0;

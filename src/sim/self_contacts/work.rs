@@ -1,8 +1,9 @@
 //! What self-contact did and costs: the work of the last resolve, and the phase that
 //! times its setup for a cloth.
 
-/// The phase that times self-contact's setup for a cloth ([`super::SelfContacts::prepare`]),
-/// when a stepper takes self-collision on: once, before the substeps.
+/// The phase that times self-contact's setup for a cloth ([`super::SelfContacts::prepare`],
+/// and the patches of the solids' face passes, which run beside it), when a stepper takes
+/// self-collision on: once, before the substeps.
 pub const SELF_SETUP: &str = "self-setup";
 
 /// Work done by the last resolve: for cost checks.
