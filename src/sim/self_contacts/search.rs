@@ -267,9 +267,10 @@ impl Search<'_> {
     /// any line are a thickness apart are at least that far apart. Two triangles of a
     /// smooth patch that share no corner overlap in their boxes wherever the patch runs
     /// across the axes, but most lie apart along the line between their centres; where
-    /// that line runs obliquely past their nearest corners (on a grid, a quarter of the
-    /// spacing for one in nine of the nearest such pairs, against 0.7 across the facing
-    /// edge), across the edge. In f64, so that no rounding keeps apart what touches.
+    /// that line runs obliquely (on a grid, two triangles whose diagonals run side by side
+    /// with a strip of two triangles between: 0.7 of the spacing apart across the
+    /// diagonals, a quarter along that line), across the edge. In f64, so that no rounding
+    /// keeps apart what touches.
     fn apart_across(&self, a: usize, b: usize) -> bool {
         let (from, to) = (&self.boxes.from, &self.boxes.to);
         let ends = |t: [u32; 3]| {
