@@ -29,6 +29,14 @@ pub(super) trait Solid {
     /// `offset` to the surface; `None` if it stays clear.
     fn catch(&self, from: Vec3, to: Vec3, offset: f32) -> Option<Vec3>;
 
+    /// Whether a particle moving from `from` to `to` is told clear of the surface at a
+    /// glance, far enough that [`Solid::catch`] could not catch it (by default none is:
+    /// every move is caught or not by the catch itself).
+    #[inline]
+    fn clear(&self, _from: Vec3, _to: Vec3, _offset: f32) -> bool {
+        false
+    }
+
     /// Where a caught move ends, with the surface's normal and velocity there: by default
     /// [`Solid::catch`], then [`Solid::surface_at`] where it ends.
     fn contact(&self, from: Vec3, to: Vec3, offset: f32) -> Option<(Vec3, Vec3, Vec3)> {
@@ -101,7 +109,7 @@ fn resolve_part(
     let mut contacts = 0;
     let particles = pos.iter_mut().zip(vel.iter_mut());
     for (i, (((x, v), &from), &w)) in particles.zip(start).zip(inv_mass).enumerate() {
-        if w == 0.0 {
+        if w == 0.0 || solid.clear(from, *x, offset) {
             continue;
         }
         let found = match memory.as_deref_mut().and_then(|m| m.get_mut(i)) {
