@@ -261,10 +261,11 @@ impl Search<'_> {
     }
 
     /// Whether triangles `a` and `b` stay a thickness apart along the motion the boxes were
-    /// made for, told along the line between their centres and then across `a`'s edge that
-    /// faces `b`: in the frame of the two triangles' mean motion each stays in the hull of
-    /// its corners' starts and ends (less that motion), and two hulls whose extents along
-    /// any line are a thickness apart are at least that far apart. Two triangles of a
+    /// made for, told along the line between their centres and then across the edge of the
+    /// lower-numbered that faces the other: in the frame of the two triangles' mean motion
+    /// each stays in the hull of its corners' starts and ends (less that motion), and two
+    /// hulls whose extents along any line are a thickness apart are at least that far
+    /// apart. Two triangles of a
     /// smooth patch that share no corner overlap in their boxes wherever the patch runs
     /// across the axes, but most lie apart along the line between their centres; where
     /// that line runs obliquely (on a grid, two triangles whose diagonals run side by side
@@ -272,6 +273,10 @@ impl Search<'_> {
     /// diagonals, a quarter along that line), across the edge. In f64, so that no rounding
     /// keeps apart what touches.
     fn apart_across(&self, a: usize, b: usize) -> bool {
+        // The lower-numbered first, so that a pair is told alike whichever way it is met
+        // (a whole walk and a refresh meet it either way; the line between the centres
+        // tells it alike both ways, the facing edge is the first's).
+        let (a, b) = (a.min(b), a.max(b));
         let (from, to) = (&self.boxes.from, &self.boxes.to);
         let ends = |t: [u32; 3]| {
             let s = t.map(|i| from[i as usize].as_dvec3());
