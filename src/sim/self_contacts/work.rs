@@ -2,8 +2,8 @@
 //! times its setup for a cloth.
 
 /// The phase that times self-contact's setup for a cloth ([`super::SelfContacts::prepare`],
-/// and the patches of the solids' face passes, which run beside it), when a stepper takes
-/// self-collision on: once, before the substeps.
+/// and, beside a sphere, the patches of its face pass, which runs only beside
+/// self-contact), when a stepper takes self-collision on: once, before the substeps.
 pub const SELF_SETUP: &str = "self-setup";
 
 /// Work done by the last resolve: for cost checks.
