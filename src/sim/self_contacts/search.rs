@@ -265,13 +265,12 @@ impl Search<'_> {
     /// lower-numbered that faces the other: in the frame of the two triangles' mean motion
     /// each stays in the hull of its corners' starts and ends (less that motion), and two
     /// hulls whose extents along any line are a thickness apart are at least that far
-    /// apart. Two triangles of a
-    /// smooth patch that share no corner overlap in their boxes wherever the patch runs
-    /// across the axes, but most lie apart along the line between their centres; where
-    /// that line runs obliquely (on a grid, two triangles whose diagonals run side by side
-    /// with a strip of two triangles between: 0.7 of the spacing apart across the
-    /// diagonals, a quarter along that line), across the edge. In f64, so that no rounding
-    /// keeps apart what touches.
+    /// apart. Two triangles of a smooth patch that share no corner overlap in their boxes
+    /// wherever the patch runs across the axes, but most lie apart along the line between
+    /// their centres; where that line runs obliquely (on a grid, two triangles whose
+    /// diagonals run side by side with a strip of two triangles between: 0.7 of the
+    /// spacing apart across the diagonals, a quarter along that line), across the edge.
+    /// In f64, so that no rounding keeps apart what touches.
     fn apart_across(&self, a: usize, b: usize) -> bool {
         // The lower-numbered first, so that a pair is told alike whichever way it is met
         // (a whole walk and a refresh meet it either way; the line between the centres
@@ -313,8 +312,13 @@ impl Search<'_> {
         for k in 0..3 {
             let out = (middle[(k + 1) % 3] - middle[k]).cross(normal);
             let length = out.length();
-            if length > 0.0 && out.dot(across) / length > best {
-                (facing, best) = (out, out.dot(across) / length);
+            let towards = if length > 0.0 {
+                out.dot(across) / length
+            } else {
+                0.0
+            };
+            if towards > best {
+                (facing, best) = (out, towards);
             }
         }
         apart_along(facing)
