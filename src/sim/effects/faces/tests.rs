@@ -72,11 +72,15 @@ fn a_face_pass_takes_every_triangle_a_ball_reaches_once_in_order_and_few_besides
     }
 }
 
+/// Prepared once for a cloth (a stepper's setup cuts them, and the face passes after find
+/// them cut), and again for another.
 #[test]
 fn patches_are_cut_again_for_another_cloth() {
     let mut patches = FacePatches::default();
     for quads in [6, 24, 3] {
         let (model, pos) = folded(quads);
+        assert!(patches.prepare(&model), "{quads}");
+        assert!(!patches.prepare(&model), "{quads}");
         let all = patches.near(&model, &pos, |_, _| true).to_vec();
         assert_eq!(all, (0..model.triangles.len() as u32).collect::<Vec<_>>());
     }
