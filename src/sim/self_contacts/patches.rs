@@ -24,7 +24,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 use super::certify::{MARGIN, frame, shave};
 use super::primitives::{Pair, boxes_apart_by, nearer};
@@ -211,12 +211,15 @@ impl Patches {
         }
         let (particle, reference) = (&self.particle[range.clone()], &self.reference[range]);
         let n = particle.len() as f32;
+        // In SSE lanes (`Vec3A`): the same operations in the same order as with `Vec3`,
+        // so the same results, in fewer instructions.
+        let at = |x: &[Vec3], j: u32| Vec3A::from(x[j as usize]);
         // The middles of the starts and of the ends, and the maps fitted to each: their
         // columns are sums over the particles weighed by the inverse second moments.
-        let (mut first, mut last) = (Vec3::ZERO, Vec3::ZERO);
-        let [mut p0, mut q0, mut p1, mut q1] = [Vec3::ZERO; 4];
+        let (mut first, mut last) = (Vec3A::ZERO, Vec3A::ZERO);
+        let [mut p0, mut q0, mut p1, mut q1] = [Vec3A::ZERO; 4];
         for (&j, r) in particle.iter().zip(reference) {
-            let (s, e) = (from[j as usize], to[j as usize]);
+            let (s, e) = (at(from, j), at(to, j));
             (first, last) = (first + s, last + e);
             let (a, b) = (xx * r.x + xy * r.y, xy * r.x + yy * r.y);
             (p0, q0, p1, q1) = (p0 + a * s, q0 + b * s, p1 + a * e, q1 + b * e);
@@ -225,7 +228,8 @@ impl Patches {
         // Along the motion the map runs from the starts' to the ends' (its third column,
         // the normal, held at the middle's): it shrinks no distance by more than the
         // middle's least stretch less half how far the map moves (Weyl).
-        let Some((middle, shrink)) = fitted(0.5 * (p0 + p1), 0.5 * (q0 + q1)) else {
+        let Some((middle, shrink)) = fitted((0.5 * (p0 + p1)).into(), (0.5 * (q0 + q1)).into())
+        else {
             return false;
         };
         let moved = 0.5 * ((p1 - p0).length_squared() + (q1 - q0).length_squared()).sqrt();
@@ -234,15 +238,15 @@ impl Patches {
             return false;
         }
         let limit = most * most;
-        let normal = middle.z_axis;
+        let normal = middle.z_axis.into();
         let (start_map, end_map) = (
-            glam::Mat3::from_cols(p0, q0, normal),
-            glam::Mat3::from_cols(p1, q1, normal),
+            glam::Mat3A::from_cols(p0, q0, normal),
+            glam::Mat3A::from_cols(p1, q1, normal),
         );
         (particle.iter().zip(reference)).all(|(&j, &r)| {
-            let j = j as usize;
-            let start = (from[j] - first - start_map * r).length_squared();
-            let end = (to[j] - last - end_map * r).length_squared();
+            let r = Vec3A::from(r);
+            let start = (at(from, j) - first - start_map * r).length_squared();
+            let end = (at(to, j) - last - end_map * r).length_squared();
             start <= limit && end <= limit
         })
     }

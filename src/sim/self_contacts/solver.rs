@@ -3,7 +3,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 use crate::cloth::{ClothModel, ClothState};
 use crate::parallel::{each_part, within};
@@ -314,7 +314,7 @@ impl SelfContacts {
             self.unchecked.clear();
             return self.find_pairs(model, thickness);
         }
-        let g = Vec3::splat(0.5 * if swept { within } else { thickness });
+        let g = Vec3A::splat(0.5 * if swept { within } else { thickness });
         // Pairs judged by the motion hold while each particle starts and ends within the
         // allowance and half of what `within` leaves of the thickness of where its path in
         // the window puts it (see `Window`): a pair kept apart by the thickness and twice
@@ -337,21 +337,32 @@ impl SelfContacts {
         };
         // A particle without a path (none can be: the search sets them all) has left.
         let has_left = |(s, p): (Vec3, Vec3), (lo, hi): (Vec3, Vec3), path: Option<_>| {
-            !((s.min(p) - g).cmpge(lo).all() && (s.max(p) + g).cmple(hi).all())
+            let (s32, p32, lo, hi) = (s.into(), p.into(), Vec3A::from(lo), Vec3A::from(hi));
+            !((Vec3A::min(s32, p32) - g).cmpge(lo).all()
+                && (Vec3A::max(s32, p32) + g).cmple(hi).all())
                 || swept && path.is_none_or(|path| strayed((s, p), path))
         };
         self.left.resize(self.to.len(), false);
         let (from, to) = (&self.from, &self.to);
         if self.all_unchecked {
             each_part([&mut self.left], |range, [left]| {
-                let part = |v| crate::parallel::within(v, range.clone()).iter().copied();
-                let (motion, room) = (
-                    part(from).zip(part(to)),
-                    part(&boxes.vertex_lo).zip(part(&boxes.vertex_hi)),
+                // Each array cut to the part's length: one bound check a part, not a
+                // particle.
+                let n = left.len();
+                let part = |v| &crate::parallel::within(v, range.clone())[..n];
+                let (from, to, lo, hi) = (
+                    part(from),
+                    part(to),
+                    part(&boxes.vertex_lo),
+                    part(&boxes.vertex_hi),
                 );
-                let mut paths = part(&boxes.from).zip(part(&boxes.to));
-                for ((l, motion), room) in left.iter_mut().zip(motion).zip(room) {
-                    *l = has_left(motion, room, if swept { paths.next() } else { None });
+                let paths =
+                    [&boxes.from, &boxes.to].map(|v| crate::parallel::within(v, range.clone()));
+                for (i, l) in left.iter_mut().enumerate() {
+                    let path = swept
+                        .then(|| Some((*paths[0].get(i)?, *paths[1].get(i)?)))
+                        .flatten();
+                    *l = has_left((from[i], to[i]), (lo[i], hi[i]), path);
                 }
             });
         } else {
