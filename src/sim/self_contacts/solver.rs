@@ -346,19 +346,19 @@ impl SelfContacts {
         let (from, to) = (&self.from, &self.to);
         if self.all_unchecked {
             each_part([&mut self.left], |range, [left]| {
-                // Each array cut to the part's length: one bound check a part, not a
-                // particle.
-                let n = left.len();
-                let part = |v| &crate::parallel::within(v, range.clone())[..n];
+                // Each array cut to the shortest's length once (as a zip of them stops),
+                // then read by index: one bound check a part, not a particle.
+                let part = |v| crate::parallel::within(v, range.clone());
                 let (from, to, lo, hi) = (
                     part(from),
                     part(to),
                     part(&boxes.vertex_lo),
                     part(&boxes.vertex_hi),
                 );
-                let paths =
-                    [&boxes.from, &boxes.to].map(|v| crate::parallel::within(v, range.clone()));
-                for (i, l) in left.iter_mut().enumerate() {
+                let n = (left.len().min(from.len()).min(to.len())).min(lo.len().min(hi.len()));
+                let (from, to, lo, hi) = (&from[..n], &to[..n], &lo[..n], &hi[..n]);
+                let paths = [&boxes.from, &boxes.to].map(|v| part(v));
+                for (i, l) in left[..n].iter_mut().enumerate() {
                     let path = swept
                         .then(|| Some((*paths[0].get(i)?, *paths[1].get(i)?)))
                         .flatten();
