@@ -342,6 +342,9 @@ impl SelfContacts {
                 && (Vec3A::max(s32, p32) + g).cmple(hi).all())
                 || swept && path.is_none_or(|path| strayed((s, p), path))
         };
+        // Particle `i`'s path in the window, from the paths' starts and ends (read only
+        // where the pairs are judged by the motion: `has_left` asks for it only then).
+        let path_at = |[from, to]: [&[Vec3]; 2], i: usize| Some((*from.get(i)?, *to.get(i)?));
         self.left.resize(self.to.len(), false);
         let (from, to) = (&self.from, &self.to);
         if self.all_unchecked {
@@ -359,19 +362,18 @@ impl SelfContacts {
                 let (from, to, lo, hi) = (&from[..n], &to[..n], &lo[..n], &hi[..n]);
                 let paths = [&boxes.from, &boxes.to].map(|v| part(v));
                 for (i, l) in left[..n].iter_mut().enumerate() {
-                    let path = swept
-                        .then(|| Some((*paths[0].get(i)?, *paths[1].get(i)?)))
-                        .flatten();
-                    *l = has_left((from[i], to[i]), (lo[i], hi[i]), path);
+                    *l = has_left((from[i], to[i]), (lo[i], hi[i]), path_at(paths, i));
                 }
             });
         } else {
             self.left.fill(false);
-            let path = |i: usize| Some((*boxes.from.get(i)?, *boxes.to.get(i)?));
-            let room = |i: usize| (boxes.vertex_lo[i], boxes.vertex_hi[i]);
+            let (room, paths) = (
+                |i: usize| (boxes.vertex_lo[i], boxes.vertex_hi[i]),
+                [&boxes.from[..], &boxes.to[..]],
+            );
             for &i in &self.unchecked {
                 let i = i as usize;
-                self.left[i] = has_left((from[i], to[i]), room(i), path(i));
+                self.left[i] = has_left((from[i], to[i]), room(i), path_at(paths, i));
             }
         }
         let left = self.left.iter().filter(|&&l| l).count();
