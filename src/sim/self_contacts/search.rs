@@ -262,10 +262,11 @@ impl Search<'_> {
 
     /// Whether triangles `a` and `b` stay a thickness apart along the motion the boxes were
     /// made for, told along the line between their centres and then across the edge of the
-    /// lower-numbered that faces the other: in the frame of the two triangles' mean motion
-    /// each stays in the hull of its corners' starts and ends (less that motion), and two
-    /// hulls whose extents along any line are a thickness apart are at least that far
-    /// apart. Two triangles of a smooth patch that share no corner overlap in their boxes
+    /// lower-numbered that faces the other: two triangles whose extents along a line are a
+    /// thickness apart, in the same direction, at the start and at the end of the motion
+    /// are at least that far apart all along it (each corner runs straight from its start
+    /// to its end, so along the line the gap runs straight from the one to the other, as
+    /// the tree's boxes do: [`super::tree`]). Two triangles of a smooth patch that share no corner overlap in their boxes
     /// wherever the patch runs across the axes, but most lie apart along the line between
     /// their centres; where that line runs obliquely (on a grid, two triangles whose
     /// diagonals run side by side with a strip of two triangles between: 0.7 of the
@@ -284,21 +285,24 @@ impl Search<'_> {
         };
         let ((sa, ea), (sb, eb)) = (ends(self.triangles[a]), ends(self.triangles[b]));
         let sum = |x: [DVec3; 3]| x[0] + x[1] + x[2];
-        let mean = (sum(ea) - sum(sa) + sum(eb) - sum(sb)) / 6.0;
         let thickness = f64::from(self.thickness);
         let apart_along = |axis: DVec3| {
             let length = axis.length();
             if length == 0.0 {
                 return false;
             }
-            let span = |s: [DVec3; 3], e: [DVec3; 3]| {
+            let span = |x: [DVec3; 3]| {
                 (0..3).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), k| {
-                    let (p, q) = (axis.dot(s[k]), axis.dot(e[k] - mean));
-                    (lo.min(p).min(q), hi.max(p).max(q))
+                    let p = axis.dot(x[k]);
+                    (lo.min(p), hi.max(p))
                 })
             };
-            let ((alo, ahi), (blo, bhi)) = (span(sa, ea), span(sb, eb));
-            (blo - ahi).max(alo - bhi) >= thickness * length
+            let ((alo, ahi), (blo, bhi)) = (span(sa), span(sb));
+            let ((aelo, aehi), (belo, behi)) = (span(ea), span(eb));
+            (blo - ahi)
+                .min(belo - aehi)
+                .max((alo - bhi).min(aelo - behi))
+                >= thickness * length
         };
         let across = (sum(sb) + sum(eb) - sum(sa) - sum(ea)) / 6.0;
         if apart_along(across) {
@@ -306,7 +310,7 @@ impl Search<'_> {
         }
         // The edge of `a` (in its shape halfway along the motion) whose outward normal in
         // `a`'s plane points most nearly at `b`'s centre.
-        let middle: [DVec3; 3] = std::array::from_fn(|k| 0.5 * (sa[k] + ea[k] - mean));
+        let middle: [DVec3; 3] = std::array::from_fn(|k| 0.5 * (sa[k] + ea[k]));
         let normal = (middle[1] - middle[0]).cross(middle[2] - middle[0]);
         let (mut facing, mut best) = (DVec3::ZERO, 0.0);
         for k in 0..3 {
@@ -428,54 +432,59 @@ impl Search<'_> {
     }
 
     /// Whether the pair's sides could come within the thickness along the particles'
-    /// straight motion the boxes were made for. First the sides' boxes in the frame that
-    /// moves with the pair's mean motion (each side stays in the box of its particles'
-    /// starts and ends less that motion; a translation changes no distance): most pairs
-    /// that move together are told apart there, by their gap along an axis. Then, in the
-    /// same frame, the gap along the line between the sides' middles (two sides a cell
-    /// apart on a patch that runs across the axes are told apart there). Then the
-    /// distances at the start and the end (`d₀`, `d₁`): either within the thickness keeps
-    /// the pair (four in five of those `layers` keeps are so); otherwise the distance
-    /// changes along the motion no faster than the sides' largest displacements relative
-    /// to the pair's mean motion add up to (`L`), so it stays above both `d₀ − τL` and
-    /// `d₁ − (1 − τ)L`, whose larger is least, `(d₀ + d₁ − L)/2`, where they cross.
+    /// straight motion the boxes were made for. First the sides' boxes: where along an
+    /// axis, in the same direction, the sides' boxes at the start lie a thickness apart and
+    /// so do those at the end, the sides keep that far apart all along (each particle runs
+    /// straight from its start to its end, and the gap between the boxes with it, as the
+    /// tree's do: [`super::tree`]); most pairs that move together are told apart there.
+    /// Then the same along the line between the sides' middles (two sides a cell apart on
+    /// a patch that runs across the axes are told apart there). Then the distances at the
+    /// start and the end (`d₀`, `d₁`): either within the thickness keeps the pair (four in
+    /// five of those `layers` keeps are so); otherwise the distance changes along the
+    /// motion no faster than the sides' largest displacements relative to the pair's mean
+    /// motion add up to (`L`), so it stays above both `d₀ − τL` and `d₁ − (1 − τ)L`, whose
+    /// larger is least, `(d₀ + d₁ − L)/2`, where they cross.
     fn swept_near(&self, pair: &Pair) -> bool {
         let ids = pair.ids();
         let (from, to) = (&self.boxes.from, &self.boxes.to);
         let x0 = ids.map(|i| from[i].as_dvec3());
         let x1 = ids.map(|i| to[i].as_dvec3());
         let moves: [DVec3; 4] = std::array::from_fn(|j| x1[j] - x0[j]);
-        let mean = moves.iter().copied().sum::<DVec3>() / 4.0;
-        let side = |r: std::ops::Range<usize>| {
-            r.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), j| {
-                let e = x1[j] - mean;
-                (lo.min(x0[j]).min(e), hi.max(x0[j]).max(e))
-            })
-        };
         let k = pair.first_side();
-        let ((alo, ahi), (blo, bhi)) = (side(0..k), side(k..4));
-        let gap = (blo - ahi).max(alo - bhi).max_element();
+        let (first, second) = (0..k, k..4);
         let thickness = f64::from(self.thickness);
-        if gap >= thickness {
+        // The gap from side `a` up to side `b` at the start and at the end, the lesser.
+        let boxes = |x: &[DVec3; 4]| {
+            let side = |r: std::ops::Range<usize>| {
+                r.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), j| {
+                    (lo.min(x[j]), hi.max(x[j]))
+                })
+            };
+            (side(first.clone()), side(second.clone()))
+        };
+        let (((alo, ahi), (blo, bhi)), ((aelo, aehi), (belo, behi))) = (boxes(&x0), boxes(&x1));
+        let gap = (blo - ahi)
+            .min(belo - aehi)
+            .max((alo - bhi).min(aelo - behi));
+        if gap.max_element() >= thickness {
             return false;
         }
-        // Then along the line between the sides' middles (in the same frame): where a
-        // smooth patch runs across the axes, two sides a cell apart are apart along it.
-        let ends: [DVec3; 4] = std::array::from_fn(|j| x1[j] - mean);
+        // Then along the line between the sides' middles: where a smooth patch runs
+        // across the axes, two sides a cell apart are apart along it.
         let middle = |r: std::ops::Range<usize>| {
             let n = r.len() as f64;
-            r.map(|j| x0[j] + ends[j]).sum::<DVec3>() / (2.0 * n)
+            r.map(|j| x0[j] + x1[j]).sum::<DVec3>() / (2.0 * n)
         };
-        let axis = middle(k..4) - middle(0..k);
-        let span = |r: std::ops::Range<usize>| {
+        let axis = middle(second.clone()) - middle(first.clone());
+        let span = |x: &[DVec3; 4], r: std::ops::Range<usize>| {
             r.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), j| {
-                let (p, q) = (axis.dot(x0[j]), axis.dot(ends[j]));
-                (lo.min(p).min(q), hi.max(p).max(q))
+                let p = axis.dot(x[j]);
+                (lo.min(p), hi.max(p))
             })
         };
-        let ((_, ahi), (blo, _)) = (span(0..k), span(k..4));
+        let ahead = |x: &[DVec3; 4]| span(x, second.clone()).0 - span(x, first.clone()).1;
         let length = axis.length();
-        if blo - ahi >= thickness * length && length > 0.0 {
+        if ahead(&x0).min(ahead(&x1)) >= thickness * length && length > 0.0 {
             return false;
         }
         let first = distance(pair, x0);
@@ -500,3 +509,6 @@ pub(super) fn pairs<'a>(
 pub(super) fn meet((alo, ahi): (Vec3, Vec3), (blo, bhi): (Vec3, Vec3)) -> bool {
     alo.cmple(bhi).all() && blo.cmple(ahi).all()
 }
+
+#[cfg(test)]
+mod tests;

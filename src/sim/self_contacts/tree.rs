@@ -6,12 +6,13 @@
 //! that keep apart are passed by with everything under them.
 //!
 //! Where the pairs are judged by the motion, a node holds two boxes — its particles'
-//! starts and ends — and their mean motion, and two nodes are told apart in the frame that
-//! moves with their mean motion: there each node stays in the box of its starts and its
-//! ends less that motion (each particle's path runs between them), and a translation
-//! changes no distance. Where the cloth lands, its parts move fast against the cloth's
-//! mean but hardly against each other: in their own frame, two patches' boxes are hardly
-//! larger than the patches.
+//! starts and ends — and two nodes are told apart where one's boxes lie `reach` beyond the
+//! other's along one axis, in the same direction, at both ends ([`moving_apart`]): each
+//! particle runs straight from its start to its end in the same time, so at every moment
+//! between a node lies in the box that runs straight from its start box to its end box,
+//! and the gap between two such boxes along an axis runs straight from the one at the
+//! start to the one at the end. Where the cloth lands, its parts move fast against the
+//! cloth's mean but hardly against each other: two patches' gaps hardly change.
 
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -45,8 +46,8 @@ enum Fit {
     /// By their boxes: apart where they do not overlap.
     #[default]
     Boxes,
-    /// By their particles' motion: apart where, in the frame of their mean motion, the
-    /// boxes of their starts and ends less that motion are `reach` apart along an axis.
+    /// By their particles' motion: apart where the boxes of their starts, and those of
+    /// their ends, are `reach` apart along one axis in the same direction.
     Motion { reach: f32 },
 }
 
@@ -75,8 +76,8 @@ pub(super) struct TriangleTree {
     pub(super) subtrees: Vec<(std::ops::Range<usize>, std::ops::Range<usize>)>,
     /// Each node's box (by boxes), or the box of its starts (by motion), as `[lo, hi]`.
     boxes: Vec<[Vec3A; 2]>,
-    /// By motion, each node's box of its ends and its mean motion, as `[lo, hi, mean]`.
-    motion: Vec<[Vec3A; 3]>,
+    /// By motion, each node's box of its ends, as `[lo, hi]`.
+    motion: Vec<[Vec3A; 2]>,
     /// Each leaf's triangles' boxes.
     lanes: Vec<Lanes>,
     fit: Fit,
@@ -183,7 +184,7 @@ impl TriangleTree {
     fn size(&mut self) {
         let n = self.nodes.len();
         self.boxes.resize(n, [Vec3A::ZERO; 2]);
-        self.motion.resize(n, [Vec3A::ZERO; 3]);
+        self.motion.resize(n, [Vec3A::ZERO; 2]);
         self.lanes.resize(self.leaves.len(), Lanes::default());
     }
 
@@ -337,8 +338,7 @@ impl TriangleTree {
         boxes_apart(self.boxes[a], self.boxes[b])
     }
 
-    /// Whether nodes `a` and `b` keep `reach` apart along their motion, told in the frame
-    /// of their mean motion.
+    /// Whether nodes `a` and `b` keep `reach` apart along their motion.
     #[inline(always)]
     fn moving_apart(&self, a: usize, b: usize, reach: f32) -> bool {
         let (a, b) = (
@@ -376,16 +376,13 @@ impl TriangleTree {
             Fit::Motion { reach } => self.walk(
                 piece,
                 |a, b| self.moving_apart(a, b, reach),
-                |[a, b], [la, lb]| {
-                    let m = 0.5 * (self.motion[a][2] + self.motion[b][2]);
-                    self.lanes[lb].moving_near_rows(&self.lanes[la], m, reach)
-                },
+                |[la, lb]| self.lanes[lb].moving_near_rows(&self.lanes[la], reach),
                 pair,
             ),
             Fit::Boxes => self.walk(
                 piece,
                 |a, b| self.boxes_apart(a, b),
-                |_, [la, lb]| self.lanes[lb].boxes_meet_rows(&self.lanes[la]),
+                |[la, lb]| self.lanes[lb].boxes_meet_rows(&self.lanes[la]),
                 pair,
             ),
         }
@@ -394,30 +391,25 @@ impl TriangleTree {
     /// Calls `pair(t, b)` for each triangle `b` sharing no corner with `t` that `t`'s box
     /// is not told apart from (as the last fit tells them), not flagged by `searched`
     /// where `b < t`: a search of each flagged triangle so calls it once for each two of
-    /// which one at least is flagged. By the boxes, the whole walk's tests of theirs and
-    /// these tell the same two apart; by the motion, `t` is told apart from each node in
-    /// their own frame rather than from the node the whole walk pairs with it (at a leaf,
-    /// in the frame of the two leaves, as the whole walk tells them).
+    /// which one at least is flagged. Its tests of two triangles are the whole walk's, so
+    /// the two tell the same two apart.
     pub(super) fn triangle_pairs(&self, t: u32, searched: &[bool], pair: impl FnMut(u32, u32)) {
         match self.fit {
             Fit::Motion { reach } => self.query(
                 t,
                 searched,
                 |a, one| {
-                    let own = ([one.lo, one.hi], [one.end_lo, one.end_hi, one.mean]);
+                    let own = ([one.lo, one.hi], [one.end_lo, one.end_hi]);
                     moving_apart((self.boxes[a], self.motion[a]), own, reach)
                 },
-                |[a, b], lanes, one| {
-                    let m = 0.5 * (self.motion[a][2] + self.motion[b][2]);
-                    lanes.moving_near(one, m, reach)
-                },
+                |lanes, one| lanes.moving_near(one, reach),
                 pair,
             ),
             Fit::Boxes => self.query(
                 t,
                 searched,
                 |a, one| boxes_apart(self.boxes[a], [one.lo, one.hi]),
-                |_, lanes, one| lanes.boxes_meet(one),
+                |lanes, one| lanes.boxes_meet(one),
                 pair,
             ),
         }
@@ -429,7 +421,7 @@ impl TriangleTree {
         t: u32,
         searched: &[bool],
         apart: impl Fn(usize, &One) -> bool,
-        lanes_near: impl Fn([usize; 2], &Lanes, (&Lanes, usize)) -> u32,
+        lanes_near: impl Fn(&Lanes, (&Lanes, usize)) -> u32,
         mut pair: impl FnMut(u32, u32),
     ) {
         if self.nodes.is_empty() {
@@ -438,7 +430,7 @@ impl TriangleTree {
         let place = self.place_of[t as usize] as usize;
         let (leaf, k) = self.lane(place);
         let (lane, corners) = ((&self.lanes[leaf], k), self.corners(leaf, k));
-        let (one, own) = (self.lanes[leaf].one(k), self.leaves[leaf] as usize);
+        let one = self.lanes[leaf].one(k);
         let mut stack = [0u32; STACK];
         let mut depth = 1;
         while depth > 0 {
@@ -450,7 +442,7 @@ impl TriangleTree {
             let node = self.nodes[a as usize];
             if Self::is_leaf(node) {
                 let leaf = self.leaf_of[a as usize] as usize;
-                let near = lanes_near([own, a as usize], &self.lanes[leaf], lane)
+                let near = lanes_near(&self.lanes[leaf], lane)
                     & share_none(corners, &self.leaf_corners[leaf]);
                 for k in flagged(near & lanes_of(node)) {
                     let b = self.order[node.first as usize + k];
@@ -470,7 +462,7 @@ impl TriangleTree {
         &self,
         piece: usize,
         apart: impl Fn(usize, usize) -> bool,
-        lanes_near: impl Fn([usize; 2], [usize; 2]) -> [u32; 4],
+        lanes_near: impl Fn([usize; 2]) -> [u32; 4],
         mut pair: impl FnMut(u32, u32),
     ) {
         // Each triangle of leaf node `a` against those of leaf node `b` (past its own,
@@ -479,7 +471,7 @@ impl TriangleTree {
             let (na, nb) = (self.nodes[a], self.nodes[b]);
             let (la, lb) = (self.leaf_of[a] as usize, self.leaf_of[b] as usize);
             let corners = &self.leaf_corners[lb];
-            let rows = lanes_near([a, b], [la, lb]);
+            let rows = lanes_near([la, lb]);
             let lanes = lanes_of(nb);
             for (k, &row) in rows.iter().enumerate().take(na.count as usize) {
                 // Past its own, where the leaves are the same.
@@ -580,7 +572,7 @@ impl Fitting<'_> {
     fn node(
         &self,
         i: usize,
-        (boxes, motion, base): (&mut [[Vec3A; 2]], &mut [[Vec3A; 3]], usize),
+        (boxes, motion, base): (&mut [[Vec3A; 2]], &mut [[Vec3A; 2]], usize),
         (lanes, first): (&[Lanes], usize),
     ) {
         let node = self.nodes[i];
@@ -602,15 +594,11 @@ impl Fitting<'_> {
         boxes[i - base] = [lo, hi];
         if self.moving {
             let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-            // The mean weighted by the triangles each part holds.
-            let (mut sum, mut total) = (Vec3A::ZERO, 0.0);
             for &k in &parts {
-                let [l, h, mean] = motion[k - base];
+                let [l, h] = motion[k - base];
                 (lo, hi) = (lo.min(l), hi.max(h));
-                let weight = self.nodes[k].count as f32;
-                (sum, total) = (sum + mean * weight, total + weight);
             }
-            motion[i - base] = [lo, hi, sum / total];
+            motion[i - base] = [lo, hi];
         }
     }
 }
@@ -624,19 +612,23 @@ fn boxes_apart([alo, ahi]: [Vec3A; 2], [blo, bhi]: [Vec3A; 2]) -> bool {
     !(alo.cmple(bhi).all() && blo.cmple(ahi).all())
 }
 
-/// Whether two boxes by motion (`[lo, hi]` of the starts, `[lo, hi, mean]` of the ends
-/// and the mean motion) keep `reach` apart along their motion, told in the frame of their
-/// mean motion.
+/// Whether two boxes by motion (`[lo, hi]` of the starts and of the ends) keep `reach`
+/// apart along their motion: where along one axis, in the same direction, the starts' boxes
+/// lie `reach` apart and so do the ends'. Every particle runs straight from its start to
+/// its end in the same time, so at a share `t` of the motion each node lies in the box
+/// `(1 − t)·start + t·end` of its two, and along each axis the gap between two such boxes
+/// is `(1 − t)` times the starts' gap and `t` times the ends'. (Unlike the box of a node's
+/// starts and ends in any one frame, it takes in no part of the motion: two triangles that
+/// close on each other and stop short are told apart.)
 #[inline(always)]
 fn moving_apart(
-    ([alo, ahi], [aend_lo, aend_hi, amean]): ([Vec3A; 2], [Vec3A; 3]),
-    ([blo, bhi], [bend_lo, bend_hi, bmean]): ([Vec3A; 2], [Vec3A; 3]),
+    ([alo, ahi], [aend_lo, aend_hi]): ([Vec3A; 2], [Vec3A; 2]),
+    ([blo, bhi], [bend_lo, bend_hi]): ([Vec3A; 2], [Vec3A; 2]),
     reach: f32,
 ) -> bool {
-    let m = 0.5 * (amean + bmean);
-    let (alo, ahi) = (alo.min(aend_lo - m), ahi.max(aend_hi - m));
-    let (blo, bhi) = (blo.min(bend_lo - m), bhi.max(bend_hi - m));
-    (blo - ahi).max(alo - bhi).max_element() >= reach
+    let up = (blo - ahi).min(bend_lo - aend_hi);
+    let down = (alo - bhi).min(aend_lo - bend_hi);
+    up.max(down).max_element() >= reach
 }
 
 #[cfg(test)]

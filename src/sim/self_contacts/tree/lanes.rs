@@ -8,14 +8,13 @@ use glam::{BVec4A, Vec3, Vec3A, Vec4};
 const _: () = assert!(super::LEAF == 4);
 
 /// One triangle's boxes: by boxes its box `[lo, hi]`; by motion also the box of its ends
-/// and its mean motion (`lo` and `hi` then bound its starts).
+/// (`lo` and `hi` then bound its starts).
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct One {
     pub(super) lo: Vec3A,
     pub(super) hi: Vec3A,
     pub(super) end_lo: Vec3A,
     pub(super) end_hi: Vec3A,
-    pub(super) mean: Vec3A,
 }
 
 impl One {
@@ -28,7 +27,6 @@ impl One {
             hi: a.max(b).max(c),
             end_lo: d.min(e).min(f),
             end_hi: d.max(e).max(f),
-            mean: ((d - a) + (e - b) + (f - c)) / 3.0,
         }
     }
 }
@@ -41,7 +39,6 @@ pub(super) struct Lanes {
     hi: [Vec4; 3],
     end_lo: [Vec4; 3],
     end_hi: [Vec4; 3],
-    mean: [Vec4; 3],
 }
 
 impl Lanes {
@@ -58,7 +55,6 @@ impl Lanes {
         for x in 0..3 {
             self.end_lo[x][lane] = one.end_lo[x];
             self.end_hi[x][lane] = one.end_hi[x];
-            self.mean[x][lane] = one.mean[x];
         }
     }
 
@@ -71,7 +67,6 @@ impl Lanes {
             hi: at(&self.hi),
             end_lo: at(&self.end_lo),
             end_hi: at(&self.end_hi),
-            mean: at(&self.mean),
         }
     }
 
@@ -86,34 +81,18 @@ impl Lanes {
         meet.bitmask()
     }
 
-    /// Each lane's box of its starts and its ends less `m`, an axis each: in the frame
-    /// that moves by `m` along the motion, its triangle stays in it (each particle's path
-    /// runs between its start and its end less `m`).
-    #[inline(always)]
-    fn hulls(&self, m: Vec3A) -> [[Vec4; 2]; 3] {
-        std::array::from_fn(|x| {
-            let mx = Vec4::splat(m[x]);
-            [
-                self.lo[x].min(self.end_lo[x] - mx),
-                self.hi[x].max(self.end_hi[x] - mx),
-            ]
-        })
-    }
-
     /// The lanes (as bits) whose triangle the triangle of lane `k` of `one` is not told
-    /// `reach` apart from along their motion, in the frame that moves by `m` (any frame
-    /// keeps the test; the two leaves' mean motion keeps it tight): the tree's test of
-    /// two nodes, four at a time.
+    /// `reach` apart from along their motion: the tree's test of two nodes, four at a
+    /// time ([`super::moving_apart`]).
     #[inline(always)]
-    pub(super) fn moving_near(&self, (one, k): (&Lanes, usize), m: Vec3A, reach: f32) -> u32 {
-        near_row(&self.hulls(m), &one.hulls(m), k, reach)
+    pub(super) fn moving_near(&self, (one, k): (&Lanes, usize), reach: f32) -> u32 {
+        near_row(self, one, k, reach)
     }
 
     /// [`Lanes::moving_near`] for each lane of `other`, as a row of bits each.
     #[inline(always)]
-    pub(super) fn moving_near_rows(&self, other: &Lanes, m: Vec3A, reach: f32) -> [u32; 4] {
-        let (b, a) = (self.hulls(m), other.hulls(m));
-        std::array::from_fn(|k| near_row(&b, &a, k, reach))
+    pub(super) fn moving_near_rows(&self, other: &Lanes, reach: f32) -> [u32; 4] {
+        std::array::from_fn(|k| near_row(self, other, k, reach))
     }
 
     /// [`Lanes::boxes_meet`] for each lane of `other`, as a row of bits each.
@@ -122,31 +101,31 @@ impl Lanes {
         std::array::from_fn(|k| self.boxes_meet((other, k)))
     }
 
-    /// The box of the first `count` lanes' boxes, and by motion the box of their ends and
-    /// the mean of their mean motions.
-    pub(super) fn bounds(&self, count: usize, moving: bool) -> ([Vec3A; 2], [Vec3A; 3]) {
+    /// The box of the first `count` lanes' boxes, and by motion the box of their ends.
+    pub(super) fn bounds(&self, count: usize, moving: bool) -> ([Vec3A; 2], [Vec3A; 2]) {
         let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-        let (mut end_lo, mut end_hi, mut sum) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY, Vec3A::ZERO);
+        let (mut end_lo, mut end_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
         for l in 0..count {
             let one = self.one(l);
             (lo, hi) = (lo.min(one.lo), hi.max(one.hi));
             if moving {
                 (end_lo, end_hi) = (end_lo.min(one.end_lo), end_hi.max(one.end_hi));
-                sum += one.mean;
             }
         }
-        ([lo, hi], [end_lo, end_hi, sum / count as f32])
+        ([lo, hi], [end_lo, end_hi])
     }
 }
 
-/// The lanes (as bits) of hulls `b` ([`Lanes::hulls`]) not told `reach` apart from lane
-/// `k` of hulls `a` along any axis.
+/// The lanes (as bits) of `b` not told `reach` apart from lane `k` of `a` along their
+/// motion along any axis ([`super::moving_apart`], four lanes at once).
 #[inline(always)]
-fn near_row(b: &[[Vec4; 2]; 3], a: &[[Vec4; 2]; 3], k: usize, reach: f32) -> u32 {
+fn near_row(b: &Lanes, a: &Lanes, k: usize, reach: f32) -> u32 {
     let mut gap = Vec4::NEG_INFINITY;
-    for ([blo, bhi], [alo, ahi]) in b.iter().zip(a) {
-        let (alo, ahi) = (Vec4::splat(alo[k]), Vec4::splat(ahi[k]));
-        gap = gap.max((*blo - ahi).max(alo - *bhi));
+    for x in 0..3 {
+        let at = |v: &[Vec4; 3]| Vec4::splat(v[x][k]);
+        let up = (b.lo[x] - at(&a.hi)).min(b.end_lo[x] - at(&a.end_hi));
+        let down = (at(&a.lo) - b.hi[x]).min(at(&a.end_lo) - b.end_hi[x]);
+        gap = gap.max(up.max(down));
     }
     (!gap.cmpge(Vec4::splat(reach))).bitmask()
 }
@@ -198,9 +177,8 @@ mod tests {
 
     /// Two leaves of four triangles each, moving 2–20 cm toward, past or along each other
     /// (each triangle a few cm wide and 1–10 cm from the other leaf): the pairs their rows
-    /// tell apart in the frame of the leaves' mean motion, of none, or of any motion, keep
-    /// the reach apart all along it (at each of 33 points their boxes lie that far apart
-    /// along an axis), and a row is what one lane's test tells.
+    /// tell apart keep the reach apart all along the motion (at each of 33 points their
+    /// boxes lie that far apart along an axis), and a row is what one lane's test tells.
     #[test]
     fn triangles_told_apart_by_their_motion_keep_apart_along_it() {
         let mut rnd = crate::test_rng::uniform(17);
@@ -221,14 +199,9 @@ mod tests {
                 (lanes, from, to)
             };
             let ((a, a_from, a_to), (b, b_from, b_to)) = (leaf(ca, ma), leaf(cb, mb));
-            let m = match trial % 3 {
-                0 => Vec3A::from(0.5 * (ma + mb)),
-                1 => Vec3A::ZERO,
-                _ => Vec3A::from(vector(0.4)),
-            };
-            let rows = b.moving_near_rows(&a, m, reach);
+            let rows = b.moving_near_rows(&a, reach);
             for (k, &row) in rows.iter().enumerate() {
-                assert_eq!(row, b.moving_near((&a, k), m, reach));
+                assert_eq!(row, b.moving_near((&a, k), reach));
                 for j in 0..4 {
                     if row & (1 << j) != 0 {
                         near += 1;
@@ -258,6 +231,29 @@ mod tests {
             }
         }
         assert!(apart > 1000 && near > 1000, "{apart} apart, {near} near");
+    }
+
+    /// A triangle that closes 10 cm on another along an axis and stops 2 cm short keeps
+    /// 2 cm away all along: told apart at a reach of 1.9 cm, not at 2.1. (Told in the
+    /// frame of their mean motion by the box of each one's start and end, it would not
+    /// be at any reach: each box takes in half of the 10 cm.)
+    #[test]
+    fn a_triangle_that_stops_short_of_another_is_told_apart() {
+        let still = [
+            Vec3::ZERO,
+            Vec3::new(0.0, 0.01, 0.0),
+            Vec3::new(0.0, 0.0, 0.01),
+        ];
+        let offset = |x: f32| still.map(|p| p - Vec3::new(x, 0.0, 0.0));
+        let lanes = |from: [Vec3; 3], to: [Vec3; 3]| {
+            let mut lanes = Lanes::default();
+            let ends: Vec<Vec3> = from.into_iter().chain(to).collect();
+            lanes.set(0, One::of([0, 1, 2], [&ends[..3], &ends[3..]]));
+            lanes
+        };
+        let (a, b) = (lanes(still, still), lanes(offset(0.12), offset(0.02)));
+        assert_eq!(a.moving_near((&b, 0), 0.019) & 1, 0);
+        assert_eq!(a.moving_near((&b, 0), 0.021) & 1, 1);
     }
 
     /// The SIMD compare and the plain one flag the same lanes, for corners drawn from a
