@@ -12,7 +12,10 @@
 //! between a node lies in the box that runs straight from its start box to its end box,
 //! and the gap between two such boxes along an axis runs straight from the one at the
 //! start to the one at the end. Where the cloth lands, its parts move fast against the
-//! cloth's mean but hardly against each other: two patches' gaps hardly change.
+//! cloth's mean but hardly against each other: two patches' gaps hardly change. Two
+//! leaves' triangles, four at a time, are told apart more cheaply: by the box of each
+//! one's starts and ends in the frame that moves with the two leaves' motion
+//! ([`TriangleTree::frame`]), each leaf's boxes carried into it once for its four rows.
 
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -348,6 +351,20 @@ impl TriangleTree {
         moving_apart(a, b, reach)
     }
 
+    /// The frame in which two leaves' triangles are told apart by the motion (nodes `a`
+    /// and `b`): their mean motion as the centres of their boxes of starts and ends
+    /// measure it. Any frame keeps the test (a translation changes no distance); theirs
+    /// keeps two leaves that move together from meeting in their boxes, and costs no
+    /// mean motion fitted.
+    #[inline(always)]
+    fn frame(&self, a: u32, b: u32) -> Vec3A {
+        let moved = |n: u32| {
+            let ([lo, hi], [end_lo, end_hi]) = (self.boxes[n as usize], self.motion[n as usize]);
+            (end_lo + end_hi) - (lo + hi)
+        };
+        0.25 * (moved(a) + moved(b))
+    }
+
     /// The leaf and lane of the triangle at `place` in the tree's order.
     fn lane(&self, place: usize) -> (usize, usize) {
         let leaf = self.leaf_at[place] as usize;
@@ -376,7 +393,10 @@ impl TriangleTree {
             Fit::Motion { reach } => self.walk(
                 piece,
                 |a, b| self.moving_apart(a, b, reach),
-                |[la, lb]| self.lanes[lb].moving_near_rows(&self.lanes[la], reach),
+                |[la, lb]| {
+                    let m = self.frame(self.leaves[la], self.leaves[lb]);
+                    self.lanes[lb].moving_near_rows(&self.lanes[la], m, reach)
+                },
                 pair,
             ),
             Fit::Boxes => self.walk(
@@ -402,14 +422,14 @@ impl TriangleTree {
                     let own = ([one.lo, one.hi], [one.end_lo, one.end_hi]);
                     moving_apart((self.boxes[a], self.motion[a]), own, reach)
                 },
-                |lanes, one| lanes.moving_near(one, reach),
+                |[a, b], lanes, one| lanes.moving_near(one, self.frame(a, b), reach),
                 pair,
             ),
             Fit::Boxes => self.query(
                 t,
                 searched,
                 |a, one| boxes_apart(self.boxes[a], [one.lo, one.hi]),
-                |lanes, one| lanes.boxes_meet(one),
+                |_, lanes, one| lanes.boxes_meet(one),
                 pair,
             ),
         }
@@ -421,7 +441,7 @@ impl TriangleTree {
         t: u32,
         searched: &[bool],
         apart: impl Fn(usize, &One) -> bool,
-        lanes_near: impl Fn(&Lanes, (&Lanes, usize)) -> u32,
+        lanes_near: impl Fn([u32; 2], &Lanes, (&Lanes, usize)) -> u32,
         mut pair: impl FnMut(u32, u32),
     ) {
         if self.nodes.is_empty() {
@@ -430,7 +450,7 @@ impl TriangleTree {
         let place = self.place_of[t as usize] as usize;
         let (leaf, k) = self.lane(place);
         let (lane, corners) = ((&self.lanes[leaf], k), self.corners(leaf, k));
-        let one = self.lanes[leaf].one(k);
+        let (one, own) = (self.lanes[leaf].one(k), self.leaves[leaf]);
         let mut stack = [0u32; STACK];
         let mut depth = 1;
         while depth > 0 {
@@ -442,7 +462,7 @@ impl TriangleTree {
             let node = self.nodes[a as usize];
             if Self::is_leaf(node) {
                 let leaf = self.leaf_of[a as usize] as usize;
-                let near = lanes_near(&self.lanes[leaf], lane)
+                let near = lanes_near([own, a], &self.lanes[leaf], lane)
                     & share_none(corners, &self.leaf_corners[leaf]);
                 for k in flagged(near & lanes_of(node)) {
                     let b = self.order[node.first as usize + k];

@@ -81,18 +81,34 @@ impl Lanes {
         meet.bitmask()
     }
 
-    /// The lanes (as bits) whose triangle the triangle of lane `k` of `one` is not told
-    /// `reach` apart from along their motion: the tree's test of two nodes, four at a
-    /// time ([`super::moving_apart`]).
+    /// Each lane's box of its starts and its ends less `m`, an axis each: in the frame
+    /// that moves by `m` along the motion, its triangle stays in it (each particle's path
+    /// runs between its start and its end less `m`).
     #[inline(always)]
-    pub(super) fn moving_near(&self, (one, k): (&Lanes, usize), reach: f32) -> u32 {
-        near_row(self, one, k, reach)
+    fn hulls(&self, m: Vec3A) -> [[Vec4; 2]; 3] {
+        std::array::from_fn(|x| {
+            let mx = Vec4::splat(m[x]);
+            [
+                self.lo[x].min(self.end_lo[x] - mx),
+                self.hi[x].max(self.end_hi[x] - mx),
+            ]
+        })
     }
 
-    /// [`Lanes::moving_near`] for each lane of `other`, as a row of bits each.
+    /// The lanes (as bits) whose triangle the triangle of lane `k` of `one` is not told
+    /// `reach` apart from along their motion, in the frame that moves by `m` (any frame
+    /// keeps the test; the two leaves' own motion keeps it tight).
     #[inline(always)]
-    pub(super) fn moving_near_rows(&self, other: &Lanes, reach: f32) -> [u32; 4] {
-        std::array::from_fn(|k| near_row(self, other, k, reach))
+    pub(super) fn moving_near(&self, (one, k): (&Lanes, usize), m: Vec3A, reach: f32) -> u32 {
+        near_row(&self.hulls(m), &one.hulls(m), k, reach)
+    }
+
+    /// [`Lanes::moving_near`] for each lane of `other`, as a row of bits each (each
+    /// leaf's boxes carried into the frame once for all four rows).
+    #[inline(always)]
+    pub(super) fn moving_near_rows(&self, other: &Lanes, m: Vec3A, reach: f32) -> [u32; 4] {
+        let (b, a) = (self.hulls(m), other.hulls(m));
+        std::array::from_fn(|k| near_row(&b, &a, k, reach))
     }
 
     /// [`Lanes::boxes_meet`] for each lane of `other`, as a row of bits each.
@@ -116,16 +132,14 @@ impl Lanes {
     }
 }
 
-/// The lanes (as bits) of `b` not told `reach` apart from lane `k` of `a` along their
-/// motion along any axis ([`super::moving_apart`], four lanes at once).
+/// The lanes (as bits) of hulls `b` ([`Lanes::hulls`]) not told `reach` apart from lane
+/// `k` of hulls `a` along any axis.
 #[inline(always)]
-fn near_row(b: &Lanes, a: &Lanes, k: usize, reach: f32) -> u32 {
+fn near_row(b: &[[Vec4; 2]; 3], a: &[[Vec4; 2]; 3], k: usize, reach: f32) -> u32 {
     let mut gap = Vec4::NEG_INFINITY;
-    for x in 0..3 {
-        let at = |v: &[Vec4; 3]| Vec4::splat(v[x][k]);
-        let up = (b.lo[x] - at(&a.hi)).min(b.end_lo[x] - at(&a.end_hi));
-        let down = (at(&a.lo) - b.hi[x]).min(at(&a.end_lo) - b.end_hi[x]);
-        gap = gap.max(up.max(down));
+    for ([blo, bhi], [alo, ahi]) in b.iter().zip(a) {
+        let (alo, ahi) = (Vec4::splat(alo[k]), Vec4::splat(ahi[k]));
+        gap = gap.max((*blo - ahi).max(alo - *bhi));
     }
     (!gap.cmpge(Vec4::splat(reach))).bitmask()
 }
@@ -177,8 +191,9 @@ mod tests {
 
     /// Two leaves of four triangles each, moving 2–20 cm toward, past or along each other
     /// (each triangle a few cm wide and 1–10 cm from the other leaf): the pairs their rows
-    /// tell apart keep the reach apart all along the motion (at each of 33 points their
-    /// boxes lie that far apart along an axis), and a row is what one lane's test tells.
+    /// tell apart in the frame of the leaves' mean motion, of none, or of any motion, keep
+    /// the reach apart all along it (at each of 33 points their boxes lie that far apart
+    /// along an axis), and a row is what one lane's test tells.
     #[test]
     fn triangles_told_apart_by_their_motion_keep_apart_along_it() {
         let mut rnd = crate::test_rng::uniform(17);
@@ -199,9 +214,14 @@ mod tests {
                 (lanes, from, to)
             };
             let ((a, a_from, a_to), (b, b_from, b_to)) = (leaf(ca, ma), leaf(cb, mb));
-            let rows = b.moving_near_rows(&a, reach);
+            let m = match trial % 3 {
+                0 => Vec3A::from(0.5 * (ma + mb)),
+                1 => Vec3A::ZERO,
+                _ => Vec3A::from(vector(0.4)),
+            };
+            let rows = b.moving_near_rows(&a, m, reach);
             for (k, &row) in rows.iter().enumerate() {
-                assert_eq!(row, b.moving_near((&a, k), reach));
+                assert_eq!(row, b.moving_near((&a, k), m, reach));
                 for j in 0..4 {
                     if row & (1 << j) != 0 {
                         near += 1;
@@ -233,27 +253,32 @@ mod tests {
         assert!(apart > 1000 && near > 1000, "{apart} apart, {near} near");
     }
 
-    /// A triangle that closes 10 cm on another along an axis and stops 2 cm short keeps
-    /// 2 cm away all along: told apart at a reach of 1.9 cm, not at 2.1. (Told in the
-    /// frame of their mean motion by the box of each one's start and end, it would not
-    /// be at any reach: each box takes in half of the 10 cm.)
+    /// Two triangles moving along an axis, one by 5 cm and the other by 15 cm after it,
+    /// closing from 12 cm to 2 cm: in the frame of their mean motion each keeps to a box
+    /// 5 cm long, and they are told apart at a reach of 1.9 cm (not at 2.1); in the
+    /// cloth's frame the second's box runs into the first's.
     #[test]
-    fn a_triangle_that_stops_short_of_another_is_told_apart() {
-        let still = [
+    fn in_their_own_frame_two_triangles_that_close_and_stop_short_are_told_apart() {
+        let flat = [
             Vec3::ZERO,
             Vec3::new(0.0, 0.01, 0.0),
             Vec3::new(0.0, 0.0, 0.01),
         ];
-        let offset = |x: f32| still.map(|p| p - Vec3::new(x, 0.0, 0.0));
+        let along = |x: f32| flat.map(|p| p + Vec3::new(x, 0.0, 0.0));
         let lanes = |from: [Vec3; 3], to: [Vec3; 3]| {
             let mut lanes = Lanes::default();
             let ends: Vec<Vec3> = from.into_iter().chain(to).collect();
             lanes.set(0, One::of([0, 1, 2], [&ends[..3], &ends[3..]]));
             lanes
         };
-        let (a, b) = (lanes(still, still), lanes(offset(0.12), offset(0.02)));
-        assert_eq!(a.moving_near((&b, 0), 0.019) & 1, 0);
-        assert_eq!(a.moving_near((&b, 0), 0.021) & 1, 1);
+        let (a, b) = (
+            lanes(along(0.0), along(0.05)),
+            lanes(along(-0.12), along(0.03)),
+        );
+        let own = Vec3A::new(0.1, 0.0, 0.0);
+        assert_eq!(a.moving_near((&b, 0), own, 0.019) & 1, 0);
+        assert_eq!(a.moving_near((&b, 0), own, 0.021) & 1, 1);
+        assert_eq!(a.moving_near((&b, 0), Vec3A::ZERO, 0.019) & 1, 1);
     }
 
     /// The SIMD compare and the plain one flag the same lanes, for corners drawn from a
