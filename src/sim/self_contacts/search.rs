@@ -266,12 +266,12 @@ impl Search<'_> {
     /// thickness apart, in the same direction, at the start and at the end of the motion
     /// are at least that far apart all along it (each corner runs straight from its start
     /// to its end, so along the line the gap runs straight from the one to the other, as
-    /// the tree's boxes do: [`super::tree`]). Two triangles of a smooth patch that share no corner overlap in their boxes
-    /// wherever the patch runs across the axes, but most lie apart along the line between
-    /// their centres; where that line runs obliquely (on a grid, two triangles whose
-    /// diagonals run side by side with a strip of two triangles between: 0.7 of the
-    /// spacing apart across the diagonals, a quarter along that line), across the edge.
-    /// In f64, so that no rounding keeps apart what touches.
+    /// the tree's boxes do: [`super::tree`]). Two triangles of a smooth patch that share
+    /// no corner overlap in their boxes wherever the patch runs across the axes, but most
+    /// lie apart along the line between their centres; where that line runs obliquely (on
+    /// a grid, two triangles whose diagonals run side by side with a strip of two
+    /// triangles between: 0.7 of the spacing apart across the diagonals, a quarter along
+    /// that line), across the edge. In f64, so that no rounding keeps apart what touches.
     fn apart_across(&self, a: usize, b: usize) -> bool {
         // The lower-numbered first, so that a pair is told alike whichever way it is met
         // (a whole walk and a refresh meet it either way; the line between the centres
