@@ -451,7 +451,7 @@ impl Search<'_> {
         let x1 = ids.map(|i| to[i].as_dvec3());
         let moves: [DVec3; 4] = std::array::from_fn(|j| x1[j] - x0[j]);
         let k = pair.first_side();
-        let (first, second) = (0..k, k..4);
+        let sides = [0..k, k..4];
         let thickness = f64::from(self.thickness);
         // The gap from side `a` up to side `b` at the start and at the end, the lesser.
         let boxes = |x: &[DVec3; 4]| {
@@ -460,7 +460,7 @@ impl Search<'_> {
                     (lo.min(x[j]), hi.max(x[j]))
                 })
             };
-            (side(first.clone()), side(second.clone()))
+            (side(sides[0].clone()), side(sides[1].clone()))
         };
         let (((alo, ahi), (blo, bhi)), ((aelo, aehi), (belo, behi))) = (boxes(&x0), boxes(&x1));
         let gap = (blo - ahi)
@@ -475,14 +475,14 @@ impl Search<'_> {
             let n = r.len() as f64;
             r.map(|j| x0[j] + x1[j]).sum::<DVec3>() / (2.0 * n)
         };
-        let axis = middle(second.clone()) - middle(first.clone());
+        let axis = middle(sides[1].clone()) - middle(sides[0].clone());
         let span = |x: &[DVec3; 4], r: std::ops::Range<usize>| {
             r.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), j| {
                 let p = axis.dot(x[j]);
                 (lo.min(p), hi.max(p))
             })
         };
-        let ahead = |x: &[DVec3; 4]| span(x, second.clone()).0 - span(x, first.clone()).1;
+        let ahead = |x: &[DVec3; 4]| span(x, sides[1].clone()).0 - span(x, sides[0].clone()).1;
         let length = axis.length();
         if ahead(&x0).min(ahead(&x1)) >= thickness * length && length > 0.0 {
             return false;

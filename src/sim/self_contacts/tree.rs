@@ -357,9 +357,9 @@ impl TriangleTree {
     /// keeps two leaves that move together from meeting in their boxes, and costs no
     /// mean motion fitted.
     #[inline(always)]
-    fn frame(&self, a: u32, b: u32) -> Vec3A {
-        let moved = |n: u32| {
-            let ([lo, hi], [end_lo, end_hi]) = (self.boxes[n as usize], self.motion[n as usize]);
+    fn frame(&self, a: usize, b: usize) -> Vec3A {
+        let moved = |n: usize| {
+            let ([lo, hi], [end_lo, end_hi]) = (self.boxes[n], self.motion[n]);
             (end_lo + end_hi) - (lo + hi)
         };
         0.25 * (moved(a) + moved(b))
@@ -393,8 +393,8 @@ impl TriangleTree {
             Fit::Motion { reach } => self.walk(
                 piece,
                 |a, b| self.moving_apart(a, b, reach),
-                |[la, lb]| {
-                    let m = self.frame(self.leaves[la], self.leaves[lb]);
+                |[a, b], [la, lb]| {
+                    let m = self.frame(a, b);
                     self.lanes[lb].moving_near_rows(&self.lanes[la], m, reach)
                 },
                 pair,
@@ -402,7 +402,7 @@ impl TriangleTree {
             Fit::Boxes => self.walk(
                 piece,
                 |a, b| self.boxes_apart(a, b),
-                |[la, lb]| self.lanes[lb].boxes_meet_rows(&self.lanes[la]),
+                |_, [la, lb]| self.lanes[lb].boxes_meet_rows(&self.lanes[la]),
                 pair,
             ),
         }
@@ -441,7 +441,7 @@ impl TriangleTree {
         t: u32,
         searched: &[bool],
         apart: impl Fn(usize, &One) -> bool,
-        lanes_near: impl Fn([u32; 2], &Lanes, (&Lanes, usize)) -> u32,
+        lanes_near: impl Fn([usize; 2], &Lanes, (&Lanes, usize)) -> u32,
         mut pair: impl FnMut(u32, u32),
     ) {
         if self.nodes.is_empty() {
@@ -450,7 +450,7 @@ impl TriangleTree {
         let place = self.place_of[t as usize] as usize;
         let (leaf, k) = self.lane(place);
         let (lane, corners) = ((&self.lanes[leaf], k), self.corners(leaf, k));
-        let (one, own) = (self.lanes[leaf].one(k), self.leaves[leaf]);
+        let (one, own) = (self.lanes[leaf].one(k), self.leaves[leaf] as usize);
         let mut stack = [0u32; STACK];
         let mut depth = 1;
         while depth > 0 {
@@ -462,7 +462,7 @@ impl TriangleTree {
             let node = self.nodes[a as usize];
             if Self::is_leaf(node) {
                 let leaf = self.leaf_of[a as usize] as usize;
-                let near = lanes_near([own, a], &self.lanes[leaf], lane)
+                let near = lanes_near([own, a as usize], &self.lanes[leaf], lane)
                     & share_none(corners, &self.leaf_corners[leaf]);
                 for k in flagged(near & lanes_of(node)) {
                     let b = self.order[node.first as usize + k];
@@ -482,7 +482,7 @@ impl TriangleTree {
         &self,
         piece: usize,
         apart: impl Fn(usize, usize) -> bool,
-        lanes_near: impl Fn([usize; 2]) -> [u32; 4],
+        lanes_near: impl Fn([usize; 2], [usize; 2]) -> [u32; 4],
         mut pair: impl FnMut(u32, u32),
     ) {
         // Each triangle of leaf node `a` against those of leaf node `b` (past its own,
@@ -491,7 +491,7 @@ impl TriangleTree {
             let (na, nb) = (self.nodes[a], self.nodes[b]);
             let (la, lb) = (self.leaf_of[a] as usize, self.leaf_of[b] as usize);
             let corners = &self.leaf_corners[lb];
-            let rows = lanes_near([la, lb]);
+            let rows = lanes_near([a, b], [la, lb]);
             let lanes = lanes_of(nb);
             for (k, &row) in rows.iter().enumerate().take(na.count as usize) {
                 // Past its own, where the leaves are the same.
