@@ -411,8 +411,11 @@ impl TriangleTree {
     /// Calls `pair(t, b)` for each triangle `b` sharing no corner with `t` that `t`'s box
     /// is not told apart from (as the last fit tells them), not flagged by `searched`
     /// where `b < t`: a search of each flagged triangle so calls it once for each two of
-    /// which one at least is flagged. Its tests of two triangles are the whole walk's, so
-    /// the two tell the same two apart.
+    /// which one at least is flagged. By the boxes, the whole walk's tests of theirs and
+    /// these tell the same two apart; by the motion, `t` is told apart from each node by
+    /// its own boxes rather than from the node the whole walk pairs with it, and the
+    /// leaves' rows (in the two leaves' frame, as the whole walk's) are not the nodes'
+    /// test, so it may pass by a few pairs more, each of which keeps the reach apart.
     pub(super) fn triangle_pairs(&self, t: u32, searched: &[bool], pair: impl FnMut(u32, u32)) {
         match self.fit {
             Fit::Motion { reach } => self.query(

@@ -320,8 +320,9 @@ fn pairs_near(
 /// A band of a fifth of the cloth moved 4 cm sideways: only its triangles are searched
 /// again (one refresh, no second search of the whole tree), and the pairs are those a
 /// search of the whole tree finds with the boxes as they now are — the band's new pairs
-/// found, its old ones gone, the rest kept: exactly, whether the pairs were judged by
-/// their boxes (the cloth still) or by the motion too (the cloth moving fast).
+/// found, its old ones gone, the rest kept: exactly, where the pairs were judged by their
+/// boxes (the cloth still); less a few pairs that stay apart, where by the motion too
+/// (the cloth moving fast).
 #[test]
 fn a_refresh_finds_what_a_whole_search_finds() {
     let model = crumpled().0;
@@ -347,16 +348,40 @@ fn a_refresh_finds_what_a_whole_search_finds() {
         let whole: Vec<StoredPair> = contacts.found.stored().copied().collect();
         assert!(whole.len() > least, "{}", whole.len());
         let (after, whole) = (sorted(after), sorted(whole));
-        // A refresh tests each pair of two triangles as the whole walk does: it finds
-        // exactly what a whole search finds, by the boxes and by the motion.
-        let differ = |a: &[StoredPair], b: &[StoredPair]| {
-            (a.iter()).filter(|p| b.binary_search(p).is_err()).count()
+        let extra: Vec<_> = (after.iter())
+            .filter(|p| whole.binary_search(p).is_err())
+            .collect();
+        let missing: Vec<_> = (whole.iter())
+            .filter(|p| after.binary_search(p).is_err())
+            .collect();
+        // By the motion, a refresh tells its triangles apart from the whole tree's nodes,
+        // not from those the whole walk pairs them with: it may pass by a few pairs more,
+        // each of which stays the reach apart along the motion (at every one of 33
+        // points); by the boxes, the tests are the same.
+        let (from, to, reach) = (
+            &contacts.boxes.from,
+            &contacts.boxes.to,
+            contacts.reach(THICKNESS),
+        );
+        let passed = |stored: &&StoredPair| {
+            let pair = stored.expand(&model.triangles, &contacts.owners.edges);
+            (0..=32).all(|k| {
+                let t = f64::from(k) / 32.0;
+                let x = (pair.ids()).map(|i| (from[i] + (to[i] - from[i]) * t as f32).as_dvec3());
+                distance(&pair, x) >= f64::from(reach)
+            })
         };
-        assert_eq!(
-            (differ(&after, &whole), differ(&whole, &after)),
-            (0, 0),
-            "pairs the refresh found that the whole search's {} did not, and missed",
-            whole.len()
+        let unexplained = missing
+            .iter()
+            .filter(|p| motion == Vec3::ZERO || !passed(p));
+        assert!(
+            extra.is_empty() && unexplained.count() == 0 && missing.len() < whole.len() / 100,
+            "{} pairs not in the whole search's {}, {} of its missing: {:?} {:?}",
+            extra.len(),
+            whole.len(),
+            missing.len(),
+            &extra[..extra.len().min(5)],
+            &missing[..missing.len().min(5)]
         );
     }
 }

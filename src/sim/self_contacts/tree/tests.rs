@@ -185,21 +185,28 @@ fn a_walk_by_the_motion_passes_by_nothing_that_comes_within_reach() {
     assert!(passed > pairs * 91 / 100, "{passed} of {pairs} passed by");
 }
 
-/// A search of some triangles finds, once each, exactly the pairs with one of them that the
-/// whole walk finds, by the boxes and by the motion.
+/// A search of some triangles finds, once each, the pairs with one of them that the whole
+/// walk finds: exactly by the boxes; by the motion (half the cloth falling, or all of it
+/// sheared, so that each leaf moves otherwise), none more, and those fewer each keep the
+/// reach apart all along the motion (the search tells a triangle apart from the nodes by
+/// its own boxes, where the whole walk tells two nodes apart, and the leaves' rows in
+/// their own frame are no test of two nodes: 33 points along it).
 #[test]
 fn a_search_of_some_triangles_finds_what_the_whole_walk_finds_of_theirs() {
     let (triangles, rest, from) = cloth();
     let mut tree = TriangleTree::build(&triangles, &rest);
-    let to: Vec<Vec3> = (from.iter())
-        .map(|&p| p + Vec3::new(0.0, if p.x < 0.0 { -0.05 } else { 0.0 }, 0.0))
-        .collect();
+    // Half the cloth falling 5 cm; and the whole sheared, each leaf moving otherwise (so
+    // that two leaves' frame, wherever it is taken from, differs from either's motion).
+    let moved =
+        |by: &dyn Fn(Vec3) -> Vec3| -> Vec<Vec3> { from.iter().map(|&p| p + by(p)).collect() };
+    let falling = moved(&|p| Vec3::new(0.0, if p.x < 0.0 { -0.05 } else { 0.0 }, 0.0));
+    let sheared = moved(&|p| Vec3::new(0.4 * p.z, -0.3 * p.x, 0.2 * p.x * p.z));
     let mut rnd = crate::test_rng::uniform(3);
     let dirty: Vec<bool> = triangles.iter().map(|_| rnd() < 0.2).collect();
     let marked = |p: &(u32, u32)| dirty[p.0 as usize] || dirty[p.1 as usize];
-    for by_motion in [false, true] {
-        if by_motion {
-            tree.fit_motion([&from, &to], 0.01);
+    for motion in [None, Some(&falling), Some(&sheared)] {
+        if let Some(to) = motion {
+            tree.fit_motion([&from, to], 0.01);
         } else {
             let (lo, hi): (Vec<Vec3>, Vec<Vec3>) = (triangles.iter())
                 .map(|t| {
@@ -225,7 +232,40 @@ fn a_search_of_some_triangles_finds_what_the_whole_walk_finds_of_theirs() {
             only.len(),
             whole.len()
         );
-        assert_eq!(only, theirs, "by the motion: {by_motion}");
+        let Some(to) = motion else {
+            assert_eq!(only, theirs, "by the boxes");
+            continue;
+        };
+        let extra = (only.iter()).filter(|p| theirs.binary_search(p).is_err());
+        assert_eq!(
+            extra.count(),
+            0,
+            "found by the search of some, not by the whole walk"
+        );
+        let samples: Vec<Vec<DVec3>> = (0..=32)
+            .map(|k| {
+                let s = f64::from(k) / 32.0;
+                (from.iter().zip(to))
+                    .map(|(a, b)| a.as_dvec3() + s * (b.as_dvec3() - a.as_dvec3()))
+                    .collect()
+            })
+            .collect();
+        for &(a, b) in theirs.iter().filter(|p| only.binary_search(p).is_err()) {
+            let (s, t) = (triangles[a as usize], triangles[b as usize]);
+            let least = (samples.iter())
+                .map(|x| apart(s, t, x))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                least >= 0.01,
+                "{a} and {b} come within {least} m, passed by"
+            );
+        }
+        assert!(
+            only.len() * 100 > theirs.len() * 99,
+            "{} of {}",
+            only.len(),
+            theirs.len()
+        );
     }
 }
 
