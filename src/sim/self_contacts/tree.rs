@@ -640,9 +640,10 @@ fn boxes_apart([alo, ahi]: [Vec3A; 2], [blo, bhi]: [Vec3A; 2]) -> bool {
 /// lie `reach` apart and so do the ends'. Every particle runs straight from its start to
 /// its end in the same time, so at a share `t` of the motion each node lies in the box
 /// `(1 − t)·start + t·end` of its two, and along each axis the gap between two such boxes
-/// is `(1 − t)` times the starts' gap and `t` times the ends'. (Unlike the box of a node's
-/// starts and ends in any one frame, it takes in no part of the motion: two triangles that
-/// close on each other and stop short are told apart.)
+/// is `(1 − t)` times the starts' gap and `t` times the ends'. (The box of a node's starts
+/// and ends in one frame takes in the node's motion against that frame: where two nodes
+/// move alike with it the two tests agree, but where a node turns or stretches along the
+/// motion, or moves otherwise than the frame, that box grows and this test does not.)
 #[inline(always)]
 fn moving_apart(
     ([alo, ahi], [aend_lo, aend_hi]): ([Vec3A; 2], [Vec3A; 2]),
