@@ -17,6 +17,7 @@ mod ccd;
 mod certify;
 mod error;
 mod found;
+mod gap;
 mod patches;
 mod primitives;
 mod rings;

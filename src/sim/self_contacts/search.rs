@@ -7,6 +7,7 @@ use rustc_hash::FxHashMap;
 
 use super::ccd::closing_bound;
 use super::found::Found;
+use super::gap::gap_at_both_ends;
 use super::primitives::{Pair, StoredPair, distance};
 use super::rings::Rings;
 use crate::cloth::ClothModel;
@@ -264,9 +265,7 @@ impl Search<'_> {
     /// made for, told along the line between their centres and then across the edge of the
     /// lower-numbered that faces the other: two triangles whose extents along a line are a
     /// thickness apart, in the same direction, at the start and at the end of the motion
-    /// are at least that far apart all along it (each corner runs straight from its start
-    /// to its end, so along the line the gap runs straight from the one to the other, as
-    /// the tree's boxes do: [`super::tree`]). Two triangles of a smooth patch that share
+    /// are at least that far apart all along it ([`super::gap`]). Two triangles of a smooth patch that share
     /// no corner overlap in their boxes wherever the patch runs across the axes, but most
     /// lie apart along the line between their centres; where that line runs obliquely (on
     /// a grid, two triangles whose diagonals run side by side with a strip of two
@@ -292,17 +291,12 @@ impl Search<'_> {
                 return false;
             }
             let span = |x: [DVec3; 3]| {
-                (0..3).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), k| {
+                (0..3).fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], k| {
                     let p = axis.dot(x[k]);
-                    (lo.min(p), hi.max(p))
+                    [lo.min(p), hi.max(p)]
                 })
             };
-            let ((alo, ahi), (blo, bhi)) = (span(sa), span(sb));
-            let ((aelo, aehi), (belo, behi)) = (span(ea), span(eb));
-            (blo - ahi)
-                .min(belo - aehi)
-                .max((alo - bhi).min(aelo - behi))
-                >= thickness * length
+            gap_at_both_ends([span(sa), span(sb)], [span(ea), span(eb)]) >= thickness * length
         };
         let across = (sum(sb) + sum(eb) - sum(sa) - sum(ea)) / 6.0;
         if apart_along(across) {
@@ -434,9 +428,8 @@ impl Search<'_> {
     /// Whether the pair's sides could come within the thickness along the particles'
     /// straight motion the boxes were made for. First the sides' boxes: where along an
     /// axis, in the same direction, the sides' boxes at the start lie a thickness apart and
-    /// so do those at the end, the sides keep that far apart all along (each particle runs
-    /// straight from its start to its end, and the gap between the boxes with it, as the
-    /// tree's do: [`super::tree`]); most pairs that move together are told apart there.
+    /// so do those at the end, the sides keep that far apart all along ([`super::gap`]);
+    /// most pairs that move together are told apart there.
     /// Then the same along the line between the sides' middles (two sides a cell apart on
     /// a patch that runs across the axes are told apart there). Then the distances at the
     /// start and the end (`d₀`, `d₁`): either within the thickness keeps the pair (four in
@@ -453,20 +446,16 @@ impl Search<'_> {
         let k = pair.first_side();
         let sides = [0..k, k..4];
         let thickness = f64::from(self.thickness);
-        // The gap from side `a` up to side `b` at the start and at the end, the lesser.
+        // The two sides' boxes with the particles at `x`.
         let boxes = |x: &[DVec3; 4]| {
             let side = |r: std::ops::Range<usize>| {
-                r.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), j| {
-                    (lo.min(x[j]), hi.max(x[j]))
+                r.fold([DVec3::INFINITY, DVec3::NEG_INFINITY], |[lo, hi], j| {
+                    [lo.min(x[j]), hi.max(x[j])]
                 })
             };
-            (side(sides[0].clone()), side(sides[1].clone()))
+            [side(0..k), side(k..4)]
         };
-        let (((alo, ahi), (blo, bhi)), ((aelo, aehi), (belo, behi))) = (boxes(&x0), boxes(&x1));
-        let gap = (blo - ahi)
-            .min(belo - aehi)
-            .max((alo - bhi).min(aelo - behi));
-        if gap.max_element() >= thickness {
+        if gap_at_both_ends(boxes(&x0), boxes(&x1)).max_element() >= thickness {
             return false;
         }
         // Then along the line between the sides' middles: where a smooth patch runs

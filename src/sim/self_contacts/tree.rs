@@ -7,11 +7,8 @@
 //!
 //! Where the pairs are judged by the motion, a node holds two boxes — its particles'
 //! starts and ends — and two nodes are told apart where one's boxes lie `reach` beyond the
-//! other's along one axis, in the same direction, at both ends ([`moving_apart`]): each
-//! particle runs straight from its start to its end in the same time, so at every moment
-//! between a node lies in the box that runs straight from its start box to its end box,
-//! and the gap between two such boxes along an axis runs straight from the one at the
-//! start to the one at the end. Where the cloth lands, its parts move fast against the
+//! other's along one axis, in the same direction, at both ends ([`moving_apart`]; why
+//! that holds all along: [`super::gap`]). Where the cloth lands, its parts move fast against the
 //! cloth's mean but hardly against each other: two patches' gaps hardly change. Two
 //! leaves' triangles, four at a time, are told apart more cheaply: by the box of each
 //! one's starts and ends in the frame that moves with the two leaves' motion
@@ -22,6 +19,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use glam::{Vec3, Vec3A};
 
 use self::lanes::{Corners, Lanes, One, share_none};
+use super::gap::gap_at_both_ends;
 use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
 use crate::sim::obstacle::{Split, split_triangles_at_medians};
 
@@ -637,22 +635,17 @@ fn boxes_apart([alo, ahi]: [Vec3A; 2], [blo, bhi]: [Vec3A; 2]) -> bool {
 
 /// Whether two boxes by motion (`[lo, hi]` of the starts and of the ends) keep `reach`
 /// apart along their motion: where along one axis, in the same direction, the starts' boxes
-/// lie `reach` apart and so do the ends'. Every particle runs straight from its start to
-/// its end in the same time, so at a share `t` of the motion each node lies in the box
-/// `(1 − t)·start + t·end` of its two, and along each axis the gap between two such boxes
-/// is `(1 − t)` times the starts' gap and `t` times the ends'. (The box of a node's starts
-/// and ends in one frame takes in the node's motion against that frame: where two nodes
-/// move alike with it the two tests agree, but where a node turns or stretches along the
+/// lie `reach` apart and so do the ends' ([`super::gap`]). (The box of a node's starts and
+/// ends in one frame takes in the node's motion against that frame: where two nodes move
+/// alike with it the two tests agree, but where a node turns or stretches along the
 /// motion, or moves otherwise than the frame, that box grows and this test does not.)
 #[inline(always)]
 fn moving_apart(
-    ([alo, ahi], [aend_lo, aend_hi]): ([Vec3A; 2], [Vec3A; 2]),
-    ([blo, bhi], [bend_lo, bend_hi]): ([Vec3A; 2], [Vec3A; 2]),
+    (a, a_end): ([Vec3A; 2], [Vec3A; 2]),
+    (b, b_end): ([Vec3A; 2], [Vec3A; 2]),
     reach: f32,
 ) -> bool {
-    let up = (blo - ahi).min(bend_lo - aend_hi);
-    let down = (alo - bhi).min(aend_lo - bend_hi);
-    up.max(down).max_element() >= reach
+    gap_at_both_ends([a, b], [a_end, b_end]).max_element() >= reach
 }
 
 #[cfg(test)]
