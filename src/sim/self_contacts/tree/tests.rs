@@ -122,6 +122,25 @@ fn apart(s: [u32; 3], t: [u32; 3], x: &[DVec3]) -> f64 {
     least
 }
 
+/// The particles at 33 points evenly along their straight motion from `from` to `to`.
+fn along(from: &[Vec3], to: &[Vec3]) -> Vec<Vec<DVec3>> {
+    (0..=32)
+        .map(|k| {
+            let s = f64::from(k) / 32.0;
+            (from.iter().zip(to))
+                .map(|(a, b)| a.as_dvec3() + s * (b.as_dvec3() - a.as_dvec3()))
+                .collect()
+        })
+        .collect()
+}
+
+/// The least distance between triangles `s` and `t` over the particles' `samples`.
+fn least_apart(s: [u32; 3], t: [u32; 3], samples: &[Vec<DVec3>]) -> f64 {
+    (samples.iter())
+        .map(|x| apart(s, t, x))
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Fitted to the motion, the cloth folded in two, its upper half falling 8 cm through the
 /// lower while turning 20° and sliding 5 cm, the lower rising 2 cm (each half as a whole):
 /// no two triangles the walk passes by come within the reach at any of 33 points along the
@@ -155,12 +174,7 @@ fn a_walk_by_the_motion_passes_by_nothing_that_comes_within_reach() {
     poison_empty_lanes(&mut tree);
     let (found, twice) = walked(&tree);
     assert!(!twice, "a pair found twice");
-    let at = |s: f64| -> Vec<DVec3> {
-        (from.iter().zip(&to))
-            .map(|(a, b)| a.as_dvec3() + s * (b.as_dvec3() - a.as_dvec3()))
-            .collect()
-    };
-    let samples: Vec<Vec<DVec3>> = (0..=32).map(|k| at(f64::from(k) / 32.0)).collect();
+    let samples = along(&from, &to);
     let (mut passed, mut near) = (0, 0);
     for a in 0..triangles.len() {
         for b in a + 1..triangles.len() {
@@ -168,9 +182,7 @@ fn a_walk_by_the_motion_passes_by_nothing_that_comes_within_reach() {
             if s.iter().any(|i| t.contains(i)) {
                 continue;
             }
-            let least = (samples.iter())
-                .map(|x| apart(s, t, x))
-                .fold(f64::INFINITY, f64::min);
+            let least = least_apart(s, t, &samples);
             let kept = found.binary_search(&(a as u32, b as u32)).is_ok();
             if least < f64::from(reach) {
                 near += 1;
@@ -242,19 +254,10 @@ fn a_search_of_some_triangles_finds_what_the_whole_walk_finds_of_theirs() {
             0,
             "found by the search of some, not by the whole walk"
         );
-        let samples: Vec<Vec<DVec3>> = (0..=32)
-            .map(|k| {
-                let s = f64::from(k) / 32.0;
-                (from.iter().zip(to))
-                    .map(|(a, b)| a.as_dvec3() + s * (b.as_dvec3() - a.as_dvec3()))
-                    .collect()
-            })
-            .collect();
+        let samples = along(&from, to);
         for &(a, b) in theirs.iter().filter(|p| only.binary_search(p).is_err()) {
             let (s, t) = (triangles[a as usize], triangles[b as usize]);
-            let least = (samples.iter())
-                .map(|x| apart(s, t, x))
-                .fold(f64::INFINITY, f64::min);
+            let least = least_apart(s, t, &samples);
             assert!(
                 least >= 0.01,
                 "{a} and {b} come within {least} m, passed by"
