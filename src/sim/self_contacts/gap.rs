@@ -19,38 +19,23 @@ pub(super) trait Extent: Copy + Sub<Output = Self> {
     fn most(self, other: Self) -> Self;
 }
 
-impl Extent for f64 {
-    #[inline(always)]
-    fn least(self, other: Self) -> Self {
-        self.min(other)
-    }
-    #[inline(always)]
-    fn most(self, other: Self) -> Self {
-        self.max(other)
-    }
+/// [`Extent`] for types whose own `min` and `max` are the lesser and the larger.
+macro_rules! extent_by_min_max {
+    ($($t:ty),*) => {$(
+        impl Extent for $t {
+            #[inline(always)]
+            fn least(self, other: Self) -> Self {
+                self.min(other)
+            }
+            #[inline(always)]
+            fn most(self, other: Self) -> Self {
+                self.max(other)
+            }
+        }
+    )*};
 }
 
-impl Extent for DVec3 {
-    #[inline(always)]
-    fn least(self, other: Self) -> Self {
-        self.min(other)
-    }
-    #[inline(always)]
-    fn most(self, other: Self) -> Self {
-        self.max(other)
-    }
-}
-
-impl Extent for Vec3A {
-    #[inline(always)]
-    fn least(self, other: Self) -> Self {
-        self.min(other)
-    }
-    #[inline(always)]
-    fn most(self, other: Self) -> Self {
-        self.max(other)
-    }
-}
+extent_by_min_max!(f64, DVec3, Vec3A);
 
 /// The gap between two extents `a` and `b` (`[lo, hi]` each) that run straight from
 /// `start` to `end` along the motion, that holds all along it: the larger of the gap from
