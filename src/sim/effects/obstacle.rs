@@ -9,10 +9,14 @@ use std::sync::Arc;
 use glam::{Quat, Vec3};
 
 use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
-use super::solid::{Solid, default_friction, resolve, resolve_remembering, touching};
+use super::solid::{Solid, default_friction, resolve, resolve_remembering};
 use crate::mesh::{ObjError, PolygonSoup, parse_obj, read_obj};
 use crate::sim::motion::{AxisAngle, Keyframe, Pose, RigidMotion};
-use crate::sim::obstacle::{Gathered, Moment, Sequence, SharpEdges, Surface};
+use crate::sim::obstacle::{Gathered, Moment, Sequence, Surface};
+
+use self::edge_pass::{EdgeFrame, EdgeMemory, push_edges};
+
+mod edge_pass;
 use crate::sim::param_error::ParamError;
 use crate::sim::self_contacts::ContactError;
 
@@ -124,9 +128,20 @@ pub struct Placed {
     /// What each particle's last contact gathered, in the obstacle's frame (a rigid
     /// obstacle's only: a sequence's surface changes every substep).
     pub memory: std::sync::Mutex<Vec<Gathered>>,
+    /// What its edge pass keeps from one substep to the next.
+    edge_memory: std::sync::Mutex<EdgeMemory>,
 }
 
 impl Placed {
+    /// `f` with the edge pass's memory, or (where another stepping copy of the simulation
+    /// holds it now) with none: it only saves work, the result is the same.
+    fn with_edge_memory<T>(&self, f: impl FnOnce(&mut EdgeMemory) -> T) -> T {
+        match self.edge_memory.try_lock() {
+            Ok(mut memory) => f(&mut memory),
+            Err(_) => f(&mut EdgeMemory::default()),
+        }
+    }
+
     /// Its vertices at simulated time `time`, in the obstacle's frame (for a sequence, in
     /// the world), and whether they change from frame to frame.
     pub fn vertices_at(&self, time: f64) -> (std::borrow::Cow<'_, [Vec3]>, bool) {
@@ -340,6 +355,7 @@ impl Obstacle {
             pivot: self.translate,
             sequence,
             memory: std::sync::Mutex::new(Vec::new()),
+            edge_memory: std::sync::Mutex::new(EdgeMemory::default()),
         })));
         Ok(())
     }
@@ -368,113 +384,10 @@ struct Posed<'a> {
     friction: f32,
 }
 
-/// How a frame of sharp edges lies in the world: `to_local` takes a world point into it,
-/// `to_world` turns a direction of it into the world's, `velocity` is the surface's
-/// velocity (world) at one of its points.
-struct EdgeFrame<S, L, W, V> {
-    /// A world point where the substep began, into the frame as it was then.
-    from_start: S,
-    to_local: L,
-    to_world: W,
-    velocity: V,
-}
-
-/// Keeps every cloth edge (its structural and shear springs, in the model's colour order)
-/// `pass.offset` from the sharp `edges` where it ends the substep: the two particles are moved apart from the edge in
-/// proportion to how near each is to the nearest point, which moves by exactly what was
-/// missing; their velocity towards the edge is removed, with Coulomb friction `mu` along it.
-/// Returns how many cloth edges it moved.
-fn push_edges<S, L, W, V>(
-    edges: &SharpEdges,
-    frame: &EdgeFrame<S, L, W, V>,
-    mu: f32,
-    pass: &mut ContactPass<'_>,
-) -> usize
-where
-    S: Fn(Vec3) -> Vec3,
-    L: Fn(Vec3) -> Vec3,
-    W: Fn(Vec3) -> Vec3,
-    V: Fn(Vec3) -> Vec3,
-{
-    if edges.is_empty() {
-        return 0;
-    }
-    let thickness = pass.offset;
-    let (springs, inv_mass) = (&pass.model.springs, &pass.model.inv_mass);
-    let state = &mut *pass.state;
-    let mut moved = 0;
-    // A cloth edge put back from a crossing can pull a neighbour across another: the pass
-    // repeats (a few times at most) while it finds crossings.
-    for _ in 0..EDGE_SWEEPS {
-        let mut crossings = 0;
-        // In colours (the GPU's order too, a colour's edges side by side there).
-        for &e in &pass.model.edge_colours.order {
-            let e = e as usize;
-            let (i, j) = (springs.a[e] as usize, springs.b[e] as usize);
-            let free = [inv_mass[i] > 0.0, inv_mass[j] > 0.0].map(f32::from);
-            if free == [0.0, 0.0] {
-                continue;
-            }
-            let local = [state.pos[i], state.pos[j]].map(&frame.to_local);
-            let before = [pass.start[i], pass.start[j]].map(&frame.from_start);
-            // An edge the cloth edge passed through in the substep puts it back on the side it
-            // came from; else one it ends within the thickness of pushes it out. Every point
-            // of the cloth edge moved at most `travel`: one that passed through a sharp edge
-            // ends within that of it, so an edge with none that near is not asked.
-            let travel = (local[0] - before[0])
-                .length()
-                .max((local[1] - before[1]).length());
-            let Some(near) = edges.nearest(local[0], local[1], thickness.max(travel)) else {
-                continue;
-            };
-            let crossed = (near.distance <= travel)
-                .then(|| edges.crossed(before, local))
-                .flatten();
-            let (hit, side) = match crossed {
-                Some((edge, side)) => {
-                    crossings += 1;
-                    (SharpEdges::between(local[0], local[1], edge), side)
-                }
-                None => {
-                    if near.distance <= thickness * 1e-3 || near.distance >= thickness {
-                        continue;
-                    }
-                    (near, (near.on_segment - near.on_edge) / near.distance)
-                }
-            };
-            // What the nearest point of the cloth edge must move by, in the frame.
-            let gap = side * thickness - (hit.on_segment - hit.on_edge);
-            let n = (frame.to_world)(side);
-            let gap = (frame.to_world)(gap);
-            let share = [1.0 - hit.along, hit.along];
-            let weight = share[0] * share[0] * free[0] + share[1] * share[1] * free[1];
-            if weight <= 0.0 {
-                continue;
-            }
-            let v_surface = (frame.velocity)(hit.on_edge);
-            for (k, p) in [i, j].into_iter().enumerate() {
-                let part = share[k] * free[k];
-                if part <= 0.0 {
-                    continue;
-                }
-                state.pos[p] += gap * (part / weight);
-                state.vel[p] = touching(state.vel[p], v_surface, n, mu, part);
-            }
-            moved += 1;
-        }
-        if crossings == 0 {
-            break;
-        }
-    }
-    moved
-}
-
-/// How many times at most the edge pass runs in one substep.
-const EDGE_SWEEPS: usize = 4;
-
 impl Posed<'_> {
-    /// [`push_edges`] against the obstacle's sharp edges where the substep ends.
-    fn push_edges(&self, pass: &mut ContactPass<'_>) -> usize {
+    /// [`push_edges`] against the obstacle's sharp edges where the substep ends (fixed in
+    /// its frame).
+    fn push_edges(&self, pass: &mut ContactPass<'_>, memory: &mut EdgeMemory) -> usize {
         let (pivot, start, end) = (self.placed.pivot, self.start, self.end);
         let frame = EdgeFrame {
             from_start: |p| start.unapply(pivot, p),
@@ -487,6 +400,7 @@ impl Posed<'_> {
             &frame,
             self.friction,
             pass,
+            (memory, true),
         )
     }
 }
@@ -499,8 +413,8 @@ struct Deforming<'a> {
 }
 
 impl Deforming<'_> {
-    /// [`push_edges`] against its sharp edges where the substep ends.
-    fn push_edges(&self, pass: &mut ContactPass<'_>) -> usize {
+    /// [`push_edges`] against its sharp edges where the substep ends (which move).
+    fn push_edges(&self, pass: &mut ContactPass<'_>, memory: &mut EdgeMemory) -> usize {
         let reach = pass.offset;
         // (Its edges are taken where the substep ends for the whole substep.)
         let frame = EdgeFrame {
@@ -510,7 +424,7 @@ impl Deforming<'_> {
             velocity: |q| self.moment.velocity_near(q, reach),
         };
         let edges = self.moment.surface.sharp_edges();
-        push_edges(edges, &frame, self.friction, pass)
+        push_edges(edges, &frame, self.friction, pass, (memory, false))
     }
 }
 
@@ -708,7 +622,8 @@ impl EffectKind for Obstacle {
                 moment: &moment,
                 friction: self.friction,
             };
-            let moved = resolve(&deforming, pass) + deforming.push_edges(pass);
+            let moved = resolve(&deforming, pass);
+            let moved = moved + placed.with_edge_memory(|m| deforming.push_edges(pass, m));
             pass.offset = offset;
             return Ok(moved);
         }
@@ -725,7 +640,8 @@ impl EffectKind for Obstacle {
             m.resize(pass.state.pos.len(), Gathered::NONE);
             &mut m[..]
         });
-        let moved = resolve_remembering(&posed, pass, memory) + posed.push_edges(pass);
+        let moved = resolve_remembering(&posed, pass, memory);
+        let moved = moved + placed.with_edge_memory(|m| posed.push_edges(pass, m));
         pass.offset = offset;
         Ok(moved)
     }
