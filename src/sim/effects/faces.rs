@@ -5,7 +5,7 @@
 //! trees are), so each is a piece of cloth that stays together however it folds and its
 //! box stays small.
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 use crate::cloth::ClothModel;
 use crate::sim::obstacle::split_triangles_at_medians;
@@ -90,11 +90,11 @@ impl FacePatches {
         for k in 0..self.starts.len() - 1 {
             let ids = &self.particles[self.particle_starts[k]..self.particle_starts[k + 1]];
             let (lo, hi) =
-                (ids.iter()).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &i| {
-                    let p = pos[i as usize];
+                (ids.iter()).fold((Vec3A::INFINITY, Vec3A::NEG_INFINITY), |(lo, hi), &i| {
+                    let p = Vec3A::from(pos[i as usize]);
                     (lo.min(p), hi.max(p))
                 });
-            let flagged = near(lo, hi);
+            let flagged = near(lo.into(), hi.into());
             self.flagged.push(flagged);
             held += if flagged {
                 self.starts[k + 1] - self.starts[k]
