@@ -232,23 +232,26 @@ impl Surface {
         let Some((near, count)) = self.gather(to, reach, memory, DRIFT * thickness) else {
             return Short::Unsure;
         };
+        let near = &near[..count];
         let corners = |t: u32| self.triangles[t as usize].map(|i| self.vertices[i as usize]);
-        let closest = (near[..count].iter())
-            .map(|&t| to.distance(closest_on_triangle(to, corners(t))))
-            .fold(f32::INFINITY, f32::min);
+        // At the end itself, the points the gathering found; elsewhere, measured.
+        let first = nearest_of(near.iter().copied(), to);
+        let nearest = |end: Vec3| {
+            nearest_of(
+                (near.iter()).map(|&(t, _)| (t, closest_on_triangle(end, corners(t)))),
+                end,
+            )
+        };
         // The move lies within `moved` of its end: with no surface that near, it crossed
         // nothing.
-        if moved >= closest {
+        if first.is_some_and(|(_, _, closest)| moved >= closest) {
             return Short::Unsure;
         }
         let mut end = to;
         let mut held = None;
-        for _ in 0..PUSHES {
-            let nearest = (near[..count].iter())
-                .map(|&t| (t, closest_on_triangle(end, corners(t))))
-                .map(|(t, q)| (t, q, end.distance(q)))
-                .min_by(|x, y| x.2.total_cmp(&y.2));
-            let Some((triangle, point, distance)) = nearest else {
+        for push in 0..PUSHES {
+            let found = if push == 0 { first } else { nearest(end) };
+            let Some((triangle, point, distance)) = found else {
                 break;
             };
             if distance >= thickness * (1.0 - 1e-4) {
@@ -273,29 +276,30 @@ impl Surface {
         }
     }
 
-    /// Every triangle within `reach` of `p`, by number (`None`: more than [`NEAR_END`]).
-    /// From `memory` when `p`'s reach lies inside what it holds; else from a walk of the
-    /// tree that gathers `drift` further and is remembered there.
+    /// Every triangle within `reach` of `p`, by number, with its point nearest to `p`
+    /// (`None`: more than [`NEAR_END`]). From `memory` when `p`'s reach lies inside what it
+    /// holds; else from a walk of the tree that gathers `drift` further and is remembered
+    /// there.
     fn gather(
         &self,
         p: Vec3,
         reach: f32,
         memory: Option<&mut Gathered>,
         drift: f32,
-    ) -> Option<([u32; NEAR_END], usize)> {
+    ) -> Option<([(u32, Vec3); NEAR_END], usize)> {
         let corners = |t: u32| self.triangles[t as usize].map(|i| self.vertices[i as usize]);
-        let mut near = [0u32; NEAR_END];
+        let mut near = [(0u32, Vec3::ZERO); NEAR_END];
         let mut count = 0;
         let Some(memory) = memory else {
-            self.tree.within(p, reach, |t, _, _| {
+            self.tree.within(p, reach, |t, q, _| {
                 if let Some(slot) = near.get_mut(count) {
-                    *slot = t;
+                    *slot = (t, q);
                 }
                 count += 1;
                 count <= NEAR_END
             });
             let found = near.get_mut(..count)?;
-            found.sort_unstable();
+            found.sort_unstable_by_key(|&(t, _)| t);
             return Some((near, count));
         };
         if memory.radius < reach + p.distance(memory.centre) {
@@ -323,8 +327,9 @@ impl Surface {
             };
         }
         for &t in &memory.triangles[..usize::from(memory.count)] {
-            if p.distance_squared(closest_on_triangle(p, corners(t))) <= reach * reach {
-                near[count] = t;
+            let q = closest_on_triangle(p, corners(t));
+            if p.distance_squared(q) <= reach * reach {
+                near[count] = (t, q);
                 count += 1;
             }
         }
@@ -432,6 +437,12 @@ impl Surface {
             on_surface: held.1,
         })
     }
+}
+
+/// Of the triangles' `points` (each triangle's number and its point nearest to `end`),
+/// the nearest to `end`, with its distance.
+fn nearest_of(points: impl Iterator<Item = (u32, Vec3)>, end: Vec3) -> Option<(u32, Vec3, f32)> {
+    (points.map(|(t, q)| (t, q, end.distance(q)))).min_by(|x, y| x.2.total_cmp(&y.2))
 }
 
 #[cfg(test)]
