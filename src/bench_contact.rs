@@ -237,4 +237,29 @@ mod tests {
             );
         }
     }
+
+    /// The bench refuses a run in which the guard acted: its cloth cut to 8 quads a side
+    /// and pinned at a corner, under semi-implicit Euler at one substep a frame, blows up at
+    /// once and the guard steps in; under the bench's own implicit Euler it hangs calmly.
+    #[test]
+    fn a_run_the_guard_acted_in_is_refused() {
+        let run = |integrator: &str, substeps: u32| {
+            let text = (SCENE.replace("quads = 63", "quads = 8"))
+                .replace("implicit-euler", integrator)
+                .replace("substeps = 64", &format!("substeps = {substeps}"))
+                .replace("[solver]", "[pins]\ncorners = [\"top-left\"]\n\n[solver]");
+            let file = SceneFile::parse(&text, std::path::Path::new("guarded.toml"))
+                .expect("the scene parses");
+            let mut sim = Simulation::new(Scene::from_file(file, None).expect("it builds"));
+            for _ in 0..3 {
+                sim.step_frame().expect("the guard recovers");
+            }
+            ContactBenchError::unless_guarded(&mut sim)
+        };
+        assert!(matches!(
+            run("semi-implicit-euler", 1),
+            Err(ContactBenchError::Guarded { count, .. }) if count > 0
+        ));
+        assert!(run("implicit-euler", 64).is_ok());
+    }
 }
