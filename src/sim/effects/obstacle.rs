@@ -13,12 +13,12 @@ use super::solid::{Solid, default_friction, resolve, resolve_remembering};
 use crate::mesh::{ObjError, PolygonSoup, parse_obj, read_obj};
 use crate::sim::motion::{AxisAngle, Keyframe, Pose, RigidMotion};
 use crate::sim::obstacle::{Gathered, Moment, Sequence, Surface};
+use crate::sim::param_error::ParamError;
+use crate::sim::self_contacts::ContactError;
 
 use self::edge_pass::{EdgeFrame, EdgeMemory, push_edges};
 
 mod edge_pass;
-use crate::sim::param_error::ParamError;
-use crate::sim::self_contacts::ContactError;
 
 /// A mesh obstacle as a scene file gives it.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -134,7 +134,7 @@ pub struct Placed {
 
 impl Placed {
     /// `f` with the edge pass's memory, or (where another stepping copy of the simulation
-    /// holds it now) with none: it only saves work, the result is the same.
+    /// holds it now) with a fresh one: the memory only saves work, the result is the same.
     fn with_edge_memory<T>(&self, f: impl FnOnce(&mut EdgeMemory) -> T) -> T {
         match self.edge_memory.try_lock() {
             Ok(mut memory) => f(&mut memory),

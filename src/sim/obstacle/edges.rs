@@ -29,7 +29,8 @@ const LOOK: f32 = 4.0;
 
 /// What the last question about one cloth edge measured
 /// ([`SharpEdges::nearest_remembering`]): where its ends were (in the surface's frame) and
-/// how near at least any sharp edge lay to it then. A fact of the surface alone, as [`super::Gathered`] is.
+/// how near at least any sharp edge lay to it then. A fact of the surface alone, as
+/// [`super::Gathered`] is.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Clearance {
     ends: [Vec3A; 2],
