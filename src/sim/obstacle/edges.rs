@@ -171,12 +171,11 @@ impl SharpEdges {
     /// the last question about the same cloth edge measured (kept in `memory`, which this
     /// one updates). Every point of the segment lies within the farther of its ends' moves
     /// of a point of the segment measured, so no sharp edge comes nearer to it than the
-    /// clearance less that move: while that exceeds `reach`, the answer is `None` without
-    /// a walk of the tree ([`Clearance::clears`]).
-    /// Otherwise the tree is walked for [`LOOK`] times the reach more, and what it finds is
-    /// remembered; the answer is the same as [`SharpEdges::nearest`]'s (the nearest within
-    /// the longer reach, where it lies within `reach`: the same edge found in the same
-    /// order).
+    /// clearance less that move: while that exceeds `reach` (with a margin for the
+    /// rounding), the answer is `None` without a walk of the tree. Otherwise the tree is
+    /// walked for four times the reach more, and what it finds is remembered; the answer
+    /// is the same as [`SharpEdges::nearest`]'s (the nearest within the longer reach,
+    /// where it lies within `reach`: the same edge found in the same order).
     #[inline]
     pub fn nearest_remembering(
         &self,
