@@ -69,14 +69,13 @@ where
     );
     memory.local.clear();
     (memory.local).extend(state.pos.iter().map(|&p| Vec3A::from((frame.to_local)(p))));
-    let clearance = if fixed {
+    let mut clearance = if fixed {
         (memory.clearance).resize(springs.a.len(), Clearance::NONE);
         Some(&mut memory.clearance[..])
     } else {
         None
     };
     let (before, local) = (&memory.before, &mut memory.local);
-    let mut clearance = clearance;
     let mut moved = 0;
     // A cloth edge put back from a crossing can pull a neighbour across another: the pass
     // repeats (a few times at most) while it finds crossings.
