@@ -133,6 +133,17 @@ pub struct Placed {
 }
 
 impl Placed {
+    /// `f` with each particle's memory of its last contact (`particles` of them), or (where
+    /// another stepping copy of the simulation holds it now) with none: the memory only
+    /// saves walks of the tree, the result is the same.
+    fn with_memory<T>(&self, particles: usize, f: impl FnOnce(Option<&mut [Gathered]>) -> T) -> T {
+        let mut memory = self.memory.try_lock().ok();
+        f(memory.as_deref_mut().map(|m| {
+            m.resize(particles, Gathered::NONE);
+            &mut m[..]
+        }))
+    }
+
     /// `f` with the edge pass's memory, or (where another stepping copy of the simulation
     /// holds it now) with a fresh one: the memory only saves work, the result is the same.
     fn with_edge_memory<T>(&self, f: impl FnOnce(&mut EdgeMemory) -> T) -> T {
@@ -633,14 +644,8 @@ impl EffectKind for Obstacle {
             end: placed.motion.at(end),
             friction: self.friction,
         };
-        // Each particle's memory of its last contact, when no other stepping copy of the
-        // simulation holds it now (it only saves walks of the tree: the result is the same).
-        let mut memory = placed.memory.try_lock().ok();
-        let memory = memory.as_deref_mut().map(|m| {
-            m.resize(pass.state.pos.len(), Gathered::NONE);
-            &mut m[..]
-        });
-        let moved = resolve_remembering(&posed, pass, memory);
+        let particles = pass.state.pos.len();
+        let moved = placed.with_memory(particles, |m| resolve_remembering(&posed, pass, m));
         let moved = moved + placed.with_edge_memory(|m| posed.push_edges(pass, m));
         pass.offset = offset;
         Ok(moved)
