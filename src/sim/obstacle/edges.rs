@@ -70,10 +70,20 @@ pub struct EdgeHit {
 
 impl SharpEdges {
     /// The edges of `triangles` over `vertices` that border one triangle, or two whose
-    /// normals (`normals`, per triangle) differ by more than about 10°.
+    /// normals (`normals`, per triangle) differ by more than about 10°. Vertices at the
+    /// same place are one vertex here: a surface written with its faces apart (each face of
+    /// a box with its own corners, a sphere cut along seams) has its creases where its
+    /// faces bend, not a border wherever a vertex was written twice.
     pub fn of(vertices: &[Vec3], triangles: &[[u32; 3]], normals: &[Vec3]) -> Self {
+        // The bits of each coordinate, −0 as +0.
+        let place = |v: &Vec3| v.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+        let mut first_at: HashMap<[u32; 3], u32> = HashMap::with_capacity(vertices.len());
+        let same: Vec<u32> = (vertices.iter().enumerate())
+            .map(|(i, v)| *first_at.entry(place(v)).or_insert(i as u32))
+            .collect();
         let mut faces: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
         for (t, tri) in triangles.iter().enumerate() {
+            let tri = tri.map(|i| same.get(i as usize).copied().unwrap_or(i));
             for k in 0..3 {
                 let (a, b) = (tri[k], tri[(k + 1) % 3]);
                 faces.entry((a.min(b), a.max(b))).or_default().push(t);
@@ -317,6 +327,45 @@ mod tests {
         let (v, t, normals) = cube();
         assert_eq!(SharpEdges::of(&v, &t, &normals).len(), 12);
         assert_eq!(SharpEdges::of(&v, &t[..1], &normals[..1]).len(), 3);
+    }
+
+    /// A box written with each face's corners apart (as for flat shading; a corner at the
+    /// origin once as −0) has the same twelve creases as one whose faces share corners:
+    /// not a border around every face, nor at the diagonals that split them.
+    #[test]
+    fn corners_written_twice_are_one_corner() {
+        let (v, t, normals) = cube();
+        let mut apart = Vec::new();
+        let faces: Vec<[u32; 3]> = (t.iter())
+            .map(|tri| {
+                tri.map(|i| {
+                    apart.push(v[i as usize]);
+                    apart.len() as u32 - 1
+                })
+            })
+            .collect();
+        if let Some(origin) = apart.iter_mut().find(|c| **c == Vec3::ZERO) {
+            *origin = Vec3::new(-0.0, 0.0, -0.0);
+        }
+        let edges = SharpEdges::of(&apart, &faces, &normals);
+        let whole = SharpEdges::of(&v, &t, &normals);
+        assert_eq!(edges.len(), 12);
+        let mut got: Vec<[Vec3; 2]> = edges.edges.clone();
+        let mut want: Vec<[Vec3; 2]> = whole.edges.clone();
+        for list in [&mut got, &mut want] {
+            for e in list.iter_mut() {
+                *e = e.map(|c| c + Vec3::ZERO);
+                if e[1].to_array() < e[0].to_array() {
+                    e.swap(0, 1);
+                }
+            }
+            list.sort_by(|a, b| {
+                a.map(|c| c.to_array())
+                    .partial_cmp(&b.map(|c| c.to_array()))
+                    .unwrap()
+            });
+        }
+        assert_eq!(got, want);
     }
 
     /// A cloth edge remembering its clearance gets the answer a walk of the tree gives,

@@ -11,5 +11,5 @@ pub use edges::{Clearance, EdgeHit, SharpEdges};
 pub(crate) use geometry::{closest_weights, segments_closest};
 pub use sequence::{Moment, Sequence};
 pub use surface::{Caught, Gathered, Surface};
-pub use tree::{Nearest, TriangleTree};
+pub use tree::{Near, Nearest, TriangleTree};
 pub(crate) use tree::{Split, split_triangles_at_medians};

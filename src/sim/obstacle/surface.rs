@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::edges::SharpEdges;
 use super::geometry::{closest_on_triangle, segment_crosses};
-use super::tree::{Nearest, TriangleTree};
+use super::tree::{Near, Nearest, TriangleTree};
 
 /// How many crossings one move may be caught at (a move that slides on into a second face
 /// after the first, as in a concave corner).
@@ -27,8 +27,10 @@ const NEAR_END: usize = 24;
 const DRIFT: f32 = 0.1;
 
 /// The triangles near one point, remembered from one substep to the next: every triangle
-/// within `radius` of `centre`, by number. A fact of the surface alone (in its own frame),
-/// so an end whose reach lies inside that ball needs no walk of the tree.
+/// within `radius` of `centre`, by number, with its distance from `centre`. A fact of the
+/// surface alone (in its own frame), so an end whose reach lies inside that ball needs no
+/// walk of the tree; and a triangle farther from the centre than the reach and the end's
+/// move from it together is out of the end's reach without being measured again.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Gathered {
     centre: Vec3,
@@ -36,6 +38,9 @@ pub struct Gathered {
     radius: f32,
     count: u8,
     triangles: [u32; NEAR_END],
+    /// Each triangle's place in the tree, where its corners are read from.
+    places: [u32; NEAR_END],
+    distances: [f32; NEAR_END],
 }
 
 impl Gathered {
@@ -45,6 +50,8 @@ impl Gathered {
         radius: -1.0,
         count: 0,
         triangles: [0; NEAR_END],
+        places: [0; NEAR_END],
+        distances: [0.0; NEAR_END],
     };
 }
 
@@ -229,32 +236,51 @@ impl Surface {
         if moved >= reach {
             return Short::Unsure;
         }
-        let Some((near, count)) = self.gather(to, reach, memory, DRIFT * thickness) else {
+        let mut near = [Near::default(); NEAR_END];
+        let Some(count) = self.gather(to, reach, memory, DRIFT * thickness, &mut near) else {
             return Short::Unsure;
         };
         let near = &near[..count];
-        let corners = |t: u32| self.triangles[t as usize].map(|i| self.vertices[i as usize]);
-        // At the end itself, the points the gathering found; elsewhere, measured.
-        let first = nearest_of(near.iter().copied(), to);
+        // At the end itself, the points and distances the gathering found.
+        let first = nearest_of(near.iter().copied());
+        // Elsewhere, measured: but a triangle `d` from the end is at least `d` less how far
+        // the end was pushed from the point asked about, and where that is beyond what
+        // would push it (by ten times the distances' rounding), it is not measured (it
+        // could not be the nearest of those that push).
+        let pushes = thickness * (1.0 - 1e-4);
+        let rounding = 1e-5 * (1.0 + to.abs().max_element());
         let nearest = |end: Vec3| {
-            nearest_of(
-                (near.iter()).map(|&(t, _)| (t, closest_on_triangle(end, corners(t)))),
-                end,
-            )
+            let beyond = pushes + rounding + end.distance(to);
+            let measured = (near.iter()).filter(|n| n.distance <= beyond).map(|n| {
+                let point = closest_on_triangle(end, self.tree.place(n.place));
+                let distance = end.distance(point);
+                Near {
+                    point,
+                    distance,
+                    ..*n
+                }
+            });
+            nearest_of(measured)
         };
         // The move lies within `moved` of its end: with no surface that near, it crossed
         // nothing.
-        if first.is_some_and(|(_, _, closest)| moved >= closest) {
+        if first.is_some_and(|n| moved >= n.distance) {
             return Short::Unsure;
         }
         let mut end = to;
         let mut held = None;
         for push in 0..PUSHES {
             let found = if push == 0 { first } else { nearest(end) };
-            let Some((triangle, point, distance)) = found else {
+            let Some(Near {
+                triangle,
+                point,
+                distance,
+                ..
+            }) = found
+            else {
                 break;
             };
-            if distance >= thickness * (1.0 - 1e-4) {
+            if distance >= pushes {
                 break;
             }
             let n = self.away(triangle, point, distance, end, from, thickness);
@@ -276,39 +302,39 @@ impl Surface {
         }
     }
 
-    /// Every triangle within `reach` of `p`, by number, with its point nearest to `p`
-    /// (`None`: more than [`NEAR_END`]). From `memory` when `p`'s reach lies inside what it
-    /// holds; else from a walk of the tree that gathers `drift` further and is remembered
-    /// there.
+    /// Every triangle within `reach` of `p`, by number, with its point nearest to `p` and
+    /// the distance to it, written to `near`; returns how many (`None`: more than
+    /// [`NEAR_END`]). From `memory` when `p`'s reach lies inside what it holds; else from a
+    /// walk of the tree that gathers `drift` further and is remembered there.
     fn gather(
         &self,
         p: Vec3,
         reach: f32,
         memory: Option<&mut Gathered>,
         drift: f32,
-    ) -> Option<([(u32, Vec3); NEAR_END], usize)> {
-        let corners = |t: u32| self.triangles[t as usize].map(|i| self.vertices[i as usize]);
-        let mut near = [(0u32, Vec3::ZERO); NEAR_END];
+        near: &mut [Near; NEAR_END],
+    ) -> Option<usize> {
         let mut count = 0;
         let Some(memory) = memory else {
-            self.tree.within(p, reach, |t, q, _| {
+            self.tree.within(p, reach, |n| {
                 if let Some(slot) = near.get_mut(count) {
-                    *slot = (t, q);
+                    *slot = n;
                 }
                 count += 1;
                 count <= NEAR_END
             });
             let found = near.get_mut(..count)?;
-            found.sort_unstable_by_key(|&(t, _)| t);
-            return Some((near, count));
+            found.sort_unstable_by_key(|n| n.triangle);
+            return Some(count);
         };
-        if memory.radius < reach + p.distance(memory.centre) {
+        let mut moved = p.distance(memory.centre);
+        if memory.radius < reach + moved {
             let radius = reach + drift;
-            let mut all = [0u32; NEAR_END];
+            let mut all = [Near::default(); NEAR_END];
             let mut n = 0;
-            self.tree.within(p, radius, |t, _, _| {
+            self.tree.within(p, radius, |found| {
                 if let Some(slot) = all.get_mut(n) {
-                    *slot = t;
+                    *slot = found;
                 }
                 n += 1;
                 n <= NEAR_END
@@ -316,24 +342,45 @@ impl Surface {
             let Some(found) = all.get_mut(..n) else {
                 // Too many to remember: this end alone, from the tree.
                 *memory = Gathered::NONE;
-                return self.gather(p, reach, None, drift);
+                return self.gather(p, reach, None, drift, near);
             };
-            found.sort_unstable();
+            found.sort_unstable_by_key(|n| n.triangle);
             *memory = Gathered {
                 centre: p,
                 radius,
                 count: n as u8,
-                triangles: all,
+                triangles: all.map(|n| n.triangle),
+                places: all.map(|n| n.place),
+                distances: all.map(|n| n.distance),
             };
+            moved = 0.0;
         }
-        for &t in &memory.triangles[..usize::from(memory.count)] {
-            let q = closest_on_triangle(p, corners(t));
-            if p.distance_squared(q) <= reach * reach {
-                near[count] = (t, q);
+        // A triangle `d` from the centre is at least `d − moved` from `p`: beyond the
+        // reach by more than the distances' rounding (a margin ten times it), it is not
+        // measured, and would not have been kept.
+        let rounding = 1e-5 * (1.0 + p.abs().max_element());
+        let beyond = reach + moved + rounding;
+        let remembered = usize::from(memory.count);
+        let triangles = (memory.triangles[..remembered].iter())
+            .zip(&memory.places)
+            .zip(&memory.distances);
+        for ((&triangle, &place), &d) in triangles {
+            if d > beyond {
+                continue;
+            }
+            let point = closest_on_triangle(p, self.tree.place(place));
+            let d2 = p.distance_squared(point);
+            if d2 <= reach * reach {
+                near[count] = Near {
+                    place,
+                    triangle,
+                    point,
+                    distance: d2.sqrt(),
+                };
                 count += 1;
             }
         }
-        Some((near, count))
+        Some(count)
     }
 
     /// The way out of the surface for `end`, `distance` from `point` of `triangle`: away
@@ -439,10 +486,10 @@ impl Surface {
     }
 }
 
-/// Of the triangles' `points` (each triangle's number and its point nearest to `end`),
-/// the nearest to `end`, with its distance.
-fn nearest_of(points: impl Iterator<Item = (u32, Vec3)>, end: Vec3) -> Option<(u32, Vec3, f32)> {
-    (points.map(|(t, q)| (t, q, end.distance(q)))).min_by(|x, y| x.2.total_cmp(&y.2))
+/// Of the triangles near some end (each with its point nearest to it and the distance),
+/// the nearest (the first of equals).
+fn nearest_of(near: impl Iterator<Item = Near>) -> Option<Near> {
+    near.min_by(|x, y| x.distance.total_cmp(&y.distance))
 }
 
 #[cfg(test)]
@@ -505,9 +552,15 @@ mod tests {
 
     /// A surface of `n` × `n` squares (two triangles each) over a metre, gently bumpy.
     fn bumpy(n: usize) -> Surface {
+        grid(n, |x, z| 0.02 * (9.0 * x).sin() * (7.0 * z).cos())
+    }
+
+    /// A surface of `n` × `n` squares (two triangles each) over a metre, at the height
+    /// `y(x, z)`.
+    fn grid(n: usize, y: impl Fn(f32, f32) -> f32) -> Surface {
         let at = |i: usize, j: usize| {
             let (x, z) = (i as f32 / n as f32 - 0.5, j as f32 / n as f32 - 0.5);
-            Vec3::new(x, 0.02 * (9.0 * x).sin() * (7.0 * z).cos(), z)
+            Vec3::new(x, y(x, z), z)
         };
         let vertices: Vec<Vec3> = (0..=n)
             .flat_map(|i| (0..=n).map(move |j| at(i, j)))
@@ -561,6 +614,44 @@ mod tests {
         assert!(
             short > 2000 && caught > 500 && crossed > 100,
             "{short} short, {caught} caught, {crossed} crossed"
+        );
+    }
+
+    /// In a groove whose sides meet at a right angle, an end pushed off one side comes
+    /// within the thickness of the other, and is pushed off that too: a short move's catch
+    /// ends where the general catch ends there as well.
+    #[test]
+    fn a_short_moves_catch_in_a_groove_agrees_with_the_general_catch() {
+        let s = grid(100, |x, _| x.abs());
+        let mut rnd = crate::test_rng::uniform(9);
+        let thickness = 0.01;
+        let (mut short, mut twice) = (0, 0);
+        for _ in 0..2000 {
+            let x = (rnd() - 0.5) * 0.03;
+            let to = Vec3::new(x, x.abs() + (0.9 + 0.6 * rnd()) * thickness, rnd() * 0.2);
+            let from = to + Vec3::new(rnd() - 0.5, rnd(), rnd() - 0.5) * 1e-3;
+            if !matches!(s.catch_short(from, to, thickness, None), Short::Unsure) {
+                short += 1;
+            }
+            let (got, general) = (
+                s.catch(from, to, thickness),
+                s.catch_among(None, from, to, thickness),
+            );
+            match (got, general) {
+                (None, None) => {}
+                (Some(a), Some(b)) => {
+                    assert!(a.at.distance(b.at) < 1e-6, "{from} → {to}: {a:?} vs {b:?}");
+                    // Held by both sides: within the thickness of neither, and touching
+                    // both.
+                    let sides = [a.at.y - a.at.x, a.at.y + a.at.x].map(|d| d / 2f32.sqrt());
+                    twice += usize::from(sides.iter().all(|d| *d < thickness * 1.001));
+                }
+                (a, b) => panic!("{from} → {to}: {a:?} vs {b:?}"),
+            }
+        }
+        assert!(
+            short > 400 && twice > 100,
+            "{short} short, {twice} held by both sides"
         );
     }
 

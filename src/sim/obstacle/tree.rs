@@ -31,6 +31,18 @@ pub struct TriangleTree {
     index: Vec<u32>,
 }
 
+/// A triangle near a query point ([`TriangleTree::within`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Near {
+    /// Where the tree keeps its corners ([`TriangleTree::place`]).
+    pub place: u32,
+    /// The triangle, as numbered when the tree was built.
+    pub triangle: u32,
+    /// Its point nearest to the query point, and how far that is.
+    pub point: Vec3,
+    pub distance: f32,
+}
+
 /// The nearest point of a surface to a query point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Nearest {
@@ -157,9 +169,10 @@ impl TriangleTree {
         })
     }
 
-    /// Calls `visit` with every triangle within `reach` of `p` (its number, the point of it
-    /// nearest to `p`, and the distance), in no order, until `visit` returns `false`.
-    pub fn within(&self, p: Vec3, reach: f32, mut visit: impl FnMut(u32, Vec3, f32) -> bool) {
+    /// Calls `visit` with every triangle within `reach` of `p` (its place in the tree, its
+    /// number, the point of it nearest to `p`, and the distance), in no order, until
+    /// `visit` returns `false`.
+    pub fn within(&self, p: Vec3, reach: f32, mut visit: impl FnMut(Near) -> bool) {
         let reach2 = reach * reach;
         self.walk(
             &mut (),
@@ -174,9 +187,26 @@ impl TriangleTree {
                 }
                 let q = closest_on_triangle(p, [a, b, c]);
                 let d2 = p.distance_squared(q);
-                d2 > reach2 || visit(self.index[place], q, d2.sqrt())
+                d2 > reach2
+                    || visit(Near {
+                        place: place as u32,
+                        triangle: self.index[place],
+                        point: q,
+                        distance: d2.sqrt(),
+                    })
             },
         );
+    }
+
+    /// The corners of the triangle at `place` in the tree's order: the triangles near one
+    /// another lie near one another there, each triangle's corners together (one read
+    /// where the surface's own triangles and vertices take four).
+    ///
+    /// # Panics
+    /// For a place past the last.
+    #[inline]
+    pub fn place(&self, place: u32) -> [Vec3; 3] {
+        self.corners[place as usize]
     }
 
     /// The first triangle the segment from `from` to `to` crosses: its number and the
