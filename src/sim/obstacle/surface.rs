@@ -27,18 +27,17 @@ const NEAR_END: usize = 24;
 const DRIFT: f32 = 0.1;
 
 /// The triangles near one point, remembered from one substep to the next: every triangle
-/// within `radius` of `centre`, by number, with its distance from `centre`. A fact of the
-/// surface alone (in its own frame), so an end whose reach lies inside that ball needs no
-/// walk of the tree; and a triangle farther from the centre than the reach and the end's
-/// move from it together is out of the end's reach without being measured again.
+/// within `radius` of `centre`, by its place in the tree (where its corners are read
+/// from) in order of its number, with its distance from `centre`. A fact of the surface
+/// alone (in its own frame), so an end whose reach lies inside that ball needs no walk of
+/// the tree; and a triangle farther from the centre than the reach and the end's move
+/// from it together is out of the end's reach without being measured again.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Gathered {
     centre: Vec3,
     /// Negative: nothing remembered.
     radius: f32,
     count: u8,
-    triangles: [u32; NEAR_END],
-    /// Each triangle's place in the tree, where its corners are read from.
     places: [u32; NEAR_END],
     distances: [f32; NEAR_END],
 }
@@ -49,7 +48,6 @@ impl Gathered {
         centre: Vec3::ZERO,
         radius: -1.0,
         count: 0,
-        triangles: [0; NEAR_END],
         places: [0; NEAR_END],
         distances: [0.0; NEAR_END],
     };
@@ -349,7 +347,6 @@ impl Surface {
                 centre: p,
                 radius,
                 count: n as u8,
-                triangles: all.map(|n| n.triangle),
                 places: all.map(|n| n.place),
                 distances: all.map(|n| n.distance),
             };
@@ -360,11 +357,8 @@ impl Surface {
         // measured, and would not have been kept.
         let rounding = 1e-5 * (1.0 + p.abs().max_element());
         let beyond = reach + moved + rounding;
-        let remembered = usize::from(memory.count);
-        let triangles = (memory.triangles[..remembered].iter())
-            .zip(&memory.places)
-            .zip(&memory.distances);
-        for ((&triangle, &place), &d) in triangles {
+        let remembered = &memory.places[..usize::from(memory.count)];
+        for (&place, &d) in remembered.iter().zip(&memory.distances) {
             if d > beyond {
                 continue;
             }
@@ -373,7 +367,7 @@ impl Surface {
             if d2 <= reach * reach {
                 near[count] = Near {
                     place,
-                    triangle,
+                    triangle: self.tree.number(place),
                     point,
                     distance: d2.sqrt(),
                 };

@@ -209,6 +209,15 @@ impl TriangleTree {
         self.corners[place as usize]
     }
 
+    /// The number of the triangle at `place` in the tree's order.
+    ///
+    /// # Panics
+    /// For a place past the last.
+    #[inline]
+    pub fn number(&self, place: u32) -> u32 {
+        self.index[place as usize]
+    }
+
     /// The first triangle the segment from `from` to `to` crosses: its number and the
     /// fraction of the way at which it does.
     pub fn first_crossing(&self, from: Vec3, to: Vec3) -> Option<(u32, f32)> {
