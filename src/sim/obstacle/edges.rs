@@ -5,7 +5,7 @@ use std::collections::HashMap;
 
 use glam::{Vec3, Vec3A};
 
-use super::geometry::segments_closest;
+use super::geometry::{rounding_near, segments_closest};
 use super::tree::TriangleTree;
 
 /// Two faces meeting at less than this cosine between their normals (about 10°) make a
@@ -83,7 +83,7 @@ impl SharpEdges {
             .collect();
         let mut faces: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
         for (t, tri) in triangles.iter().enumerate() {
-            let tri = tri.map(|i| same.get(i as usize).copied().unwrap_or(i));
+            let tri = tri.map(|i| same[i as usize]);
             for k in 0..3 {
                 let (a, b) = (tri[k], tri[(k + 1) % 3]);
                 faces.entry((a.min(b), a.max(b))).or_default().push(t);
@@ -205,9 +205,7 @@ impl SharpEdges {
         let [a, b] = ends.map(Vec3::from);
         let far = (1.0 + LOOK) * reach;
         let near = self.nearest(a, b, far);
-        // Less a margin ten times the distances' rounding (about a millionth of the
-        // coordinates), far below any thickness.
-        let rounding = 1e-5 * (1.0 + a.abs().max(b.abs()).max_element());
+        let rounding = rounding_near(a.abs().max(b.abs()));
         *memory = Clearance {
             ends,
             clear: near.map_or(far, |hit| hit.distance) - rounding,

@@ -3,6 +3,14 @@
 
 use glam::{DVec3, Vec3};
 
+/// A margin for the rounding of distances measured among points no farther from the
+/// origin than `p` is along any axis: ten times it (f32 rounds a distance to about a
+/// millionth of the coordinates), far below any thickness. What a remembered distance is
+/// trusted to, less this.
+pub fn rounding_near(p: Vec3) -> f32 {
+    1e-5 * (1.0 + p.abs().max_element())
+}
+
 /// The point of triangle `abc` closest to `p` (its inside, an edge or a corner).
 pub fn closest_on_triangle(p: Vec3, t: [Vec3; 3]) -> Vec3 {
     let w = closest_weights(p, t);

@@ -4,7 +4,7 @@
 use glam::Vec3;
 
 use super::edges::SharpEdges;
-use super::geometry::{closest_on_triangle, segment_crosses};
+use super::geometry::{closest_on_triangle, rounding_near, segment_crosses};
 use super::tree::{Near, Nearest, TriangleTree};
 
 /// How many crossings one move may be caught at (a move that slides on into a second face
@@ -243,10 +243,10 @@ impl Surface {
         let first = nearest_of(near.iter().copied());
         // Elsewhere, measured: but a triangle `d` from the end is at least `d` less how far
         // the end was pushed from the point asked about, and where that is beyond what
-        // would push it (by ten times the distances' rounding), it is not measured (it
+        // would push it (by more than the distances' rounding), it is not measured (it
         // could not be the nearest of those that push).
         let pushes = thickness * (1.0 - 1e-4);
-        let rounding = 1e-5 * (1.0 + to.abs().max_element());
+        let rounding = rounding_near(to);
         let nearest = |end: Vec3| {
             let beyond = pushes + rounding + end.distance(to);
             let measured = (near.iter()).filter(|n| n.distance <= beyond).map(|n| {
@@ -353,10 +353,9 @@ impl Surface {
             moved = 0.0;
         }
         // A triangle `d` from the centre is at least `d − moved` from `p`: beyond the
-        // reach by more than the distances' rounding (a margin ten times it), it is not
-        // measured, and would not have been kept.
-        let rounding = 1e-5 * (1.0 + p.abs().max_element());
-        let beyond = reach + moved + rounding;
+        // reach by more than the distances' rounding, it is not measured, and would not
+        // have been kept.
+        let beyond = reach + moved + rounding_near(p);
         let remembered = &memory.places[..usize::from(memory.count)];
         for (&place, &d) in remembered.iter().zip(&memory.distances) {
             if d > beyond {
