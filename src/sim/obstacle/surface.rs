@@ -634,9 +634,10 @@ mod tests {
                 (None, None) => {}
                 (Some(a), Some(b)) => {
                     assert!(a.at.distance(b.at) < 1e-6, "{from} → {to}: {a:?} vs {b:?}");
-                    // Held by both sides: within the thickness of neither, and touching
-                    // both.
+                    // Its distances from the two sides (the surface's, inside the groove):
+                    // within the thickness of neither; held by both where it touches both.
                     let sides = [a.at.y - a.at.x, a.at.y + a.at.x].map(|d| d / 2f32.sqrt());
+                    assert!(sides.iter().all(|d| *d > thickness * 0.9998), "{a:?}");
                     twice += usize::from(sides.iter().all(|d| *d < thickness * 1.001));
                 }
                 (a, b) => panic!("{from} → {to}: {a:?} vs {b:?}"),
