@@ -30,6 +30,12 @@ use super::certify::{MARGIN, frame, shave};
 use super::primitives::{Pair, boxes_apart_by, nearer};
 use super::search::{NONE, Owners};
 use super::tree::{TRIANGLES_PER_PIECE, TriangleTree};
+use flat::{Across, Flat, Scratch};
+
+mod flat;
+
+/// The cloth's triangles, and some of them by number (a patch's).
+type Triangles<'a> = (&'a [[u32; 3]], &'a [u32]);
 use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
 
 /// Triangles in the smallest node certified on its own (smaller ones are covered only
@@ -66,6 +72,14 @@ pub(super) struct Patches {
     /// The least distance at rest between the sides of a pair of the cloth, up to its
     /// longest edge, rounded down, m.
     gap: f32,
+    /// The cloth's plane, where it lies flat at rest: then every patch's frame is the
+    /// plane's, and a patch whose rest shape is convex is certified by its triangles'
+    /// turns too ([`flat`]).
+    flat: Option<Flat>,
+    /// Whether each node's, and each corner's ring's, triangles make one convex region of
+    /// the plane at rest (none where the cloth is not flat).
+    convex: Vec<bool>,
+    ring_convex: Vec<bool>,
 }
 
 impl Patches {
@@ -84,6 +98,14 @@ impl Patches {
             parent: vec![0; nodes.len()],
             start: vec![0],
             gap: rest_gap(tree, triangles, rest, (owners, corners)),
+            flat: {
+                let all: Vec<u32> = (0..rest.len() as u32).collect();
+                Flat::of(
+                    triangles,
+                    rest,
+                    anchor(&all, rest).map(|j| rest[j as usize]),
+                )
+            },
             ..Patches::default()
         };
         for (i, node) in nodes.iter().enumerate() {
@@ -92,6 +114,12 @@ impl Patches {
                 patches.parent[node.second as usize] = i as u32;
             }
         }
+        // Where the cloth is flat, each triangle's neighbours, to tell the patches' edges.
+        let across = match patches.flat {
+            Some(_) => Across::of(triangles, owners.rings.around()),
+            None => Across::default(),
+        };
+        let mut scratch = Scratch::default();
         // Each node's particles, each once: the stamp is the node that took it last.
         let mut stamp = vec![NONE; rest.len()];
         let mut held = Vec::new();
@@ -109,6 +137,13 @@ impl Patches {
             let inverse = patches.add(&held, rest);
             patches.inverse.push(inverse);
             patches.start.push(patches.particle.len() as u32);
+            let convex = (patches.flat.as_ref()).is_some_and(|f| {
+                let (first, count) = (node.first, node.count);
+                let holds = |t: u32| (first..first + count).contains(&tree.place(t));
+                !held.is_empty()
+                    && f.convex(tree.held(i), (triangles, &across), holds, &mut scratch)
+            });
+            patches.convex.push(convex);
         }
         patches.rings.push(patches.particle.len() as u32);
         for c in 0..rest.len() {
@@ -119,6 +154,12 @@ impl Patches {
             }
             let inverse = patches.add(&held, rest);
             patches.ring_inverse.push(inverse);
+            let around = owners.rings.triangles_of(c);
+            let convex = (patches.flat.as_ref()).is_some_and(|f| {
+                let holds = |t: u32| around.contains(&t);
+                !held.is_empty() && f.convex(around, (triangles, &across), holds, &mut scratch)
+            });
+            patches.ring_convex.push(convex);
             patches.rings.push(patches.particle.len() as u32);
         }
         patches.home = homes(tree, &nodes, &patches.parent, triangles, rest.len());
@@ -137,13 +178,16 @@ impl Patches {
     pub(super) fn decide(
         &self,
         tree: &mut TriangleTree,
+        triangles: &[[u32; 3]],
         [from, to]: [&[Vec3]; 2],
         reach: f32,
         backoff: &mut Vec<u8>,
     ) {
         let least = reach * (1.0 + MARGIN);
         // Each of the tree's subtrees (the nodes a certificate can cover) is one piece.
-        let (subtrees, covered) = (&tree.subtrees, &mut tree.covered);
+        // Taken out while the tree is read for each node's triangles, then put back.
+        let mut covered = std::mem::take(&mut tree.covered);
+        let (held, subtrees) = (&*tree, &tree.subtrees);
         covered.clear();
         covered.resize(self.parent.len(), false);
         if backoff.len() != self.parent.len() {
@@ -151,7 +195,7 @@ impl Patches {
             backoff.resize(self.parent.len(), 0);
         }
         // Each subtree from its root down: a node under a certified one is covered with it.
-        let (flags, counts) = (Disjoint::new(covered), Disjoint::new(backoff));
+        let (flags, counts) = (Disjoint::new(&mut covered), Disjoint::new(backoff));
         let work = |_: usize, piece: usize| {
             let range = subtrees[piece].0.clone();
             // SAFETY: the subtrees' ranges are disjoint.
@@ -163,12 +207,16 @@ impl Patches {
                     i - range.start,
                     i != range.start && flags[parent - range.start],
                 );
-                flags[at] =
-                    above || tried(&mut counts[at], || self.certified(i, [from, to], least));
+                let patch = (self.convex[i]).then(|| (triangles, held.held(i)));
+                flags[at] = above
+                    || tried(&mut counts[at], || {
+                        self.certified(i, patch, [from, to], least)
+                    });
             }
         };
         let parallel = self.particle.len() >= PARALLEL_ELEMENTS;
         Team::current().run_large_pieces_if(parallel, subtrees.len(), &work);
+        tree.covered = covered;
     }
 
     /// Whether corner `c`'s ring is held by a node of `tree` covered for the motion last
@@ -184,25 +232,46 @@ impl Patches {
     /// puts its rest offset, carried with the middle of the starts (ends). The maps are
     /// least-squares fits; any maps would do. Never for a node with no entries, nor where a
     /// distance is NaN.
-    fn certified(&self, i: usize, motion: [&[Vec3]; 2], least: f32) -> bool {
+    fn certified(
+        &self,
+        i: usize,
+        patch: Option<Triangles<'_>>,
+        motion: [&[Vec3]; 2],
+        least: f32,
+    ) -> bool {
         let range = self.start[i] as usize..self.start[i + 1] as usize;
-        self.holds(range, self.inverse[i], motion, least)
+        self.holds(range, self.inverse[i], patch, motion, least)
     }
 
     /// Whether corner `c`'s ring keeps so near its rest shape along the motion from
     /// `from` to `to` that none of the corner's pairs comes within `reach` (as for a node:
     /// a ring is a patch too).
-    pub(super) fn ring_holds(&self, c: usize, motion: [&[Vec3]; 2], reach: f32) -> bool {
+    pub(super) fn ring_holds(
+        &self,
+        c: usize,
+        (triangles, around): Triangles<'_>,
+        motion: [&[Vec3]; 2],
+        reach: f32,
+    ) -> bool {
         let range = self.rings[c] as usize..self.rings[c + 1] as usize;
-        self.holds(range, self.ring_inverse[c], motion, reach * (1.0 + MARGIN))
+        let patch = (self.ring_convex[c]).then_some((triangles, around));
+        self.holds(
+            range,
+            self.ring_inverse[c],
+            patch,
+            motion,
+            reach * (1.0 + MARGIN),
+        )
     }
 
     /// [`Patches::certified`] for the entries in `range`, whose inverse second moments
-    /// are `inverse`.
+    /// are `inverse`; where the patch is convex in the cloth's plane (its triangles
+    /// `patch`), by their turns too ([`flat`]).
     fn holds(
         &self,
         range: std::ops::Range<usize>,
         [xx, xy, yy]: [f32; 3],
+        patch: Option<Triangles<'_>>,
         [from, to]: [&[Vec3]; 2],
         least: f32,
     ) -> bool {
@@ -243,12 +312,21 @@ impl Patches {
             glam::Mat3A::from_cols(p0, q0, normal),
             glam::Mat3A::from_cols(p1, q1, normal),
         );
-        (particle.iter().zip(reference)).all(|(&j, &r)| {
+        let near = (particle.iter().zip(reference)).all(|(&j, &r)| {
             let r = Vec3A::from(r);
             let start = (at(from, j) - first - start_map * r).length_squared();
             let end = (at(to, j) - last - end_map * r).length_squared();
             start <= limit && end <= limit
-        })
+        });
+        near || patch
+            .zip(self.flat.as_ref())
+            .is_some_and(|((triangles, held), flat)| {
+                // The least stretch along the motion, less what the rest gap needs to keep the
+                // reach: how far each triangle's gradient may stray from the map.
+                let room = shrink - moved - least / flat.gap(self.gap);
+                room > 0.0
+                    && flat.turns_within(held, triangles, [from, to], [[p0, q0], [p1, q1]], room)
+            })
     }
 
     /// Adds a patch's entries for its particles `held` at `rest` (none: not certified);
@@ -259,8 +337,13 @@ impl Patches {
         }
         let at = |j: u32| rest[j as usize];
         let middle = held.iter().map(|&j| at(j)).sum::<Vec3>() / held.len() as f32;
-        let [a, b, c] = anchor(held, rest).map(at);
-        let back = frame(a, b, c).transpose();
+        let back = match &self.flat {
+            Some(flat) => flat.back,
+            None => {
+                let [a, b, c] = anchor(held, rest).map(at);
+                frame(a, b, c).transpose()
+            }
+        };
         let start = self.reference.len();
         (self.reference).extend(held.iter().map(|&j| back * (at(j) - middle)));
         self.particle.extend_from_slice(held);

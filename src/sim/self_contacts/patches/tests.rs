@@ -32,7 +32,12 @@ fn cloth(quads: u32, mut shape: impl FnMut(Vec3) -> Vec3) -> Cloth {
     for p in &mut mesh.positions {
         *p = shape(*p);
     }
-    let model = ClothModel::new(&mesh, 0.2, &[]);
+    cloth_of(&mesh)
+}
+
+/// The cloth of `mesh`, with its owners, tree and patches.
+fn cloth_of(mesh: &crate::mesh::ClothMesh) -> Cloth {
+    let model = ClothModel::new(mesh, 0.2, &[]);
     let owners = Owners::build(&model);
     let rest = model.rest_positions.clone();
     let mut tree = TriangleTree::build(&model.triangles, &rest);
@@ -101,9 +106,9 @@ fn closest_within(triangles: &[[u32; 3]], held: &[u32], [from, to]: [&[Vec3]; 2]
 /// theirs comes within the reach. Returns the triangles covered, the least distance of a
 /// covered pair, and the corners whose ring holds.
 fn decide_and_check(c: &mut Cloth, motion: [&[Vec3]; 2], what: &str) -> (usize, f64, usize) {
-    c.patches
-        .decide(&mut c.tree, motion, REACH, &mut Vec::new());
     let triangles = &c.model.triangles;
+    c.patches
+        .decide(&mut c.tree, triangles, motion, REACH, &mut Vec::new());
     let (mut covered, mut least) = (0, f64::INFINITY);
     for (i, _) in c.tree.nodes().iter().enumerate() {
         let parent = c.patches.parent[i] as usize;
@@ -121,9 +126,11 @@ fn decide_and_check(c: &mut Cloth, motion: [&[Vec3]; 2], what: &str) -> (usize, 
     let (start, around) = crate::mesh::triangles_around(c.rest.len(), triangles);
     let mut rings = 0;
     for corner in 0..c.rest.len() {
-        let held = c.patches.ring_holds(corner, motion, REACH);
+        let ring = &around[start[corner] as usize..start[corner + 1] as usize];
+        let held = c
+            .patches
+            .ring_holds(corner, (triangles, ring), motion, REACH);
         if c.patches.covers(&c.tree, corner) || held {
-            let ring = &around[start[corner] as usize..start[corner + 1] as usize];
             let near = closest_within(triangles, ring, motion);
             assert!(
                 near >= f64::from(REACH),
@@ -290,8 +297,13 @@ fn a_node_that_failed_is_tried_again_after_a_few_searches() {
         })
         .collect();
     let mut covered = |motion: &[Vec3], backoff: &mut Vec<u8>| {
-        c.patches
-            .decide(&mut c.tree, [motion, motion], REACH, backoff);
+        c.patches.decide(
+            &mut c.tree,
+            &c.model.triangles,
+            [motion, motion],
+            REACH,
+            backoff,
+        );
         c.tree.covered.clone()
     };
     let (folded, flat) = (
@@ -317,6 +329,121 @@ fn a_node_that_failed_is_tried_again_after_a_few_searches() {
         assert!(fewer(&covered(&rest, &mut backoff)), "flat search {search}");
     }
     assert_eq!(covered(&rest, &mut backoff), flat);
+}
+
+/// A cloth rolled onto a cylinder of radius 10 cm across x (the normals turn 2.4 rad
+/// over its 24 cm), then drifting as it unrolls to a radius of 12 cm: far from any
+/// linear map of its rest shape where a node spans 12 cm, yet its triangles turn little
+/// from one to the next. No covered pair comes within the reach; the triangles' turns
+/// cover it in larger patches than the particles' places alone (the same cloth taken as
+/// not flat).
+#[test]
+fn a_patch_bent_evenly_is_certified_by_its_triangles_turns() {
+    let mut c = cloth(12, |p| p);
+    assert!(c.patches.flat.is_some() && c.patches.convex.iter().filter(|&&x| x).count() > 8);
+    // Every corner's ring that has pairs (the pairs of two triangles are taken at the
+    // first corner they share).
+    let with_pairs = |k: &usize| !c.owners.corner_pairs(*k).is_empty();
+    assert!(
+        (0..c.rest.len())
+            .filter(with_pairs)
+            .all(|k| c.patches.ring_convex[k])
+    );
+    let rolled = |rest: &[Vec3], radius: f32, drift: f32| -> Vec<Vec3> {
+        (rest.iter())
+            .map(|&p| {
+                let a = p.x / radius;
+                Vec3::new(
+                    radius * a.sin() + drift,
+                    radius * (1.0 - a.cos()),
+                    p.z - drift,
+                )
+            })
+            .collect()
+    };
+    // The covered nodes no covered node holds (the patches a walk passes by whole), and
+    // the corners whose rings hold, each certificate taken alone: with the cloth's plane
+    // and without it.
+    let decide = |c: &mut Cloth, [from, to]: [&[Vec3]; 2], flat: &Option<Flat>| {
+        c.patches.flat = flat.clone();
+        let (covered, near, rings) = decide_and_check(c, [from, to], "rolled");
+        let tops: Vec<u32> = (c.tree.nodes().iter().enumerate())
+            .filter(|&(i, _)| {
+                let parent = c.patches.parent[i] as usize;
+                c.tree.covered[i] && (i == 0 || !c.tree.covered[parent])
+            })
+            .map(|(_, n)| n.count)
+            .collect();
+        (covered, near, rings, tops)
+    };
+    let flat = c.patches.flat.clone();
+    let rest = c.rest.clone();
+    let (from, to) = (rolled(&rest, 0.10, 0.0), rolled(&rest, 0.12, 0.004));
+    let (turns, near, _, by_turns) = decide(&mut c, [&from, &to], &flat);
+    let (places, _, _, by_places) = decide(&mut c, [&from, &to], &None);
+    let triangles = c.model.triangles.len();
+    // All of it either way, by the turns in a third as many patches, twice as large.
+    assert!(
+        turns == triangles && places == triangles,
+        "{turns}, {places}"
+    );
+    let largest = |tops: &[u32]| tops.iter().copied().max().unwrap_or(0);
+    assert!(
+        largest(&by_turns) >= 2 * largest(&by_places) && by_turns.len() * 3 <= by_places.len(),
+        "{by_turns:?} against {by_places:?}"
+    );
+    assert!(near < 4.0 * f64::from(REACH), "{near}");
+}
+
+/// An island of 2 × 2 quads in the hole of a cloth of 8 × 8 with the middle 4 × 4 cut
+/// out, sliding 18 mm towards the hole's edge (2 mm from it at the end: within the
+/// reach). Every triangle keeps its rest shape and the patch holding both keeps its
+/// linear map (the island lies in its middle), so only that its rest shape is no convex
+/// region tells that the island may meet the rest: no covered pair comes within the
+/// reach. A cloth that does not lie flat at rest gets no certificate by its turns.
+#[test]
+fn a_patch_with_a_hole_or_off_its_plane_is_not_certified_by_turns() {
+    let mut obj = String::new();
+    let at = |i: i32, j: i32| (i + 4) * 9 + (j + 4) + 1;
+    for i in -4..=4 {
+        for j in -4..=4 {
+            obj += &format!("v {} 0 {}\n", 0.02 * i as f32, 0.02 * j as f32);
+        }
+    }
+    for i in -4..4 {
+        for j in -4..4 {
+            let (x, z) = (i as f32 + 0.5, j as f32 + 0.5);
+            let (hole, island) = (
+                x.abs() < 2.0 && z.abs() < 2.0,
+                x.abs() < 1.0 && z.abs() < 1.0,
+            );
+            if island || !hole {
+                let [a, b, c, d] = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+                obj += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
+            }
+        }
+    }
+    let built = crate::mesh::obj_from_str(&obj, "island.obj").unwrap();
+    let mut c = cloth_of(&built.mesh);
+    assert_eq!(c.model.triangles.len(), 2 * (64 - 16 + 4));
+    assert!(c.patches.flat.is_some());
+    let island = |p: Vec3| p.x.abs() < 0.03 && p.z.abs() < 0.03;
+    let to: Vec<Vec3> = (c.rest.iter())
+        .map(|&p| {
+            if island(p) {
+                p + Vec3::new(0.018, 0.0, 0.0)
+            } else {
+                p
+            }
+        })
+        .collect();
+    let rest = c.rest.clone();
+    let (covered, _, _) = decide_and_check(&mut c, [&rest, &to], "island");
+    // The parts of the cloth around the hole are covered; the whole is no convex patch.
+    assert!(covered > 0 && !c.patches.convex[0], "{covered}");
+    // Bent at rest by a tenth of a millimetre: not flat.
+    let c = cloth(12, |p| p + Vec3::new(0.0, 0.001 * (10.0 * p.x).sin(), 0.0));
+    assert!(c.patches.flat.is_none() && !c.patches.convex.contains(&true));
 }
 
 /// The rest gap is the least distance between the sides of any pair at rest, found by

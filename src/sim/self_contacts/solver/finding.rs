@@ -59,7 +59,9 @@ impl SelfContacts {
             let (patches, tree, reach) = (&self.patches, &self.tree, self.reach(thickness));
             let only = refreshed.then_some(&self.touched[..]);
             let covered = |c: usize| !refreshed && patches.covers(tree, c);
-            let near_rest = |c: usize| patches.ring_holds(c, motion, reach);
+            let rings = &self.owners.rings;
+            let near_rest =
+                |c: usize| patches.ring_holds(c, (triangles, rings.triangles_of(c)), motion, reach);
             let settled: [&(dyn Fn(usize) -> bool + Sync); 2] = [&covered, &near_rest];
             let certificates = &mut self.certificates;
             self.work.retaken +=
@@ -351,7 +353,13 @@ impl SelfContacts {
                 [&self.boxes.from[..], &self.boxes.to[..]],
                 self.reach(thickness),
             );
-            (self.patches).decide(&mut self.tree, motion, reach, &mut self.backoff);
+            (self.patches).decide(
+                &mut self.tree,
+                &model.triangles,
+                motion,
+                reach,
+                &mut self.backoff,
+            );
         } else {
             // The pairs are judged by the boxes: nothing is covered.
             self.tree.covered.clear();
