@@ -171,12 +171,12 @@ impl TriangleTree {
         &self.nodes
     }
 
-    /// The triangles node `i` holds.
     /// Triangle `t`'s place in the tree's order.
     pub(super) fn place(&self, t: u32) -> u32 {
         self.place_of[t as usize]
     }
 
+    /// The triangles node `i` holds.
     pub(super) fn held(&self, i: usize) -> &[u32] {
         let node = self.nodes[i];
         &self.order[node.first as usize..(node.first + node.count) as usize]
