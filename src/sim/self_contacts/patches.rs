@@ -17,6 +17,10 @@
 //! map's least stretch less half how far the map moves (Weyl's inequality), so a patch
 //! that turns as a whole stays certified.
 //!
+//! Where the cloth lies flat at rest, a patch that is one convex region of its plane is
+//! also certified by how far its triangles turn from the map, rather than how far its
+//! particles stray from it ([`flat`]): a patch bent evenly keeps that one.
+//!
 //! A certified node is covered, and so is every node under it: a whole search walks past a
 //! covered node against itself and leaves the corners whose ring a covered node holds
 //! closed. A corner's ring is such a patch too. The certificates need no reference taken
@@ -30,13 +34,13 @@ use super::certify::{MARGIN, frame, shave};
 use super::primitives::{Pair, boxes_apart_by, nearer};
 use super::search::{NONE, Owners};
 use super::tree::{TRIANGLES_PER_PIECE, TriangleTree};
+use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
 use flat::{Across, Flat, Scratch};
 
 mod flat;
 
 /// The cloth's triangles, and some of them by number (a patch's).
 type Triangles<'a> = (&'a [[u32; 3]], &'a [u32]);
-use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
 
 /// Triangles in the smallest node certified on its own (smaller ones are covered only
 /// with a node above them: their walk is short, and their frames would turn on a few
@@ -187,7 +191,7 @@ impl Patches {
         // Each of the tree's subtrees (the nodes a certificate can cover) is one piece.
         // Taken out while the tree is read for each node's triangles, then put back.
         let mut covered = std::mem::take(&mut tree.covered);
-        let (held, subtrees) = (&*tree, &tree.subtrees);
+        let (shape, subtrees) = (&*tree, &tree.subtrees);
         covered.clear();
         covered.resize(self.parent.len(), false);
         if backoff.len() != self.parent.len() {
@@ -207,7 +211,7 @@ impl Patches {
                     i - range.start,
                     i != range.start && flags[parent - range.start],
                 );
-                let patch = (self.convex[i]).then(|| (triangles, held.held(i)));
+                let patch = (self.convex[i]).then(|| (triangles, shape.held(i)));
                 flags[at] = above
                     || tried(&mut counts[at], || {
                         self.certified(i, patch, [from, to], least)
@@ -230,8 +234,10 @@ impl Patches {
     /// starts (ends) within half of what the rest gap, shrunk by the least the maps along
     /// the motion stretch, leaves over `least` of where the map fitted to the starts (ends)
     /// puts its rest offset, carried with the middle of the starts (ends). The maps are
-    /// least-squares fits; any maps would do. Never for a node with no entries, nor where a
-    /// distance is NaN.
+    /// least-squares fits; any maps would do. Or, where the node is one convex region of
+    /// the cloth's plane (its triangles `patch`), every triangle keeps near the maps in
+    /// how it turns ([`flat`]). Never for a node with no entries, nor where a distance is
+    /// NaN.
     fn certified(
         &self,
         i: usize,
@@ -245,7 +251,7 @@ impl Patches {
 
     /// Whether corner `c`'s ring keeps so near its rest shape along the motion from
     /// `from` to `to` that none of the corner's pairs comes within `reach` (as for a node:
-    /// a ring is a patch too).
+    /// a ring is a patch too; its triangles, `around` of `triangles`, for their turns).
     pub(super) fn ring_holds(
         &self,
         c: usize,
