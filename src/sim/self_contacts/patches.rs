@@ -35,7 +35,7 @@ use super::primitives::{Pair, boxes_apart_by, nearer};
 use super::search::{NONE, Owners};
 use super::tree::{TRIANGLES_PER_PIECE, TriangleTree};
 use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
-use flat::{Across, Flat, Scratch};
+use flat::Flat;
 
 mod flat;
 
@@ -98,18 +98,15 @@ impl Patches {
         (owners, corners): (&Owners, f32),
     ) -> Patches {
         let nodes = tree.nodes().to_vec();
+        let all: Vec<u32> = (0..rest.len() as u32).collect();
+        let plane = anchor(&all, rest).map(|j| rest[j as usize]);
+        // Where the cloth is flat, its outline tells which patches are convex.
+        let (flat, mut outline) = Flat::of(triangles, rest, plane, owners.rings.around()).unzip();
         let mut patches = Patches {
             parent: vec![0; nodes.len()],
             start: vec![0],
             gap: rest_gap(tree, triangles, rest, (owners, corners)),
-            flat: {
-                let all: Vec<u32> = (0..rest.len() as u32).collect();
-                Flat::of(
-                    triangles,
-                    rest,
-                    anchor(&all, rest).map(|j| rest[j as usize]),
-                )
-            },
+            flat,
             ..Patches::default()
         };
         for (i, node) in nodes.iter().enumerate() {
@@ -118,12 +115,6 @@ impl Patches {
                 patches.parent[node.second as usize] = i as u32;
             }
         }
-        // Where the cloth is flat, each triangle's neighbours, to tell the patches' edges.
-        let across = match patches.flat {
-            Some(_) => Across::of(triangles, owners.rings.around()),
-            None => Across::default(),
-        };
-        let mut scratch = Scratch::default();
         // Each node's particles, each once: the stamp is the node that took it last.
         let mut stamp = vec![NONE; rest.len()];
         let mut held = Vec::new();
@@ -141,11 +132,10 @@ impl Patches {
             let inverse = patches.add(&held, rest);
             patches.inverse.push(inverse);
             patches.start.push(patches.particle.len() as u32);
-            let convex = (patches.flat.as_ref()).is_some_and(|f| {
+            let convex = (outline.as_mut()).is_some_and(|o| {
                 let (first, count) = (node.first, node.count);
                 let holds = |t: u32| (first..first + count).contains(&tree.place(t));
-                !held.is_empty()
-                    && f.convex(tree.held(i), (triangles, &across), holds, &mut scratch)
+                !held.is_empty() && o.convex(tree.held(i), triangles, holds)
             });
             patches.convex.push(convex);
         }
@@ -159,9 +149,9 @@ impl Patches {
             let inverse = patches.add(&held, rest);
             patches.ring_inverse.push(inverse);
             let around = owners.rings.triangles_of(c);
-            let convex = (patches.flat.as_ref()).is_some_and(|f| {
+            let convex = (outline.as_mut()).is_some_and(|o| {
                 let holds = |t: u32| around.contains(&t);
-                !held.is_empty() && f.convex(around, (triangles, &across), holds, &mut scratch)
+                !held.is_empty() && o.convex(around, triangles, holds)
             });
             patches.ring_convex.push(convex);
             patches.rings.push(patches.particle.len() as u32);
@@ -326,12 +316,12 @@ impl Patches {
         });
         near || patch
             .zip(self.flat.as_ref())
-            .is_some_and(|((triangles, held), flat)| {
+            .is_some_and(|((triangles, tris), flat)| {
                 // The least stretch along the motion, less what the rest gap needs to keep the
                 // reach: how far each triangle's gradient may stray from the map.
                 let room = shrink - moved - least / flat.gap(self.gap);
                 room > 0.0
-                    && flat.turns_within(held, triangles, [from, to], [[p0, q0], [p1, q1]], room)
+                    && flat.turns_within(tris, triangles, [from, to], [[p0, q0], [p1, q1]], room)
             })
     }
 

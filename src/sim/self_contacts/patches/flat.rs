@@ -28,46 +28,15 @@
 use glam::{Mat3, Vec2, Vec3, Vec3A};
 
 use super::super::certify::frame;
+use super::super::search::NONE;
 
 /// Rounding allowed for, as a part of the rest shape's extent (one plus its largest
 /// coordinate, m): how far off its plane a flat cloth's particle may lie, and beyond an
 /// edge of a convex patch.
 const ROUNDING: f32 = 1e-5;
 
-/// No triangle across an edge, or more than one.
-const NONE: u32 = u32::MAX;
+/// More than one triangle across an edge ([`NONE`]: none).
 const MANY: u32 = u32::MAX - 1;
-
-/// Each triangle's neighbour across each of its edges (edge `k` from corner `k` to the
-/// next): the other triangle that has it, [`NONE`] for none, [`MANY`] for more than one.
-#[derive(Default)]
-pub(super) struct Across(Vec<[u32; 3]>);
-
-impl Across {
-    /// From each particle's triangles, `around` (as [`crate::mesh::triangles_around`]
-    /// gives them: `around.1[around.0[i]..around.0[i + 1]]`).
-    pub(super) fn of(triangles: &[[u32; 3]], (start, around): (&[u32], &[u32])) -> Across {
-        let of = |i: u32| &around[start[i as usize] as usize..start[i as usize + 1] as usize];
-        let across = (triangles.iter().enumerate())
-            .map(|(t, c)| {
-                std::array::from_fn(|k| {
-                    let (a, b) = (c[k], c[(k + 1) % 3]);
-                    let mut others = (of(a).iter())
-                        .filter(|&&u| u as usize != t && triangles[u as usize].contains(&b));
-                    match (others.next(), others.next()) {
-                        (None, _) => NONE,
-                        (Some(&u), None) => u,
-                        _ => MANY,
-                    }
-                })
-            })
-            .collect();
-        Across(across)
-    }
-}
-
-/// Room for [`Flat::convex`]'s edges and their ends, kept from one patch to the next.
-pub(super) type Scratch = (Vec<[u32; 3]>, Vec<Vec2>);
 
 /// A cloth that lies flat at rest.
 #[derive(Clone, Debug)]
@@ -80,24 +49,37 @@ pub(super) struct Flat {
     slopes: Vec<[f32; 4]>,
     /// How far a particle may lie off the plane, or beyond an edge of a convex patch, m.
     slack: f32,
-    /// Each particle's place at rest in the plane (its first two coordinates in the
-    /// plane's frame), m.
+}
+
+/// What deciding which patches are convex reads, at setup only: each particle's place at
+/// rest in the plane, each triangle's neighbour across each of its edges (edge `k` from
+/// corner `k` to the next: the other triangle that has it, [`NONE`] for none, [`MANY`]
+/// for more than one), the rounding allowed for, and room for a patch's edges and their
+/// ends, kept from one patch to the next.
+pub(super) struct Outline {
     places: Vec<Vec2>,
+    across: Vec<[u32; 3]>,
+    slack: f32,
+    edges: Vec<[u32; 3]>,
+    ends: Vec<Vec2>,
 }
 
 impl Flat {
     /// The plane of a cloth of `triangles` whose `rest` positions lie in one (up to the
-    /// rounding): the plane through `a`, `b` and `c`, three of them far apart; `None`
-    /// where they do not lie in it.
-    pub(super) fn of(triangles: &[[u32; 3]], rest: &[Vec3], [a, b, c]: [Vec3; 3]) -> Option<Flat> {
+    /// rounding), the plane through `a`, `b` and `c` (three of them far apart), with the
+    /// cloth's outline in it, from each particle's triangles `around` (as
+    /// [`crate::mesh::triangles_around`] gives them: `around.1[around.0[i]..around.0[i +
+    /// 1]]`); `None` where they do not lie in it.
+    pub(super) fn of(
+        triangles: &[[u32; 3]],
+        rest: &[Vec3],
+        [a, b, c]: [Vec3; 3],
+        (start, around): (&[u32], &[u32]),
+    ) -> Option<(Flat, Outline)> {
         let back = frame(a, b, c).transpose();
-        let extent = rest
-            .iter()
-            .fold(0.0f32, |m, p| m.max(p.abs().max_element()));
+        let extent = (rest.iter()).fold(0.0f32, |m, p| m.max(p.abs().max_element()));
         let slack = ROUNDING * (1.0 + extent);
-        let off = rest
-            .iter()
-            .fold(0.0f32, |m, &p| m.max((back * (p - a)).z.abs()));
+        let off = (rest.iter()).fold(0.0f32, |m, &p| m.max((back * (p - a)).z.abs()));
         // Three particles in a line turn no frame: the identity stands in, and the check
         // of every particle against its plane then decides.
         if off.is_nan() || off > slack || triangles.is_empty() {
@@ -115,66 +97,40 @@ impl Flat {
                 [e2.y / det, -e2.x / det, -e1.y / det, e1.x / det]
             })
             .collect();
-        Some(Flat {
+        let of = |i: u32| &around[start[i as usize] as usize..start[i as usize + 1] as usize];
+        let across = (triangles.iter().enumerate())
+            .map(|(t, c)| {
+                std::array::from_fn(|k| {
+                    let (a, b) = (c[k], c[(k + 1) % 3]);
+                    let mut others = (of(a).iter())
+                        .filter(|&&u| u as usize != t && triangles[u as usize].contains(&b));
+                    match (others.next(), others.next()) {
+                        (None, _) => NONE,
+                        (Some(&u), None) => u,
+                        _ => MANY,
+                    }
+                })
+            })
+            .collect();
+        let outline = Outline {
+            places,
+            across,
+            slack,
+            edges: Vec::new(),
+            ends: Vec::new(),
+        };
+        let flat = Flat {
             back,
             slopes,
             slack,
-            places,
-        })
+        };
+        Some((flat, outline))
     }
 
     /// The rest gap less what the rounding of the plane and of the patches' edges could
     /// take from it, m (what the certificate may count on).
     pub(super) fn gap(&self, gap: f32) -> f32 {
         gap - 4.0 * self.slack
-    }
-
-    /// Whether triangles `tris` (of `triangles`) make one convex region at rest: every edge
-    /// of one of them that no other of them has (`across`: each triangle's neighbours,
-    /// [`Across`]; `holds`: whether a triangle is one of them) keeps every end of those
-    /// edges on its triangle's side, to the rounding (the region lies within the hull of
-    /// its edges' ends). An edge of more than two triangles is no edge of a flat region:
-    /// none is convex.
-    pub(super) fn convex(
-        &self,
-        tris: &[u32],
-        (triangles, across): (&[[u32; 3]], &Across),
-        holds: impl Fn(u32) -> bool,
-        scratch: &mut Scratch,
-    ) -> bool {
-        if tris.is_empty() {
-            return false;
-        }
-        let at = |j: u32| self.places[j as usize];
-        // The region's edges, each with the corner across it, and their ends (each twice
-        // or more: checked again rather than sorted out).
-        let (edges, ends) = scratch;
-        edges.clear();
-        ends.clear();
-        for &t in tris {
-            let c = triangles[t as usize];
-            for k in 0..3 {
-                match across.0[t as usize][k] {
-                    MANY => return false,
-                    next if next != NONE && holds(next) => {}
-                    _ => {
-                        edges.push([c[k], c[(k + 1) % 3], c[(k + 2) % 3]]);
-                        ends.extend([at(c[k]), at(c[(k + 1) % 3])]);
-                    }
-                }
-            }
-        }
-        edges.iter().all(|&[a, b, c]| {
-            let (a, b) = (at(a), at(b));
-            let along = b - a;
-            let inside = along.perp_dot(at(c) - a);
-            let length = along.length();
-            if inside == 0.0 || length == 0.0 {
-                return false;
-            }
-            let (side, beyond) = (inside.signum(), -self.slack * length);
-            ends.iter().all(|&p| side * along.perp_dot(p - a) >= beyond)
-        })
     }
 
     /// Whether every triangle of `tris` (of `triangles`) has its deformation gradient, in
@@ -199,6 +155,54 @@ impl Flat {
                 (u - p).length_squared() + (v - q).length_squared()
             };
             strays(from, maps[0]) <= limit && strays(to, maps[1]) <= limit
+        })
+    }
+}
+
+impl Outline {
+    /// Whether triangles `tris` (of `triangles`) make one convex region at rest: every edge
+    /// of one of them that no other of them has (`holds`: whether a triangle is one of
+    /// them) keeps every end of those edges on its triangle's side, to the rounding (the
+    /// region lies within the hull of its edges' ends). An edge of more than two triangles
+    /// is no edge of a flat region: none is convex.
+    pub(super) fn convex(
+        &mut self,
+        tris: &[u32],
+        triangles: &[[u32; 3]],
+        holds: impl Fn(u32) -> bool,
+    ) -> bool {
+        if tris.is_empty() {
+            return false;
+        }
+        // The region's edges, each with the corner across it, and their ends (each twice
+        // or more: checked again rather than sorted out).
+        let (edges, ends, places) = (&mut self.edges, &mut self.ends, &self.places);
+        let at = |j: u32| places[j as usize];
+        edges.clear();
+        ends.clear();
+        for &t in tris {
+            let c = triangles[t as usize];
+            for k in 0..3 {
+                match self.across[t as usize][k] {
+                    MANY => return false,
+                    next if next != NONE && holds(next) => {}
+                    _ => {
+                        edges.push([c[k], c[(k + 1) % 3], c[(k + 2) % 3]]);
+                        ends.extend([at(c[k]), at(c[(k + 1) % 3])]);
+                    }
+                }
+            }
+        }
+        edges.iter().all(|&[a, b, c]| {
+            let (a, b) = (at(a), at(b));
+            let along = b - a;
+            let inside = along.perp_dot(at(c) - a);
+            let length = along.length();
+            if inside == 0.0 || length == 0.0 {
+                return false;
+            }
+            let (side, beyond) = (inside.signum(), -self.slack * length);
+            ends.iter().all(|&p| side * along.perp_dot(p - a) >= beyond)
         })
     }
 }
