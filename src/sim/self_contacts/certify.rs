@@ -39,7 +39,9 @@ pub(super) struct Certificates {
     /// Each corner's least distance between the sides of its pairs at its reference, m
     /// (`-∞`: none taken).
     apart: Vec<f32>,
-    /// Whether each corner's pairs must be tested one by one (its certificate failed).
+    /// Whether each corner's pairs must be tested one by one (its certificate failed; where
+    /// the pairs are judged by the boxes, no covered patch holds its ring, or a refresh
+    /// touched it).
     pub(super) open: Vec<bool>,
     /// Whether each corner was last closed by its ring keeping near its rest shape: its
     /// ring is tested first then (its rest shape as a reference, turned with the corner,
@@ -82,6 +84,21 @@ impl Certificates {
         let pieces = corners.div_ceil(CORNERS_PER_PIECE);
         Team::current().run_large_pieces_if(corners >= PARALLEL_ELEMENTS, pieces, &work);
         certificates
+    }
+
+    /// Opens every one of `corners` but those `closed` flags (where the pairs are judged by
+    /// the boxes, the corners are certified by the patches alone, which hold for every
+    /// place in the boxes).
+    pub(super) fn open_unless(&mut self, corners: usize, closed: impl Fn(usize) -> bool) {
+        self.open.clear();
+        self.open.extend((0..corners).map(|c| !closed(c)));
+    }
+
+    /// Opens the corners `touched` flags.
+    pub(super) fn reopen(&mut self, touched: &[bool]) {
+        for (open, &touched) in self.open.iter_mut().zip(touched) {
+            *open |= touched;
+        }
     }
 
     /// The least distance at rest between the sides of any pair of two triangles that

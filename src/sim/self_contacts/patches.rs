@@ -166,15 +166,17 @@ impl Patches {
     }
 
     /// Covers the tree's nodes certified for the motion of each particle from `from` to
-    /// `to`, with `reach` (see the module's notes). A node whose certificate failed is
-    /// left uncovered, untested, for the next searches that `backoff` (one count a node,
-    /// kept from search to search; zeros: test every node) counts out.
+    /// `to`, with `reach` (see the module's notes); by their triangles' turns too only
+    /// with `turns` (a motion's straight paths, not places anywhere in a box). A node
+    /// whose certificate failed is left uncovered, untested, for the next searches that
+    /// `backoff` (one count a node, kept from search to search; zeros: test every node)
+    /// counts out.
     pub(super) fn decide(
         &self,
         tree: &mut TriangleTree,
         triangles: &[[u32; 3]],
         [from, to]: [&[Vec3]; 2],
-        reach: f32,
+        (reach, turns): (f32, bool),
         backoff: &mut Vec<u8>,
     ) {
         let least = reach * (1.0 + MARGIN);
@@ -201,7 +203,7 @@ impl Patches {
                     i - range.start,
                     i != range.start && flags[parent - range.start],
                 );
-                let patch = (self.convex[i]).then(|| (triangles, shape.held(i)));
+                let patch = (turns && self.convex[i]).then(|| (triangles, shape.held(i)));
                 flags[at] = above
                     || tried(&mut counts[at], || {
                         self.certified(i, patch, [from, to], least)
@@ -211,6 +213,12 @@ impl Patches {
         let parallel = self.particle.len() >= PARALLEL_ELEMENTS;
         Team::current().run_large_pieces_if(parallel, subtrees.len(), &work);
         tree.covered = covered;
+    }
+
+    /// The least distance at rest between the sides of a pair of the cloth, up to its
+    /// longest edge, rounded down, m: no reach as wide certifies a patch.
+    pub(super) fn gap(&self) -> f32 {
+        self.gap
     }
 
     /// Whether corner `c`'s ring is held by a node of `tree` covered for the motion last

@@ -241,8 +241,9 @@ pub(super) struct Search<'a> {
     pub(super) triangles: &'a [[u32; 3]],
     pub(super) boxes: &'a Boxes,
     pub(super) thickness: f32,
-    /// Which corners' pairs are tested where the pairs are judged by the motion (see
-    /// [`super::certify`]); judged by the boxes alone, every corner's are.
+    /// Which corners' pairs are tested: by the motion, those the certificates left open
+    /// (see [`super::certify`]); by the boxes, those whose ring no covered patch holds,
+    /// and those a refresh touched. A corner past its end is open.
     pub(super) open: &'a [bool],
 }
 
@@ -335,7 +336,7 @@ impl Search<'_> {
         let starts = &self.owners.piece_start;
         let owner = &self.owners.vertex_owner;
         for c in starts[piece] as usize..starts[piece + 1] as usize {
-            if self.boxes.swept && !self.open[c] {
+            if self.open.get(c) == Some(&false) {
                 continue;
             }
             if dirty.is_some_and(|[_, corners]| !corners[c]) {

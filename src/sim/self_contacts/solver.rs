@@ -68,6 +68,8 @@ pub struct SelfContacts {
     tree: TriangleTree,
     /// The tree's patches certified apart by the rest shape.
     patches: Patches,
+    /// Each particle's box's middle, where the patches are certified for the boxes.
+    middles: Vec<Vec3>,
     /// How many searches each node's certificate is left out of (see [`Patches::decide`]).
     backoff: Vec<u8>,
     owners: Owners,

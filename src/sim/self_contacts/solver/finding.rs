@@ -212,6 +212,11 @@ impl SelfContacts {
         // closed and is open now still leaves out the pairs of its triangles that stayed:
         // it held for their motion, which has not changed.
         self.decide_corners(&model.triangles, thickness, true);
+        if !self.boxes.swept {
+            // The patches' certificate held for the places the boxes allowed: not for the
+            // particles that left theirs, nor for the corners whose pairs they are on.
+            self.certificates.reopen(&self.touched);
+        }
         let (tree, dirty, touched) = (&self.tree, &self.dirty, &self.touched);
         let owner = &self.owners.vertex_owner;
         let mut found = std::mem::take(&mut self.found);
@@ -239,6 +244,38 @@ impl SelfContacts {
         self.work.refreshed += refreshed as u64;
         self.found_for = Some(thickness);
         Ok(())
+    }
+
+    /// Where the pairs are judged by the boxes, covers the patches certified for every
+    /// place their particles may take while the pairs hold: a particle's motion keeps
+    /// within its box less half the thickness, so within that room's half-diagonal of the
+    /// box's middle; a patch whose middles keep within `(σ·gap − reach)/2` of its map,
+    /// `reach` the thickness and twice the widest room, keeps its pairs the thickness
+    /// apart wherever in their rooms its particles go (by their places alone: a turn is
+    /// told along a motion, not in a box). The corners whose ring a covered patch holds
+    /// are closed, the others open. Where the widest room leaves the rest gap nothing to
+    /// certify (a particle whose box looks far ahead), nothing is covered.
+    pub(super) fn cover_boxes(&mut self, triangles: &[[u32; 3]], thickness: f32) {
+        let half = Vec3::splat(0.5 * thickness);
+        let (lo, hi) = (&self.boxes.vertex_lo, &self.boxes.vertex_hi);
+        self.middles.clear();
+        self.middles
+            .extend(lo.iter().zip(hi).map(|(&lo, &hi)| 0.5 * (lo + hi)));
+        let widest = (lo.iter().zip(hi))
+            .map(|(&lo, &hi)| (0.5 * (hi - lo) - half).max(Vec3::ZERO).length_squared())
+            .fold(0.0f32, f32::max)
+            .sqrt();
+        let reach = thickness + 2.0 * widest;
+        if reach < self.patches.gap() {
+            let places = [&self.middles[..], &self.middles[..]];
+            let (tree, backoff) = (&mut self.tree, &mut self.backoff);
+            self.patches
+                .decide(tree, triangles, places, (reach, false), backoff);
+        } else {
+            self.tree.covered.clear();
+        }
+        let (patches, tree) = (&self.patches, &self.tree);
+        (self.certificates).open_unless(lo.len(), |c| patches.covers(tree, c));
     }
 
     /// Fits the tree to the boxes, or where the pairs are judged by the motion, to the
@@ -357,12 +394,11 @@ impl SelfContacts {
                 &mut self.tree,
                 &model.triangles,
                 motion,
-                reach,
+                (reach, true),
                 &mut self.backoff,
             );
         } else {
-            // The pairs are judged by the boxes: nothing is covered.
-            self.tree.covered.clear();
+            self.cover_boxes(&model.triangles, thickness);
         }
         self.decide_corners(&model.triangles, thickness, false);
         let mut found = std::mem::take(&mut self.found);

@@ -614,6 +614,7 @@ fn pairs_judged_by_the_boxes_are_kept_exactly_where_their_balls_come_near() {
     );
 }
 
+mod boxes;
 mod windows;
 
 /// The substeps (counted from 1) at which the particles of `start`'s left half, creeping
