@@ -25,6 +25,19 @@ fn step(contacts: &mut SelfContacts, model: &ClothModel, start: &[Vec3], end: &[
     contacts.update_pairs(model, T, T).unwrap();
 }
 
+/// A solver with the pairs found, for thickness [`T`], for the motion from `start` to
+/// `end`.
+fn searched_for(model: &ClothModel, start: &[Vec3], end: &[Vec3]) -> SelfContacts {
+    let mut contacts = SelfContacts::default();
+    step(&mut contacts, model, start, end);
+    contacts
+}
+
+/// How many corners are closed.
+fn closed(contacts: &SelfContacts) -> usize {
+    contacts.certificates.open.iter().filter(|&&o| !o).count()
+}
+
 /// Every pair of the cloth: of each two triangles that share no corner, and each corner's.
 fn every_pair(contacts: &SelfContacts, triangles: &[[u32; 3]]) -> Vec<(Pair, StoredPair)> {
     let mut pairs = Vec::new();
@@ -103,11 +116,9 @@ fn least_in_rooms(contacts: &SelfContacts, pairs: &[Pair]) -> f64 {
 fn patches_covered_for_the_boxes_keep_their_pairs_apart_anywhere_in_them() {
     let (model, rest) = flat(8);
     let triangles = &model.triangles;
-    let mut still = SelfContacts::default();
-    step(&mut still, &model, &rest, &rest);
+    let still = searched_for(&model, &rest, &rest);
     assert!(!still.boxes.swept);
-    let pairs = certified(&still, triangles);
-    let closed = still.certificates.open.iter().filter(|&&o| !o).count();
+    let (pairs, closed) = (certified(&still, triangles), closed(&still));
     assert!(
         pairs.len() > 5000 && closed > 40,
         "{} pairs, {closed} corners",
@@ -118,8 +129,7 @@ fn patches_covered_for_the_boxes_keep_their_pairs_apart_anywhere_in_them() {
 
     let along = Vec3::new(1.0, 0.0, 1.0).normalize() * 0.003;
     let end: Vec<Vec3> = rest.iter().map(|&p| p + along).collect();
-    let mut moving = SelfContacts::default();
-    step(&mut moving, &model, &rest, &end);
+    let moving = searched_for(&model, &rest, &end);
     assert!(!moving.boxes.swept);
     let every: Vec<Pair> = (every_pair(&moving, triangles).into_iter())
         .map(|(p, _)| p)
@@ -145,13 +155,12 @@ fn patches_covered_for_the_boxes_keep_their_pairs_apart_anywhere_in_them() {
 fn a_refresh_by_the_boxes_searches_the_corners_that_left_them() {
     let (model, rest) = flat(8);
     let triangles = &model.triangles;
-    let mut contacts = SelfContacts::default();
-    step(&mut contacts, &model, &rest, &rest);
+    let mut contacts = searched_for(&model, &rest, &rest);
     let moved = 4 * 9 + 4;
-    let covered = contacts.certificates.open.iter().filter(|&&o| !o).count();
+    let closed = closed(&contacts);
     assert!(
         !contacts.certificates.open[moved + 1],
-        "{covered} corners closed"
+        "{closed} corners closed"
     );
     let mut pos = rest.clone();
     let mut near_total = 0;
