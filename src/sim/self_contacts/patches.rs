@@ -101,7 +101,7 @@ impl Patches {
         let all: Vec<u32> = (0..rest.len() as u32).collect();
         let plane = anchor(&all, rest).map(|j| rest[j as usize]);
         // Where the cloth is flat, its outline tells which patches are convex.
-        let (flat, mut outline) = Flat::of(triangles, rest, plane, owners.rings.around()).unzip();
+        let (flat, mut outline) = Flat::of(triangles, rest, plane, &owners.rings).unzip();
         let mut patches = Patches {
             parent: vec![0; nodes.len()],
             start: vec![0],

@@ -52,11 +52,6 @@ impl Rings {
         &self.around[self.around_start[i] as usize..self.around_start[i + 1] as usize]
     }
 
-    /// Every particle's triangles: particle `i`'s are `.1[.0[i]...0[i + 1]]`.
-    pub(super) fn around(&self) -> (&[u32], &[u32]) {
-        (&self.around_start, &self.around)
-    }
-
     /// Particle `i`'s ring, as the range of entries it takes.
     pub(super) fn range(&self, i: usize) -> std::ops::Range<usize> {
         self.start[i] as usize..self.start[i + 1] as usize

@@ -28,6 +28,7 @@
 use glam::{Mat3, Vec2, Vec3, Vec3A};
 
 use super::super::certify::frame;
+use super::super::rings::Rings;
 use super::super::search::NONE;
 
 /// Rounding allowed for, as a part of the rest shape's extent (one plus its largest
@@ -67,14 +68,13 @@ pub(super) struct Outline {
 impl Flat {
     /// The plane of a cloth of `triangles` whose `rest` positions lie in one (up to the
     /// rounding), the plane through `a`, `b` and `c` (three of them far apart), with the
-    /// cloth's outline in it, from each particle's triangles `around` (as
-    /// [`crate::mesh::triangles_around`] gives them: `around.1[around.0[i]..around.0[i +
-    /// 1]]`); `None` where they do not lie in it.
+    /// cloth's outline in it, from each particle's triangles (`rings`); `None` where they
+    /// do not lie in it.
     pub(super) fn of(
         triangles: &[[u32; 3]],
         rest: &[Vec3],
         [a, b, c]: [Vec3; 3],
-        (start, around): (&[u32], &[u32]),
+        rings: &Rings,
     ) -> Option<(Flat, Outline)> {
         let back = frame(a, b, c).transpose();
         let extent = (rest.iter()).fold(0.0f32, |m, p| m.max(p.abs().max_element()));
@@ -97,12 +97,11 @@ impl Flat {
                 [e2.y / det, -e2.x / det, -e1.y / det, e1.x / det]
             })
             .collect();
-        let of = |i: u32| &around[start[i as usize] as usize..start[i as usize + 1] as usize];
         let across = (triangles.iter().enumerate())
             .map(|(t, c)| {
                 std::array::from_fn(|k| {
                     let (a, b) = (c[k], c[(k + 1) % 3]);
-                    let mut others = (of(a).iter())
+                    let mut others = (rings.triangles_of(a as usize).iter())
                         .filter(|&&u| u as usize != t && triangles[u as usize].contains(&b));
                     match (others.next(), others.next()) {
                         (None, _) => NONE,
