@@ -166,17 +166,15 @@ impl Patches {
     }
 
     /// Covers the tree's nodes certified for the motion of each particle from `from` to
-    /// `to`, with `reach` (see the module's notes); by their triangles' turns too only
-    /// with `turns` (a motion's straight paths, not places anywhere in a box). A node
-    /// whose certificate failed is left uncovered, untested, for the next searches that
-    /// `backoff` (one count a node, kept from search to search; zeros: test every node)
-    /// counts out.
+    /// `to`, with `reach` (see the module's notes). A node whose certificate failed is
+    /// left uncovered, untested, for the next searches that `backoff` (one count a node,
+    /// kept from search to search; zeros: test every node) counts out.
     pub(super) fn decide(
         &self,
         tree: &mut TriangleTree,
         triangles: &[[u32; 3]],
         [from, to]: [&[Vec3]; 2],
-        (reach, turns): (f32, bool),
+        reach: f32,
         backoff: &mut Vec<u8>,
     ) {
         let least = reach * (1.0 + MARGIN);
@@ -203,7 +201,7 @@ impl Patches {
                     i - range.start,
                     i != range.start && flags[parent - range.start],
                 );
-                let patch = (turns && self.convex[i]).then(|| (triangles, shape.held(i)));
+                let patch = (self.convex[i]).then(|| (triangles, shape.held(i)));
                 flags[at] = above
                     || tried(&mut counts[at], || {
                         self.certified(i, patch, [from, to], least)

@@ -107,13 +107,8 @@ fn closest_within(triangles: &[[u32; 3]], held: &[u32], [from, to]: [&[Vec3]; 2]
 /// covered pair, and the corners whose ring holds.
 fn decide_and_check(c: &mut Cloth, motion: [&[Vec3]; 2], what: &str) -> (usize, f64, usize) {
     let triangles = &c.model.triangles;
-    c.patches.decide(
-        &mut c.tree,
-        triangles,
-        motion,
-        (REACH, true),
-        &mut Vec::new(),
-    );
+    c.patches
+        .decide(&mut c.tree, triangles, motion, REACH, &mut Vec::new());
     let (mut covered, mut least) = (0, f64::INFINITY);
     for (i, _) in c.tree.nodes().iter().enumerate() {
         let parent = c.patches.parent[i] as usize;
@@ -306,7 +301,7 @@ fn a_node_that_failed_is_tried_again_after_a_few_searches() {
             &mut c.tree,
             &c.model.triangles,
             [motion, motion],
-            (REACH, true),
+            REACH,
             backoff,
         );
         c.tree.covered.clone()

@@ -249,12 +249,13 @@ impl SelfContacts {
     /// Where the pairs are judged by the boxes, covers the patches certified for every
     /// place their particles may take while the pairs hold: a particle's motion keeps
     /// within its box less half the thickness, so within that room's half-diagonal of the
-    /// box's middle; a patch whose middles keep within `(σ·gap − reach)/2` of its map,
-    /// `reach` the thickness and twice the widest room, keeps its pairs the thickness
-    /// apart wherever in their rooms its particles go (by their places alone: a turn is
-    /// told along a motion, not in a box). The corners whose ring a covered patch holds
-    /// are closed, the others open. Where the widest room leaves the rest gap nothing to
-    /// certify (a particle whose box looks far ahead), nothing is covered.
+    /// box's middle, and so does every point of its triangles of the one where the
+    /// middles put it. A patch certified (by either certificate) to keep its pairs `reach`
+    /// apart with its particles at the middles, `reach` the thickness and twice the
+    /// widest room, keeps them the thickness apart wherever in their rooms they go. The
+    /// corners whose ring a covered patch holds are closed, the others open. Where the
+    /// widest room leaves the rest gap nothing to certify (a particle whose box looks far
+    /// ahead), nothing is covered.
     pub(super) fn cover_boxes(&mut self, triangles: &[[u32; 3]], thickness: f32) {
         let half = Vec3::splat(0.5 * thickness);
         let (lo, hi) = (&self.boxes.vertex_lo, &self.boxes.vertex_hi);
@@ -269,8 +270,7 @@ impl SelfContacts {
         if reach < self.patches.gap() {
             let places = [&self.middles[..], &self.middles[..]];
             let (tree, backoff) = (&mut self.tree, &mut self.backoff);
-            self.patches
-                .decide(tree, triangles, places, (reach, false), backoff);
+            self.patches.decide(tree, triangles, places, reach, backoff);
         } else {
             self.tree.covered.clear();
         }
@@ -394,7 +394,7 @@ impl SelfContacts {
                 &mut self.tree,
                 &model.triangles,
                 motion,
-                (reach, true),
+                reach,
                 &mut self.backoff,
             );
         } else {
