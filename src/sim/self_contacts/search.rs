@@ -243,7 +243,7 @@ pub(super) struct Search<'a> {
     pub(super) thickness: f32,
     /// Which corners' pairs are tested: by the motion, those the certificates left open
     /// (see [`super::certify`]); by the boxes, those whose ring no covered patch holds,
-    /// and those a refresh touched. A corner past its end is open.
+    /// and those a refresh touched (every search sets one flag a corner).
     pub(super) open: &'a [bool],
 }
 
@@ -336,7 +336,7 @@ impl Search<'_> {
         let starts = &self.owners.piece_start;
         let owner = &self.owners.vertex_owner;
         for c in starts[piece] as usize..starts[piece + 1] as usize {
-            if self.open.get(c) == Some(&false) {
+            if !self.open[c] {
                 continue;
             }
             if dirty.is_some_and(|[_, corners]| !corners[c]) {
