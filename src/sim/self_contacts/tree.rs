@@ -457,14 +457,17 @@ impl TriangleTree {
         let (leaf, k) = self.lane(place);
         let (lane, corners) = ((&self.lanes[leaf], k), self.corners(leaf, k));
         let (one, own) = (self.lanes[leaf].one(k), self.leaves[leaf] as usize);
+        // As in the whole walk, a node goes on the stack only where it is not told apart.
         let mut stack = [0u32; STACK];
-        let mut depth = 1;
+        let mut depth = 0;
+        let push = |stack: &mut [u32; STACK], depth: &mut usize, a: u32| {
+            stack[*depth] = a;
+            *depth += usize::from(!apart(a as usize, &one));
+        };
+        push(&mut stack, &mut depth, 0);
         while depth > 0 {
             depth -= 1;
             let a = stack[depth];
-            if apart(a as usize, &one) {
-                continue;
-            }
             let node = self.nodes[a as usize];
             if Self::is_leaf(node) {
                 let leaf = self.leaf_of[a as usize] as usize;
@@ -477,8 +480,8 @@ impl TriangleTree {
                     }
                 }
             } else {
-                stack[depth..depth + 2].copy_from_slice(&[node.second, a + 1]);
-                depth += 2;
+                push(&mut stack, &mut depth, node.second);
+                push(&mut stack, &mut depth, a + 1);
             }
         }
     }
@@ -492,63 +495,72 @@ impl TriangleTree {
         mut pair: impl FnMut(u32, u32),
     ) {
         // Each triangle of leaf node `a` against those of leaf node `b` (past its own,
-        // where they are the same).
+        // where they are the same). The rows that hold a pair are flagged first, without a
+        // branch a row (most hold none).
         let mut leaves = |a: usize, b: usize| {
             let (na, nb) = (self.nodes[a], self.nodes[b]);
             let (la, lb) = (self.leaf_of[a] as usize, self.leaf_of[b] as usize);
             let corners = &self.leaf_corners[lb];
-            let rows = lanes_near([a, b], [la, lb]);
-            let lanes = lanes_of(nb);
-            for (k, &row) in rows.iter().enumerate().take(na.count as usize) {
+            let mut rows = lanes_near([a, b], [la, lb]);
+            let (lanes, same) = (lanes_of(nb), a == b);
+            let mut held = 0;
+            for (k, row) in rows.iter_mut().enumerate() {
                 // Past its own, where the leaves are the same.
-                let row = if a == b { row & !((2 << k) - 1) } else { row } & lanes;
-                if row == 0 {
-                    continue;
-                }
+                let own = if same { (2 << k) - 1 } else { 0 };
+                *row &= lanes & !own;
+                held |= u32::from(*row != 0) << k;
+            }
+            for k in flagged(held & lanes_of(na)) {
                 let p = na.first as usize + k;
-                let near = share_none(self.corners(la, k), corners) & row;
+                let near = share_none(self.corners(la, k), corners) & rows[k];
                 for q in flagged(near) {
                     pair(self.order[p], self.order[nb.first as usize + q]);
                 }
             }
         };
+        // Only two nodes not told apart go on the stack: each two is tested as it is put
+        // there, and the slot is kept only where the test fails, so no branch hangs on
+        // the test (callgrind's branch model mispredicted that branch about every third
+        // time); a node against itself goes on only where it is not covered.
+        let open = |a: u32, b: u32| {
+            if a == b {
+                !self.covered.get(a as usize).copied().unwrap_or(false)
+            } else {
+                !apart(a as usize, b as usize)
+            }
+        };
         let mut stack = [(0u32, 0u32); STACK];
-        stack[0] = self.tasks[piece];
-        let mut depth = 1;
+        let mut depth = 0;
+        let push = |stack: &mut [Task; STACK], depth: &mut usize, (a, b): Task| {
+            stack[*depth] = (a, b);
+            *depth += usize::from(open(a, b));
+        };
+        push(&mut stack, &mut depth, self.tasks[piece]);
         while depth > 0 {
             depth -= 1;
             let (a, b) = stack[depth];
             let (na, nb) = (self.nodes[a as usize], self.nodes[b as usize]);
             if a == b {
-                if self.covered.get(a as usize).copied().unwrap_or(false) {
-                    continue;
-                }
                 if Self::is_leaf(na) {
                     leaves(a as usize, a as usize);
                 } else {
                     let (first, second) = (a + 1, na.second);
-                    stack[depth..depth + 3].copy_from_slice(&[
-                        (first, second),
-                        (second, second),
-                        (first, first),
-                    ]);
-                    depth += 3;
+                    for task in [(first, second), (second, second), (first, first)] {
+                        push(&mut stack, &mut depth, task);
+                    }
                 }
-                continue;
-            }
-            if apart(a as usize, b as usize) {
                 continue;
             }
             match (Self::is_leaf(na), Self::is_leaf(nb)) {
                 (true, true) => leaves(a as usize, b as usize),
                 // The larger is split.
                 (false, _) if na.count >= nb.count || Self::is_leaf(nb) => {
-                    stack[depth..depth + 2].copy_from_slice(&[(na.second, b), (a + 1, b)]);
-                    depth += 2;
+                    push(&mut stack, &mut depth, (na.second, b));
+                    push(&mut stack, &mut depth, (a + 1, b));
                 }
                 _ => {
-                    stack[depth..depth + 2].copy_from_slice(&[(a, nb.second), (a, b + 1)]);
-                    depth += 2;
+                    push(&mut stack, &mut depth, (a, nb.second));
+                    push(&mut stack, &mut depth, (a, b + 1));
                 }
             }
         }
