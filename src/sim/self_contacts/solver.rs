@@ -154,7 +154,16 @@ impl SelfContacts {
         if thickness <= 0.0 || model.triangles.is_empty() {
             return Ok(0);
         }
-        if let Some(particle) = state.pos.iter().position(|p| !p.is_finite()) {
+        // Pairs are found, and kept while they hold, in a frame that moves with the
+        // cloth's mean motion (it changes no distance): a cloth falling as a whole moves
+        // little in it. A position that is not finite makes the mean so.
+        let n = start.len() as f64;
+        let mean = (start.iter().zip(&state.pos))
+            .fold(glam::DVec3::ZERO, |m, (s, p)| m + (*p - *s).as_dvec3())
+            / n;
+        if !mean.is_finite()
+            && let Some(particle) = state.pos.iter().position(|p| !p.is_finite())
+        {
             return Err(ContactError::NonFinite { particle });
         }
         // Nothing to build where it was prepared for this cloth.
@@ -164,13 +173,6 @@ impl SelfContacts {
             forced_total: self.work.forced_total,
             ..SelfWork::default()
         };
-        // Pairs are found, and kept while they hold, in a frame that moves with the
-        // cloth's mean motion (it changes no distance): a cloth falling as a whole moves
-        // little in it.
-        let n = start.len() as f64;
-        let mean = (start.iter().zip(&state.pos))
-            .fold(glam::DVec3::ZERO, |m, (s, p)| m + (*p - *s).as_dvec3())
-            / n;
         let mean = mean.as_vec3();
         // A substep further into the window: every particle's motion is checked again.
         self.window.at = self.window.at.saturating_add(1);
@@ -409,19 +411,28 @@ impl SelfContacts {
         // A pass whose cuts move nothing (a particle already held at its start against
         // prescribed motion is cut again to where it is) ends them; its forced pairs are
         // the substep's, counted once however many passes saw them.
+        // No pair: nothing to cut (most substeps of a cloth falling free).
+        if self.found.len() == 0 {
+            return Ok(());
+        }
         let mut round = 0;
         loop {
+            let first = round;
             let forced =
                 self.cut_rounds(model, [start, &state.pos], keep, &mut round, thickness)?;
             let mut moved = false;
-            let cuts = (self.scale.iter().zip(start)).zip(state.pos.iter_mut().zip(&mut state.vel));
-            for ((&s, from), (pos, vel)) in cuts {
-                if s < 1.0 {
-                    let from = from.as_dvec3();
-                    let to = from + s * (pos.as_dvec3() - from);
-                    moved |= to.as_vec3() != *pos;
-                    *pos = to.as_vec3();
-                    *vel = ((to - from) / f64::from(substep)).as_vec3();
+            // Where the first round cut nothing, every particle keeps its whole motion.
+            if round > first + 1 {
+                let cuts =
+                    (self.scale.iter().zip(start)).zip(state.pos.iter_mut().zip(&mut state.vel));
+                for ((&s, from), (pos, vel)) in cuts {
+                    if s < 1.0 {
+                        let from = from.as_dvec3();
+                        let to = from + s * (pos.as_dvec3() - from);
+                        moved |= to.as_vec3() != *pos;
+                        *pos = to.as_vec3();
+                        *vel = ((to - from) / f64::from(substep)).as_vec3();
+                    }
                 }
             }
             if !moved {
