@@ -403,6 +403,10 @@ impl SelfContacts {
         thickness: f32,
         substep: f32,
     ) -> Result<(), ContactError> {
+        // No pair: nothing to cut (most substeps of a cloth falling free).
+        if self.found.len() == 0 {
+            return Ok(());
+        }
         let keep = KEEP * f64::from(thickness);
         // Rounds of cuts until none cuts; the cut positions are rounded to `f32`, which
         // can undo a cut's last fraction where the pair has come close (`crumple`-like
@@ -411,18 +415,13 @@ impl SelfContacts {
         // A pass whose cuts move nothing (a particle already held at its start against
         // prescribed motion is cut again to where it is) ends them; its forced pairs are
         // the substep's, counted once however many passes saw them.
-        // No pair: nothing to cut (most substeps of a cloth falling free).
-        if self.found.len() == 0 {
-            return Ok(());
-        }
         let mut round = 0;
         loop {
-            let first = round;
-            let forced =
+            let (forced, cut) =
                 self.cut_rounds(model, [start, &state.pos], keep, &mut round, thickness)?;
             let mut moved = false;
-            // Where the first round cut nothing, every particle keeps its whole motion.
-            if round > first + 1 {
+            // Where no round cut, every particle keeps its whole motion.
+            if cut {
                 let cuts =
                     (self.scale.iter().zip(start)).zip(state.pos.iter_mut().zip(&mut state.vel));
                 for ((&s, from), (pos, vel)) in cuts {
@@ -445,7 +444,8 @@ impl SelfContacts {
 
     /// Rounds of cuts of the motion from `start` to `end`, counted on from `round`, until one
     /// cuts nothing; leaves each particle's share of its motion in `scale`, and returns
-    /// how many pairs were forced (no particle of theirs could be cut).
+    /// how many pairs were forced (no particle of theirs could be cut) and whether any
+    /// round cut (where none did, every share is whole).
     fn cut_rounds(
         &mut self,
         model: &ClothModel,
@@ -453,14 +453,14 @@ impl SelfContacts {
         keep: f64,
         round: &mut usize,
         thickness: f32,
-    ) -> Result<u64, ContactError> {
+    ) -> Result<(u64, bool), ContactError> {
         let n = end.len();
         let pinned_free = |i: usize| model.inv_mass[i] > 0.0;
         self.scale.clear();
         self.scale.resize(n, 1.0);
         self.changed.clear();
         self.changed.resize(n, true);
-        let mut forced_here = 0;
+        let (mut forced_here, first) = (0, *round);
         loop {
             let round_now = *round;
             *round += 1;
@@ -517,7 +517,7 @@ impl SelfContacts {
             forced_here += stuck;
             // Every impact cut something, or was forced.
             if impacted == stuck {
-                return Ok(forced_here);
+                return Ok((forced_here, round_now > first));
             }
             let rounds = (self.changed.iter_mut()).zip(self.scale.iter_mut().zip(&self.cut.0));
             for (changed, (scale, cut)) in rounds {
