@@ -1,11 +1,12 @@
 //! A sphere the cloth cannot enter, still or spinning about its centre.
 
-use glam::{Vec3, Vec3A};
+use glam::Vec3;
 
 use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 #[cfg(doc)]
 use super::faces::FacePatches;
 use super::solid::{Solid, default_friction, resolve};
+use crate::sim::kernels::bounds;
 use crate::sim::obstacle::closest_weights;
 use crate::sim::param_error::ParamError;
 use crate::sim::self_contacts::ContactError;
@@ -194,15 +195,10 @@ impl EffectKind for Sphere {
         // The substep's whole motion lies in a box clear of the sphere (a cloth falling
         // onto it, still above): no path enters it and no triangle reaches it. A margin
         // of a ten-thousandth keeps the paths' rounding out of the question.
-        let (lo, hi) = [pass.start, &pass.state.pos[..]].iter().fold(
-            (Vec3A::INFINITY, Vec3A::NEG_INFINITY),
-            |(lo, hi), x| {
-                (x.iter()).fold((lo, hi), |(lo, hi), &p| {
-                    (lo.min(p.into()), hi.max(p.into()))
-                })
-            },
-        );
-        let (lo, hi) = (Vec3::from(lo), Vec3::from(hi));
+        let (Some(start), Some(end)) = (bounds(pass.start), bounds(&pass.state.pos)) else {
+            return Ok(0);
+        };
+        let (lo, hi) = (start.0.min(end.0), start.1.max(end.1));
         let reach = (self.radius + pass.offset) * 1.0001;
         if self.center.clamp(lo, hi).distance_squared(self.center) > reach * reach {
             return Ok(0);

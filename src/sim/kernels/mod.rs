@@ -5,6 +5,7 @@
 mod components;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
+mod points;
 mod run_pass;
 mod spring_runs;
 mod two_passes;
@@ -16,6 +17,7 @@ pub use crate::cloth::Real;
 pub use components::{
     Blocks, Components, Scratch, blocks_times, join, split, split_blocks, zeroed,
 };
+pub use points::{bounds, less_into};
 pub use run_pass::Projectors;
 pub use spring_runs::SpringRuns;
 pub use two_passes::{BlockPass, TwoPasses};

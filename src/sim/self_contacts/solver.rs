@@ -7,6 +7,7 @@ use glam::{Vec3, Vec3A};
 
 use crate::cloth::{ClothModel, ClothState};
 use crate::parallel::{each_part, within};
+use crate::sim::kernels::less_into;
 
 use super::ccd::safe_fraction;
 use super::certify::Certificates;
@@ -280,12 +281,8 @@ impl SelfContacts {
         self.from.resize(start.len(), Vec3::ZERO);
         self.to.resize(pos.len(), Vec3::ZERO);
         each_part([&mut self.from, &mut self.to], |range, [from, to]| {
-            for (f, &s) in from.iter_mut().zip(within(start, range.clone())) {
-                *f = s - shift;
-            }
-            for (t, &p) in to.iter_mut().zip(within(pos, range)) {
-                *t = p - shift - mean;
-            }
+            less_into(from, within(start, range.clone()), shift, Vec3::ZERO);
+            less_into(to, within(pos, range), shift, mean);
         });
     }
 
