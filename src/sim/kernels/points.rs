@@ -3,32 +3,43 @@
 //! own arithmetic is scalar. Each float goes through the same IEEE operations in the same
 //! order as the `Vec3` arithmetic it replaces, so the results are the same bits.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 /// Floats in a step: four points, the least whole number of points that fills whole
 /// vector lanes.
 const STEP: usize = 12;
 
-/// `a` repeated along a step (x, y, z, x, y, z, …).
-fn repeated(a: Vec3) -> [f32; STEP] {
-    std::array::from_fn(|k| a[k % 3])
+/// The first `n` points of `v` as floats.
+fn floats(v: &[Vec3], n: usize) -> &[f32] {
+    bytemuck::cast_slice(&v[..n])
+}
+
+/// `a` repeated along a step (x, y, z, x, y, z, …), as the step's three lanes.
+fn repeated(a: Vec3) -> [Vec4; 3] {
+    let step: [f32; STEP] = std::array::from_fn(|k| a[k % 3]);
+    [0, 4, 8].map(|k| Vec4::from_slice(&step[k..]))
+}
+
+/// A step of floats as its three lanes.
+fn lanes(x: &[f32]) -> [Vec4; 3] {
+    [0, 4, 8].map(|k| Vec4::from_slice(&x[k..]))
 }
 
 /// Sets `out[i] = x[i] − a − b` (in that order) for each point both have.
 pub fn less_into(out: &mut [Vec3], x: &[Vec3], a: Vec3, b: Vec3) {
     let n = out.len().min(x.len());
     let out: &mut [f32] = bytemuck::cast_slice_mut(&mut out[..n]);
-    let x: &[f32] = bytemuck::cast_slice(&x[..n]);
+    let x = floats(x, n);
     let (a, b) = (repeated(a), repeated(b));
     let (mut outs, mut xs) = (out.chunks_exact_mut(STEP), x.chunks_exact(STEP));
     for (o, x) in (&mut outs).zip(&mut xs) {
-        for k in 0..STEP {
-            o[k] = x[k] - a[k] - b[k];
+        for (k, x) in lanes(x).into_iter().enumerate() {
+            (x - a[k] - b[k]).write_to_slice(&mut o[4 * k..]);
         }
     }
     let rest = outs.into_remainder().iter_mut().zip(xs.remainder());
     for (k, (o, x)) in rest.enumerate() {
-        *o = x - a[k] - b[k];
+        *o = x - a[k / 4][k % 4] - b[k / 4][k % 4];
     }
 }
 
@@ -40,11 +51,14 @@ pub fn bounds(points: &[Vec3]) -> Option<(Vec3, Vec3)> {
     let (mut lo, mut hi) = (repeated(first), repeated(first));
     let mut steps = x.chunks_exact(STEP);
     for x in &mut steps {
-        for k in 0..STEP {
-            lo[k] = if lo[k] < x[k] { lo[k] } else { x[k] };
-            hi[k] = if hi[k] > x[k] { hi[k] } else { x[k] };
+        for (k, x) in lanes(x).into_iter().enumerate() {
+            (lo[k], hi[k]) = (lo[k].min(x), hi[k].max(x));
         }
     }
+    let (mut lo, mut hi): ([f32; STEP], [f32; STEP]) = (
+        std::array::from_fn(|k| lo[k / 4][k % 4]),
+        std::array::from_fn(|k| hi[k / 4][k % 4]),
+    );
     for (k, &x) in steps.remainder().iter().enumerate() {
         lo[k] = lo[k].min(x);
         hi[k] = hi[k].max(x);
@@ -55,6 +69,41 @@ pub fn bounds(points: &[Vec3]) -> Option<(Vec3, Vec3)> {
         }))
     };
     Some((fold(lo, f32::min), fold(hi, f32::max)))
+}
+
+/// Sets `out[i]` to whether the motion from `from[i]` to `to[i]`, grown by `g` along
+/// every axis, leaves the box `lo[i]..hi[i]` (as `Vec3A`'s lane-wise `min`, `max` and
+/// comparisons tell it: a NaN coordinate leaves), for each point all five have.
+pub fn outside(out: &mut [bool], [from, to]: [&[Vec3]; 2], [lo, hi]: [&[Vec3]; 2], g: f32) {
+    let n = (out.len().min(from.len()).min(to.len())).min(lo.len().min(hi.len()));
+    let (s, e, lo, hi) = (floats(from, n), floats(to, n), floats(lo, n), floats(hi, n));
+    let whole = n / 4 * 4;
+    let steps = (out[..whole].chunks_exact_mut(4).zip(s.chunks_exact(STEP))).zip(
+        e.chunks_exact(STEP)
+            .zip(lo.chunks_exact(STEP).zip(hi.chunks_exact(STEP))),
+    );
+    let g4 = Vec4::splat(g);
+    for ((out, s), (e, (lo, hi))) in steps {
+        let [s, e, lo, hi] = [s, e, lo, hi].map(lanes);
+        // Each float's bit: whether its axis keeps within the box.
+        let inside = (0..3).fold(0u32, |bits, k| {
+            let within = (s[k].min(e[k]) - g4).cmpge(lo[k]) & (s[k].max(e[k]) + g4).cmple(hi[k]);
+            bits | within.bitmask() << (4 * k)
+        });
+        for (j, out) in out.iter_mut().enumerate() {
+            *out = ((inside >> (3 * j)) & 7) != 7;
+        }
+    }
+    // One float of a point: whether its axis keeps within the box.
+    let within = |k: usize| {
+        let (a, b) = (s[k], e[k]);
+        let (least, most) = (if a < b { a } else { b }, if a > b { a } else { b });
+        (least - g >= lo[k]) & (most + g <= hi[k])
+    };
+    for (i, out) in out[whole..n].iter_mut().enumerate() {
+        let k = 3 * (whole + i);
+        *out = !(within(k) & within(k + 1) & within(k + 2));
+    }
 }
 
 #[cfg(test)]
@@ -92,6 +141,47 @@ mod tests {
         let (x, mut out) = (points(9), vec![Vec3::ZERO; 6]);
         less_into(&mut out, &x, a, b);
         assert_eq!(out[5], x[5] - a - b);
+    }
+
+    /// Whether a motion grown by `g` leaves a box, as `Vec3A` tells it, for boxes around
+    /// each motion grown by a little more or less than `g` along one axis or another, and
+    /// for NaN coordinates.
+    #[test]
+    fn a_motion_leaves_its_box_where_vec3as_lanes_say_it_does() {
+        use glam::Vec3A;
+        let g = 0.01;
+        let mut rnd = crate::test_rng::uniform(9);
+        for n in [0, 1, 4, 6, 99] {
+            let (from, to) = (points(n), points(n + 3));
+            let mut to: Vec<Vec3> = to[3..].to_vec();
+            if n > 5 {
+                to[5].y = f32::NAN;
+            }
+            // Every third box just holds its motion (to the rounding), every third leaves
+            // room, the others are a little off along random axes.
+            let grown: Vec<[Vec3; 2]> = (from.iter().zip(&to).enumerate())
+                .map(|(i, (&a, &b))| {
+                    let mut wiggle = || Vec3::new(rnd(), rnd(), rnd()) * 0.004 - 0.002;
+                    let room = [Vec3::ZERO, Vec3::splat(0.001), wiggle()][i % 3];
+                    [a.min(b) - g - room, a.max(b) + g + room]
+                })
+                .collect();
+            let (lo, hi): (Vec<Vec3>, Vec<Vec3>) = grown.iter().map(|&[l, h]| (l, h)).unzip();
+            let mut out = vec![false; n];
+            outside(&mut out, [&from, &to], [&lo, &hi], g);
+            let want: Vec<bool> = (0..n)
+                .map(|i| {
+                    let (s, p) = (Vec3A::from(from[i]), Vec3A::from(to[i]));
+                    let (l, h) = (Vec3A::from(lo[i]), Vec3A::from(hi[i]));
+                    !((s.min(p) - g).cmpge(l).all() && (s.max(p) + g).cmple(h).all())
+                })
+                .collect();
+            assert_eq!(out, want, "{n}");
+            if n > 5 {
+                assert!(out[5], "a NaN leaves");
+                assert!(out.iter().any(|&o| !o) && out.iter().filter(|&&o| o).count() > 1);
+            }
+        }
     }
 
     #[test]

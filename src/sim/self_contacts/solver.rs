@@ -7,7 +7,7 @@ use glam::{Vec3, Vec3A};
 
 use crate::cloth::{ClothModel, ClothState};
 use crate::parallel::{each_part, within};
-use crate::sim::kernels::less_into;
+use crate::sim::kernels::{less_into, outside};
 
 use super::ccd::safe_fraction;
 use super::certify::Certificates;
@@ -361,9 +361,14 @@ impl SelfContacts {
                 );
                 let n = (left.len().min(from.len()).min(to.len())).min(lo.len().min(hi.len()));
                 let (from, to, lo, hi) = (&from[..n], &to[..n], &lo[..n], &hi[..n]);
-                let paths = [&boxes.from, &boxes.to].map(|v| part(v));
-                for (i, l) in left[..n].iter_mut().enumerate() {
-                    *l = has_left((from[i], to[i]), (lo[i], hi[i]), path_at(paths, i));
+                // The boxes four particles at a time (as `has_left` tells them), then the
+                // paths of those still in theirs.
+                outside(&mut left[..n], [from, to], [lo, hi], g.x);
+                if swept {
+                    let paths = [&boxes.from, &boxes.to].map(|v| part(v));
+                    for (i, l) in left[..n].iter_mut().enumerate().filter(|(_, l)| !**l) {
+                        *l = path_at(paths, i).is_none_or(|path| strayed((from[i], to[i]), path));
+                    }
                 }
             });
         } else {
