@@ -1,7 +1,7 @@
 //! Loops over arrays of points (`Vec3`, three floats each) read as plain floats, twelve
-//! (four points) at a time, so that the compiler runs them in vector lanes: a `Vec3`'s
-//! own arithmetic is scalar. Each float goes through the same IEEE operations in the same
-//! order as the `Vec3` arithmetic it replaces, so the results are the same bits.
+//! (four points) at a time in three SSE lanes (glam's `Vec4`): a `Vec3`'s own arithmetic
+//! is scalar. Each float goes through the same IEEE operations in the same order as the
+//! `Vec3` (or `Vec3A`) arithmetic it replaces, so the results are the same bits.
 
 use glam::{Vec3, Vec4};
 
