@@ -6,7 +6,7 @@ use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 #[cfg(doc)]
 use super::faces::FacePatches;
 use super::solid::{Solid, default_friction, resolve};
-use crate::sim::kernels::bounds;
+use crate::mesh::bounds;
 use crate::sim::obstacle::closest_weights;
 use crate::sim::param_error::ParamError;
 use crate::sim::self_contacts::ContactError;
@@ -195,9 +195,7 @@ impl EffectKind for Sphere {
         // The substep's whole motion lies in a box clear of the sphere (a cloth falling
         // onto it, still above): no path enters it and no triangle reaches it. A margin
         // of a ten-thousandth keeps the paths' rounding out of the question.
-        let (Some(start), Some(end)) = (bounds(pass.start), bounds(&pass.state.pos)) else {
-            return Ok(0);
-        };
+        let (start, end) = (bounds(pass.start), bounds(&pass.state.pos));
         let (lo, hi) = (start.0.min(end.0), start.1.max(end.1));
         let reach = (self.radius + pass.offset) * 1.0001;
         if self.center.clamp(lo, hi).distance_squared(self.center) > reach * reach {

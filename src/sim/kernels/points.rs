@@ -3,7 +3,7 @@
 //! is scalar. Each float goes through the same IEEE operations in the same order as the
 //! `Vec3` (or `Vec3A`) arithmetic it replaces, so the results are the same bits.
 
-use glam::{Vec3, Vec4};
+use glam::{Vec3, Vec3A, Vec4};
 
 /// Floats in a step: four points, the least whole number of points that fills whole
 /// vector lanes.
@@ -43,38 +43,11 @@ pub fn less_into(out: &mut [Vec3], x: &[Vec3], a: Vec3, b: Vec3) {
     }
 }
 
-/// The box of `points` (its least and greatest coordinates), or `None` for no point.
-/// Where a coordinate is NaN the box is not a box (as with any order of comparisons).
-pub fn bounds(points: &[Vec3]) -> Option<(Vec3, Vec3)> {
-    let first = *points.first()?;
-    let x: &[f32] = bytemuck::cast_slice(points);
-    let (mut lo, mut hi) = (repeated(first), repeated(first));
-    let mut steps = x.chunks_exact(STEP);
-    for x in &mut steps {
-        for (k, x) in lanes(x).into_iter().enumerate() {
-            (lo[k], hi[k]) = (lo[k].min(x), hi[k].max(x));
-        }
-    }
-    let (mut lo, mut hi): ([f32; STEP], [f32; STEP]) = (
-        std::array::from_fn(|k| lo[k / 4][k % 4]),
-        std::array::from_fn(|k| hi[k / 4][k % 4]),
-    );
-    for (k, &x) in steps.remainder().iter().enumerate() {
-        lo[k] = lo[k].min(x);
-        hi[k] = hi[k].max(x);
-    }
-    let fold = |v: [f32; STEP], pick: fn(f32, f32) -> f32| {
-        Vec3::from_array(std::array::from_fn(|axis| {
-            (axis..STEP).step_by(3).map(|k| v[k]).fold(v[axis], pick)
-        }))
-    };
-    Some((fold(lo, f32::min), fold(hi, f32::max)))
-}
-
 /// Sets `out[i]` to whether the motion from `from[i]` to `to[i]`, grown by `g` along
-/// every axis, leaves the box `lo[i]..hi[i]` (as `Vec3A`'s lane-wise `min`, `max` and
-/// comparisons tell it: a NaN coordinate leaves), for each point all five have.
-pub fn outside(out: &mut [bool], [from, to]: [&[Vec3]; 2], [lo, hi]: [&[Vec3]; 2], g: f32) {
+/// every axis, leaves the box `boxes[0][i]..boxes[1][i]`, as [`leaves`] tells it, for each
+/// point all five have.
+pub fn outside(out: &mut [bool], [from, to]: [&[Vec3]; 2], boxes: [&[Vec3]; 2], g: f32) {
+    let [lo, hi] = boxes;
     let n = (out.len().min(from.len()).min(to.len())).min(lo.len().min(hi.len()));
     let (s, e, lo, hi) = (floats(from, n), floats(to, n), floats(lo, n), floats(hi, n));
     let whole = n / 4 * 4;
@@ -94,16 +67,18 @@ pub fn outside(out: &mut [bool], [from, to]: [&[Vec3]; 2], [lo, hi]: [&[Vec3]; 2
             *out = ((inside >> (3 * j)) & 7) != 7;
         }
     }
-    // One float of a point: whether its axis keeps within the box.
-    let within = |k: usize| {
-        let (a, b) = (s[k], e[k]);
-        let (least, most) = (if a < b { a } else { b }, if a > b { a } else { b });
-        (least - g >= lo[k]) & (most + g <= hi[k])
-    };
-    for (i, out) in out[whole..n].iter_mut().enumerate() {
-        let k = 3 * (whole + i);
-        *out = !(within(k) & within(k + 1) & within(k + 2));
+    for i in whole..n {
+        out[i] = leaves(from[i], to[i], [boxes[0][i], boxes[1][i]], g);
     }
+}
+
+/// Whether the motion from `from` to `to`, grown by `g` along every axis, leaves the box
+/// `lo..hi` (told lane-wise in `Vec3A`: a NaN coordinate leaves); [`outside`] tells four
+/// at a time what this tells of one.
+#[inline]
+pub fn leaves(from: Vec3, to: Vec3, [lo, hi]: [Vec3; 2], g: f32) -> bool {
+    let (s, p) = (Vec3A::from(from), Vec3A::from(to));
+    !((s.min(p) - g).cmpge(lo.into()).all() && (s.max(p) + g).cmple(hi.into()).all())
 }
 
 #[cfg(test)]
@@ -181,17 +156,6 @@ mod tests {
                 assert!(out[5], "a NaN leaves");
                 assert!(out.iter().any(|&o| !o) && out.iter().filter(|&&o| o).count() > 1);
             }
-        }
-    }
-
-    #[test]
-    fn the_bounds_are_the_least_and_greatest_coordinates() {
-        assert_eq!(bounds(&[]), None);
-        for n in [1, 2, 4, 5, 13, 4225] {
-            let x = points(n);
-            let lo = x.iter().fold(Vec3::INFINITY, |lo, &p| lo.min(p));
-            let hi = x.iter().fold(Vec3::NEG_INFINITY, |hi, &p| hi.max(p));
-            assert_eq!(bounds(&x), Some((lo, hi)), "{n}");
         }
     }
 }

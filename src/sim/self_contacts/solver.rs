@@ -3,11 +3,11 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use glam::{Vec3, Vec3A};
+use glam::Vec3;
 
 use crate::cloth::{ClothModel, ClothState};
 use crate::parallel::{each_part, within};
-use crate::sim::kernels::{less_into, outside};
+use crate::sim::kernels::{leaves, less_into, outside};
 
 use super::ccd::safe_fraction;
 use super::certify::Certificates;
@@ -315,7 +315,7 @@ impl SelfContacts {
             self.unchecked.clear();
             return self.find_pairs(model, thickness);
         }
-        let g = Vec3A::splat(0.5 * if swept { within } else { thickness });
+        let g = 0.5 * if swept { within } else { thickness };
         // Pairs judged by the motion hold while each particle starts and ends within the
         // allowance and half of what `within` leaves of the thickness of where its path in
         // the window puts it (see `Window`): a pair kept apart by the thickness and twice
@@ -338,10 +338,7 @@ impl SelfContacts {
         };
         // A particle without a path (none can be: the search sets them all) has left.
         let has_left = |(s, p): (Vec3, Vec3), (lo, hi): (Vec3, Vec3), path: Option<_>| {
-            let (s32, p32, lo, hi) = (s.into(), p.into(), Vec3A::from(lo), Vec3A::from(hi));
-            !((Vec3A::min(s32, p32) - g).cmpge(lo).all()
-                && (Vec3A::max(s32, p32) + g).cmple(hi).all())
-                || swept && path.is_none_or(|path| strayed((s, p), path))
+            leaves(s, p, [lo, hi], g) || swept && path.is_none_or(|path| strayed((s, p), path))
         };
         // Particle `i`'s path in the window, from the paths' starts and ends (read only
         // where the pairs are judged by the motion: `has_left` asks for it only then).
@@ -363,7 +360,7 @@ impl SelfContacts {
                 let (from, to, lo, hi) = (&from[..n], &to[..n], &lo[..n], &hi[..n]);
                 // The boxes four particles at a time (as `has_left` tells them), then the
                 // paths of those still in theirs.
-                outside(&mut left[..n], [from, to], [lo, hi], g.x);
+                outside(&mut left[..n], [from, to], [lo, hi], g);
                 if swept {
                     let paths = [&boxes.from, &boxes.to].map(|v| part(v));
                     for (i, l) in left[..n].iter_mut().enumerate().filter(|(_, l)| !**l) {
