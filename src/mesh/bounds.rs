@@ -13,13 +13,9 @@ pub fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
     }
     let x: &[f32] = bytemuck::cast_slice(points);
     let (mut lo, mut hi) = ([Vec4::splat(f32::MAX); 3], [Vec4::splat(f32::MIN); 3]);
-    let mut steps = x.chunks_exact(12);
-    for step in &mut steps {
-        let (a, b, c) = (
-            Vec4::from_slice(&step[..4]),
-            Vec4::from_slice(&step[4..8]),
-            Vec4::from_slice(&step[8..]),
-        );
+    let (steps, rest) = x.as_chunks::<12>();
+    for step in steps {
+        let [a, b, c] = bytemuck::cast::<_, [[f32; 4]; 3]>(*step).map(Vec4::from);
         // `a.min(lo)` is `a < lo ? a : lo`: a NaN in `a` leaves `lo` (never NaN).
         lo = [a.min(lo[0]), b.min(lo[1]), c.min(lo[2])];
         hi = [a.max(hi[0]), b.max(hi[1]), c.max(hi[2])];
@@ -30,7 +26,7 @@ pub fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
         least[k % 3] = least[k % 3].min(lane(&lo, k));
         most[k % 3] = most[k % 3].max(lane(&hi, k));
     }
-    for (k, &x) in steps.remainder().iter().enumerate() {
+    for (k, &x) in rest.iter().enumerate() {
         least[k % 3] = least[k % 3].min(x);
         most[k % 3] = most[k % 3].max(x);
     }

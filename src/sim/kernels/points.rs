@@ -16,13 +16,12 @@ fn floats(v: &[Vec3], n: usize) -> &[f32] {
 
 /// `a` repeated along a step (x, y, z, x, y, z, …), as the step's three lanes.
 fn repeated(a: Vec3) -> [Vec4; 3] {
-    let step: [f32; STEP] = std::array::from_fn(|k| a[k % 3]);
-    [0, 4, 8].map(|k| Vec4::from_slice(&step[k..]))
+    lanes(&std::array::from_fn(|k| a[k % 3]))
 }
 
-/// A step of floats as its three lanes.
-fn lanes(x: &[f32]) -> [Vec4; 3] {
-    [0, 4, 8].map(|k| Vec4::from_slice(&x[k..]))
+/// A step of floats as its three lanes (each one unaligned load).
+fn lanes(x: &[f32; STEP]) -> [Vec4; 3] {
+    bytemuck::cast::<_, [[f32; 4]; 3]>(*x).map(Vec4::from)
 }
 
 /// Sets `out[i] = x[i] − a − b` (in that order) for each point both have.
@@ -31,14 +30,13 @@ pub fn less_into(out: &mut [Vec3], x: &[Vec3], a: Vec3, b: Vec3) {
     let out: &mut [f32] = bytemuck::cast_slice_mut(&mut out[..n]);
     let x = floats(x, n);
     let (a, b) = (repeated(a), repeated(b));
-    let (mut outs, mut xs) = (out.chunks_exact_mut(STEP), x.chunks_exact(STEP));
-    for (o, x) in (&mut outs).zip(&mut xs) {
+    let ((outs, out_rest), (xs, x_rest)) = (out.as_chunks_mut::<STEP>(), x.as_chunks::<STEP>());
+    for (o, x) in outs.iter_mut().zip(xs) {
         for (k, x) in lanes(x).into_iter().enumerate() {
             (x - a[k] - b[k]).write_to_slice(&mut o[4 * k..]);
         }
     }
-    let rest = outs.into_remainder().iter_mut().zip(xs.remainder());
-    for (k, (o, x)) in rest.enumerate() {
+    for (k, (o, x)) in out_rest.iter_mut().zip(x_rest).enumerate() {
         *o = x - a[k / 4][k % 4] - b[k / 4][k % 4];
     }
 }
@@ -51,13 +49,11 @@ pub fn outside(out: &mut [bool], [from, to]: [&[Vec3]; 2], boxes: [&[Vec3]; 2], 
     let n = (out.len().min(from.len()).min(to.len())).min(lo.len().min(hi.len()));
     let (s, e, lo, hi) = (floats(from, n), floats(to, n), floats(lo, n), floats(hi, n));
     let whole = n / 4 * 4;
-    let steps = (out[..whole].chunks_exact_mut(4).zip(s.chunks_exact(STEP))).zip(
-        e.chunks_exact(STEP)
-            .zip(lo.chunks_exact(STEP).zip(hi.chunks_exact(STEP))),
-    );
+    let [s, e, lo, hi] = [s, e, lo, hi].map(|x| x.as_chunks::<STEP>().0);
+    let steps = (out[..whole].chunks_exact_mut(4).zip(s)).zip(e.iter().zip(lo.iter().zip(hi)));
     let g4 = Vec4::splat(g);
     for ((out, s), (e, (lo, hi))) in steps {
-        let [s, e, lo, hi] = [s, e, lo, hi].map(lanes);
+        let [s, e, lo, hi] = [lanes(s), lanes(e), lanes(lo), lanes(hi)];
         // Each float's bit: whether its axis keeps within the box.
         let inside = (0..3).fold(0u32, |bits, k| {
             let within = (s[k].min(e[k]) - g4).cmpge(lo[k]) & (s[k].max(e[k]) + g4).cmple(hi[k]);
