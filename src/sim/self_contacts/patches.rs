@@ -173,7 +173,7 @@ impl Patches {
         &self,
         tree: &mut TriangleTree,
         triangles: &[[u32; 3]],
-        [from, to]: [&[Vec3]; 2],
+        [from, to]: [&[Vec3A]; 2],
         reach: f32,
         backoff: &mut Vec<u8>,
     ) {
@@ -238,7 +238,7 @@ impl Patches {
         &self,
         i: usize,
         patch: Option<Triangles<'_>>,
-        motion: [&[Vec3]; 2],
+        motion: [&[Vec3A]; 2],
         least: f32,
     ) -> bool {
         let range = self.start[i] as usize..self.start[i + 1] as usize;
@@ -252,7 +252,7 @@ impl Patches {
         &self,
         c: usize,
         (triangles, around): Triangles<'_>,
-        motion: [&[Vec3]; 2],
+        motion: [&[Vec3A]; 2],
         reach: f32,
     ) -> bool {
         let range = self.rings[c] as usize..self.rings[c + 1] as usize;
@@ -274,7 +274,7 @@ impl Patches {
         range: std::ops::Range<usize>,
         [xx, xy, yy]: [f32; 3],
         patch: Option<Triangles<'_>>,
-        [from, to]: [&[Vec3]; 2],
+        [from, to]: [&[Vec3A]; 2],
         least: f32,
     ) -> bool {
         if range.is_empty() {
@@ -284,7 +284,7 @@ impl Patches {
         let n = particle.len() as f32;
         // In SSE lanes (`Vec3A`): the same operations in the same order as with `Vec3`,
         // so the same results, in fewer instructions.
-        let at = |x: &[Vec3], j: u32| Vec3A::from(x[j as usize]);
+        let at = |x: &[Vec3A], j: u32| x[j as usize];
         // The middles of the starts and of the ends, and the maps fitted to each: their
         // columns are sums over the particles weighed by the inverse second moments.
         let (mut first, mut last) = (Vec3A::ZERO, Vec3A::ZERO);

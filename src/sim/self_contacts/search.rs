@@ -2,7 +2,7 @@
 //! the boxes, and the test that keeps a vertex–triangle or edge–edge pair of two triangles
 //! whose boxes overlap.
 
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec3, Vec3A};
 use rustc_hash::FxHashMap;
 
 use super::ccd::closing_bound;
@@ -233,6 +233,48 @@ pub(super) struct Boxes {
     pub(super) swept: bool,
     pub(super) from: Vec<Vec3>,
     pub(super) to: Vec<Vec3>,
+    /// `from` and `to` again, in SSE lanes (`Vec3A`): the patches' and the tree's fits read
+    /// each particle's motion many times a search, and a `Vec3` is three loads and a
+    /// shuffle to get into lanes (kept with [`Boxes::set_motion`] and [`Boxes::set_path`]).
+    lanes: [Vec<Vec3A>; 2],
+}
+
+impl Boxes {
+    /// Sets each particle's motion to run from `from` to `to`, carried on `len` times as
+    /// far from its start.
+    pub(super) fn set_motion(&mut self, from: &[Vec3], to: &[Vec3], len: u32) {
+        self.from.clear();
+        self.from.extend_from_slice(from);
+        self.to.clear();
+        self.to.extend_from_slice(to);
+        if len > 1 {
+            let len = len as f32;
+            for (to, &s) in self.to.iter_mut().zip(from) {
+                *to = s + (*to - s) * len;
+            }
+        }
+        for (lanes, x) in self.lanes.iter_mut().zip([&self.from, &self.to]) {
+            lanes.clear();
+            lanes.extend(x.iter().map(|&p| Vec3A::from(p)));
+        }
+    }
+
+    /// Sets particle `i`'s motion to run from `s` to `p`.
+    pub(super) fn set_path(&mut self, i: usize, s: Vec3, p: Vec3) {
+        (self.from[i], self.to[i]) = (s, p);
+        (self.lanes[0][i], self.lanes[1][i]) = (s.into(), p.into());
+    }
+
+    /// Each particle's motion, from its start to its end, in SSE lanes.
+    pub(super) fn motion(&self) -> [&[Vec3A]; 2] {
+        [&self.lanes[0], &self.lanes[1]]
+    }
+}
+
+/// Points in SSE lanes, as the patches' and the tree's fits read a motion.
+#[cfg(test)]
+pub(super) fn in_lanes(x: &[Vec3]) -> Vec<Vec3A> {
+    x.iter().map(|&p| p.into()).collect()
 }
 
 /// What a search for pairs reads.

@@ -70,7 +70,7 @@ pub struct SelfContacts {
     /// The tree's patches certified apart by the rest shape.
     patches: Patches,
     /// Each particle's box's middle, where the patches are certified for the boxes.
-    middles: Vec<Vec3>,
+    middles: Vec<glam::Vec3A>,
     /// How many searches each node's certificate is left out of (see [`Patches::decide`]).
     backoff: Vec<u8>,
     owners: Owners,

@@ -290,7 +290,7 @@ impl TriangleTree {
     /// Fits the tree to the motion of its triangles' particles from `from` to `to`, told
     /// apart by `reach` (see [`Fit::Motion`]). Returns the widest any triangle's particles
     /// span along an axis over the motion.
-    pub(super) fn fit_motion(&mut self, [from, to]: [&[Vec3]; 2], reach: f32) -> f32 {
+    pub(super) fn fit_motion(&mut self, [from, to]: [&[Vec3A]; 2], reach: f32) -> f32 {
         let widest = self.fit_all(true, &|lanes, lane, _, corners| {
             set_motion(lanes, lane, One::of(corners, [from, to]))
         });
@@ -305,7 +305,7 @@ impl TriangleTree {
     pub(super) fn refit_motion(
         &mut self,
         changed: &[u32],
-        [from, to]: [&[Vec3]; 2],
+        [from, to]: [&[Vec3A]; 2],
         reach: f32,
     ) -> f32 {
         if self.fit != (Fit::Motion { reach }) || self.motion.len() != self.nodes.len() {

@@ -139,16 +139,16 @@ impl Flat {
         &self,
         tris: &[u32],
         triangles: &[[u32; 3]],
-        [from, to]: [&[Vec3]; 2],
+        [from, to]: [&[Vec3A]; 2],
         maps: [[Vec3A; 2]; 2],
         room: f32,
     ) -> bool {
         let limit = room * room;
-        let at = |x: &[Vec3], j: u32| Vec3A::from(x[j as usize]);
+        let at = |x: &[Vec3A], j: u32| x[j as usize];
         tris.iter().all(|&t| {
             let [a, b, c] = triangles[t as usize];
             let s = self.slopes[t as usize];
-            let strays = |x: &[Vec3], [p, q]: [Vec3A; 2]| {
+            let strays = |x: &[Vec3A], [p, q]: [Vec3A; 2]| {
                 let (e1, e2) = (at(x, b) - at(x, a), at(x, c) - at(x, a));
                 let (u, v) = (e1 * s[0] + e2 * s[2], e1 * s[1] + e2 * s[3]);
                 (u - p).length_squared() + (v - q).length_squared()

@@ -9,6 +9,7 @@ use crate::cloth::ClothModel;
 use crate::mesh::{GridOrientation, GridSpec};
 use crate::sim::self_contacts::certify::Certificates;
 use crate::sim::self_contacts::primitives::distance;
+use crate::sim::self_contacts::search::in_lanes;
 
 const REACH: f32 = 0.004;
 
@@ -107,8 +108,10 @@ fn closest_within(triangles: &[[u32; 3]], held: &[u32], [from, to]: [&[Vec3]; 2]
 /// covered pair, and the corners whose ring holds.
 fn decide_and_check(c: &mut Cloth, motion: [&[Vec3]; 2], what: &str) -> (usize, f64, usize) {
     let triangles = &c.model.triangles;
+    let lanes = motion.map(in_lanes);
+    let lanes = [&lanes[0][..], &lanes[1][..]];
     c.patches
-        .decide(&mut c.tree, triangles, motion, REACH, &mut Vec::new());
+        .decide(&mut c.tree, triangles, lanes, REACH, &mut Vec::new());
     let (mut covered, mut least) = (0, f64::INFINITY);
     for (i, _) in c.tree.nodes().iter().enumerate() {
         let parent = c.patches.parent[i] as usize;
@@ -129,7 +132,7 @@ fn decide_and_check(c: &mut Cloth, motion: [&[Vec3]; 2], what: &str) -> (usize, 
         let ring = &around[start[corner] as usize..start[corner + 1] as usize];
         let held = c
             .patches
-            .ring_holds(corner, (triangles, ring), motion, REACH);
+            .ring_holds(corner, (triangles, ring), lanes, REACH);
         if c.patches.covers(&c.tree, corner) || held {
             let near = closest_within(triangles, ring, motion);
             assert!(
@@ -297,6 +300,7 @@ fn a_node_that_failed_is_tried_again_after_a_few_searches() {
         })
         .collect();
     let mut covered = |motion: &[Vec3], backoff: &mut Vec<u8>| {
+        let motion = &in_lanes(motion)[..];
         c.patches.decide(
             &mut c.tree,
             &c.model.triangles,

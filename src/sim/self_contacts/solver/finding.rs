@@ -2,7 +2,7 @@
 //! (fitted to the boxes or to the motion, with the patches and the corners decided for
 //! it), and the refresh of the triangles whose particles left their boxes.
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 use super::*;
 
@@ -52,7 +52,10 @@ impl SelfContacts {
         refreshed: bool,
     ) {
         if self.boxes.swept {
-            let motion = [&self.boxes.from[..], &self.boxes.to[..]];
+            let (motion, lanes) = (
+                [&self.boxes.from[..], &self.boxes.to[..]],
+                self.boxes.motion(),
+            );
             // Closed as they are: in a whole search the corners the patches cover (a
             // refresh decides those whose motion changed, covered or not), and those whose
             // reference fails but whose ring keeps near its rest shape.
@@ -61,7 +64,7 @@ impl SelfContacts {
             let covered = |c: usize| !refreshed && patches.covers(tree, c);
             let rings = &self.owners.rings;
             let near_rest =
-                |c: usize| patches.ring_holds(c, (triangles, rings.triangles_of(c)), motion, reach);
+                |c: usize| patches.ring_holds(c, (triangles, rings.triangles_of(c)), lanes, reach);
             let settled: [&(dyn Fn(usize) -> bool + Sync); 2] = [&covered, &near_rest];
             let certificates = &mut self.certificates;
             self.work.retaken +=
@@ -186,7 +189,7 @@ impl SelfContacts {
                         s + v * (window.len - window.at) as f32,
                     );
                 }
-                (self.boxes.from[i], self.boxes.to[i]) = (s, p);
+                self.boxes.set_path(i, s, p);
             }
             let ahead = ahead(look, s, p, thickness);
             (self.boxes.vertex_lo[i], self.boxes.vertex_hi[i]) = Self::vertex_box(s, ahead, grow);
@@ -260,8 +263,11 @@ impl SelfContacts {
         let half = Vec3::splat(0.5 * thickness);
         let (lo, hi) = (&self.boxes.vertex_lo, &self.boxes.vertex_hi);
         self.middles.clear();
-        self.middles
-            .extend(lo.iter().zip(hi).map(|(&lo, &hi)| 0.5 * (lo + hi)));
+        self.middles.extend(
+            lo.iter()
+                .zip(hi)
+                .map(|(&lo, &hi)| Vec3A::from(0.5 * (lo + hi))),
+        );
         let widest = (lo.iter().zip(hi))
             .map(|(&lo, &hi)| (0.5 * (hi - lo) - half).max(Vec3::ZERO).length_squared())
             .fold(0.0f32, f32::max)
@@ -294,8 +300,7 @@ impl SelfContacts {
     ) -> Result<(), ContactError> {
         let changed = &self.searched[..];
         if self.boxes.swept {
-            let motion = [&self.boxes.from[..], &self.boxes.to[..]];
-            let reach = self.reach(thickness);
+            let (motion, reach) = (self.boxes.motion(), self.reach(thickness));
             let widest = if refreshed {
                 self.tree.refit_motion(changed, motion, reach)
             } else {
@@ -339,14 +344,7 @@ impl SelfContacts {
         self.window = self.window.next(slow, self.boxes.swept);
         self.boxes.swept = !slow;
         if self.boxes.swept {
-            self.boxes.from.clone_from(&self.from);
-            self.boxes.to.clone_from(&self.to);
-            if self.window.len > 1 {
-                let len = self.window.len as f32;
-                for (to, &s) in self.boxes.to.iter_mut().zip(&self.from) {
-                    *to = s + (*to - s) * len;
-                }
-            }
+            (self.boxes).set_motion(&self.from, &self.to, self.window.len);
         }
         let (grow, swept, look) = (self.grow(thickness), self.boxes.swept, self.look_ahead());
         let (from, to) = if swept {
@@ -386,10 +384,7 @@ impl SelfContacts {
         self.fit_tree(model, thickness, false)?;
         self.found.clear();
         if self.boxes.swept {
-            let (motion, reach) = (
-                [&self.boxes.from[..], &self.boxes.to[..]],
-                self.reach(thickness),
-            );
+            let (motion, reach) = (self.boxes.motion(), self.reach(thickness));
             (self.patches).decide(
                 &mut self.tree,
                 &model.triangles,

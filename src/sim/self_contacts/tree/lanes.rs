@@ -2,7 +2,7 @@
 //! that one triangle is told apart from a whole leaf's at once (four lanes: one SSE
 //! register an axis), where two leaves are tested triangle by triangle.
 
-use glam::{BVec4A, Vec3, Vec3A, Vec4};
+use glam::{BVec4A, Vec3A, Vec4};
 
 // A leaf's triangles fill one vector of four lanes.
 const _: () = assert!(super::LEAF == 4);
@@ -19,9 +19,9 @@ pub(super) struct One {
 
 impl One {
     /// The boxes by motion of a triangle with `corners`, moving from `from` to `to`.
-    pub(super) fn of(corners: [u32; 3], [from, to]: [&[Vec3]; 2]) -> One {
-        let [a, b, c] = corners.map(|k| Vec3A::from(from[k as usize]));
-        let [d, e, f] = corners.map(|k| Vec3A::from(to[k as usize]));
+    pub(super) fn of(corners: [u32; 3], [from, to]: [&[Vec3A]; 2]) -> One {
+        let [a, b, c] = corners.map(|k| from[k as usize]);
+        let [d, e, f] = corners.map(|k| to[k as usize]);
         One {
             lo: a.min(b).min(c),
             hi: a.max(b).max(c),
@@ -188,6 +188,8 @@ fn share_none_plainly(corners: [u32; 3], lanes: &Corners) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sim::self_contacts::search::in_lanes;
+    use glam::Vec3;
 
     /// Two leaves of four triangles each, moving 2–20 cm toward, past or along each other
     /// (each triangle a few cm wide and 1–10 cm from the other leaf): the pairs their rows
@@ -209,7 +211,7 @@ mod tests {
                 let mut lanes = Lanes::default();
                 for lane in 0..4 {
                     let corners = [0, 1, 2].map(|c| (3 * lane + c) as u32);
-                    lanes.set(lane, One::of(corners, [&from, &to]));
+                    lanes.set(lane, One::of(corners, [&in_lanes(&from), &in_lanes(&to)]));
                 }
                 (lanes, from, to)
             };
@@ -268,6 +270,7 @@ mod tests {
         let lanes = |from: [Vec3; 3], to: [Vec3; 3]| {
             let mut lanes = Lanes::default();
             let ends: Vec<Vec3> = from.into_iter().chain(to).collect();
+            let ends = in_lanes(&ends);
             lanes.set(0, One::of([0, 1, 2], [&ends[..3], &ends[3..]]));
             lanes
         };

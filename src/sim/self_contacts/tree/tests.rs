@@ -9,6 +9,7 @@ use glam::{DVec3, Quat, Vec3};
 use super::*;
 use crate::mesh::{GridOrientation, GridSpec};
 use crate::sim::self_contacts::primitives::{Pair, distance};
+use crate::sim::self_contacts::search::in_lanes;
 
 /// A 15 × 15-quad cloth 1 m wide (450 triangles: several pieces of a walk, and leaves of
 /// three triangles as well as of four), its particles jittered by up to 2 cm about the
@@ -170,7 +171,7 @@ fn a_walk_by_the_motion_passes_by_nothing_that_comes_within_reach() {
         })
         .collect();
     let reach = 0.01;
-    tree.fit_motion([&from, &to], reach);
+    tree.fit_motion([&in_lanes(&from), &in_lanes(&to)], reach);
     poison_empty_lanes(&mut tree);
     let (found, twice) = walked(&tree);
     assert!(!twice, "a pair found twice");
@@ -218,7 +219,7 @@ fn a_search_of_some_triangles_finds_what_the_whole_walk_finds_of_theirs() {
     let marked = |p: &(u32, u32)| dirty[p.0 as usize] || dirty[p.1 as usize];
     for motion in [None, Some(&falling), Some(&sheared)] {
         if let Some(to) = motion {
-            tree.fit_motion([&from, to], 0.01);
+            tree.fit_motion([&in_lanes(&from), &in_lanes(to)], 0.01);
         } else {
             let (lo, hi): (Vec<Vec3>, Vec<Vec3>) = (triangles.iter())
                 .map(|t| {
@@ -328,18 +329,18 @@ fn fitting_the_moved_triangles_again_leaves_the_tree_as_a_whole_fit_does() {
     // By the motion: first rest → pos, then rest → lifted for the moved triangles.
     let reach = 0.01;
     let mut tree = whole(&|t| {
-        t.fit_motion([&rest, &pos], reach);
+        t.fit_motion([&in_lanes(&rest), &in_lanes(&pos)], reach);
     });
-    let widest = tree.refit_motion(&changed, [&rest, &lifted], reach);
+    let widest = tree.refit_motion(&changed, [&in_lanes(&rest), &in_lanes(&lifted)], reach);
     let mut fresh = whole(&|t| {
-        t.fit_motion([&rest, &lifted], reach);
+        t.fit_motion([&in_lanes(&rest), &in_lanes(&lifted)], reach);
     });
     same(&tree, &fresh, true);
     // The moved triangles are the widest over the motion: 5 cm up and more.
     assert!(widest > 0.05, "{widest}");
     // Fitted by boxes last, a fit by the motion of some triangles fits them all.
     fresh.fit_boxes(&lo, &hi);
-    fresh.refit_motion(&changed, [&rest, &lifted], reach);
+    fresh.refit_motion(&changed, [&in_lanes(&rest), &in_lanes(&lifted)], reach);
     same(&fresh, &tree, true);
 }
 
@@ -370,7 +371,7 @@ fn a_fit_by_the_motion_tells_the_widest_triangle_wherever_it_lies() {
         let flung = triangles[tree.order[place] as usize][0] as usize;
         let mut to = pos.clone();
         to[flung] += Vec3::new(3.0, 0.0, 0.0);
-        let told = tree.fit_motion([&rest, &to], 0.01);
+        let told = tree.fit_motion([&in_lanes(&rest), &in_lanes(&to)], 0.01);
         assert!(told >= 3.0, "place {place}: {told}");
         assert_eq!(told, widest(&to), "place {place}");
     }
