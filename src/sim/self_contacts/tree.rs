@@ -217,7 +217,7 @@ impl TriangleTree {
     /// triangles, and fits every node's boxes around its parts', subtree by subtree
     /// (shared with the team for a large cloth), then the nodes above them. Returns the
     /// largest `set` returned.
-    fn fit_all(&mut self, moving: bool, set: &SetLane<'_>) -> f32 {
+    fn fit_all(&mut self, moving: bool, set: impl SetLane) -> f32 {
         self.size();
         // The largest as bits: non-negative floats order as their bits do.
         let largest = AtomicU32::new(0);
@@ -267,7 +267,7 @@ impl TriangleTree {
 
     /// Fits the tree to the triangles' boxes `lo..hi`.
     pub(super) fn fit_boxes(&mut self, lo: &[Vec3], hi: &[Vec3]) {
-        self.fit_all(false, &|lanes, lane, t, _| {
+        self.fit_all(false, |lanes, lane, t, _| {
             lanes.set_box(lane, [lo[t].into(), hi[t].into()]);
             0.0
         });
@@ -291,7 +291,7 @@ impl TriangleTree {
     /// apart by `reach` (see [`Fit::Motion`]). Returns the widest any triangle's particles
     /// span along an axis over the motion.
     pub(super) fn fit_motion(&mut self, [from, to]: [&[Vec3A]; 2], reach: f32) -> f32 {
-        let widest = self.fit_all(true, &|lanes, lane, _, corners| {
+        let widest = self.fit_all(true, |lanes, lane, _, corners| {
             set_motion(lanes, lane, One::of(corners, [from, to]))
         });
         self.fit = Fit::Motion { reach };
@@ -586,7 +586,11 @@ fn lanes_of(node: Split) -> u32 {
 
 /// Sets lane `lane` of a leaf's lanes to triangle `t`'s boxes (its corners given); returns
 /// what the fit keeps the largest of (the widest triangle by motion).
-type SetLane<'a> = dyn Fn(&mut Lanes, usize, usize, [u32; 3]) -> f32 + Sync + 'a;
+/// (A trait of its own rather than a `dyn Fn`: each fit is compiled with its own, inlined
+/// into the loop over the leaves.)
+trait SetLane: Fn(&mut Lanes, usize, usize, [u32; 3]) -> f32 + Sync {}
+
+impl<F: Fn(&mut Lanes, usize, usize, [u32; 3]) -> f32 + Sync> SetLane for F {}
 
 /// Sets lane `lane` to a triangle's boxes by motion `one`; returns the widest its particles
 /// span along an axis over the motion.
