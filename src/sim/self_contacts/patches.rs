@@ -282,8 +282,8 @@ impl Patches {
         }
         let (particle, reference) = (&self.particle[range.clone()], &self.reference[range]);
         let n = particle.len() as f32;
-        // In SSE lanes (`Vec3A`): the same operations in the same order as with `Vec3`,
-        // so the same results, in fewer instructions.
+        // The motion comes in SSE lanes (`Vec3A`): the same operations in the same order
+        // as with `Vec3`, so the same results, in fewer instructions.
         let at = |x: &[Vec3A], j: u32| x[j as usize];
         // The middles of the starts and of the ends, and the maps fitted to each: their
         // columns are sums over the particles weighed by the inverse second moments.

@@ -231,11 +231,12 @@ pub(super) struct Boxes {
     /// (in the moving frame): where the cloth moves fast, and the boxes have no room to
     /// reuse them in later substeps anyway.
     pub(super) swept: bool,
-    pub(super) from: Vec<Vec3>,
-    pub(super) to: Vec<Vec3>,
+    from: Vec<Vec3>,
+    to: Vec<Vec3>,
     /// `from` and `to` again, in SSE lanes (`Vec3A`): the patches' and the tree's fits read
     /// each particle's motion many times a search, and a `Vec3` is three loads and a
-    /// shuffle to get into lanes (kept with [`Boxes::set_motion`] and [`Boxes::set_path`]).
+    /// shuffle to get into lanes (both set only by [`Boxes::set_motion`] and
+    /// [`Boxes::set_path`]).
     lanes: [Vec<Vec3A>; 2],
 }
 
@@ -265,7 +266,12 @@ impl Boxes {
         (self.lanes[0][i], self.lanes[1][i]) = (s.into(), p.into());
     }
 
-    /// Each particle's motion, from its start to its end, in SSE lanes.
+    /// Each particle's motion, from its start to its end.
+    pub(super) fn paths(&self) -> [&[Vec3]; 2] {
+        [&self.from, &self.to]
+    }
+
+    /// [`Boxes::paths`] in SSE lanes.
     pub(super) fn motion(&self) -> [&[Vec3A]; 2] {
         [&self.lanes[0], &self.lanes[1]]
     }

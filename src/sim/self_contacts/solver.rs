@@ -362,7 +362,9 @@ impl SelfContacts {
                 // paths of those still in theirs.
                 outside(&mut left[..n], [from, to], [lo, hi], g);
                 if swept {
-                    let paths = [&boxes.from, &boxes.to].map(|v| part(v));
+                    let paths = boxes
+                        .paths()
+                        .map(|v| crate::parallel::within(v, range.clone()));
                     for (i, l) in left[..n].iter_mut().enumerate().filter(|(_, l)| !**l) {
                         *l = path_at(paths, i).is_none_or(|path| strayed((from[i], to[i]), path));
                     }
@@ -372,7 +374,7 @@ impl SelfContacts {
             self.left.fill(false);
             let (room, paths) = (
                 |i: usize| (boxes.vertex_lo[i], boxes.vertex_hi[i]),
-                [&boxes.from[..], &boxes.to[..]],
+                boxes.paths(),
             );
             for &i in &self.unchecked {
                 let i = i as usize;

@@ -52,10 +52,7 @@ impl SelfContacts {
         refreshed: bool,
     ) {
         if self.boxes.swept {
-            let (motion, lanes) = (
-                [&self.boxes.from[..], &self.boxes.to[..]],
-                self.boxes.motion(),
-            );
+            let (motion, lanes) = (self.boxes.paths(), self.boxes.motion());
             // Closed as they are: in a whole search the corners the patches cover (a
             // refresh decides those whose motion changed, covered or not), and those whose
             // reference fails but whose ring keeps near its rest shape.
@@ -347,20 +344,25 @@ impl SelfContacts {
             (self.boxes).set_motion(&self.from, &self.to, self.window.len);
         }
         let (grow, swept, look) = (self.grow(thickness), self.boxes.swept, self.look_ahead());
-        let (from, to) = if swept {
-            (&self.boxes.from, &self.boxes.to)
+        // The boxes taken out while the paths are read.
+        let (mut lo, mut hi) = (
+            std::mem::take(&mut self.boxes.vertex_lo),
+            std::mem::take(&mut self.boxes.vertex_hi),
+        );
+        let [from, to] = if swept {
+            self.boxes.paths()
         } else {
-            (&self.from, &self.to)
+            [&self.from[..], &self.to[..]]
         };
-        self.boxes.vertex_lo.resize(from.len(), Vec3::ZERO);
-        self.boxes.vertex_hi.resize(from.len(), Vec3::ZERO);
-        let boxes = [&mut self.boxes.vertex_lo[..], &mut self.boxes.vertex_hi[..]];
-        each_part(boxes, |range, [lo, hi]| {
+        lo.resize(from.len(), Vec3::ZERO);
+        hi.resize(from.len(), Vec3::ZERO);
+        each_part([&mut lo[..], &mut hi[..]], |range, [lo, hi]| {
             for ((lo, hi), i) in lo.iter_mut().zip(hi).zip(range) {
                 let (s, p) = (from[i], to[i]);
                 (*lo, *hi) = Self::vertex_box(s, ahead(look, s, p, thickness), grow);
             }
         });
+        (self.boxes.vertex_lo, self.boxes.vertex_hi) = (lo, hi);
         self.search_all(model, thickness)
     }
 

@@ -358,11 +358,7 @@ fn a_refresh_finds_what_a_whole_search_finds() {
         // not from those the whole walk pairs them with: it may pass by a few pairs more,
         // each of which stays the reach apart along the motion (at every one of 33
         // points); by the boxes, the tests are the same.
-        let (from, to, reach) = (
-            &contacts.boxes.from,
-            &contacts.boxes.to,
-            contacts.reach(THICKNESS),
-        );
+        let ([from, to], reach) = (contacts.boxes.paths(), contacts.reach(THICKNESS));
         let passed = |stored: &&StoredPair| {
             let pair = stored.expand(&model.triangles, &contacts.owners.edges);
             (0..=32).all(|k| {
