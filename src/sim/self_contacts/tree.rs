@@ -610,7 +610,7 @@ impl Fitting<'_> {
     /// Fits node `i`'s boxes around its parts': a leaf's around its triangles', another's
     /// around its two children's (fitted before). `boxes` and `motion` hold the nodes from
     /// node `base` on, `lanes` the leaves from leaf `first` on.
-    #[inline]
+    #[inline(always)]
     fn node(
         &self,
         i: usize,
