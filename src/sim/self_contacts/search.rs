@@ -245,18 +245,14 @@ impl Boxes {
     /// far from its start.
     pub(super) fn set_motion(&mut self, from: &[Vec3], to: &[Vec3], len: u32) {
         self.from.clear();
-        self.from.extend_from_slice(from);
         self.to.clear();
-        self.to.extend_from_slice(to);
-        if len > 1 {
-            let len = len as f32;
-            for (to, &s) in self.to.iter_mut().zip(from) {
-                *to = s + (*to - s) * len;
-            }
-        }
-        for (lanes, x) in self.lanes.iter_mut().zip([&self.from, &self.to]) {
-            lanes.clear();
-            lanes.extend(x.iter().map(|&p| Vec3A::from(p)));
+        self.lanes.iter_mut().for_each(Vec::clear);
+        for (&s, &e) in from.iter().zip(to) {
+            let e = if len > 1 { s + (e - s) * len as f32 } else { e };
+            self.from.push(s);
+            self.to.push(e);
+            self.lanes[0].push(s.into());
+            self.lanes[1].push(e.into());
         }
     }
 
