@@ -3,7 +3,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 use crate::cloth::{ClothModel, ClothState};
 use crate::parallel::{each_part, within};
@@ -70,7 +70,7 @@ pub struct SelfContacts {
     /// The tree's patches certified apart by the rest shape.
     patches: Patches,
     /// Each particle's box's middle, where the patches are certified for the boxes.
-    middles: Vec<glam::Vec3A>,
+    middles: Vec<Vec3A>,
     /// How many searches each node's certificate is left out of (see [`Patches::decide`]).
     backoff: Vec<u8>,
     owners: Owners,
@@ -362,6 +362,7 @@ impl SelfContacts {
                 // paths of those still in theirs.
                 outside(&mut left[..n], [from, to], [lo, hi], g);
                 if swept {
+                    // (`within` is the parameter here.)
                     let paths = boxes
                         .paths()
                         .map(|v| crate::parallel::within(v, range.clone()));
