@@ -22,7 +22,6 @@ pub fn each_part<T: Send, const K: usize>(
     arrays: [&mut [T]; K],
     part: impl Fn(std::ops::Range<usize>, [&mut [T]; K]) + Sync,
 ) {
-    const LINE: usize = 16;
     let len = arrays.iter().map(|a| a.len()).min().unwrap_or(0);
     let team = Team::current();
     if len < PARALLEL_ELEMENTS || team.members() == 1 {
@@ -32,12 +31,51 @@ pub fn each_part<T: Send, const K: usize>(
     let arrays = arrays.map(Disjoint::new);
     let members = team.members();
     team.run(&|i| {
-        let lines = share(len.div_ceil(LINE), members, i);
-        let range = (lines.start * LINE).min(len)..(lines.end * LINE).min(len);
+        let range = member_range(len, members, i);
         // SAFETY: the members' ranges are disjoint (shares of whole lines).
         let mine = std::array::from_fn(|k| unsafe { arrays[k].part(range.clone()) });
         part(range, mine);
     });
+}
+
+/// Member `i`'s range of `0..len` in [`each_part`]: its share of the whole cache lines (16
+/// `f32`s) of `len` elements.
+fn member_range(len: usize, members: usize, i: usize) -> std::ops::Range<usize> {
+    const LINE: usize = 16;
+    let lines = share(len.div_ceil(LINE), members, i);
+    (lines.start * LINE).min(len)..(lines.end * LINE).min(len)
+}
+
+/// The most members [`fold_parts`] takes results from (a team of more folds alone).
+const MOST_FOLDED: usize = 16;
+
+/// `part(range)` over the ranges [`each_part`] cuts `0..len` into (so a member reads the
+/// elements it writes in the loops beside), joined with `join` in the ranges' order: for
+/// loops that only read, whose result does not depend on how they are cut (a least, a
+/// greatest, a count). `None` for no element.
+pub fn fold_parts<R: Send>(
+    len: usize,
+    part: impl Fn(std::ops::Range<usize>) -> R + Sync,
+    join: impl Fn(R, R) -> R,
+) -> Option<R> {
+    let team = Team::current();
+    let members = team.members();
+    if len == 0 {
+        return None;
+    }
+    if len < PARALLEL_ELEMENTS || members == 1 || members > MOST_FOLDED {
+        return Some(part(0..len));
+    }
+    let mut results: [Option<R>; MOST_FOLDED] = std::array::from_fn(|_| None);
+    let slots = Disjoint::new(&mut results[..members]);
+    team.run(&|i| {
+        let range = member_range(len, members, i);
+        if !range.is_empty() {
+            // SAFETY: each member writes only its own slot.
+            unsafe { *slots.at(i) = Some(part(range)) };
+        }
+    });
+    results.into_iter().flatten().reduce(join)
 }
 
 /// `slice[range]`, cut short where `slice` ends: for arrays read beside those that
@@ -84,6 +122,38 @@ mod tests {
             );
             assert!(parts.windows(2).all(|w| w[0].end == w[1].start));
             assert_eq!((parts[0].start, parts[members - 1].end), (0, len));
+        }
+    }
+
+    /// The ranges folded are `each_part`'s (one a member from its size on), joined in
+    /// order; no element, no result.
+    #[test]
+    fn fold_parts_joins_each_members_part_in_order() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .expect("a pool of 3");
+        for len in [0, 5, PARALLEL_ELEMENTS - 1, PARALLEL_ELEMENTS + 37] {
+            let join = |mut a: Vec<std::ops::Range<usize>>, b| {
+                a.extend(b);
+                a
+            };
+            let parts = pool.install(|| fold_parts(len, |r| vec![r], join));
+            let Some(parts) = parts else {
+                assert_eq!(len, 0);
+                continue;
+            };
+            let members = if len >= PARALLEL_ELEMENTS { 3 } else { 1 };
+            assert_eq!(parts.len(), members, "{len}");
+            assert!(parts.windows(2).all(|w| w[0].end == w[1].start));
+            assert_eq!((parts[0].start, parts[members - 1].end), (0, len));
+            // The same ranges as `each_part`'s.
+            let cut = Mutex::new(Vec::new());
+            let mut x = vec![0u8; len];
+            pool.install(|| each_part([&mut x], |r, _| cut.lock().unwrap().push(r)));
+            let mut cut = cut.into_inner().unwrap();
+            cut.sort_by_key(|r| r.start);
+            assert_eq!(cut, parts, "{len}");
         }
     }
 

@@ -7,6 +7,7 @@ use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 use super::faces::FacePatches;
 use super::solid::{Solid, default_friction, resolve};
 use crate::mesh::bounds;
+use crate::parallel::{fold_parts, within};
 use crate::sim::obstacle::closest_weights;
 use crate::sim::param_error::ParamError;
 use crate::sim::self_contacts::ContactError;
@@ -147,6 +148,20 @@ fn clear_of(center: Vec3, reach: f32, x: [Vec3; 3]) -> bool {
     least - spread[0].max(spread[1]).max(spread[2]) >= 1.001 * reach * reach
 }
 
+/// The box of the points of `start` and `end` (`(0, 0)` for none), each member of the team
+/// reading the particles it moved.
+fn motion_bounds(start: &[Vec3], end: &[Vec3]) -> (Vec3, Vec3) {
+    let part = |range: std::ops::Range<usize>| {
+        let (a, b) = (
+            bounds(within(start, range.clone())),
+            bounds(within(end, range)),
+        );
+        (a.0.min(b.0), a.1.max(b.1))
+    };
+    let join = |a: (Vec3, Vec3), b: (Vec3, Vec3)| (a.0.min(b.0), a.1.max(b.1));
+    fold_parts(start.len().min(end.len()), part, join).unwrap_or((Vec3::ZERO, Vec3::ZERO))
+}
+
 /// The first point (relative to the sphere's centre) where the segment `a → b` enters the
 /// sphere of radius `r`, if `a` is outside it and the segment reaches it.
 #[inline]
@@ -195,8 +210,7 @@ impl EffectKind for Sphere {
         // The substep's whole motion lies in a box clear of the sphere (a cloth falling
         // onto it, still above): no path enters it and no triangle reaches it. A margin
         // of a ten-thousandth keeps the paths' rounding out of the question.
-        let (start, end) = (bounds(pass.start), bounds(&pass.state.pos));
-        let (lo, hi) = (start.0.min(end.0), start.1.max(end.1));
+        let (lo, hi) = motion_bounds(pass.start, &pass.state.pos);
         let reach = (self.radius + pass.offset) * 1.0001;
         if self.center.clamp(lo, hi).distance_squared(self.center) > reach * reach {
             return Ok(0);
@@ -293,6 +307,28 @@ mod tests {
         let (moved, pos) = fall(0.5);
         assert_eq!(moved, 0);
         assert!((0..pos.len()).all(|i| pos[i] == start[i] - 0.5 * Vec3::Y));
+    }
+
+    /// The box of a substep's motion holds both ends' points and no more, whether the
+    /// team's members take a part each (two threads, above the size they share from) or
+    /// one takes all.
+    #[test]
+    fn the_box_of_the_motion_is_that_of_both_ends() {
+        let mut rnd = crate::test_rng::uniform(7);
+        let mut point = || Vec3::new(rnd() - 0.5, rnd() * 2.0, rnd() - 0.3);
+        let n = crate::parallel::PARALLEL_ELEMENTS + 37;
+        let start: Vec<Vec3> = (0..n).map(|_| point()).collect();
+        let end: Vec<Vec3> = (0..n).map(|_| point() * 1.5).collect();
+        let both: Vec<Vec3> = start.iter().chain(&end).copied().collect();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("a pool of 2");
+        assert_eq!(pool.install(|| motion_bounds(&start, &end)), bounds(&both));
+        assert_eq!(motion_bounds(&start[..9], &end[..9]), {
+            bounds(&[&start[..9], &end[..9]].concat())
+        });
+        assert_eq!(motion_bounds(&[], &[]), (Vec3::ZERO, Vec3::ZERO));
     }
 
     /// The nearest any point of the triangle `x` comes to `c`, in f64, from a fine

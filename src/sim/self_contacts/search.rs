@@ -12,6 +12,7 @@ use super::primitives::{Pair, StoredPair, distance};
 use super::rings::Rings;
 use crate::cloth::ClothModel;
 use crate::mesh::{grouped, triangles_around};
+use crate::parallel::{each_part, within};
 
 /// Which vertices and edges each triangle owns: each vertex and each edge belongs to the
 /// first triangle that has it, so a pair of triangles yields each vertex–triangle and
@@ -244,16 +245,27 @@ impl Boxes {
     /// Sets each particle's motion to run from `from` to `to`, carried on `len` times as
     /// far from its start.
     pub(super) fn set_motion(&mut self, from: &[Vec3], to: &[Vec3], len: u32) {
-        self.from.clear();
-        self.to.clear();
-        self.lanes.iter_mut().for_each(Vec::clear);
-        for (&s, &e) in from.iter().zip(to) {
-            let e = if len > 1 { s + (e - s) * len as f32 } else { e };
-            self.from.push(s);
-            self.to.push(e);
-            self.lanes[0].push(s.into());
-            self.lanes[1].push(e.into());
-        }
+        let n = from.len().min(to.len());
+        self.from.resize(n, Vec3::ZERO);
+        self.to.resize(n, Vec3::ZERO);
+        // Each member of the team sets the particles it moved.
+        each_part([&mut self.from, &mut self.to], |range, [s_out, e_out]| {
+            let (from, to) = (within(from, range.clone()), within(to, range));
+            for (((s_out, e_out), &s), &e) in s_out.iter_mut().zip(e_out).zip(from).zip(to) {
+                let e = if len > 1 { s + (e - s) * len as f32 } else { e };
+                (*s_out, *e_out) = (s, e);
+            }
+        });
+        let [starts, ends] = &mut self.lanes;
+        starts.resize(n, Vec3A::ZERO);
+        ends.resize(n, Vec3A::ZERO);
+        let (from, to) = (&self.from, &self.to);
+        each_part([starts, ends], |range, [starts, ends]| {
+            let (from, to) = (within(from, range.clone()), within(to, range));
+            for (((s_out, e_out), &s), &e) in starts.iter_mut().zip(ends).zip(from).zip(to) {
+                (*s_out, *e_out) = (s.into(), e.into());
+            }
+        });
     }
 
     /// Sets particle `i`'s motion to run from `s` to `p`.

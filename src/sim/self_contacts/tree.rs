@@ -85,8 +85,12 @@ pub(super) struct TriangleTree {
     /// Whether each node's own pairs are certified apart for the motion of the last fit
     /// (see [`super::patches`]): a whole walk passes by a node against itself then.
     pub(super) covered: Vec<bool>,
-    /// Scratch of a fit of some triangles: the nodes that hold one.
+    /// Each node's parent (the root's: [`NO_PARENT`]).
+    parent: Vec<u32>,
+    /// Scratch of a fit of some triangles: the nodes that hold one, as flags (all clear
+    /// between fits) and as a list.
     stale: Vec<bool>,
+    stale_nodes: Vec<u32>,
 }
 
 impl TriangleTree {
@@ -99,8 +103,12 @@ impl TriangleTree {
             place_of[t as usize] = place as u32;
         }
         let (mut leaves, mut leaf_of) = (Vec::new(), vec![NOT_A_LEAF; nodes.len()]);
+        let mut parent = vec![NO_PARENT; nodes.len()];
         let (mut leaf_at, mut leaf_corners) = (vec![0; order.len()], Vec::new());
         for (i, &node) in nodes.iter().enumerate() {
+            if !Self::is_leaf(node) {
+                (parent[i + 1], parent[node.second as usize]) = (i as u32, i as u32);
+            }
             if Self::is_leaf(node) {
                 leaf_of[i] = leaves.len() as u32;
                 // Lanes past the leaf's triangles hold no particle's number.
@@ -116,6 +124,7 @@ impl TriangleTree {
                 leaf_corners.push(lanes);
             }
         }
+        let nodes_len = nodes.len();
         let mut tree = TriangleTree {
             nodes,
             leaves,
@@ -124,6 +133,8 @@ impl TriangleTree {
             leaf_corners,
             order,
             place_of,
+            stale: vec![false; nodes_len],
+            parent,
             ..TriangleTree::default()
         };
         if !tree.nodes.is_empty() {
@@ -194,23 +205,29 @@ impl TriangleTree {
         self.lanes.resize(self.leaves.len(), Lanes::default());
     }
 
-    /// Fits the nodes [`TriangleTree::stale`] flags and their parents (flagged on the
-    /// way), from the last node back (children come after their parents).
+    /// Lists node `i` and the nodes above it that are not yet (a leaf whose lanes changed).
+    fn make_stale(&mut self, mut i: u32) {
+        while i != NO_PARENT && !std::mem::replace(&mut self.stale[i as usize], true) {
+            self.stale_nodes.push(i);
+            i = self.parent[i as usize];
+        }
+    }
+
+    /// Fits the nodes listed stale, from the last node back (children come after their
+    /// parents), and clears the list.
     fn fit_stale(&mut self, moving: bool) {
         let fitting = Fitting {
             nodes: &self.nodes,
             leaf_of: &self.leaf_of,
             moving,
         };
-        for i in (0..self.nodes.len()).rev() {
-            let node = self.nodes[i];
-            if !Self::is_leaf(node) {
-                self.stale[i] = self.stale[i + 1] || self.stale[node.second as usize];
-            }
-            if self.stale[i] {
-                fitting.node(i, (&mut self.boxes, &mut self.motion, 0), (&self.lanes, 0));
-            }
+        self.stale_nodes.sort_unstable_by(|a, b| b.cmp(a));
+        for &i in &self.stale_nodes {
+            let i = i as usize;
+            fitting.node(i, (&mut self.boxes, &mut self.motion, 0), (&self.lanes, 0));
+            self.stale[i] = false;
         }
+        self.stale_nodes.clear();
     }
 
     /// Sets every leaf's lanes by `set(lanes, lane, triangle, corners)`, for each of its
@@ -325,14 +342,12 @@ impl TriangleTree {
         moving: bool,
         set: impl Fn(&mut Lanes, usize, usize, [u32; 3]) -> f32,
     ) -> f32 {
-        self.stale.clear();
-        self.stale.resize(self.nodes.len(), false);
         let mut most = 0.0f32;
         for &t in changed {
             let (leaf, lane) = self.lane(self.place_of[t as usize] as usize);
             let corners = self.corners(leaf, lane);
             most = most.max(set(&mut self.lanes[leaf], lane, t as usize, corners));
-            self.stale[self.leaves[leaf] as usize] = true;
+            self.make_stale(self.leaves[leaf]);
         }
         self.fit_stale(moving);
         most
@@ -378,8 +393,10 @@ impl TriangleTree {
     }
 
     /// The corners of lane `lane`'s triangle of leaf `leaf`.
+    #[inline(always)]
     fn corners(&self, leaf: usize, lane: usize) -> [u32; 3] {
-        self.leaf_corners[leaf].map(|c| c[lane])
+        let [a, b, c] = &self.leaf_corners[leaf];
+        [a[lane], b[lane], c[lane]]
     }
 
     /// Pieces a search of the whole tree is cut into, for a team to share.
@@ -390,6 +407,7 @@ impl TriangleTree {
     /// Calls `pair(a, b)` for each two triangles that share no corner, that the walk of
     /// piece `piece` does not tell apart (as the last fit tells them) and that no covered
     /// node holds both of; the pieces together call it once for every such two.
+    #[inline(never)]
     pub(super) fn piece_pairs(&self, piece: usize, pair: impl FnMut(u32, u32)) {
         // One walk for each fit, each with its tests inlined.
         match self.fit {
@@ -419,6 +437,7 @@ impl TriangleTree {
     /// its own boxes rather than from the node the whole walk pairs with it, and the
     /// leaves' rows (in the two leaves' frame, as the whole walk's) are not the nodes'
     /// test, so it may pass by a few pairs more, each of which keeps the reach apart.
+    #[inline(never)]
     pub(super) fn triangle_pairs(&self, t: u32, searched: &[bool], pair: impl FnMut(u32, u32)) {
         match self.fit {
             Fit::Motion { reach } => self.query(
@@ -647,6 +666,9 @@ impl Fitting<'_> {
 
 /// A node that is not a leaf, in [`TriangleTree`]'s `leaf_of`.
 const NOT_A_LEAF: u32 = u32::MAX;
+
+/// The root's parent.
+const NO_PARENT: u32 = u32::MAX;
 
 /// Whether two boxes `[lo, hi]` do not overlap.
 #[inline(always)]

@@ -4,6 +4,8 @@
 
 use glam::{Vec3, Vec3A};
 
+use crate::parallel::fold_parts;
+
 use super::*;
 
 /// The particles' boxes are given room for later substeps only while none moves more
@@ -330,10 +332,15 @@ impl SelfContacts {
         self.found_for = None;
         // Room to reuse the pairs only where the cloth moves slowly in the moving frame; a
         // fast substep would leave its boxes at once, and the room would only add pairs.
-        let fastest = (self.from.iter().zip(&self.to))
-            .map(|(s, p)| s.distance_squared(*p))
-            .fold(0.0f32, f32::max)
-            .sqrt();
+        let (from, to) = (&self.from, &self.to);
+        let part = |range: std::ops::Range<usize>| {
+            let (from, to) = (within(from, range.clone()), within(to, range));
+            (from.iter().zip(to))
+                .map(|(s, p)| s.distance_squared(*p))
+                .fold(0.0f32, f32::max)
+        };
+        let len = from.len().min(to.len());
+        let fastest = fold_parts(len, part, f32::max).unwrap_or(0.0).sqrt();
         let slow = fastest < REUSE_BELOW * thickness;
         // Fast, the pairs are judged by the motion too (see `Boxes::swept`), carried on
         // for a window: twice as long as the last where it ran out, half where it did

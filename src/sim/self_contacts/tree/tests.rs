@@ -342,6 +342,12 @@ fn fitting_the_moved_triangles_again_leaves_the_tree_as_a_whole_fit_does() {
     fresh.fit_boxes(&lo, &hi);
     fresh.refit_motion(&changed, [&in_lanes(&rest), &in_lanes(&lifted)], reach);
     same(&fresh, &tree, true);
+    // Refitted again, back: the nodes fitted by the first refit are fitted by the second.
+    tree.refit_motion(&changed, [&in_lanes(&rest), &in_lanes(&pos)], reach);
+    let back = whole(&|t| {
+        t.fit_motion([&in_lanes(&rest), &in_lanes(&pos)], reach);
+    });
+    same(&tree, &back, true);
 }
 
 /// A fit by the motion tells the widest any triangle's particles span along an axis over
