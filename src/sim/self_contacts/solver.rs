@@ -124,6 +124,10 @@ pub struct SelfContacts {
     /// This round's cuts: each particle's smallest scale yet, as the bits of an `f64`.
     cut: Cuts,
     changed: Vec<bool>,
+    /// Whether `scale`, `cut` and `changed` are as a first round needs them (every share
+    /// whole, every particle changed): left so by the calls in which no round cut, so that
+    /// most calls need not fill them again.
+    cuts_whole: bool,
     pub work: SelfWork,
 }
 
@@ -269,8 +273,13 @@ impl SelfContacts {
         self.update_pairs(model, thickness, CHECKED * thickness)?;
         let impacts = self.work.impacts;
         // What the solids just moved stays where they put it: the cut falls on the rest.
-        self.fixed.clear();
-        (self.fixed).extend(placed.iter().zip(&state.pos).map(|(a, b)| a != b));
+        self.fixed.resize(placed.len().min(state.pos.len()), false);
+        each_part([&mut self.fixed], |range, [fixed]| {
+            let (placed, pos) = (within(placed, range.clone()), within(&state.pos, range));
+            for ((fixed, a), b) in fixed.iter_mut().zip(placed).zip(pos) {
+                *fixed = a != b;
+            }
+        });
         self.keep_apart(model, start, state, thickness, substep)?;
         Ok((self.work.impacts - impacts) as usize)
     }
@@ -469,10 +478,16 @@ impl SelfContacts {
     ) -> Result<(u64, bool), ContactError> {
         let n = end.len();
         let pinned_free = |i: usize| model.inv_mass[i] > 0.0;
-        self.scale.clear();
-        self.scale.resize(n, 1.0);
-        self.changed.clear();
-        self.changed.resize(n, true);
+        let sized = [self.scale.len(), self.changed.len(), self.cut.0.len()] == [n; 3];
+        if !(self.cuts_whole && sized) {
+            self.scale.clear();
+            self.scale.resize(n, 1.0);
+            self.changed.clear();
+            self.changed.resize(n, true);
+            self.cut.0.clear();
+            (self.cut.0).extend(self.scale.iter().map(|s| AtomicU64::new(s.to_bits())));
+            self.cuts_whole = true;
+        }
         let (mut forced_here, first) = (0, *round);
         loop {
             let round_now = *round;
@@ -482,8 +497,8 @@ impl SelfContacts {
             // A round's cuts depend only on the last round's scales, and each particle keeps
             // the smallest: the pairs can be shared out in any order and give the same bits.
             let parallel = self.found.len() >= PARALLEL_PAIRS;
-            self.cut.0.clear();
-            (self.cut.0).extend(self.scale.iter().map(|s| AtomicU64::new(s.to_bits())));
+            // Each round starts with the cuts at the scales: as filled, or as the last
+            // round left both.
             let (impacts, forced) = (AtomicU64::new(0), AtomicU64::new(0));
             let (scale, changed, cut) = (&self.scale, &self.changed, &self.cut.0);
             let (triangles, edges) = (&model.triangles, &self.owners.edges);
@@ -528,10 +543,12 @@ impl SelfContacts {
             let (impacted, stuck) = (impacts.into_inner(), forced.into_inner());
             self.work.impacts += impacted;
             forced_here += stuck;
-            // Every impact cut something, or was forced.
+            // Every impact cut something, or was forced (no cut lowered: where no round
+            // before did either, the shares are still whole).
             if impacted == stuck {
                 return Ok((forced_here, round_now > first));
             }
+            self.cuts_whole = false;
             let rounds = (self.changed.iter_mut()).zip(self.scale.iter_mut().zip(&self.cut.0));
             for (changed, (scale, cut)) in rounds {
                 let cut = f64::from_bits(cut.load(Ordering::Relaxed));
