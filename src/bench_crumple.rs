@@ -37,6 +37,11 @@ pub struct CrumpleRow {
     /// The spring forces per substep, µs (0 for an integrator without them: XPBD's
     /// constraints stand in their place).
     pub springs_us: f64,
+    /// The contact phases' time over the springs' in the same substeps (0 without
+    /// springs).
+    pub contact_per_springs: f64,
+    /// The runs the row's times are the medians of ([`median_row`]); 1 for one run.
+    pub runs: usize,
     /// Pairs the search kept per particle, averaged over the last substep of each frame.
     pub pairs_per_particle: f64,
     /// Searches of the whole tree per substep (sampled as the pairs are).
@@ -99,9 +104,82 @@ pub fn crumple_one(
         contact_us: per(contact),
         setup_ms: setup.as_secs_f64() * 1e3,
         springs_us: per(springs),
+        contact_per_springs: if springs.is_zero() {
+            0.0
+        } else {
+            contact.as_secs_f64() / springs.as_secs_f64()
+        },
+        runs: 1,
         pairs_per_particle: pairs as f64 / sampled.max(1) as f64 / particles as f64,
         searches_per_substep: searches as f64 / sampled.max(1) as f64,
         refreshes_per_substep: refreshes as f64 / sampled.max(1) as f64,
         forced: work.forced_total,
     })
+}
+
+/// One row for several runs of the same: each time, and the ratio of the contact phases to
+/// the springs, the runs' median (of an even count, the mean of the middle two); the
+/// counts as the first run's (the same in every run: a run's pairs and searches do not
+/// depend on its timing). A bench on a shared machine swings from run to run with the
+/// machine's load, the springs' few microseconds a substep most. `None` for no run.
+pub fn median_row(runs: &[CrumpleRow]) -> Option<CrumpleRow> {
+    let first = runs.first()?;
+    let median = |field: fn(&CrumpleRow) -> f64| {
+        let mut x: Vec<f64> = runs.iter().map(field).collect();
+        x.sort_by(f64::total_cmp);
+        let n = x.len();
+        0.5 * (x[(n - 1) / 2] + x[n / 2])
+    };
+    Some(CrumpleRow {
+        wall_per_second: median(|r| r.wall_per_second),
+        contact_us: median(|r| r.contact_us),
+        setup_ms: median(|r| r.setup_ms),
+        springs_us: median(|r| r.springs_us),
+        contact_per_springs: median(|r| r.contact_per_springs),
+        runs: runs.len(),
+        ..first.clone()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(contact_us: f64, springs_us: f64) -> CrumpleRow {
+        CrumpleRow {
+            quads: 8,
+            particles: 81,
+            integrator: "implicit-euler".into(),
+            threads: 2,
+            substeps: 240,
+            wall_per_second: contact_us / 100.0,
+            contact_us,
+            setup_ms: 1.0,
+            springs_us,
+            contact_per_springs: contact_us / springs_us,
+            pairs_per_particle: 0.5,
+            searches_per_substep: 0.1,
+            refreshes_per_substep: 0.2,
+            forced: 0,
+            runs: 1,
+        }
+    }
+
+    /// Each time is its own median, and so is the ratio: the ratio of the medians would
+    /// pair one run's contact with another's springs.
+    #[test]
+    fn a_rows_times_are_the_medians_of_its_runs() {
+        assert_eq!(median_row(&[]), None);
+        let runs = [row(300.0, 30.0), row(500.0, 25.0), row(400.0, 50.0)];
+        let m = median_row(&runs).unwrap();
+        assert_eq!(
+            (m.contact_us, m.springs_us, m.wall_per_second),
+            (400.0, 30.0, 4.0)
+        );
+        assert_eq!((m.contact_per_springs, m.runs), (10.0, 3));
+        assert_eq!((m.quads, m.pairs_per_particle), (8, 0.5));
+        let even = median_row(&runs[..2]).unwrap();
+        assert_eq!((even.contact_us, even.contact_per_springs), (400.0, 15.0));
+        assert_eq!(median_row(&runs[..1]), Some(runs[0].clone()));
+    }
 }

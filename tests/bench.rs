@@ -245,6 +245,8 @@ fn crumple_bench_prints_a_row_per_size_and_integrator() {
         "xpbd,implicit-euler",
         "--threads",
         "1",
+        "--repeat",
+        "2",
         "--json",
     ]);
     let shape: Vec<_> = (rows.iter())
@@ -264,9 +266,13 @@ fn crumple_bench_prints_a_row_per_size_and_integrator() {
         assert_eq!(row["substeps"], 240, "{row}");
         assert!(row["contact_us"].as_f64().unwrap() > 0.0, "{row}");
         assert_eq!(row["forced"], 0, "{row}");
+        // Each row the medians of its two runs.
+        assert_eq!(row["runs"], 2, "{row}");
     }
     assert_eq!(rows[0]["springs_us"], 0.0);
+    assert_eq!(rows[0]["contact_per_springs"], 0.0);
     assert!(rows[1]["springs_us"].as_f64().unwrap() > 0.0);
+    assert!(rows[1]["contact_per_springs"].as_f64().unwrap() > 0.0);
 }
 
 #[test]
@@ -285,6 +291,8 @@ fn bench_cli_refuses_bad_thread_counts_and_gpu_integrators_in_one_line() {
     };
     let err = run(&["bench", "--crumple", "--quads", "0"]);
     assert!(err.contains("--quads") && err.contains("1..=2048"), "{err}");
+    let err = run(&["bench", "--crumple", "--quads", "8", "--repeat", "0"]);
+    assert!(err.contains("--repeat") && err.contains("1..=100"), "{err}");
     let err = run(&["bench", "--sizes", "8", "--threads", "0"]);
     assert!(
         err.contains("--threads") && err.contains("1..=256"),

@@ -173,6 +173,10 @@ pub enum Command {
             requires = "crumple"
         )]
         quads: Vec<u32>,
+        /// Runs of each --crumple row, taken in turn across the thread counts; the row
+        /// prints each time's median (a shared machine's load swings one run's).
+        #[arg(long, default_value_t = 3, requires = "crumple")]
+        repeat: u32,
     },
     /// Write a rectangular grid cloth as an OBJ file (quads: diagonals become shear springs).
     Grid {

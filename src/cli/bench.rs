@@ -179,21 +179,40 @@ pub fn contact_bench(threads: &[usize], json: bool) -> Result<()> {
     Ok(())
 }
 
-/// Runs and prints the crumple bench: one row per thread count × grid size × integrator.
+/// Runs and prints the crumple bench: one row per thread count × grid size × integrator,
+/// each the medians of `repeat` runs, the rows run in turn `repeat` times over (so that a
+/// swing in the machine's load falls on every row alike).
 pub fn crumple_bench(
     quads: &[u32],
     integrators: Option<&[IntegratorKind]>,
     threads: &[usize],
+    repeat: u32,
     json: bool,
 ) -> Result<()> {
-    use clothsim::bench_crumple::crumple_one;
+    use clothsim::bench_crumple::{crumple_one, median_row};
     check_threads(threads)?;
     if let Some(&q) = quads.iter().find(|&&q| !(1..=2048).contains(&q)) {
         bail!("--quads: {q} is outside 1..=2048");
     }
+    if !(1..=100).contains(&repeat) {
+        bail!("--repeat: {repeat} is outside 1..=100");
+    }
     // The scene's own integrator (`None`), or each asked for.
     let integrators: Vec<Option<IntegratorKind>> =
         integrators.map_or(vec![None], |ks| ks.iter().copied().map(Some).collect());
+    let pools = (threads.iter())
+        .map(|&t| pool(t))
+        .collect::<Result<Vec<_>>>()?;
+    let rows: Vec<(&rayon::ThreadPool, u32, Option<IntegratorKind>)> = (pools.iter())
+        .flat_map(|p| quads.iter().map(move |&q| (p, q)))
+        .flat_map(|(p, q)| integrators.iter().map(move |&k| (p, q, k)))
+        .collect();
+    let mut runs = vec![Vec::new(); rows.len()];
+    for _ in 0..repeat {
+        for (&(pool, q, k), runs) in rows.iter().zip(&mut runs) {
+            runs.push(pool.install(|| crumple_one(q, k))?);
+        }
+    }
     if !json {
         println!(
             "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11} {:>9} {:>13} {:>13} {:>9} {:>11} {:>9} {:>9}",
@@ -212,42 +231,35 @@ pub fn crumple_bench(
             "refreshes",
         );
     }
-    for &t in threads {
-        let pool = pool(t)?;
-        for (&q, &k) in quads
-            .iter()
-            .flat_map(|q| integrators.iter().map(move |k| (q, k)))
-        {
-            let row = pool.install(|| crumple_one(q, k))?;
-            if json {
-                println!("{}", serde_json::to_string(&row)?);
-            } else {
-                println!(
-                    "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11.2} {:>9.1} {:>13.1} {:>13.1} {:>9} {:>11.4} {:>9.2} {:>9.2}",
-                    row.quads,
-                    row.particles,
-                    row.integrator,
-                    row.threads,
-                    row.substeps,
-                    row.wall_per_second,
-                    row.setup_ms,
-                    row.contact_us,
-                    row.springs_us,
-                    ratio(row.contact_us, row.springs_us),
-                    row.pairs_per_particle,
-                    row.searches_per_substep,
-                    row.refreshes_per_substep,
-                );
-            }
+    for row in runs.iter().filter_map(|runs| median_row(runs)) {
+        if json {
+            println!("{}", serde_json::to_string(&row)?);
+        } else {
+            println!(
+                "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11.2} {:>9.1} {:>13.1} {:>13.1} {:>9} {:>11.4} {:>9.2} {:>9.2}",
+                row.quads,
+                row.particles,
+                row.integrator,
+                row.threads,
+                row.substeps,
+                row.wall_per_second,
+                row.setup_ms,
+                row.contact_us,
+                row.springs_us,
+                ratio(row.contact_per_springs),
+                row.pairs_per_particle,
+                row.searches_per_substep,
+                row.refreshes_per_substep,
+            );
         }
     }
     Ok(())
 }
 
-/// `a / b` to one decimal, or "-" without a `b` to compare with.
-fn ratio(a: f64, b: f64) -> String {
-    if b > 0.0 {
-        format!("{:.1}", a / b)
+/// A ratio to one decimal, or "-" for none (0: nothing to compare with).
+fn ratio(x: f64) -> String {
+    if x > 0.0 {
+        format!("{x:.1}")
     } else {
         "-".to_string()
     }

@@ -113,8 +113,9 @@ pub fn run(cli: Cli) -> Result<()> {
             crumple: true,
             quads,
             integrators,
+            repeat,
             ..
-        }) => crumple_bench(&quads, integrators.as_deref(), &threads, json),
+        }) => crumple_bench(&quads, integrators.as_deref(), &threads, repeat, json),
         Some(Command::Bench {
             sizes,
             integrators,
