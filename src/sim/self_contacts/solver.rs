@@ -139,7 +139,7 @@ const REFRESHED_PER_PIECE: usize = 16;
 /// members (two pieces): where `crumple` settles at 64² a refresh searches 300–400, and
 /// sharing those cut its second and third seconds' self-contact by a sixth on two threads
 /// (from 512 on, it ran them alone); sharing from 32 rather than 128 took the refreshes
-/// run alone from 2.6 % of the contact phases' samples on two threads to 0.7 %.
+/// run alone from 2.6 % of the contact phases' samples on two threads to 1.1 %.
 const PARALLEL_REFRESHED: usize = 2 * REFRESHED_PER_PIECE;
 
 impl SelfContacts {
