@@ -8,7 +8,7 @@
 use std::fmt::Debug;
 use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 
-use glam::{DMat3, DVec3, Mat3, Vec3};
+use glam::{DMat3, DVec3, Mat3, Vec3, Vec3A};
 
 /// A floating-point type a kernel can be compiled for. The methods are the ones the kernels
 /// use, each inlined to the type's own (`f32::mul_add` is one fused instruction where the
@@ -218,6 +218,7 @@ macro_rules! matrix {
 
 vector!(Vec3, f32);
 vector!(DVec3, f64);
+vector!(Vec3A, f32);
 matrix!(Mat3, Vec3, f32);
 matrix!(DMat3, DVec3, f64);
 

@@ -10,7 +10,7 @@ use super::found::Found;
 use super::gap::gap_at_both_ends;
 use super::primitives::{Pair, StoredPair, distance};
 use super::rings::Rings;
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, Real, Vector};
 use crate::mesh::{grouped, triangles_around};
 use crate::parallel::{each_part, within};
 
@@ -370,21 +370,7 @@ impl Search<'_> {
         // The edge of `a` (in its shape halfway along the motion) whose outward normal in
         // `a`'s plane points most nearly at `b`'s centre.
         let middle: [DVec3; 3] = std::array::from_fn(|k| 0.5 * (sa[k] + ea[k]));
-        let normal = (middle[1] - middle[0]).cross(middle[2] - middle[0]);
-        let (mut facing, mut best) = (DVec3::ZERO, 0.0);
-        for k in 0..3 {
-            let out = (middle[(k + 1) % 3] - middle[k]).cross(normal);
-            let length = out.length();
-            let towards = if length > 0.0 {
-                out.dot(across) / length
-            } else {
-                0.0
-            };
-            if towards > best {
-                (facing, best) = (out, towards);
-            }
-        }
-        apart_along(facing)
+        apart_along(facing_edge(middle, across))
     }
 
     /// [`Search::apart_across`] told first in f32, the four ends of the two triangles
@@ -440,21 +426,7 @@ impl Search<'_> {
         // The edge of `a` (halfway along the motion) whose outward normal in `a`'s plane
         // points most nearly at `b`'s centre.
         let middle = corners.map(|c| 0.5 * (c[0] + c[2]));
-        let normal = (middle[1] - middle[0]).cross(middle[2] - middle[0]);
-        let (mut facing, mut best) = (Vec3A::ZERO, 0.0);
-        for k in 0..3 {
-            let out = (middle[(k + 1) % 3] - middle[k]).cross(normal);
-            let length = out.length();
-            let towards = if length > 0.0 {
-                out.dot(across) / length
-            } else {
-                0.0
-            };
-            if towards > best {
-                (facing, best) = (out, towards);
-            }
-        }
-        apart_along(facing)
+        apart_along(facing_edge(middle, across))
     }
 
     /// Adds to `out` the pairs of piece `piece` of [`Owners::neighbours`] that could come
@@ -632,6 +604,27 @@ pub(super) fn pairs<'a>(
 /// Whether boxes `a` and `b` overlap.
 pub(super) fn meet((alo, ahi): (Vec3, Vec3), (blo, bhi): (Vec3, Vec3)) -> bool {
     alo.cmple(bhi).all() && blo.cmple(ahi).all()
+}
+
+/// The outward normal, in the plane of the triangle with corners `middle`, of its edge
+/// that faces most nearly along `across` (zero where none faces along it at all).
+#[inline(always)]
+fn facing_edge<R: Real, V: Vector<R>>(middle: [V; 3], across: V) -> V {
+    let normal = (middle[1] - middle[0]).cross(middle[2] - middle[0]);
+    let (mut facing, mut best) = (V::ZERO, R::ZERO);
+    for k in 0..3 {
+        let out = (middle[(k + 1) % 3] - middle[k]).cross(normal);
+        let length = out.length();
+        let towards = if length > R::ZERO {
+            out.dot(across) / length
+        } else {
+            R::ZERO
+        };
+        if towards > best {
+            (facing, best) = (out, towards);
+        }
+    }
+    facing
 }
 
 #[cfg(test)]
