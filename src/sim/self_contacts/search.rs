@@ -379,8 +379,10 @@ impl Search<'_> {
     /// the last place of their size), and a gap must clear the thickness by a
     /// hundred-thousandth of it and of the points' farthest coordinate, some twenty times
     /// what the projections' and the length's rounding could take. Where it says apart,
-    /// the two are apart (and the f64 test would say so: the same pairs are kept but
-    /// where a gap lies within that room of the thickness).
+    /// the two are apart, and the f64 test along its own lines would say so too (they
+    /// differ from these by rounding, far inside the room), so the same pairs are kept;
+    /// only where two edges face `b` almost alike could each test pick another, and
+    /// either edge's gap is a proof.
     #[inline(always)]
     fn apart_in_lanes(&self, a: usize, b: usize) -> bool {
         const ROOM: f32 = 1e-5;
