@@ -35,7 +35,7 @@ macro_rules! extent_by_min_max {
     )*};
 }
 
-extent_by_min_max!(f64, DVec3, Vec3A);
+extent_by_min_max!(f32, f64, DVec3, Vec3A);
 
 /// The gap between two extents `a` and `b` (`[lo, hi]` each) that run straight from
 /// `start` to `end` along the motion, that holds all along it: the larger of the gap from

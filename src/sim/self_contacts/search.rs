@@ -2,7 +2,7 @@
 //! the boxes, and the test that keeps a vertex–triangle or edge–edge pair of two triangles
 //! whose boxes overlap.
 
-use glam::{DVec3, Vec3, Vec3A, Vec4, Vec4Swizzles};
+use glam::{DVec3, Vec3, Vec3A, Vec4};
 use rustc_hash::FxHashMap;
 
 use super::ccd::closing_bound;
@@ -411,14 +411,13 @@ impl Search<'_> {
             if length == 0.0 {
                 return false;
             }
-            // Each corner's place along the axis at the four ends, and each end's span.
+            // Each corner's place along the axis at the four ends, and each end's span
+            // (lanes: `a`'s start, `b`'s, `a`'s end, `b`'s).
             let along = rows.map(|[x, y, z]| axis.x * x + axis.y * y + axis.z * z);
             let lo = along[0].min(along[1]).min(along[2]);
             let hi = along[0].max(along[1]).max(along[2]);
-            // `b` above `a` at both ends (lanes 1 and 3) or below it (lanes 0 and 2).
-            let gaps = lo - hi.yxwz();
-            let both = gaps.min(gaps.zwxy());
-            both.x.max(both.y) >= slack * length
+            let span = |k: usize| [lo[k], hi[k]];
+            gap_at_both_ends([span(0), span(1)], [span(2), span(3)]) >= slack * length
         };
         let sum = |s: usize| corners[0][s] + corners[1][s] + corners[2][s];
         let across = (sum(1) + sum(3) - sum(0) - sum(2)) / 6.0;
