@@ -263,10 +263,8 @@ impl TriangleTree {
             let mut most = 0.0f32;
             for (leaf, lanes) in held.clone().zip(lanes.iter_mut()) {
                 let node = fitting.nodes[leaves[leaf] as usize];
-                for lane in 0..node.count as usize {
-                    let t = order[node.first as usize + lane] as usize;
-                    most = most.max(set(lanes, lane, t, corners[leaf].map(|c| c[lane])));
-                }
+                let held = &order[node.first as usize..(node.first + node.count) as usize];
+                most = most.max(set(lanes, held, &corners[leaf]));
             }
             for i in at.clone().rev() {
                 fitting.node(i, (boxes, motion, at.start), (lanes, held.start));
@@ -284,8 +282,11 @@ impl TriangleTree {
 
     /// Fits the tree to the triangles' boxes `lo..hi`.
     pub(super) fn fit_boxes(&mut self, lo: &[Vec3], hi: &[Vec3]) {
-        self.fit_all(false, |lanes, lane, t, _| {
-            lanes.set_box(lane, [lo[t].into(), hi[t].into()]);
+        self.fit_all(false, |lanes, held, _| {
+            for (lane, &t) in held.iter().enumerate() {
+                let t = t as usize;
+                lanes.set_box(lane, [lo[t].into(), hi[t].into()]);
+            }
             0.0
         });
         self.fit = Fit::Boxes;
@@ -308,8 +309,8 @@ impl TriangleTree {
     /// apart by `reach` (see [`Fit::Motion`]). Returns the widest any triangle's particles
     /// span along an axis over the motion.
     pub(super) fn fit_motion(&mut self, [from, to]: [&[Vec3A]; 2], reach: f32) -> f32 {
-        let widest = self.fit_all(true, |lanes, lane, _, corners| {
-            set_motion(lanes, lane, One::of(corners, [from, to]))
+        let widest = self.fit_all(true, |lanes, held, corners| {
+            lanes.set_leaf(corners, held.len(), [from, to])
         });
         self.fit = Fit::Motion { reach };
         widest
@@ -603,13 +604,13 @@ fn lanes_of(node: Split) -> u32 {
     (1 << node.count) - 1
 }
 
-/// Sets lane `lane` of a leaf's lanes to triangle `t`'s boxes (its corners given); returns
-/// what the fit keeps the largest of (the widest triangle by motion).
-/// (A trait of its own rather than a `dyn Fn`: each fit is compiled with its own, inlined
-/// into the loop over the leaves.)
-trait SetLane: Fn(&mut Lanes, usize, usize, [u32; 3]) -> f32 + Sync {}
+/// Sets a leaf's lanes to the boxes of its triangles `held` (in the tree's order; their
+/// corners `corners`, lane by lane); returns what the fit keeps the largest of (the widest
+/// triangle by motion). (A trait of its own rather than a `dyn Fn`: each fit is compiled
+/// with its own, inlined into the loop over the leaves.)
+trait SetLane: Fn(&mut Lanes, &[u32], &Corners) -> f32 + Sync {}
 
-impl<F: Fn(&mut Lanes, usize, usize, [u32; 3]) -> f32 + Sync> SetLane for F {}
+impl<F: Fn(&mut Lanes, &[u32], &Corners) -> f32 + Sync> SetLane for F {}
 
 /// Sets lane `lane` to a triangle's boxes by motion `one`; returns the widest its particles
 /// span along an axis over the motion.

@@ -60,6 +60,41 @@ impl Lanes {
         }
     }
 
+    /// Sets the lanes to the boxes by motion of the first `count` triangles whose
+    /// corners are `corners` (the lanes past them to the first's), their particles moving
+    /// from `from` to `to`, a whole leaf at once: each corner's four particles taken into
+    /// a vector an axis. The same boxes, to the bit, as [`One::of`] and [`Lanes::set`]
+    /// give a lane at a time. Returns the widest a triangle's particles span along an
+    /// axis over the motion.
+    #[inline(always)]
+    pub(super) fn set_leaf(
+        &mut self,
+        corners: &Corners,
+        count: usize,
+        [from, to]: [&[Vec3A]; 2],
+    ) -> f32 {
+        // Each corner's particle in each lane (the first triangle's past `count`).
+        let ids = corners.map(|c| {
+            std::array::from_fn::<usize, 4, _>(|l| c[if l < count { l } else { 0 }] as usize)
+        });
+        // Corner `k`'s four particles at `x`, an axis a vector.
+        let axes = |x: &[Vec3A], k: usize| by_axis(ids[k].map(|i| x[i]));
+        let (s, e) = (
+            [0, 1, 2].map(|k| axes(from, k)),
+            [0, 1, 2].map(|k| axes(to, k)),
+        );
+        let mut widest = Vec4::ZERO;
+        for d in 0..3 {
+            self.lo[d] = s[0][d].min(s[1][d]).min(s[2][d]);
+            self.hi[d] = s[0][d].max(s[1][d]).max(s[2][d]);
+            self.end_lo[d] = e[0][d].min(e[1][d]).min(e[2][d]);
+            self.end_hi[d] = e[0][d].max(e[1][d]).max(e[2][d]);
+            let span = self.hi[d].max(self.end_hi[d]) - self.lo[d].min(self.end_lo[d]);
+            widest = widest.max(span);
+        }
+        widest.max_element()
+    }
+
     /// Lane `lane`'s triangle.
     #[inline(always)]
     pub(super) fn one(&self, lane: usize) -> One {
@@ -127,6 +162,23 @@ impl Lanes {
     /// The box of the first `count` lanes' boxes, and by motion the box of their ends.
     #[inline(always)]
     pub(super) fn bounds(&self, count: usize, moving: bool) -> ([Vec3A; 2], [Vec3A; 2]) {
+        if count == 4 {
+            // A full leaf: each bound's four lanes back into points, then joined.
+            let least = |v: &[Vec4; 3]| {
+                let [a, b, c, d] = by_lane(v);
+                a.min(b).min(c).min(d)
+            };
+            let most = |v: &[Vec4; 3]| {
+                let [a, b, c, d] = by_lane(v);
+                a.max(b).max(c).max(d)
+            };
+            let ends = if moving {
+                [least(&self.end_lo), most(&self.end_hi)]
+            } else {
+                [Vec3A::INFINITY, Vec3A::NEG_INFINITY]
+            };
+            return ([least(&self.lo), most(&self.hi)], ends);
+        }
         let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
         let (mut end_lo, mut end_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
         for l in 0..count {
@@ -138,6 +190,58 @@ impl Lanes {
         }
         ([lo, hi], [end_lo, end_hi])
     }
+}
+
+/// Four points' coordinates, an axis a vector (the lanes in the points' order).
+#[inline(always)]
+fn by_axis(p: [Vec3A; 4]) -> [Vec4; 3] {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{
+            __m128, _mm_movehl_ps, _mm_movelh_ps, _mm_unpackhi_ps, _mm_unpacklo_ps,
+        };
+        let [a, b, c, d] = p.map(__m128::from);
+        // SAFETY: SSE is part of every x86-64 CPU; these only move lanes.
+        unsafe {
+            let (ab_xy, cd_xy) = (_mm_unpacklo_ps(a, b), _mm_unpacklo_ps(c, d));
+            let (ab_zw, cd_zw) = (_mm_unpackhi_ps(a, b), _mm_unpackhi_ps(c, d));
+            [
+                _mm_movelh_ps(ab_xy, cd_xy),
+                _mm_movehl_ps(cd_xy, ab_xy),
+                _mm_movelh_ps(ab_zw, cd_zw),
+            ]
+            .map(Vec4::from)
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    [0, 1, 2].map(|d| Vec4::new(p[0][d], p[1][d], p[2][d], p[3][d]))
+}
+
+/// The four lanes of three axes' vectors as points (the inverse of [`by_axis`]).
+#[inline(always)]
+fn by_lane(v: &[Vec4; 3]) -> [Vec3A; 4] {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{
+            __m128, _mm_movehl_ps, _mm_movelh_ps, _mm_setzero_ps, _mm_unpackhi_ps, _mm_unpacklo_ps,
+        };
+        let [x, y, z] = v.map(__m128::from);
+        // SAFETY: SSE is part of every x86-64 CPU; these only move lanes.
+        unsafe {
+            let w = _mm_setzero_ps();
+            let (xy_01, zw_01) = (_mm_unpacklo_ps(x, y), _mm_unpacklo_ps(z, w));
+            let (xy_23, zw_23) = (_mm_unpackhi_ps(x, y), _mm_unpackhi_ps(z, w));
+            [
+                _mm_movelh_ps(xy_01, zw_01),
+                _mm_movehl_ps(zw_01, xy_01),
+                _mm_movelh_ps(xy_23, zw_23),
+                _mm_movehl_ps(zw_23, xy_23),
+            ]
+            .map(Vec3A::from)
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    std::array::from_fn(|l| Vec3A::new(v[0][l], v[1][l], v[2][l]))
 }
 
 /// The lanes (as bits) of hulls `b` ([`Lanes::hulls`]) not told `reach` apart from lane
@@ -261,6 +365,52 @@ mod tests {
             }
         }
         assert!(apart > 1000 && near > 1000, "{apart} apart, {near} near");
+    }
+
+    /// A leaf's lanes set at once hold, to the bit, the boxes each lane's triangle gets on
+    /// its own ([`One::of`]), for full leaves and for leaves of one to three; the widest
+    /// is the widest triangle's span; a full leaf's bounds are its lanes' boxes together.
+    #[test]
+    fn a_leaf_set_at_once_holds_each_triangles_own_boxes() {
+        let mut rnd = crate::test_rng::uniform(29);
+        let mut point = || Vec3A::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 3.0;
+        let from: Vec<Vec3A> = (0..40).map(|_| point()).collect();
+        let to: Vec<Vec3A> = (0..40).map(|_| point()).collect();
+        let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
+        for trial in 0..400 {
+            let count = 1 + trial % 4;
+            // Lanes past the count hold no particle's number, as in the tree.
+            let corners: Corners = [0, 11, 23].map(|offset| {
+                std::array::from_fn(|lane| {
+                    let first = (trial * 7 + lane * 13) as u32;
+                    if lane < count {
+                        (first + offset) % 40
+                    } else {
+                        u32::MAX
+                    }
+                })
+            });
+            let mut leaf = Lanes::default();
+            let widest = leaf.set_leaf(&corners, count, [&from, &to]);
+            let mut most = 0.0f32;
+            let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+            let (mut end_lo, mut end_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+            for lane in 0..count {
+                let own = One::of(corners.map(|c| c[lane]), [&from, &to]);
+                let set = leaf.one(lane);
+                assert_eq!(
+                    [set.lo, set.hi, set.end_lo, set.end_hi].map(bits),
+                    [own.lo, own.hi, own.end_lo, own.end_hi].map(bits),
+                    "trial {trial}, lane {lane}"
+                );
+                most = most.max((own.hi.max(own.end_hi) - own.lo.min(own.end_lo)).max_element());
+                (lo, hi) = (lo.min(own.lo), hi.max(own.hi));
+                (end_lo, end_hi) = (end_lo.min(own.end_lo), end_hi.max(own.end_hi));
+            }
+            assert_eq!(widest.to_bits(), most.to_bits(), "trial {trial}");
+            let ([l, h], [el, eh]) = leaf.bounds(count, true);
+            assert_eq!([l, h, el, eh].map(bits), [lo, hi, end_lo, end_hi].map(bits));
+        }
     }
 
     /// Two triangles moving along an axis, one by 5 cm and the other by 15 cm after it,
