@@ -65,7 +65,7 @@ impl Lanes {
     /// from `from` to `to`, a whole leaf at once: each corner's four particles taken into
     /// a vector an axis. The same boxes, to the bit, as [`One::of`] and [`Lanes::set`]
     /// give a lane at a time. Returns the widest a triangle's particles span along an
-    /// axis over the motion.
+    /// axis over the motion (0 for no triangle: the lanes are left as they are).
     #[inline(always)]
     pub(super) fn set_leaf(
         &mut self,
@@ -73,6 +73,9 @@ impl Lanes {
         count: usize,
         [from, to]: [&[Vec3A]; 2],
     ) -> f32 {
+        if count == 0 {
+            return 0.0;
+        }
         // Each corner's particle in each lane (the first triangle's past `count`).
         let ids = corners.map(|c| {
             std::array::from_fn::<usize, 4, _>(|l| c[if l < count { l } else { 0 }] as usize)
@@ -369,7 +372,8 @@ mod tests {
 
     /// A leaf's lanes set at once hold, to the bit, the boxes each lane's triangle gets on
     /// its own ([`One::of`]), for full leaves and for leaves of one to three; the widest
-    /// is the widest triangle's span; a full leaf's bounds are its lanes' boxes together.
+    /// is the widest triangle's span; a full leaf's bounds are its lanes' boxes together;
+    /// a leaf of none reads no particle.
     #[test]
     fn a_leaf_set_at_once_holds_each_triangles_own_boxes() {
         let mut rnd = crate::test_rng::uniform(29);
@@ -411,6 +415,9 @@ mod tests {
             let ([l, h], [el, eh]) = leaf.bounds(count, true);
             assert_eq!([l, h, el, eh].map(bits), [lo, hi, end_lo, end_hi].map(bits));
         }
+        // No triangle: no particle is read (every lane holds none's number).
+        let none = Lanes::default().set_leaf(&[[u32::MAX; 4]; 3], 0, [&from, &to]);
+        assert_eq!(none, 0.0);
     }
 
     /// Two triangles moving along an axis, one by 5 cm and the other by 15 cm after it,
