@@ -76,15 +76,25 @@ impl Lanes {
         if count == 0 {
             return 0.0;
         }
-        // Each corner's particle in each lane (the first triangle's past `count`).
-        let ids = corners.map(|c| {
-            std::array::from_fn::<usize, 4, _>(|l| c[if l < count { l } else { 0 }] as usize)
-        });
+        // Each corner's particle in each lane (the first triangle's past `count`). Spelled
+        // out rather than by arrays' `map`, which the compiler did not always inline here
+        // (its closures index, and may panic): the fit took 66 → 116 million instructions
+        // in `crumple`'s first second at 64² in a build that left them calls.
+        let lane = |l: usize| if l < count { l } else { 0 };
+        let (l1, l2, l3) = (lane(1), lane(2), lane(3));
+        let ids = |k: usize| {
+            let c = &corners[k];
+            [c[0], c[l1], c[l2], c[l3]]
+        };
+        let ids = [ids(0), ids(1), ids(2)];
         // Corner `k`'s four particles at `x`, an axis a vector.
-        let axes = |x: &[Vec3A], k: usize| by_axis(ids[k].map(|i| x[i]));
+        let axes = |x: &[Vec3A], k: usize| {
+            let [a, b, c, d] = ids[k];
+            by_axis([x[a as usize], x[b as usize], x[c as usize], x[d as usize]])
+        };
         let (s, e) = (
-            [0, 1, 2].map(|k| axes(from, k)),
-            [0, 1, 2].map(|k| axes(to, k)),
+            [axes(from, 0), axes(from, 1), axes(from, 2)],
+            [axes(to, 0), axes(to, 1), axes(to, 2)],
         );
         let mut widest = Vec4::ZERO;
         for d in 0..3 {
