@@ -46,8 +46,15 @@ fn searched(model: &ClothModel, start: &[Vec3], motion: Vec3) -> SelfContacts {
 fn searched_to(model: &ClothModel, start: &[Vec3], end: &[Vec3]) -> SelfContacts {
     let mut contacts = SelfContacts::default();
     contacts.prepare(model).unwrap();
-    contacts.relative(start, end, Vec3::ZERO, Vec3::ZERO);
-    contacts.update_pairs(model, THICKNESS, THICKNESS).unwrap();
+    let moved = Moved {
+        start,
+        end,
+        shift: Vec3::ZERO,
+        mean: Vec3::ZERO,
+    };
+    contacts
+        .update_pairs(model, THICKNESS, THICKNESS, Some(moved))
+        .unwrap();
     contacts
 }
 
@@ -95,8 +102,15 @@ fn refreshed(
     let end: Vec<Vec3> = (start.iter())
         .map(|&s| s + motion + if s.x < band { shift } else { Vec3::ZERO })
         .collect();
-    contacts.relative(&start, &end, Vec3::ZERO, Vec3::ZERO);
-    contacts.update_pairs(&model, THICKNESS, within).unwrap();
+    let moved = Moved {
+        start: &start,
+        end: &end,
+        shift: Vec3::ZERO,
+        mean: Vec3::ZERO,
+    };
+    contacts
+        .update_pairs(&model, THICKNESS, within, Some(moved))
+        .unwrap();
     let after = contacts.found.stored().copied().collect();
     (contacts, before, after)
 }
@@ -411,7 +425,9 @@ fn pairs_judged_by_the_motion_hold_within_the_slack() {
         );
         if motion == FAST && searched == 0 {
             let model = crumpled().0;
-            contacts.update_pairs(&model, THICKNESS, THICKNESS).unwrap();
+            contacts
+                .update_pairs(&model, THICKNESS, THICKNESS, None)
+                .unwrap();
             assert_eq!(contacts.work.searches + contacts.work.refreshes, 2);
         }
     }
@@ -629,8 +645,15 @@ fn creeping(model: &ClothModel, start: &[Vec3], v: f32) -> ([usize; 2], f32) {
     let (mut out, mut per_particle) = (Vec::new(), 0.0);
     for k in 1..100 {
         let found = contacts.found.len() as f32 / start.len() as f32;
-        contacts.relative(&at(k), &at(k + 1), Vec3::ZERO, Vec3::ZERO);
-        contacts.update_pairs(model, THICKNESS, THICKNESS).unwrap();
+        let moved = Moved {
+            start: &at(k),
+            end: &at(k + 1),
+            shift: Vec3::ZERO,
+            mean: Vec3::ZERO,
+        };
+        contacts
+            .update_pairs(model, THICKNESS, THICKNESS, Some(moved))
+            .unwrap();
         if contacts.work.searches + contacts.work.refreshes > 1 + out.len() as u64 {
             if out.is_empty() {
                 per_particle = found;
@@ -704,8 +727,13 @@ fn the_pairs_hold_for_the_motion_as_pushed_and_cut() {
         assert!(work.contacts > 100, "{work:?}");
         // Every particle checked again for the motion as it ended, in the frame it was
         // resolved in.
-        contacts.relative(&start, &state.pos, Vec3::ZERO, contacts.mean);
-        (contacts.update_pairs(&model, THICKNESS, CHECKED * THICKNESS)).unwrap();
+        let moved = Moved {
+            start: &start,
+            end: &state.pos,
+            shift: Vec3::ZERO,
+            mean: contacts.mean,
+        };
+        (contacts.update_pairs(&model, THICKNESS, CHECKED * THICKNESS, Some(moved))).unwrap();
         let again = contacts.work;
         assert_eq!(
             (again.searches, again.refreshes),

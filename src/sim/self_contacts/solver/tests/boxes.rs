@@ -21,8 +21,13 @@ fn flat(quads: u32) -> (ClothModel, Vec<Vec3>) {
 /// for thickness [`T`], finding them (again) where it must.
 fn step(contacts: &mut SelfContacts, model: &ClothModel, start: &[Vec3], end: &[Vec3]) {
     contacts.prepare(model).unwrap();
-    contacts.relative(start, end, Vec3::ZERO, Vec3::ZERO);
-    contacts.update_pairs(model, T, T).unwrap();
+    let moved = Moved {
+        start,
+        end,
+        shift: Vec3::ZERO,
+        mean: Vec3::ZERO,
+    };
+    contacts.update_pairs(model, T, T, Some(moved)).unwrap();
 }
 
 /// A solver with the pairs found, for thickness [`T`], for the motion from `start` to

@@ -46,7 +46,9 @@ fn particles_that_leave_a_window_get_paths_of_their_own() {
             assert_eq!((contacts.window.len, contacts.window.at), (2, 1));
             assert_eq!(contacts.work.refreshes, 1, "{:?}", contacts.work);
             let work = contacts.work;
-            contacts.update_pairs(model, THICKNESS, THICKNESS).unwrap();
+            contacts
+                .update_pairs(model, THICKNESS, THICKNESS, None)
+                .unwrap();
             assert_eq!(contacts.work, work, "checked again");
         }
     });
@@ -181,8 +183,15 @@ fn hold_through(
     [start, end]: [&[Vec3]; 2],
 ) -> usize {
     contacts.window.at += 1;
-    contacts.relative(start, end, Vec3::ZERO, Vec3::ZERO);
-    contacts.update_pairs(model, THICKNESS, THICKNESS).unwrap();
+    let moved = Moved {
+        start,
+        end,
+        shift: Vec3::ZERO,
+        mean: Vec3::ZERO,
+    };
+    contacts
+        .update_pairs(model, THICKNESS, THICKNESS, Some(moved))
+        .unwrap();
     assert!(contacts.boxes.swept);
     let held: std::collections::HashSet<[u32; 5]> = (contacts.found.stored())
         .map(|p| pair_key(&p.expand(&model.triangles, &contacts.owners.edges)))
