@@ -3,11 +3,13 @@
 //! then an inelastic velocity response with Coulomb friction against the surface's own
 //! velocity (a spinning sphere drags the cloth).
 
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use glam::Vec3;
 
 use super::effect_kind::ContactPass;
+use crate::mesh::bounds;
 use crate::parallel::{Disjoint, each_part, within};
 use crate::sim::obstacle::Gathered;
 
@@ -59,6 +61,14 @@ pub(super) trait Solid {
 
     /// Coulomb friction coefficient (dimensionless, ≥ 0).
     fn friction(&self) -> f32;
+
+    /// Whether every move within the box `lo..hi` keeps farther than `offset` from the
+    /// surface, with a margin no rounding of [`Solid::catch`] bridges (by default no box
+    /// is: every move is tested on its own). See [`resolve_in_boxes`].
+    #[inline]
+    fn box_clear(&self, _lo: Vec3, _hi: Vec3, _offset: f32) -> bool {
+        false
+    }
 }
 
 /// Resolves every free particle's move in this substep, from `pass.start` to where the
@@ -93,6 +103,46 @@ pub(super) fn resolve_remembering(
         contacts.fetch_add(found, Ordering::Relaxed);
     });
     contacts.into_inner()
+}
+
+/// [`resolve`] for a solid that tells boxes of moves clear ([`Solid::box_clear`]): each
+/// member takes the box of its particles' moves first and tests none of them where that box
+/// is clear (a cloth falling onto a sphere, still above it, moves none). Returns how many
+/// particles it moved and the box of every particle's move as the integrator left it
+/// (`(0, 0)` for no particle). The result is the same however the particles are cut: a
+/// move in a clear box is not caught either way.
+pub(super) fn resolve_in_boxes(
+    solid: &(impl Solid + Sync),
+    pass: &mut ContactPass<'_>,
+) -> (usize, (Vec3, Vec3)) {
+    let (start, inv_mass) = (pass.start, &pass.model.inv_mass[..]);
+    let contacts = AtomicUsize::new(0);
+    let state = &mut *pass.state;
+    let offset = pass.offset;
+    // The parts' boxes, joined as they come: a least and a greatest, in any order.
+    let joined: Mutex<Option<(Vec3, Vec3)>> = Mutex::new(None);
+    each_part([&mut state.pos, &mut state.vel], |range, [pos, vel]| {
+        let (start, inv_mass) = (within(start, range.clone()), within(inv_mass, range));
+        let part = join(bounds(start), bounds(pos));
+        if !start.is_empty() && !solid.box_clear(part.0, part.1, offset) {
+            let found = resolve_part(solid, offset, pos, vel, start, inv_mass, None);
+            contacts.fetch_add(found, Ordering::Relaxed);
+        }
+        if !start.is_empty() {
+            let mut joined = joined.lock().unwrap_or_else(|e| e.into_inner());
+            *joined = Some(joined.map_or(part, |all| join(all, part)));
+        }
+    });
+    let joined = joined.into_inner().unwrap_or_else(|e| e.into_inner());
+    (
+        contacts.into_inner(),
+        joined.unwrap_or((Vec3::ZERO, Vec3::ZERO)),
+    )
+}
+
+/// The box of two boxes.
+fn join(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> (Vec3, Vec3) {
+    (a.0.min(b.0), a.1.max(b.1))
 }
 
 /// [`resolve`] over one run of particles.
