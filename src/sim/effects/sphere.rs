@@ -249,6 +249,24 @@ mod tests {
     use super::*;
     use crate::mesh::bounds;
 
+    /// A substep of 10 ms of `model` from `start` to `state`, an offset of 1 cm, no faces.
+    fn pass_of<'a>(
+        model: &'a crate::cloth::ClothModel,
+        start: &'a [Vec3],
+        state: &'a mut crate::cloth::ClothState,
+        self_contacts: &'a mut crate::sim::self_contacts::SelfContacts,
+    ) -> ContactPass<'a> {
+        ContactPass {
+            model,
+            start,
+            substep: 0.01,
+            state,
+            offset: 0.01,
+            self_contacts,
+            faces: None,
+        }
+    }
+
     /// A 4 × 4-quad cloth 1 m wide falls from 1 m above a sphere of 10 cm to 1 m below it
     /// within one substep: it starts and ends far from the sphere, yet the path of its
     /// middle particle goes through it, and is caught where it enters: that particle ends
@@ -277,15 +295,7 @@ mod tests {
         let mut fall = |by: f32| {
             let mut state = ClothState::at_rest(&model);
             state.pos.iter_mut().for_each(|p| p.y -= by);
-            let mut pass = ContactPass {
-                model: &model,
-                start: &start,
-                substep: 0.01,
-                state: &mut state,
-                offset: 0.01,
-                self_contacts: &mut self_contacts,
-                faces: None,
-            };
+            let mut pass = pass_of(&model, &start, &mut state, &mut self_contacts);
             let moved = sphere.resolve(&mut pass).unwrap();
             (moved, state.pos)
         };
@@ -339,15 +349,7 @@ mod tests {
             }
             let both: Vec<Vec3> = start.iter().chain(&state.pos).copied().collect();
             let mut self_contacts = SelfContacts::default();
-            let mut pass = ContactPass {
-                model: &model,
-                start: &start,
-                substep: 0.01,
-                state: &mut state,
-                offset: 0.01,
-                self_contacts: &mut self_contacts,
-                faces: None,
-            };
+            let mut pass = pass_of(&model, &start, &mut state, &mut self_contacts);
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()

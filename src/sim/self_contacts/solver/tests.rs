@@ -46,12 +46,7 @@ fn searched(model: &ClothModel, start: &[Vec3], motion: Vec3) -> SelfContacts {
 fn searched_to(model: &ClothModel, start: &[Vec3], end: &[Vec3]) -> SelfContacts {
     let mut contacts = SelfContacts::default();
     contacts.prepare(model).unwrap();
-    let moved = Moved {
-        start,
-        end,
-        shift: Vec3::ZERO,
-        mean: Vec3::ZERO,
-    };
+    let moved = Moved::plain(start, end);
     contacts
         .update_pairs(model, THICKNESS, THICKNESS, Some(moved))
         .unwrap();
@@ -102,12 +97,7 @@ fn refreshed(
     let end: Vec<Vec3> = (start.iter())
         .map(|&s| s + motion + if s.x < band { shift } else { Vec3::ZERO })
         .collect();
-    let moved = Moved {
-        start: &start,
-        end: &end,
-        shift: Vec3::ZERO,
-        mean: Vec3::ZERO,
-    };
+    let moved = Moved::plain(&start, &end);
     contacts
         .update_pairs(&model, THICKNESS, within, Some(moved))
         .unwrap();
@@ -629,6 +619,18 @@ fn pairs_judged_by_the_boxes_are_kept_exactly_where_their_balls_come_near() {
 mod boxes;
 mod windows;
 
+impl<'a> Moved<'a> {
+    /// The motion from `start` to `end` in a frame that has not moved.
+    fn plain(start: &'a [Vec3], end: &'a [Vec3]) -> Self {
+        Moved {
+            start,
+            end,
+            shift: Vec3::ZERO,
+            mean: Vec3::ZERO,
+        }
+    }
+}
+
 /// The substeps (counted from 1) at which the particles of `start`'s left half, creeping
 /// along x at `v` a substep while the rest stays, leave their boxes the first and the
 /// second time, and the pairs per particle the first time (whose count the new boxes are
@@ -645,12 +647,8 @@ fn creeping(model: &ClothModel, start: &[Vec3], v: f32) -> ([usize; 2], f32) {
     let (mut out, mut per_particle) = (Vec::new(), 0.0);
     for k in 1..100 {
         let found = contacts.found.len() as f32 / start.len() as f32;
-        let moved = Moved {
-            start: &at(k),
-            end: &at(k + 1),
-            shift: Vec3::ZERO,
-            mean: Vec3::ZERO,
-        };
+        let (from, to) = (at(k), at(k + 1));
+        let moved = Moved::plain(&from, &to);
         contacts
             .update_pairs(model, THICKNESS, THICKNESS, Some(moved))
             .unwrap();

@@ -21,12 +21,7 @@ fn flat(quads: u32) -> (ClothModel, Vec<Vec3>) {
 /// for thickness [`T`], finding them (again) where it must.
 fn step(contacts: &mut SelfContacts, model: &ClothModel, start: &[Vec3], end: &[Vec3]) {
     contacts.prepare(model).unwrap();
-    let moved = Moved {
-        start,
-        end,
-        shift: Vec3::ZERO,
-        mean: Vec3::ZERO,
-    };
+    let moved = Moved::plain(start, end);
     contacts.update_pairs(model, T, T, Some(moved)).unwrap();
 }
 

@@ -183,12 +183,7 @@ fn hold_through(
     [start, end]: [&[Vec3]; 2],
 ) -> usize {
     contacts.window.at += 1;
-    let moved = Moved {
-        start,
-        end,
-        shift: Vec3::ZERO,
-        mean: Vec3::ZERO,
-    };
+    let moved = Moved::plain(start, end);
     contacts
         .update_pairs(model, THICKNESS, THICKNESS, Some(moved))
         .unwrap();
