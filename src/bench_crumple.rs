@@ -40,6 +40,12 @@ pub struct CrumpleRow {
     /// The contact phases' time over the springs' in the same substeps (0 without
     /// springs).
     pub contact_per_springs: f64,
+    /// Self-contact alone (its pass and its recheck), per substep, µs: the contact phases
+    /// less the solids'.
+    pub self_contact_us: f64,
+    /// Self-contact's time over the springs' in the same substeps (0 without springs):
+    /// what the 70–77× that self-collision cost when self-contact was planned measured.
+    pub self_per_springs: f64,
     /// The runs the row's times are the medians of ([`median_row`]); 1 for one run.
     pub runs: usize,
     /// Pairs the search kept per particle, averaged over the last substep of each frame.
@@ -84,13 +90,19 @@ pub fn crumple_one(
     }
     let wall = start.elapsed().as_secs_f64();
     let timings = sim.take_timings();
-    let phase = |name| timings.totals(name);
+    let phase = |name: &str| timings.totals(name);
     // Every substep resolves self-contact once (XPBD has no spring-force phase).
     let (springs, substeps) = (phase("springs").0, phase("self-collision").1);
-    let contact: Duration = ["self-collision", "self-recheck", "sphere", "plane"]
-        .iter()
-        .map(|&name| phase(name).0)
-        .sum();
+    let sum = |names: [&str; 2]| -> Duration { names.iter().map(|&name| phase(name).0).sum() };
+    let own = sum(["self-collision", "self-recheck"]);
+    let contact = own + sum(["sphere", "plane"]);
+    let over_springs = |t: Duration| {
+        if springs.is_zero() {
+            0.0
+        } else {
+            t.as_secs_f64() / springs.as_secs_f64()
+        }
+    };
     let per = |t: Duration| t.as_secs_f64() * 1e6 / substeps.max(1) as f64;
     let particles = sim.model().particle_count();
     let work = sim.self_collision_work().unwrap_or_default();
@@ -104,11 +116,9 @@ pub fn crumple_one(
         contact_us: per(contact),
         setup_ms: setup.as_secs_f64() * 1e3,
         springs_us: per(springs),
-        contact_per_springs: if springs.is_zero() {
-            0.0
-        } else {
-            contact.as_secs_f64() / springs.as_secs_f64()
-        },
+        contact_per_springs: over_springs(contact),
+        self_contact_us: per(own),
+        self_per_springs: over_springs(own),
         runs: 1,
         pairs_per_particle: pairs as f64 / sampled.max(1) as f64 / particles as f64,
         searches_per_substep: searches as f64 / sampled.max(1) as f64,
@@ -136,6 +146,8 @@ pub fn median_row(runs: &[CrumpleRow]) -> Option<CrumpleRow> {
         setup_ms: median(|r| r.setup_ms),
         springs_us: median(|r| r.springs_us),
         contact_per_springs: median(|r| r.contact_per_springs),
+        self_contact_us: median(|r| r.self_contact_us),
+        self_per_springs: median(|r| r.self_per_springs),
         runs: runs.len(),
         ..first.clone()
     })
@@ -157,6 +169,8 @@ mod tests {
             setup_ms: 1.0,
             springs_us,
             contact_per_springs: contact_us / springs_us,
+            self_contact_us: 0.8 * contact_us,
+            self_per_springs: 0.8 * contact_us / springs_us,
             pairs_per_particle: 0.5,
             searches_per_substep: 0.1,
             refreshes_per_substep: 0.2,
@@ -177,6 +191,7 @@ mod tests {
             (400.0, 30.0, 4.0)
         );
         assert_eq!((m.contact_per_springs, m.runs), (10.0, 3));
+        assert_eq!((m.self_contact_us, m.self_per_springs), (320.0, 8.0));
         assert_eq!((m.quads, m.pairs_per_particle), (8, 0.5));
         let even = median_row(&runs[..2]).unwrap();
         assert_eq!((even.contact_us, even.contact_per_springs), (400.0, 15.0));

@@ -265,6 +265,15 @@ fn crumple_bench_prints_a_row_per_size_and_integrator() {
         // 60 frames of the scene's 4 substeps.
         assert_eq!(row["substeps"], 240, "{row}");
         assert!(row["contact_us"].as_f64().unwrap() > 0.0, "{row}");
+        // Self-contact is one of the contact phases (and the rows' medians keep the order
+        // each run's times have).
+        let own = row["self_contact_us"].as_f64().unwrap();
+        assert!(
+            own > 0.0 && own <= row["contact_us"].as_f64().unwrap(),
+            "{row}"
+        );
+        let ratios = ["self_per_springs", "contact_per_springs"].map(|k| row[k].as_f64().unwrap());
+        assert!(ratios[0] <= ratios[1], "{row}");
         assert_eq!(row["forced"], 0, "{row}");
         // Each row the medians of its two runs.
         assert_eq!(row["runs"], 2, "{row}");

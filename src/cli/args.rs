@@ -162,7 +162,8 @@ pub enum Command {
         obstacles: bool,
         /// Instead: the `crumple` scene's first simulated second at --quads (its own
         /// integrator, or each of --integrators), the contact phases per substep
-        /// against the springs' and the pairs per particle (per --threads).
+        /// against the springs', self-contact's alone, and the pairs per particle (per
+        /// --threads).
         #[arg(long, conflicts_with_all = ["sizes", "backend", "obstacles", "seconds"])]
         crumple: bool,
         /// Comma-separated grid sizes (quads a side) for --crumple.

@@ -215,7 +215,7 @@ pub fn crumple_bench(
     }
     if !json {
         println!(
-            "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11} {:>9} {:>13} {:>13} {:>9} {:>11} {:>9} {:>9}",
+            "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11} {:>9} {:>13} {:>13} {:>9} {:>10} {:>9} {:>11} {:>9} {:>9}",
             "quads",
             "particles",
             "integrator",
@@ -226,6 +226,8 @@ pub fn crumple_bench(
             "contact µs/ss",
             "springs µs/ss",
             "× springs",
+            "self µs/ss",
+            "self ×",
             "pairs/part.",
             "searches",
             "refreshes",
@@ -236,7 +238,7 @@ pub fn crumple_bench(
             println!("{}", serde_json::to_string(&row)?);
         } else {
             println!(
-                "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11.2} {:>9.1} {:>13.1} {:>13.1} {:>9} {:>11.4} {:>9.2} {:>9.2}",
+                "{:>6} {:>9} {:<20} {:>7} {:>8} {:>11.2} {:>9.1} {:>13.1} {:>13.1} {:>9} {:>10.1} {:>9} {:>11.4} {:>9.2} {:>9.2}",
                 row.quads,
                 row.particles,
                 row.integrator,
@@ -247,6 +249,8 @@ pub fn crumple_bench(
                 row.contact_us,
                 row.springs_us,
                 ratio(row.contact_per_springs),
+                row.self_contact_us,
+                ratio(row.self_per_springs),
                 row.pairs_per_particle,
                 row.searches_per_substep,
                 row.refreshes_per_substep,
