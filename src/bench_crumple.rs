@@ -11,7 +11,10 @@ use serde::Serialize;
 use crate::bench_contact::ContactBenchError;
 use crate::mesh::ImportOptions;
 use crate::scene::{Scene, Simulation};
-use crate::sim::IntegratorKind;
+use crate::sim::effects::EffectKind;
+use crate::sim::{
+    ClothSprings, IntegratorKind, PhaseTimings, Plane, SELF_RECHECK, SelfCollision, Sphere,
+};
 
 /// The simulated seconds timed.
 pub const CRUMPLE_SECONDS: f64 = 1.0;
@@ -43,8 +46,9 @@ pub struct CrumpleRow {
     /// Self-contact alone (its pass and its recheck), per substep, µs: the contact phases
     /// less the solids'.
     pub self_contact_us: f64,
-    /// Self-contact's time over the springs' in the same substeps (0 without springs):
-    /// what the 70–77× that self-collision cost when self-contact was planned measured.
+    /// Self-contact's time over the springs' in the same substeps (0 without springs): the
+    /// measure of the 70–77× self-collision cost before its tree (docs/performance.md,
+    /// "Self-contact").
     pub self_per_springs: f64,
     /// The runs the row's times are the medians of ([`median_row`]); 1 for one run.
     pub runs: usize,
@@ -90,12 +94,9 @@ pub fn crumple_one(
     }
     let wall = start.elapsed().as_secs_f64();
     let timings = sim.take_timings();
-    let phase = |name: &str| timings.totals(name);
     // Every substep resolves self-contact once (XPBD has no spring-force phase).
-    let (springs, substeps) = (phase("springs").0, phase("self-collision").1);
-    let sum = |names: [&str; 2]| -> Duration { names.iter().map(|&name| phase(name).0).sum() };
-    let own = sum(["self-collision", "self-recheck"]);
-    let contact = own + sum(["sphere", "plane"]);
+    let substeps = timings.totals(SelfCollision::NAME).1;
+    let [springs, own, contact] = phase_times(&timings);
     let over_springs = |t: Duration| {
         if springs.is_zero() {
             0.0
@@ -125,6 +126,18 @@ pub fn crumple_one(
         refreshes_per_substep: refreshes as f64 / sampled.max(1) as f64,
         forced: work.forced_total,
     })
+}
+
+/// The springs' time, self-contact's (its pass and its recheck) and the contact phases'
+/// (self-contact's and the solids': `crumple`'s sphere and ground), from a run's timings.
+fn phase_times(timings: &PhaseTimings) -> [Duration; 3] {
+    let time = |name: &str| timings.totals(name).0;
+    let own = time(SelfCollision::NAME) + time(SELF_RECHECK);
+    [
+        time(ClothSprings::NAME),
+        own,
+        own + time(Sphere::NAME) + time(Plane::NAME),
+    ]
 }
 
 /// One row for several runs of the same: each time, and the ratio of the contact phases to
@@ -177,6 +190,27 @@ mod tests {
             forced: 0,
             runs: 1,
         }
+    }
+
+    /// The contact phases are self-contact's pass and recheck and the solids'; the springs
+    /// are their own phase; the other phases count in none of them.
+    #[test]
+    fn the_contact_phases_are_self_contacts_and_the_solids() {
+        let mut timings = PhaseTimings::default();
+        let ms = Duration::from_millis;
+        for (name, t) in [
+            ("springs", 1),
+            ("self-collision", 30),
+            ("self-recheck", 4),
+            ("sphere", 200),
+            ("plane", 1000),
+            ("solve", 7000),
+            ("self-setup", 50_000),
+        ] {
+            timings.add(name, ms(t));
+        }
+        assert_eq!(phase_times(&timings), [ms(1), ms(34), ms(1234)]);
+        assert_eq!(phase_times(&PhaseTimings::default()), [Duration::ZERO; 3]);
     }
 
     /// Each time is its own median, and so is the ratio: the ratio of the medians would

@@ -229,7 +229,7 @@ impl<R: Real> CpuStepper<R> {
                     let motion = [pass.start, &placed[..]];
                     (pass.self_contacts).settle(own.thickness, h, model, motion, pass.state)
                 };
-                if self.timings.time("self-recheck", settle)? == 0 {
+                if self.timings.time(super::SELF_RECHECK, settle)? == 0 {
                     break;
                 }
             }

@@ -6,6 +6,10 @@
 /// self-contact), when a stepper takes self-collision on: once, before the substeps.
 pub const SELF_SETUP: &str = "self-setup";
 
+/// The phase that times self-contact's recheck after the solids moved the cloth again
+/// ([`super::SelfContacts::settle`]).
+pub const SELF_RECHECK: &str = "self-recheck";
+
 /// Work done by the last resolve: for cost checks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub struct SelfWork {
