@@ -616,7 +616,7 @@ impl<F: Fn(&mut Lanes, &[u32], &Corners) -> f32 + Sync> SetLane for F {}
 /// span along an axis over the motion.
 fn set_motion(lanes: &mut Lanes, lane: usize, one: One) -> f32 {
     lanes.set(lane, one);
-    (one.hi.max(one.end_hi) - one.lo.min(one.end_lo)).max_element()
+    one.widest()
 }
 
 /// What fitting a node reads: the tree's nodes, each node's leaf, and whether by motion.

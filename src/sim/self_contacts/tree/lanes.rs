@@ -29,6 +29,11 @@ impl One {
             end_hi: d.max(e).max(f),
         }
     }
+
+    /// The widest its particles span along an axis over the motion.
+    pub(super) fn widest(&self) -> f32 {
+        (self.hi.max(self.end_hi) - self.lo.min(self.end_lo)).max_element()
+    }
 }
 
 /// A leaf's triangles' boxes (as [`One`]), one lane each in the tree's order, a vector an
@@ -403,7 +408,7 @@ mod tests {
                     [own.lo, own.hi, own.end_lo, own.end_hi].map(bits),
                     "trial {trial}, lane {lane}"
                 );
-                most = most.max((own.hi.max(own.end_hi) - own.lo.min(own.end_lo)).max_element());
+                most = most.max(own.widest());
                 (lo, hi) = (lo.min(own.lo), hi.max(own.hi));
                 (end_lo, end_hi) = (end_lo.min(own.end_lo), end_hi.max(own.end_hi));
             }
