@@ -90,19 +90,7 @@ pub(super) fn resolve_remembering(
     pass: &mut ContactPass<'_>,
     memory: Option<&mut [Gathered]>,
 ) -> usize {
-    let (start, inv_mass) = (pass.start, &pass.model.inv_mass[..]);
-    let contacts = AtomicUsize::new(0);
-    let state = &mut *pass.state;
-    let offset = pass.offset;
-    let memory = memory.map(Disjoint::new);
-    each_part([&mut state.pos, &mut state.vel], |range, [pos, vel]| {
-        // SAFETY: `each_part`'s ranges are disjoint, so are these parts of the memory.
-        let memory = memory.as_ref().map(|m| unsafe { m.part(range.clone()) });
-        let (start, inv_mass) = (within(start, range.clone()), within(inv_mass, range));
-        let found = resolve_part(solid, offset, pos, vel, start, inv_mass, memory);
-        contacts.fetch_add(found, Ordering::Relaxed);
-    });
-    contacts.into_inner()
+    resolve_parts(solid, pass, memory, false).0
 }
 
 /// [`resolve`] for a solid that tells boxes of moves clear ([`Solid::box_clear`]): each
@@ -115,29 +103,46 @@ pub(super) fn resolve_in_boxes(
     solid: &(impl Solid + Sync),
     pass: &mut ContactPass<'_>,
 ) -> (usize, (Vec3, Vec3)) {
+    let (contacts, joined) = resolve_parts(solid, pass, None, true);
+    (contacts, joined.unwrap_or((Vec3::ZERO, Vec3::ZERO)))
+}
+
+/// The one loop of [`resolve_remembering`] and [`resolve_in_boxes`]: each member resolves
+/// its part of the particles (with its part of `memory`); where `boxed`, it first takes
+/// its part's box of moves, joins it to the others' (returned: `None` for no particle),
+/// and passes the part by where that box is clear.
+fn resolve_parts(
+    solid: &(impl Solid + Sync),
+    pass: &mut ContactPass<'_>,
+    memory: Option<&mut [Gathered]>,
+    boxed: bool,
+) -> (usize, Option<(Vec3, Vec3)>) {
     let (start, inv_mass) = (pass.start, &pass.model.inv_mass[..]);
     let contacts = AtomicUsize::new(0);
     let state = &mut *pass.state;
     let offset = pass.offset;
+    let memory = memory.map(Disjoint::new);
     // The parts' boxes, joined as they come: a least and a greatest, in any order.
     let joined: Mutex<Option<(Vec3, Vec3)>> = Mutex::new(None);
     each_part([&mut state.pos, &mut state.vel], |range, [pos, vel]| {
+        // SAFETY: `each_part`'s ranges are disjoint, so are these parts of the memory.
+        let memory = memory.as_ref().map(|m| unsafe { m.part(range.clone()) });
         let (start, inv_mass) = (within(start, range.clone()), within(inv_mass, range));
-        let part = join(bounds(start), bounds(pos));
-        if !start.is_empty() && !solid.box_clear(part.0, part.1, offset) {
-            let found = resolve_part(solid, offset, pos, vel, start, inv_mass, None);
-            contacts.fetch_add(found, Ordering::Relaxed);
+        if boxed && !start.is_empty() {
+            let part = join(bounds(start), bounds(pos));
+            {
+                let mut joined = joined.lock().unwrap_or_else(|e| e.into_inner());
+                *joined = Some(joined.map_or(part, |all| join(all, part)));
+            }
+            if solid.box_clear(part.0, part.1, offset) {
+                return;
+            }
         }
-        if !start.is_empty() {
-            let mut joined = joined.lock().unwrap_or_else(|e| e.into_inner());
-            *joined = Some(joined.map_or(part, |all| join(all, part)));
-        }
+        let found = resolve_part(solid, offset, pos, vel, start, inv_mass, memory);
+        contacts.fetch_add(found, Ordering::Relaxed);
     });
     let joined = joined.into_inner().unwrap_or_else(|e| e.into_inner());
-    (
-        contacts.into_inner(),
-        joined.unwrap_or((Vec3::ZERO, Vec3::ZERO)),
-    )
+    (contacts.into_inner(), joined)
 }
 
 /// The box of two boxes.
