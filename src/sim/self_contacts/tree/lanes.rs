@@ -181,9 +181,9 @@ impl Lanes {
     #[inline(always)]
     pub(super) fn bounds(&self, count: usize, moving: bool) -> ([Vec3A; 2], [Vec3A; 2]) {
         // Each bound's lanes back into points, the first `count` of them joined.
-        let join = |v: &[Vec4; 3], start: Vec3A, join: fn(Vec3A, Vec3A) -> Vec3A| {
+        let join = |v: &[Vec4; 3], start: Vec3A, with: fn(Vec3A, Vec3A) -> Vec3A| {
             let points = by_lane(v);
-            (0..4).fold(start, |m, l| if l < count { join(m, points[l]) } else { m })
+            (0..4).fold(start, |m, l| if l < count { with(m, points[l]) } else { m })
         };
         let least = |v| join(v, Vec3A::INFINITY, Vec3A::min);
         let most = |v| join(v, Vec3A::NEG_INFINITY, Vec3A::max);
