@@ -262,9 +262,12 @@ fn never_passes_through_under(
     }
 }
 
+/// At its own 32² and for 2 s, where it lands on the sphere and folds onto the ground: at
+/// 16² for 1.5 s it kept free of itself under every integrator even with the edge–edge pairs
+/// left out; here five of the eight cross.
 #[test]
 fn crumple_never_passes_through_itself() {
-    never_passes_through_under(&IntegratorKind::ALL, "crumple", Some(16), 24, 1.5);
+    never_passes_through_under(&IntegratorKind::ALL, "crumple", Some(32), 24, 2.0);
 }
 
 #[test]
