@@ -842,7 +842,7 @@ fn phases_of(scene: &str, change: impl FnOnce(&mut Vec<Effect>)) -> Vec<String> 
 #[test]
 fn only_the_effects_a_scene_lists_appear_as_phases() {
     let hanging = phases_of("hanging", |_| {});
-    for absent in ["sphere", "plane", "self-collision", "wind"] {
+    for absent in ["sphere", "plane", "self-collision", "self-upkeep", "wind"] {
         assert!(
             !hanging.iter().any(|p| p == absent),
             "{absent} in {hanging:?}"
@@ -859,6 +859,8 @@ fn only_the_effects_a_scene_lists_appear_as_phases() {
         drop.contains(&"sphere".into()) && drop.contains(&"plane".into()),
         "{drop:?}"
     );
+    // Self-contact's upkeep between the effects runs only with self-contact.
+    assert!(!drop.contains(&"self-upkeep".into()), "{drop:?}");
     assert!(phases_of("flag", |_| {}).contains(&"wind".into()));
     assert!(phases_of("self-fold", |_| {}).contains(&"self-collision".into()));
     // Adding an effect adds its phase; removing one removes it.
@@ -868,6 +870,7 @@ fn only_the_effects_a_scene_lists_appear_as_phases() {
         e.push(Effect::SelfCollision(SelfCollision::default()))
     });
     assert!(folding.contains(&"self-collision".into()), "{folding:?}");
+    assert!(folding.contains(&"self-upkeep".into()), "{folding:?}");
     let limp = phases_of("hanging", |e| {
         e.retain(|e| !matches!(e, Effect::Bending(_)))
     });

@@ -17,6 +17,7 @@ use super::guard_state::GuardState;
 use super::integrator::{
     Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport,
 };
+use super::kernels::{take_changes, take_moves};
 use super::params::{Changes, SimParams, SolverConfig};
 use super::precise_state::{PreciseState, as_f32, f32_view};
 use super::precision::Precision;
@@ -27,6 +28,14 @@ use super::timings::PhaseTimings;
 /// Rounds of solids then the self-contact check after self-contact, at most: another
 /// round only follows one whose check had to cut.
 const RECHECKS: usize = 3;
+
+/// Runs `work`, adding its wall time to `spent`.
+fn timed<T>(spent: &mut Duration, work: impl FnOnce() -> T) -> T {
+    let start = Instant::now();
+    let out = work();
+    *spent += start.elapsed();
+    out
+}
 
 /// Advances a cloth on the CPU, its forces and integrator computing in precision `R`
 /// (`f32`, or `f64` on a state of its own whose rounding the caller sees). Built from a
@@ -193,17 +202,21 @@ impl<R: Real> CpuStepper<R> {
             self_contacts: &mut self.self_contacts,
             faces: (self.self_collision.is_some()).then_some(&mut self.faces),
         };
+        // Self-contact's upkeep between the effects, timed as a phase of its own.
+        let mut upkeep = Duration::ZERO;
         if self.self_collision.is_some() {
-            self.before_solids.clone_from(&pass.state.pos);
+            timed(&mut upkeep, || {
+                self.before_solids.clone_from(&pass.state.pos)
+            });
         }
         for c in &self.contacts {
             if matches!(c, Effect::SelfCollision(_)) {
-                // What the solids moved rests on them.
+                // What the solids moved rests on them; self-contact starts from where they
+                // left the cloth (it comes last).
                 let held = &mut pass.self_contacts.held;
-                held.clear();
-                held.extend((self.before_solids.iter().zip(&pass.state.pos)).map(|(a, b)| a != b));
-                // Where self-contact starts from (it comes last).
-                self.before_solids.clone_from(&pass.state.pos);
+                timed(&mut upkeep, || {
+                    take_moves(&mut self.before_solids, &pass.state.pos, held)
+                });
             }
             contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
         }
@@ -213,15 +226,21 @@ impl<R: Real> CpuStepper<R> {
         // meet.
         if let Some(own) = self.self_collision
             && self.contacts.len() > 1
-            && self.before_solids != pass.state.pos
+            && timed(&mut upkeep, || {
+                take_changes(&mut self.before_solids, &pass.state.pos)
+            })
         {
-            for _ in 0..RECHECKS {
-                self.before_solids.clone_from(&pass.state.pos);
+            for round in 0..RECHECKS {
+                if round > 0 {
+                    timed(&mut upkeep, || {
+                        take_changes(&mut self.before_solids, &pass.state.pos)
+                    });
+                }
                 for c in self.contacts.iter().filter(|c| c.is_solid()) {
                     contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
                 }
                 // Nothing moved since self-contact: nothing to check.
-                if self.before_solids == pass.state.pos {
+                if !timed(&mut upkeep, || self.before_solids != pass.state.pos) {
                     break;
                 }
                 let (placed, h) = (&self.before_solids, pass.substep);
@@ -233,6 +252,9 @@ impl<R: Real> CpuStepper<R> {
                     break;
                 }
             }
+        }
+        if self.self_collision.is_some() {
+            self.timings.add(super::SELF_UPKEEP, upkeep);
         }
         if contacts > 0 {
             // Contacts changed positions and velocities after the integrator's step.

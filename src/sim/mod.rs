@@ -48,7 +48,7 @@ pub use param_error::ParamError;
 pub use params::{Changes, ContactConfig, Material, SimParams, SolverConfig, StepConfig};
 pub use precision::Precision;
 pub use self_contacts::{
-    ContactError, SELF_RECHECK, SELF_SETUP, SelfContacts, SelfWork, owned_parts,
+    ContactError, SELF_RECHECK, SELF_SETUP, SELF_UPKEEP, SelfContacts, SelfWork, owned_parts,
 };
 pub use stats::StepStats;
 pub use timings::{Phase, PhaseTimings};

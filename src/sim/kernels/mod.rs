@@ -17,7 +17,7 @@ pub use crate::cloth::Real;
 pub use components::{
     Blocks, Components, Scratch, blocks_times, join, split, split_blocks, zeroed,
 };
-pub use points::{leaves, less_into, outside};
+pub use points::{leaves, less_into, outside, take_changes, take_moves};
 pub use run_pass::Projectors;
 pub use spring_runs::SpringRuns;
 pub use two_passes::{BlockPass, TwoPasses};

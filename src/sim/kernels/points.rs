@@ -77,6 +77,56 @@ pub fn leaves(from: Vec3, to: Vec3, [lo, hi]: [Vec3; 2], g: f32) -> bool {
     !((s.min(p) - g).cmpge(lo.into()).all() && (s.max(p) + g).cmple(hi.into()).all())
 }
 
+/// Sets `before` to `now`, flagging in `moved` (resized to match) each point that
+/// differed, as `!=` tells it (a NaN differs from itself; the zeros of both signs are
+/// equal), four points at a time.
+pub fn take_moves(before: &mut [Vec3], now: &[Vec3], moved: &mut Vec<bool>) {
+    let n = before.len().min(now.len());
+    moved.clear();
+    moved.resize(n, false);
+    let whole = n / 4 * 4;
+    let (b, x): (&mut [f32], _) = (bytemuck::cast_slice_mut(&mut before[..n]), floats(now, n));
+    let (bs, xs) = (b.as_chunks_mut::<STEP>().0, x.as_chunks::<STEP>().0);
+    for ((m, b), x) in moved[..whole].chunks_exact_mut(4).zip(bs).zip(xs) {
+        let differ = differing(b, x);
+        *b = *x;
+        for (j, m) in m.iter_mut().enumerate() {
+            *m = (differ >> (3 * j)) & 7 != 0;
+        }
+    }
+    for i in whole..n {
+        moved[i] = before[i] != now[i];
+        before[i] = now[i];
+    }
+}
+
+/// Sets `before` to `now` (the points both have); returns whether any differed, as `!=`
+/// tells it ([`take_moves`] without the flags).
+pub fn take_changes(before: &mut [Vec3], now: &[Vec3]) -> bool {
+    let n = before.len().min(now.len());
+    let whole = n / 4 * 4;
+    let (b, x): (&mut [f32], _) = (bytemuck::cast_slice_mut(&mut before[..n]), floats(now, n));
+    let (bs, xs) = (b.as_chunks_mut::<STEP>().0, x.as_chunks::<STEP>().0);
+    let mut differ = 0;
+    for (b, x) in bs.iter_mut().zip(xs) {
+        differ |= differing(b, x);
+        *b = *x;
+    }
+    let mut rest = false;
+    for i in whole..n {
+        rest |= before[i] != now[i];
+        before[i] = now[i];
+    }
+    differ != 0 || rest
+}
+
+/// The floats of a step (as bits, in order) that differ between `a` and `b`.
+#[inline(always)]
+fn differing(a: &[f32; STEP], b: &[f32; STEP]) -> u32 {
+    let (a, b) = (lanes(a), lanes(b));
+    (0..3).fold(0, |bits, k| bits | a[k].cmpne(b[k]).bitmask() << (4 * k))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -112,6 +162,62 @@ mod tests {
         let (x, mut out) = (points(9), vec![Vec3::ZERO; 6]);
         less_into(&mut out, &x, a, b);
         assert_eq!(out[5], x[5] - a - b);
+    }
+
+    /// Taking the points flags each that differed as `!=` tells it (a NaN, even the same
+    /// NaN, differs; the zeros of both signs do not), whatever the remainder of a step, and
+    /// leaves the points taken.
+    #[test]
+    fn taking_points_flags_those_that_moved_as_not_equal_tells_it() {
+        for n in [0, 1, 3, 4, 5, 8, 11, 99, 4225] {
+            let before = points(n);
+            let mut now = before.clone();
+            for (i, p) in now.iter_mut().enumerate() {
+                match i % 5 {
+                    1 => p.z += 1e-6,
+                    2 if i % 3 == 0 => p.x = -p.x,
+                    3 => *p = -*p * 0.0,
+                    _ => {}
+                }
+            }
+            if n > 6 {
+                (now[6].y, now[4]) = (f32::NAN, Vec3::splat(f32::NAN));
+            }
+            if n > 7 {
+                // `points` puts (0, −0, 1) there.
+                now[7] = Vec3::new(-0.0, 0.0, 1.0);
+            }
+            let mut before_nan = before.clone();
+            if n > 6 {
+                before_nan[4] = Vec3::splat(f32::NAN);
+            }
+            let want: Vec<bool> = before_nan.iter().zip(&now).map(|(a, b)| a != b).collect();
+            let (mut taken, mut moved) = (before_nan.clone(), vec![true; 2]);
+            take_moves(&mut taken, &now, &mut moved);
+            assert_eq!(moved, want, "{n}");
+            let bits = |v: &[Vec3]| {
+                v.iter()
+                    .map(|p| p.to_array().map(f32::to_bits))
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(bits(&taken), bits(&now), "{n}");
+            let mut again = before_nan.clone();
+            assert_eq!(take_changes(&mut again, &now), want.contains(&true), "{n}");
+            assert_eq!(bits(&again), bits(&now), "{n}");
+            if n > 7 {
+                assert!(!moved[7], "the zeros of both signs are equal");
+            }
+            if n > 6 {
+                assert!(moved[4] && moved[6], "a NaN differs, even from itself");
+                assert!(want.iter().any(|&m| !m) && want.iter().filter(|&&m| m).count() > 2);
+            }
+        }
+        // Nothing moved: nothing flagged, no change.
+        let same = points(13);
+        let (mut taken, mut moved) = (same.clone(), Vec::new());
+        take_moves(&mut taken, &same, &mut moved);
+        assert_eq!(moved, vec![false; 13]);
+        assert!(!take_changes(&mut taken, &same));
     }
 
     /// Whether a motion grown by `g` leaves a box, as `Vec3A` tells it, for boxes around

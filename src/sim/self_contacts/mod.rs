@@ -32,4 +32,4 @@ pub use error::ContactError;
 pub(crate) use primitives::point_triangle_distance;
 pub use search::owned_parts;
 pub use solver::SelfContacts;
-pub use work::{SELF_RECHECK, SELF_SETUP, SelfWork};
+pub use work::{SELF_RECHECK, SELF_SETUP, SELF_UPKEEP, SelfWork};

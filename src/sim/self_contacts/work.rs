@@ -10,6 +10,11 @@ pub const SELF_SETUP: &str = "self-setup";
 /// ([`super::SelfContacts::settle`]).
 pub const SELF_RECHECK: &str = "self-recheck";
 
+/// The phase that times self-contact's upkeep between the contact effects: the positions
+/// kept before the solids act, to flag what they moved (which rests on them), and after
+/// self-contact, to tell whether the solids moved anything again (the recheck's start).
+pub const SELF_UPKEEP: &str = "self-upkeep";
+
 /// Work done by the last resolve: for cost checks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub struct SelfWork {
