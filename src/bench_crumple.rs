@@ -194,8 +194,8 @@ mod tests {
         }
     }
 
-    /// The contact phases are self-contact's pass, recheck and upkeep and the solids'; the springs
-    /// are their own phase; the other phases count in none of them.
+    /// The contact phases are self-contact's pass, recheck and upkeep and the solids'; the
+    /// springs are their own phase; the other phases count in none of them.
     #[test]
     fn the_contact_phases_are_self_contacts_and_the_solids() {
         let mut timings = PhaseTimings::default();

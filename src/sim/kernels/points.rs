@@ -81,43 +81,42 @@ pub fn leaves(from: Vec3, to: Vec3, [lo, hi]: [Vec3; 2], g: f32) -> bool {
 /// differed, as `!=` tells it (a NaN differs from itself; the zeros of both signs are
 /// equal), four points at a time.
 pub fn take_moves(before: &mut [Vec3], now: &[Vec3], moved: &mut Vec<bool>) {
-    let n = before.len().min(now.len());
     moved.clear();
-    moved.resize(n, false);
-    let whole = n / 4 * 4;
-    let (b, x): (&mut [f32], _) = (bytemuck::cast_slice_mut(&mut before[..n]), floats(now, n));
-    let (bs, xs) = (b.as_chunks_mut::<STEP>().0, x.as_chunks::<STEP>().0);
-    for ((m, b), x) in moved[..whole].chunks_exact_mut(4).zip(bs).zip(xs) {
-        let differ = differing(b, x);
-        *b = *x;
-        for (j, m) in m.iter_mut().enumerate() {
-            *m = (differ >> (3 * j)) & 7 != 0;
+    moved.resize(before.len().min(now.len()), false);
+    take(before, now, |first, points, bits| {
+        for (j, m) in moved[first..first + points].iter_mut().enumerate() {
+            *m = (bits >> (3 * j)) & 7 != 0;
         }
-    }
-    for i in whole..n {
-        moved[i] = before[i] != now[i];
-        before[i] = now[i];
-    }
+    });
 }
 
 /// Sets `before` to `now` (the points both have); returns whether any differed, as `!=`
 /// tells it ([`take_moves`] without the flags).
 pub fn take_changes(before: &mut [Vec3], now: &[Vec3]) -> bool {
+    let mut any = 0;
+    take(before, now, |_, _, bits| any |= bits);
+    any != 0
+}
+
+/// Sets `before` to `now` (the points both have), calling `differ(first, points, bits)`
+/// for each four points (one past the last four) with the bits, three a point in order,
+/// of their coordinates that differed.
+#[inline(always)]
+fn take(before: &mut [Vec3], now: &[Vec3], mut differ: impl FnMut(usize, usize, u32)) {
     let n = before.len().min(now.len());
     let whole = n / 4 * 4;
     let (b, x): (&mut [f32], _) = (bytemuck::cast_slice_mut(&mut before[..n]), floats(now, n));
     let (bs, xs) = (b.as_chunks_mut::<STEP>().0, x.as_chunks::<STEP>().0);
-    let mut differ = 0;
-    for (b, x) in bs.iter_mut().zip(xs) {
-        differ |= differing(b, x);
+    for (k, (b, x)) in bs.iter_mut().zip(xs).enumerate() {
+        differ(4 * k, 4, differing(b, x));
         *b = *x;
     }
-    let mut rest = false;
     for i in whole..n {
-        rest |= before[i] != now[i];
-        before[i] = now[i];
+        let (b, x) = (before[i], now[i]);
+        let bits = (0..3).fold(0, |bits, k| bits | u32::from(b[k] != x[k]) << k);
+        differ(i, 1, bits);
+        before[i] = x;
     }
-    differ != 0 || rest
 }
 
 /// The floats of a step (as bits, in order) that differ between `a` and `b`.
@@ -169,7 +168,7 @@ mod tests {
     /// leaves the points taken.
     #[test]
     fn taking_points_flags_those_that_moved_as_not_equal_tells_it() {
-        for n in [0, 1, 3, 4, 5, 8, 11, 99, 4225] {
+        for n in [0, 1, 3, 4, 5, 6, 8, 11, 99, 4225] {
             let before = points(n);
             let mut now = before.clone();
             for (i, p) in now.iter_mut().enumerate() {
@@ -191,6 +190,13 @@ mod tests {
             if n > 6 {
                 before_nan[4] = Vec3::splat(f32::NAN);
             }
+            // Past the last four points too: the zeros of both signs, and the same NaN.
+            let last = n.saturating_sub(1);
+            if n % 4 >= 2 && n > 4 {
+                (before_nan[last], now[last]) =
+                    (Vec3::new(0.0, -0.0, 0.0), Vec3::new(-0.0, 0.0, 0.0));
+                (before_nan[last - 1], now[last - 1]) = (Vec3::NAN, Vec3::NAN);
+            }
             let want: Vec<bool> = before_nan.iter().zip(&now).map(|(a, b)| a != b).collect();
             let (mut taken, mut moved) = (before_nan.clone(), vec![true; 2]);
             take_moves(&mut taken, &now, &mut moved);
@@ -206,6 +212,9 @@ mod tests {
             assert_eq!(bits(&again), bits(&now), "{n}");
             if n > 7 {
                 assert!(!moved[7], "the zeros of both signs are equal");
+            }
+            if n % 4 >= 2 && n > 4 {
+                assert!(!moved[last] && moved[last - 1], "past the last four, {n}");
             }
             if n > 6 {
                 assert!(moved[4] && moved[6], "a NaN differs, even from itself");
