@@ -842,7 +842,14 @@ fn phases_of(scene: &str, change: impl FnOnce(&mut Vec<Effect>)) -> Vec<String> 
 #[test]
 fn only_the_effects_a_scene_lists_appear_as_phases() {
     let hanging = phases_of("hanging", |_| {});
-    for absent in ["sphere", "plane", "self-collision", "self-upkeep", "wind"] {
+    for absent in [
+        "sphere",
+        "plane",
+        "self-collision",
+        "self-upkeep",
+        "contact-start",
+        "wind",
+    ] {
         assert!(
             !hanging.iter().any(|p| p == absent),
             "{absent} in {hanging:?}"
@@ -859,7 +866,9 @@ fn only_the_effects_a_scene_lists_appear_as_phases() {
         drop.contains(&"sphere".into()) && drop.contains(&"plane".into()),
         "{drop:?}"
     );
-    // Self-contact's upkeep between the effects runs only with self-contact.
+    // The contacts' start is kept wherever there are contacts; self-contact's upkeep
+    // between the effects only with self-contact.
+    assert!(drop.contains(&"contact-start".into()), "{drop:?}");
     assert!(!drop.contains(&"self-upkeep".into()), "{drop:?}");
     assert!(phases_of("flag", |_| {}).contains(&"wind".into()));
     assert!(phases_of("self-fold", |_| {}).contains(&"self-collision".into()));

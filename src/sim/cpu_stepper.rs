@@ -29,6 +29,10 @@ use super::timings::PhaseTimings;
 /// round only follows one whose check had to cut.
 const RECHECKS: usize = 3;
 
+/// The phase that times the copy of each substep's start positions, from which every
+/// contact's paths run (taken before the integrator's step, where there are contacts).
+pub const CONTACT_START: &str = "contact-start";
+
 /// Runs `work`, adding its wall time to `spent`.
 fn timed<T>(spent: &mut Duration, work: impl FnOnce() -> T) -> T {
     let start = Instant::now();
@@ -146,16 +150,18 @@ impl<R: Real> CpuStepper<R> {
     ) -> Result<StepReport, StepError> {
         let h = self.step_length();
         if self.contacts_exist() {
-            match R::f32_slice(&state.pos) {
-                Some(pos) => {
-                    self.substep_start.clear();
-                    self.substep_start.extend_from_slice(pos);
-                }
-                None => {
-                    self.substep_start.clear();
-                    (self.substep_start).extend(state.pos.iter().map(|p| R::v3_f32(*p)));
-                }
-            }
+            let start = &mut self.substep_start;
+            self.timings
+                .time(CONTACT_START, || match R::f32_slice(&state.pos) {
+                    Some(pos) => {
+                        start.clear();
+                        start.extend_from_slice(pos);
+                    }
+                    None => {
+                        start.clear();
+                        start.extend(state.pos.iter().map(|p| R::v3_f32(*p)));
+                    }
+                });
         }
         self.forces.set_time(state.time);
         let report = self.integrate_with(model, state, |integrator, ctx, state| {
