@@ -151,17 +151,13 @@ impl<R: Real> CpuStepper<R> {
         let h = self.step_length();
         if self.contacts_exist() {
             let start = &mut self.substep_start;
-            self.timings
-                .time(CONTACT_START, || match R::f32_slice(&state.pos) {
-                    Some(pos) => {
-                        start.clear();
-                        start.extend_from_slice(pos);
-                    }
-                    None => {
-                        start.clear();
-                        start.extend(state.pos.iter().map(|p| R::v3_f32(*p)));
-                    }
-                });
+            self.timings.time(CONTACT_START, || {
+                start.clear();
+                match R::f32_slice(&state.pos) {
+                    Some(pos) => start.extend_from_slice(pos),
+                    None => start.extend(state.pos.iter().map(|p| R::v3_f32(*p))),
+                }
+            });
         }
         self.forces.set_time(state.time);
         let report = self.integrate_with(model, state, |integrator, ctx, state| {
@@ -236,12 +232,7 @@ impl<R: Real> CpuStepper<R> {
                 take_changes(&mut self.before_solids, &pass.state.pos)
             })
         {
-            for round in 0..RECHECKS {
-                if round > 0 {
-                    timed(&mut upkeep, || {
-                        take_changes(&mut self.before_solids, &pass.state.pos)
-                    });
-                }
+            for _ in 0..RECHECKS {
                 for c in self.contacts.iter().filter(|c| c.is_solid()) {
                     contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
                 }
@@ -257,6 +248,10 @@ impl<R: Real> CpuStepper<R> {
                 if self.timings.time(super::SELF_RECHECK, settle)? == 0 {
                     break;
                 }
+                // The next round starts from where the check left the cloth.
+                timed(&mut upkeep, || {
+                    take_changes(&mut self.before_solids, &pass.state.pos)
+                });
             }
         }
         if self.self_collision.is_some() {
