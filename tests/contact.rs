@@ -481,9 +481,9 @@ fn a_cloth_that_starts_intersecting_is_warned_with_the_count() {
 /// ground's particles not held they came within 0.72 of it.
 #[test]
 fn a_cloth_resting_on_a_solid_is_not_pushed_into_it() {
-    let thickness = 0.01;
+    let (thickness, quads) = (0.01, 8);
     let text = format!(
-        "name = \"stack\"\n[cloth]\ngrid = {{ quads = 8, size = 0.5, layers = 2, spacing = {} }}\n\
+        "name = \"stack\"\n[cloth]\ngrid = {{ quads = {quads}, size = 0.5, layers = 2, spacing = {} }}\n\
          [solver]\nintegrator = \"implicit-euler\"\nsubsteps = 2\n\
          [[effects]]\ntype = \"gravity\"\n\
          [[effects]]\ntype = \"plane\"\npoint = [0.0, -0.002, 0.0]\n\
@@ -498,7 +498,9 @@ fn a_cloth_resting_on_a_solid_is_not_pushed_into_it() {
         sim.step_frame().unwrap();
         let pos = &sim.state().pos;
         // Inside the borders, where the upper cloth lies over the lower one.
-        let inside = (0..n).filter(|i| (1..8).contains(&(i % 9)) && (1..8).contains(&(i / 9)));
+        let side = quads + 1;
+        let inner = |k: usize| (1..quads).contains(&k);
+        let inside = (0..n).filter(|i| inner(i % side) && inner(i / side));
         let gap = inside
             .map(|i| pos[n + i].y - pos[i].y)
             .fold(f32::INFINITY, f32::min);
