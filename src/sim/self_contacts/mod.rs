@@ -15,6 +15,7 @@
 
 mod ccd;
 mod certify;
+mod costs;
 mod error;
 mod found;
 mod gap;

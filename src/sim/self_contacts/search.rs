@@ -439,9 +439,10 @@ impl Search<'_> {
         piece: usize,
         dirty: Option<[&[bool]; 2]>,
         out: &mut Vec<StoredPair>,
-    ) {
+    ) -> u64 {
         let starts = &self.owners.piece_start;
         let owner = &self.owners.vertex_owner;
+        let mut tested = 0;
         for c in starts[piece] as usize..starts[piece + 1] as usize {
             if !self.open[c] {
                 continue;
@@ -454,12 +455,14 @@ impl Search<'_> {
                 if dirty.is_some_and(|d| !stored.triangles(owner).iter().any(|&t| d[t as usize])) {
                     continue;
                 }
+                tested += 1;
                 let pair = stored.expand(self.triangles, &self.owners.edges);
                 if self.sides_meet(&pair) {
                     self.keep(pair, stored, out);
                 }
             }
         }
+        tested
     }
 
     /// Pieces [`Search::neighbours`] is cut into.

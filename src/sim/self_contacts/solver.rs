@@ -11,6 +11,7 @@ use crate::sim::kernels::{leaves, less_into, outside};
 
 use super::ccd::safe_fraction;
 use super::certify::Certificates;
+use super::costs::SearchCosts;
 use super::error::ContactError;
 use super::found::Found;
 use super::patches::Patches;
@@ -26,7 +27,8 @@ use super::work::SelfWork;
 const KEEP: f64 = 0.1;
 
 /// Only the triangles whose particles left their boxes are searched again while those
-/// particles are fewer than one in this many; more, and the whole tree is.
+/// particles are fewer than one in this many (and the refreshes since the last whole
+/// search have cost less than it did: [`SearchCosts`]); more, and the whole tree is.
 const REFRESH_BELOW: usize = 4;
 
 /// The most triangles self-contact takes: a stored edge–edge pair numbers each edge as
@@ -154,6 +156,8 @@ pub struct SelfContacts {
     /// most calls need not fill them again.
     cuts_whole: bool,
     pub work: SelfWork,
+    /// What the searches since the last whole one cost.
+    costs: SearchCosts,
 }
 
 /// Triangles searched again in one piece of a refresh (the pieces' pairs come in the
@@ -334,7 +338,8 @@ impl SelfContacts {
     /// thickness, whatever `within` (the pairs kept are only those that could come within
     /// the thickness from there: [`Search::keep`]). Particles whose motion left theirs get new
     /// boxes, and their triangles are searched again ([`SelfContacts::refresh`]); where
-    /// many left, the whole tree is ([`SelfContacts::find_pairs`]).
+    /// many left, or the refreshes since the last whole search have cost as much as it
+    /// did, the whole tree is ([`SelfContacts::find_pairs`]).
     /// Where the pairs are judged by the motion, also while the window they were found for
     /// lasts ([`Window`]). With `moved`, a new motion: every particle's start and end are
     /// put in the moving frame first, as each member checks its part (one section rather
@@ -453,7 +458,7 @@ impl SelfContacts {
         if left == 0 {
             return Ok(());
         }
-        if left * REFRESH_BELOW < self.left.len() {
+        if left * REFRESH_BELOW < self.left.len() && !self.costs.whole_due() {
             return self.refresh(model, thickness);
         }
         self.find_pairs(model, thickness)

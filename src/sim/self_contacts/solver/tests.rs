@@ -617,6 +617,7 @@ fn pairs_judged_by_the_boxes_are_kept_exactly_where_their_balls_come_near() {
 }
 
 mod boxes;
+mod trickle;
 mod windows;
 
 impl<'a> Moved<'a> {

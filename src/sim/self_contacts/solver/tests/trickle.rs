@@ -1,0 +1,65 @@
+//! Refreshes that would go on for ever: where a few particles leave their boxes every
+//! substep, the whole tree is searched again once the refreshes since the last whole
+//! search have cost as much as it did.
+
+use super::*;
+
+/// Two particles (far apart) of a 24 × 24-quad cloth lying flat, set down 0.4 of the
+/// thickness at each of 60 substeps and staying there: slow, so the pairs are judged by
+/// the boxes, and each of those two leaves its box (a quarter of the thickness of room)
+/// once. Every substep takes a refresh or a whole search; a refresh only while the
+/// refreshes since the last whole search have cost less than it did (counted in
+/// triangles and the pairs of triangles tested, a triangle refreshed as twelve searched
+/// whole), and a whole search as soon as they have cost as much: two of them here, after
+/// 10 and 43 refreshes, and 5 refreshes after the second (which costs more than the
+/// first: the boxes of the particles set down look ahead along their motion, and the
+/// patches certify nothing then).
+#[test]
+fn refreshes_that_go_on_give_way_to_a_whole_search_now_and_then() {
+    let mesh = GridSpec::square(24, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
+        .build()
+        .unwrap();
+    let model = ClothModel::new(&mesh, 0.2, &[]);
+    let n = mesh.positions.len();
+    // Particle `i` is set down at substep `i / 2 + 1` of a walk through the cloth in
+    // strides of 97 particles (coprime with its 625).
+    let moved_at = |i: usize| (i * 97 % n) / 2 + 1;
+    let at = |k: usize| -> Vec<Vec3> {
+        (mesh.positions.iter().enumerate())
+            .map(|(i, &p)| {
+                p - Vec3::Y
+                    * if moved_at(i) <= k {
+                        0.4 * THICKNESS
+                    } else {
+                        0.0
+                    }
+            })
+            .collect()
+    };
+    let mut contacts = searched_to(&model, &at(0), &at(0));
+    let mut runs = Vec::new();
+    let mut refreshes = 0;
+    for k in 1..=60 {
+        let (before, work) = (contacts.costs, contacts.work);
+        let (from, to) = (at(k - 1), at(k));
+        let moved = Moved::plain(&from, &to);
+        contacts
+            .update_pairs(&model, THICKNESS, THICKNESS, Some(moved))
+            .unwrap();
+        assert!(!contacts.boxes.swept, "substep {k}");
+        let (searched, refreshed) = (
+            contacts.work.searches - work.searches,
+            contacts.work.refreshes - work.refreshes,
+        );
+        assert_eq!(searched + refreshed, 1, "substep {k}");
+        // Each is taken by what the refreshes since the last whole search cost.
+        let due = before.whole_due();
+        assert_eq!(searched == 1, due, "substep {k}: {before:?}");
+        if searched == 1 {
+            runs.push(std::mem::take(&mut refreshes));
+        } else {
+            refreshes += 1;
+        }
+    }
+    assert_eq!((runs, refreshes), (vec![10, 43], 5));
+}
