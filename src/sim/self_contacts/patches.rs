@@ -178,6 +178,44 @@ impl Patches {
         backoff: &mut Vec<u8>,
     ) {
         let least = reach * (1.0 + MARGIN);
+        self.decide_by(tree, triangles, [from, to], |_| least, backoff);
+    }
+
+    /// [`Patches::decide`] for the particles anywhere within `rooms` (each particle's, m)
+    /// of `places`: each node for `thickness` and twice the widest room of its own
+    /// particles (a node's pairs are of its particles alone), so that one particle whose
+    /// box looks far ahead leaves the others' nodes to be certified. A node whose reach
+    /// comes to the rest gap is not tried (no reach as wide certifies it).
+    pub(super) fn decide_in_rooms(
+        &self,
+        tree: &mut TriangleTree,
+        triangles: &[[u32; 3]],
+        places: &[Vec3A],
+        (thickness, rooms): (f32, &[f32]),
+        backoff: &mut Vec<u8>,
+    ) {
+        let least = |i: usize| {
+            let entries = &self.particle[self.start[i] as usize..self.start[i + 1] as usize];
+            let room = (entries.iter()).fold(0.0f32, |m, &p| m.max(rooms[p as usize]));
+            let reach = thickness + 2.0 * room;
+            if reach < self.gap {
+                reach * (1.0 + MARGIN)
+            } else {
+                f32::NAN
+            }
+        };
+        self.decide_by(tree, triangles, [places, places], least, backoff);
+    }
+
+    /// [`Patches::decide`] with each node `i` certified for `least(i)` (NaN: not tried).
+    fn decide_by(
+        &self,
+        tree: &mut TriangleTree,
+        triangles: &[[u32; 3]],
+        [from, to]: [&[Vec3A]; 2],
+        least: impl Fn(usize) -> f32 + Sync,
+        backoff: &mut Vec<u8>,
+    ) {
         // Each of the tree's subtrees (the nodes a certificate can cover) is one piece.
         // Taken out while the tree is read for each node's triangles, then put back.
         let mut covered = std::mem::take(&mut tree.covered);
@@ -202,21 +240,17 @@ impl Patches {
                     i != range.start && flags[parent - range.start],
                 );
                 let patch = (self.convex[i]).then(|| (triangles, shape.held(i)));
+                let least = if above { f32::NAN } else { least(i) };
                 flags[at] = above
-                    || tried(&mut counts[at], || {
-                        self.certified(i, patch, [from, to], least)
-                    });
+                    || !least.is_nan()
+                        && tried(&mut counts[at], || {
+                            self.certified(i, patch, [from, to], least)
+                        });
             }
         };
         let parallel = self.particle.len() >= PARALLEL_ELEMENTS;
         Team::current().run_large_pieces_if(parallel, subtrees.len(), &work);
         tree.covered = covered;
-    }
-
-    /// The least distance at rest between the sides of a pair of the cloth, up to its
-    /// longest edge, rounded down, m: no reach as wide certifies a patch.
-    pub(super) fn gap(&self) -> f32 {
-        self.gap
     }
 
     /// Whether corner `c`'s ring is held by a node of `tree` covered for the motion last

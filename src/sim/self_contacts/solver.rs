@@ -96,8 +96,10 @@ pub struct SelfContacts {
     tree: TriangleTree,
     /// The tree's patches certified apart by the rest shape.
     patches: Patches,
-    /// Each particle's box's middle, where the patches are certified for the boxes.
+    /// Each particle's box's middle, where the patches are certified for the boxes, and
+    /// how far from it the particle may go (the room its box leaves), m.
     middles: Vec<Vec3A>,
+    rooms: Vec<f32>,
     /// How many searches each node's certificate is left out of (see [`Patches::decide`]).
     backoff: Vec<u8>,
     owners: Owners,

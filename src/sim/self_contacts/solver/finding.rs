@@ -262,10 +262,10 @@ impl SelfContacts {
     /// box's middle, and so does every point of its triangles of the one where the
     /// middles put it. A patch certified (by either certificate) to keep its pairs `reach`
     /// apart with its particles at the middles, `reach` the thickness and twice the
-    /// widest room, keeps them the thickness apart wherever in their rooms they go. The
-    /// corners whose ring a covered patch holds are closed, the others open. Where the
-    /// widest room leaves the rest gap nothing to certify (a particle whose box looks far
-    /// ahead), nothing is covered.
+    /// widest room of its own particles, keeps them the thickness apart wherever in their
+    /// rooms they go. The corners whose ring a covered patch holds are closed, the others
+    /// open. A patch whose widest room leaves the rest gap nothing to certify (a particle
+    /// whose box looks far ahead) is not covered; the others still are.
     pub(super) fn cover_boxes(&mut self, triangles: &[[u32; 3]], thickness: f32) {
         let half = Vec3::splat(0.5 * thickness);
         let (lo, hi) = (&self.boxes.vertex_lo, &self.boxes.vertex_hi);
@@ -275,18 +275,13 @@ impl SelfContacts {
                 .zip(hi)
                 .map(|(&lo, &hi)| Vec3A::from(0.5 * (lo + hi))),
         );
-        let widest = (lo.iter().zip(hi))
-            .map(|(&lo, &hi)| (0.5 * (hi - lo) - half).max(Vec3::ZERO).length_squared())
-            .fold(0.0f32, f32::max)
-            .sqrt();
-        let reach = thickness + 2.0 * widest;
-        if reach < self.patches.gap() {
-            let places = [&self.middles[..], &self.middles[..]];
-            let (tree, backoff) = (&mut self.tree, &mut self.backoff);
-            self.patches.decide(tree, triangles, places, reach, backoff);
-        } else {
-            self.tree.covered.clear();
-        }
+        self.rooms.clear();
+        (self.rooms).extend(
+            (lo.iter().zip(hi)).map(|(&lo, &hi)| (0.5 * (hi - lo) - half).max(Vec3::ZERO).length()),
+        );
+        let (tree, backoff) = (&mut self.tree, &mut self.backoff);
+        let rooms = (thickness, &self.rooms[..]);
+        (self.patches).decide_in_rooms(tree, triangles, &self.middles, rooms, backoff);
         let (patches, tree) = (&self.patches, &self.tree);
         (self.certificates).open_unless(lo.len(), |c| patches.covers(tree, c));
     }
