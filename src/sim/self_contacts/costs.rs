@@ -33,7 +33,8 @@ impl SearchCosts {
     /// one have cost as much as it did. A whole search gives every particle a new box,
     /// with room along its motion now; a refresh, only those that left theirs, so where a
     /// cloth keeps moving a few more leave every substep, and the refreshes would go on
-    /// costing more than the searches they save.
+    /// costing more than the searches they save. (Asked only where the pairs are judged
+    /// by the boxes: by the motion, the window brings a whole search every few substeps.)
     pub(super) fn whole_due(&self) -> bool {
         self.whole > 0 && self.spent >= self.whole
     }

@@ -27,8 +27,9 @@ use super::work::SelfWork;
 const KEEP: f64 = 0.1;
 
 /// Only the triangles whose particles left their boxes are searched again while those
-/// particles are fewer than one in this many (and the refreshes since the last whole
-/// search have cost less than it did: [`SearchCosts`]); more, and the whole tree is.
+/// particles are fewer than one in this many (and, judged by the boxes, the refreshes
+/// since the last whole search have cost less than it did: [`SearchCosts`]); more, and
+/// the whole tree is.
 const REFRESH_BELOW: usize = 4;
 
 /// The most triangles self-contact takes: a stored edge–edge pair numbers each edge as
@@ -340,8 +341,8 @@ impl SelfContacts {
     /// thickness, whatever `within` (the pairs kept are only those that could come within
     /// the thickness from there: [`Search::keep`]). Particles whose motion left theirs get new
     /// boxes, and their triangles are searched again ([`SelfContacts::refresh`]); where
-    /// many left, or the refreshes since the last whole search have cost as much as it
-    /// did, the whole tree is ([`SelfContacts::find_pairs`]).
+    /// many left, or (judged by the boxes) the refreshes since the last whole search have
+    /// cost as much as it did, the whole tree is ([`SelfContacts::find_pairs`]).
     /// Where the pairs are judged by the motion, also while the window they were found for
     /// lasts ([`Window`]). With `moved`, a new motion: every particle's start and end are
     /// put in the moving frame first, as each member checks its part (one section rather
@@ -460,7 +461,10 @@ impl SelfContacts {
         if left == 0 {
             return Ok(());
         }
-        if left * REFRESH_BELOW < self.left.len() && !self.costs.whole_due() {
+        // Judged by the motion, the window brings a whole search every few substeps anyway;
+        // judged by the boxes, once the refreshes since the last have cost as much.
+        let due = !swept && self.costs.whole_due();
+        if left * REFRESH_BELOW < self.left.len() && !due {
             return self.refresh(model, thickness);
         }
         self.find_pairs(model, thickness)
