@@ -2,6 +2,8 @@
 //! piece of a search records where its pairs went, so that read piece by piece they come
 //! in the same order however the pieces were shared out.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use crate::parallel::{Disjoint, Team};
 
 use super::primitives::StoredPair;
@@ -43,13 +45,14 @@ impl Found {
 
     /// Runs `search(piece, out)` for each piece in `0..pieces` — shared with the team's
     /// helpers when `parallel` — each appending its pairs to `out`; they follow the pairs
-    /// already kept, piece after piece.
+    /// already kept, piece after piece. Returns the sum of what the pieces returned (the
+    /// pairs of triangles they tested: the same however the pieces were shared out).
     pub(super) fn extend(
         &mut self,
         pieces: usize,
         parallel: bool,
-        search: &(dyn Fn(usize, &mut Vec<StoredPair>) + Sync),
-    ) {
+        search: &(dyn Fn(usize, &mut Vec<StoredPair>) -> u64 + Sync),
+    ) -> u64 {
         let team = Team::current();
         (self.members).resize_with(team.members().max(1), Vec::new);
         let first = self.segments.len();
@@ -58,12 +61,13 @@ impl Found {
             Disjoint::new(&mut self.members),
             Disjoint::new(&mut self.segments[first..]),
         );
+        let total = AtomicU64::new(0);
         let work = |member: usize, piece: usize| {
             // SAFETY: a member takes only its own buffer, and each piece is run once and
             // writes only its own segment.
             let (out, segment) = unsafe { (found.at(member), segments.at(piece)) };
             let start = out.len();
-            search(piece, out);
+            total.fetch_add(search(piece, out), Ordering::Relaxed);
             *segment = Segment {
                 member: member as u32,
                 start: start as u32,
@@ -72,6 +76,7 @@ impl Found {
         };
         team.run_large_pieces_if(parallel, pieces, &work);
         self.segments.retain(|s| s.start != s.end);
+        total.into_inner()
     }
 
     /// How many pairs there are.

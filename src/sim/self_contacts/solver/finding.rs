@@ -2,8 +2,6 @@
 //! (fitted to the boxes or to the motion, with the patches and the corners decided for
 //! it), and the refresh of the triangles whose particles left their boxes.
 
-use std::sync::atomic::{AtomicU64, Ordering};
-
 use glam::{Vec3, Vec3A};
 
 use crate::parallel::fold_parts;
@@ -228,28 +226,25 @@ impl SelfContacts {
         let search = self.search(&model.triangles, thickness);
         let searched = &self.searched;
         let pieces = searched.len().div_ceil(REFRESHED_PER_PIECE);
-        let tested = AtomicU64::new(0);
         let work = |piece: usize, out: &mut Vec<StoredPair>| {
             if piece >= pieces {
                 // The pairs of triangles sharing a corner, where either is one of those.
-                let count = search.neighbours(piece - pieces, Some([dirty, touched]), out);
-                tested.fetch_add(count, Ordering::Relaxed);
-                return;
+                return search.neighbours(piece - pieces, Some([dirty, touched]), out);
             }
-            let (first, mut count) = (piece * REFRESHED_PER_PIECE, 0);
+            let (first, mut tested) = (piece * REFRESHED_PER_PIECE, 0);
             for &t in &searched[first..(first + REFRESHED_PER_PIECE).min(searched.len())] {
                 tree.triangle_pairs(t, dirty, |a, b| {
-                    count += 1;
+                    tested += 1;
                     search.pairs_of(a as usize, b as usize, out);
                 });
             }
-            tested.fetch_add(count, Ordering::Relaxed);
+            tested
         };
         let refreshed = searched.len();
         let parallel = refreshed >= PARALLEL_REFRESHED;
-        found.extend(pieces + search.neighbour_pieces(), parallel, &work);
+        let tested = found.extend(pieces + search.neighbour_pieces(), parallel, &work);
         self.found = found;
-        (self.costs).refreshed(refreshed, tested.into_inner());
+        (self.costs).refreshed(refreshed, tested);
         self.work.refreshes += 1;
         self.work.refreshed += refreshed as u64;
         self.found_for = Some(thickness);
@@ -411,25 +406,22 @@ impl SelfContacts {
         let mut found = std::mem::take(&mut self.found);
         let search = self.search(&model.triangles, thickness);
         let tree = &self.tree;
-        let tested = AtomicU64::new(0);
         let work = |piece: usize, out: &mut Vec<StoredPair>| {
-            let count = if piece >= tree.pieces() {
-                search.neighbours(piece - tree.pieces(), None, out)
-            } else {
-                let mut count = 0;
-                tree.piece_pairs(piece, |a, b| {
-                    count += 1;
-                    search.pairs_of(a as usize, b as usize, out);
-                });
-                count
-            };
-            tested.fetch_add(count, Ordering::Relaxed);
+            if piece >= tree.pieces() {
+                return search.neighbours(piece - tree.pieces(), None, out);
+            }
+            let mut tested = 0;
+            tree.piece_pairs(piece, |a, b| {
+                tested += 1;
+                search.pairs_of(a as usize, b as usize, out);
+            });
+            tested
         };
         let parallel = model.triangles.len() >= PARALLEL_TRIANGLES;
         let pieces = tree.pieces() + search.neighbour_pieces();
-        found.extend(pieces, parallel, &work);
+        let tested = found.extend(pieces, parallel, &work);
         self.found = found;
-        (self.costs).searched(model.triangles.len(), tested.into_inner());
+        (self.costs).searched(model.triangles.len(), tested);
         self.work.searches += 1;
         self.found_for = Some(thickness);
         Ok(())
