@@ -178,7 +178,7 @@ impl Patches {
         backoff: &mut Vec<u8>,
     ) {
         let least = reach * (1.0 + MARGIN);
-        self.decide_by(tree, triangles, [from, to], |_| least, backoff);
+        self.decide_by(tree, triangles, [from, to], |_| Some(least), backoff);
     }
 
     /// [`Patches::decide`] for the particles anywhere within `rooms` (each particle's, m)
@@ -198,22 +198,18 @@ impl Patches {
             let entries = &self.particle[self.start[i] as usize..self.start[i + 1] as usize];
             let room = (entries.iter()).fold(0.0f32, |m, &p| m.max(rooms[p as usize]));
             let reach = thickness + 2.0 * room;
-            if reach < self.gap {
-                reach * (1.0 + MARGIN)
-            } else {
-                f32::NAN
-            }
+            (reach < self.gap).then_some(reach * (1.0 + MARGIN))
         };
         self.decide_by(tree, triangles, [places, places], least, backoff);
     }
 
-    /// [`Patches::decide`] with each node `i` certified for `least(i)` (NaN: not tried).
+    /// [`Patches::decide`] with each node `i` certified for `least(i)` (`None`: not tried).
     fn decide_by(
         &self,
         tree: &mut TriangleTree,
         triangles: &[[u32; 3]],
         [from, to]: [&[Vec3A]; 2],
-        least: impl Fn(usize) -> f32 + Sync,
+        least: impl Fn(usize) -> Option<f32> + Sync,
         backoff: &mut Vec<u8>,
     ) {
         // Each of the tree's subtrees (the nodes a certificate can cover) is one piece.
@@ -240,12 +236,12 @@ impl Patches {
                     i != range.start && flags[parent - range.start],
                 );
                 let patch = (self.convex[i]).then(|| (triangles, shape.held(i)));
-                let least = if above { f32::NAN } else { least(i) };
                 flags[at] = above
-                    || !least.is_nan()
-                        && tried(&mut counts[at], || {
+                    || least(i).is_some_and(|least| {
+                        tried(&mut counts[at], || {
                             self.certified(i, patch, [from, to], least)
-                        });
+                        })
+                    });
             }
         };
         let parallel = self.particle.len() >= PARALLEL_ELEMENTS;
