@@ -21,14 +21,19 @@ fn crumpled() -> (ClothModel, Vec<Vec3>) {
 
 /// [`crumpled`] with `quads`² quads.
 fn crumpled_of(quads: u32) -> (ClothModel, Vec<Vec3>) {
-    let mesh = GridSpec::square(quads, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
-        .build()
-        .unwrap();
-    let model = ClothModel::new(&mesh, 0.2, &[]);
+    let (model, flat) = grid(quads, 1.0);
     let mut rnd = crate::test_rng::uniform(5);
     let mut jitter = || Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.03;
-    let pos = mesh.positions.iter().map(|&p| p + jitter()).collect();
+    let pos = flat.iter().map(|&p| p + jitter()).collect();
     (model, pos)
+}
+
+/// A flat `quads`² cloth `size` m wide in the xz plane, and its particles.
+fn grid(quads: u32, size: f32) -> (ClothModel, Vec<Vec3>) {
+    let mesh = GridSpec::square(quads, size, GridOrientation::Horizontal, Vec3::ZERO)
+        .build()
+        .unwrap();
+    (ClothModel::new(&mesh, 0.2, &[]), mesh.positions)
 }
 
 /// A solver for `model` with the pairs found for every particle moving by `motion` from
@@ -683,11 +688,8 @@ fn a_creeping_particle_keeps_its_box_longer_where_the_pairs_are_few() {
     // Out once crept past ¼ + 1 thickness (1.25 / 0.045 = 27.8 substeps), then past
     // ¼ + ¼ from where it was out (11.1).
     assert_eq!([first, second - first], [28, 12]);
-    let mesh = GridSpec::square(24, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
-        .build()
-        .unwrap();
-    let flat = ClothModel::new(&mesh, 0.2, &[]);
-    let ([first, second], per_particle) = creeping(&flat, &mesh.positions, v);
+    let (flat, start) = grid(24, 1.0);
+    let ([first, second], per_particle) = creeping(&flat, &start, v);
     assert!(per_particle < 1.0, "{per_particle} pairs a particle");
     assert_eq!([first, second - first], [28, 28]);
 }

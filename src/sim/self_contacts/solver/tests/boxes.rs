@@ -10,11 +10,7 @@ const T: f32 = 0.007;
 
 /// A flat `quads`² cloth 2 cm between particles in the xz plane, and its particles.
 fn flat(quads: u32) -> (ClothModel, Vec<Vec3>) {
-    let size = 0.02 * quads as f32;
-    let mesh = GridSpec::square(quads, size, GridOrientation::Horizontal, Vec3::ZERO)
-        .build()
-        .unwrap();
-    (ClothModel::new(&mesh, 0.2, &[]), mesh.positions)
+    grid(quads, 0.02 * quads as f32)
 }
 
 /// Checks the particles' motion from `start` to `end` against the pairs `contacts` holds

@@ -14,16 +14,13 @@ use super::*;
 /// after 10, 13, 12 and 12 refreshes, and 9 refreshes after the last.
 #[test]
 fn refreshes_that_go_on_give_way_to_a_whole_search_now_and_then() {
-    let mesh = GridSpec::square(24, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
-        .build()
-        .unwrap();
-    let model = ClothModel::new(&mesh, 0.2, &[]);
-    let n = mesh.positions.len();
+    let (model, flat) = grid(24, 1.0);
+    let n = flat.len();
     // Particle `i` is set down at substep `i / 2 + 1` of a walk through the cloth in
     // strides of 97 particles (coprime with its 625).
     let moved_at = |i: usize| (i * 97 % n) / 2 + 1;
     let at = |k: usize| -> Vec<Vec3> {
-        (mesh.positions.iter().enumerate())
+        (flat.iter().enumerate())
             .map(|(i, &p)| {
                 p - Vec3::Y
                     * if moved_at(i) <= k {

@@ -140,13 +140,10 @@ fn held_along(
 /// the thickness; particle `i` moved `more(i, k)` besides at substep boundary `k`. Nine
 /// boundaries, for eight substeps.
 fn folded_and_sinking(more: impl Fn(usize, usize) -> Vec3) -> (ClothModel, Vec<Vec<Vec3>>) {
-    let mesh = GridSpec::square(12, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
-        .build()
-        .unwrap();
-    let model = ClothModel::new(&mesh, 0.2, &[]);
-    let upper: Vec<bool> = mesh.positions.iter().map(|p| p.x < 0.0).collect();
+    let (model, flat) = grid(12, 1.0);
+    let upper: Vec<bool> = flat.iter().map(|p| p.x < 0.0).collect();
     let mut rnd = crate::test_rng::uniform(21);
-    let folded: Vec<Vec3> = (mesh.positions.iter().zip(&upper))
+    let folded: Vec<Vec3> = (flat.iter().zip(&upper))
         .map(|(&p, &up)| {
             let lift = if up { 1.5 * THICKNESS } else { 0.0 };
             Vec3::new(p.x.abs(), lift + 0.3 * THICKNESS * (rnd() - 0.5), p.z)
