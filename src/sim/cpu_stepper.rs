@@ -13,7 +13,7 @@ use super::effects::{
 };
 use super::forces::ForceSet;
 use super::guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check};
-use super::guard_state::GuardState;
+use super::guard_state::{GuardState, Kept};
 use super::integrator::{
     Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport,
 };
@@ -60,12 +60,12 @@ pub struct CpuStepper<R: Real = f32> {
     /// Substeps per frame in effect (the guard may have raised them).
     substeps: u32,
     offset: f32,
-    guard: GuardState<ClothState<R>>,
+    guard: GuardState<Kept<R>>,
     timings: PhaseTimings,
     stats: StepStats,
     meter: StepMeter,
-    /// The frame's start state, restored when nothing saves a frame.
-    frame_start: ClothState<R>,
+    /// The frame's start, restored when nothing saves a frame.
+    frame_start: Kept<R>,
     /// Positions at the start of the current substep: the paths colliders sweep.
     substep_start: Vec<glam::Vec3>,
     self_collision: Option<SelfCollision>,
@@ -122,7 +122,7 @@ impl<R: Real> CpuStepper<R> {
             timings: PhaseTimings::default(),
             stats: StepStats::default(),
             meter: StepMeter::default(),
-            frame_start: ClothState::default(),
+            frame_start: Kept::default(),
             substep_start: Vec::new(),
             self_collision: None,
             self_contacts: SelfContacts::default(),
@@ -384,18 +384,24 @@ impl<R: Real> CpuStepper<R> {
             .checkpoint
             .clone()
             .unwrap_or_else(|| self.frame_start.clone());
-        state.clone_from(&from);
+        self.restore(&from, state);
         self.integrator.invalidate();
         let frames = ((end - state.time) / self.dt as f64).round().max(1.0) as u32;
         for k in 1..=frames {
             let frame_end = if k == frames {
                 end
             } else {
-                from.time + k as f64 * self.dt as f64
+                from.state.time + k as f64 * self.dt as f64
             };
             self.try_frame(model, state, frame_end)?;
         }
         Ok(())
+    }
+
+    /// Puts `state` back at the rollback point `kept`, with what the run had counted there.
+    fn restore(&mut self, kept: &Kept<R>, state: &mut ClothState<R>) {
+        state.clone_from(&kept.state);
+        self.self_contacts.work.forced_total = kept.forced;
     }
 
     fn record(&mut self, time: f64, reason: Option<&Trouble>, action: GuardAction, before: u32) {
@@ -452,7 +458,9 @@ impl<R: Real> CpuStepper<R> {
                 }
             }
         }
-        state.clone_from(&self.frame_start);
+        let start = std::mem::take(&mut self.frame_start);
+        self.restore(&start, state);
+        self.frame_start = start;
         self.integrator.invalidate();
         self.substeps = before;
         self.record(state.time, Some(&last), GuardAction::GaveUp, before);
@@ -513,9 +521,11 @@ impl<R: Real> CpuStepper<R> {
         let end = state.time + self.dt as f64;
         if !self.guard.policy.enabled {
             // With the guard off a failed step is all there is to report.
-            self.frame_start.clone_from(state);
+            self.frame_start.state.clone_from(state);
             if let Err(trouble) = self.frame_substeps(model, state, false) {
-                let pos = f32_view(&self.frame_start, &mut self.view).pos.clone();
+                let pos = f32_view(&self.frame_start.state, &mut self.view)
+                    .pos
+                    .clone();
                 return Err(Diverged {
                     time: state.time,
                     reason: trouble.to_string(),
@@ -537,7 +547,8 @@ impl<R: Real> CpuStepper<R> {
                 &self.effects,
             ));
         }
-        self.frame_start.clone_from(state);
+        self.frame_start.state.clone_from(state);
+        self.frame_start.forced = self.self_contacts.work.forced_total;
         match self.try_frame(model, state, end) {
             Ok(()) => {
                 let start = std::mem::take(&mut self.frame_start);

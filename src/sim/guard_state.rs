@@ -13,15 +13,25 @@ pub trait Snapshot: Default {
     fn copy_from(&mut self, from: &Self);
 }
 
-impl<R: Real> Snapshot for ClothState<R> {
+/// A rollback point of the CPU stepper: the state, and what the run had counted by then
+/// that a rollback must take back with it (the pairs prescribed motion forced: a frame rolled
+/// back and redone counts only the pairs of the try that stands).
+#[derive(Clone, Debug, Default)]
+pub struct Kept<R: Real = f32> {
+    pub state: ClothState<R>,
+    pub forced: u64,
+}
+
+impl<R: Real> Snapshot for Kept<R> {
     fn copy_from(&mut self, from: &Self) {
-        self.clone_from(from);
+        self.state.clone_from(&from.state);
+        self.forced = from.forced;
     }
 }
 
 /// What the guard keeps between frames, with rollback points of type `S`.
 #[derive(Clone, Debug)]
-pub struct GuardState<S = ClothState> {
+pub struct GuardState<S = Kept> {
     pub policy: GuardPolicy,
     pub limits: Option<GuardLimits>,
     /// A state that stayed healthy for `checkpoint_frames` frames after it: where a failed

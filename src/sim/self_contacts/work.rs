@@ -37,6 +37,7 @@ pub struct SelfWork {
     /// Pairs that prescribed motion (pins, handles) drove together, so no cut could keep
     /// them apart.
     pub forced: u64,
-    /// [`SelfWork::forced`] added up since the solver was made.
+    /// [`SelfWork::forced`] added up since the solver was made, over the substeps that stand:
+    /// the CPU stepper's guard sets it back with the state when it rolls a frame back.
     pub forced_total: u64,
 }
