@@ -651,6 +651,42 @@ fn simulate_counts_intersections_and_resizes_a_grid() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--quads"));
 }
 
+/// A cloth that already crosses itself at the start is warned about on stderr, with the
+/// count of triangle pairs that meet, beside the import's own warnings; one that starts
+/// free is not.
+#[test]
+fn simulate_warns_of_a_cloth_that_starts_through_itself() {
+    let dir = tempfile::tempdir().unwrap();
+    // A strip lying flat and a small square standing up through it, clear of the strip's
+    // diagonal (their two pieces warned about by the import).
+    let crossed = "v -0.5 0 -0.1\nv 0.5 0 -0.1\nv 0.5 0 0.1\nv -0.5 0 0.1\n\
+                   v 0.05 -0.3 0.05\nv 0.05 0.3 0.05\nv 0.15 0.3 0.05\nv 0.15 -0.3 0.05\n\
+                   f 1 2 3 4\nf 5 6 7 8\n";
+    let path = dir.path().join("crossed.obj");
+    std::fs::write(&path, crossed).unwrap();
+    let run = |scene: &str, obj: &str| {
+        let args = [
+            "simulate",
+            "--scene",
+            scene,
+            "--obj",
+            obj,
+            "--seconds",
+            "0.05",
+        ];
+        let out = clothsim(&args);
+        assert!(out.status.success(), "{out:?}");
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let warned = run("self-fold", path.to_str().unwrap());
+    assert!(warned.contains("2 disconnected pieces"), "{warned}");
+    // Each of the square's two triangles crosses the one of the strip's it stands in.
+    let start = "crossed.obj: the cloth intersects itself at the start (2 triangle pairs meet)";
+    assert!(warned.contains(start), "{warned}");
+    let free = run("self-fold", "assets/cloth.obj");
+    assert!(!free.contains("at the start"), "{free}");
+}
+
 /// `--iterations` sets XPBD's and VBD's sweeps per substep: VBD reports three a step.
 #[test]
 fn iterations_set_the_sweeps_per_substep() {

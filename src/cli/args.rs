@@ -293,16 +293,24 @@ impl RunArgs {
                 self.seconds
             );
         }
+        // The import's warnings before anything can fail, then those the simulation adds
+        // about the start (a cloth that meets itself or a solid, a sphere smaller than the
+        // spacing), which follow them in its list.
+        let imported = scene.warnings.len();
         for w in &scene.warnings {
             eprintln!("warning: {}: {w}", scene.cloth_name);
         }
-        match self.backend {
-            Backend::Cpu => Ok(Simulation::new(scene)),
+        let sim = match self.backend {
+            Backend::Cpu => Simulation::new(scene),
             Backend::Gpu => {
                 let (sim, adapter) = gpu_simulation(scene, true)?;
                 eprintln!("note: stepping on the GPU: {adapter}");
-                Ok(sim)
+                sim
             }
+        };
+        for w in sim.warnings().iter().skip(imported) {
+            eprintln!("warning: {}: {w}", sim.cloth_name());
         }
+        Ok(sim)
     }
 }

@@ -183,7 +183,8 @@ impl Simulation {
         &self.cloth_name
     }
 
-    /// Notes from importing the cloth.
+    /// Notes from importing the cloth, then about the scene's start: a sphere smaller than
+    /// the cloth's spacing, a solid the cloth already meets, a cloth that intersects itself.
     pub fn warnings(&self) -> &[String] {
         &self.warnings
     }
