@@ -13,7 +13,7 @@ use super::effects::{
 };
 use super::forces::ForceSet;
 use super::guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check};
-use super::guard_state::{GuardState, Kept};
+use super::guard_state::{CpuSnapshot, GuardState};
 use super::integrator::{
     Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport,
 };
@@ -60,12 +60,12 @@ pub struct CpuStepper<R: Real = f32> {
     /// Substeps per frame in effect (the guard may have raised them).
     substeps: u32,
     offset: f32,
-    guard: GuardState<Kept<R>>,
+    guard: GuardState<CpuSnapshot<R>>,
     timings: PhaseTimings,
     stats: StepStats,
     meter: StepMeter,
     /// The frame's start, restored when nothing saves a frame.
-    frame_start: Kept<R>,
+    frame_start: CpuSnapshot<R>,
     /// Positions at the start of the current substep: the paths colliders sweep.
     substep_start: Vec<glam::Vec3>,
     self_collision: Option<SelfCollision>,
@@ -122,7 +122,7 @@ impl<R: Real> CpuStepper<R> {
             timings: PhaseTimings::default(),
             stats: StepStats::default(),
             meter: StepMeter::default(),
-            frame_start: Kept::default(),
+            frame_start: CpuSnapshot::default(),
             substep_start: Vec::new(),
             self_collision: None,
             self_contacts: SelfContacts::default(),
@@ -399,7 +399,7 @@ impl<R: Real> CpuStepper<R> {
     }
 
     /// Puts `state` back at the rollback point `kept`, with what the run had counted there.
-    fn restore(&mut self, kept: &Kept<R>, state: &mut ClothState<R>) {
+    fn restore(&mut self, kept: &CpuSnapshot<R>, state: &mut ClothState<R>) {
         state.clone_from(&kept.state);
         self.self_contacts.work.forced_total = kept.forced;
     }

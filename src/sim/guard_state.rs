@@ -6,7 +6,7 @@ use crate::cloth::{ClothState, Real};
 use super::guard::{GuardAction, GuardEvent, GuardLimits, Trouble};
 use super::guard_policy::GuardPolicy;
 
-/// A copy of a cloth's state the guard can roll back to: the state itself on the CPU, a
+/// A copy of a cloth's state the guard can roll back to: [`CpuSnapshot`] on the CPU, a
 /// buffer on the device for the GPU backend.
 pub trait Snapshot: Default {
     /// Makes `self` a copy of `from`, reusing `self`'s storage.
@@ -17,12 +17,12 @@ pub trait Snapshot: Default {
 /// that a rollback must take back with it (the pairs prescribed motion forced: a frame rolled
 /// back and redone counts only the pairs of the try that stands).
 #[derive(Clone, Debug, Default)]
-pub struct Kept<R: Real = f32> {
+pub struct CpuSnapshot<R: Real = f32> {
     pub state: ClothState<R>,
     pub forced: u64,
 }
 
-impl<R: Real> Snapshot for Kept<R> {
+impl<R: Real> Snapshot for CpuSnapshot<R> {
     fn copy_from(&mut self, from: &Self) {
         self.state.clone_from(&from.state);
         self.forced = from.forced;
@@ -31,7 +31,7 @@ impl<R: Real> Snapshot for Kept<R> {
 
 /// What the guard keeps between frames, with rollback points of type `S`.
 #[derive(Clone, Debug)]
-pub struct GuardState<S = Kept> {
+pub struct GuardState<S = CpuSnapshot> {
     pub policy: GuardPolicy,
     pub limits: Option<GuardLimits>,
     /// A state that stayed healthy for `checkpoint_frames` frames after it: where a failed

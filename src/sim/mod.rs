@@ -40,7 +40,7 @@ pub use guard::{
     Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Motion, Trouble, check,
 };
 pub use guard_policy::GuardPolicy;
-pub use guard_state::{GuardState, Kept, Snapshot};
+pub use guard_state::{CpuSnapshot, GuardState, Snapshot};
 pub use integrator::{Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport};
 pub use intersections::{Intersections, intersections};
 pub use motion::{AxisAngle, Ease, Keyframe, MotionError, Pose, RigidMotion};
