@@ -685,6 +685,20 @@ fn simulate_warns_of_a_cloth_that_starts_through_itself() {
     assert!(warned.contains(start), "{warned}");
     let free = run("self-fold", "assets/cloth.obj");
     assert!(!free.contains("at the start"), "{free}");
+    // `--json` carries them too; a cloth with nothing to warn of has no `warnings`.
+    let obj = path.to_str().unwrap();
+    let args = ["simulate", "--scene", "self-fold", "--obj", obj, "--json"];
+    let v = json(&clothsim(&[&args[..], &["--seconds", "0.05"]].concat()));
+    let warnings = v["warnings"].as_array().expect("a list of warnings");
+    assert_eq!(warnings.len(), 2, "{warnings:?}");
+    assert!(
+        warnings[1]
+            .as_str()
+            .unwrap()
+            .contains("(2 triangle pairs meet)")
+    );
+    let v = json(&clothsim(&["simulate", "--seconds", "0.05", "--json"]));
+    assert!(v.get("warnings").is_none(), "{v}");
 }
 
 /// `--iterations` sets XPBD's and VBD's sweeps per substep: VBD reports three a step.

@@ -58,12 +58,18 @@ pub struct RunSummary {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub intersections: Option<Intersections>,
     /// With self-collision: the pairs of the cloth that prescribed motion (pins, handles)
-    /// drove together where no cut could keep them apart, since the simulation began
-    /// (substeps a rollback redid counted again); 0 when the guarantee held everywhere.
+    /// drove together where no cut could keep them apart, since the simulation began, in
+    /// the substeps that stand (not those of the tries the stability guard threw away);
+    /// 0 when the guarantee held everywhere.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub forced_pairs: Option<u64>,
     /// Set when the run stopped early because it diverged.
     pub error: Option<String>,
+    /// What [`Simulation::warnings`] says about the cloth and the scene's start (the
+    /// import's notes, a cloth that starts through itself or a solid, a sphere smaller
+    /// than the spacing); left out where there is none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// One phase of a run.
@@ -172,6 +178,7 @@ impl Simulation {
             intersections: None,
             forced_pairs: self.self_collision_work().map(|w| w.forced_total),
             error: None,
+            warnings: self.warnings().to_vec(),
         }
     }
 }
