@@ -189,6 +189,42 @@ fn a_forced_pair_is_counted_once_and_the_check_ends() {
     );
 }
 
+/// Story: a grab moved the held particle between frames, outside every substep, so a drag
+/// through the cloth made it cross itself unseen: nothing cut, nothing counted. The move
+/// now runs in the next frame's first substep, so self-contact sees it: every frame in which
+/// a drag down through `layers` makes the cloth cross itself counts forced pairs, and a
+/// drag along the top layer, through nothing, counts none.
+#[test]
+fn a_grab_dragged_through_the_cloth_is_counted_not_hidden() {
+    let drag = |by: Vec3| {
+        let mut sim = builtin("layers", Some(8));
+        let forced = |sim: &Simulation| sim.self_collision_work().unwrap().forced_total;
+        // The middle particle of the top layer (the last of the five).
+        let n = sim.model().particle_count();
+        let p = (4 * n / 5 + n / 10) as u32;
+        let start = sim.state().pos[p as usize];
+        let (mut crossings, mut counted) = (0, 0);
+        for k in 1..=6 {
+            let (before, was) = (forced(&sim), sim.intersections().self_pairs);
+            sim.grab(p, start + by * k as f32);
+            sim.step_frame().expect("the drag is stepped");
+            if sim.intersections().self_pairs > was {
+                crossings += 1;
+                counted += usize::from(forced(&sim) > before);
+            }
+        }
+        (crossings, counted, forced(&sim))
+    };
+    let (crossings, counted, total) = drag(Vec3::new(0.0, -0.03, 0.0));
+    assert!(crossings > 0, "the drag goes through the layers below");
+    assert_eq!(counted, crossings, "{total} forced in all");
+    assert_eq!(
+        drag(Vec3::new(0.01, 0.0, 0.0)),
+        (0, 0, 0),
+        "along the top layer"
+    );
+}
+
 fn builtin(name: &str, quads: Option<u32>) -> Simulation {
     let scene = Scene::open_resized(name, None, &ImportOptions::default(), quads).unwrap();
     Simulation::new(scene)

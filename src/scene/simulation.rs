@@ -25,6 +25,10 @@ struct Held {
     /// `(simulated time, target)`, oldest first: the samples of the last [`GRAB_WINDOW`]
     /// and the newest one before that.
     trail: Vec<(f64, glam::Vec3)>,
+    /// Where the particle was when the backend last stepped, while the pointer has moved
+    /// it since (outside any substep): the next frame takes that move into its first
+    /// substep ([`StepBackend::moved_outside`]).
+    from: Option<glam::Vec3>,
 }
 
 impl Held {
@@ -163,6 +167,7 @@ impl Simulation {
     pub fn adopt_state(&mut self, state: &ClothState, frames: u64) {
         self.state.clone_from(state);
         self.frames = frames;
+        self.move_taken();
         self.backend.invalidate();
     }
 
@@ -457,15 +462,40 @@ impl Simulation {
             self.held = Some(Held {
                 particle: p,
                 trail: Vec::new(),
+                from: None,
             });
             self.refresh_pins();
         }
         let now = self.state.time;
-        let pointer = self.held.as_mut().and_then(|h| h.follow(now, target));
         let i = p as usize;
-        self.state.vel[i] = pointer.unwrap_or((target - self.state.pos[i]) / self.params.step.dt);
+        let was = self.state.pos[i];
+        let pointer = self.held.as_mut().and_then(|h| {
+            h.from.get_or_insert(was);
+            h.follow(now, target)
+        });
+        self.state.vel[i] = pointer.unwrap_or((target - was) / self.params.step.dt);
         self.state.pos[i] = target;
         self.backend.invalidate();
+    }
+
+    /// Hands the backend the move the pointer made since the last step, for the frame
+    /// about to be stepped.
+    fn hand_over_move(&mut self) {
+        if let Some(Held {
+            particle,
+            from: Some(from),
+            ..
+        }) = self.held
+        {
+            self.backend.moved_outside(particle, from);
+        }
+    }
+
+    /// The step took the pointer's move (or the state it started from was replaced).
+    fn move_taken(&mut self) {
+        if let Some(held) = &mut self.held {
+            held.from = None;
+        }
     }
 
     /// Lets go of the held particle; it flies on at the pointer's velocity (see
@@ -542,6 +572,7 @@ impl Simulation {
             self.state.vel[p as usize] = glam::Vec3::ZERO;
         }
         self.frames = 0;
+        self.move_taken();
         self.backend.invalidate();
     }
 
@@ -551,6 +582,7 @@ impl Simulation {
     /// [`Diverged`]: the state is left at the frame's start. Its cause is the held
     /// particle's pull where the backend saw nothing more specific.
     pub fn step_frame(&mut self) -> Result<FrameOutcome, Diverged> {
+        self.hand_over_move();
         let out = self
             .backend
             .frame(&self.model, &mut self.state)
@@ -562,6 +594,7 @@ impl Simulation {
                 }
                 e
             })?;
+        self.move_taken();
         self.frames += 1;
         Ok(out)
     }
@@ -572,7 +605,10 @@ impl Simulation {
     /// # Errors
     /// The integrator's [`StepError`].
     pub fn substep(&mut self) -> Result<StepReport, StepError> {
-        self.backend.substep(&self.model, &mut self.state)
+        self.hand_over_move();
+        let report = self.backend.substep(&self.model, &mut self.state)?;
+        self.move_taken();
+        Ok(report)
     }
 
     /// Makes [`Simulation::state`] current when the backend steps a copy of its own (the

@@ -33,6 +33,13 @@ pub trait StepBackend: Send {
     /// whatever was kept from earlier steps is dropped.
     fn invalidate(&mut self);
 
+    /// Pinned `particle` (the held one of a grab) was moved outside the substeps, from
+    /// `from` to where the state has it: the next [`StepBackend::frame`] takes that move
+    /// as part of its first substep's motion, so that the contacts see it (self-contact
+    /// cuts what it would cross and counts the pairs it forces). It holds for that call
+    /// alone. By default nothing: the move is not seen (the GPU backend).
+    fn moved_outside(&mut self, _particle: u32, _from: glam::Vec3) {}
+
     /// One frame of `params.step.dt` seconds, under the stability guard.
     ///
     /// # Errors

@@ -68,6 +68,9 @@ pub struct CpuStepper<R: Real = f32> {
     frame_start: CpuSnapshot<R>,
     /// Positions at the start of the current substep: the paths colliders sweep.
     substep_start: Vec<glam::Vec3>,
+    /// A pinned particle moved outside the substeps before the frame being stepped, and
+    /// where from ([`StepBackend::moved_outside`]): each try's first substep starts it there.
+    outside: Option<(u32, glam::Vec3)>,
     self_collision: Option<SelfCollision>,
     self_contacts: SelfContacts,
     /// Positions before the solids act (first, and again after self-contact), and before
@@ -124,6 +127,7 @@ impl<R: Real> CpuStepper<R> {
             meter: StepMeter::default(),
             frame_start: CpuSnapshot::default(),
             substep_start: Vec::new(),
+            outside: None,
             self_collision: None,
             self_contacts: SelfContacts::default(),
             before_solids: Vec::new(),
@@ -341,7 +345,7 @@ impl<R: Real> CpuStepper<R> {
         }
         let limits = self.guard.limits.filter(|_| checked);
         let depth = limits.map_or(0.0, |l| l.depth_of(f32_view(state, &mut self.view)));
-        for _ in 0..count {
+        for k in 0..count {
             self.advance(model, state)?;
             if let Some(l) = limits
                 && let Some(trouble) =
@@ -349,9 +353,23 @@ impl<R: Real> CpuStepper<R> {
             {
                 return Err(trouble);
             }
+            if k == 0 {
+                self.start_outside();
+            }
             self.resolve_contacts(model, state)?;
         }
         Ok(())
+    }
+
+    /// Starts the particle moved outside the substeps where it was moved from, in the
+    /// substep's start positions the contacts' paths run from (it is pinned: the step left
+    /// it where the move put it).
+    fn start_outside(&mut self) {
+        if let Some((p, from)) = self.outside
+            && let Some(start) = self.substep_start.get_mut(p as usize)
+        {
+            *start = from;
+        }
     }
 
     /// One frame at the substeps in effect, ending exactly at `end` (seconds); checked
@@ -635,11 +653,14 @@ impl<R: Real> StepBackend for CpuStepper<R> {
         model: &ClothModel,
         state: &mut ClothState,
     ) -> Result<StepReport, StepError> {
-        self.on_state(state, |stepper, state| {
+        let stepped = self.on_state(state, |stepper, state| {
             let report = stepper.advance(model, state)?;
+            stepper.start_outside();
             stepper.resolve_contacts(model, state)?;
             Ok(report)
-        })
+        });
+        self.outside = None;
+        stepped
     }
 
     /// One frame under the guard: a frame that breaks a limit (non-finite, too fast, a
@@ -652,7 +673,13 @@ impl<R: Real> StepBackend for CpuStepper<R> {
         model: &ClothModel,
         state: &mut ClothState,
     ) -> Result<FrameOutcome, Diverged> {
-        self.on_state(state, |stepper, state| stepper.guarded_frame(model, state))
+        let stepped = self.on_state(state, |stepper, state| stepper.guarded_frame(model, state));
+        self.outside = None;
+        stepped
+    }
+
+    fn moved_outside(&mut self, particle: u32, from: glam::Vec3) {
+        self.outside = Some((particle, from));
     }
 
     fn substeps(&self) -> u32 {
