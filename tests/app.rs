@@ -709,6 +709,50 @@ fn dragging_the_cloth_pulls_a_particle_and_ctrl_click_pins_it_under_every_integr
     }
 }
 
+/// Dragging a particle of `layers` down through the cloths below forces pairs together
+/// (the held particle's path is prescribed): the status area says how many, in one message
+/// that counts up as the drag goes on.
+#[test]
+fn a_drag_through_the_cloth_is_reported_with_the_pairs_it_forced() {
+    let mut harness = harness();
+    harness.get_by_label("layers").click();
+    harness.run_steps(2);
+    step_frames(&mut harness, 1);
+    // A point over the top cloth with cloth 10 points below it too (where the drag starts).
+    let app = harness.state();
+    let rect = app.view_rect().expect("the view was drawn");
+    let top = app.sim().model().particle_count() as u32 * 4 / 5;
+    let on_top = |at: egui::Pos2| app.particle_at(rect, at).is_some_and(|(p, _)| p >= top);
+    let at = (0..1600)
+        .map(|k| rect.center() + egui::vec2((k % 40) as f32 - 20.0, (k / 40) as f32 - 30.0) * 8.0)
+        .find(|&at| on_top(at) && on_top(at + egui::vec2(0.0, 10.0)))
+        .expect("the top cloth in the view");
+    harness.hover_at(at);
+    harness.run_steps(1);
+    harness.drag_at(at);
+    harness.run_steps(1);
+    for k in 1..=8 {
+        harness.hover_at(at + egui::vec2(0.0, 20.0 * k as f32));
+        harness.run_steps(1);
+        harness.state_mut().step_once();
+    }
+    harness.state_mut().settle();
+    run_settled(&mut harness, 1);
+    let app = harness.state();
+    assert!(app.sim().grabbed().is_some(), "the drag holds a particle");
+    let forced = app.in_effect().forced;
+    assert!(forced > 0, "the drag forced no pair");
+    let tallies: Vec<_> = (app.messages.iter())
+        .filter(|m| m.text.contains("prescribed motion"))
+        .collect();
+    assert_eq!(tallies.len(), 1, "{:?}", app.messages);
+    assert!(
+        tallies[0].text.contains(&format!("forced {forced} pairs")),
+        "{:?}",
+        tallies[0]
+    );
+}
+
 #[test]
 fn the_gpu_button_moves_the_cloth_to_the_gpu_and_back_keeping_its_state() {
     let mut harness = harness();

@@ -11,7 +11,7 @@ use crate::view;
 
 use super::accuracy::{AccuracyWindow, Start};
 use super::background::{Load, PngWriter};
-use super::messages::{Level, Message};
+use super::messages::{Level, Message, forced_pairs};
 use super::panel::{Action, Panel, PanelContext, Status};
 use super::panels::{SidePanel, StatusBar, TransportBar, drop_hint};
 use super::pointer::{Pointer, particle_at};
@@ -428,7 +428,13 @@ impl ClothApp {
             notes,
             behind,
         } = news;
+        let forced_before = self.in_effect.forced;
         self.in_effect = in_effect;
+        if in_effect.forced > forced_before
+            && let Some(m) = forced_pairs(self.messages.last_mut(), in_effect.forced)
+        {
+            self.message(m.level, m.text);
+        }
         for event in guard_events {
             let level = match event.action {
                 GuardAction::Recovered => Level::Info,

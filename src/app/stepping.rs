@@ -51,6 +51,9 @@ pub struct InEffect {
     pub substep_length: f32,
     /// The requested integrator, or the guard's fallback.
     pub integrator: IntegratorKind,
+    /// The pairs of the cloth prescribed motion (a grab, pins, a handle) forced together
+    /// since the simulation began (0 without self-collision).
+    pub forced: u64,
 }
 
 impl InEffect {
@@ -66,6 +69,7 @@ impl InEffect {
             substeps: sim.substeps(),
             substep_length: sim.substep_length(),
             integrator: sim.integrator_in_effect(),
+            forced: sim.self_collision_work().map_or(0, |w| w.forced_total),
         }
     }
 }
