@@ -13,8 +13,8 @@ use crate::mesh::ImportOptions;
 use crate::scene::{Scene, Simulation};
 use crate::sim::effects::EffectKind;
 use crate::sim::{
-    CONTACT_START, ClothSprings, IntegratorKind, PhaseTimings, Plane, SELF_RECHECK, SELF_UPKEEP,
-    SelfCollision, Sphere,
+    CONTACT_START, ClothSprings, GuardAction, IntegratorKind, PhaseTimings, Plane, SELF_RECHECK,
+    SELF_UPKEEP, SelfCollision, Sphere,
 };
 
 /// The simulated seconds timed.
@@ -62,6 +62,10 @@ pub struct CrumpleRow {
     pub refreshes_per_substep: f64,
     /// Pairs prescribed motion forced, over the run (0: nothing was forced).
     pub forced: u64,
+    /// The integrator the stability guard fell back to during the run, where it did: the
+    /// row's substeps are then partly that one's (`integrator` is the one asked for).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fell_back_to: Option<String>,
 }
 
 /// Runs `crumple` at `quads` quads a side under `integrator` (the scene's own with `None`)
@@ -108,10 +112,14 @@ pub fn crumple_one(
     let per = |t: Duration| t.as_secs_f64() * 1e6 / substeps.max(1) as f64;
     let particles = sim.model().particle_count();
     let work = sim.self_collision_work().unwrap_or_default();
+    let fell_back_to = (sim.take_guard_events().iter()).find_map(|e| match e.action {
+        GuardAction::FellBack { integrator } => Some(integrator.name().to_string()),
+        _ => None,
+    });
     Ok(CrumpleRow {
         quads,
         particles,
-        integrator: sim.integrator_in_effect().name().to_string(),
+        integrator: sim.params().step.integrator.name().to_string(),
         threads: crate::parallel::Team::current().members(),
         substeps,
         wall_per_second: wall / sim.state().time.max(f64::EPSILON),
@@ -126,6 +134,7 @@ pub fn crumple_one(
         searches_per_substep: searches as f64 / sampled.max(1) as f64,
         refreshes_per_substep: refreshes as f64 / sampled.max(1) as f64,
         forced: work.forced_total,
+        fell_back_to,
     })
 }
 
@@ -191,6 +200,7 @@ mod tests {
             searches_per_substep: 0.1,
             refreshes_per_substep: 0.2,
             forced: 0,
+            fell_back_to: None,
             runs: 1,
         }
     }

@@ -255,6 +255,12 @@ pub fn crumple_bench(
                 row.searches_per_substep,
                 row.refreshes_per_substep,
             );
+            if let Some(fallback) = &row.fell_back_to {
+                println!(
+                    "       (the stability guard fell back to {fallback}: the row counts its \
+                     substeps too)"
+                );
+            }
         }
     }
     Ok(())
