@@ -57,10 +57,10 @@ pub struct RunSummary {
     /// --check-intersections`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub intersections: Option<Intersections>,
-    /// With self-collision: the pairs of the cloth that prescribed motion (pins, handles)
-    /// drove together where no cut could keep them apart, since the simulation began, in
-    /// the substeps that stand (not those of the tries the stability guard threw away);
-    /// 0 when the guarantee held everywhere.
+    /// With self-collision: the pairs of the cloth that prescribed motion (pins, handles,
+    /// a grab) drove together where no cut could keep them apart, since the simulation
+    /// began, in the substeps that stand (not those of the tries the stability guard threw
+    /// away); 0 when the guarantee held everywhere.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub forced_pairs: Option<u64>,
     /// Set when the run stopped early because it diverged.
