@@ -469,10 +469,11 @@ impl Simulation {
         let now = self.state.time;
         let i = p as usize;
         let was = self.state.pos[i];
-        let pointer = self.held.as_mut().and_then(|h| {
-            h.from.get_or_insert(was);
-            h.follow(now, target)
-        });
+        let Some(held) = self.held.as_mut() else {
+            return;
+        };
+        held.from.get_or_insert(was);
+        let pointer = held.follow(now, target);
         self.state.vel[i] = pointer.unwrap_or((target - was) / self.params.step.dt);
         self.state.pos[i] = target;
         self.backend.invalidate();

@@ -70,6 +70,8 @@ pub struct CpuStepper<R: Real = f32> {
     substep_start: Vec<glam::Vec3>,
     /// A pinned particle moved outside the substeps before the frame being stepped, and
     /// where from ([`StepBackend::moved_outside`]): each try's first substep starts it there.
+    /// (A grab invalidates the stepper, which drops the guard's rollback points: a try
+    /// after a move starts at the frame's start, never at an earlier frame.)
     outside: Option<(u32, glam::Vec3)>,
     self_collision: Option<SelfCollision>,
     self_contacts: SelfContacts,
