@@ -193,10 +193,19 @@ fn a_forced_pair_is_counted_once_and_the_check_ends() {
 /// through the cloth made it cross itself unseen: nothing cut, nothing counted. The move
 /// now runs in the next frame's first substep, so self-contact sees it: every frame in which
 /// a drag down through `layers` makes the cloth cross itself counts forced pairs, and a
-/// drag along the top layer, through nothing, counts none.
+/// drag along the top layer, through nothing, counts none; stepped a frame at a time or a
+/// substep at a time.
 #[test]
 fn a_grab_dragged_through_the_cloth_is_counted_not_hidden() {
-    let drag = |by: Vec3| {
+    let by_frames = |sim: &mut Simulation| {
+        sim.step_frame().expect("the drag is stepped");
+    };
+    let by_substeps = |sim: &mut Simulation| {
+        for _ in 0..sim.substeps() {
+            sim.substep().expect("the drag is stepped");
+        }
+    };
+    let drag = |by: Vec3, step: &dyn Fn(&mut Simulation)| {
         let mut sim = builtin("layers", Some(8));
         let forced = |sim: &Simulation| sim.self_collision_work().unwrap().forced_total;
         // The middle particle of the top layer (the last of the five).
@@ -207,7 +216,7 @@ fn a_grab_dragged_through_the_cloth_is_counted_not_hidden() {
         for k in 1..=6 {
             let (before, was) = (forced(&sim), sim.intersections().self_pairs);
             sim.grab(p, start + by * k as f32);
-            sim.step_frame().expect("the drag is stepped");
+            step(&mut sim);
             if sim.intersections().self_pairs > was {
                 crossings += 1;
                 counted += usize::from(forced(&sim) > before);
@@ -215,14 +224,13 @@ fn a_grab_dragged_through_the_cloth_is_counted_not_hidden() {
         }
         (crossings, counted, forced(&sim))
     };
-    let (crossings, counted, total) = drag(Vec3::new(0.0, -0.03, 0.0));
-    assert!(crossings > 0, "the drag goes through the layers below");
-    assert_eq!(counted, crossings, "{total} forced in all");
-    assert_eq!(
-        drag(Vec3::new(0.01, 0.0, 0.0)),
-        (0, 0, 0),
-        "along the top layer"
-    );
+    for step in [&by_frames as &dyn Fn(&mut Simulation), &by_substeps] {
+        let (crossings, counted, total) = drag(Vec3::new(0.0, -0.03, 0.0), step);
+        assert!(crossings > 0, "the drag goes through the layers below");
+        assert_eq!(counted, crossings, "{total} forced in all");
+        let along = drag(Vec3::new(0.01, 0.0, 0.0), step);
+        assert_eq!(along, (0, 0, 0), "along the top layer");
+    }
 }
 
 fn builtin(name: &str, quads: Option<u32>) -> Simulation {
