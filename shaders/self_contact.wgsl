@@ -76,11 +76,12 @@ const BIG: u32 = 2u;
 const TRIANGLE_PAIRS: u32 = 3u;
 const IMPACTS: u32 = 4u;
 const STUCK: u32 = 20u;
-// The most grid entries and pairs any substep of the submission asked for (zeroed by the
-// host before each, not by `clear`).
+// The most grid entries and pairs any substep of the submission asked for, and the pairs
+// its substeps forced (zeroed by the host before each, not by `clear`).
 const MOST_ENTRIES: u32 = 34u;
 const MOST_PAIRS: u32 = 35u;
-const COUNTERS: u32 = 36u;
+const FORCED: u32 = 36u;
+const COUNTERS: u32 = 37u;
 // Rounds of cuts by the safe fraction; later rounds cut to the start (the CPU's).
 const SCALED_ROUNDS: u32 = 4u;
 // Cells a triangle's box may cover and still go into the grid.
@@ -742,6 +743,9 @@ fn cut_apply(@builtin(global_invocation_id) id: vec3<u32>) {
 // it kept. Every free particle goes back to its start where the last round recorded
 // still cut something, or the grid's or the pairs' room ran out.
 fn finish_one(i: u32) {
+    if (i == 0u) {
+        count_forced();
+    }
     if (i >= sp.counts.x) {
         return;
     }
@@ -764,6 +768,18 @@ fn finish_one(i: u32) {
     p.x = vec4<f32>(to, p.x.w);
     state[i] = p;
     tell_solver(i, p.v.xyz - v);
+}
+
+// Adds the substep's forced pairs to the submission's: those the last round that ran found
+// could meet and could not cut. Each round checks every pair again and a forced pair's
+// particles are never cut, so a pair forced in one round is forced in every later one and
+// is counted once.
+fn count_forced() {
+    var r = 0u;
+    while (r + 1u < sp.more.w && cut_something(r)) {
+        r++;
+    }
+    atomicAdd(&atomics[FORCED], atomicLoad(&atomics[STUCK + r]));
 }
 
 @compute @workgroup_size(64)

@@ -111,7 +111,6 @@ pub fn crumple_one(
     };
     let per = |t: Duration| t.as_secs_f64() * 1e6 / substeps.max(1) as f64;
     let particles = sim.model().particle_count();
-    let work = sim.self_collision_work().unwrap_or_default();
     let fell_back_to = (sim.take_guard_events().iter()).find_map(|e| match e.action {
         GuardAction::FellBack { integrator } => Some(integrator.name().to_string()),
         _ => None,
@@ -133,7 +132,7 @@ pub fn crumple_one(
         pairs_per_particle: pairs as f64 / sampled.max(1) as f64 / particles as f64,
         searches_per_substep: searches as f64 / sampled.max(1) as f64,
         refreshes_per_substep: refreshes as f64 / sampled.max(1) as f64,
-        forced: work.forced_total,
+        forced: sim.forced_pairs().unwrap_or(0),
         fell_back_to,
     })
 }

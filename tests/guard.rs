@@ -1,12 +1,13 @@
 //! The stability guard: what it catches, how it rolls back, refines, falls back and
 //! recovers, and what it records.
 
-use std::path::Path;
-
-use clothsim::scene::{Scene, SceneFile, Simulation};
+use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::{
     Cause, Effect, FrameOutcome, GuardAction, GuardPolicy, IntegratorKind, SelfCollision,
 };
+
+mod common;
+use common::driven_through;
 
 fn hanging(configure: impl FnOnce(&mut Scene)) -> Simulation {
     let mut scene = Scene::builtin("hanging").unwrap();
@@ -495,60 +496,9 @@ fn explicit() -> impl Iterator<Item = IntegratorKind> {
     (IntegratorKind::ALL.into_iter()).filter(|k| k.stable_substep(1.0, 0.0).is_some())
 }
 
-/// Three stacked 4 × 4 squares of 20 cm, 3 cm apart, with gravity and self-collision: the
-/// lowest free but for a corner, its springs `stiffness` N/m (symplectic Euler at the
-/// scene's 4 substeps blows up as it sags from 400 on), the middle one pinned, the top one
-/// a handle that jumps 4.5 cm down through the middle one and back up, once a frame. Each
-/// jump takes 0.1 ms from 0.2 ms into its frame, inside the frame's first substep at any
-/// count the guard tries (up to 32), so it forces the same pairs of the two prescribed
-/// squares however the frame is stepped, and before a blow-up stops a try; the free square
-/// swings down, clear of them.
-fn driven_through(
-    integrator: &str,
-    stiffness: f32,
-    configure: impl FnOnce(&mut Scene),
-) -> Simulation {
-    let keyframes: Vec<String> = (0..12)
-        .flat_map(|frame| {
-            let t = frame as f32 / 60.0 + 2e-4;
-            let [from, to] = if frame % 2 == 0 {
-                [0.0, -0.045]
-            } else {
-                [-0.045, 0.0]
-            };
-            [(t, from), (t + 1e-4, to)]
-        })
-        .map(|(t, y)| format!("{{ time = {t}, translate = [0.0, {y}, 0.0] }}"))
-        .collect();
-    let toml = format!(
-        r#"
-name = "driven"
-[cloth]
-grid = {{ quads = 4, size = 0.2, layers = 3, spacing = 0.03 }}
-orientation = "horizontal"
-center = [0.0, 1.0, 0.0]
-[solver]
-integrator = "{integrator}"
-dt = 0.016666668
-substeps = 4
-[material]
-stiffness = {{ structural = {stiffness}, shear = {stiffness}, bend = {stiffness} }}
-[pins]
-region = {{ min = [-1.0, 0.99, -1.0], max = [1.0, 1.01, 1.0] }}
-indices = [0]
-[[effects]]
-type = "gravity"
-[[effects]]
-type = "self-collision"
-thickness = 0.005
-[[handles]]
-region = {{ min = [-1.0, 1.02, -1.0], max = [1.0, 1.04, 1.0] }}
-keyframes = [ {} ]
-"#,
-        keyframes.join(", ")
-    );
-    let file = SceneFile::parse(&toml, Path::new("driven.toml")).unwrap_or_else(|e| panic!("{e}"));
-    let mut scene = Scene::from_file(file, None).unwrap_or_else(|e| panic!("{e}"));
+/// [`driven_through`] with `configure` applied, simulated.
+fn driven(integrator: &str, stiffness: f32, configure: impl FnOnce(&mut Scene)) -> Simulation {
+    let mut scene = driven_through(integrator, stiffness);
     configure(&mut scene);
     Simulation::new(scene)
 }
@@ -566,13 +516,13 @@ fn forced(sim: &Simulation) -> u64 {
 /// integrator, reports the pairs a run that needed no rescue reports.
 #[test]
 fn a_frame_redone_counts_only_the_pairs_forced_in_the_try_that_stands() {
-    let mut clean = driven_through("implicit-euler", 400.0, |_| {});
+    let mut clean = driven("implicit-euler", 400.0, |_| {});
     let summary = clean.run(0.2);
     assert!(summary.guard_events.is_empty() && summary.error.is_none());
     let expected = forced(&clean);
     assert!(expected > 0, "the jumps force pairs");
     for (stiffness, fell_back) in [(400.0, false), (2000.0, true)] {
-        let mut sim = driven_through("semi-implicit-euler", stiffness, |_| {});
+        let mut sim = driven("semi-implicit-euler", stiffness, |_| {});
         let summary = sim.run(0.2);
         assert!(summary.error.is_none(), "{:?}", summary.error);
         let rescued = summary.guard_events.iter().any(|e| match e.action {
@@ -589,7 +539,7 @@ fn a_frame_redone_counts_only_the_pairs_forced_in_the_try_that_stands() {
 /// two frames, then symplectic Euler, with one refinement and no fallback, blows up.
 #[test]
 fn a_frame_given_up_takes_back_the_pairs_it_forced() {
-    let mut sim = driven_through("implicit-euler", 2000.0, |s| {
+    let mut sim = driven("implicit-euler", 2000.0, |s| {
         s.params.guard = GuardPolicy {
             max_refinements: 1,
             fallback: None,

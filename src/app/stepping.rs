@@ -69,7 +69,7 @@ impl InEffect {
             substeps: sim.substeps(),
             substep_length: sim.substep_length(),
             integrator: sim.integrator_in_effect(),
-            forced: sim.self_collision_work().map_or(0, |w| w.forced_total),
+            forced: sim.forced_pairs().unwrap_or(0),
         }
     }
 }

@@ -47,11 +47,12 @@ impl Contacts {
 
     /// These passes, with self-contact's settings for tests as in `old`: how often its
     /// pushes sweep and in how many rounds, whether one workgroup runs it whatever the
-    /// size, and its room.
+    /// size, and its room; and its count of forced pairs.
     pub(super) fn tuned_as(mut self, old: &Contacts) -> Self {
         if let (Some(own), Some(old)) = (self.own.as_mut(), old.own.as_ref()) {
             (own.sweeps, own.push_rounds) = (old.sweeps, old.push_rounds);
             (own.forced, own.room) = (old.forced, old.room);
+            own.forced_pairs = old.forced_pairs;
         }
         self
     }
@@ -128,6 +129,19 @@ impl Contacts {
     pub(super) fn after_submission(&mut self, encoder: &mut wgpu::CommandEncoder) {
         if let Some(own) = self.own.as_mut() {
             own.copy_counters(encoder);
+        }
+    }
+
+    /// The pairs prescribed motion forced together over the submissions read, where the
+    /// scene has self-contact.
+    pub(super) fn forced_pairs(&self) -> Option<u64> {
+        self.own.as_ref().map(|own| own.forced_pairs)
+    }
+
+    /// The state went back to a rollback point where `forced` pairs had been forced.
+    pub(super) fn roll_back_forced(&mut self, forced: u64) {
+        if let Some(own) = self.own.as_mut() {
+            own.roll_back_forced(forced);
         }
     }
 

@@ -54,11 +54,15 @@ const ROUND_STRIDE: u64 = 256;
 const PUSH_WORDS: u64 = 9;
 
 /// The shader's counters before the buckets (its `COUNTERS`).
-const COUNTERS: u32 = 36;
+const COUNTERS: u32 = 37;
 
 /// Where the shader keeps the most grid entries and pairs a substep of the submission
-/// asked for (`MOST_ENTRIES`, `MOST_PAIRS`), in bytes.
+/// asked for and the pairs its substeps forced (`MOST_ENTRIES`, `MOST_PAIRS`, `FORCED`),
+/// in bytes.
 const MOST_AT: u64 = 4 * 34;
+
+/// Bytes of those three counters.
+const MOST_BYTES: u64 = 12;
 
 /// The pass's uniform (the shader's `SelfParams`).
 #[repr(C)]
@@ -197,6 +201,11 @@ pub(super) struct SelfPass {
     /// The counters read after a submission, and whether one is waiting there.
     readout: wgpu::Buffer,
     pending: bool,
+    /// The pairs prescribed motion forced together (no particle of theirs could be cut),
+    /// added up over the submissions read since the pass was made; and whether the one
+    /// waiting in `readout` was rolled back (its count is then not added).
+    pub(super) forced_pairs: u64,
+    undone: bool,
     /// Whether one workgroup runs the submission's substeps (see [`TOGETHER_TRIANGLES`]).
     together: bool,
     /// Whether one workgroup runs every substep (`Some(true)`) or none, whatever the size
@@ -331,6 +340,8 @@ impl SelfPass {
             params,
             readout,
             pending: false,
+            forced_pairs: 0,
+            undone: false,
             together: small(n, 0),
             forced: None,
             room: None,
@@ -477,13 +488,13 @@ impl SelfPass {
             Memory::Accelerations(at) => (2, at),
         };
         queue.write_buffer(&self.buffers[0], 0, bytemuck::bytes_of(&self.params));
-        queue.write_buffer(&self.buffers[3], MOST_AT, &[0; 8]);
+        queue.write_buffer(&self.buffers[3], MOST_AT, &[0; MOST_BYTES as usize]);
         Ok(())
     }
 
     /// Reads what the last submission's substeps asked for, if it has not been read: grows
-    /// the room where they ran out of it (to twice what they asked) and picks the path for
-    /// the next. Returns whether they ran out (then the substeps concerned left the cloth
+    /// the room where they ran out of it (to twice what they asked), picks the path for
+    /// the next and adds the pairs they forced to [`Self::forced_pairs`]. Returns whether they ran out (then the substeps concerned left the cloth
     /// where they started it).
     ///
     /// # Errors
@@ -496,12 +507,15 @@ impl SelfPass {
         let slice = self.readout.slice(..);
         let failed = |e: &dyn std::fmt::Display| GpuError::Readback(e.to_string());
         map_read(device, &slice).map_err(|e| failed(&e))?;
-        let (entries, pairs) = {
+        let [entries, pairs, forced] = {
             let view = slice.get_mapped_range().map_err(|e| failed(&e))?;
             let words: &[u32] = bytemuck::cast_slice(&view);
-            (words[0], words[1])
+            [words[0], words[1], words[2]]
         };
         self.readout.unmap();
+        if !std::mem::take(&mut self.undone) {
+            self.forced_pairs += u64::from(forced);
+        }
         self.together = small(self.params.counts[1], pairs);
         let mut grown = self.params;
         if entries > grown.counts[3] {
@@ -669,8 +683,21 @@ impl SelfPass {
 
     /// Records a copy of the last substep's counters, read before the next submission.
     pub(super) fn copy_counters(&mut self, encoder: &mut wgpu::CommandEncoder) {
-        encoder.copy_buffer_to_buffer(&self.buffers[3], MOST_AT, &self.readout, 0, Some(8));
-        self.pending = true;
+        encoder.copy_buffer_to_buffer(
+            &self.buffers[3],
+            MOST_AT,
+            &self.readout,
+            0,
+            Some(MOST_BYTES),
+        );
+        (self.pending, self.undone) = (true, false);
+    }
+
+    /// The state went back to a rollback point where `forced` pairs had been forced: the
+    /// count goes back with it, and what a submission not yet read forced is not added.
+    pub(super) fn roll_back_forced(&mut self, forced: u64) {
+        self.forced_pairs = forced;
+        self.undone = self.pending;
     }
 }
 

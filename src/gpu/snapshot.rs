@@ -10,6 +10,8 @@ pub(super) struct DeviceSnapshot {
     copy: Option<(wgpu::Device, wgpu::Queue, wgpu::Buffer)>,
     /// Seconds.
     pub(super) time: f64,
+    /// The pairs prescribed motion had forced together by then (self-contact's count).
+    pub(super) forced: u64,
 }
 
 impl DeviceSnapshot {
@@ -24,23 +26,26 @@ impl DeviceSnapshot {
         Self {
             copy: Some((device.clone(), queue.clone(), buffer)),
             time: 0.0,
+            forced: 0,
         }
     }
 
-    /// Encodes the copy of `particles` into the snapshot, which then holds `time`.
+    /// Encodes the copy of `particles` into the snapshot, which then holds `time` and
+    /// `forced` pairs forced.
     pub(super) fn take(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         particles: &wgpu::Buffer,
-        time: f64,
+        (time, forced): (f64, u64),
     ) {
         if let Some((_, _, buffer)) = &self.copy {
             encoder.copy_buffer_to_buffer(particles, 0, buffer, 0, None);
         }
-        self.time = time;
+        (self.time, self.forced) = (time, forced);
     }
 
-    /// Encodes the copy of the snapshot into `particles`; returns the time it holds.
+    /// Encodes the copy of the snapshot into `particles`; returns the time it holds (the
+    /// caller sets the forced pairs' count back to [`DeviceSnapshot::forced`]).
     pub(super) fn restore(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -56,7 +61,7 @@ impl DeviceSnapshot {
 impl Snapshot for DeviceSnapshot {
     /// Copies on the device, in a submission of its own (queued after the frames before it).
     fn copy_from(&mut self, from: &Self) {
-        self.time = from.time;
+        (self.time, self.forced) = (from.time, from.forced);
         let Some((device, queue, source)) = &from.copy else {
             self.copy = None;
             return;
@@ -64,7 +69,7 @@ impl Snapshot for DeviceSnapshot {
         let fits = matches!(&self.copy, Some((_, _, b)) if b.size() == source.size());
         if !fits {
             *self = Self::new(device, queue, source.size());
-            self.time = from.time;
+            (self.time, self.forced) = (from.time, from.forced);
         }
         let Some((_, _, buffer)) = &self.copy else {
             return;

@@ -414,7 +414,8 @@ impl GpuStepper {
             });
         if watch.keep_start {
             let live = &self.particles[self.current];
-            self.frame_start.take(&mut encoder, live, time);
+            let forced = self.contacts.forced_pairs().unwrap_or(0);
+            self.frame_start.take(&mut encoder, live, (time, forced));
         }
         self.elements.start(&self.queue, time);
         // The substep counted, when something reads the count: the element pass's clock, the
@@ -516,6 +517,7 @@ impl GpuStepper {
             });
         let live = &self.particles[self.current];
         let time = snapshot.restore(&mut encoder, live);
+        self.contacts.roll_back_forced(snapshot.forced);
         if let Some(display) = &self.display {
             encoder.copy_buffer_to_buffer(live, 0, display, 0, None);
         }
@@ -786,6 +788,10 @@ impl StepBackend for GpuStepper {
             self.lost = Some(why.clone());
             StepError::Device(why)
         })
+    }
+
+    fn forced_pairs(&self) -> Option<u64> {
+        self.contacts.forced_pairs()
     }
 
     fn state_behind(&self) -> bool {

@@ -317,6 +317,13 @@ impl Simulation {
         self.backend.self_collision_work()
     }
 
+    /// The pairs of the cloth that prescribed motion (a grab, pins, a handle) forced
+    /// together since the simulation was made, over the substeps that stand, on either
+    /// backend; `None` without self-collision.
+    pub fn forced_pairs(&self) -> Option<u64> {
+        self.backend.forced_pairs()
+    }
+
     /// Total mechanical energy (kinetic plus the potential of the conservative forces),
     /// joules.
     pub fn energy(&self) -> f64 {

@@ -176,7 +176,7 @@ impl Simulation {
             phases: BTreeMap::new(),
             solver_iterations_per_step: 0.0,
             intersections: None,
-            forced_pairs: self.self_collision_work().map(|w| w.forced_total),
+            forced_pairs: self.forced_pairs(),
             error: None,
             warnings: self.warnings().to_vec(),
         }

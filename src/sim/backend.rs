@@ -85,6 +85,14 @@ pub trait StepBackend: Send {
         None
     }
 
+    /// The pairs of the cloth prescribed motion forced together (self-contact could cut
+    /// no particle of theirs) over the substeps that stand, when the scene has
+    /// self-collision: [`SelfWork::forced_total`](super::self_contacts::SelfWork) by
+    /// default.
+    fn forced_pairs(&self) -> Option<u64> {
+        self.self_collision_work().map(|w| w.forced_total)
+    }
+
     /// Makes `state` and a copy the backend keeps elsewhere (a GPU buffer) agree: the copy
     /// is read back when it stepped since they last agreed, or replaced by `state` when
     /// that is the newer one (after [`StepBackend::invalidate`] or
