@@ -193,11 +193,18 @@ fn a_forced_pair_is_counted_once_and_the_check_ends() {
 /// through the cloth made it cross itself unseen: nothing cut, nothing counted. The move
 /// now runs in the next frame's first substep, so self-contact sees it: every frame in which
 /// a drag down through `layers` makes the cloth cross itself counts forced pairs, and a
-/// drag along the top layer, through nothing, counts none; stepped a frame at a time or a
-/// substep at a time.
+/// drag along the top layer, through nothing, counts none; stepped a frame at a time (the
+/// state read or not before it) or a substep at a time, on the CPU and on the GPU (the software adapter), where the state is
+/// sent with the held particle where the move started and the first substep carries it on.
 #[test]
 fn a_grab_dragged_through_the_cloth_is_counted_not_hidden() {
     let by_frames = |sim: &mut Simulation| {
+        sim.step_frame().expect("the drag is stepped");
+    };
+    // The state read between the grab and the step (on the GPU: sent before the move is
+    // handed over, so sent again with it).
+    let read_first = |sim: &mut Simulation| {
+        sim.sync_state().expect("read back");
         sim.step_frame().expect("the drag is stepped");
     };
     let by_substeps = |sim: &mut Simulation| {
@@ -205,9 +212,14 @@ fn a_grab_dragged_through_the_cloth_is_counted_not_hidden() {
             sim.substep().expect("the drag is stepped");
         }
     };
-    let drag = |by: Vec3, step: &dyn Fn(&mut Simulation)| {
-        let mut sim = builtin("layers", Some(8));
-        let forced = |sim: &Simulation| sim.self_collision_work().unwrap().forced_total;
+    let drag = |by: Vec3, step: &dyn Fn(&mut Simulation), on_gpu: bool| {
+        let scene = Scene::open_resized("layers", None, &ImportOptions::default(), Some(8));
+        let scene = scene.expect("layers");
+        let mut sim = match on_gpu {
+            true => common::gpu_simulation(scene, true).expect("GPU backend").0,
+            false => Simulation::new(scene),
+        };
+        let forced = |sim: &Simulation| sim.forced_pairs().expect("self-collision");
         // The middle particle of the top layer (the last of the five).
         let n = sim.model().particle_count();
         let p = (4 * n / 5 + n / 10) as u32;
@@ -217,6 +229,7 @@ fn a_grab_dragged_through_the_cloth_is_counted_not_hidden() {
             let (before, was) = (forced(&sim), sim.intersections().self_pairs);
             sim.grab(p, start + by * k as f32);
             step(&mut sim);
+            sim.sync_state().expect("read back");
             if sim.intersections().self_pairs > was {
                 crossings += 1;
                 counted += usize::from(forced(&sim) > before);
@@ -224,12 +237,18 @@ fn a_grab_dragged_through_the_cloth_is_counted_not_hidden() {
         }
         (crossings, counted, forced(&sim))
     };
-    for step in [&by_frames as &dyn Fn(&mut Simulation), &by_substeps] {
-        let (crossings, counted, total) = drag(Vec3::new(0.0, -0.03, 0.0), step);
-        assert!(crossings > 0, "the drag goes through the layers below");
-        assert_eq!(counted, crossings, "{total} forced in all");
-        let along = drag(Vec3::new(0.01, 0.0, 0.0), step);
-        assert_eq!(along, (0, 0, 0), "along the top layer");
+    for on_gpu in [false, true] {
+        for step in [
+            &by_frames as &dyn Fn(&mut Simulation),
+            &read_first,
+            &by_substeps,
+        ] {
+            let (crossings, counted, total) = drag(Vec3::new(0.0, -0.03, 0.0), step, on_gpu);
+            assert!(crossings > 0, "the drag goes through the layers below");
+            assert_eq!(counted, crossings, "{total} forced in all (GPU: {on_gpu})");
+            let along = drag(Vec3::new(0.01, 0.0, 0.0), step, on_gpu);
+            assert_eq!(along, (0, 0, 0), "along the top layer (GPU: {on_gpu})");
+        }
     }
 }
 

@@ -1,6 +1,6 @@
-//! What the GPU stepper builds anew when its parameters change: XPBD's constraints or
-//! VBD's stencil, the element pass's buffers, the handles' stamps on the device's state,
-//! and the substep's bind groups over them.
+//! What the GPU stepper sends or builds anew when the state or its parameters change: the
+//! state, XPBD's constraints or VBD's stencil, the element pass's buffers, the handles'
+//! stamps on the device's state, and the substep's bind groups over them.
 
 use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{Effect, IntegratorKind, StepError};
@@ -8,6 +8,7 @@ use crate::sim::{Effect, IntegratorKind, StepError};
 use super::elements::{elements_wanted, pack_elements};
 use super::error::GpuError;
 use super::implicit::{ImplicitPass, MOVED_FLAG};
+use super::packing::Particle;
 use super::stepper::GpuStepper;
 use super::substep_ends::Memory;
 use super::support::fits_elements;
@@ -15,6 +16,36 @@ use super::vbd::VbdPass;
 use super::xpbd::XpbdPass;
 
 impl GpuStepper {
+    /// Sends `state` to the device, each particle stamped with its handle's slot; a pinned
+    /// particle moved before the frame being stepped (`outside`) goes where it was moved
+    /// from, with a slot that takes it where it was moved to in the first substep.
+    pub(super) fn upload_state(&mut self, model: &ClothModel, state: &ClothState) {
+        let moved = (self.outside).filter(|&(p, _)| (p as usize) < state.pos.len());
+        let held = moved.map(|(p, _)| (p, state.pos[p as usize], state.vel[p as usize]));
+        let taken = self.carried.hold(held);
+        let stamps = self.carried.stamps(state.pos.len());
+        let mut data: Vec<Particle> = (state.pos.iter().zip(&state.vel))
+            .zip(model.inv_mass.iter().zip(stamps))
+            .map(|((x, v), (&w, slot))| Particle {
+                x: [x.x, x.y, x.z, w],
+                v: [v.x, v.y, v.z, slot],
+            })
+            .collect();
+        if let Some((p, from)) = moved.filter(|_| taken) {
+            data[p as usize].x[..3].copy_from_slice(&from.to_array());
+        }
+        if !data.is_empty() {
+            for buffer in std::iter::once(&self.particles[self.current]).chain(&self.display) {
+                self.queue
+                    .write_buffer(buffer, 0, bytemuck::cast_slice(&data));
+            }
+        }
+        self.upload = false;
+        self.restamp = false;
+        self.forget_guesses();
+        self.behind = false;
+    }
+
     /// Stamps the device's state with the handles' slots anew (the handles changed): the
     /// latest state read back and sent again.
     pub(super) fn restamp(

@@ -56,7 +56,10 @@ pub struct GpuStepper {
     /// The particles the handles carry, and whether the device's state must be stamped
     /// with their slots anew.
     pub(super) carried: Carried,
-    restamp: bool,
+    pub(super) restamp: bool,
+    /// A pinned particle the caller moved before the frame being stepped, and where from
+    /// ([`StepBackend::moved_outside`]): the state is sent with it there.
+    pub(super) outside: Option<(u32, Vec3)>,
     /// The handles' targets of the last submission (kept for its storage).
     targets: Vec<[f32; 4]>,
     /// The integrator in effect (one of those the GPU runs).
@@ -101,7 +104,7 @@ pub struct GpuStepper {
     readback: wgpu::Buffer,
     /// A copy of the state at the end of the last frame, for a renderer on the same device;
     /// made on the first [`GpuStepper::display_buffer`], then kept current.
-    display: Option<wgpu::Buffer>,
+    pub(super) display: Option<wgpu::Buffer>,
     pub(super) current: usize,
     pub(super) count: u32,
     pub(super) params: Params,
@@ -218,6 +221,7 @@ impl GpuStepper {
             elements,
             elements_for: (false, false),
             carried: Carried::default(),
+            outside: None,
             restamp: false,
             targets: Vec::new(),
             integrator: params.step.integrator,
@@ -328,27 +332,6 @@ impl GpuStepper {
             self.ends_sent += 1;
             self.sent = Some(key);
         }
-    }
-
-    pub(super) fn upload_state(&mut self, model: &ClothModel, state: &ClothState) {
-        let stamps = self.carried.stamps(state.pos.len());
-        let data: Vec<Particle> = (state.pos.iter().zip(&state.vel))
-            .zip(model.inv_mass.iter().zip(stamps))
-            .map(|((x, v), (&w, slot))| Particle {
-                x: [x.x, x.y, x.z, w],
-                v: [v.x, v.y, v.z, slot],
-            })
-            .collect();
-        if !data.is_empty() {
-            for buffer in std::iter::once(&self.particles[self.current]).chain(&self.display) {
-                self.queue
-                    .write_buffer(buffer, 0, bytemuck::cast_slice(&data));
-            }
-        }
-        self.upload = false;
-        self.restamp = false;
-        self.forget_guesses();
-        self.behind = false;
     }
 
     /// Encodes and submits `substeps` substeps, with what `watch` asks for.
@@ -546,7 +529,7 @@ impl GpuStepper {
 
     /// The state changed outside: VBD's last accelerations and implicit Euler's last Δv
     /// are no first guess for the next step.
-    fn forget_guesses(&mut self) {
+    pub(super) fn forget_guesses(&mut self) {
         self.vbd_fresh = true;
         if let Some(pass) = &mut self.implicit {
             pass.fresh = true;
@@ -684,7 +667,7 @@ impl StepBackend for GpuStepper {
             self.params.colliders = solids;
             self.effects = effects.to_vec();
             (self.gravity, self.air_damping) = (g, drag);
-            let carried = Carried::of(effects);
+            let carried = Carried::of(effects).holding_as(&self.carried);
             if carried != self.carried {
                 self.carried = carried;
                 self.restamp = true;
@@ -733,7 +716,16 @@ impl StepBackend for GpuStepper {
         model: &ClothModel,
         state: &mut ClothState,
     ) -> Result<FrameOutcome, Diverged> {
-        self.guarded_frame(model, state)
+        let stepped = self.guarded_frame(model, state);
+        self.outside = None;
+        stepped
+    }
+
+    /// The state is sent again with the particle where it was moved from (where the caller's
+    /// state is the device's: the move invalidated it, or it was read back since).
+    fn moved_outside(&mut self, particle: u32, from: Vec3) {
+        self.outside = Some((particle, from));
+        self.upload |= !self.behind;
     }
 
     fn substep(
@@ -741,7 +733,9 @@ impl StepBackend for GpuStepper {
         model: &ClothModel,
         state: &mut ClothState,
     ) -> Result<StepReport, StepError> {
-        self.timed_run(model, state, 1)?;
+        let ran = self.timed_run(model, state, 1);
+        self.outside = None;
+        ran?;
         state.time += self.substep_length() as f64;
         let sweeps = match self.integrator {
             IntegratorKind::Xpbd | IntegratorKind::Vbd => self.sweeps(),

@@ -37,7 +37,8 @@ pub trait StepBackend: Send {
     /// `from` to where the state has it: the next [`StepBackend::frame`] takes that move
     /// as part of its first substep's motion, so that the contacts see it (self-contact
     /// cuts what it would cross and counts the pairs it forces). It holds for that call
-    /// alone. By default nothing: the move is not seen (the GPU backend).
+    /// alone (or the next [`StepBackend::substep`]). By default nothing: the move is not
+    /// seen.
     fn moved_outside(&mut self, _particle: u32, _from: glam::Vec3) {}
 
     /// One frame of `params.step.dt` seconds, under the stability guard.

@@ -14,7 +14,8 @@ use crate::scene::{Scene, SceneFile, Simulation};
 use crate::sim::{FrameOutcome, StepBackend};
 
 /// The host's copies of the shader's counter layout are the shader's: where the buckets
-/// start and where the most entries and pairs a submission asked for are read from; each
+/// start and where the most entries and pairs a submission asked for, and the pairs it
+/// forced, are read from; each
 /// round of cuts has its two counters, clear of those; the pair kernels' indirect
 /// dispatches are sized by the workgroup they run in; a particle has as many push words,
 /// and the number of every push round of a substep fits above a key's depth and hash.
@@ -24,7 +25,12 @@ fn the_host_and_the_shader_agree_on_the_counters() {
     assert_eq!(c("COUNTERS"), super::COUNTERS);
     assert_eq!(4 * u64::from(c("MOST_ENTRIES")), super::MOST_AT);
     assert_eq!(c("MOST_PAIRS"), c("MOST_ENTRIES") + 1);
-    assert!(c("MOST_PAIRS") < c("COUNTERS"));
+    assert_eq!(c("FORCED"), c("MOST_PAIRS") + 1);
+    assert_eq!(
+        super::MOST_BYTES,
+        4 * u64::from(c("FORCED") + 1 - c("MOST_ENTRIES"))
+    );
+    assert!(c("FORCED") < c("COUNTERS"));
     assert!(
         c("IMPACTS") + super::ROUNDS <= c("STUCK"),
         "the rounds' impacts fit"
