@@ -76,12 +76,15 @@ const BIG: u32 = 2u;
 const TRIANGLE_PAIRS: u32 = 3u;
 const IMPACTS: u32 = 4u;
 const STUCK: u32 = 20u;
-// The most grid entries and pairs any substep of the submission asked for, and the pairs
-// its substeps forced (zeroed by the host before each, not by `clear`).
+// The most grid entries and pairs any substep of the submission asked for, the pairs its
+// substeps forced, and the fastest particle (an `f32`'s bits, m/s) as its substeps found
+// them before their contacts, for the guard (zeroed by the host before each, not by
+// `clear`).
 const MOST_ENTRIES: u32 = 34u;
 const MOST_PAIRS: u32 = 35u;
 const FORCED: u32 = 36u;
-const COUNTERS: u32 = 37u;
+const FASTEST: u32 = 37u;
+const COUNTERS: u32 = 38u;
 // Rounds of cuts by the safe fraction; later rounds cut to the start (the CPU's).
 const SCALED_ROUNDS: u32 = 4u;
 // Cells a triangle's box may cover and still go into the grid.
@@ -169,6 +172,12 @@ fn particle_boxes_one(i: u32) {
     }
     let a = start[i].x.xyz;
     let b = state[i].x.xyz;
+    // Non-negative floats order as their bits do, and a NaN's bits above infinity's; a
+    // load first spares most particles the atomic.
+    let speed = bitcast<u32>(length(state[i].v.xyz));
+    if (speed > atomicLoad(&atomics[FASTEST])) {
+        atomicMax(&atomics[FASTEST], speed);
+    }
     let g = vec3<f32>(0.5 * sp.lengths.x);
     let word = pushes_at() + PUSH_WORDS * i + HELD;
     let moved = atomicLoad(&atomics[word]) & MOVED;

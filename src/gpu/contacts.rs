@@ -9,7 +9,7 @@ use super::error::GpuError;
 use super::kernel::SubstepKernel;
 use super::obstacles::ObstaclePass;
 use super::packing::Params;
-use super::self_contact::SelfPass;
+use super::self_contact::{Counters, SelfPass};
 use super::substep_ends::{Memory, Start};
 
 /// The scene's mesh obstacles and self-contact on the device, where it has them.
@@ -145,14 +145,33 @@ impl Contacts {
         }
     }
 
-    /// Whether self-contact's room for pairs or grid entries ran out in the last
-    /// submission (read once; the room is grown then).
+    /// What self-contact's last submission asked for and measured, read once (`None`
+    /// where there is nothing to read).
     ///
     /// # Errors
     /// [`GpuError::Readback`] when the counters cannot be read.
-    pub(super) fn room_ran_out(&mut self, device: &wgpu::Device) -> Result<bool, GpuError> {
+    pub(super) fn read_counters(
+        &mut self,
+        device: &wgpu::Device,
+    ) -> Result<Option<Counters>, GpuError> {
         match self.own.as_mut() {
             Some(own) => own.read_counters(device),
+            None => Ok(None),
+        }
+    }
+
+    /// Whether self-contact's room for pairs or grid entries ran out in a submission that
+    /// `asked` for so many; the room is grown then.
+    ///
+    /// # Errors
+    /// [`GpuError::Unsupported`] when the room needed exceeds one binding.
+    pub(super) fn make_room(
+        &mut self,
+        device: &wgpu::Device,
+        asked: [u32; 2],
+    ) -> Result<bool, GpuError> {
+        match self.own.as_mut() {
+            Some(own) => own.make_room(device, asked),
             None => Ok(false),
         }
     }

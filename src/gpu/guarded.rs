@@ -15,6 +15,7 @@ use std::time::Instant;
 use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{Cause, Diverged, FrameOutcome, GuardAction, GuardLimits, Trouble};
 
+use super::error::GpuError;
 use super::health::Watch;
 use super::stepper::GpuStepper;
 use super::support::GPU_INTEGRATORS;
@@ -140,17 +141,27 @@ impl GpuStepper {
             self.lost = Some(why.clone());
             Failed::Device(why)
         })?;
-        let ran_out = (self.contacts.room_ran_out(&self.device))
-            .map_err(|e| Failed::Device(e.to_string()))?;
-        if ran_out && self.room_tries > 0 {
+        let device = |e: GpuError| Failed::Device(e.to_string());
+        let counters = self.contacts.read_counters(&self.device).map_err(device)?;
+        // Self-contact measures each substep's fastest particle before its contacts, as the
+        // CPU's guard checks each substep: a blow-up inside the frame is caught there even
+        // where the contacts or the room running out held the cloth back by its end.
+        let mut motion = health.motion;
+        if let Some(read) = &counters {
+            motion.speed = motion.speed.max(read.fastest);
+            motion.finite &= read.fastest.is_finite();
+        }
+        let limits = (self.guard.limits.as_ref()).ok_or(Failed::Limit(Trouble::NonFinite))?;
+        if let Some(trouble) = limits.judge(&motion, || health.strain) {
+            // The room a blown-up try asked for (its boxes cover everything) is not given.
+            return Err(Failed::Limit(trouble));
+        }
+        let asked = counters.map(|read| self.contacts.make_room(&self.device, read.asked));
+        if asked.transpose().map_err(device)? == Some(true) && self.room_tries > 0 {
             self.room_tries -= 1;
             return Ok(Tried::RanOut);
         }
-        let limits = (self.guard.limits.as_ref()).ok_or(Failed::Limit(Trouble::NonFinite))?;
-        match limits.judge(&health.motion, || health.strain) {
-            Some(trouble) => Err(Failed::Limit(trouble)),
-            None => Ok(Tried::Stood),
-        }
+        Ok(Tried::Stood)
     }
 
     /// Replays from the rollback point to `end` at the substeps in effect, from the start

@@ -54,15 +54,25 @@ const ROUND_STRIDE: u64 = 256;
 const PUSH_WORDS: u64 = 9;
 
 /// The shader's counters before the buckets (its `COUNTERS`).
-const COUNTERS: u32 = 37;
+const COUNTERS: u32 = 38;
 
 /// Where the shader keeps the most grid entries and pairs a substep of the submission
-/// asked for and the pairs its substeps forced (`MOST_ENTRIES`, `MOST_PAIRS`, `FORCED`),
-/// in bytes.
+/// asked for, the pairs its substeps forced and its fastest particle before the contacts
+/// (`MOST_ENTRIES`, `MOST_PAIRS`, `FORCED`, `FASTEST`), in bytes.
 const MOST_AT: u64 = 4 * 34;
 
-/// Bytes of those three counters.
-const MOST_BYTES: u64 = 12;
+/// Bytes of those four counters.
+const MOST_BYTES: u64 = 16;
+
+/// What a submission's substeps asked for and measured ([`SelfPass::read_counters`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Counters {
+    /// The most grid entries and pairs a substep asked for.
+    pub(super) asked: [u32; 2],
+    /// The fastest particle any substep left its integrator with, before the contacts
+    /// (m/s; not finite where a velocity was not).
+    pub(super) fastest: f32,
+}
 
 /// The pass's uniform (the shader's `SelfParams`).
 #[repr(C)]
@@ -469,7 +479,9 @@ impl SelfPass {
         memory: Memory,
         cloth: &Params,
     ) -> Result<(), GpuError> {
-        self.read_counters(device)?;
+        if let Some(read) = self.read_counters(device)? {
+            self.make_room(device, read.asked)?;
+        }
         if let Some([pairs, entries]) = self.room.take() {
             let mut shrunk = self.params;
             (shrunk.more[0], shrunk.counts[3]) = (pairs, entries);
@@ -492,30 +504,49 @@ impl SelfPass {
         Ok(())
     }
 
-    /// Reads what the last submission's substeps asked for, if it has not been read: grows
-    /// the room where they ran out of it (to twice what they asked), picks the path for
-    /// the next and adds the pairs they forced to [`Self::forced_pairs`]. Returns whether they ran out (then the substeps concerned left the cloth
-    /// where they started it).
+    /// Reads what the last submission's substeps asked for and measured, if it has not been
+    /// read (`None` where it has), and adds the pairs they forced to
+    /// [`Self::forced_pairs`].
     ///
     /// # Errors
-    /// As [`Self::prepare`].
-    pub(super) fn read_counters(&mut self, device: &wgpu::Device) -> Result<bool, GpuError> {
+    /// [`GpuError::Readback`] when the counters cannot be read.
+    pub(super) fn read_counters(
+        &mut self,
+        device: &wgpu::Device,
+    ) -> Result<Option<Counters>, GpuError> {
         if !self.pending {
-            return Ok(false);
+            return Ok(None);
         }
         self.pending = false;
         let slice = self.readout.slice(..);
         let failed = |e: &dyn std::fmt::Display| GpuError::Readback(e.to_string());
         map_read(device, &slice).map_err(|e| failed(&e))?;
-        let [entries, pairs, forced] = {
+        let [entries, pairs, forced, fastest] = {
             let view = slice.get_mapped_range().map_err(|e| failed(&e))?;
             let words: &[u32] = bytemuck::cast_slice(&view);
-            [words[0], words[1], words[2]]
+            [words[0], words[1], words[2], words[3]]
         };
         self.readout.unmap();
         if !std::mem::take(&mut self.undone) {
             self.forced_pairs += u64::from(forced);
         }
+        Ok(Some(Counters {
+            asked: [entries, pairs],
+            fastest: f32::from_bits(fastest),
+        }))
+    }
+
+    /// Grows the room where a submission that `asked` for grid entries and pairs ran out of
+    /// it (to twice what it asked) and picks the path for the next. Returns whether it ran
+    /// out (then the substeps concerned left the cloth where they started it).
+    ///
+    /// # Errors
+    /// [`GpuError::Unsupported`] when the room needed exceeds one binding.
+    pub(super) fn make_room(
+        &mut self,
+        device: &wgpu::Device,
+        [entries, pairs]: [u32; 2],
+    ) -> Result<bool, GpuError> {
         self.together = small(self.params.counts[1], pairs);
         let mut grown = self.params;
         if entries > grown.counts[3] {
