@@ -480,7 +480,13 @@ fn a_pull_the_cloth_cannot_follow_is_named_as_the_cause() {
             sim.step_frame().err()
         })
         .expect("the pull tears the flag");
-    assert_eq!(err.cause, Cause::Pull, "{err}");
+    assert_eq!(
+        err.cause,
+        Cause::Pull {
+            implicit_tried: false
+        },
+        "{err}"
+    );
     assert!(err.to_string().contains("held particle"), "{err}");
     // The springs alone are within symplectic Euler's stable step: without the grab the
     // stiffness would have been named.
@@ -563,4 +569,29 @@ fn a_frame_given_up_takes_back_the_pairs_it_forced() {
     assert_eq!(events.last().map(|e| &e.action), Some(&GuardAction::GaveUp));
     assert!(before > 0, "the jumps forced pairs before");
     assert_eq!(forced(&sim), before);
+}
+
+/// Story: a frame nothing saved under XPBD, with implicit Euler tried as the fallback, was
+/// reported as "…and with Implicit Euler (CG)…" followed by "Lower the stiffness, raise the
+/// substeps, or choose implicit Euler": advice to choose what had just failed. The advice
+/// now names no integrator the guard tried. `crumple` at 32² under XPBD at one 50 ms
+/// substep a frame gives up as it lands (a spring stretched 560 %).
+#[test]
+fn the_advice_names_no_integrator_the_guard_already_tried() {
+    let mut scene = Scene::open_resized("crumple", None, &Default::default(), Some(32)).unwrap();
+    scene.params.step.integrator = IntegratorKind::Xpbd;
+    (scene.params.step.dt, scene.params.step.substeps) = (0.05, 1);
+    let mut sim = Simulation::new(scene);
+    let err = (0..20)
+        .find_map(|_| sim.step_frame().err())
+        .expect("XPBD at 50 ms gives up where the cloth lands");
+    let text = err.to_string();
+    assert!(text.contains("and with Implicit Euler"), "{text}");
+    assert!(!text.contains("choose implicit Euler"), "{text}");
+    assert_eq!(
+        err.cause,
+        Cause::Stiffness {
+            implicit_tried: true
+        }
+    );
 }

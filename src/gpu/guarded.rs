@@ -206,7 +206,7 @@ impl GpuStepper {
             }
         }
         let tried = self.substeps;
-        let mut fallback = String::new();
+        let (mut fallback, mut fell_back) = (String::new(), None);
         if let Some(kind) = self.guard.policy.fallback
             && kind != self.integrator
             && GPU_INTEGRATORS.contains(&kind)
@@ -224,6 +224,7 @@ impl GpuStepper {
                     last = t;
                     self.switch_integrator(original);
                     fallback = format!(", and with {}", kind.label());
+                    fell_back = Some(kind);
                 }
                 Err(Failed::Device(why)) => return Err(self.device_failure(state.time, why)),
             }
@@ -250,7 +251,7 @@ impl GpuStepper {
             reason: last.to_string(),
             substeps: tried,
             fallback,
-            cause: cause.unwrap_or(Cause::Stiffness),
+            cause: Cause::of_springs(cause, self.integrator, fell_back),
         })
     }
 

@@ -597,8 +597,10 @@ impl Simulation {
             .map_err(|mut e| {
                 // The backend cannot see a grab; with nothing more specific, the pull is the
                 // likely cause.
-                if self.held.is_some() && e.cause == Cause::Stiffness {
-                    e.cause = Cause::Pull;
+                if let (Some(_), Cause::Stiffness { implicit_tried }) = (&self.held, &e.cause) {
+                    e.cause = Cause::Pull {
+                        implicit_tried: *implicit_tried,
+                    };
                 }
                 e
             })?;

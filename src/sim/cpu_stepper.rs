@@ -271,25 +271,24 @@ impl<R: Real> CpuStepper<R> {
     }
 
     /// The likely cause of a frame that failed from positions `pos` at up to `tried`
-    /// substeps per frame: a self-collision thickness the cloth cannot take, an explicit
-    /// integrator past its stable step, or else the stiffness.
-    fn diagnose(&self, model: &ClothModel, pos: &[glam::Vec3], tried: u32) -> Cause {
+    /// substeps per frame, and with `fallback` where the guard tried it: a self-collision
+    /// thickness the cloth cannot take, an explicit integrator past its stable step, or
+    /// else the stiffness.
+    fn diagnose(
+        &self,
+        model: &ClothModel,
+        pos: &[glam::Vec3],
+        (tried, fallback): (u32, Option<IntegratorKind>),
+    ) -> Cause {
         if let Some(s) = &self.self_collision
             && let Err(too_thick) = s.fits(shortest_edge(model))
         {
             return Cause::Thickness(too_thick);
         }
         let kind = self.integrator.kind();
-        Cause::substeps(
-            kind,
-            model,
-            &self.forces,
-            pos,
-            self.air_damping,
-            self.dt,
-            tried,
-        )
-        .unwrap_or(Cause::Stiffness)
+        let forces = &self.forces;
+        let substeps = Cause::substeps(kind, model, forces, pos, self.air_damping, self.dt, tried);
+        Cause::of_springs(substeps, kind, fallback)
     }
 
     /// Runs `steps` (the integrator's work) on `state` and charges its phases.
@@ -455,7 +454,7 @@ impl<R: Real> CpuStepper<R> {
             }
         }
         let tried = self.substeps;
-        let mut fallback = String::new();
+        let (mut fallback, mut fell_back) = (String::new(), None);
         if let Some(kind) = self.guard.policy.fallback
             && kind != self.integrator.kind()
         {
@@ -475,6 +474,7 @@ impl<R: Real> CpuStepper<R> {
                     last = t;
                     self.integrator = original;
                     fallback = format!(", and with {}", kind.label());
+                    fell_back = Some(kind);
                 }
             }
         }
@@ -491,7 +491,7 @@ impl<R: Real> CpuStepper<R> {
             fallback,
             cause: {
                 let pos = f32_view(state, &mut self.view).pos.clone();
-                self.diagnose(model, &pos, tried)
+                self.diagnose(model, &pos, (tried, fell_back))
             },
         })
     }
@@ -551,7 +551,7 @@ impl<R: Real> CpuStepper<R> {
                     reason: trouble.to_string(),
                     substeps: self.substeps,
                     fallback: String::new(),
-                    cause: self.diagnose(model, &pos, self.substeps),
+                    cause: self.diagnose(model, &pos, (self.substeps, None)),
                 });
             }
             state.time = end;

@@ -30,54 +30,78 @@ pub enum Cause {
         needed: Option<u32>,
         /// The most substeps per frame the guard tried.
         tried: u32,
+        /// Implicit Euler was among the integrators tried (the advice then names only
+        /// XPBD).
+        implicit_tried: bool,
     },
     /// The self-collision thickness is at or above the cloth's shortest rest edge.
     Thickness(TooThick),
-    /// A held particle pulls the cloth harder than it can follow.
-    Pull,
+    /// A held particle pulls the cloth harder than it can follow (`implicit_tried` as for
+    /// [`Cause::Substeps`]).
+    Pull { implicit_tried: bool },
     /// The step backend failed or cannot run the scene.
     Backend,
-    /// Nothing more specific: the springs are too stiff for the step.
-    Stiffness,
+    /// Nothing more specific: the springs are too stiff for the step (`implicit_tried` as
+    /// for [`Cause::Substeps`]).
+    Stiffness { implicit_tried: bool },
 }
 
 impl std::fmt::Display for Cause {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        // The integrators stable at any step, less one that already failed.
+        let stable = |tried: bool| match tried {
+            true => "XPBD",
+            false => "implicit Euler or XPBD",
+        };
         match self {
             Cause::Substeps {
                 integrator,
                 omega,
                 needed: Some(needed),
                 tried,
+                implicit_tried,
             } => write!(
                 f,
                 "Too few substeps for the stiffness: {} is stable on this cloth's stiffest \
                  spring vibration ({omega:.0} rad/s) only from about {needed} substeps per \
                  frame (tried up to {tried}). Raise the substeps, lower the stiffness, or \
-                 choose implicit Euler or XPBD (stable at any step).",
-                integrator.label()
+                 choose {} (stable at any step).",
+                integrator.label(),
+                stable(*implicit_tried)
             ),
             Cause::Substeps {
                 integrator,
                 omega,
                 needed: None,
+                implicit_tried,
                 ..
             } => write!(
                 f,
                 "{} has no practical stable step on this cloth's stiffest spring vibration \
-                 ({omega:.0} rad/s) with so little damping. Choose implicit Euler or XPBD \
-                 (stable at any step), or add damping.",
-                integrator.label()
+                 ({omega:.0} rad/s) with so little damping. Choose {} (stable at any step), \
+                 or add damping.",
+                integrator.label(),
+                stable(*implicit_tried)
             ),
             Cause::Thickness(too_thick) => write!(f, "The likely cause: {too_thick}."),
-            Cause::Pull => f.write_str(
+            Cause::Pull { implicit_tried } => write!(
+                f,
                 "The held particle pulls the cloth harder than it can follow: move the pointer \
-                 more slowly, raise the substeps, or choose implicit Euler.",
+                 more slowly{}.",
+                match implicit_tried {
+                    true => " or raise the substeps (implicit Euler failed too)",
+                    false => ", raise the substeps, or choose implicit Euler",
+                }
             ),
             Cause::Backend => f.write_str("The step backend failed; try the CPU backend."),
-            Cause::Stiffness => {
-                f.write_str("Lower the stiffness, raise the substeps, or choose implicit Euler.")
-            }
+            Cause::Stiffness {
+                implicit_tried: true,
+            } => f.write_str(
+                "Lower the stiffness or raise the substeps (implicit Euler failed too).",
+            ),
+            Cause::Stiffness {
+                implicit_tried: false,
+            } => f.write_str("Lower the stiffness, raise the substeps, or choose implicit Euler."),
         }
     }
 }
@@ -107,7 +131,37 @@ impl Cause {
             omega: vibration.omega,
             needed: (needed <= PRACTICAL_SUBSTEPS).then_some(needed as u32),
             tried,
+            implicit_tried: false,
         })
+    }
+
+    /// The cause of a frame that failed under `integrator` and, where the guard tried it,
+    /// `fallback`: [`Cause::Substeps`] as [`Cause::substeps`] finds it, else
+    /// [`Cause::Stiffness`]; their advice names no integrator among those.
+    pub fn of_springs(
+        substeps: Option<Cause>,
+        integrator: IntegratorKind,
+        fallback: Option<IntegratorKind>,
+    ) -> Cause {
+        let implicit_tried =
+            [Some(integrator), fallback].contains(&Some(IntegratorKind::ImplicitEuler));
+        match substeps {
+            Some(Cause::Substeps {
+                integrator,
+                omega,
+                needed,
+                tried,
+                ..
+            }) => Cause::Substeps {
+                integrator,
+                omega,
+                needed,
+                tried,
+                implicit_tried,
+            },
+            Some(other) => other,
+            None => Cause::Stiffness { implicit_tried },
+        }
     }
 }
 
