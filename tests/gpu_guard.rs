@@ -234,30 +234,6 @@ fn the_gpu_counts_the_pairs_prescribed_motion_forces_in_the_tries_that_stand() {
 /// fallback, blows up.
 #[test]
 fn a_frame_the_gpu_gives_up_takes_back_the_pairs_it_forced() {
-    let mut scene = common::driven_through("implicit-euler", 2000.0);
-    scene.params.guard = GuardPolicy {
-        max_refinements: 1,
-        fallback: None,
-        ..GuardPolicy::default()
-    };
-    let (mut sim, _) = gpu_simulation(scene, false).expect("GPU backend");
-    let forced = |sim: &Simulation| sim.forced_pairs().expect("self-collision");
-    for _ in 0..2 {
-        sim.step_frame().expect("implicit Euler holds");
-    }
-    let mut params = sim.params().clone();
-    params.step.integrator = IntegratorKind::SemiImplicitEuler;
-    sim.set_params(params)
-        .expect("symplectic Euler runs on the GPU");
-    let mut before = forced(&sim);
-    for _ in 0..8 {
-        before = forced(&sim);
-        if sim.step_frame().is_err() {
-            break;
-        }
-    }
-    let events = sim.take_guard_events();
-    assert_eq!(events.last().map(|e| &e.action), Some(&GuardAction::GaveUp));
-    assert!(before > 0, "the jumps forced pairs before");
-    assert_eq!(forced(&sim), before);
+    let (sim, _) = gpu_simulation(common::driven_to_give_up(), false).expect("GPU backend");
+    common::a_frame_given_up_keeps_its_count(sim);
 }

@@ -545,30 +545,7 @@ fn a_frame_redone_counts_only_the_pairs_forced_in_the_try_that_stands() {
 /// two frames, then symplectic Euler, with one refinement and no fallback, blows up.
 #[test]
 fn a_frame_given_up_takes_back_the_pairs_it_forced() {
-    let mut sim = driven("implicit-euler", 2000.0, |s| {
-        s.params.guard = GuardPolicy {
-            max_refinements: 1,
-            fallback: None,
-            ..GuardPolicy::default()
-        };
-    });
-    for _ in 0..2 {
-        sim.step_frame().expect("implicit Euler holds");
-    }
-    let mut params = sim.params().clone();
-    params.step.integrator = IntegratorKind::SemiImplicitEuler;
-    sim.set_params(params).unwrap();
-    let mut before = forced(&sim);
-    for _ in 0..8 {
-        before = forced(&sim);
-        if sim.step_frame().is_err() {
-            break;
-        }
-    }
-    let events = sim.take_guard_events();
-    assert_eq!(events.last().map(|e| &e.action), Some(&GuardAction::GaveUp));
-    assert!(before > 0, "the jumps forced pairs before");
-    assert_eq!(forced(&sim), before);
+    common::a_frame_given_up_keeps_its_count(Simulation::new(common::driven_to_give_up()));
 }
 
 /// Story: a frame nothing saved under XPBD, with implicit Euler tried as the fallback, was

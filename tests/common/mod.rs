@@ -137,3 +137,42 @@ keyframes = [ {} ]
     let file = clothsim::scene::SceneFile::parse(&toml, path).unwrap_or_else(|e| panic!("{e}"));
     clothsim::scene::Scene::from_file(file, None).unwrap_or_else(|e| panic!("{e}"))
 }
+
+/// [`driven_through`] under implicit Euler at 2 000 N/m, the guard with one refinement and
+/// no fallback.
+#[allow(dead_code)]
+pub fn driven_to_give_up() -> clothsim::scene::Scene {
+    let mut scene = driven_through("implicit-euler", 2000.0);
+    scene.params.guard = clothsim::sim::GuardPolicy {
+        max_refinements: 1,
+        fallback: None,
+        ..Default::default()
+    };
+    scene
+}
+
+/// Steps `sim` (of [`driven_to_give_up`], on either backend) two frames, then under
+/// symplectic Euler, which blows up: the frame given up leaves the count of forced pairs
+/// where the frame found it.
+#[allow(dead_code)]
+pub fn a_frame_given_up_keeps_its_count(mut sim: clothsim::scene::Simulation) {
+    use clothsim::sim::{GuardAction, IntegratorKind};
+    let forced = |sim: &clothsim::scene::Simulation| sim.forced_pairs().expect("self-collision");
+    for _ in 0..2 {
+        sim.step_frame().expect("implicit Euler holds");
+    }
+    let mut params = sim.params().clone();
+    params.step.integrator = IntegratorKind::SemiImplicitEuler;
+    sim.set_params(params).expect("symplectic Euler runs");
+    let mut before = forced(&sim);
+    for _ in 0..8 {
+        before = forced(&sim);
+        if sim.step_frame().is_err() {
+            break;
+        }
+    }
+    let events = sim.take_guard_events();
+    assert_eq!(events.last().map(|e| &e.action), Some(&GuardAction::GaveUp));
+    assert!(before > 0, "the jumps forced pairs before");
+    assert_eq!(forced(&sim), before);
+}
