@@ -714,9 +714,25 @@ fn dragging_the_cloth_pulls_a_particle_and_ctrl_click_pins_it_under_every_integr
 /// that counts up as the drag goes on.
 #[test]
 fn a_drag_through_the_cloth_is_reported_with_the_pairs_it_forced() {
+    drag_through_layers(false);
+}
+
+/// The same on the GPU backend, which takes the drag's move into its first substep too.
+#[test]
+fn a_drag_through_the_cloth_on_the_gpu_is_reported_with_the_pairs_it_forced() {
+    drag_through_layers(true);
+}
+
+fn drag_through_layers(on_gpu: bool) {
     let mut harness = harness();
     harness.get_by_label("layers").click();
     harness.run_steps(2);
+    if on_gpu {
+        harness.get_by_label("GPU").click();
+        run_settled(&mut harness, 2);
+        let backend = harness.state().in_effect().backend;
+        assert_eq!(backend, "gpu", "{:?}", harness.state().last_error());
+    }
     step_frames(&mut harness, 1);
     // A point over the top cloth with cloth 10 points below it too (where the drag starts).
     let app = harness.state();
