@@ -125,10 +125,14 @@ pub fn obstacle_overlap_warnings(
 
 /// A warning for each sphere smaller than the cloth's particle spacing (its median spring
 /// rest length): collisions are per particle, so such a sphere can pass between particles
-/// and the cloth's triangles over it.
+/// and the cloth's triangles over it. None with self-collision, whose contacts push out
+/// the triangles that dip into a sphere as well.
 pub fn small_sphere_warnings(effects: &[Effect], model: &ClothModel) -> Vec<String> {
     let mut rest = model.springs.rest.clone();
-    if rest.is_empty() {
+    let faces_kept_out = effects
+        .iter()
+        .any(|e| matches!(e, Effect::SelfCollision(_)));
+    if rest.is_empty() || faces_kept_out {
         return Vec::new();
     }
     rest.sort_by(f32::total_cmp);
