@@ -31,8 +31,10 @@ impl GpuStepper {
                 v: [v.x, v.y, v.z, slot],
             })
             .collect();
-        if let Some((p, from)) = moved.filter(|_| taken) {
-            data[p as usize].x[..3].copy_from_slice(&from.to_array());
+        if let Some((p, from)) = moved.filter(|_| taken)
+            && let Some(particle) = data.get_mut(p as usize)
+        {
+            particle.x[..3].copy_from_slice(&from.to_array());
         }
         if !data.is_empty() {
             for buffer in std::iter::once(&self.particles[self.current]).chain(&self.display) {
