@@ -597,10 +597,10 @@ impl Simulation {
             .map_err(|mut e| {
                 // The backend cannot see a grab; with nothing more specific, the pull is the
                 // likely cause.
-                if let (Some(_), Cause::Stiffness { implicit_tried }) = (&self.held, &e.cause) {
-                    e.cause = Cause::Pull {
-                        implicit_tried: *implicit_tried,
-                    };
+                if self.held.is_some()
+                    && let Cause::Stiffness { implicit_tried } = e.cause
+                {
+                    e.cause = Cause::Pull { implicit_tried };
                 }
                 e
             })?;

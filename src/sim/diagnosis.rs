@@ -145,23 +145,14 @@ impl Cause {
     ) -> Cause {
         let implicit_tried =
             [Some(integrator), fallback].contains(&Some(IntegratorKind::ImplicitEuler));
-        match substeps {
-            Some(Cause::Substeps {
-                integrator,
-                omega,
-                needed,
-                tried,
-                ..
-            }) => Cause::Substeps {
-                integrator,
-                omega,
-                needed,
-                tried,
-                implicit_tried,
-            },
-            Some(other) => other,
-            None => Cause::Stiffness { implicit_tried },
+        let mut cause = substeps.unwrap_or(Cause::Stiffness { implicit_tried });
+        if let Cause::Substeps {
+            implicit_tried: t, ..
+        } = &mut cause
+        {
+            *t = implicit_tried;
         }
+        cause
     }
 }
 
