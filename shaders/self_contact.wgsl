@@ -77,8 +77,8 @@ const TRIANGLE_PAIRS: u32 = 3u;
 const IMPACTS: u32 = 4u;
 const STUCK: u32 = 20u;
 // The most grid entries and pairs any substep of the submission asked for, the pairs its
-// substeps forced, and the fastest particle (an `f32`'s bits, m/s) as its substeps found
-// them before their contacts, for the guard (zeroed by the host before each, not by
+// substeps forced, and the fastest particle (an `f32`'s bits, m/s) its substeps' searches
+// found, before their cuts, for the guard (zeroed by the host before each, not by
 // `clear`).
 const MOST_ENTRIES: u32 = 34u;
 const MOST_PAIRS: u32 = 35u;

@@ -143,7 +143,7 @@ impl GpuStepper {
         })?;
         let device = |e: GpuError| Failed::Device(e.to_string());
         let counters = self.contacts.read_counters(&self.device).map_err(device)?;
-        // Self-contact measures each substep's fastest particle before its contacts, as the
+        // Self-contact's searches measure each substep's fastest particle before its cuts, as the
         // CPU's guard checks each substep: a blow-up inside the frame is caught there even
         // where the contacts or the room running out held the cloth back by its end.
         let mut motion = health.motion;
@@ -156,8 +156,11 @@ impl GpuStepper {
             // The room a blown-up try asked for (its boxes cover everything) is not given.
             return Err(Failed::Limit(trouble));
         }
-        let asked = counters.map(|read| self.contacts.make_room(&self.device, read.asked));
-        if asked.transpose().map_err(device)? == Some(true) && self.room_tries > 0 {
+        let ran_out = match counters {
+            Some(read) => (self.contacts.make_room(&self.device, read.asked)).map_err(device)?,
+            None => false,
+        };
+        if ran_out && self.room_tries > 0 {
             self.room_tries -= 1;
             return Ok(Tried::RanOut);
         }

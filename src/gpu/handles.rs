@@ -47,10 +47,9 @@ impl Carried {
     }
 
     /// These handles, with the held particle's slot as in `old`.
-    pub(super) fn holding_as(self, old: &Carried) -> Self {
-        let mut carried = self;
-        carried.hold(old.held);
-        carried
+    pub(super) fn holding_as(mut self, old: &Carried) -> Self {
+        self.hold(old.held);
+        self
     }
 
     /// Gives held particle `particle` a slot that keeps it `at` (m) moving at `velocity`

@@ -57,7 +57,7 @@ const PUSH_WORDS: u64 = 9;
 const COUNTERS: u32 = 38;
 
 /// Where the shader keeps the most grid entries and pairs a substep of the submission
-/// asked for, the pairs its substeps forced and its fastest particle before the contacts
+/// asked for, the pairs its substeps forced and its fastest particle before the cuts
 /// (`MOST_ENTRIES`, `MOST_PAIRS`, `FORCED`, `FASTEST`), in bytes.
 const MOST_AT: u64 = 4 * 34;
 
@@ -69,8 +69,8 @@ const MOST_BYTES: u64 = 16;
 pub(super) struct Counters {
     /// The most grid entries and pairs a substep asked for.
     pub(super) asked: [u32; 2],
-    /// The fastest particle any substep left its integrator with, before the contacts
-    /// (m/s; not finite where a velocity was not).
+    /// The fastest particle any substep's searches found, after its integrator and
+    /// before its cuts (m/s; not finite where a velocity was not).
     pub(super) fastest: f32,
 }
 

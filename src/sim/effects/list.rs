@@ -128,13 +128,11 @@ pub fn obstacle_overlap_warnings(
 /// and the cloth's triangles over it. None with self-collision, whose contacts push out
 /// the triangles that dip into a sphere as well.
 pub fn small_sphere_warnings(effects: &[Effect], model: &ClothModel) -> Vec<String> {
-    let mut rest = model.springs.rest.clone();
-    let faces_kept_out = effects
-        .iter()
-        .any(|e| matches!(e, Effect::SelfCollision(_)));
-    if rest.is_empty() || faces_kept_out {
+    let faces_kept_out = (effects.iter()).any(|e| matches!(e, Effect::SelfCollision(_)));
+    if faces_kept_out || model.springs.rest.is_empty() {
         return Vec::new();
     }
+    let mut rest = model.springs.rest.clone();
     rest.sort_by(f32::total_cmp);
     let spacing = rest[rest.len() / 2];
     effects
