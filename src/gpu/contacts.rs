@@ -107,6 +107,14 @@ impl Contacts {
         }
     }
 
+    /// The copies of the substep's start that [`Contacts::keep_start`] makes.
+    pub(super) fn kept_starts(&self) -> impl Iterator<Item = &wgpu::Buffer> {
+        let obstacles = self.obstacles.as_ref().map(ObstaclePass::kept);
+        obstacles
+            .into_iter()
+            .chain(self.own.as_ref().map(SelfPass::kept))
+    }
+
     /// Records substep `k`'s contacts, where `start` says its start and end are.
     pub(super) fn encode(&self, pass: &mut wgpu::ComputePass<'_>, k: u32, start: Start) {
         if let Some(obstacles) = &self.obstacles {

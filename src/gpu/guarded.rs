@@ -17,6 +17,7 @@ use crate::sim::{Cause, Diverged, FrameOutcome, GuardAction, GuardLimits, Troubl
 
 use super::error::GpuError;
 use super::health::Watch;
+use super::snapshot::DeviceSnapshot;
 use super::stepper::GpuStepper;
 use super::support::GPU_INTEGRATORS;
 
@@ -165,6 +166,28 @@ impl GpuStepper {
             return Ok(Tried::RanOut);
         }
         Ok(Tried::Stood)
+    }
+
+    /// Encodes and submits the copy of `snapshot` into the live particle buffer (and the
+    /// display's); returns the time it holds. The device's copy is then ahead of the
+    /// caller's state.
+    pub(super) fn restore(&mut self, snapshot: &DeviceSnapshot) -> f64 {
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("particles rollback"),
+            });
+        let live = &self.particles[self.current];
+        let time = snapshot.restore(&mut encoder, live);
+        self.contacts.roll_back_forced(snapshot.forced);
+        if let Some(display) = &self.display {
+            encoder.copy_buffer_to_buffer(live, 0, display, 0, None);
+        }
+        self.queue.submit([encoder.finish()]);
+        self.upload = false;
+        self.forget_guesses();
+        self.behind = true;
+        time
     }
 
     /// Replays from the rollback point to `end` at the substeps in effect, from the start

@@ -63,7 +63,13 @@ impl GpuStepper {
             });
             let mut pass = encoder.begin_compute_pass(&Default::default());
             solve.finish(&mut pass, this);
-            contacts.encode(&mut pass, k, Start::In(self.current));
+            let start = Start::In(self.current);
+            if k == 0 && self.held.pending() {
+                drop(pass);
+                (self.held).start(encoder, (&self.particles, contacts), start);
+                pass = encoder.begin_compute_pass(&Default::default());
+            }
+            contacts.encode(&mut pass, k, start);
             if counting {
                 self.kernel.count_substep(&mut pass, this);
             }

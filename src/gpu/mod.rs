@@ -16,6 +16,7 @@ mod error;
 mod guarded;
 mod handles;
 mod health;
+mod held;
 mod implicit;
 mod implicit_steps;
 mod kernel;

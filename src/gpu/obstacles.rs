@@ -498,6 +498,11 @@ impl ObstaclePass {
         Ok(())
     }
 
+    /// The copy [`ObstaclePass::keep_start`] makes.
+    pub(super) fn kept(&self) -> &wgpu::Buffer {
+        &self.buffers[4]
+    }
+
     /// Records a copy of the substep's start, `particles[at]`, for an integrator that
     /// writes its end over it ([`Start::Kept`] then reads it).
     pub(super) fn keep_start(&self, pass: &mut wgpu::ComputePass<'_>, at: usize) {

@@ -16,26 +16,16 @@ use super::vbd::VbdPass;
 use super::xpbd::XpbdPass;
 
 impl GpuStepper {
-    /// Sends `state` to the device, each particle stamped with its handle's slot; a pinned
-    /// particle moved before the frame being stepped (`outside`) goes where it was moved
-    /// from, with a slot that takes it where it was moved to in the first substep.
+    /// Sends `state` to the device, each particle stamped with its handle's slot.
     pub(super) fn upload_state(&mut self, model: &ClothModel, state: &ClothState) {
-        let moved = (self.outside).filter(|&(p, _)| (p as usize) < state.pos.len());
-        let held = moved.map(|(p, _)| (p, state.pos[p as usize], state.vel[p as usize]));
-        let taken = self.carried.hold(held);
         let stamps = self.carried.stamps(state.pos.len());
-        let mut data: Vec<Particle> = (state.pos.iter().zip(&state.vel))
+        let data: Vec<Particle> = (state.pos.iter().zip(&state.vel))
             .zip(model.inv_mass.iter().zip(stamps))
             .map(|((x, v), (&w, slot))| Particle {
                 x: [x.x, x.y, x.z, w],
                 v: [v.x, v.y, v.z, slot],
             })
             .collect();
-        if let Some((p, from)) = moved.filter(|_| taken)
-            && let Some(particle) = data.get_mut(p as usize)
-        {
-            particle.x[..3].copy_from_slice(&from.to_array());
-        }
         if !data.is_empty() {
             for buffer in std::iter::once(&self.particles[self.current]).chain(&self.display) {
                 self.queue

@@ -571,6 +571,11 @@ impl SelfPass {
         Ok(())
     }
 
+    /// The copy [`SelfPass::keep_start`] makes.
+    pub(super) fn kept(&self) -> &wgpu::Buffer {
+        &self.buffers[5]
+    }
+
     /// Records a copy of the substep's start, `particles[at]`, for an integrator that
     /// writes its end over it.
     pub(super) fn keep_start(&self, pass: &mut wgpu::ComputePass<'_>, at: usize) {

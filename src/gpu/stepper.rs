@@ -22,6 +22,7 @@ use super::elements::{ElementKernel, pack_elements};
 use super::error::GpuError;
 use super::handles::Carried;
 use super::health::{HealthKernel, Watch};
+use super::held::HeldMove;
 use super::implicit::ImplicitPass;
 use super::kernel::{SubstepKernel, WORKGROUP};
 use super::packing::{
@@ -58,8 +59,8 @@ pub struct GpuStepper {
     pub(super) carried: Carried,
     pub(super) restamp: bool,
     /// A pinned particle the caller moved before the frame being stepped, and where from
-    /// ([`StepBackend::moved_outside`]): the state is sent with it there.
-    pub(super) outside: Option<(u32, Vec3)>,
+    /// ([`StepBackend::moved_outside`]): its path in the first substep's contacts.
+    pub(super) held: HeldMove,
     /// The handles' targets of the last submission (kept for its storage).
     targets: Vec<[f32; 4]>,
     /// The integrator in effect (one of those the GPU runs).
@@ -221,7 +222,7 @@ impl GpuStepper {
             elements,
             elements_for: (false, false),
             carried: Carried::default(),
-            outside: None,
+            held: HeldMove::new(device),
             restamp: false,
             targets: Vec::new(),
             integrator: params.step.integrator,
@@ -387,6 +388,7 @@ impl GpuStepper {
         let prepared =
             (self.contacts).prepare(&self.device, &self.queue, when, memory, &self.params);
         prepared.map_err(|e| StepError::Unsupported(e.to_string()))?;
+        self.held.send(&self.queue);
         if vbd {
             self.kernel.vbd(&self.device);
         }
@@ -439,7 +441,7 @@ impl GpuStepper {
                 }
                 self.elements.dispatch(&mut pass, self.current);
                 let (this, other) = (&self.groups[self.current], &self.groups[1 - self.current]);
-                if let Some((predict, sweep, colours, finish)) = solver {
+                let start = if let Some((predict, sweep, colours, finish)) = solver {
                     self.contacts.keep_start(&mut pass, self.current);
                     // The state stays where it is; the other buffer holds the predictions
                     // (XPBD) or the displacements (VBD).
@@ -452,13 +454,21 @@ impl GpuStepper {
                     pass.set_pipeline(finish);
                     pass.set_bind_group(0, other, &[]);
                     pass.dispatch_workgroups(groups, 1, 1);
-                    (self.contacts).encode(&mut pass, k, Start::Kept(self.current));
+                    Start::Kept(self.current)
                 } else {
                     pass.set_pipeline(&self.kernel.pipeline);
                     pass.set_bind_group(0, this, &[]);
                     pass.dispatch_workgroups(groups, 1, 1);
-                    (self.contacts).encode(&mut pass, k, Start::In(self.current));
-                    self.current = 1 - self.current;
+                    Start::In(self.current)
+                };
+                if k == 0 && self.held.pending() {
+                    drop(pass);
+                    (self.held).start(&mut encoder, (&self.particles, &self.contacts), start);
+                    pass = encoder.begin_compute_pass(&Default::default());
+                }
+                (self.contacts).encode(&mut pass, k, start);
+                if let Start::In(i) = start {
+                    self.current = 1 - i;
                 }
                 if counting {
                     (self.kernel).count_substep(&mut pass, &self.groups[self.current]);
@@ -487,28 +497,6 @@ impl GpuStepper {
             self.stats.record(&report);
         }
         Ok(())
-    }
-
-    /// Encodes and submits the copy of `snapshot` into the live particle buffer (and the
-    /// display's); returns the time it holds. The device's copy is then ahead of the
-    /// caller's state.
-    pub(super) fn restore(&mut self, snapshot: &DeviceSnapshot) -> f64 {
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("particles rollback"),
-            });
-        let live = &self.particles[self.current];
-        let time = snapshot.restore(&mut encoder, live);
-        self.contacts.roll_back_forced(snapshot.forced);
-        if let Some(display) = &self.display {
-            encoder.copy_buffer_to_buffer(live, 0, display, 0, None);
-        }
-        self.queue.submit([encoder.finish()]);
-        self.upload = false;
-        self.forget_guesses();
-        self.behind = true;
-        time
     }
 
     /// Sweeps a substep of the integrator in effect (XPBD's or VBD's).
@@ -667,7 +655,7 @@ impl StepBackend for GpuStepper {
             self.params.colliders = solids;
             self.effects = effects.to_vec();
             (self.gravity, self.air_damping) = (g, drag);
-            let carried = Carried::of(effects).holding_as(&self.carried);
+            let carried = Carried::of(effects);
             if carried != self.carried {
                 self.carried = carried;
                 self.restamp = true;
@@ -717,15 +705,14 @@ impl StepBackend for GpuStepper {
         state: &mut ClothState,
     ) -> Result<FrameOutcome, Diverged> {
         let stepped = self.guarded_frame(model, state);
-        self.outside = None;
+        self.held.moved = None;
         stepped
     }
 
-    /// The state is sent again with the particle where it was moved from (where the caller's
-    /// state is the device's: the move invalidated it, or it was read back since).
+    /// The contacts of the next run's first substep see the particle's path from `from`
+    /// (`held.rs`).
     fn moved_outside(&mut self, particle: u32, from: Vec3) {
-        self.outside = Some((particle, from));
-        self.upload |= !self.behind;
+        self.held.moved = Some((particle, from));
     }
 
     fn substep(
@@ -734,7 +721,7 @@ impl StepBackend for GpuStepper {
         state: &mut ClothState,
     ) -> Result<StepReport, StepError> {
         let ran = self.timed_run(model, state, 1);
-        self.outside = None;
+        self.held.moved = None;
         ran?;
         state.time += self.substep_length() as f64;
         let sweeps = match self.integrator {
