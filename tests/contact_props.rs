@@ -99,6 +99,13 @@ fn set(text: &str, key: &str, mut value: impl FnMut() -> String) -> String {
     lines.collect::<Vec<_>>().join("\n")
 }
 
+/// `text` with `from` replaced by `to`; `from` must be there (a scene's text changed
+/// under the test would otherwise leave its setting as it was).
+fn swap(text: &str, from: &str, to: String) -> String {
+    assert!(text.contains(from), "no `{from}` in the scene");
+    text.replace(from, &to)
+}
+
 /// The scene's file with `v`'s settings written in.
 fn scene_text(v: &Variation) -> String {
     let (_, text) = BUILTIN_SCENES.iter().find(|(n, _)| *n == v.scene).unwrap();
@@ -118,9 +125,10 @@ fn scene_text(v: &Variation) -> String {
     text = set(&text, "density", || v.density.to_string());
     text = set(&text, "substeps", || v.substeps.to_string());
     text = set(&text, "rate", || v.air_damping.to_string());
-    text = text.replace(
+    text = swap(
+        &text,
         "stiffness = { structural = 400.0,",
-        &format!("stiffness = {{ structural = {},", v.structural),
+        format!("stiffness = {{ structural = {},", v.structural),
     );
     match v.scene {
         "crumple" => {
@@ -134,8 +142,8 @@ fn scene_text(v: &Variation) -> String {
             text = set(&text, "center", || centres.next().unwrap_or_default());
             text = set(&text, "radius", || v.drop.1.to_string());
         }
-        "fast-fold" => text = text.replace("time = 0.357", &format!("time = {}", v.pace)),
-        "twist" => text = text.replace("time = 4.0", &format!("time = {}", v.pace)),
+        "fast-fold" => text = swap(&text, "time = 0.357", format!("time = {}", v.pace)),
+        "twist" => text = swap(&text, "time = 4.0", format!("time = {}", v.pace)),
         _ => {}
     }
     text
