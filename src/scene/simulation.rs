@@ -236,6 +236,16 @@ impl Simulation {
         )
     }
 
+    /// Whether a handle has moved the cloth by the end of the frame from `start` (seconds):
+    /// its pose then is not its first.
+    fn handle_moved(&self, start: f64) -> bool {
+        let end = start + f64::from(self.params.step.dt);
+        (self.effects.iter()).any(|e| match e {
+            Effect::Handle(h) => h.motion.at(end) != h.motion.at(f64::NEG_INFINITY),
+            _ => false,
+        })
+    }
+
     /// The solids among the effects (spheres, planes): what a particle may not enter.
     pub fn solids(&self) -> impl Iterator<Item = &Effect> {
         self.effects.iter().filter(|e| e.is_solid())
@@ -588,19 +598,28 @@ impl Simulation {
     ///
     /// # Errors
     /// [`Diverged`]: the state is left at the frame's start. Its cause is the held
-    /// particle's pull where the backend saw nothing more specific.
+    /// particle's pull, or a handle that has moved, where the backend saw nothing more
+    /// specific.
     pub fn step_frame(&mut self) -> Result<FrameOutcome, Diverged> {
         self.hand_over_move();
+        let start = self.state.time;
         let out = self
             .backend
             .frame(&self.model, &mut self.state)
             .map_err(|mut e| {
                 // The backend cannot see a grab; with nothing more specific, the pull is the
-                // likely cause.
-                if self.held.is_some()
-                    && let Cause::Stiffness { implicit_tried } = e.cause
-                {
-                    e.cause = Cause::Pull { implicit_tried };
+                // likely cause, and then a handle that has moved the cloth.
+                if let Cause::Stiffness { implicit_tried } = e.cause {
+                    if self.held.is_some() {
+                        e.cause = Cause::Pull { implicit_tried };
+                    } else if self.handle_moved(start) {
+                        let self_contact =
+                            (self.effects.iter()).any(|e| matches!(e, Effect::SelfCollision(_)));
+                        e.cause = Cause::Handle {
+                            implicit_tried,
+                            self_contact,
+                        };
+                    }
                 }
                 e
             })?;

@@ -39,6 +39,13 @@ pub enum Cause {
     /// A held particle pulls the cloth harder than it can follow (`implicit_tried` as for
     /// [`Cause::Substeps`]).
     Pull { implicit_tried: bool },
+    /// A handle has moved the cloth: it may carry it faster than it can follow, or, with
+    /// `self_contact`, hold it nearer other cloth than the thickness leaves room for
+    /// (`implicit_tried` as for [`Cause::Substeps`]).
+    Handle {
+        implicit_tried: bool,
+        self_contact: bool,
+    },
     /// The step backend failed or cannot run the scene.
     Backend,
     /// Nothing more specific: the springs are too stiff for the step (`implicit_tried` as
@@ -88,6 +95,26 @@ impl std::fmt::Display for Cause {
                 f,
                 "The held particle pulls the cloth harder than it can follow: move the pointer \
                  more slowly{}.",
+                match implicit_tried {
+                    true => " or raise the substeps (implicit Euler failed too)",
+                    false => ", raise the substeps, or choose implicit Euler",
+                }
+            ),
+            Cause::Handle {
+                implicit_tried,
+                self_contact,
+            } => write!(
+                f,
+                "A handle carries the cloth: it may move it faster than the cloth can follow{}. \
+                 Slow the handle's keyframes{}, lower the stiffness{}.",
+                match self_contact {
+                    true => ", or hold it nearer other cloth than the self-collision thickness",
+                    false => "",
+                },
+                match self_contact {
+                    true => ", lower the thickness",
+                    false => "",
+                },
                 match implicit_tried {
                     true => " or raise the substeps (implicit Euler failed too)",
                     false => ", raise the substeps, or choose implicit Euler",
