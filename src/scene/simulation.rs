@@ -237,11 +237,14 @@ impl Simulation {
     }
 
     /// Whether a handle has moved the cloth by the end of the frame from `start` (seconds):
-    /// its pose then is not its first.
+    /// its pose then is not its first, and it holds a particle (one still pinned).
     fn handle_moved(&self, start: f64) -> bool {
         let end = start + f64::from(self.params.step.dt);
+        let pinned = |p: &u32| self.model.inv_mass.get(*p as usize) == Some(&0.0);
         (self.effects.iter()).any(|e| match e {
-            Effect::Handle(h) => h.motion.at(end) != h.motion.at(f64::NEG_INFINITY),
+            Effect::Handle(h) => {
+                h.motion.at(end) != h.motion.at(f64::NEG_INFINITY) && h.particles.iter().any(pinned)
+            }
             _ => false,
         })
     }

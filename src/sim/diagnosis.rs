@@ -103,23 +103,24 @@ impl std::fmt::Display for Cause {
             Cause::Handle {
                 implicit_tried,
                 self_contact,
-            } => write!(
-                f,
-                "A handle carries the cloth: it may move it faster than the cloth can follow{}. \
-                 Slow the handle's keyframes{}, lower the stiffness{}.",
-                match self_contact {
-                    true => ", or hold it nearer other cloth than the self-collision thickness",
-                    false => "",
-                },
-                match self_contact {
-                    true => ", lower the thickness",
-                    false => "",
-                },
-                match implicit_tried {
-                    true => " or raise the substeps (implicit Euler failed too)",
-                    false => ", raise the substeps, or choose implicit Euler",
-                }
-            ),
+            } => {
+                let (hold, thinner) = match self_contact {
+                    true => (
+                        ", or hold it nearer other cloth than the self-collision thickness",
+                        ", lower the thickness",
+                    ),
+                    false => ("", ""),
+                };
+                write!(
+                    f,
+                    "A handle carries the cloth: it may move it faster than the cloth can \
+                     follow{hold}. Slow the handle's keyframes{thinner}, lower the stiffness{}.",
+                    match implicit_tried {
+                        true => " or raise the substeps (implicit Euler failed too)",
+                        false => ", raise the substeps, or choose implicit Euler",
+                    }
+                )
+            }
             Cause::Backend => f.write_str("The step backend failed; try the CPU backend."),
             Cause::Stiffness {
                 implicit_tried: true,
