@@ -54,11 +54,11 @@ impl HeldMove {
             return;
         };
         let at = u64::from(p) * std::mem::size_of::<Particle>() as u64;
-        let copies: Vec<&wgpu::Buffer> = match start {
-            Start::In(i) => vec![&particles[i]],
-            Start::Kept(_) => contacts.kept_starts().collect(),
+        let (live, kept) = match start {
+            Start::In(i) => (Some(&particles[i]), None),
+            Start::Kept(_) => (None, Some(contacts.kept_starts())),
         };
-        for copy in copies {
+        for copy in live.into_iter().chain(kept.into_iter().flatten()) {
             // The position's three components; its fourth (the inverse mass) stays.
             encoder.copy_buffer_to_buffer(&self.from, 0, copy, at, Some(12));
         }
