@@ -236,6 +236,26 @@ impl Simulation {
         )
     }
 
+    /// The likely cause of the frame from `start` (seconds) failing, where the backend saw
+    /// only `cause`: it cannot see a grab, so with nothing more specific than the stiffness
+    /// the held particle's pull is named, and else a handle that has moved the cloth.
+    fn cause_beyond(&self, cause: Cause, start: f64) -> Cause {
+        let Cause::Stiffness { implicit_tried } = cause else {
+            return cause;
+        };
+        if self.held.is_some() {
+            Cause::Pull { implicit_tried }
+        } else if self.handle_moved(start) {
+            let self_contact = (self.effects.iter()).any(|e| matches!(e, Effect::SelfCollision(_)));
+            Cause::Handle {
+                implicit_tried,
+                self_contact,
+            }
+        } else {
+            cause
+        }
+    }
+
     /// Whether a handle has moved the cloth by the end of the frame from `start` (seconds):
     /// its pose then is not its first, and it holds a particle (one still pinned).
     fn handle_moved(&self, start: f64) -> bool {
@@ -610,20 +630,7 @@ impl Simulation {
             .backend
             .frame(&self.model, &mut self.state)
             .map_err(|mut e| {
-                // The backend cannot see a grab; with nothing more specific, the pull is the
-                // likely cause, and then a handle that has moved the cloth.
-                if let Cause::Stiffness { implicit_tried } = e.cause {
-                    if self.held.is_some() {
-                        e.cause = Cause::Pull { implicit_tried };
-                    } else if self.handle_moved(start) {
-                        let self_contact =
-                            (self.effects.iter()).any(|e| matches!(e, Effect::SelfCollision(_)));
-                        e.cause = Cause::Handle {
-                            implicit_tried,
-                            self_contact,
-                        };
-                    }
-                }
+                e.cause = self.cause_beyond(e.cause, start);
                 e
             })?;
         self.move_taken();
