@@ -10,7 +10,7 @@ use clothsim::sim::{GuardAction, IntegratorKind, SelfContacts};
 use glam::{DVec3, Vec3};
 
 mod common;
-use common::{incline, slope_acceleration, slope_speed};
+use common::{incline, parsed, slope_acceleration, slope_speed};
 
 fn d(x: f64, y: f64, z: f64) -> DVec3 {
     DVec3::new(x, y, z)
@@ -478,11 +478,6 @@ fn self_contact_gives_the_same_bits_on_two_threads_as_on_one() {
     let ((one, most), (two, _)) = (run(1), run(2));
     assert!(most.0 > 20_000 && most.1 > 1000, "{most:?}");
     assert!(one.pos == two.pos && one.vel == two.vel);
-}
-
-fn parsed(text: &str) -> Scene {
-    let file = SceneFile::parse(text, std::path::Path::new("start.toml")).unwrap();
-    Scene::from_file(file, None).unwrap()
 }
 
 /// A cloth that starts through a solid, or through itself, is warned about with the count

@@ -8,10 +8,11 @@
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
 
-use clothsim::scene::{BUILTIN_SCENES, Scene, SceneFile, Simulation};
+use clothsim::scene::Simulation;
 use clothsim::sim::IntegratorKind;
 
 mod common;
+use common::{edited_builtin, parsed};
 
 /// One draw of a stress scene's settings.
 #[derive(Clone, Debug)]
@@ -103,16 +104,19 @@ fn set(text: &str, key: &str, mut value: impl FnMut() -> String) -> String {
     lines.collect::<Vec<_>>().join("\n")
 }
 
-/// `text` with `from` replaced by `to`; `from` must be there (a scene's text changed
-/// under the test would otherwise leave its setting as it was).
-fn swap(text: &str, from: &str, to: String) -> String {
-    assert!(text.contains(from), "no `{from}` in the scene");
-    text.replace(from, &to)
-}
-
 /// The scene's file with `v`'s settings written in.
 fn scene_text(v: &Variation) -> String {
-    let (_, text) = BUILTIN_SCENES.iter().find(|(n, _)| *n == v.scene).unwrap();
+    let stiffness = (
+        "stiffness = { structural = 400.0,",
+        format!("stiffness = {{ structural = {},", v.structural),
+    );
+    let pace = |from: &'static str| (from, format!("time = {}", v.pace));
+    let edits = match v.scene {
+        "fast-fold" => vec![stiffness, pace("time = 0.357")],
+        "twist" => vec![stiffness, pace("time = 4.0")],
+        _ => vec![stiffness],
+    };
+    let text = edited_builtin(v.scene, &edits);
     let q = v.quads;
     let (grid, size) = match v.scene {
         "twist" => (format!("[{q}, {}]", (q / 4).max(2)), "[1.0, 0.25]"),
@@ -120,7 +124,7 @@ fn scene_text(v: &Variation) -> String {
         _ => (q.to_string(), "1.0"),
     };
     let spacing = if v.scene == "layers" { 0.8 } else { 1.0 } / q as f32;
-    let mut text = set(text, "grid", || {
+    let mut text = set(&text, "grid", || {
         format!("{{ quads = {grid}, size = {size} }}")
     });
     text = set(&text, "thickness", || (v.thickness * spacing).to_string());
@@ -129,26 +133,16 @@ fn scene_text(v: &Variation) -> String {
     text = set(&text, "density", || v.density.to_string());
     text = set(&text, "substeps", || v.substeps.to_string());
     text = set(&text, "rate", || v.air_damping.to_string());
-    text = swap(
-        &text,
-        "stiffness = { structural = 400.0,",
-        format!("stiffness = {{ structural = {},", v.structural),
-    );
-    match v.scene {
-        "crumple" => {
-            // The cloth's centre comes first, then the sphere's, which rests on the ground.
-            let (height, radius) = (v.drop.0 + 2.0 * v.drop.1 + 0.1, v.drop.1);
-            let mut centres = [
-                format!("[0.05, {height}, 0.08]"),
-                format!("[0.0, {radius}, 0.0]"),
-            ]
-            .into_iter();
-            text = set(&text, "center", || centres.next().unwrap_or_default());
-            text = set(&text, "radius", || v.drop.1.to_string());
-        }
-        "fast-fold" => text = swap(&text, "time = 0.357", format!("time = {}", v.pace)),
-        "twist" => text = swap(&text, "time = 4.0", format!("time = {}", v.pace)),
-        _ => {}
+    if v.scene == "crumple" {
+        // The cloth's centre comes first, then the sphere's, which rests on the ground.
+        let (height, radius) = (v.drop.0 + 2.0 * v.drop.1 + 0.1, v.drop.1);
+        let mut centres = [
+            format!("[0.05, {height}, 0.08]"),
+            format!("[0.0, {radius}, 0.0]"),
+        ]
+        .into_iter();
+        text = set(&text, "center", || centres.next().unwrap_or_default());
+        text = set(&text, "radius", || v.drop.1.to_string());
     }
     text
 }
@@ -157,10 +151,7 @@ fn scene_text(v: &Variation) -> String {
 /// frame. A frame the guard gave up on leaves the last good state, which is checked too,
 /// and ends the run.
 fn holds(v: &Variation, on_gpu: bool) -> Result<(), TestCaseError> {
-    let text = scene_text(v);
-    let file = SceneFile::parse(&text, std::path::Path::new("variation.toml"))
-        .map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;
-    let mut scene = Scene::from_file(file, None).map_err(|e| TestCaseError::fail(e.to_string()))?;
+    let mut scene = parsed(&scene_text(v));
     scene.params.step.integrator = v.integrator;
     let mut sim = match on_gpu {
         true => {

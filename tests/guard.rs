@@ -7,7 +7,7 @@ use clothsim::sim::{
 };
 
 mod common;
-use common::driven_through;
+use common::{driven_through, edited_builtin, parsed};
 
 fn hanging(configure: impl FnOnce(&mut Scene)) -> Simulation {
     let mut scene = Scene::builtin("hanging").unwrap();
@@ -501,11 +501,7 @@ fn a_pull_the_cloth_cannot_follow_is_named_as_the_cause() {
 /// under RK2 from 8 substeps a frame, its handle turning about a line `pivot_height` above
 /// the ground. At 2 cm the handle lays the flung half 2 cm above the pinned one.
 fn folded_onto_itself(pivot_height: f32) -> Simulation {
-    let (_, text) = (clothsim::scene::BUILTIN_SCENES.iter())
-        .find(|(name, _)| *name == "fast-fold")
-        .unwrap();
-    let mut text = text.to_string();
-    for (from, to) in [
+    let edits = [
         ("quads = 32", "quads = 17".to_string()),
         ("thickness = 0.006", "thickness = 0.0205".to_string()),
         ("substeps = 4", "substeps = 8".to_string()),
@@ -514,12 +510,8 @@ fn folded_onto_itself(pivot_height: f32) -> Simulation {
             "pivot = [0.0, 0.02, 0.0]",
             format!("pivot = [0.0, {pivot_height}, 0.0]"),
         ),
-    ] {
-        assert!(text.contains(from), "{from}");
-        text = text.replace(from, &to);
-    }
-    let file = clothsim::scene::SceneFile::parse(&text, std::path::Path::new("fold.toml")).unwrap();
-    let mut scene = Scene::from_file(file, None).unwrap();
+    ];
+    let mut scene = parsed(&edited_builtin("fast-fold", &edits));
     scene.params.step.integrator = IntegratorKind::Rk2;
     Simulation::new(scene)
 }

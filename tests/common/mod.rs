@@ -11,6 +11,29 @@ pub fn gpu_simulation(
     clothsim::gpu::gpu_simulation_on(scene, read_every_frame, software)
 }
 
+/// A scene from TOML `text` (a file of no directory).
+#[allow(dead_code)] // Not every test file writes scenes out.
+pub fn parsed(text: &str) -> clothsim::scene::Scene {
+    let path = std::path::Path::new("test.toml");
+    let file =
+        clothsim::scene::SceneFile::parse(text, path).unwrap_or_else(|e| panic!("{e}\n{text}"));
+    clothsim::scene::Scene::from_file(file, None).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The text of the built-in scene `name` with each edit's first string replaced by its
+/// second. Each must be there: a scene whose text changed under a test would otherwise
+/// keep the setting the test means to change.
+#[allow(dead_code)]
+pub fn edited_builtin(name: &str, edits: &[(&str, String)]) -> String {
+    let (_, text) = (clothsim::scene::BUILTIN_SCENES.iter())
+        .find(|(n, _)| *n == name)
+        .unwrap_or_else(|| panic!("no built-in `{name}`"));
+    edits.iter().fold(text.to_string(), |text, (from, to)| {
+        assert!(text.contains(from), "no `{from}` in `{name}`");
+        text.replace(from, to)
+    })
+}
+
 /// The largest distance between the same particle in `a` and `b`, metres.
 pub fn farthest(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
     (a.iter().zip(b))
