@@ -437,7 +437,7 @@ impl ClothApp {
         }
         for event in guard_events {
             let level = match event.action {
-                GuardAction::Recovered => Level::Info,
+                GuardAction::Recovered | GuardAction::Raised { .. } => Level::Info,
                 GuardAction::Refined | GuardAction::FellBack { .. } => Level::Warning,
                 // The failure below says it.
                 GuardAction::GaveUp => continue,

@@ -12,7 +12,9 @@ use super::effects::{
     ContactPass, Effect, FacePatches, SelfCollision, air_damping_of, gravity_of, shortest_edge,
 };
 use super::forces::ForceSet;
-use super::guard::{Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check};
+use super::guard::{
+    Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check, resolved,
+};
 use super::guard_state::{CpuSnapshot, GuardState};
 use super::integrator::{
     Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport,
@@ -437,6 +439,9 @@ impl<R: Real> CpuStepper<R> {
         end: f64,
         trouble: Trouble,
     ) -> Result<FrameOutcome, Diverged> {
+        if let Some(outcome) = self.admit(model, state, end, &trouble) {
+            return Ok(outcome);
+        }
         self.guard.failed_frame();
         let before = self.substeps;
         let mut last = trouble;
@@ -494,6 +499,70 @@ impl<R: Real> CpuStepper<R> {
                 self.diagnose(model, &pos, (tried, fell_back))
             },
         })
+    }
+
+    /// A speed or kinetic-energy limit crossed: the frame redone from its start against the
+    /// limits raised to admit what it reached ([`GuardLimits::admitting`]), with the
+    /// substeps in effect and then with twice as many. Where both stand and their
+    /// velocities agree ([`resolved`]), the motion is the scene's: the first stands, and so
+    /// do the raised limits. A blow-up outgrows the raised limits within the frame, so its
+    /// first redo stops where it crosses them. Else the state is left for the rescue.
+    fn admit(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState<R>,
+        end: f64,
+        trouble: &Trouble,
+    ) -> Option<FrameOutcome> {
+        let limits = self.guard.limits?;
+        self.guard.limits = Some(limits.admitting(trouble)?);
+        let stood = self.redone(model, state, end, 1).and_then(|coarse| {
+            let stood = (state.clone(), self.self_contacts.work.forced_total);
+            let fine = self.redone(model, state, end, 2)?;
+            resolved(&coarse, &fine).then_some(stood)
+        });
+        let Some((stood, forced)) = stood else {
+            self.guard.limits = Some(limits);
+            return None;
+        };
+        state.clone_from(&stood);
+        self.self_contacts.work.forced_total = forced;
+        self.integrator.invalidate();
+        let start = std::mem::take(&mut self.frame_start);
+        self.guard.healthy_frame(&start);
+        self.frame_start = start;
+        let raised = self.guard.limits.unwrap_or(limits);
+        let (speed, joules) = (raised.speed, raised.kinetic_energy);
+        let substeps = self.substeps;
+        (self.guard).record(
+            end,
+            Some(trouble),
+            GuardAction::Raised { speed, joules },
+            (substeps, substeps),
+        );
+        Some(FrameOutcome::Stepped)
+    }
+
+    /// The frame ending at `end` redone from its start with `factor` × the substeps in
+    /// effect, against the guard's limits: its end velocities where it stood.
+    fn redone(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState<R>,
+        end: f64,
+        factor: u32,
+    ) -> Option<Vec<glam::Vec3>> {
+        let start = std::mem::take(&mut self.frame_start);
+        self.restore(&start, state);
+        self.frame_start = start;
+        self.integrator.invalidate();
+        let substeps = self.substeps;
+        self.substeps = substeps.saturating_mul(factor);
+        let tried = self.try_frame(model, state, end);
+        self.substeps = substeps;
+        tried
+            .ok()
+            .map(|()| f32_view(state, &mut self.view).vel.clone())
     }
 
     /// After a healthy frame: maybe bring raised substeps back down.
