@@ -237,3 +237,39 @@ fn a_frame_the_gpu_gives_up_takes_back_the_pairs_it_forced() {
     let (sim, _) = gpu_simulation(common::driven_to_give_up(), false).expect("GPU backend");
     common::a_frame_given_up_keeps_its_count(sim);
 }
+
+/// `flag` on the GPU for `frames` frames with the guard's headroom at `headroom` (or off):
+/// the cloth and what the guard did.
+fn gpu_flag(headroom: Option<f32>, frames: usize) -> (Simulation, Vec<GuardEvent>) {
+    let mut scene = Scene::builtin("flag").unwrap();
+    match headroom {
+        Some(h) => scene.params.guard.headroom = h,
+        None => scene.params.guard.enabled = false,
+    }
+    let (mut sim, _) = gpu_simulation(scene, true).expect("GPU backend on the software adapter");
+    let mut events = Vec::new();
+    for _ in 0..frames {
+        sim.step_frame().expect("frame");
+        events.extend(sim.take_guard_events());
+    }
+    (sim, events)
+}
+
+/// The GPU's guard judges a frame's end: with the headroom at 1 the flag's whipping corners
+/// cross its speed limit there. Twice the substeps agree with the frame, so it stands, as on
+/// the CPU: no refinement, no fallback, and the cloth is the unguarded run's.
+#[test]
+fn a_flags_whip_stands_on_the_gpu_as_on_the_cpu() {
+    let (guarded, events) = gpu_flag(Some(1.0), 60);
+    let (free, _) = gpu_flag(None, 60);
+    assert!(!events.is_empty(), "the limit was crossed");
+    for e in &events {
+        assert!(matches!(e.action, GuardAction::Raised { .. }), "{e}");
+    }
+    assert_eq!(
+        guarded.integrator_in_effect(),
+        IntegratorKind::SemiImplicitEuler
+    );
+    assert_eq!(guarded.substeps(), 48);
+    assert_eq!(farthest(&guarded.state().pos, &free.state().pos), 0.0);
+}

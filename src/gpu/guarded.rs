@@ -13,7 +13,7 @@
 use std::time::Instant;
 
 use crate::cloth::{ClothModel, ClothState};
-use crate::sim::{Cause, Diverged, FrameOutcome, GuardAction, GuardLimits, Trouble};
+use crate::sim::{Cause, Diverged, FrameOutcome, GuardAction, GuardLimits, Trouble, resolved};
 
 use super::error::GpuError;
 use super::health::Watch;
@@ -216,6 +216,11 @@ impl GpuStepper {
         end: f64,
         trouble: Trouble,
     ) -> Result<FrameOutcome, Diverged> {
+        match self.admit(model, state, end, &trouble) {
+            Ok(Some(outcome)) => return Ok(outcome),
+            Ok(None) => {}
+            Err(why) => return Err(self.device_failure(state.time, why)),
+        }
         self.guard.failed_frame();
         let before = self.substeps;
         let mut last = trouble;
@@ -279,6 +284,77 @@ impl GpuStepper {
             fallback,
             cause: Cause::of_springs(cause, self.integrator, fell_back),
         })
+    }
+
+    /// A speed or kinetic-energy limit crossed, as on the CPU: the frame redone from its
+    /// start against the limits raised to admit what it reached, with twice the substeps
+    /// and then with the substeps in effect, which it ends with on the device. Where both
+    /// stand and their velocities agree ([`resolved`]), the motion is the scene's: the frame
+    /// and the raised limits stand. Else nothing stands, for the rescue to roll back; an
+    /// error is the device's failure.
+    fn admit(
+        &mut self,
+        model: &ClothModel,
+        state: &ClothState,
+        end: f64,
+        trouble: &Trouble,
+    ) -> Result<Option<FrameOutcome>, String> {
+        let Some(limits) = self.guard.limits else {
+            return Ok(None);
+        };
+        let Some(raised) = limits.admitting(trouble) else {
+            return Ok(None);
+        };
+        self.guard.limits = Some(raised);
+        let before = self.substeps;
+        let mut ends = Vec::new();
+        for substeps in [before.saturating_mul(2), before] {
+            self.set_substeps(substeps);
+            match self.redone(model, state)? {
+                Some(velocities) => ends.push(velocities),
+                None => break,
+            }
+        }
+        self.set_substeps(before);
+        if let [fine, coarse] = ends.as_slice()
+            && resolved(coarse, fine)
+        {
+            self.guard.healthy_frame(&self.frame_start);
+            let action = GuardAction::Raised {
+                speed: raised.speed,
+                joules: raised.kinetic_energy,
+            };
+            (self.guard).record(end, Some(trouble), action, (before, before));
+            return Ok(Some(FrameOutcome::Stepped));
+        }
+        self.guard.limits = Some(limits);
+        Ok(None)
+    }
+
+    /// The frame redone from its start at the substeps in effect, against the guard's
+    /// limits, from the start again where self-contact's room ran out: its end velocities
+    /// (read back) where it stood, `None` where it broke a limit.
+    fn redone(
+        &mut self,
+        model: &ClothModel,
+        state: &ClothState,
+    ) -> Result<Option<Vec<glam::Vec3>>, String> {
+        loop {
+            let start = self.frame_start.clone();
+            let time = self.restore(&start);
+            match self.try_frame(model, state, time, REPLAY) {
+                Ok(Tried::RanOut) => continue,
+                Ok(Tried::Stood) => {
+                    let mut end = state.clone();
+                    self.read_back(&mut end).map_err(|e| e.to_string())?;
+                    // Read into a copy: the caller's state is still behind the device's.
+                    self.behind = true;
+                    return Ok(Some(end.vel));
+                }
+                Err(Failed::Limit(_)) => return Ok(None),
+                Err(Failed::Device(why)) => return Err(why),
+            }
+        }
     }
 
     /// After a healthy frame: maybe bring raised substeps back down.

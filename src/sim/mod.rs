@@ -37,7 +37,8 @@ pub use effects::{
 };
 pub use forces::{Force, ForceSet, ForceTerm, JacobianMode, SystemMatrix};
 pub use guard::{
-    Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Motion, Trouble, check,
+    Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Motion, RESOLVED, Trouble, check,
+    resolved,
 };
 pub use guard_policy::GuardPolicy;
 pub use guard_state::{CpuSnapshot, GuardState, Snapshot};
