@@ -169,6 +169,12 @@ impl Contacts {
     }
 
     /// Whether self-contact's room for pairs or grid entries ran out in a submission that
+    /// `asked` for so many, the room left as it is.
+    pub(super) fn runs_out(&self, asked: [u32; 2]) -> bool {
+        self.own.as_ref().is_some_and(|own| own.runs_out(asked))
+    }
+
+    /// Whether self-contact's room for pairs or grid entries ran out in a submission that
     /// `asked` for so many; the room is grown then.
     ///
     /// # Errors

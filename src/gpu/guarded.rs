@@ -85,7 +85,7 @@ impl GpuStepper {
         }
         self.room_tries = ROOM_TRIES;
         let outcome = loop {
-            match self.try_frame(model, state, state.time, FRAME) {
+            match self.try_frame(model, state, state.time, FRAME, true) {
                 Ok(Tried::RanOut) => {
                     let start = self.frame_start.clone();
                     self.restore(&start);
@@ -127,13 +127,15 @@ impl GpuStepper {
 
     /// One frame from `time` (seconds) at the substeps in effect, submitted with what
     /// `watch` asks, and its end judged against the guard's limits; or, while the frame has
-    /// tries left, to be redone where self-contact's room ran out.
+    /// tries left, to be redone where self-contact's room ran out, the room grown when
+    /// `grow` (else it ran out, whatever the tries).
     fn try_frame(
         &mut self,
         model: &ClothModel,
         state: &ClothState,
         time: f64,
         watch: Watch,
+        grow: bool,
     ) -> Result<Tried, Failed> {
         (self.run(model, state, (self.substeps, time), watch))
             .map_err(|e| Failed::Device(e.to_string()))?;
@@ -158,9 +160,15 @@ impl GpuStepper {
             return Err(Failed::Limit(trouble));
         }
         let ran_out = match counters {
-            Some(read) => (self.contacts.make_room(&self.device, read.asked)).map_err(device)?,
+            Some(read) if grow => {
+                (self.contacts.make_room(&self.device, read.asked)).map_err(device)?
+            }
+            Some(read) => self.contacts.runs_out(read.asked),
             None => false,
         };
+        if ran_out && !grow {
+            return Ok(Tried::RanOut);
+        }
         if ran_out && self.room_tries > 0 {
             self.room_tries -= 1;
             return Ok(Tried::RanOut);
@@ -199,7 +207,7 @@ impl GpuStepper {
             let frames = ((end - time) / self.dt as f64).round().max(1.0) as u32;
             for k in 0..frames {
                 let start = time + k as f64 * self.dt as f64;
-                if let Tried::RanOut = self.try_frame(model, state, start, REPLAY)? {
+                if let Tried::RanOut = self.try_frame(model, state, start, REPLAY, true)? {
                     continue 'again;
                 }
             }
@@ -332,8 +340,8 @@ impl GpuStepper {
     }
 
     /// The frame redone from its start at the substeps in effect, against the guard's
-    /// limits, from the start again where self-contact's room ran out: its end velocities
-    /// (read back) where it stood, `None` where it broke a limit.
+    /// limits: its end velocities (read back) where it stood, `None` where it broke a limit
+    /// or self-contact's room ran out.
     fn redone(
         &mut self,
         model: &ClothModel,
@@ -342,8 +350,10 @@ impl GpuStepper {
         loop {
             let start = self.frame_start.clone();
             let time = self.restore(&start);
-            match self.try_frame(model, state, time, REPLAY) {
-                Ok(Tried::RanOut) => continue,
+            // Limits raised to admit a speed could let a blow-up's try ask for room it
+            // must not get: a try that ran out is not admitted, and the room stays.
+            match self.try_frame(model, state, time, REPLAY, false) {
+                Ok(Tried::RanOut) => return Ok(None),
                 Ok(Tried::Stood) => {
                     let mut end = state.clone();
                     self.read_back(&mut end).map_err(|e| e.to_string())?;

@@ -536,6 +536,11 @@ impl SelfPass {
         }))
     }
 
+    /// Whether a submission that `asked` for grid entries and pairs ran out of the room.
+    pub(super) fn runs_out(&self, [entries, pairs]: [u32; 2]) -> bool {
+        entries > self.params.counts[3] || pairs > self.params.more[0]
+    }
+
     /// Grows the room where a submission that `asked` for grid entries and pairs ran out of
     /// it (to twice what it asked) and picks the path for the next. Returns whether it ran
     /// out (then the substeps concerned left the cloth where they started it).
