@@ -347,23 +347,20 @@ impl GpuStepper {
         model: &ClothModel,
         state: &ClothState,
     ) -> Result<Option<Vec<glam::Vec3>>, String> {
-        loop {
-            let start = self.frame_start.clone();
-            let time = self.restore(&start);
-            // Limits raised to admit a speed could let a blow-up's try ask for room it
-            // must not get: a try that ran out is not admitted, and the room stays.
-            match self.try_frame(model, state, time, REPLAY, false) {
-                Ok(Tried::RanOut) => return Ok(None),
-                Ok(Tried::Stood) => {
-                    let mut end = state.clone();
-                    self.read_back(&mut end).map_err(|e| e.to_string())?;
-                    // Read into a copy: the caller's state is still behind the device's.
-                    self.behind = true;
-                    return Ok(Some(end.vel));
-                }
-                Err(Failed::Limit(_)) => return Ok(None),
-                Err(Failed::Device(why)) => return Err(why),
+        let start = self.frame_start.clone();
+        let time = self.restore(&start);
+        // Limits raised to admit a speed could let a blow-up's try ask for room it must not
+        // get: a try that ran out is not admitted, and the room stays.
+        match self.try_frame(model, state, time, REPLAY, false) {
+            Ok(Tried::Stood) => {
+                let mut end = state.clone();
+                self.read_back(&mut end).map_err(|e| e.to_string())?;
+                // Read into a copy: the caller's state is still behind the device's.
+                self.behind = true;
+                Ok(Some(end.vel))
             }
+            Ok(Tried::RanOut) | Err(Failed::Limit(_)) => Ok(None),
+            Err(Failed::Device(why)) => Err(why),
         }
     }
 
