@@ -123,6 +123,26 @@ fn a_blow_up_that_stays_finite_within_the_frame_is_not_admitted() {
     assert!(summary.max_speed < 5.0, "{} m/s", summary.max_speed);
 }
 
+/// Explicit Euler gains energy at every step: on `orders` refined past its first blow-up
+/// it grows slowly, so slowly that twice the substeps agree with a frame that crossed a
+/// limit. It is never admitted (it was, twice, until a stretch of 683 % stopped it): its
+/// crossings are refined, then implicit Euler takes over.
+#[test]
+fn a_slow_blow_up_under_an_integrator_that_gains_energy_is_never_admitted() {
+    let mut scene = Scene::builtin("orders").unwrap();
+    scene.params.step.integrator = IntegratorKind::ExplicitEuler;
+    let mut sim = Simulation::new(scene);
+    let summary = sim.run(1.5);
+    let events = &summary.guard_events;
+    assert!(events.len() > 1, "{events:?}");
+    assert!(
+        !events
+            .iter()
+            .any(|e| matches!(e.action, GuardAction::Raised { .. })),
+        "{events:?}"
+    );
+}
+
 /// Story: a hard pull raised the limits (the stretch a drag makes is the user's doing, not a
 /// blow-up). Raised, they still catch one before anything becomes non-finite: with the
 /// cloth held stretched past the default strain limit, explicit Euler at the scene's 48
@@ -666,17 +686,42 @@ fn a_frame_given_up_takes_back_the_pairs_it_forced() {
     common::a_frame_given_up_keeps_its_count(Simulation::new(common::driven_to_give_up()));
 }
 
-/// Story: a frame nothing saved under XPBD, with implicit Euler tried as the fallback, was
-/// reported as "…and with Implicit Euler (CG)…" followed by "Lower the stiffness, raise the
-/// substeps, or choose implicit Euler": advice to choose what had just failed. The advice
-/// now names no integrator the guard tried. `crumple` at 32² under XPBD at one 50 ms
-/// substep a frame gives up as it lands (a spring stretched 560 %).
-#[test]
-fn the_advice_names_no_integrator_the_guard_already_tried() {
+/// `crumple` at 32² under XPBD at one 50 ms substep a frame, with `refinements` allowed.
+fn crumple_in_one_long_substep(refinements: u32) -> Simulation {
     let mut scene = Scene::open_resized("crumple", None, &Default::default(), Some(32)).unwrap();
     scene.params.step.integrator = IntegratorKind::Xpbd;
     (scene.params.step.dt, scene.params.step.substeps) = (0.05, 1);
-    let mut sim = Simulation::new(scene);
+    scene.params.guard.max_refinements = refinements;
+    Simulation::new(scene)
+}
+
+/// Story: the fallback was tried at the requested substeps only. `crumple` landing under
+/// XPBD at one 50 ms substep is not saved by 8 × the substeps nor by implicit Euler at one
+/// (a spring stretched 560 %), and the run stopped; implicit Euler at more substeps lands
+/// it. The fallback is now refined as the integrator asked for was.
+#[test]
+fn the_fallback_is_refined_too() {
+    let mut sim = crumple_in_one_long_substep(3);
+    for _ in 0..20 {
+        sim.step_frame()
+            .expect("the fallback, refined, saves every frame");
+    }
+    let events = sim.take_guard_events();
+    let fell_back = (events.iter())
+        .find(|e| matches!(e.action, GuardAction::FellBack { .. }))
+        .expect("a fallback");
+    assert!(fell_back.substeps_after > 1, "{fell_back}");
+    assert_eq!(sim.integrator_in_effect(), IntegratorKind::ImplicitEuler);
+}
+
+/// Story: a frame nothing saved under XPBD, with implicit Euler tried as the fallback, was
+/// reported as "…and with Implicit Euler (CG)…" followed by "Lower the stiffness, raise the
+/// substeps, or choose implicit Euler": advice to choose what had just failed. The advice
+/// now names no integrator the guard tried. The landing above with no refinement allowed
+/// gives up (a spring stretched 560 %).
+#[test]
+fn the_advice_names_no_integrator_the_guard_already_tried() {
+    let mut sim = crumple_in_one_long_substep(0);
     let err = (0..20)
         .find_map(|_| sim.step_frame().err())
         .expect("XPBD at 50 ms gives up where the cloth lands");

@@ -252,21 +252,29 @@ impl GpuStepper {
         {
             let original = self.integrator;
             self.switch_integrator(kind);
+            // At the requested substeps, then refined as the integrator asked for was.
             self.set_substeps(self.requested);
-            match self.replay(model, state, end) {
-                Ok(()) => {
-                    let action = GuardAction::FellBack { integrator: kind };
-                    (self.guard).record(end, Some(&last), action, (before, self.substeps));
-                    return Ok(FrameOutcome::FellBack { integrator: kind });
+            for refinement in 0..=self.guard.policy.max_refinements {
+                if refinement > 0 {
+                    self.set_substeps(self.substeps.saturating_mul(2));
                 }
-                Err(Failed::Limit(t)) => {
-                    last = t;
-                    self.switch_integrator(original);
-                    fallback = format!(", and with {}", kind.label());
-                    fell_back = Some(kind);
+                match self.replay(model, state, end) {
+                    Ok(()) => {
+                        let action = GuardAction::FellBack { integrator: kind };
+                        (self.guard).record(end, Some(&last), action, (before, self.substeps));
+                        return Ok(FrameOutcome::FellBack { integrator: kind });
+                    }
+                    Err(Failed::Limit(t)) => last = t,
+                    Err(Failed::Device(why)) => return Err(self.device_failure(state.time, why)),
                 }
-                Err(Failed::Device(why)) => return Err(self.device_failure(state.time, why)),
             }
+            self.switch_integrator(original);
+            fallback = format!(
+                ", and with {} at up to {} substeps",
+                kind.label(),
+                self.substeps
+            );
+            fell_back = Some(kind);
         }
         let start = self.frame_start.clone();
         self.restore(&start);
@@ -310,7 +318,7 @@ impl GpuStepper {
         let Some(limits) = self.guard.limits else {
             return Ok(None);
         };
-        let Some(raised) = limits.admitting(trouble) else {
+        let Some(raised) = limits.admitting(trouble, self.integrator) else {
             return Ok(None);
         };
         self.guard.limits = Some(raised);

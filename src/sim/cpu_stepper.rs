@@ -464,24 +464,28 @@ impl<R: Real> CpuStepper<R> {
             && kind != self.integrator.kind()
         {
             let original = std::mem::replace(&mut self.integrator, kind.build());
+            // At the requested substeps, then refined as the integrator asked for was.
             self.substeps = self.requested;
-            match self.replay(model, state, end) {
-                Ok(()) => {
-                    self.record(
-                        end,
-                        Some(&last),
-                        GuardAction::FellBack { integrator: kind },
-                        before,
-                    );
-                    return Ok(FrameOutcome::FellBack { integrator: kind });
+            for refinement in 0..=self.guard.policy.max_refinements {
+                if refinement > 0 {
+                    self.substeps = self.substeps.saturating_mul(2);
                 }
-                Err(t) => {
-                    last = t;
-                    self.integrator = original;
-                    fallback = format!(", and with {}", kind.label());
-                    fell_back = Some(kind);
+                match self.replay(model, state, end) {
+                    Ok(()) => {
+                        let action = GuardAction::FellBack { integrator: kind };
+                        self.record(end, Some(&last), action, before);
+                        return Ok(FrameOutcome::FellBack { integrator: kind });
+                    }
+                    Err(t) => last = t,
                 }
             }
+            self.integrator = original;
+            fallback = format!(
+                ", and with {} at up to {} substeps",
+                kind.label(),
+                self.substeps
+            );
+            fell_back = Some(kind);
         }
         let start = std::mem::take(&mut self.frame_start);
         self.restore(&start, state);
@@ -515,7 +519,7 @@ impl<R: Real> CpuStepper<R> {
         trouble: &Trouble,
     ) -> Option<FrameOutcome> {
         let limits = self.guard.limits?;
-        self.guard.limits = Some(limits.admitting(trouble)?);
+        self.guard.limits = Some(limits.admitting(trouble, self.integrator.kind())?);
         let stood = self.redone(model, state, end, 1).and_then(|coarse| {
             let stood = (state.clone(), self.self_contacts.work.forced_total);
             let fine = self.redone(model, state, end, 2)?;

@@ -230,8 +230,13 @@ impl GuardLimits {
     /// frame that crossed them to be redone against: `headroom` × the speed reached in
     /// place of the thrown, dragged or flung part of the speed limit (so a deeper fall still
     /// adds to it), or `headroom` × the energy reached. `None` for what motion cannot explain
-    /// (a non-finite state, a stretch, a solver's failure) and for a speed the policy fixed.
-    pub fn admitting(&self, trouble: &Trouble) -> Option<Self> {
+    /// (a non-finite state, a stretch, a solver's failure), for a speed the policy fixed,
+    /// and under an `integrator` that gains energy at every step
+    /// ([`IntegratorKind::gains_energy`]: a blow-up as slow as the step makes it).
+    pub fn admitting(&self, trouble: &Trouble, integrator: IntegratorKind) -> Option<Self> {
+        if integrator.gains_energy() {
+            return None;
+        }
         let mut raised = *self;
         match *trouble {
             Trouble::Speed { speed, .. } => {

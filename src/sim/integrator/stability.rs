@@ -49,6 +49,15 @@ impl IntegratorKind {
         Some(ok)
     }
 
+    /// Whether every step, however short, grows an undamped vibration (explicit Euler and
+    /// midpoint RK2: their one-step maps' spectral radii are `√(1 + (ωh)²)` and
+    /// `√(1 + (ωh)⁴/4)`). A blow-up under them can be as slow as the step makes it, so one
+    /// frame cannot tell it from motion the step resolves: the guard never admits a limit
+    /// crossed under them ([`crate::sim::GuardLimits::admitting`]).
+    pub fn gains_energy(self) -> bool {
+        matches!(self, IntegratorKind::ExplicitEuler | IntegratorKind::Rk2)
+    }
+
     /// Spectral radius of one step of `h` seconds on the damped oscillator.
     fn spectral_radius(self, omega: f64, gamma: f64, h: f64) -> f64 {
         let (x1, v1) = self.step_oscillator(omega, gamma, h, 1.0, 0.0);
@@ -124,6 +133,20 @@ mod tests {
             None
         );
         assert_eq!(IntegratorKind::Xpbd.stable_substep(omega, 0.0), None);
+    }
+
+    /// The methods said to gain energy are those whose step grows an undamped vibration at
+    /// every step length tried, and the others' never does (symplectic Euler and Verlet keep
+    /// it, RK4 damps it; implicit Euler, XPBD and VBD are not analysed here: stable).
+    #[test]
+    fn the_methods_that_gain_energy_grow_a_vibration_at_every_step() {
+        let omega = 1000.0;
+        for kind in IntegratorKind::ALL {
+            let grows = [0.01, 0.1, 0.5, 1.0, 1.5]
+                .map(|wh| kind.spectral_radius(omega, 0.0, wh / omega) > 1.0 + 1e-12);
+            let expected = [kind.gains_energy(); 5];
+            assert_eq!(grows, expected, "{kind}");
+        }
     }
 
     /// Damping makes explicit Euler stable below `h = γ/ω²`: for `λ = −γ/2 ± i√(ω² − γ²/4)`,
