@@ -453,7 +453,7 @@ impl std::fmt::Display for GuardEvent {
             ),
             GuardAction::Raised { speed, joules } => write!(
                 f,
-                "t = {:.2} s: {why}; twice the substeps gave the same frame, so it is the scene's motion, not a blow-up: it stands, and the limits are raised to {speed:.1} m/s and {joules:.3e} J",
+                "t = {:.2} s: {why}; twice the substeps agree, so it is the scene's motion: the frame stands, and the limits are now {speed:.1} m/s and {joules:.1} J",
                 self.time
             ),
             GuardAction::Recovered => write!(
