@@ -232,17 +232,16 @@ impl GpuStepper {
         self.guard.failed_frame();
         let before = self.substeps;
         let mut last = trouble;
-        for _ in 0..self.guard.policy.max_refinements {
-            self.set_substeps(self.substeps.saturating_mul(2));
-            match self.replay(model, state, end) {
-                Ok(()) => {
-                    let to = self.substeps;
-                    (self.guard).record(end, Some(&last), GuardAction::Refined, (before, to));
-                    return Ok(FrameOutcome::Refined { from: before, to });
-                }
-                Err(Failed::Limit(t)) => last = t,
-                Err(Failed::Device(why)) => return Err(self.device_failure(state.time, why)),
+        let refinements = self.guard.policy.max_refinements;
+        let tries = (before.saturating_mul(2), refinements);
+        match self.replay_doubling(model, state, end, tries, &mut last) {
+            Ok(true) => {
+                let to = self.substeps;
+                (self.guard).record(end, Some(&last), GuardAction::Refined, (before, to));
+                return Ok(FrameOutcome::Refined { from: before, to });
             }
+            Ok(false) => {}
+            Err(why) => return Err(self.device_failure(state.time, why)),
         }
         let tried = self.substeps;
         let (mut fallback, mut fell_back) = (String::new(), None);
@@ -253,20 +252,15 @@ impl GpuStepper {
             let original = self.integrator;
             self.switch_integrator(kind);
             // At the requested substeps, then refined as the integrator asked for was.
-            self.set_substeps(self.requested);
-            for refinement in 0..=self.guard.policy.max_refinements {
-                if refinement > 0 {
-                    self.set_substeps(self.substeps.saturating_mul(2));
+            let tries = (self.requested, refinements + 1);
+            match self.replay_doubling(model, state, end, tries, &mut last) {
+                Ok(true) => {
+                    let action = GuardAction::FellBack { integrator: kind };
+                    (self.guard).record(end, Some(&last), action, (before, self.substeps));
+                    return Ok(FrameOutcome::FellBack { integrator: kind });
                 }
-                match self.replay(model, state, end) {
-                    Ok(()) => {
-                        let action = GuardAction::FellBack { integrator: kind };
-                        (self.guard).record(end, Some(&last), action, (before, self.substeps));
-                        return Ok(FrameOutcome::FellBack { integrator: kind });
-                    }
-                    Err(Failed::Limit(t)) => last = t,
-                    Err(Failed::Device(why)) => return Err(self.device_failure(state.time, why)),
-                }
+                Ok(false) => {}
+                Err(why) => return Err(self.device_failure(state.time, why)),
             }
             self.switch_integrator(original);
             fallback = format!(
@@ -302,6 +296,33 @@ impl GpuStepper {
         })
     }
 
+    /// Replays to `end` at `from` substeps a frame, then at twice as many, `tries` times in
+    /// all, until one stands (`Ok(true)`; its substeps stay in effect); `last` is the last
+    /// try's trouble, an error the device's failure. The substeps are the last tried where
+    /// none stood.
+    fn replay_doubling(
+        &mut self,
+        model: &ClothModel,
+        state: &ClothState,
+        end: f64,
+        (from, tries): (u32, u32),
+        last: &mut Trouble,
+    ) -> Result<bool, String> {
+        for k in 0..tries {
+            self.set_substeps(if k == 0 {
+                from
+            } else {
+                self.substeps.saturating_mul(2)
+            });
+            match self.replay(model, state, end) {
+                Ok(()) => return Ok(true),
+                Err(Failed::Limit(t)) => *last = t,
+                Err(Failed::Device(why)) => return Err(why),
+            }
+        }
+        Ok(false)
+    }
+
     /// A speed or kinetic-energy limit crossed, as on the CPU: the frame redone from its
     /// start against the limits raised to admit what it reached, with twice the substeps
     /// and then with the substeps in effect, which it ends with on the device. Where both
@@ -323,17 +344,15 @@ impl GpuStepper {
         };
         self.guard.limits = Some(raised);
         let before = self.substeps;
-        let mut ends = Vec::new();
-        for substeps in [before.saturating_mul(2), before] {
-            self.set_substeps(substeps);
-            match self.redone(model, state)? {
-                Some(velocities) => ends.push(velocities),
-                None => break,
-            }
-        }
+        self.set_substeps(before.saturating_mul(2));
+        let fine = self.redone(model, state)?;
         self.set_substeps(before);
-        if let [fine, coarse] = ends.as_slice()
-            && resolved(coarse, fine)
+        let coarse = match fine {
+            Some(_) => self.redone(model, state)?,
+            None => None,
+        };
+        if let (Some(fine), Some(coarse)) = (fine, coarse)
+            && resolved(&coarse, &fine)
         {
             self.guard.healthy_frame(&self.frame_start);
             let action = GuardAction::Raised {

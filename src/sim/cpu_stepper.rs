@@ -12,9 +12,7 @@ use super::effects::{
     ContactPass, Effect, FacePatches, SelfCollision, air_damping_of, gravity_of, shortest_edge,
 };
 use super::forces::ForceSet;
-use super::guard::{
-    Diverged, FrameOutcome, GuardAction, GuardEvent, GuardLimits, Trouble, check, resolved,
-};
+use super::guard::{Diverged, FrameOutcome, GuardEvent, GuardLimits, Trouble, check};
 use super::guard_state::{CpuSnapshot, GuardState};
 use super::integrator::{
     Integrator, IntegratorKind, StepContext, StepError, StepMeter, StepReport,
@@ -26,6 +24,8 @@ use super::precision::Precision;
 use super::self_contacts::{SelfContacts, SelfWork};
 use super::stats::StepStats;
 use super::timings::PhaseTimings;
+
+mod rescue;
 
 /// Rounds of solids then the self-contact check after self-contact, at most: another
 /// round only follows one whose check had to cut.
@@ -392,193 +392,6 @@ impl<R: Real> CpuStepper<R> {
             None => Ok(()),
         }
     }
-
-    /// Replays from the rollback point to `end` at the substeps in effect.
-    fn replay(
-        &mut self,
-        model: &ClothModel,
-        state: &mut ClothState<R>,
-        end: f64,
-    ) -> Result<(), Trouble> {
-        let from = self
-            .guard
-            .checkpoint
-            .clone()
-            .unwrap_or_else(|| self.frame_start.clone());
-        self.restore(&from, state);
-        self.integrator.invalidate();
-        let frames = ((end - state.time) / self.dt as f64).round().max(1.0) as u32;
-        for k in 1..=frames {
-            let frame_end = if k == frames {
-                end
-            } else {
-                from.state.time + k as f64 * self.dt as f64
-            };
-            self.try_frame(model, state, frame_end)?;
-        }
-        Ok(())
-    }
-
-    /// Puts `state` back at the rollback point `kept`, with what the run had counted there.
-    fn restore(&mut self, kept: &CpuSnapshot<R>, state: &mut ClothState<R>) {
-        state.clone_from(&kept.state);
-        self.self_contacts.work.forced_total = kept.forced;
-    }
-
-    fn record(&mut self, time: f64, reason: Option<&Trouble>, action: GuardAction, before: u32) {
-        let after = self.substeps;
-        self.guard.record(time, reason, action, (before, after));
-    }
-
-    /// A frame failed with `trouble`: roll back and redo it with more substeps, then with
-    /// the fallback integrator; else restore the frame's start.
-    fn rescue(
-        &mut self,
-        model: &ClothModel,
-        state: &mut ClothState<R>,
-        end: f64,
-        trouble: Trouble,
-    ) -> Result<FrameOutcome, Diverged> {
-        if let Some(outcome) = self.admit(model, state, end, &trouble) {
-            return Ok(outcome);
-        }
-        self.guard.failed_frame();
-        let before = self.substeps;
-        let mut last = trouble;
-        for _ in 0..self.guard.policy.max_refinements {
-            self.substeps = self.substeps.saturating_mul(2);
-            match self.replay(model, state, end) {
-                Ok(()) => {
-                    self.record(end, Some(&last), GuardAction::Refined, before);
-                    return Ok(FrameOutcome::Refined {
-                        from: before,
-                        to: self.substeps,
-                    });
-                }
-                Err(t) => last = t,
-            }
-        }
-        let tried = self.substeps;
-        let (mut fallback, mut fell_back) = (String::new(), None);
-        if let Some(kind) = self.guard.policy.fallback
-            && kind != self.integrator.kind()
-        {
-            let original = std::mem::replace(&mut self.integrator, kind.build());
-            // At the requested substeps, then refined as the integrator asked for was.
-            self.substeps = self.requested;
-            for refinement in 0..=self.guard.policy.max_refinements {
-                if refinement > 0 {
-                    self.substeps = self.substeps.saturating_mul(2);
-                }
-                match self.replay(model, state, end) {
-                    Ok(()) => {
-                        let action = GuardAction::FellBack { integrator: kind };
-                        self.record(end, Some(&last), action, before);
-                        return Ok(FrameOutcome::FellBack { integrator: kind });
-                    }
-                    Err(t) => last = t,
-                }
-            }
-            self.integrator = original;
-            fallback = format!(
-                ", and with {} at up to {} substeps",
-                kind.label(),
-                self.substeps
-            );
-            fell_back = Some(kind);
-        }
-        let start = std::mem::take(&mut self.frame_start);
-        self.restore(&start, state);
-        self.frame_start = start;
-        self.integrator.invalidate();
-        self.substeps = before;
-        self.record(state.time, Some(&last), GuardAction::GaveUp, before);
-        Err(Diverged {
-            time: state.time,
-            reason: last.to_string(),
-            substeps: tried,
-            fallback,
-            cause: {
-                let pos = f32_view(state, &mut self.view).pos.clone();
-                self.diagnose(model, &pos, (tried, fell_back))
-            },
-        })
-    }
-
-    /// A speed or kinetic-energy limit crossed: the frame redone from its start against the
-    /// limits raised to admit what it reached ([`GuardLimits::admitting`]), with the
-    /// substeps in effect and then with twice as many. Where both stand and their
-    /// velocities agree ([`resolved`]), the motion is the scene's: the first stands, and so
-    /// do the raised limits. A blow-up outgrows the raised limits within the frame, so its
-    /// first redo stops where it crosses them. Else the state is left for the rescue.
-    fn admit(
-        &mut self,
-        model: &ClothModel,
-        state: &mut ClothState<R>,
-        end: f64,
-        trouble: &Trouble,
-    ) -> Option<FrameOutcome> {
-        let limits = self.guard.limits?;
-        self.guard.limits = Some(limits.admitting(trouble, self.integrator.kind())?);
-        let stood = self.redone(model, state, end, 1).and_then(|coarse| {
-            let stood = (state.clone(), self.self_contacts.work.forced_total);
-            let fine = self.redone(model, state, end, 2)?;
-            resolved(&coarse, &fine).then_some(stood)
-        });
-        let Some((stood, forced)) = stood else {
-            self.guard.limits = Some(limits);
-            return None;
-        };
-        state.clone_from(&stood);
-        self.self_contacts.work.forced_total = forced;
-        self.integrator.invalidate();
-        let start = std::mem::take(&mut self.frame_start);
-        self.guard.healthy_frame(&start);
-        self.frame_start = start;
-        let raised = self.guard.limits.unwrap_or(limits);
-        let (speed, joules) = (raised.speed, raised.kinetic_energy);
-        let substeps = self.substeps;
-        (self.guard).record(
-            end,
-            Some(trouble),
-            GuardAction::Raised { speed, joules },
-            (substeps, substeps),
-        );
-        Some(FrameOutcome::Stepped)
-    }
-
-    /// The frame ending at `end` redone from its start with `factor` × the substeps in
-    /// effect, against the guard's limits: its end velocities where it stood.
-    fn redone(
-        &mut self,
-        model: &ClothModel,
-        state: &mut ClothState<R>,
-        end: f64,
-        factor: u32,
-    ) -> Option<Vec<glam::Vec3>> {
-        let start = std::mem::take(&mut self.frame_start);
-        self.restore(&start, state);
-        self.frame_start = start;
-        self.integrator.invalidate();
-        let substeps = self.substeps;
-        self.substeps = substeps.saturating_mul(factor);
-        let tried = self.try_frame(model, state, end);
-        self.substeps = substeps;
-        tried
-            .ok()
-            .map(|()| f32_view(state, &mut self.view).vel.clone())
-    }
-
-    /// After a healthy frame: maybe bring raised substeps back down.
-    fn maybe_recover(&mut self, end: f64) -> Option<FrameOutcome> {
-        let before = self.substeps;
-        self.substeps = self.guard.step_down(before, self.requested)?;
-        self.record(end, None, GuardAction::Recovered, before);
-        Some(FrameOutcome::Recovered {
-            from: before,
-            to: self.substeps,
-        })
-    }
 }
 
 impl<R: Real> CpuStepper<R> {
@@ -644,9 +457,7 @@ impl<R: Real> CpuStepper<R> {
         self.frame_start.forced = self.self_contacts.work.forced_total;
         match self.try_frame(model, state, end) {
             Ok(()) => {
-                let start = std::mem::take(&mut self.frame_start);
-                self.guard.healthy_frame(&start);
-                self.frame_start = start;
+                self.frame_stood();
                 Ok(self.maybe_recover(end).unwrap_or(FrameOutcome::Stepped))
             }
             Err(trouble) => self.rescue(model, state, end, trouble),
