@@ -3,7 +3,8 @@
 
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::{
-    Cause, Effect, FrameOutcome, GuardAction, GuardPolicy, IntegratorKind, SelfCollision,
+    Cause, Effect, FrameOutcome, GuardAction, GuardEvent, GuardPolicy, IntegratorKind,
+    SelfCollision,
 };
 
 mod common;
@@ -90,6 +91,33 @@ fn a_flags_whip_that_the_step_resolves_stands_and_the_limits_admit_it() {
     );
     assert_eq!(guarded.substeps(), 48);
     assert_eq!(bits(&guarded), bits(&free), "the unguarded run's state");
+}
+
+/// What `flag` with the policy `configure`d did in its first `frames` frames.
+fn flag_events(configure: impl FnOnce(&mut GuardPolicy), frames: usize) -> Vec<GuardEvent> {
+    let mut scene = Scene::builtin("flag").unwrap();
+    configure(&mut scene.params.guard);
+    let mut sim = Simulation::new(scene);
+    (0..frames)
+        .flat_map(|_| {
+            sim.step_frame().expect("frame");
+            sim.take_guard_events()
+        })
+        .collect()
+}
+
+/// A speed limit the policy fixes is the user's: the flag's whip past 30 m/s is refined,
+/// never admitted.
+#[test]
+fn a_speed_limit_the_policy_fixes_is_never_raised() {
+    let fixed = flag_events(|g| g.max_speed = Some(30.0), 60);
+    assert!(!fixed.is_empty(), "the whip crosses 30 m/s");
+    assert!(
+        !fixed
+            .iter()
+            .any(|e| matches!(e.action, GuardAction::Raised { .. })),
+        "{fixed:?}"
+    );
 }
 
 /// The other side: a cloth beyond its integrator's step (`hanging` at 2.5 × the stiffness,
