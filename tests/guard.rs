@@ -49,6 +49,12 @@ fn when_nothing_saves_a_frame_the_rollback_is_exact() {
     assert_eq!(events.last().unwrap().action, GuardAction::GaveUp);
 }
 
+/// No event among `events` admitted a crossing.
+fn assert_none_raised(events: &[GuardEvent]) {
+    let raised = |e: &GuardEvent| matches!(e.action, GuardAction::Raised { .. });
+    assert!(!events.iter().any(raised), "{events:?}");
+}
+
 /// `flag` with the guard's headroom at `headroom` (or off): its limits then sit under the
 /// speeds the flag's corners reach in the first half second, whipping in the gusts.
 fn whipping_flag(headroom: Option<f32>) -> Simulation {
@@ -112,12 +118,7 @@ fn flag_events(configure: impl FnOnce(&mut GuardPolicy), frames: usize) -> Vec<G
 fn a_speed_limit_the_policy_fixes_is_never_raised() {
     let fixed = flag_events(|g| g.max_speed = Some(30.0), 60);
     assert!(!fixed.is_empty(), "the whip crosses 30 m/s");
-    assert!(
-        !fixed
-            .iter()
-            .any(|e| matches!(e.action, GuardAction::Raised { .. })),
-        "{fixed:?}"
-    );
+    assert_none_raised(&fixed);
 }
 
 /// The other side: a cloth beyond its integrator's step (`hanging` at 2.5 × the stiffness,
@@ -142,12 +143,7 @@ fn a_blow_up_that_stays_finite_within_the_frame_is_not_admitted() {
     );
     let reason = events[0].reason.as_deref().unwrap_or_default();
     assert!(reason.contains("m/s"), "a speed, still finite: {reason}");
-    assert!(
-        !events
-            .iter()
-            .any(|e| matches!(e.action, GuardAction::Raised { .. })),
-        "{events:?}"
-    );
+    assert_none_raised(events);
     assert!(summary.max_speed < 5.0, "{} m/s", summary.max_speed);
 }
 
@@ -163,12 +159,7 @@ fn a_slow_blow_up_under_an_integrator_that_gains_energy_is_never_admitted() {
     let summary = sim.run(1.5);
     let events = &summary.guard_events;
     assert!(events.len() > 1, "{events:?}");
-    assert!(
-        !events
-            .iter()
-            .any(|e| matches!(e.action, GuardAction::Raised { .. })),
-        "{events:?}"
-    );
+    assert_none_raised(events);
 }
 
 /// Story: a hard pull raised the limits (the stretch a drag makes is the user's doing, not a
