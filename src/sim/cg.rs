@@ -3,7 +3,7 @@
 
 use crate::cloth::{ClothModel, Matrix, Real, Vector};
 
-use super::forces::{SystemMatrix, SystemProduct};
+use super::forces::SystemMatrix;
 use super::integrator::StepError;
 use super::kernels::{Blocks, Components, blocks_times, split, split_blocks, zeroed};
 
@@ -29,7 +29,6 @@ pub struct ConjugateGradient<R: Real = f32> {
     /// The preconditioner's 3×3 blocks, one array per entry (column-major).
     precond: Blocks<R>,
     free: Vec<bool>,
-    product: SystemProduct<R>,
 }
 
 /// `Σ a_i·b_i`: eight f32 lanes sum a block of 64 particles (eight each, side by side in
@@ -106,15 +105,20 @@ impl<R: Real> ConjugateGradient<R> {
                 converged: true,
             });
         }
-        let inverse = |(d, &free): (&R::M3, &bool)| if free { d.inverse() } else { R::M3::ZERO };
-        split_blocks(sys.diag.iter().zip(free).map(inverse), &mut self.precond);
+        let inverse = |(p, &free)| {
+            if free {
+                sys.diag_block(p).inverse()
+            } else {
+                R::M3::ZERO
+            }
+        };
+        split_blocks((0..n).zip(free).map(inverse), &mut self.precond);
         for v in [&mut self.r, &mut self.z, &mut self.p, &mut self.q] {
             zeroed(v, n);
         }
         split(x, &mut self.x, n);
         // r = b − A·x for the starting guess.
-        self.product.load(model, sys);
-        self.product.apply_components(&self.x, &mut self.q);
+        sys.apply_components(&self.x, &mut self.q);
         for (c, r) in self.r.iter_mut().enumerate() {
             for (i, r) in r.iter_mut().enumerate() {
                 *r = if free[i] {
@@ -132,7 +136,7 @@ impl<R: Real> ConjugateGradient<R> {
         let mut iterations = 0;
         while iterations < max_iterations && residual > target {
             iterations += 1;
-            self.product.apply_components(&self.p, &mut self.q);
+            sys.apply_components(&self.p, &mut self.q);
             for q in &mut self.q {
                 for (q, &free) in q.iter_mut().zip(free) {
                     *q = if free { *q } else { R::ZERO };

@@ -452,6 +452,7 @@ impl<R: Real> ForceSet<R> {
         for term in &self.terms {
             term.add_to_system(model, pos, vel, sys);
         }
+        sys.finish(&model.springs, pos, vel);
     }
 }
 

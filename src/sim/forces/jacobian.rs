@@ -3,7 +3,17 @@
 
 use crate::cloth::{ClothModel, Matrix, Real, Springs, Vector};
 
-use crate::sim::kernels::{Blocks, Components, Projectors, SpringRuns, blocks_times, split_blocks};
+use std::ops::Range;
+
+use crate::sim::kernels::{Blocks, Components, SystemSums, blocks_times, split, zeroed};
+
+use super::system_springs::{SpringBlock, SystemSprings};
+
+/// The entries of a block (column-major) on its diagonal: `xx, yy, zz`.
+const ON_DIAGONAL: [usize; 3] = [0, 4, 8];
+/// The entries below a block's diagonal (`xy, xz, yz`, as [`SystemSums::off_diagonal`]
+/// holds them), each with its mirror above.
+const BELOW_DIAGONAL: [(usize, usize); 3] = [(1, 3), (2, 6), (5, 7)];
 
 /// Which derivative a force term reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -15,128 +25,171 @@ pub enum JacobianMode {
     Definite,
 }
 
-/// A spring's block in the system, `S = α·I + β·n nᵀ` (kg): the form every definite spring
-/// Jacobian takes (see [`super::SpringForce::add_to_system`]). Five numbers instead of
-/// nine, and half the arithmetic in a product.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SpringBlock<R: Real = f32> {
-    pub alpha: R,
-    pub beta: R,
-    pub n: R::V3,
-}
-
-impl<R: Real> SpringBlock<R> {
-    /// The block as a matrix.
-    pub fn matrix(&self) -> R::M3 {
-        let bn = self.n * self.beta;
-        let n = self.n;
-        R::M3::IDENTITY * self.alpha + R::M3::from_cols(bn * n.x(), bn * n.y(), bn * n.z())
-    }
-
-    /// `[α, β, n.x, n.y, n.z]`: the numbers `SpringRuns::add_block_products` reads per
-    /// spring.
-    pub fn numbers(&self) -> [R; 5] {
-        let n = self.n;
-        [self.alpha, self.beta, n.x(), n.y(), n.z()]
-    }
-
-    /// `S·u`.
-    pub fn times(&self, u: R::V3) -> R::V3 {
-        u * self.alpha + self.n * (self.beta * self.n.dot(u))
-    }
-}
-
 /// `A = M − h·∂f/∂v − h²·∂f/∂x` for one step of length `h`, plus `∂f/∂x·v` for the
 /// right-hand side. With [`JacobianMode::Definite`] blocks it is symmetric positive definite.
 ///
 /// A spring `e = (a, b)` with blocks `K_x`, `K_v` contributes `S_e = h·K_v + h²·K_x`: `+S_e`
 /// to the diagonal blocks of `a` and `b` and `−S_e` to the off-diagonal blocks `(a, b)`,
-/// `(b, a)`. Per-particle terms (air damping) add to the diagonal only.
+/// `(b, a)`. Per-particle terms (air damping) add to the diagonal only. The spring terms
+/// say which springs and how strong ([`SystemMatrix::add_springs`]); their blocks are
+/// computed together when the matrix is finished ([`SystemMatrix::finish`]), in the
+/// springs' runs ([`SpringRuns::add_system_blocks`]), so that assembling them and
+/// multiplying by them are the vector loops and threads of the spring forces.
+///
+/// [`SpringRuns::add_system_blocks`]: crate::sim::kernels::SpringRuns::add_system_blocks
 #[derive(Clone, Debug)]
 pub struct SystemMatrix<R: Real = f32> {
     /// Step length, seconds.
     pub h: R,
-    /// `S_e` per spring.
-    pub spring: Vec<SpringBlock<R>>,
-    /// Diagonal block per particle, kg.
-    pub diag: Vec<R::M3>,
-    /// `(∂f/∂x)·v` at the state the matrix was built at, N/s.
-    pub dfdx_v: Vec<R::V3>,
+    /// The springs' blocks.
+    springs: SystemSprings<R>,
+    /// Diagonal block per particle, kg, one array per entry (column-major: entry `3c + r`
+    /// is row `r` of column `c`).
+    diag: Blocks<R>,
+    /// `(∂f/∂x)·v` at the state the matrix was built at, N/s, one array per component.
+    dfdx_v: Components<R>,
+    /// The state one array per component.
+    pos: Components<R>,
+    vel: Components<R>,
 }
 
 impl<R: Real> Default for SystemMatrix<R> {
     fn default() -> Self {
         Self {
             h: R::ZERO,
-            spring: Vec::new(),
-            diag: Vec::new(),
-            dfdx_v: Vec::new(),
+            springs: SystemSprings::default(),
+            diag: Default::default(),
+            dfdx_v: Default::default(),
+            pos: Default::default(),
+            vel: Default::default(),
         }
     }
 }
 
 impl<R: Real> SystemMatrix<R> {
-    /// Starts a new matrix `M` for a step of `h` seconds (no allocation once sized).
+    /// Starts a new matrix `M` for a step of `h` seconds (no allocation once sized); the
+    /// terms add to it, and [`SystemMatrix::finish`] completes it.
     pub fn begin(&mut self, model: &ClothModel, h: R) {
-        let (n, e) = (model.particle_count(), model.springs.len());
+        let n = model.particle_count();
         self.h = h;
-        self.spring.clear();
-        self.spring.resize(e, SpringBlock::default());
-        self.diag.clear();
-        self.diag.extend(
-            model
-                .mass
-                .iter()
-                .map(|&m| R::M3::from_diagonal(R::V3::splat(R::of_f32(m)))),
-        );
-        self.dfdx_v.clear();
-        self.dfdx_v.resize(n, R::V3::ZERO);
+        self.springs.begin();
+        for (entry, d) in self.diag.iter_mut().enumerate() {
+            d.clear();
+            if ON_DIAGONAL.contains(&entry) {
+                d.extend(model.mass.iter().map(|&m| R::of_f32(m)));
+            } else {
+                d.resize(n, R::ZERO);
+            }
+        }
+        zeroed(&mut self.dfdx_v, n);
     }
 
-    /// Sets spring `e`'s system block `S_e = h·K_v + h²·K_x` (one force term per spring) and
-    /// adds `K_x·(v_b − v_a)`.
-    #[inline]
-    pub fn add_spring_block(
+    /// Particle `p`'s diagonal block.
+    pub fn diag_block(&self, p: usize) -> R::M3 {
+        let d = &self.diag;
+        let col = |c: usize| R::V3::new(d[3 * c][p], d[3 * c + 1][p], d[3 * c + 2][p]);
+        R::M3::from_cols(col(0), col(1), col(2))
+    }
+
+    /// How many particles the matrix is for.
+    pub fn particles(&self) -> usize {
+        self.diag[0].len()
+    }
+
+    /// `(∂f/∂x)·v` at particle `p`, N/s.
+    pub fn dfdx_v(&self, p: usize) -> R::V3 {
+        let d = &self.dfdx_v;
+        R::V3::new(d[0][p], d[1][p], d[2][p])
+    }
+
+    /// Adds the springs `range` of `springs`, with stiffness `k` and damping `c` per
+    /// spring of the range: at [`SystemMatrix::finish`], each spring's block
+    /// `S_e = α·I + β·n nᵀ` with `α = h²·k·s`, `β = h·c + h²·k(1 − s)`,
+    /// `s = max(0, 1 − l₀/|d|)`, and `K_x·(v_b − v_a) = k·s·w + k(1 − s)(n·w)·n` (see
+    /// [`SpringForce::add_to_system`](super::SpringForce::add_to_system)). Each spring
+    /// once a matrix.
+    pub fn add_springs(
         &mut self,
         springs: &Springs,
-        e: usize,
-        s: SpringBlock<R>,
-        dfdx_w: R::V3,
+        range: Range<usize>,
+        strengths: (&[f32], &[f32]),
     ) {
-        let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
-        debug_assert_eq!(
-            self.spring[e],
-            SpringBlock::default(),
-            "spring {e} set twice"
-        );
-        self.spring[e] = s;
-        let m = s.matrix();
-        self.diag[a] += m;
-        self.diag[b] += m;
-        self.dfdx_v[a] += dfdx_w;
-        self.dfdx_v[b] -= dfdx_w;
+        self.springs.add(springs.len(), range, strengths);
+    }
+
+    /// Completes the matrix at positions `pos` and velocities `vel`: the blocks of the
+    /// springs added, and their sums on the diagonal and in `(∂f/∂x)·v`.
+    pub fn finish(&mut self, springs: &Springs, pos: &[R::V3], vel: &[R::V3]) {
+        let n = self.particles().min(pos.len()).min(vel.len());
+        split(pos, &mut self.pos, n);
+        split(vel, &mut self.vel, n);
+        // The sums are added where they belong: the diagonal entries, the entries below it
+        // (copied above it after), and `(∂f/∂x)·v`.
+        let d = &mut self.diag;
+        let take = std::mem::take::<Vec<R>>;
+        let mut sums = SystemSums {
+            diagonal: ON_DIAGONAL.map(|e| take(&mut d[e])),
+            off_diagonal: BELOW_DIAGONAL.map(|(e, _)| take(&mut d[e])),
+            dfdx_v: std::mem::take(&mut self.dfdx_v),
+        };
+        let state = (&self.pos, &self.vel, self.h);
+        self.springs.assemble(springs, n, state, &mut sums);
+        let SystemSums {
+            diagonal,
+            off_diagonal,
+            dfdx_v,
+        } = sums;
+        for (e, sum) in ON_DIAGONAL.into_iter().zip(diagonal) {
+            d[e] = sum;
+        }
+        for ((below, above), sum) in BELOW_DIAGONAL.into_iter().zip(off_diagonal) {
+            d[above].clone_from(&sum);
+            d[below] = sum;
+        }
+        self.dfdx_v = dfdx_v;
     }
 
     /// Adds a per-particle `∂f_p/∂v_p = d·I` (N·s/m).
     pub fn add_dv_diagonal(&mut self, p: usize, d: R) {
-        self.diag[p] -= R::M3::from_diagonal(R::V3::splat(self.h * d));
+        for e in ON_DIAGONAL {
+            self.diag[e][p] -= self.h * d;
+        }
     }
 
-    /// `out = A·u`, gathered per particle over `model.adjacency`.
+    /// Each spring's block `S_e`, indexed as the model's `springs` springs (zero for a
+    /// spring no term added).
+    pub fn spring_blocks(&self, springs: usize) -> Vec<SpringBlock<R>> {
+        self.springs.by_spring(springs)
+    }
+
+    /// `out = A·u`, gathered per particle over `model.adjacency`, one block at a time
+    /// (for tests: the solver multiplies with [`SystemMatrix::apply_components`]).
     pub fn apply(&self, model: &ClothModel, u: &[R::V3], out: &mut [R::V3]) {
         let adj = &model.adjacency;
+        let spring = self.spring_blocks(model.springs.len());
         for (p, o) in out.iter_mut().enumerate() {
-            let mut sum = self.diag[p] * u[p];
+            let mut sum = self.diag_block(p) * u[p];
             for slot in adj.range(p) {
-                sum -= self.spring[adj.spring[slot] as usize].times(u[adj.other[slot] as usize]);
+                sum -= spring[adj.spring[slot] as usize].times(u[adj.other[slot] as usize]);
             }
             *o = sum;
         }
     }
 
+    /// `out = A·u` with `u` and `out` stored one array per component (`out` as long as
+    /// `u`): the springs' products in their runs, with the threads of the spring forces. The same as [`SystemMatrix::apply`] up to rounding.
+    pub fn apply_components(&self, u: &Components<R>, out: &mut Components<R>) {
+        let n = u[0].len().min(self.particles());
+        for o in out.iter_mut() {
+            o[..n].fill(R::ZERO);
+        }
+        self.springs.add_products(u, out);
+        blocks_times(&self.diag, u, out, |diagonal, sums| diagonal - sums);
+    }
+
     /// The whole matrix, dense and row-major (`3n × 3n`), for tests on small systems.
     pub fn dense(&self, springs: &Springs) -> Vec<Vec<f64>> {
-        let n = self.diag.len();
+        let n = self.particles();
         let mut m = vec![vec![0.0f64; 3 * n]; 3 * n];
         let mut put = |i: usize, j: usize, block: R::M3, sign: f64| {
             for r in 0..3 {
@@ -145,73 +198,14 @@ impl<R: Real> SystemMatrix<R> {
                 }
             }
         };
-        for (p, &d) in self.diag.iter().enumerate() {
-            put(p, p, d, 1.0);
+        for p in 0..n {
+            put(p, p, self.diag_block(p), 1.0);
         }
-        for (e, s) in self.spring.iter().enumerate() {
+        for (e, s) in self.spring_blocks(springs.len()).iter().enumerate() {
             let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
             put(a, b, s.matrix(), -1.0);
             put(b, a, s.matrix(), -1.0);
         }
         m
-    }
-}
-
-/// [`SystemMatrix::apply`] for repeated products with one matrix (a linear solve's): each
-/// spring's `α, β, n` copied once into the order of the springs' runs, one array per
-/// number, so each product is the vector loops and threads of the spring forces rather
-/// than a 3×3 product per neighbour. The runs are kept while the model's springs stay the
-/// same.
-#[derive(Clone, Debug)]
-pub struct SystemProduct<R: Real = f32> {
-    /// The springs the runs were made for.
-    ends: (Vec<u32>, Vec<u32>),
-    runs: Option<SpringRuns<R>>,
-    blocks: Projectors<R>,
-    /// The particles' diagonal blocks, one array per entry (column-major).
-    diag: Blocks<R>,
-}
-
-impl<R: Real> Default for SystemProduct<R> {
-    fn default() -> Self {
-        Self {
-            ends: Default::default(),
-            runs: None,
-            blocks: Default::default(),
-            diag: Default::default(),
-        }
-    }
-}
-
-impl<R: Real> SystemProduct<R> {
-    /// Takes `sys`'s spring blocks (call again when the matrix changes).
-    pub fn load(&mut self, model: &ClothModel, sys: &SystemMatrix<R>) {
-        let springs = &model.springs;
-        if self.runs.is_none() || self.ends.0 != springs.a || self.ends.1 != springs.b {
-            self.ends = (springs.a.clone(), springs.b.clone());
-            let none = vec![R::ZERO; springs.len()];
-            let particles = model.particle_count();
-            self.runs = Some(SpringRuns::new(
-                particles, &springs.a, &springs.b, &none, &none, &none,
-            ));
-        }
-        if let Some(runs) = &self.runs {
-            runs.in_order(|e| sys.spring[e].numbers(), &mut self.blocks);
-        }
-        split_blocks(sys.diag.iter().copied(), &mut self.diag);
-    }
-
-    /// `out = A·u` with the matrix last [loaded](SystemProduct::load), `u` and `out` stored
-    /// one array per component (`out` as long as `u`): the same as [`SystemMatrix::apply`] up
-    /// to rounding.
-    pub fn apply_components(&self, u: &Components<R>, out: &mut Components<R>) {
-        let n = u[0].len().min(self.diag[0].len());
-        for o in out.iter_mut() {
-            o[..n].fill(R::ZERO);
-        }
-        if let Some(runs) = &self.runs {
-            runs.add_block_products(&self.blocks, u, out);
-        }
-        blocks_times(&self.diag, u, out, |diagonal, sums| diagonal - sums);
     }
 }

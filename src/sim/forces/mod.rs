@@ -9,13 +9,15 @@ mod force_set;
 mod force_term;
 mod jacobian;
 mod springs;
+mod system_springs;
 
 pub use dihedral::{DihedralBending, hinge_angle};
 pub use force::Force;
 pub use force_set::{ForceSet, TermTimes, to_accelerations};
 pub use force_term::{ForceTerm, Fused};
-pub use jacobian::{JacobianMode, SpringBlock, SystemMatrix, SystemProduct};
+pub use jacobian::{JacobianMode, SystemMatrix};
 pub use springs::{SpringBlocks, SpringForce};
+pub use system_springs::SpringBlock;
 
 #[cfg(test)]
 mod derivative_tests;

@@ -13,7 +13,7 @@ use crate::cloth::{ClothModel, Matrix, Real, Springs, Vector};
 use crate::sim::kernels::{Components, SpringRuns, TwoPasses};
 
 use super::force_term::{ForceTerm, Fused};
-use super::jacobian::{JacobianMode, SpringBlock, SystemMatrix};
+use super::jacobian::{JacobianMode, SystemMatrix};
 use crate::sim::constraints::DistanceConstraints;
 use crate::sim::params::Material;
 
@@ -280,35 +280,11 @@ impl SpringForce {
     /// [`SpringForce::blocks`] in definite form are `K_x = k·s·I + k(1 − s)·n nᵀ` (with
     /// `s = max(0, 1 − l₀/|d|)`) and `K_v = c·n nᵀ`, so the system's block is
     /// `S_e = h·K_v + h²·K_x = α·I + β·n nᵀ` and `K_x·(v_b − v_a) = k·s·w + k(1 − s)(n·w)·n`:
-    /// built from those scalars directly, a third of the arithmetic of the 3×3 products.
-    pub fn add_to_system<R: Real>(
-        &self,
-        springs: &Springs,
-        pos: &[R::V3],
-        vel: &[R::V3],
-        sys: &mut SystemMatrix<R>,
-    ) {
-        let h = sys.h;
-        let one = R::ONE;
-        for e in self.range.clone() {
-            let (a, b) = (springs.a[e] as usize, springs.b[e] as usize);
-            let d = pos[b] - pos[a];
-            let len = d.length();
-            if len <= R::TINY_LENGTH {
-                // No direction: both blocks are zero.
-                continue;
-            }
-            // One division instead of four (three for `n`, one for `s`).
-            let inv = one / len;
-            let n = d * inv;
-            let (k, c) = (self.k[e - self.range.start], self.c[e - self.range.start]);
-            let (k, c) = (R::of_f32(k), R::of_f32(c));
-            let s = (one - R::of_f32(springs.rest[e]) * inv).max(R::ZERO);
-            let (alpha, beta) = (h * h * (k * s), h * c + h * h * (k * (one - s)));
-            let w = vel[b] - vel[a];
-            let dfdx_w = w * (k * s) + n * (k * (one - s) * n.dot(w));
-            sys.add_spring_block(springs, e, SpringBlock { alpha, beta, n }, dfdx_w);
-        }
+    /// built from those scalars directly, a third of the arithmetic of the 3×3 products, in
+    /// the vector loops of the springs' runs, for every spring term at once when the
+    /// matrix is finished ([`SystemMatrix::add_springs`]).
+    pub fn add_to_system<R: Real>(&self, springs: &Springs, sys: &mut SystemMatrix<R>) {
+        sys.add_springs(springs, self.range(), (&self.k, &self.c));
     }
 
     /// The same springs as distance constraints for position-based methods: rest length
@@ -404,10 +380,11 @@ impl<R: Real> ForceTerm<R> for SpringForce {
     fn add_to_system(
         &self,
         model: &ClothModel,
-        pos: &[R::V3],
-        vel: &[R::V3],
+        _pos: &[R::V3],
+        _vel: &[R::V3],
         sys: &mut SystemMatrix<R>,
     ) {
-        SpringForce::add_to_system::<R>(self, &model.springs, pos, vel, sys);
+        // The blocks are computed when the matrix is finished, at the state it is given.
+        SpringForce::add_to_system::<R>(self, &model.springs, sys);
     }
 }

@@ -106,12 +106,9 @@ impl<R: Real> Integrator<R> for ImplicitEuler<R> {
         let sys = &mut self.sys;
         ctx.derivative_work(|m, f| f.assemble(m, &state.pos, &state.vel, h, sys));
         self.rhs.clear();
-        self.rhs.extend(
-            self.force
-                .iter()
-                .zip(&self.sys.dfdx_v)
-                .map(|(f, k)| (*f + *k * h) * h),
-        );
+        let sys = &self.sys;
+        self.rhs
+            .extend((self.force.iter().enumerate()).map(|(i, f)| (*f + sys.dfdx_v(i) * h) * h));
         let force_scale = self
             .rhs
             .iter()

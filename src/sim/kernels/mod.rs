@@ -19,7 +19,7 @@ pub use components::{
 };
 pub use points::{leaves, less_into, outside, take_changes, take_moves};
 pub use run_pass::Projectors;
-pub use spring_runs::SpringRuns;
+pub use spring_runs::{SpringRuns, SystemSums};
 pub use two_passes::{BlockPass, TwoPasses};
 pub use vbd_lanes::{Particle, StepLength, descend_range, descend_range_plain};
 pub use vbd_stencil::Stencil;

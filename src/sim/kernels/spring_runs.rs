@@ -24,6 +24,9 @@ use super::components::{Components, Scratch, split};
 use super::run_pass::{ForcePass, ProductPass, Projectors, RunPass, at};
 use crate::cloth::Real;
 
+mod system;
+pub use system::SystemSums;
+
 /// Particles per block (a block is one parallel task).
 const BLOCK: usize = 1024;
 /// Blocks from which the blocks run in parallel (on the [`Team`]): as many as hold
