@@ -29,15 +29,21 @@ impl Default for UnitCosts {
     /// `hanging` scene (625 particles, below the size whose steps are shared between
     /// threads), 2026-11-26, the development machine (2 vCPUs of an AMD EPYC): three runs
     /// gave an assembly of 10.5–10.9, a CG iteration 0.75–0.77, an XPBD sweep 1.25–1.41, a
-    /// VBD sweep 2.56–2.59 (one semi-implicit Euler substep 7.3–7.4 µs).
+    /// VBD sweep 2.56–2.59 (one semi-implicit Euler substep 7.3–7.4 µs). The assembly is
+    /// that 10.6 less what assembling in the springs' runs saved, 2026-12-06 on a 2-vCPU
+    /// Intel Xeon host: the assembly alone on `hanging` took 64–72 µs before and 18–24
+    /// after, 5.3 of that host's semi-implicit Euler substeps (8.5–9.5 µs). (`--calibrate`
+    /// there, alternating with the build before: medians of 4.9 and 10.6 in a quiet hour,
+    /// of 6.8 and 10.9 in a busy one.)
     fn default() -> Self {
         Self {
-            assembly: 10.6,
+            assembly: 5.3,
             linear_iteration: 0.76,
             xpbd_sweep: 1.3,
             vbd_sweep: 2.6,
             source: "`clothsim accuracy --calibrate` on `hanging`, 625 particles, 2026-11-26, \
-                     2 vCPUs of an AMD EPYC"
+                     2 vCPUs of an AMD EPYC (the assembly 2026-12-06, after it went into the \
+                     springs' runs)"
                 .into(),
         }
     }
