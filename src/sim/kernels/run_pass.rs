@@ -28,6 +28,7 @@ pub(super) trait RunPass<R: Real>: Sync {
 }
 
 /// The spring forces (see [`kernel`]).
+#[derive(Clone, Copy)]
 pub(super) struct ForcePass<'a, R: Real> {
     pub(super) rest: &'a [R],
     pub(super) k: &'a [R],
@@ -171,12 +172,9 @@ fn kernel<R: Real, const WRITE: bool>(
 /// `[α, β, n]` written at its place in run order, and `K_x·(v_b − v_a)` summed at its first
 /// ends (and at its second, where it is subtracted).
 pub(super) struct SystemPass<'a, 'b, R: Real> {
-    pub(super) rest: &'a [R],
-    pub(super) k: &'a [R],
-    pub(super) c: &'a [R],
+    /// The springs' strengths and the state, as the forces take them.
+    pub(super) springs: ForcePass<'a, R>,
     pub(super) h: R,
-    pub(super) p: &'a Components<R>,
-    pub(super) v: &'a Components<R>,
     /// `[α, β, n.x, n.y, n.z]` in run order; each run writes its own springs' places.
     pub(super) blocks: [Disjoint<'b, R>; 5],
 }
@@ -190,14 +188,14 @@ impl<R: Real> RunPass<R> for SystemPass<'_, '_, R> {
         first: [&mut [R]; 3],
         second: [&mut [R]; 3],
     ) {
-        let (p, v) = (self.p, self.v);
+        let ForcePass { rest, k, c, p, v } = self.springs;
         // SAFETY: a run's springs are its own places in run order; no other run writes them.
         let [al, be, nx, ny, nz] =
             (self.blocks.each_ref()).map(|b| unsafe { b.part(springs.clone()) });
         let ([f0, f1, f2], [t0, t1, t2]) = (first, second);
         system_kernel::<R, WRITE>(
             [at(p, &ea), at(p, &eb), at(v, &ea), at(v, &eb)],
-            [self.rest, self.k, self.c].map(|s| &s[springs.clone()]),
+            [rest, k, c].map(|s| &s[springs.clone()]),
             self.h,
             [al, be, nx, ny, nz],
             [f0, f1, f2, t0, t1, t2],

@@ -45,6 +45,18 @@ fn stencil(w: usize, h: usize, offsets: &[(usize, usize)]) -> (Vec<u32>, Vec<u32
     (a, b)
 }
 
+/// A `w` × `h` grid's springs to the right, below, diagonally and two below, each with its
+/// ends in an order `rnd` draws.
+fn stencil_either_way(w: usize, h: usize, rnd: &mut impl FnMut() -> f32) -> (Vec<u32>, Vec<u32>) {
+    let (mut a, mut b) = stencil(w, h, &[(1, 0), (0, 1), (1, 1), (0, 2)]);
+    for (x, y) in a.iter_mut().zip(&mut b) {
+        if rnd() >= 0.5 {
+            std::mem::swap(x, y);
+        }
+    }
+    (a, b)
+}
+
 /// `start` plus the forces, computed on component arrays.
 fn on_components(runs: &SpringRuns, pos: &[Vec3], vel: &[Vec3], start: &[Vec3]) -> Vec<Vec3> {
     let n = pos.len();
@@ -251,23 +263,7 @@ fn block_products_are_each_springs_block_times_the_other_end() {
     let (w, h) = (60usize, 50usize);
     let n = w * h;
     let mut rnd = crate::test_rng::uniform(99);
-    let (mut a, mut b) = (Vec::new(), Vec::new());
-    for p in 0..n {
-        for (di, dj) in [(1, 0), (0, 1), (1, 1), (0, 2)] {
-            let (i, j) = (p % w + di, p / w + dj);
-            if i < w && j < h {
-                // Ends in either order.
-                let q = (j * w + i) as u32;
-                let (x, y) = if rnd() < 0.5 {
-                    (p as u32, q)
-                } else {
-                    (q, p as u32)
-                };
-                a.push(x);
-                b.push(y);
-            }
-        }
-    }
+    let (a, b) = stencil_either_way(w, h, &mut rnd);
     // Random α, β and (not unit) n: every number of a block weighs in.
     let blocks: Vec<SpringBlock> = (0..a.len())
         .map(|_| SpringBlock {
@@ -447,4 +443,161 @@ fn the_runs_compute_in_f64_from_the_same_code() {
         f32_error < 0.2 * scale,
         "f32 runs off by {f32_error:e} of {scale:e}"
     );
+}
+
+/// One spring's block and `K_x·(v_b − v_a)` by the formula, spring by spring:
+/// `None` for coincident ends.
+fn by_formula(d: Vec3, w: Vec3, (rest, k, c, h): (f32, f32, f32, f32)) -> Option<([f32; 5], Vec3)> {
+    let len = d.length();
+    if len <= 1e-9 {
+        return None;
+    }
+    let n = d / len;
+    let s = (1.0 - rest / len).max(0.0);
+    let (alpha, beta) = (h * h * k * s, h * c + h * h * k * (1.0 - s));
+    let dfdx_w = k * s * w + k * (1.0 - s) * n.dot(w) * n;
+    Some(([alpha, beta, n.x, n.y, n.z], dfdx_w))
+}
+
+/// A 60 × 50 grid's stencil springs (ends in either order, several blocks) and some
+/// random ones, stretched and compressed (the transverse stiffness clamps), two of them
+/// with coincident ends: every spring's block in run order and the sums at its ends are
+/// the formula's, and one thread and two give the same bits.
+#[test]
+fn system_blocks_are_each_springs_by_the_formula_on_any_number_of_threads() {
+    let (w, rows) = (60usize, 50usize);
+    let n = w * rows;
+    let mut rnd = crate::test_rng::uniform(4242);
+    let mut pos: Vec<Vec3> = (0..n)
+        .map(|p| Vec3::new((p % w) as f32, -((p / w) as f32), rnd()) * 0.01)
+        .collect();
+    let vel: Vec<Vec3> = (0..n)
+        .map(|_| Vec3::new(rnd(), rnd(), rnd()) - 0.5)
+        .collect();
+    let (mut a, mut b) = stencil_either_way(w, rows, &mut rnd);
+    for _ in 0..300 {
+        a.push((rnd() * n as f32) as u32 % n as u32);
+        b.push((rnd() * n as f32) as u32 % n as u32);
+    }
+    // Coincident ends: particle 1 and 61 on top of their stencil neighbours 0 and 60.
+    pos[1] = pos[0];
+    pos[61] = pos[60];
+    let rest: Vec<f32> = (0..a.len()).map(|_| 0.005 + 0.02 * rnd()).collect();
+    let k: Vec<f32> = (0..a.len()).map(|_| 100.0 + 900.0 * rnd()).collect();
+    let c: Vec<f32> = (0..a.len()).map(|_| 0.05 * rnd()).collect();
+    let h = 1.0 / 240.0;
+    let runs = SpringRuns::new(n, &a, &b, &rest, &k, &c);
+    let (mut p, mut v) = (Components::default(), Components::default());
+    split(&pos, &mut p, n);
+    split(&vel, &mut v, n);
+    let assemble = |runs: &SpringRuns| {
+        let mut blocks = Projectors::default();
+        let mut sums = SystemSums::default();
+        for s in [&mut sums.diagonal, &mut sums.off_diagonal, &mut sums.dfdx_v] {
+            *s = std::array::from_fn(|_| vec![0.0; n]);
+        }
+        runs.add_system_blocks(&p, &v, h, &mut blocks, &mut sums);
+        (blocks, sums)
+    };
+    let (blocks, sums) = assemble(&runs);
+
+    let (mut diagonal, mut dfdx) = (vec![[0.0f32; 6]; n], vec![Vec3::ZERO; n]);
+    let mut want_blocks = vec![None; a.len()];
+    let (mut stretched, mut compressed, mut coincident) = (0, 0, 0);
+    for e in 0..a.len() {
+        let (i, j) = (a[e] as usize, b[e] as usize);
+        if i == j {
+            continue;
+        }
+        let d = pos[j] - pos[i];
+        let Some((block, g)) = by_formula(d, vel[j] - vel[i], (rest[e], k[e], c[e], h)) else {
+            coincident += 1;
+            want_blocks[e] = Some([0.0; 5]);
+            continue;
+        };
+        if d.length() > rest[e] {
+            stretched += 1;
+        } else {
+            compressed += 1;
+        }
+        let [al, be, x, y, z] = block;
+        let entries = [
+            al + be * x * x,
+            al + be * y * y,
+            al + be * z * z,
+            be * x * y,
+            be * x * z,
+            be * y * z,
+        ];
+        for end in [i, j] {
+            for (s, e) in diagonal[end].iter_mut().zip(entries) {
+                *s += e;
+            }
+        }
+        dfdx[i] += g;
+        dfdx[j] -= g;
+        want_blocks[e] = Some(block);
+    }
+    assert!(stretched > 100 && compressed > 100 && coincident == 2);
+
+    for (place, e) in runs.places() {
+        let got = blocks.each_ref().map(|b| b[place]);
+        let mut want = want_blocks[e].expect("a spring from a particle to itself has no place");
+        // The runs take each spring from its lower-numbered end.
+        if a[e] > b[e] {
+            want[2..].iter_mut().for_each(|x| *x = -*x);
+        }
+        for (g, w) in got.iter().zip(want) {
+            assert!(
+                (g - w).abs() <= 1e-6 * (1.0 + w.abs()),
+                "spring {e}: {got:?} vs {want:?}"
+            );
+        }
+    }
+    let largest = |v: &[f32]| v.iter().fold(0.0f32, |m, x| m.max(x.abs()));
+    let scale = diagonal.iter().map(|d| largest(d)).fold(0.0, f32::max);
+    let g_scale = dfdx.iter().map(|g| g.length()).fold(0.0, f32::max);
+    assert!(scale > 0.0 && g_scale > 0.0);
+    for i in 0..n {
+        let got = [
+            sums.diagonal[0][i],
+            sums.diagonal[1][i],
+            sums.diagonal[2][i],
+            sums.off_diagonal[0][i],
+            sums.off_diagonal[1][i],
+            sums.off_diagonal[2][i],
+        ];
+        for (g, w) in got.iter().zip(diagonal[i]) {
+            assert!(
+                (g - w).abs() <= 1e-5 * scale,
+                "particle {i}: {got:?} vs {:?}",
+                diagonal[i]
+            );
+        }
+        let g = Vec3::new(sums.dfdx_v[0][i], sums.dfdx_v[1][i], sums.dfdx_v[2][i]);
+        assert!(
+            (g - dfdx[i]).length() <= 1e-5 * g_scale,
+            "particle {i}: {g} vs {}",
+            dfdx[i]
+        );
+    }
+
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool");
+        let parallel = runs.clone().parallel_from(1);
+        let (b2, s2) = pool.install(|| assemble(&parallel));
+        assert!(b2 == blocks, "{threads} threads: the blocks");
+        let same = [
+            (&s2.diagonal, &sums.diagonal),
+            (&s2.off_diagonal, &sums.off_diagonal),
+            (&s2.dfdx_v, &sums.dfdx_v),
+        ];
+        assert!(
+            same.iter().all(|(x, y)| x == y),
+            "{threads} threads: the sums"
+        );
+    }
 }
