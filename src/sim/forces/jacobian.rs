@@ -177,7 +177,8 @@ impl<R: Real> SystemMatrix<R> {
     }
 
     /// `out = A·u` with `u` and `out` stored one array per component (`out` as long as
-    /// `u`): the springs' products in their runs, with the threads of the spring forces. The same as [`SystemMatrix::apply`] up to rounding.
+    /// `u`): the springs' products in their runs, with the threads of the spring forces.
+    /// The same as [`SystemMatrix::apply`] up to rounding.
     pub fn apply_components(&self, u: &Components<R>, out: &mut Components<R>) {
         let n = u[0].len().min(self.particles());
         for o in out.iter_mut() {

@@ -25,7 +25,8 @@ impl<R: Real> SpringBlock<R> {
     }
 
     /// `[α, β, n.x, n.y, n.z]`: the numbers `SpringRuns::add_block_products` reads per
-    /// spring.
+    /// spring (tests put blocks of their own in run order with them).
+    #[cfg(test)]
     pub fn numbers(&self) -> [R; 5] {
         let n = self.n;
         [self.alpha, self.beta, n.x(), n.y(), n.z()]

@@ -8,9 +8,9 @@ use super::components::Components;
 use crate::cloth::Real;
 use crate::parallel::Disjoint;
 
-/// Springs' system blocks `α·I + β·n nᵀ` in run order: `[α, β, n.x, n.y, n.z]`
-/// ([`SpringBlock::numbers`](crate::sim::forces::SpringBlock::numbers)), one array each
-/// ([`SpringRuns::add_block_products`](super::SpringRuns::add_block_products)).
+/// Springs' system blocks `α·I + β·n nᵀ` in run order: `[α, β, n.x, n.y, n.z]`, one array
+/// each ([`SpringRuns::add_system_blocks`](super::SpringRuns::add_system_blocks) writes them,
+/// [`SpringRuns::add_block_products`](super::SpringRuns::add_block_products) reads them).
 pub type Projectors<R = f32> = [Vec<R>; 5];
 
 /// What a block pass does with each run: `run` gets the run's two ranges of ends, its

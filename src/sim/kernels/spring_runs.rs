@@ -476,7 +476,9 @@ impl<R: Real> SpringRuns<R> {
     }
 
     /// `K` numbers per spring (`value(e)` for spring `e` as given to [`SpringRuns::new`]) in
-    /// run order, one array each, zero for gap fillers.
+    /// run order, one array each, zero for gap fillers (tests put blocks of their own in
+    /// run order with it).
+    #[cfg(test)]
     pub fn in_order<const K: usize>(&self, value: impl Fn(usize) -> [R; K], out: &mut [Vec<R>; K]) {
         let n = self.order.len();
         for entry in out.iter_mut() {
@@ -493,7 +495,7 @@ impl<R: Real> SpringRuns<R> {
     }
 
     /// Adds `Σ_e S_e·u_other` to `out` at both ends of every spring `e`, with
-    /// `S_e = α·I + β·n nᵀ` as put in run order by [`SpringRuns::in_order`]
+    /// `S_e = α·I + β·n nᵀ` as [`SpringRuns::add_system_blocks`] puts them in run order
     /// (`[α, β, n.x, n.y, n.z]`): the off-diagonal part of a matrix-vector product with the
     /// implicit system (whose off-diagonal blocks are `−S_e`). In parallel as the forces
     /// are, with the same result on any number of threads.
