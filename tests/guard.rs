@@ -3,8 +3,8 @@
 
 use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::{
-    Cause, Effect, FrameOutcome, GuardAction, GuardEvent, GuardPolicy, IntegratorKind,
-    SelfCollision,
+    Cause, ContactError, Effect, FrameOutcome, GuardAction, GuardEvent, GuardPolicy,
+    IntegratorKind, SelfCollision, StepError, Trouble,
 };
 
 mod common;
@@ -393,6 +393,33 @@ fn a_cloth_diverging_with_self_collision_is_rolled_back_not_aborted() {
     // the frame): fewer than 48 self-collision passes each, then the 96 of the frame redone.
     let passes = sim.take_timings().get("self-collision").unwrap().calls;
     assert!(passes > 96 && passes < 2 * 48 + 96, "{passes} passes");
+}
+
+/// Self-contact measures the springs of a substep whose search finds more pairs than cloth
+/// in contact does, and refuses one stretched past the guard's limit (a state blown up
+/// within the frame, which otherwise cost the pushes seconds a substep): the guard takes
+/// that as the strain the frame's end would have judged, named as such, not as a solver's
+/// failure.
+#[test]
+fn a_stretch_self_contact_refuses_is_judged_as_the_guards_strain() {
+    let refused = StepError::Contact(ContactError::Stretched {
+        strain: 3.5,
+        limit: 1.26,
+        pairs: 90_000,
+        particles: 1_000,
+    });
+    let trouble = Trouble::from(refused);
+    assert_eq!(
+        trouble,
+        Trouble::Strain {
+            strain: 3.5,
+            limit: 1.26
+        }
+    );
+    assert_eq!(
+        trouble.to_string(),
+        "a spring stretched by 350 % (limit 126 %)"
+    );
 }
 
 /// With the guard off nothing checks the substeps, and the diverging state reaches

@@ -347,6 +347,7 @@ impl<R: Real> CpuStepper<R> {
             }
         }
         let limits = self.guard.limits.filter(|_| checked);
+        self.self_contacts.strain_limit = limits.map(|l| l.strain);
         let depth = limits.map_or(0.0, |l| l.depth_of(f32_view(state, &mut self.view)));
         for k in 0..count {
             self.advance(model, state)?;

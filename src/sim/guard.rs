@@ -11,6 +11,7 @@ use super::effects::{Effect, Gravity};
 use super::forces::ForceSet;
 use super::guard_policy::GuardPolicy;
 use super::integrator::{IntegratorKind, StepError};
+use super::self_contacts::ContactError;
 use crate::parallel::wide;
 
 /// The limits a healthy frame stays within, derived from the scene.
@@ -306,13 +307,7 @@ fn weight_strain<R: Real>(model: &ClothModel, forces: &ForceSet<R>, weight: f32)
 
 /// The largest relative extension of a spring in `state` (0 when none is stretched).
 fn max_strain(model: &ClothModel, state: &ClothState) -> f32 {
-    let s = &model.springs;
-    (0..s.len())
-        .map(|e| {
-            state.pos[s.a[e] as usize].distance(state.pos[s.b[e] as usize]) / s.rest[e].max(1e-12)
-                - 1.0
-        })
-        .fold(0.0f32, f32::max)
+    model.springs.largest_strain(&state.pos)
 }
 
 /// What went wrong in a frame.
@@ -354,9 +349,16 @@ impl std::fmt::Display for Trouble {
 }
 
 impl From<StepError> for Trouble {
+    /// A spring self-contact found stretched past the limit is the strain the frame's end
+    /// would have judged; anything else the step refused, a solver's trouble.
     fn from(e: StepError) -> Self {
-        Trouble::Solver {
-            detail: e.to_string(),
+        match e {
+            StepError::Contact(ContactError::Stretched { strain, limit, .. }) => {
+                Trouble::Strain { strain, limit }
+            }
+            e => Trouble::Solver {
+                detail: e.to_string(),
+            },
         }
     }
 }

@@ -622,6 +622,7 @@ fn pairs_judged_by_the_boxes_are_kept_exactly_where_their_balls_come_near() {
 }
 
 mod boxes;
+mod refusals;
 mod trickle;
 mod windows;
 
@@ -741,42 +742,5 @@ fn the_pairs_hold_for_the_motion_as_pushed_and_cut() {
             (work.searches, work.refreshes),
             "{motion}"
         );
-    }
-}
-
-/// A state that has blown up is refused by the first particle whose position is not
-/// finite (a NaN, an infinity, or two infinities of opposite signs, which a sum of the
-/// motion would cancel into a NaN), and nothing is moved.
-#[test]
-fn a_position_that_is_not_finite_is_refused_by_its_first_particle() {
-    let (model, start) = crumpled();
-    let n = start.len();
-    let bits = |x: &[Vec3]| {
-        x.iter()
-            .map(|p| p.to_array().map(f32::to_bits))
-            .collect::<Vec<_>>()
-    };
-    for (first, other, bad) in [
-        (7, n - 1, [f32::NAN, f32::NAN]),
-        (n / 2, n - 3, [f32::INFINITY, f32::INFINITY]),
-        (3, n / 3, [f32::INFINITY, f32::NEG_INFINITY]),
-        (n - 1, n - 1, [f32::NEG_INFINITY; 2]),
-    ] {
-        let mut state = ClothState::at_rest(&model);
-        state.pos = start
-            .iter()
-            .map(|&p| p + Vec3::new(0.0, -0.002, 0.0))
-            .collect();
-        // Along one axis, so that two infinities of opposite signs meet in the sum.
-        (state.pos[other].x, state.pos[first].x) = (bad[1], bad[0]);
-        let before = bits(&state.pos);
-        let refused =
-            SelfContacts::default().resolve([THICKNESS, 0.3, 0.01], &model, &start, &mut state);
-        assert_eq!(
-            refused,
-            Err(ContactError::NonFinite { particle: first }),
-            "{first}"
-        );
-        assert_eq!(bits(&state.pos), before, "nothing moved");
     }
 }
