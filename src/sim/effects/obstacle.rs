@@ -16,7 +16,7 @@ use crate::sim::obstacle::{Gathered, Moment, Sequence, Surface};
 use crate::sim::param_error::ParamError;
 use crate::sim::self_contacts::ContactError;
 
-use self::edge_pass::{EdgeFrame, EdgeMemory, push_edges};
+use self::edge_pass::{EdgeFrame, EdgeMemory, EdgesMoved, push_edges};
 
 mod edge_pass;
 
@@ -411,7 +411,7 @@ impl Posed<'_> {
             &frame,
             self.friction,
             pass,
-            (memory, true),
+            (memory, EdgesMoved::Fixed),
         )
     }
 }
@@ -435,7 +435,8 @@ impl Deforming<'_> {
             velocity: |q| self.moment.velocity_near(q, reach),
         };
         let edges = self.moment.surface.sharp_edges();
-        push_edges(edges, &frame, self.friction, pass, (memory, false))
+        let moved = memory.deformed(self.moment.span(), self.moment.largest_shift);
+        push_edges(edges, &frame, self.friction, pass, (memory, moved))
     }
 }
 

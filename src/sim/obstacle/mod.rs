@@ -7,7 +7,7 @@ mod sequence;
 mod surface;
 mod tree;
 
-pub use edges::{Clearance, EdgeHit, SharpEdges};
+pub use edges::{Clearance, EdgeHit, LOOK, LOOK_DEFORMING, SharpEdges};
 pub(crate) use geometry::{closest_weights, segments_closest};
 pub use sequence::{Moment, Sequence};
 pub use surface::{Caught, Gathered, Surface};

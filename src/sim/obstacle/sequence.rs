@@ -45,6 +45,11 @@ impl Moment {
         (0..3).map(|k| field[tri[k] as usize] * w[k]).sum()
     }
 
+    /// The substep the surface stands over: its start and end, seconds.
+    pub fn span(&self) -> (f64, f64) {
+        (self.start, self.end)
+    }
+
     /// `field` at the point `near` found on the surface.
     pub fn at_nearest(&self, near: &Nearest, field: &[Vec3]) -> Vec3 {
         self.at(near.triangle, near.point, field)

@@ -6,7 +6,7 @@ use glam::{Vec3, Vec3A};
 
 use super::super::effect_kind::ContactPass;
 use super::super::solid::touching;
-use crate::sim::obstacle::{Clearance, SharpEdges};
+use crate::sim::obstacle::{Clearance, LOOK, LOOK_DEFORMING, SharpEdges};
 
 /// How the frame of the sharp edges lies in the world: `to_local` takes a world point into
 /// it, `to_world` turns a direction of it into the world's, `velocity` is the surface's
@@ -28,6 +28,35 @@ pub(super) struct EdgeMemory {
     clearance: Vec<Clearance>,
     before: Vec<Vec3A>,
     local: Vec<Vec3A>,
+    /// Where the edges deform: the time of the surface the clearances were last measured
+    /// against (the end of that substep).
+    surface_at: Option<f64>,
+}
+
+impl EdgeMemory {
+    /// How far a deforming surface's sharp edges may have moved since the clearances were
+    /// measured, now that it stands over the substep `span` (start and end, seconds) with
+    /// its vertices each moved at most `largest_shift` in it: nothing where it is the
+    /// surface measured against, that move where the substep follows it, and anything
+    /// (the clearances forgotten) after a jump (a frame rolled back and redone).
+    pub(super) fn deformed(&mut self, (start, end): (f64, f64), largest_shift: f32) -> EdgesMoved {
+        let by = match self.surface_at {
+            Some(at) if at == end => 0.0,
+            Some(at) if at == start => largest_shift,
+            _ => f32::INFINITY,
+        };
+        self.surface_at = Some(end);
+        EdgesMoved::By(by)
+    }
+}
+
+/// How far the sharp edges moved in the edge pass's frame since its last pass.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum EdgesMoved {
+    /// Not at all: they are fixed in it (a rigid obstacle's, in its own frame).
+    Fixed,
+    /// At most this far, metres (a deforming surface's: [`EdgeMemory::deformed`]).
+    By(f32),
 }
 
 /// How many times at most the edge pass runs in one substep.
@@ -38,8 +67,10 @@ const EDGE_SWEEPS: usize = 4;
 /// moved apart from the edge in proportion to how near each is to the nearest point, which
 /// moves by exactly what was missing; their velocity towards the edge is removed, with
 /// Coulomb friction `mu` along it. Each particle is taken into the frame once, and again
-/// only when a push moves it. Where the edges are fixed in the frame (`fixed`), each cloth
-/// edge's last measured clearance spares it the walk of the tree while it stays clear
+/// only when a push moves it. Each cloth edge's last measured clearance, less how far the
+/// edges `moved` in the frame since (nothing where they are fixed in it: a rigid
+/// obstacle's; a deforming surface's largest vertex move over the substep,
+/// [`EdgeMemory::deformed`]), spares it the walk of the tree while it stays clear
 /// ([`SharpEdges::nearest_remembering`]: the same answers). Returns how many cloth edges
 /// it moved.
 pub(super) fn push_edges<S, L, W, V>(
@@ -47,7 +78,7 @@ pub(super) fn push_edges<S, L, W, V>(
     frame: &EdgeFrame<S, L, W, V>,
     mu: f32,
     pass: &mut ContactPass<'_>,
-    (memory, fixed): (&mut EdgeMemory, bool),
+    (memory, moved): (&mut EdgeMemory, EdgesMoved),
 ) -> usize
 where
     S: Fn(Vec3) -> Vec3,
@@ -69,12 +100,15 @@ where
     );
     memory.local.clear();
     (memory.local).extend(state.pos.iter().map(|&p| Vec3A::from((frame.to_local)(p))));
-    let mut clearance = if fixed {
-        (memory.clearance).resize(springs.a.len(), Clearance::NONE);
-        Some(&mut memory.clearance[..])
-    } else {
-        None
+    (memory.clearance).resize(springs.a.len(), Clearance::NONE);
+    let look = match moved {
+        EdgesMoved::Fixed => LOOK,
+        EdgesMoved::By(by) => {
+            (memory.clearance.iter_mut()).for_each(|c| c.surface_moved(by));
+            LOOK_DEFORMING
+        }
     };
+    let clearance = &mut memory.clearance;
     let (before, local) = (&memory.before, &mut memory.local);
     let mut moved = 0;
     // A cloth edge put back from a crossing can pull a neighbour across another: the pass
@@ -97,8 +131,8 @@ where
             // asked.
             let travel = (now[0] - then[0]).length().max((now[1] - then[1]).length());
             let reach = thickness.max(travel);
-            let near = match clearance.as_deref_mut().and_then(|c| c.get_mut(e)) {
-                Some(c) => edges.nearest_remembering(now, reach, c),
+            let near = match clearance.get_mut(e) {
+                Some(c) => edges.nearest_remembering(now, [reach, look], c),
                 None => edges.nearest(now[0].into(), now[1].into(), reach),
             };
             let Some(near) = near else {
