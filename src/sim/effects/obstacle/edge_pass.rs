@@ -181,3 +181,36 @@ where
     }
     moved
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A deforming surface's edges moved by nothing while it is the surface measured
+    /// against (a second pass in the same substep), by the substep's largest vertex move
+    /// where the substep follows it, and by anything after a jump: the first pass, a frame
+    /// rolled back and redone, a copy of the simulation at another time.
+    #[test]
+    fn a_deforming_surfaces_move_is_counted_from_the_surface_measured_against() {
+        let mut memory = EdgeMemory::default();
+        let h = 1.0 / 240.0;
+        let moved =
+            |memory: &mut EdgeMemory, k: f64, shift| memory.deformed((k * h, (k + 1.0) * h), shift);
+        assert_eq!(
+            moved(&mut memory, 0.0, 0.002),
+            EdgesMoved::By(f32::INFINITY)
+        );
+        assert_eq!(moved(&mut memory, 0.0, 0.002), EdgesMoved::By(0.0));
+        assert_eq!(moved(&mut memory, 1.0, 0.003), EdgesMoved::By(0.003));
+        assert_eq!(moved(&mut memory, 2.0, 0.001), EdgesMoved::By(0.001));
+        // Rolled back to the frame's start, or skipped ahead.
+        assert_eq!(
+            moved(&mut memory, 0.0, 0.002),
+            EdgesMoved::By(f32::INFINITY)
+        );
+        assert_eq!(
+            moved(&mut memory, 5.0, 0.002),
+            EdgesMoved::By(f32::INFINITY)
+        );
+    }
+}
