@@ -377,6 +377,38 @@ mod tests {
         }
     }
 
+    /// Questions a cloth edge remembering its clearance asked: those answered `None`, those
+    /// of them that walked the tree, and the others.
+    #[derive(Default)]
+    struct Asked {
+        clear: usize,
+        walks: usize,
+        near: usize,
+    }
+
+    impl Asked {
+        /// Asks `edges` about the cloth edge at `ends` with `memory`, checks the answer
+        /// against a walk of the tree, and counts it.
+        fn ask(
+            &mut self,
+            edges: &SharpEdges,
+            ends: [Vec3A; 2],
+            [reach, look]: [f32; 2],
+            memory: &mut Clearance,
+        ) {
+            let before = *memory;
+            let remembered = edges.nearest_remembering(ends, [reach, look], memory);
+            let [a, b] = ends.map(Vec3::from);
+            assert_eq!(remembered, edges.nearest(a, b, reach), "{a} – {b}");
+            if remembered.is_some() {
+                self.near += 1;
+            } else {
+                self.clear += 1;
+                self.walks += usize::from(*memory != before);
+            }
+        }
+    }
+
     /// Where the sharp edges move (a box sweeping through a cloth edge 5 cm off one of its
     /// edges at 1 mm a step, each corner up to 0.9 mm more in a direction of its own), a
     /// cloth edge that barely moves (0.2 mm a step), remembering its clearance made less at
@@ -390,7 +422,7 @@ mod tests {
         let mut edges = SharpEdges::of(&v, &t, &normals);
         let mut rnd = crate::test_rng::uniform(23);
         let mut step = || Vec3A::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5);
-        let (mut clear, mut walks, mut near) = (0, 0, 0);
+        let mut asked = Asked::default();
         for k in 0..40 {
             let mut corners = v.clone();
             edges.refit(&corners);
@@ -412,20 +444,10 @@ mod tests {
                 edges.refit(&corners);
                 memory.surface_moved(moves.iter().map(|m| m.length()).fold(0.0, f32::max));
                 ends = ends.map(|e| e + step() * 2e-4);
-                let reach = 0.01;
-                let before = memory;
-                let remembered =
-                    edges.nearest_remembering(ends, [reach, LOOK_DEFORMING], &mut memory);
-                let [a, b] = ends.map(Vec3::from);
-                assert_eq!(remembered, edges.nearest(a, b, reach), "{a} – {b}");
-                if remembered.is_some() {
-                    near += 1;
-                } else {
-                    clear += 1;
-                    walks += usize::from(memory != before);
-                }
+                asked.ask(&edges, ends, [0.01, LOOK_DEFORMING], &mut memory);
             }
         }
+        let Asked { clear, walks, near } = asked;
         assert!(
             near * 10 > clear && near < clear,
             "{near} near, {clear} clear"
@@ -446,8 +468,7 @@ mod tests {
         let edges = SharpEdges::of(&v, &t, &normals);
         let mut rnd = crate::test_rng::uniform(17);
         let mut step = || Vec3A::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5);
-        // Questions answered `None`, those of them that walked the tree, and the others.
-        let (mut clear, mut walks, mut near) = (0, 0, 0);
+        let mut asked = Asked::default();
         for k in 0..60 {
             // Beside one of the box's edges, 4 cm long.
             let [p, q] = edges.edges[k % 12].map(Vec3A::from);
@@ -457,18 +478,10 @@ mod tests {
             for _ in 0..400 {
                 ends = ends.map(|e| e + step() * 2e-3);
                 let reach = 0.01 + 0.01 * (step().x + 0.5);
-                let before = memory;
-                let remembered = edges.nearest_remembering(ends, [reach, LOOK], &mut memory);
-                let [a, b] = ends.map(Vec3::from);
-                assert_eq!(remembered, edges.nearest(a, b, reach), "{a} – {b}");
-                if remembered.is_some() {
-                    near += 1;
-                } else {
-                    clear += 1;
-                    walks += usize::from(memory != before);
-                }
+                asked.ask(&edges, ends, [reach, LOOK], &mut memory);
             }
         }
+        let Asked { clear, walks, near } = asked;
         assert!(
             near * 5 > clear && near < clear,
             "{near} near, {clear} clear"
