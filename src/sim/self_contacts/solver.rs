@@ -144,7 +144,7 @@ pub struct SelfContacts {
     pub held: Vec<bool>,
     /// The stability guard's strain limit (relative extension), where it judges the
     /// substep (set by the stepper before [`SelfContacts::resolve`]). A state whose first
-    /// search finds more than [`SUSPECT_PAIRS`] pairs a particle is measured against it,
+    /// search finds more than 8 pairs a particle (`SUSPECT_PAIRS`) is measured against it,
     /// and one past it is refused ([`ContactError::Stretched`]) before the pushes and the
     /// continuous check, whose work grows with the pairs (a state blown up within a frame
     /// otherwise cost them seconds a substep, the guard judging strain at the frame's end
