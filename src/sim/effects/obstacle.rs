@@ -9,10 +9,10 @@ use std::sync::Arc;
 use glam::{Quat, Vec3};
 
 use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
-use super::solid::{Solid, default_friction, resolve, resolve_remembering};
+use super::solid::{Solid, default_friction, resolve_remembering};
 use crate::mesh::{ObjError, PolygonSoup, parse_obj, read_obj};
 use crate::sim::motion::{AxisAngle, Keyframe, Pose, RigidMotion};
-use crate::sim::obstacle::{Gathered, Moment, Sequence, Surface};
+use crate::sim::obstacle::{Gathered, Moment, Sequence, Surface, SurfaceClock};
 use crate::sim::param_error::ParamError;
 use crate::sim::self_contacts::ContactError;
 
@@ -125,22 +125,36 @@ pub struct Placed {
     pub motion: RigidMotion,
     pub pivot: Vec3,
     pub sequence: Option<Sequence>,
-    /// What each particle's last contact gathered, in the obstacle's frame (a rigid
-    /// obstacle's only: a sequence's surface changes every substep).
-    pub memory: std::sync::Mutex<Vec<Gathered>>,
+    /// What each particle's last contact gathered, in the obstacle's frame, and (for a
+    /// sequence, whose surface changes every substep) when the surface it was gathered
+    /// from stood.
+    memory: std::sync::Mutex<(Vec<Gathered>, SurfaceClock)>,
     /// What its edge pass keeps from one substep to the next.
     edge_memory: std::sync::Mutex<EdgeMemory>,
 }
 
 impl Placed {
-    /// `f` with each particle's memory of its last contact (`particles` of them), or (where
-    /// another stepping copy of the simulation holds it now) with none: the memory only
-    /// saves walks of the tree, the result is the same.
-    fn with_memory<T>(&self, particles: usize, f: impl FnOnce(Option<&mut [Gathered]>) -> T) -> T {
+    /// `f` with each particle's memory of its last contact (`particles` of them), made less
+    /// by how far a sequence's surface moved since where `moment` is its surface now
+    /// ([`Gathered::surface_moved`]), or (where another stepping copy of the simulation
+    /// holds it now) with none: the memory only saves walks of the tree, the result is the
+    /// same.
+    fn with_memory<T>(
+        &self,
+        particles: usize,
+        moment: Option<&Moment>,
+        f: impl FnOnce(Option<&mut [Gathered]>) -> T,
+    ) -> T {
         let mut memory = self.memory.try_lock().ok();
-        f(memory.as_deref_mut().map(|m| {
-            m.resize(particles, Gathered::NONE);
-            &mut m[..]
+        f(memory.as_deref_mut().map(|(gathered, clock)| {
+            gathered.resize(particles, Gathered::NONE);
+            if let Some(moment) = moment {
+                let by = clock.moved_to(moment);
+                if by > 0.0 {
+                    gathered.iter_mut().for_each(|g| g.surface_moved(by));
+                }
+            }
+            &mut gathered[..]
         }))
     }
 
@@ -365,7 +379,7 @@ impl Obstacle {
             motion,
             pivot: self.translate,
             sequence,
-            memory: std::sync::Mutex::new(Vec::new()),
+            memory: std::sync::Mutex::new((Vec::new(), SurfaceClock::default())),
             edge_memory: std::sync::Mutex::new(EdgeMemory::default()),
         })));
         Ok(())
@@ -424,6 +438,28 @@ struct Deforming<'a> {
 }
 
 impl Deforming<'_> {
+    /// [`Solid::contact`], with what the particle's last contact gathered where there is
+    /// `memory` (made less by the surface's move since: [`Placed::with_memory`]).
+    fn caught(
+        &self,
+        from: Vec3,
+        to: Vec3,
+        offset: f32,
+        memory: Option<&mut Gathered>,
+    ) -> Option<(Vec3, Vec3, Vec3)> {
+        let m = self.moment;
+        let start = if m.largest_shift >= 0.5 * offset {
+            let reach = 2.0 * (offset + m.largest_shift);
+            (m.surface.nearest(from, reach))
+                .map_or(from, |near| from + m.at_nearest(&near, &m.shift))
+        } else {
+            from
+        };
+        let caught = m.surface.catch_remembering(start, to, offset, memory)?;
+        let velocity = m.at(caught.triangle, caught.on_surface, &m.velocity);
+        Some((caught.at, caught.normal, velocity))
+    }
+
     /// [`push_edges`] against its sharp edges where the substep ends (which move).
     fn push_edges(&self, pass: &mut ContactPass<'_>, memory: &mut EdgeMemory) -> usize {
         let reach = pass.offset;
@@ -435,7 +471,7 @@ impl Deforming<'_> {
             velocity: |q| self.moment.velocity_near(q, reach),
         };
         let edges = self.moment.surface.sharp_edges();
-        let moved = memory.deformed(self.moment.span(), self.moment.largest_shift);
+        let moved = EdgesMoved::By(memory.clock.moved_to(self.moment));
         push_edges(edges, &frame, self.friction, pass, (memory, moved))
     }
 }
@@ -462,17 +498,17 @@ impl Solid for Deforming<'_> {
     /// that moves less than half the thickness in the substep carries nothing: what rests
     /// on it is still outside it, and pushed back out to the thickness.
     fn contact(&self, from: Vec3, to: Vec3, offset: f32) -> Option<(Vec3, Vec3, Vec3)> {
-        let m = self.moment;
-        let start = if m.largest_shift >= 0.5 * offset {
-            let reach = 2.0 * (offset + m.largest_shift);
-            (m.surface.nearest(from, reach))
-                .map_or(from, |near| from + m.at_nearest(&near, &m.shift))
-        } else {
-            from
-        };
-        let caught = m.surface.catch(start, to, offset)?;
-        let velocity = m.at(caught.triangle, caught.on_surface, &m.velocity);
-        Some((caught.at, caught.normal, velocity))
+        self.caught(from, to, offset, None)
+    }
+
+    fn contact_remembering(
+        &self,
+        from: Vec3,
+        to: Vec3,
+        offset: f32,
+        memory: &mut Gathered,
+    ) -> Option<(Vec3, Vec3, Vec3)> {
+        self.caught(from, to, offset, Some(memory))
     }
 
     fn friction(&self) -> f32 {
@@ -634,7 +670,10 @@ impl EffectKind for Obstacle {
                 moment: &moment,
                 friction: self.friction,
             };
-            let moved = resolve(&deforming, pass);
+            let particles = pass.state.pos.len();
+            let moved = placed.with_memory(particles, Some(&moment), |m| {
+                resolve_remembering(&deforming, pass, m)
+            });
             let moved = moved + placed.with_edge_memory(|m| deforming.push_edges(pass, m));
             pass.offset = offset;
             return Ok(moved);
@@ -646,7 +685,7 @@ impl EffectKind for Obstacle {
             friction: self.friction,
         };
         let particles = pass.state.pos.len();
-        let moved = placed.with_memory(particles, |m| resolve_remembering(&posed, pass, m));
+        let moved = placed.with_memory(particles, None, |m| resolve_remembering(&posed, pass, m));
         let moved = moved + placed.with_edge_memory(|m| posed.push_edges(pass, m));
         pass.offset = offset;
         Ok(moved)

@@ -45,11 +45,6 @@ impl Moment {
         (0..3).map(|k| field[tri[k] as usize] * w[k]).sum()
     }
 
-    /// The substep the surface stands over: its start and end, seconds.
-    pub fn span(&self) -> (f64, f64) {
-        (self.start, self.end)
-    }
-
     /// `field` at the point `near` found on the surface.
     pub fn at_nearest(&self, near: &Nearest, field: &[Vec3]) -> Vec3 {
         self.at(near.triangle, near.point, field)
@@ -59,6 +54,32 @@ impl Moment {
     /// within `reach`).
     pub fn velocity_near(&self, p: Vec3, reach: f32) -> Vec3 {
         (self.surface.nearest(p, reach)).map_or(Vec3::ZERO, |n| self.at_nearest(&n, &self.velocity))
+    }
+}
+
+/// When the surface something was measured against stood: what a memory of a deforming
+/// surface keeps to tell how far the surface may have moved since.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SurfaceClock {
+    /// The end of the substep whose surface was last measured against.
+    at: Option<f64>,
+}
+
+impl SurfaceClock {
+    /// How far any point of the surface may have moved since it was last measured
+    /// against, now that it is `moment`'s (which it then is): nothing where it is the
+    /// same surface (a second pass in one substep), the moment's largest vertex move where
+    /// its substep follows (a point of a triangle or an edge moves no farther than its
+    /// farthest corner), and anything after a jump (the first pass, a frame rolled back and
+    /// redone, a copy of the simulation at another time).
+    pub fn moved_to(&mut self, moment: &Moment) -> f32 {
+        let by = match self.at {
+            Some(at) if at == moment.end => 0.0,
+            Some(at) if at == moment.start => moment.largest_shift,
+            _ => f32::INFINITY,
+        };
+        self.at = Some(moment.end);
+        by
     }
 }
 
@@ -256,5 +277,25 @@ mod tests {
         assert_eq!(m.shift[2], Vec3::new(0.0, 0.5, 0.0));
         assert_eq!(m.largest_shift, 0.5);
         assert!((m.velocity_near(Vec3::new(0.0, 1.5, 1.0), 0.1) - Vec3::Y * 2.0).length() < 1e-5);
+    }
+
+    /// A memory's clock counts the surface as moved by nothing while it is the surface
+    /// measured against (a second pass in the same substep), by the substep's largest
+    /// vertex move where the substep follows it, and by anything after a jump: the first
+    /// pass, a frame rolled back and redone, a copy of the simulation at another time.
+    #[test]
+    fn a_surfaces_move_is_counted_from_the_surface_measured_against() {
+        let s = rising(false);
+        let mut clock = SurfaceClock::default();
+        let h = 0.125;
+        let mut moved = |k: f64| clock.moved_to(&s.moment(k * h, (k + 1.0) * h));
+        assert_eq!(moved(0.0), f32::INFINITY);
+        assert_eq!(moved(0.0), 0.0);
+        // The corner rises 2 m/s.
+        assert_eq!(moved(1.0), 0.25);
+        assert_eq!(moved(2.0), 0.25);
+        // Rolled back to the frame's start, or skipped ahead.
+        assert_eq!(moved(0.0), f32::INFINITY);
+        assert_eq!(moved(5.0), f32::INFINITY);
     }
 }

@@ -29,7 +29,8 @@ const DRIFT: f32 = 0.1;
 /// The triangles near one point, remembered from one substep to the next: every triangle
 /// within `radius` of `centre`, by its place in the tree (where its corners are read
 /// from) in order of its number, with its distance from `centre`. A fact of the surface
-/// alone (in its own frame), so an end whose reach lies inside that ball needs no walk of
+/// alone (in its own frame; where it deforms, made less by its move since:
+/// [`Gathered::surface_moved`]), so an end whose reach lies inside that ball needs no walk of
 /// the tree; and a triangle farther from the centre than the reach and the end's move
 /// from it together is out of the end's reach without being measured again.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,6 +52,18 @@ impl Gathered {
         places: [0; NEAR_END],
         distances: [0.0; NEAR_END],
     };
+
+    /// The same gathering after the surface deformed, no point of it moving farther than
+    /// `by` metres: a triangle now within the radius less `by` of the centre was within the
+    /// radius, and none is nearer than its distance less `by`. Both lowered that much,
+    /// rounded down, with a ten-thousandth of `by` more for the rounding of the move. The
+    /// triangles' places in the tree stay theirs (a refit keeps its shape).
+    pub fn surface_moved(&mut self, by: f32) {
+        let less = |d: f32| (d - by * (1.0 + 1e-4)).next_down();
+        self.radius = less(self.radius);
+        let count = usize::from(self.count);
+        (self.distances.iter_mut().take(count)).for_each(|d| *d = less(*d));
+    }
 }
 
 /// What [`Surface::catch_short`] can tell.
@@ -673,6 +686,47 @@ mod tests {
             }
         }
         assert!(walks * 4 < moves, "{walks} walks in {moves} moves");
+    }
+
+    /// The same on a surface that deforms, rising 0.3 mm a step towards a particle that
+    /// barely moves and each vertex up to 0.1 mm more in a direction of its own, the
+    /// gathering made less at each step by the vertices' largest move: every move ends
+    /// where one walking the tree does, bit for bit (made less by half the move, a move
+    /// ends clear of triangles that have come within reach), and fewer than one in two
+    /// walks it.
+    #[test]
+    fn remembering_what_was_gathered_on_a_deforming_surface_changes_nothing() {
+        let mut s = bumpy(40);
+        let rest = s.vertices().to_vec();
+        let mut rnd = crate::test_rng::uniform(13);
+        let thickness = 0.01;
+        let (mut walks, mut moves) = (0, 0);
+        for _ in 0..20 {
+            let mut vertices = rest.clone();
+            s.refit(&vertices);
+            let mut memory = Gathered::NONE;
+            let mut p = Vec3::new(rnd() - 0.5, 0.0, rnd() - 0.5) * 0.8;
+            p.y = s.nearest(p + Vec3::Y, 2.0).map_or(0.0, |n| n.point.y) + 2.0 * thickness;
+            for _ in 0..100 {
+                let shifts: Vec<Vec3> = (vertices.iter())
+                    .map(|_| Vec3::new(rnd() - 0.5, rnd(), rnd() - 0.5) * 1e-4 + Vec3::Y * 3e-4)
+                    .collect();
+                for (v, m) in vertices.iter_mut().zip(&shifts) {
+                    *v += *m;
+                }
+                s.refit(&vertices);
+                let by = (shifts.iter()).fold(0.0f32, |m, v| m.max(v.length()));
+                memory.surface_moved(by);
+                let to = p + Vec3::new(rnd() - 0.5, rnd() - 0.6, rnd() - 0.5) * 4e-5;
+                let before = memory;
+                let remembered = s.catch_remembering(p, to, thickness, Some(&mut memory));
+                assert_eq!(remembered, s.catch(p, to, thickness), "{p} → {to}");
+                walks += usize::from(memory != before);
+                moves += 1;
+                p = remembered.map_or(to, |c| c.at);
+            }
+        }
+        assert!(walks * 2 < moves, "{walks} walks in {moves} moves");
     }
 
     /// `n` random triangles of sides up to 0.3 m in a cube of side `size` (`v`: a random

@@ -6,7 +6,7 @@ use glam::{Vec3, Vec3A};
 
 use super::super::effect_kind::ContactPass;
 use super::super::solid::touching;
-use crate::sim::obstacle::{Clearance, LOOK, LOOK_DEFORMING, SharpEdges};
+use crate::sim::obstacle::{Clearance, LOOK, LOOK_DEFORMING, SharpEdges, SurfaceClock};
 
 /// How the frame of the sharp edges lies in the world: `to_local` takes a world point into
 /// it, `to_world` turns a direction of it into the world's, `velocity` is the surface's
@@ -28,26 +28,8 @@ pub(super) struct EdgeMemory {
     clearance: Vec<Clearance>,
     before: Vec<Vec3A>,
     local: Vec<Vec3A>,
-    /// Where the edges deform: the time of the surface the clearances were last measured
-    /// against (the end of that substep).
-    surface_at: Option<f64>,
-}
-
-impl EdgeMemory {
-    /// How far a deforming surface's sharp edges may have moved since the clearances were
-    /// measured, now that it stands over the substep `span` (start and end, seconds) with
-    /// its vertices each moved at most `largest_shift` in it: nothing where it is the
-    /// surface measured against, that move where the substep follows it, and anything
-    /// (the clearances forgotten) after a jump (a frame rolled back and redone).
-    pub(super) fn deformed(&mut self, (start, end): (f64, f64), largest_shift: f32) -> EdgesMoved {
-        let by = match self.surface_at {
-            Some(at) if at == end => 0.0,
-            Some(at) if at == start => largest_shift,
-            _ => f32::INFINITY,
-        };
-        self.surface_at = Some(end);
-        EdgesMoved::By(by)
-    }
+    /// Where the edges deform: when the surface the clearances were measured against stood.
+    pub(super) clock: SurfaceClock,
 }
 
 /// How far the sharp edges moved in the edge pass's frame since its last pass.
@@ -55,7 +37,7 @@ impl EdgeMemory {
 pub(super) enum EdgesMoved {
     /// Not at all: they are fixed in it (a rigid obstacle's, in its own frame).
     Fixed,
-    /// At most this far, metres (a deforming surface's: [`EdgeMemory::deformed`]).
+    /// At most this far, metres (a deforming surface's: [`SurfaceClock::moved_to`]).
     By(f32),
 }
 
@@ -70,7 +52,7 @@ const EDGE_SWEEPS: usize = 4;
 /// only when a push moves it. Each cloth edge's last measured clearance, less how far the
 /// edges `moved` in the frame since (nothing where they are fixed in it: a rigid
 /// obstacle's; a deforming surface's largest vertex move over the substep,
-/// [`EdgeMemory::deformed`]), spares it the walk of the tree while it stays clear
+/// [`SurfaceClock::moved_to`]), spares it the walk of the tree while it stays clear
 /// ([`SharpEdges::nearest_remembering`]: the same answers). Returns how many cloth edges
 /// it moved.
 pub(super) fn push_edges<S, L, W, V>(
@@ -180,37 +162,4 @@ where
         }
     }
     moved
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A deforming surface's edges moved by nothing while it is the surface measured
-    /// against (a second pass in the same substep), by the substep's largest vertex move
-    /// where the substep follows it, and by anything after a jump: the first pass, a frame
-    /// rolled back and redone, a copy of the simulation at another time.
-    #[test]
-    fn a_deforming_surfaces_move_is_counted_from_the_surface_measured_against() {
-        let mut memory = EdgeMemory::default();
-        let h = 1.0 / 240.0;
-        let moved =
-            |memory: &mut EdgeMemory, k: f64, shift| memory.deformed((k * h, (k + 1.0) * h), shift);
-        assert_eq!(
-            moved(&mut memory, 0.0, 0.002),
-            EdgesMoved::By(f32::INFINITY)
-        );
-        assert_eq!(moved(&mut memory, 0.0, 0.002), EdgesMoved::By(0.0));
-        assert_eq!(moved(&mut memory, 1.0, 0.003), EdgesMoved::By(0.003));
-        assert_eq!(moved(&mut memory, 2.0, 0.001), EdgesMoved::By(0.001));
-        // Rolled back to the frame's start, or skipped ahead.
-        assert_eq!(
-            moved(&mut memory, 0.0, 0.002),
-            EdgesMoved::By(f32::INFINITY)
-        );
-        assert_eq!(
-            moved(&mut memory, 5.0, 0.002),
-            EdgesMoved::By(f32::INFINITY)
-        );
-    }
 }
