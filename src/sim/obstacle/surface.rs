@@ -662,6 +662,22 @@ mod tests {
         );
     }
 
+    /// Where a particle remembering what it gathered (`memory`) ends the move `from → to`,
+    /// checked against a catch that walks the tree; `walks` counts the moves that walked it.
+    fn moved_remembering(
+        s: &Surface,
+        [from, to]: [Vec3; 2],
+        thickness: f32,
+        memory: &mut Gathered,
+        walks: &mut usize,
+    ) -> Vec3 {
+        let before = *memory;
+        let remembered = s.catch_remembering(from, to, thickness, Some(memory));
+        assert_eq!(remembered, s.catch(from, to, thickness), "{from} → {to}");
+        *walks += usize::from(*memory != before);
+        remembered.map_or(to, |c| c.at)
+    }
+
     /// A particle remembering what it gathered ends every move where one walking the tree
     /// each time does, bit for bit, as it drifts, slides and sinks over a bumpy surface; and
     /// it walks the tree for fewer than one move in four.
@@ -677,12 +693,8 @@ mod tests {
             p.y = s.nearest(p + Vec3::Y, 2.0).map_or(0.0, |n| n.point.y) + thickness;
             for _ in 0..100 {
                 let to = p + Vec3::new(rnd() - 0.5, rnd() - 0.6, rnd() - 0.5) * 4e-4;
-                let before = memory;
-                let remembered = s.catch_remembering(p, to, thickness, Some(&mut memory));
-                assert_eq!(remembered, s.catch(p, to, thickness), "{p} → {to}");
-                walks += usize::from(memory != before);
+                p = moved_remembering(&s, [p, to], thickness, &mut memory, &mut walks);
                 moves += 1;
-                p = remembered.map_or(to, |c| c.at);
             }
         }
         assert!(walks * 4 < moves, "{walks} walks in {moves} moves");
@@ -718,12 +730,8 @@ mod tests {
                 let by = (shifts.iter()).fold(0.0f32, |m, v| m.max(v.length()));
                 memory.surface_moved(by);
                 let to = p + Vec3::new(rnd() - 0.5, rnd() - 0.6, rnd() - 0.5) * 4e-5;
-                let before = memory;
-                let remembered = s.catch_remembering(p, to, thickness, Some(&mut memory));
-                assert_eq!(remembered, s.catch(p, to, thickness), "{p} → {to}");
-                walks += usize::from(memory != before);
+                p = moved_remembering(&s, [p, to], thickness, &mut memory, &mut walks);
                 moves += 1;
-                p = remembered.map_or(to, |c| c.at);
             }
         }
         assert!(walks * 2 < moves, "{walks} walks in {moves} moves");
