@@ -176,7 +176,8 @@ impl<R: Real> CpuStepper<R> {
     }
 
     /// Resolves the contacts (solids, then self-collision) after a substep, from the paths since its
-    /// start, and charges their phases.
+    /// start, and charges their phases. `strain_limit`: the guard's, where it judges the
+    /// substep (self-contact then refuses a state past it: [`SelfContacts::strain_limit`]).
     ///
     /// # Errors
     /// [`StepError::Contact`] when self-collision refuses a state that has blown up.
@@ -184,10 +185,12 @@ impl<R: Real> CpuStepper<R> {
         &mut self,
         model: &ClothModel,
         state: &mut ClothState<R>,
+        strain_limit: Option<f32>,
     ) -> Result<(), StepError> {
         if !self.contacts_exist() {
             return Ok(());
         }
+        self.self_contacts.strain_limit = strain_limit;
         let mut view = std::mem::take(&mut self.view);
         let resolved = as_f32(state, &mut view, |state| {
             self.resolve_contacts_f32(model, state)
@@ -347,7 +350,6 @@ impl<R: Real> CpuStepper<R> {
             }
         }
         let limits = self.guard.limits.filter(|_| checked);
-        self.self_contacts.strain_limit = limits.map(|l| l.strain);
         let depth = limits.map_or(0.0, |l| l.depth_of(f32_view(state, &mut self.view)));
         for k in 0..count {
             self.advance(model, state)?;
@@ -360,7 +362,7 @@ impl<R: Real> CpuStepper<R> {
             if k == 0 {
                 self.start_outside();
             }
-            self.resolve_contacts(model, state)?;
+            self.resolve_contacts(model, state, limits.map(|l| l.strain))?;
         }
         Ok(())
     }
@@ -543,7 +545,7 @@ impl<R: Real> StepBackend for CpuStepper<R> {
         let stepped = self.on_state(state, |stepper, state| {
             let report = stepper.advance(model, state)?;
             stepper.start_outside();
-            stepper.resolve_contacts(model, state)?;
+            stepper.resolve_contacts(model, state, None)?;
             Ok(report)
         });
         self.outside = None;

@@ -157,7 +157,7 @@ impl GuardLimits {
             strain: policy
                 .max_strain
                 .max(policy.headroom * weight_strain(model, forces, weight))
-                .max(policy.headroom * max_strain(model, state)),
+                .max(policy.headroom * model.springs.largest_strain(&state.pos)),
             kinetic_energy: policy.headroom as f64 * available + 1e-9,
             up,
             floor: bottom,
@@ -305,11 +305,6 @@ fn weight_strain<R: Real>(model: &ClothModel, forces: &ForceSet<R>, weight: f32)
     }
 }
 
-/// The largest relative extension of a spring in `state` (0 when none is stretched).
-fn max_strain(model: &ClothModel, state: &ClothState) -> f32 {
-    model.springs.largest_strain(&state.pos)
-}
-
 /// What went wrong in a frame.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
@@ -385,7 +380,7 @@ pub fn resolved(coarse: &[Vec3], fine: &[Vec3]) -> bool {
 /// The first limit `state` breaks, if any: non-finite, speed, strain, kinetic energy.
 pub fn check(model: &ClothModel, state: &ClothState, limits: &GuardLimits) -> Option<Trouble> {
     limits.judge(&Motion::of(model, state, limits.up), || {
-        max_strain(model, state)
+        model.springs.largest_strain(&state.pos)
     })
 }
 
