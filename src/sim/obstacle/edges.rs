@@ -5,7 +5,7 @@ use std::collections::HashMap;
 
 use glam::{Vec3, Vec3A};
 
-use super::geometry::{rounding_near, segments_closest};
+use super::geometry::{less_by_move, rounding_near, segments_closest};
 use super::tree::TriangleTree;
 
 /// Two faces meeting at less than this cosine between their normals (about 10°) make a
@@ -53,12 +53,11 @@ impl Clearance {
 
     /// The same measure after the sharp edges moved by up to `by` metres (a deforming
     /// surface's largest vertex move: every point of an edge moves at most as far as the
-    /// farther of its ends): the clearance is that much less, rounded down, with a
-    /// ten-thousandth of `by` more for the rounding of the move itself. Nothing measured
-    /// stays so.
+    /// farther of its ends): the clearance is that much less (`less_by_move`). Nothing
+    /// measured stays so.
     #[inline]
     pub fn surface_moved(&mut self, by: f32) {
-        self.clear = (self.clear - by * (1.0 + 1e-4)).next_down();
+        self.clear = less_by_move(self.clear, by);
     }
 
     /// Whether the segment from `a` to `b` is told farther than `reach` from every sharp

@@ -11,6 +11,12 @@ pub fn rounding_near(p: Vec3) -> f32 {
     1e-5 * (1.0 + p.abs().max_element())
 }
 
+/// A remembered distance `d` (m) after the surface moved by up to `by` metres: that much
+/// less, with a ten-thousandth of `by` more for the rounding of the move, rounded down.
+pub fn less_by_move(d: f32, by: f32) -> f32 {
+    (d - by * (1.0 + 1e-4)).next_down()
+}
+
 /// The point of triangle `abc` closest to `p` (its inside, an edge or a corner).
 pub fn closest_on_triangle(p: Vec3, t: [Vec3; 3]) -> Vec3 {
     let w = closest_weights(p, t);

@@ -4,7 +4,7 @@
 use glam::Vec3;
 
 use super::edges::SharpEdges;
-use super::geometry::{closest_on_triangle, rounding_near, segment_crosses};
+use super::geometry::{closest_on_triangle, less_by_move, rounding_near, segment_crosses};
 use super::tree::{Near, Nearest, TriangleTree};
 
 /// How many crossings one move may be caught at (a move that slides on into a second face
@@ -55,14 +55,13 @@ impl Gathered {
 
     /// The same gathering after the surface deformed, no point of it moving farther than
     /// `by` metres: a triangle now within the radius less `by` of the centre was within the
-    /// radius, and none is nearer than its distance less `by`. Both lowered that much,
-    /// rounded down, with a ten-thousandth of `by` more for the rounding of the move. The
-    /// triangles' places in the tree stay theirs (a refit keeps its shape).
+    /// radius, and none is nearer than its distance less `by`. Both lowered that much
+    /// (`less_by_move`). The triangles' places in the tree stay theirs (a refit keeps its
+    /// shape).
     pub fn surface_moved(&mut self, by: f32) {
-        let less = |d: f32| (d - by * (1.0 + 1e-4)).next_down();
-        self.radius = less(self.radius);
+        self.radius = less_by_move(self.radius, by);
         let count = usize::from(self.count);
-        (self.distances.iter_mut().take(count)).for_each(|d| *d = less(*d));
+        (self.distances.iter_mut().take(count)).for_each(|d| *d = less_by_move(*d, by));
     }
 }
 

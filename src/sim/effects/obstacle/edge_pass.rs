@@ -86,7 +86,9 @@ where
     let look = match moved {
         EdgesMoved::Fixed => LOOK,
         EdgesMoved::By(by) => {
-            (memory.clearance.iter_mut()).for_each(|c| c.surface_moved(by));
+            if by > 0.0 {
+                (memory.clearance.iter_mut()).for_each(|c| c.surface_moved(by));
+            }
             LOOK_DEFORMING
         }
     };
@@ -113,10 +115,7 @@ where
             // asked.
             let travel = (now[0] - then[0]).length().max((now[1] - then[1]).length());
             let reach = thickness.max(travel);
-            let near = match clearance.get_mut(e) {
-                Some(c) => edges.nearest_remembering(now, [reach, look], c),
-                None => edges.nearest(now[0].into(), now[1].into(), reach),
-            };
+            let near = edges.nearest_remembering(now, [reach, look], &mut clearance[e]);
             let Some(near) = near else {
                 continue;
             };
