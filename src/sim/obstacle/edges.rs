@@ -71,6 +71,17 @@ impl Clearance {
             .max(b.distance_squared(self.ends[1]));
         room > 0.0 && moved < room * room
     }
+
+    /// How much of the clearance is left with the segment's ends at `a` and `b`: the
+    /// clearance less the farther of the ends' moves since it was measured, m (`-∞`:
+    /// nothing measured).
+    #[inline]
+    pub fn left(&self, [a, b]: [Vec3A; 2]) -> f32 {
+        let moved = a
+            .distance_squared(self.ends[0])
+            .max(b.distance_squared(self.ends[1]));
+        self.clear - moved.sqrt()
+    }
 }
 
 /// The nearest points of a segment and a sharp edge.

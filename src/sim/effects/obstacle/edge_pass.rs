@@ -22,14 +22,101 @@ pub(super) struct EdgeFrame<S, L, W, V> {
 /// What the edge pass of one obstacle keeps from one substep to the next: how clear of the
 /// sharp edges each cloth edge (spring) was last measured, in the obstacle's frame (where
 /// the edges are fixed in it: a rigid obstacle's), and each particle where the substep
-/// began and where it is now, in the frame (scratch: nothing is allocated once warm).
+/// began and where the last pass left it, in the frame (nothing is allocated once warm).
 #[derive(Debug, Default)]
 pub(super) struct EdgeMemory {
     clearance: Vec<Clearance>,
     before: Vec<Vec3A>,
     local: Vec<Vec3A>,
+    /// Where the edges are fixed in the frame (a rigid obstacle's): how far each particle
+    /// can have moved in it since the odometers were set to zero, m (its moves between
+    /// one pass and the next and its pushes, each with room for its rounding).
+    odometers: Vec<f64>,
+    /// For each cloth edge, in the colour order the pass takes them in: its particles'
+    /// odometers added up when it was last asked, and how much of its clearance was left
+    /// then (less its rounding). Until those odometers have run on by that much less the
+    /// reach, the answer would be the same (none), and it is passed by unasked (`-∞` left:
+    /// ask).
+    asked_at: Vec<(f64, f32)>,
+    /// Each particle's pushes in this pass added up (in the frame), m, and the particles
+    /// pushed.
+    pushed: Vec<f32>,
+    pushed_list: Vec<u32>,
     /// Where the edges deform: when the surface the clearances were measured against stood.
     pub(super) clock: SurfaceClock,
+    /// Cloth edges asked about (not passed by on the odometers) since the memory was made.
+    #[cfg(test)]
+    asked: usize,
+}
+
+/// How far the particles moved since the substep began (the most any did: `travel`),
+/// and the room for the rounding of a distance between two of them (`rounding`), m.
+struct Reading {
+    travel: f32,
+    rounding: f32,
+}
+
+impl EdgeMemory {
+    /// Takes every particle of `pos` into the frame (`to_local`). Where the sharp edges are
+    /// `fixed` in it, runs each particle's odometer on by its move since the last pass (all
+    /// set to zero, and each of the `edges` cloth edges to be asked, where the particles
+    /// are not the last pass's), and reads how far the particles moved since the substep
+    /// began (`before` must be filled). Where the edges move, every cloth edge is asked:
+    /// their own move wears each clearance down by about as much as is left of it over a
+    /// substep (`arm`: every one was asked every substep), and no odometer is kept.
+    fn take_in(
+        &mut self,
+        pos: &[Vec3],
+        to_local: impl Fn(Vec3) -> Vec3,
+        edges: usize,
+        fixed: bool,
+    ) -> Reading {
+        for &i in &self.pushed_list {
+            self.pushed[i as usize] = 0.0;
+        }
+        self.pushed_list.clear();
+        // Room for every particle once: a pass lists each at most once.
+        self.pushed_list.reserve(pos.len());
+        self.pushed.resize(pos.len(), 0.0);
+        let counted = (self.local.len(), self.odometers.len(), self.asked_at.len())
+            == (pos.len(), pos.len(), edges);
+        if !(fixed && counted) {
+            self.local.clear();
+            (self.local).extend(pos.iter().map(|&p| Vec3A::from(to_local(p))));
+            self.odometers.clear();
+            self.odometers.resize(pos.len(), 0.0);
+            self.asked_at.clear();
+            self.asked_at.resize(edges, (0.0, f32::NEG_INFINITY));
+            if !fixed {
+                // Without odometers, no cloth edge is passed by.
+                let travel = f32::INFINITY;
+                return Reading {
+                    travel,
+                    rounding: 0.0,
+                };
+            }
+        }
+        let (mut travel, mut scale) = (0.0f32, 0.0f32);
+        let moves =
+            (self.local.iter_mut().zip(&mut self.odometers)).zip(pos.iter().zip(&self.before));
+        for ((local, odometer), (&p, before)) in moves {
+            let now = Vec3A::from(to_local(p));
+            // The sum of the move's components: never less than its length, and no root.
+            *odometer += f64::from((now - *local).abs().element_sum());
+            travel = travel.max(now.distance_squared(*before));
+            scale = scale.max(now.abs().max_element());
+            *local = now;
+        }
+        // A distance between two points of this size is rounded by far less.
+        let rounding = 4.0 * f32::EPSILON * (1.0 + scale);
+        for odometer in &mut self.odometers {
+            *odometer += f64::from(rounding);
+        }
+        Reading {
+            travel: travel.sqrt() + rounding,
+            rounding,
+        }
+    }
 }
 
 /// How far the sharp edges moved in the edge pass's frame since its last pass.
@@ -53,8 +140,11 @@ const EDGE_SWEEPS: usize = 4;
 /// edges `moved` in the frame since (nothing where they are fixed in it: a rigid
 /// obstacle's; a deforming surface's largest vertex move over the substep,
 /// [`SurfaceClock::moved_to`]), spares it the walk of the tree while it stays clear
-/// ([`SharpEdges::nearest_remembering`]: the same answers). Returns how many cloth edges
-/// it moved.
+/// ([`SharpEdges::nearest_remembering`]: the same answers); and where the edges are fixed
+/// in the frame, while its two particles' odometers (how far each can have moved since)
+/// have not run on by what was left of it when last asked, less the reach, the cloth edge
+/// is passed by unasked (its answer would be the same: none). Returns how many cloth
+/// edges it moved.
 pub(super) fn push_edges<S, L, W, V>(
     edges: &SharpEdges,
     frame: &EdgeFrame<S, L, W, V>,
@@ -80,8 +170,9 @@ where
             .iter()
             .map(|&p| Vec3A::from((frame.from_start)(p))),
     );
-    memory.local.clear();
-    (memory.local).extend(state.pos.iter().map(|&p| Vec3A::from((frame.to_local)(p))));
+    let order = &pass.model.edge_colours.order;
+    let fixed = moved == EdgesMoved::Fixed;
+    let reading = memory.take_in(&state.pos, &frame.to_local, order.len(), fixed);
     (memory.clearance).resize(springs.a.len(), Clearance::NONE);
     let look = match moved {
         EdgesMoved::Fixed => LOOK,
@@ -92,17 +183,33 @@ where
             LOOK_DEFORMING
         }
     };
-    let clearance = &mut memory.clearance;
+    let (clearance, asked_at) = (&mut memory.clearance, &mut memory.asked_at);
     let (before, local) = (&memory.before, &mut memory.local);
+    let odometers = &mut memory.odometers;
+    let (pushed, pushed_list) = (&mut memory.pushed, &mut memory.pushed_list);
+    let rounding = reading.rounding;
+    // The most any particle's pushes of this pass have added up to yet.
+    let mut most_pushed = 0.0f32;
     let mut moved = 0;
     // A cloth edge put back from a crossing can pull a neighbour across another: the pass
     // repeats (a few times at most) while it finds crossings.
     for _ in 0..EDGE_SWEEPS {
         let mut crossings = 0;
         // In colours (the GPU's order too, a colour's edges side by side there).
-        for &e in &pass.model.edge_colours.order {
+        for (k, &e) in order.iter().enumerate() {
             let e = e as usize;
             let (i, j) = (springs.a[e] as usize, springs.b[e] as usize);
+            // Neither particle has moved farther than its odometer ran on since this cloth
+            // edge was last asked, nor (any particle) farther than `reach_most` since the
+            // substep began: while the two odometers leave it more than the reach clear, it
+            // is not asked.
+            let reading_now = odometers[i] + odometers[j];
+            let (then, left) = asked_at[k];
+            let reach_most = thickness.max(reading.travel + most_pushed);
+            let wanted = reach_most * (1.0 + 2e-4) + 2.0 * rounding;
+            if (reading_now - then) + f64::from(wanted) < f64::from(left) {
+                continue;
+            }
             let free = [inv_mass[i] > 0.0, inv_mass[j] > 0.0].map(f32::from);
             if free == [0.0, 0.0] {
                 continue;
@@ -116,6 +223,12 @@ where
             let travel = (now[0] - then[0]).length().max((now[1] - then[1]).length());
             let reach = thickness.max(travel);
             let near = edges.nearest_remembering(now, [reach, look], &mut clearance[e]);
+            #[cfg(test)]
+            {
+                memory.asked += 1;
+            }
+            // What is left of its clearance, from the odometers' reading now.
+            asked_at[k] = (reading_now, clearance[e].left(now) - rounding);
             let Some(near) = near else {
                 continue;
             };
@@ -152,7 +265,14 @@ where
                 }
                 state.pos[p] += gap * (part / weight);
                 state.vel[p] = touching(state.vel[p], v_surface, n, mu, part);
-                local[p] = (frame.to_local)(state.pos[p]).into();
+                let was = std::mem::replace(&mut local[p], (frame.to_local)(state.pos[p]).into());
+                if pushed[p] == 0.0 {
+                    pushed_list.push(p as u32);
+                }
+                let push = local[p].distance(was) + rounding;
+                pushed[p] += push;
+                odometers[p] += f64::from(push);
+                most_pushed = most_pushed.max(pushed[p]);
             }
             moved += 1;
         }
@@ -162,3 +282,6 @@ where
     }
     moved
 }
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,136 @@
+use glam::Vec3;
+
+use super::*;
+use crate::cloth::{ClothModel, ClothState};
+use crate::mesh::{GridOrientation, GridSpec};
+use crate::sim::self_contacts::SelfContacts;
+
+/// The twelve sharp edges of a 20 cm cube about the origin, raised by `lift` m.
+fn cube_edges(lift: f32) -> SharpEdges {
+    let v: Vec<Vec3> = (0..8)
+        .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32))
+        .map(|c| (c - Vec3::splat(0.5)) * 0.2 + Vec3::Y * lift)
+        .collect();
+    let quads = [
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+    ];
+    let t: Vec<[u32; 3]> = (quads.iter())
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
+    let normals: Vec<Vec3> = (t.iter())
+        .map(|t| {
+            let [a, b, c] = t.map(|i| v[i as usize]);
+            (b - a).cross(c - a).normalize()
+        })
+        .collect();
+    SharpEdges::of(&v, &t, &normals)
+}
+
+/// One edge pass of `model` from `start` to `state` (the substep's end) against `edges`
+/// fixed in the world, with a thickness of 1 cm; returns the cloth edges it moved.
+fn pass(
+    edges: &SharpEdges,
+    model: &ClothModel,
+    start: &[Vec3],
+    state: &mut ClothState,
+    (memory, moved): (&mut EdgeMemory, EdgesMoved),
+) -> usize {
+    let mut self_contacts = SelfContacts::default();
+    let mut pass = ContactPass {
+        model,
+        start,
+        substep: 0.01,
+        state,
+        offset: 0.01,
+        self_contacts: &mut self_contacts,
+        faces: None,
+    };
+    let frame = EdgeFrame {
+        from_start: |p| p,
+        to_local: |p| p,
+        to_world: |n| n,
+        velocity: |_| Vec3::ZERO,
+    };
+    push_edges(edges, &frame, 0.3, &mut pass, (memory, moved))
+}
+
+/// A 60 cm cloth 8 mm over a 20 cm cube's top, its parts beyond the top falling and swinging
+/// past the rim, every particle jittering; now and then a substep moves nothing, and one
+/// jumps back to where the cloth was some substeps before (as a rolled-back frame does).
+/// Each substep's edge pass with the memory kept from substep to substep (clearances and
+/// odometers: most cloth edges passed by unasked) must leave every position and velocity
+/// as a pass with no memory at all (every cloth edge asked, every tree walked) leaves them,
+/// to the bit; and so must they where the cube rises into a still cloth from 3 cm below
+/// it (as a deforming surface's edges move: every cloth edge asked, the clearances worn
+/// down by the move).
+#[test]
+fn cloth_edges_passed_by_on_their_odometers_end_where_every_one_asked_ends() {
+    let mesh = GridSpec::square(24, 0.6, GridOrientation::Horizontal, Vec3::ZERO)
+        .build()
+        .unwrap();
+    let model = ClothModel::new(&mesh, 0.2, &[]);
+    // Fixed under a moving cloth 8 mm above its top, or rising 1 mm a substep (as a
+    // deforming surface's edges move) into a still one 3 cm above it.
+    for (moved, rise, above) in [
+        (EdgesMoved::Fixed, 0.0, 0.008),
+        (EdgesMoved::By(1e-3), 1e-3, 0.03),
+    ] {
+        let mut rnd = crate::test_rng::uniform(33);
+        let mut state = ClothState::at_rest(&model);
+        state.pos.iter_mut().for_each(|p| p.y += 0.1 + above);
+        let mut memory = EdgeMemory::default();
+        let (mut asked_fresh, mut pushes, mut earlier) = (0, 0, Vec::new());
+        for substep in 0..160 {
+            let start = state.pos.clone();
+            if substep % 40 == 39 {
+                // Back to where the cloth was ten substeps before.
+                state.pos.clone_from(&earlier[substep - 10]);
+            } else if substep % 13 != 12 && rise == 0.0 {
+                for p in &mut state.pos {
+                    let beyond = (p.x.abs().max(p.z.abs()) - 0.1).max(0.0);
+                    let jitter = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.0005;
+                    let swing =
+                        Vec3::new(p.x.signum(), 0.0, 0.0) * 0.001 * (0.1 * substep as f32).sin();
+                    *p += jitter + (swing - Vec3::Y * 0.002) * (beyond * 20.0).min(1.0);
+                }
+            }
+            earlier.push(state.pos.clone());
+            let edges = cube_edges(rise * substep as f32);
+            let mut fresh = state.clone();
+            let mut none = EdgeMemory::default();
+            let expected = pass(&edges, &model, &start, &mut fresh, (&mut none, moved));
+            let got = pass(&edges, &model, &start, &mut state, (&mut memory, moved));
+            assert_eq!(
+                got, expected,
+                "{moved:?}, substep {substep}: cloth edges moved"
+            );
+            let bits = |s: &ClothState| {
+                (s.pos.iter().chain(&s.vel))
+                    .flat_map(|v| v.to_array().map(f32::to_bits))
+                    .collect::<Vec<_>>()
+            };
+            assert!(
+                bits(&state) == bits(&fresh),
+                "{moved:?}, substep {substep}: states differ"
+            );
+            asked_fresh += none.asked;
+            pushes += got;
+        }
+        // Not a test that could pass by asking every cloth edge, or by pushing none: where
+        // the edges are fixed, most are passed by; where they move, none is.
+        let asked = match moved {
+            EdgesMoved::Fixed => 2 * memory.asked < asked_fresh,
+            EdgesMoved::By(_) => memory.asked == asked_fresh,
+        };
+        assert!(
+            asked && pushes > 500,
+            "{moved:?}: {} asked of {asked_fresh}, {pushes} pushes",
+            memory.asked
+        );
+    }
+}
