@@ -32,12 +32,9 @@ pub(super) struct EdgeMemory {
     /// can have moved in it since the odometers were set to zero, m (its moves between
     /// one pass and the next and its pushes, each with room for its rounding).
     odometers: Vec<f64>,
-    /// For each cloth edge, in the colour order the pass takes them in: its particles'
-    /// odometers added up when it was last asked, and how much of its clearance was left
-    /// then (less its rounding). Until those odometers have run on by that much less the
-    /// reach, the answer would be the same (none), and it is passed by unasked (`-∞` left:
-    /// ask).
-    asked_at: Vec<(f64, f32)>,
+    /// For each cloth edge, in the colour order the pass takes them in, what it was when
+    /// last asked.
+    asked_at: Vec<Asked>,
     /// Each particle's pushes in this pass added up (in the frame), m, and the particles
     /// pushed.
     pushed: Vec<f32>,
@@ -47,6 +44,26 @@ pub(super) struct EdgeMemory {
     /// Cloth edges asked about (not passed by on the odometers) since the memory was made.
     #[cfg(test)]
     asked: usize,
+}
+
+/// A cloth edge when it was last asked: its two particles, their odometers added up then,
+/// and how much of its clearance was left then (less its rounding). Until those odometers
+/// have run on by that much less the reach, its answer would be the same (none), and it is
+/// passed by unasked: only for the same two particles (another cloth of as many particles
+/// and edges may have taken the memory on) and where something was left (`-∞`: ask).
+#[derive(Clone, Copy, Debug)]
+struct Asked {
+    ends: [u32; 2],
+    reading: f64,
+    left: f32,
+}
+
+impl Asked {
+    const NOT: Asked = Asked {
+        ends: [u32::MAX; 2],
+        reading: 0.0,
+        left: f32::NEG_INFINITY,
+    };
 }
 
 /// How far the particles moved since the substep began (the most any did: `travel`),
@@ -86,7 +103,7 @@ impl EdgeMemory {
             self.odometers.clear();
             self.odometers.resize(pos.len(), 0.0);
             self.asked_at.clear();
-            self.asked_at.resize(edges, (0.0, f32::NEG_INFINITY));
+            self.asked_at.resize(edges, Asked::NOT);
             if !fixed {
                 // Without odometers, no cloth edge is passed by.
                 let travel = f32::INFINITY;
@@ -204,10 +221,12 @@ where
             // substep began: while the two odometers leave it more than the reach clear, it
             // is not asked.
             let reading_now = odometers[i] + odometers[j];
-            let (then, left) = asked_at[k];
+            let (last, ends) = (asked_at[k], [i as u32, j as u32]);
             let reach_most = thickness.max(reading.travel + most_pushed);
             let wanted = reach_most * (1.0 + 2e-4) + 2.0 * rounding;
-            if (reading_now - then) + f64::from(wanted) < f64::from(left) {
+            if (reading_now - last.reading) + f64::from(wanted) < f64::from(last.left)
+                && last.ends == ends
+            {
                 continue;
             }
             let free = [inv_mass[i] > 0.0, inv_mass[j] > 0.0].map(f32::from);
@@ -228,7 +247,11 @@ where
                 memory.asked += 1;
             }
             // What is left of its clearance, from the odometers' reading now.
-            asked_at[k] = (reading_now, clearance[e].left(now) - rounding);
+            asked_at[k] = Asked {
+                ends,
+                reading: reading_now,
+                left: clearance[e].left(now) - rounding,
+            };
             let Some(near) = near else {
                 continue;
             };

@@ -134,3 +134,45 @@ fn cloth_edges_passed_by_on_their_odometers_end_where_every_one_asked_ends() {
         );
     }
 }
+
+/// A memory another cloth of as many particles and edges took on (here the same cloth with
+/// its edges taken in the other order: each place in the order another edge) answers for
+/// each cloth edge only from what it kept for those two particles: every pass ends where a
+/// pass with no memory ends, to the bit.
+#[test]
+fn a_memory_kept_for_other_edges_passes_none_of_these_by() {
+    let mesh = GridSpec::square(24, 0.6, GridOrientation::Horizontal, Vec3::ZERO)
+        .build()
+        .unwrap();
+    let model = ClothModel::new(&mesh, 0.2, &[]);
+    let mut reversed = model.clone();
+    reversed.edge_colours.order.reverse();
+    let edges = cube_edges(0.0);
+    let mut state = ClothState::at_rest(&model);
+    state.pos.iter_mut().for_each(|p| p.y += 0.108);
+    let mut memory = EdgeMemory::default();
+    let mut rnd = crate::test_rng::uniform(34);
+    for (substep, model) in [&model; 4].into_iter().chain([&reversed; 4]).enumerate() {
+        let start = state.pos.clone();
+        for p in &mut state.pos {
+            let beyond = (p.x.abs().max(p.z.abs()) - 0.1).max(0.0);
+            let jitter = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.0005;
+            *p += jitter - Vec3::Y * 0.002 * (beyond * 20.0).min(1.0);
+        }
+        let mut fresh = state.clone();
+        let fixed = EdgesMoved::Fixed;
+        let expected = pass(
+            &edges,
+            model,
+            &start,
+            &mut fresh,
+            (&mut EdgeMemory::default(), fixed),
+        );
+        let got = pass(&edges, model, &start, &mut state, (&mut memory, fixed));
+        assert_eq!(
+            (got, &state.pos, &state.vel),
+            (expected, &fresh.pos, &fresh.vel),
+            "{substep}"
+        );
+    }
+}
