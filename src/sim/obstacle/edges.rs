@@ -300,6 +300,33 @@ fn closest_between(a: Vec3, b: Vec3, p: Vec3, q: Vec3) -> EdgeHit {
     }
 }
 
+/// The unit cube's corners and its faces' triangles, with their normals (twelve sharp
+/// edges): for tests.
+#[cfg(test)]
+pub(crate) fn unit_cube() -> (Vec<Vec3>, Vec<[u32; 3]>, Vec<Vec3>) {
+    let v: Vec<Vec3> = (0..8)
+        .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32))
+        .collect();
+    let quads = [
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+    ];
+    let t: Vec<[u32; 3]> = (quads.iter())
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
+    let normals: Vec<Vec3> = (t.iter())
+        .map(|t| {
+            let [a, b, c] = t.map(|i| v[i as usize]);
+            (b - a).cross(c - a).normalize()
+        })
+        .collect();
+    (v, t, normals)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -325,36 +352,11 @@ mod tests {
         }
     }
 
-    /// The unit cube's corners and its faces' triangles, with their normals.
-    fn cube() -> (Vec<Vec3>, Vec<[u32; 3]>, Vec<Vec3>) {
-        let v: Vec<Vec3> = (0..8)
-            .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32))
-            .collect();
-        let quads = [
-            [0, 1, 3, 2],
-            [4, 6, 7, 5],
-            [0, 4, 5, 1],
-            [2, 3, 7, 6],
-            [0, 2, 6, 4],
-            [1, 5, 7, 3],
-        ];
-        let t: Vec<[u32; 3]> = (quads.iter())
-            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-            .collect();
-        let normals: Vec<Vec3> = (t.iter())
-            .map(|t| {
-                let [a, b, c] = t.map(|i| v[i as usize]);
-                (b - a).cross(c - a).normalize()
-            })
-            .collect();
-        (v, t, normals)
-    }
-
     /// A box's twelve edges are sharp; the diagonals that split its square faces are not;
     /// a lone triangle's three borders are.
     #[test]
     fn creases_and_borders_are_sharp_and_flat_diagonals_are_not() {
-        let (v, t, normals) = cube();
+        let (v, t, normals) = unit_cube();
         assert_eq!(SharpEdges::of(&v, &t, &normals).len(), 12);
         assert_eq!(SharpEdges::of(&v, &t[..1], &normals[..1]).len(), 3);
     }
@@ -364,7 +366,7 @@ mod tests {
     /// not a border around every face, nor at the diagonals that split them.
     #[test]
     fn corners_written_twice_are_one_corner() {
-        let (v, t, normals) = cube();
+        let (v, t, normals) = unit_cube();
         let mut apart = Vec::new();
         let faces: Vec<[u32; 3]> = (t.iter())
             .map(|tri| {
@@ -428,7 +430,7 @@ mod tests {
     /// answers clear where an edge is within reach.
     #[test]
     fn a_clearance_made_less_by_the_surfaces_move_changes_nothing() {
-        let (v, t, normals) = cube();
+        let (v, t, normals) = unit_cube();
         let mut edges = SharpEdges::of(&v, &t, &normals);
         let mut rnd = crate::test_rng::uniform(23);
         let mut step = || Vec3A::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5);
@@ -474,7 +476,7 @@ mod tests {
     /// reach, walks the tree for fewer than one question in four.
     #[test]
     fn remembering_the_clearance_changes_nothing() {
-        let (v, t, normals) = cube();
+        let (v, t, normals) = unit_cube();
         let edges = SharpEdges::of(&v, &t, &normals);
         let mut rnd = crate::test_rng::uniform(17);
         let mut step = || Vec3A::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5);

@@ -7,6 +7,8 @@ mod sequence;
 mod surface;
 mod tree;
 
+#[cfg(test)]
+pub(crate) use edges::unit_cube;
 pub use edges::{Clearance, EdgeHit, LOOK, LOOK_DEFORMING, SharpEdges};
 pub(crate) use geometry::{closest_weights, segments_closest};
 pub use sequence::{Moment, Sequence, SurfaceClock};

@@ -7,28 +7,34 @@ use crate::sim::self_contacts::SelfContacts;
 
 /// The twelve sharp edges of a 20 cm cube about the origin, raised by `lift` m.
 fn cube_edges(lift: f32) -> SharpEdges {
-    let v: Vec<Vec3> = (0..8)
-        .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32))
-        .map(|c| (c - Vec3::splat(0.5)) * 0.2 + Vec3::Y * lift)
-        .collect();
-    let quads = [
-        [0, 1, 3, 2],
-        [4, 6, 7, 5],
-        [0, 4, 5, 1],
-        [2, 3, 7, 6],
-        [0, 2, 6, 4],
-        [1, 5, 7, 3],
-    ];
-    let t: Vec<[u32; 3]> = (quads.iter())
-        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .collect();
-    let normals: Vec<Vec3> = (t.iter())
-        .map(|t| {
-            let [a, b, c] = t.map(|i| v[i as usize]);
-            (b - a).cross(c - a).normalize()
-        })
+    let (v, t, normals) = crate::sim::obstacle::unit_cube();
+    let v: Vec<Vec3> = (v.iter())
+        .map(|&c| (c - Vec3::splat(0.5)) * 0.2 + Vec3::Y * lift)
         .collect();
     SharpEdges::of(&v, &t, &normals)
+}
+
+/// A 60 cm cloth of 24 × 24 quads at rest, lying flat `above` m over the cube's top.
+fn cloth_over_cube(above: f32) -> (ClothModel, ClothState) {
+    let mesh = GridSpec::square(24, 0.6, GridOrientation::Horizontal, Vec3::ZERO)
+        .build()
+        .unwrap();
+    let model = ClothModel::new(&mesh, 0.2, &[]);
+    let mut state = ClothState::at_rest(&model);
+    state.pos.iter_mut().for_each(|p| p.y += 0.1 + above);
+    (model, state)
+}
+
+/// Moves every particle of `pos` by up to a quarter of a millimetre each way (drawn from
+/// `rnd`), and those beyond the cube's top (fully from 5 cm out) 2 mm down and `swing` m
+/// outwards along x.
+fn drift(pos: &mut [Vec3], rnd: &mut impl FnMut() -> f32, swing: f32) {
+    for p in pos {
+        let beyond = (p.x.abs().max(p.z.abs()) - 0.1).max(0.0);
+        let jitter = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.0005;
+        let swing = Vec3::X * p.x.signum() * swing;
+        *p += jitter + (swing - Vec3::Y * 0.002) * (beyond * 20.0).min(1.0);
+    }
 }
 
 /// One edge pass of `model` from `start` to `state` (the substep's end) against `edges`
@@ -70,10 +76,6 @@ fn pass(
 /// down by the move).
 #[test]
 fn cloth_edges_passed_by_on_their_odometers_end_where_every_one_asked_ends() {
-    let mesh = GridSpec::square(24, 0.6, GridOrientation::Horizontal, Vec3::ZERO)
-        .build()
-        .unwrap();
-    let model = ClothModel::new(&mesh, 0.2, &[]);
     // Fixed under a moving cloth 8 mm above its top, or rising 1 mm a substep (as a
     // deforming surface's edges move) into a still one 3 cm above it.
     for (moved, rise, above) in [
@@ -81,8 +83,7 @@ fn cloth_edges_passed_by_on_their_odometers_end_where_every_one_asked_ends() {
         (EdgesMoved::By(1e-3), 1e-3, 0.03),
     ] {
         let mut rnd = crate::test_rng::uniform(33);
-        let mut state = ClothState::at_rest(&model);
-        state.pos.iter_mut().for_each(|p| p.y += 0.1 + above);
+        let (model, mut state) = cloth_over_cube(above);
         let mut memory = EdgeMemory::default();
         let (mut asked_fresh, mut pushes, mut earlier) = (0, 0, Vec::new());
         for substep in 0..160 {
@@ -91,13 +92,11 @@ fn cloth_edges_passed_by_on_their_odometers_end_where_every_one_asked_ends() {
                 // Back to where the cloth was ten substeps before.
                 state.pos.clone_from(&earlier[substep - 10]);
             } else if substep % 13 != 12 && rise == 0.0 {
-                for p in &mut state.pos {
-                    let beyond = (p.x.abs().max(p.z.abs()) - 0.1).max(0.0);
-                    let jitter = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.0005;
-                    let swing =
-                        Vec3::new(p.x.signum(), 0.0, 0.0) * 0.001 * (0.1 * substep as f32).sin();
-                    *p += jitter + (swing - Vec3::Y * 0.002) * (beyond * 20.0).min(1.0);
-                }
+                drift(
+                    &mut state.pos,
+                    &mut rnd,
+                    0.001 * (0.1 * substep as f32).sin(),
+                );
             }
             earlier.push(state.pos.clone());
             let edges = cube_edges(rise * substep as f32);
@@ -141,24 +140,15 @@ fn cloth_edges_passed_by_on_their_odometers_end_where_every_one_asked_ends() {
 /// pass with no memory ends, to the bit.
 #[test]
 fn a_memory_kept_for_other_edges_passes_none_of_these_by() {
-    let mesh = GridSpec::square(24, 0.6, GridOrientation::Horizontal, Vec3::ZERO)
-        .build()
-        .unwrap();
-    let model = ClothModel::new(&mesh, 0.2, &[]);
+    let (model, mut state) = cloth_over_cube(0.008);
     let mut reversed = model.clone();
     reversed.edge_colours.order.reverse();
     let edges = cube_edges(0.0);
-    let mut state = ClothState::at_rest(&model);
-    state.pos.iter_mut().for_each(|p| p.y += 0.108);
     let mut memory = EdgeMemory::default();
     let mut rnd = crate::test_rng::uniform(34);
     for (substep, model) in [&model; 4].into_iter().chain([&reversed; 4]).enumerate() {
         let start = state.pos.clone();
-        for p in &mut state.pos {
-            let beyond = (p.x.abs().max(p.z.abs()) - 0.1).max(0.0);
-            let jitter = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.0005;
-            *p += jitter - Vec3::Y * 0.002 * (beyond * 20.0).min(1.0);
-        }
+        drift(&mut state.pos, &mut rnd, 0.0);
         let mut fresh = state.clone();
         let fixed = EdgesMoved::Fixed;
         let expected = pass(
