@@ -422,6 +422,38 @@ fn a_stretch_self_contact_refuses_is_judged_as_the_guards_strain() {
     );
 }
 
+/// The substeps the accuracy report takes one by one run outside the guard, and nothing
+/// there measures the springs against a strain limit: not even right after guarded frames,
+/// whose substeps handed self-contact the guard's limit. A cloth balled up into 2 cm, one
+/// particle flung 30 cm (springs stretched past 500 %, hundreds of pairs a particle), is
+/// resolved, not refused.
+#[test]
+fn a_substep_outside_the_guard_is_not_refused_for_its_stretch() {
+    let mut sim = builtin("self-fold", |_| {});
+    sim.step_frame().unwrap();
+    sim.modify_state(|state| {
+        let n = state.pos.len();
+        let centre = state.pos.iter().sum::<glam::Vec3>() / n as f32;
+        let mut rnd = 0.37f32;
+        for p in &mut state.pos {
+            rnd = (rnd * 997.0 + 0.11).fract();
+            *p = centre + (*p - centre) * 0.03 + glam::Vec3::new(0.0, 0.02 * rnd - 0.01, 0.0);
+        }
+        state.pos[n / 2] += glam::Vec3::new(0.3, 0.0, 0.0);
+        state.vel.iter_mut().for_each(|v| *v = glam::Vec3::ZERO);
+    });
+    let strain = sim.model().springs.largest_strain(&sim.state().pos);
+    assert!(strain > 5.0, "stretched by {strain}");
+    let stepped = sim.substep();
+    assert!(stepped.is_ok(), "{stepped:?}");
+    let (pairs, particles) = (
+        sim.self_collision_work().unwrap().candidates,
+        sim.model().particle_count() as u64,
+    );
+    // Past where self-contact measures the springs under a guard (8 pairs a particle).
+    assert!(pairs > 50 * particles, "{pairs} pairs");
+}
+
 /// With the guard off nothing checks the substeps, and the diverging state reaches
 /// self-contact: the run either ends with contact detection's refusal (a non-finite or
 /// absurdly spread state) or stays finite, its motion cut wherever the cloth would cross
