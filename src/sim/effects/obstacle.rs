@@ -438,28 +438,6 @@ struct Deforming<'a> {
 }
 
 impl Deforming<'_> {
-    /// [`Solid::contact`], with what the particle's last contact gathered where there is
-    /// `memory` (made less by the surface's move since: [`Placed::with_memory`]).
-    fn caught(
-        &self,
-        from: Vec3,
-        to: Vec3,
-        offset: f32,
-        memory: Option<&mut Gathered>,
-    ) -> Option<(Vec3, Vec3, Vec3)> {
-        let m = self.moment;
-        let start = if m.largest_shift >= 0.5 * offset {
-            let reach = 2.0 * (offset + m.largest_shift);
-            (m.surface.nearest(from, reach))
-                .map_or(from, |near| from + m.at_nearest(&near, &m.shift))
-        } else {
-            from
-        };
-        let caught = m.surface.catch_remembering(start, to, offset, memory)?;
-        let velocity = m.at(caught.triangle, caught.on_surface, &m.velocity);
-        Some((caught.at, caught.normal, velocity))
-    }
-
     /// [`push_edges`] against its sharp edges where the substep ends (which move).
     fn push_edges(&self, pass: &mut ContactPass<'_>, memory: &mut EdgeMemory) -> usize {
         let reach = pass.offset;
@@ -489,7 +467,7 @@ impl Solid for Deforming<'_> {
     }
 
     fn catch(&self, from: Vec3, to: Vec3, offset: f32) -> Option<Vec3> {
-        self.contact(from, to, offset).map(|(at, _, _)| at)
+        self.contact(from, to, offset, None).map(|(at, _, _)| at)
     }
 
     /// The move seen from the surface: a start near it is carried by the surface's own
@@ -497,18 +475,26 @@ impl Solid for Deforming<'_> {
     /// surface moves), then caught against the surface where the substep ends. A surface
     /// that moves less than half the thickness in the substep carries nothing: what rests
     /// on it is still outside it, and pushed back out to the thickness.
-    fn contact(&self, from: Vec3, to: Vec3, offset: f32) -> Option<(Vec3, Vec3, Vec3)> {
-        self.caught(from, to, offset, None)
-    }
-
-    fn contact_remembering(
+    /// `memory`: what the particle's last contact gathered, made less by the surface's move
+    /// since ([`Placed::with_memory`]).
+    fn contact(
         &self,
         from: Vec3,
         to: Vec3,
         offset: f32,
-        memory: &mut Gathered,
+        memory: Option<&mut Gathered>,
     ) -> Option<(Vec3, Vec3, Vec3)> {
-        self.caught(from, to, offset, Some(memory))
+        let m = self.moment;
+        let start = if m.largest_shift >= 0.5 * offset {
+            let reach = 2.0 * (offset + m.largest_shift);
+            (m.surface.nearest(from, reach))
+                .map_or(from, |near| from + m.at_nearest(&near, &m.shift))
+        } else {
+            from
+        };
+        let caught = m.surface.catch_remembering(start, to, offset, memory)?;
+        let velocity = m.at(caught.triangle, caught.on_surface, &m.velocity);
+        Some((caught.at, caught.normal, velocity))
     }
 
     fn friction(&self) -> f32 {
@@ -531,32 +517,12 @@ impl Solid for Posed<'_> {
     }
 
     fn catch(&self, from: Vec3, to: Vec3, offset: f32) -> Option<Vec3> {
-        self.contact(from, to, offset).map(|(at, _, _)| at)
+        self.contact(from, to, offset, None).map(|(at, _, _)| at)
     }
 
-    fn contact(&self, from: Vec3, to: Vec3, offset: f32) -> Option<(Vec3, Vec3, Vec3)> {
-        self.caught(from, to, offset, None)
-    }
-
-    fn contact_remembering(
-        &self,
-        from: Vec3,
-        to: Vec3,
-        offset: f32,
-        memory: &mut Gathered,
-    ) -> Option<(Vec3, Vec3, Vec3)> {
-        self.caught(from, to, offset, Some(memory))
-    }
-
-    fn friction(&self) -> f32 {
-        self.friction
-    }
-}
-
-impl Posed<'_> {
     /// The move seen from the obstacle (start and end each in its frame at that time), so
     /// a moving obstacle sweeps particles along as a still one stops them.
-    fn caught(
+    fn contact(
         &self,
         from: Vec3,
         to: Vec3,
@@ -569,6 +535,10 @@ impl Posed<'_> {
         let at = self.end.apply(pivot, caught.at);
         let normal = self.end.rotation * caught.normal;
         Some((at, normal, self.end.velocity_at(pivot, at)))
+    }
+
+    fn friction(&self) -> f32 {
+        self.friction
     }
 }
 

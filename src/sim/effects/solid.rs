@@ -40,23 +40,18 @@ pub(super) trait Solid {
     }
 
     /// Where a caught move ends, with the surface's normal and velocity there: by default
-    /// [`Solid::catch`], then [`Solid::surface_at`] where it ends.
-    fn contact(&self, from: Vec3, to: Vec3, offset: f32) -> Option<(Vec3, Vec3, Vec3)> {
-        let caught = self.catch(from, to, offset)?;
-        let (_, n, v_surface) = self.surface_at(caught);
-        Some((caught, n, v_surface))
-    }
-
-    /// [`Solid::contact`] for a particle whose last contact left `memory` (what a mesh
-    /// gathered near it; other solids need none).
-    fn contact_remembering(
+    /// [`Solid::catch`], then [`Solid::surface_at`] where it ends. `memory`: what the
+    /// particle's last contact left (what a mesh gathered near it; other solids need none).
+    fn contact(
         &self,
         from: Vec3,
         to: Vec3,
         offset: f32,
-        _memory: &mut Gathered,
+        _memory: Option<&mut Gathered>,
     ) -> Option<(Vec3, Vec3, Vec3)> {
-        self.contact(from, to, offset)
+        let caught = self.catch(from, to, offset)?;
+        let (_, n, v_surface) = self.surface_at(caught);
+        Some((caught, n, v_surface))
     }
 
     /// Coulomb friction coefficient (dimensionless, ≥ 0).
@@ -167,11 +162,8 @@ fn resolve_part(
         if w == 0.0 || solid.clear(from, *x, offset) {
             continue;
         }
-        let found = match memory.as_deref_mut().and_then(|m| m.get_mut(i)) {
-            Some(memory) => solid.contact_remembering(from, *x, offset, memory),
-            None => solid.contact(from, *x, offset),
-        };
-        let Some((caught, n, v_surface)) = found else {
+        let memory = memory.as_deref_mut().and_then(|m| m.get_mut(i));
+        let Some((caught, n, v_surface)) = solid.contact(from, *x, offset, memory) else {
             continue;
         };
         contacts += 1;
