@@ -66,9 +66,7 @@ impl Clearance {
     #[inline]
     fn clears(&self, [a, b]: [Vec3A; 2], reach: f32) -> bool {
         let room = self.clear - reach * (1.0 + 1e-4);
-        let moved = a
-            .distance_squared(self.ends[0])
-            .max(b.distance_squared(self.ends[1]));
+        let moved = self.moved_squared([a, b]);
         room > 0.0 && moved < room * room
     }
 
@@ -76,11 +74,16 @@ impl Clearance {
     /// clearance less the farther of the ends' moves since it was measured, m (`-∞`:
     /// nothing measured).
     #[inline]
-    pub fn left(&self, [a, b]: [Vec3A; 2]) -> f32 {
-        let moved = a
-            .distance_squared(self.ends[0])
-            .max(b.distance_squared(self.ends[1]));
-        self.clear - moved.sqrt()
+    pub fn left(&self, ends: [Vec3A; 2]) -> f32 {
+        self.clear - self.moved_squared(ends).sqrt()
+    }
+
+    /// The square of the farther of the ends' moves, from where it was measured to `a`
+    /// and `b`.
+    #[inline]
+    fn moved_squared(&self, [a, b]: [Vec3A; 2]) -> f32 {
+        a.distance_squared(self.ends[0])
+            .max(b.distance_squared(self.ends[1]))
     }
 }
 
