@@ -87,7 +87,7 @@ impl EdgeMemory {
         to_local: impl Fn(Vec3) -> Vec3,
         edges: usize,
         fixed: bool,
-    ) -> Reading {
+    ) -> Option<Reading> {
         for &i in &self.pushed_list {
             self.pushed[i as usize] = 0.0;
         }
@@ -95,23 +95,23 @@ impl EdgeMemory {
         // Room for every particle once: a pass lists each at most once.
         self.pushed_list.reserve(pos.len());
         self.pushed.resize(pos.len(), 0.0);
+        if !fixed {
+            // No odometers: every cloth edge is asked.
+            self.odometers.clear();
+            self.asked_at.clear();
+            self.local.clear();
+            (self.local).extend(pos.iter().map(|&p| Vec3A::from(to_local(p))));
+            return None;
+        }
         let counted = (self.local.len(), self.odometers.len(), self.asked_at.len())
             == (pos.len(), pos.len(), edges);
-        if !(fixed && counted) {
+        if !counted {
             self.local.clear();
             (self.local).extend(pos.iter().map(|&p| Vec3A::from(to_local(p))));
             self.odometers.clear();
             self.odometers.resize(pos.len(), 0.0);
             self.asked_at.clear();
             self.asked_at.resize(edges, Asked::NOT);
-            if !fixed {
-                // Without odometers, no cloth edge is passed by.
-                let travel = f32::INFINITY;
-                return Reading {
-                    travel,
-                    rounding: 0.0,
-                };
-            }
         }
         let (mut travel, mut scale) = (0.0f32, 0.0f32);
         let moves =
@@ -129,10 +129,10 @@ impl EdgeMemory {
         for odometer in &mut self.odometers {
             *odometer += f64::from(rounding);
         }
-        Reading {
+        Some(Reading {
             travel: travel.sqrt() + rounding,
             rounding,
-        }
+        })
     }
 }
 
@@ -204,7 +204,7 @@ where
     let (before, local) = (&memory.before, &mut memory.local);
     let odometers = &mut memory.odometers;
     let (pushed, pushed_list) = (&mut memory.pushed, &mut memory.pushed_list);
-    let rounding = reading.rounding;
+    let rounding = reading.as_ref().map_or(0.0, |r| r.rounding);
     // The most any particle's pushes of this pass have added up to yet.
     let mut most_pushed = 0.0f32;
     let mut moved = 0;
@@ -220,14 +220,17 @@ where
             // edge was last asked, nor (any particle) farther than `reach_most` since the
             // substep began: while the two odometers leave it more than the reach clear, it
             // is not asked.
-            let reading_now = odometers[i] + odometers[j];
-            let (last, ends) = (asked_at[k], [i as u32, j as u32]);
-            let reach_most = thickness.max(reading.travel + most_pushed);
-            let wanted = reach_most * (1.0 + 2e-4) + 2.0 * rounding;
-            if (reading_now - last.reading) + f64::from(wanted) < f64::from(last.left)
-                && last.ends == ends
-            {
-                continue;
+            let ends = [i as u32, j as u32];
+            let reading_now = reading.as_ref().map(|r| (r, odometers[i] + odometers[j]));
+            if let Some((r, at)) = reading_now {
+                let last = asked_at[k];
+                let reach_most = thickness.max(r.travel + most_pushed);
+                let wanted = reach_most * (1.0 + 2e-4) + 2.0 * rounding;
+                if last.ends == ends
+                    && (at - last.reading) + f64::from(wanted) < f64::from(last.left)
+                {
+                    continue;
+                }
             }
             let free = [inv_mass[i] > 0.0, inv_mass[j] > 0.0].map(f32::from);
             if free == [0.0, 0.0] {
@@ -247,11 +250,14 @@ where
                 memory.asked += 1;
             }
             // What is left of its clearance, from the odometers' reading now.
-            asked_at[k] = Asked {
-                ends,
-                reading: reading_now,
-                left: clearance[e].left(now) - rounding,
-            };
+            if let Some((_, at)) = reading_now {
+                let left = clearance[e].left(now) - rounding;
+                asked_at[k] = Asked {
+                    ends,
+                    reading: at,
+                    left,
+                };
+            }
             let Some(near) = near else {
                 continue;
             };
@@ -289,13 +295,15 @@ where
                 state.pos[p] += gap * (part / weight);
                 state.vel[p] = touching(state.vel[p], v_surface, n, mu, part);
                 let was = std::mem::replace(&mut local[p], (frame.to_local)(state.pos[p]).into());
-                if pushed[p] == 0.0 {
-                    pushed_list.push(p as u32);
+                if reading.is_some() {
+                    if pushed[p] == 0.0 {
+                        pushed_list.push(p as u32);
+                    }
+                    let push = local[p].distance(was) + rounding;
+                    pushed[p] += push;
+                    odometers[p] += f64::from(push);
+                    most_pushed = most_pushed.max(pushed[p]);
                 }
-                let push = local[p].distance(was) + rounding;
-                pushed[p] += push;
-                odometers[p] += f64::from(push);
-                most_pushed = most_pushed.max(pushed[p]);
             }
             moved += 1;
         }
