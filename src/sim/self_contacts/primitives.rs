@@ -182,12 +182,11 @@ pub fn point_triangle_distance(p: DVec3, [a, b, c]: [DVec3; 3]) -> f64 {
     to_segment(a, b).min(to_segment(b, c)).min(to_segment(c, a))
 }
 
-/// Where the pair's sides are closer than `d` with its particles at `pos`, the weights of
+/// Where the pair's sides are closer than `d` with its particles at `x`, the weights of
 /// their closest points ([`Pair::weights`]) and the offset between them (first side less
 /// the other); where they are not, how far apart they are at least (the gap between their
 /// boxes along an axis, or their closest points' distance, as rounded).
-fn separation(pair: &Pair, pos: &[Vec3], d: f32) -> Result<([f32; 4], Vec3), f32> {
-    let x = pair.ids().map(|i| pos[i]);
+fn separation(pair: &Pair, x: [Vec3; 4], d: f32) -> Result<([f32; 4], Vec3), f32> {
     let k = pair.first_side();
     // Sides whose boxes are `d` apart along an axis are not closer.
     let [(alo, ahi), (blo, bhi)] = side_boxes(pair, x);
@@ -213,17 +212,17 @@ fn separation(pair: &Pair, pos: &[Vec3], d: f32) -> Result<([f32; 4], Vec3), f32
 /// nothing else in the pair can. Returns whether it pushed, or (`Err`) how far apart its
 /// sides were at least where they were not closer than the thickness: measured where
 /// they are closer than `within` (at least the thickness), and where not, at least that.
-pub fn push_apart(
+pub fn push_apart<P: Particles + ?Sized>(
     pair: &Pair,
     [thickness, friction, within]: [f32; 3],
     model: &ClothModel,
     start: &[Vec3],
-    state: &mut ClothState,
+    state: &mut P,
     held: &[bool],
 ) -> Result<bool, f32> {
     let ids = pair.ids();
     let k = pair.first_side();
-    let (w, gap) = separation(pair, &state.pos, within.max(thickness))?;
+    let (w, gap) = separation(pair, ids.map(|i| state.pos(i)), within.max(thickness))?;
     let dist = gap.length();
     if dist >= thickness {
         return Err(dist);
@@ -261,9 +260,9 @@ pub fn push_apart(
     let share = (weight / most).min(1.0);
     let lambda = share * depth / weight;
     for i in 0..4 {
-        state.pos[ids[i]] += (sign(i) * w[i] * inv[i] * lambda) * direction;
+        state.move_by(ids[i], (sign(i) * w[i] * inv[i] * lambda) * direction);
     }
-    let relative: Vec3 = (0..4).map(|i| sign(i) * w[i] * state.vel[ids[i]]).sum();
+    let relative: Vec3 = (0..4).map(|i| sign(i) * w[i] * state.vel(ids[i])).sum();
     let approach = relative.dot(direction);
     if approach < 0.0 {
         let sliding = relative - approach * direction;
@@ -275,10 +274,40 @@ pub fn push_apart(
         };
         let impulse = share * (-approach * direction - friction * sliding) / weight;
         for i in 0..4 {
-            state.vel[ids[i]] += (sign(i) * w[i] * inv[i]) * impulse;
+            state.speed_up(ids[i], (sign(i) * w[i] * inv[i]) * impulse);
         }
     }
     Ok(true)
+}
+
+/// The particles a push reads and moves: a whole cloth's state, or (on the pushes' team)
+/// the part of it one group of pairs reaches.
+pub trait Particles {
+    fn pos(&self, i: usize) -> Vec3;
+    fn vel(&self, i: usize) -> Vec3;
+    /// Moves particle `i` by `by`.
+    fn move_by(&mut self, i: usize, by: Vec3);
+    /// Adds `by` to particle `i`'s velocity.
+    fn speed_up(&mut self, i: usize, by: Vec3);
+}
+
+impl Particles for ClothState {
+    #[inline(always)]
+    fn pos(&self, i: usize) -> Vec3 {
+        self.pos[i]
+    }
+    #[inline(always)]
+    fn vel(&self, i: usize) -> Vec3 {
+        self.vel[i]
+    }
+    #[inline(always)]
+    fn move_by(&mut self, i: usize, by: Vec3) {
+        self.pos[i] += by;
+    }
+    #[inline(always)]
+    fn speed_up(&mut self, i: usize, by: Vec3) {
+        self.vel[i] += by;
+    }
 }
 
 #[cfg(test)]
