@@ -55,29 +55,45 @@ fn allocations_per_frame(sim: &mut Simulation, frames: usize) -> Vec<usize> {
 /// its checkpoint again after the reset). On two threads each member of the team fills
 /// its own buffer of pairs, with whichever pieces it takes first, so a second run may need
 /// a larger buffer in one member than the first did: growth, not a frame's allocation;
-/// one thread keeps the runs alike.
+/// one thread keeps the runs alike. `layers` at 16² too, whose pairs pass the 4 096 from
+/// which the pushes go in groups of slabs, each group with its own lists.
 #[test]
 fn a_warm_frame_allocates_nothing_in_any_scene() {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
         .unwrap();
-    for &(name, _) in BUILTIN_SCENES {
-        let quads = if name == "layers" { 8 } else { 12 };
+    // The most pairs a frame's last substep found.
+    let run = |name: &str, quads: u32| {
         let scene = Scene::open_resized(name, None, &ImportOptions::default(), Some(quads))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         let mut sim = Simulation::new(scene);
         let frames = (1.5 / sim.params().step.dt as f64).round() as usize;
-        let (first, again) = pool.install(|| {
+        let (first, again, most) = pool.install(|| {
             let first = allocations_per_frame(&mut sim, frames);
             sim.reset();
-            (first, allocations_per_frame(&mut sim, frames))
+            let mut most = 0;
+            let again = (0..frames)
+                .map(|frame| {
+                    let allocated = allocations_per_frame(&mut sim, 1)[0];
+                    let found = sim.self_collision_work().map_or(0, |w| w.candidates);
+                    most = most.max(found);
+                    if frame == 0 { 0 } else { allocated }
+                })
+                .collect::<Vec<_>>();
+            (first, again, most)
         });
         assert!(first[0] > 0, "{name}: the first frame sets up its buffers");
-        let warm: usize = again[1..].iter().sum();
+        let warm: usize = again.iter().sum();
         assert_eq!(
             warm, 0,
-            "{name}: frames after the first allocated again: {again:?}"
+            "{name} at {quads}²: frames after the first allocated again: {again:?}"
         );
+        most
+    };
+    for &(name, _) in BUILTIN_SCENES {
+        run(name, if name == "layers" { 8 } else { 12 });
     }
+    let most = run("layers", 16);
+    assert!(most > 4096, "{most} pairs at most");
 }

@@ -83,6 +83,44 @@ fn a_blow_up_on_the_gpu_is_rolled_back_refined_and_recovered_as_on_the_cpu() {
     assert!(worst < 1e-5, "GPU and CPU differ by {worst} m");
 }
 
+/// A reset starts the GPU run over as a new one would: the run above ends with its
+/// substeps raised and its guard's wait for a step down doubled, and after a reset it
+/// refines and recovers at the same times again; a run that fell back to implicit Euler
+/// starts again under the integrator asked for, and falls back in the same frame.
+#[test]
+fn a_reset_starts_the_gpu_run_over() {
+    let run = |gpu: &mut Simulation, frames: usize| {
+        for frame in 0..frames {
+            (gpu.step_frame()).unwrap_or_else(|e| panic!("frame {frame}: {e}"));
+        }
+        actions(&gpu.take_guard_events())
+    };
+    let policy = GuardPolicy {
+        recover_after: 10,
+        fallback: None,
+        ..GuardPolicy::default()
+    };
+    let (mut gpu, _) = gpu_simulation(stiff_cloth(30, policy), true).expect("GPU backend");
+    let first = run(&mut gpu, 40);
+    assert_eq!((first.len(), gpu.substeps()), (5, 60), "{first:?}");
+    gpu.reset();
+    assert_eq!(gpu.substeps(), 30);
+    assert_eq!(run(&mut gpu, 40), first);
+    let policy = GuardPolicy {
+        max_refinements: 1,
+        ..GuardPolicy::default()
+    };
+    let (mut gpu, _) = gpu_simulation(stiff_cloth(8, policy), true).expect("GPU backend");
+    let first = run(&mut gpu, 3);
+    assert_eq!(gpu.integrator_in_effect(), IntegratorKind::ImplicitEuler);
+    gpu.reset();
+    assert_eq!(
+        gpu.integrator_in_effect(),
+        IntegratorKind::SemiImplicitEuler
+    );
+    assert_eq!(run(&mut gpu, 3), first);
+}
+
 /// With one refinement (16 substeps) where 52 are needed, nothing saves the first frame:
 /// the GPU run stops with the CPU's cause and count, and its state is the frame's start,
 /// to the bit.

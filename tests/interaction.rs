@@ -1,9 +1,11 @@
-//! Grabbing and pinning particles while the simulation runs, under every integrator.
+//! Grabbing and pinning particles while the simulation runs, under every integrator, and
+//! a reset.
 
 use std::path::Path;
 
+use clothsim::mesh::ImportOptions;
 use clothsim::scene::{GRAB_WINDOW, Scene, SceneFile, Simulation};
-use clothsim::sim::IntegratorKind;
+use clothsim::sim::{GuardAction, IntegratorKind};
 use glam::Vec3;
 
 /// A 10×10-quad cloth held by its top corners, run for a moment with `kind` at substeps it
@@ -253,4 +255,64 @@ fn a_hard_pull_and_its_snap_back_are_not_mistaken_for_a_blow_up() {
         let back = let_go.z - sim.state().pos[p as usize].z;
         assert!(back > 1.0, "{kind:?}: sprang back by only {back} m");
     }
+}
+
+/// A reset starts the run over as a new simulation would: the frames after it are the
+/// first run's, bit for bit, and so are the guard's events. Where the first run left
+/// self-contact's search memory behind (`layers`, five stacked cloths, at 16², and `arm`,
+/// a cloth a turning body wraps, at 12²: replayed with that memory, they parted from the
+/// first run in frames 16 and 13), and where its guard changed how it steps (`hanging` at
+/// 100 × the stiffness: with one refinement allowed it falls back to implicit Euler, and
+/// the replay starts under the integrator asked for; with three and no fallback it ends
+/// with its substeps raised, and the replay starts at those asked for, with the guard's
+/// wait for a step down as a new run's).
+#[test]
+fn a_reset_replays_the_run_bit_for_bit() {
+    let replayed = |mut sim: Simulation, frames: usize, name: &str| {
+        let first: Vec<(Vec<Vec3>, Vec<Vec3>)> = (0..frames)
+            .map(|f| {
+                sim.step_frame()
+                    .unwrap_or_else(|e| panic!("{name}, frame {f}: {e}"));
+                (sim.state().pos.clone(), sim.state().vel.clone())
+            })
+            .collect();
+        let events = sim.take_guard_events();
+        sim.reset();
+        for (f, (pos, vel)) in first.iter().enumerate() {
+            sim.step_frame()
+                .unwrap_or_else(|e| panic!("{name}, frame {f} again: {e}"));
+            let s = sim.state();
+            assert!(s.pos == *pos && s.vel == *vel, "{name}: frame {f} differs");
+        }
+        assert_eq!(events, sim.take_guard_events(), "{name}");
+        events
+    };
+    for (name, quads, frames) in [("layers", 8, 40), ("layers", 16, 30), ("arm", 12, 30)] {
+        let scene = Scene::open_resized(name, None, &ImportOptions::default(), Some(quads));
+        let sim = Simulation::new(scene.unwrap_or_else(|e| panic!("{name}: {e}")));
+        assert!(sim.self_collision_work().is_some(), "{name}: self-contact");
+        replayed(sim, frames, name);
+    }
+    let stiff = |refinements: u32, fallback: Option<IntegratorKind>| {
+        let mut scene = Scene::builtin("hanging").expect("hanging");
+        scene.params.material.stiffness = scene.params.material.stiffness.map(|k| k * 100.0);
+        scene.params.guard.max_refinements = refinements;
+        scene.params.guard.fallback = fallback;
+        Simulation::new(scene)
+    };
+    let events = replayed(
+        stiff(1, Some(IntegratorKind::ImplicitEuler)),
+        60,
+        "fell back",
+    );
+    assert!(
+        (events.iter()).any(|e| matches!(e.action, GuardAction::FellBack { .. })),
+        "{events:?}"
+    );
+    // Refined at the first frame, down again after a second of health, up again at once:
+    // the run ends with its substeps raised and its wait for the next step down doubled.
+    let events = replayed(stiff(3, None), 90, "refined");
+    let actions: Vec<_> = events.iter().map(|e| e.action.clone()).collect();
+    use GuardAction::{Recovered, Refined};
+    assert_eq!(actions, [Refined, Recovered, Refined], "{events:?}");
 }

@@ -65,6 +65,8 @@ pub struct GpuStepper {
     targets: Vec<[f32; 4]>,
     /// The integrator in effect (one of those the GPU runs).
     pub(super) integrator: IntegratorKind,
+    /// The integrator the parameters ask for (the guard may have fallen back from it).
+    asked: IntegratorKind,
     /// XPBD's constraints in colour order and VBD's stencil, and whether the one in effect
     /// must be built again (XPBD's from the positions of the next step's start, as the CPU
     /// builds its own).
@@ -226,6 +228,7 @@ impl GpuStepper {
             restamp: false,
             targets: Vec::new(),
             integrator: params.step.integrator,
+            asked: params.step.integrator,
             xpbd,
             vbd,
             implicit: None,
@@ -627,6 +630,7 @@ impl StepBackend for GpuStepper {
         if self.unsupported.is_none() && changes.contains(Changes::INTEGRATOR) {
             self.integrator = params.step.integrator;
         }
+        self.asked = params.step.integrator;
         self.solver = params.solver;
         if let Some(pass) =
             (self.implicit.as_ref()).filter(|_| self.integrator == IntegratorKind::ImplicitEuler)
@@ -693,6 +697,16 @@ impl StepBackend for GpuStepper {
     fn invalidate(&mut self) {
         self.upload = true;
         self.guard.forget_history();
+    }
+
+    fn restart(&mut self) {
+        self.invalidate();
+        self.set_substeps(self.requested);
+        if self.integrator != self.asked && self.unsupported.is_none() {
+            self.switch_integrator(self.asked);
+        }
+        self.forget_guesses();
+        self.guard.restart();
     }
 
     /// One frame of substeps in one submission, under the stability guard: a reduction on

@@ -606,7 +606,9 @@ impl Simulation {
         self.backend.substep_length()
     }
 
-    /// Back to the initial state; parameters, effects and pins are kept.
+    /// Back to the initial state; parameters, effects and pins are kept. The run starts
+    /// over as a new one would ([`StepBackend::restart`]): the frames after it are the
+    /// first run's again.
     pub fn reset(&mut self) {
         self.state.clone_from(&self.initial);
         for &p in &self.model.pins {
@@ -614,7 +616,7 @@ impl Simulation {
         }
         self.frames = 0;
         self.move_taken();
-        self.backend.invalidate();
+        self.backend.restart();
     }
 
     /// Advances one frame (`params.step.dt`).

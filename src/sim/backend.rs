@@ -33,6 +33,15 @@ pub trait StepBackend: Send {
     /// whatever was kept from earlier steps is dropped.
     fn invalidate(&mut self);
 
+    /// The run starts over from a state of its own (a reset): as
+    /// [`StepBackend::invalidate`], and whatever of the run steers how later frames are
+    /// stepped is dropped too (substeps the guard raised, its counters and events, the
+    /// contacts' search memory), so that the run steps as a new backend would. By default
+    /// only `invalidate`.
+    fn restart(&mut self) {
+        self.invalidate();
+    }
+
     /// Pinned `particle` (the held one of a grab) was moved outside the substeps, from
     /// `from` to where the state has it: the next [`StepBackend::frame`] takes that move
     /// as part of its first substep's motion, so that the contacts see it (self-contact

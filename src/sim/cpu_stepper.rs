@@ -48,6 +48,8 @@ fn timed<T>(spent: &mut Duration, work: impl FnOnce() -> T) -> T {
 /// scene's effect list: absent effects are not in it and cost nothing.
 pub struct CpuStepper<R: Real = f32> {
     integrator: Box<dyn Integrator<R>>,
+    /// The integrator the parameters ask for (the guard may have fallen back from it).
+    asked: IntegratorKind,
     forces: ForceSet<R>,
     /// The effects that act after each substep: solids in the scene's order, then
     /// self-collision.
@@ -116,6 +118,7 @@ impl<R: Real> CpuStepper<R> {
     pub fn build(model: &ClothModel, params: &SimParams, effects: &[Effect]) -> Self {
         let mut stepper = Self {
             integrator: params.step.integrator.build(),
+            asked: params.step.integrator,
             forces: ForceSet::default(),
             contacts: Vec::new(),
             effects: Vec::new(),
@@ -511,6 +514,7 @@ impl<R: Real> StepBackend for CpuStepper<R> {
             self.air_damping = air_damping_of(effects);
             self.gravity = gravity_of(effects);
         }
+        self.asked = params.step.integrator;
         if changes.contains(Changes::INTEGRATOR) && self.integrator.kind() != params.step.integrator
         {
             self.integrator = params.step.integrator.build::<R>();
@@ -535,6 +539,17 @@ impl<R: Real> StepBackend for CpuStepper<R> {
         self.integrator.invalidate();
         self.guard.forget_history();
         self.precise.forget();
+    }
+
+    fn restart(&mut self) {
+        self.invalidate();
+        self.substeps = self.requested;
+        if self.integrator.kind() != self.asked {
+            self.integrator = self.asked.build();
+        }
+        self.guard.restart();
+        self.outside = None;
+        self.self_contacts.forget();
     }
 
     fn substep(

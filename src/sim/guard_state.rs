@@ -75,6 +75,15 @@ impl<S: Snapshot> GuardState<S> {
         self.forget_history();
     }
 
+    /// The run starts over: the history is forgotten and the counters start as a new
+    /// guard's (the unread events and the spare rollback point's buffers are kept).
+    pub fn restart(&mut self) {
+        self.forget_history();
+        self.good_frames = 0;
+        self.recover_wait = self.policy.recover_after;
+        self.stepped_down = false;
+    }
+
     /// The history changed outside the stepper: old rollback points and limits are stale.
     pub fn forget_history(&mut self) {
         self.limits = None;

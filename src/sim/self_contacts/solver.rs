@@ -331,6 +331,20 @@ impl SelfContacts {
         Ok(true)
     }
 
+    /// Forgets what the run so far steers the next searches by (the pairs, the windows,
+    /// the frame that moves with the cloth, the searches' costs, how many searches each
+    /// patch sits out), keeping the buffers and what was built from the rest shape: the
+    /// next substep searches as a new one's first would, and the run goes on as a new one
+    /// would (a reset).
+    pub fn forget(&mut self) {
+        self.backoff.iter_mut().for_each(|b| *b = 0);
+        self.found_for = None;
+        (self.window, self.boxes.swept) = (Window::default(), false);
+        (self.shift, self.mean) = (Vec3::ZERO, Vec3::ZERO);
+        self.costs = SearchCosts::default();
+        self.work = SelfWork::default();
+    }
+
     /// Checks the substep's motion again after [`SelfContacts::resolve`] and a move of the
     /// solids (from `start`, the substep's, free of intersections, to `state`; `placed`:
     /// the positions before the solids moved them) along its whole length, cutting it where
