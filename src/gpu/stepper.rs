@@ -705,7 +705,6 @@ impl StepBackend for GpuStepper {
         if self.integrator != self.asked && self.unsupported.is_none() {
             self.switch_integrator(self.asked);
         }
-        self.forget_guesses();
         self.guard.restart();
     }
 
