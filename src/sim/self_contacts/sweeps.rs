@@ -24,12 +24,12 @@ use super::found::Found;
 use super::primitives::{Pair, Particles, push_apart};
 use super::search::{Owners, pairs};
 use crate::cloth::{ClothModel, ClothState};
-use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
+use crate::parallel::{Disjoint, Team};
 
 /// Pairs from which the sweeps go through them in slabs' groups, shared with the team.
 /// `layers` finds 20 000–100 000 a substep where its cloths lie pressed together;
 /// `crumple` at 64², a hundred or so.
-const GROUPED_FROM: usize = PARALLEL_ELEMENTS;
+const GROUPED_FROM: usize = 4_096;
 
 /// Slabs the particles are cut into for the groups (a power of two: each size of group is
 /// twice the one before).
@@ -53,9 +53,14 @@ struct Group {
     pairs: Vec<Pair>,
     /// The pairs its first sweep did not leave out.
     near: Vec<Near>,
-    /// The particles its pushes moved, each once.
+    tally: Tally,
+}
+
+/// What a group's pushes did this pass.
+#[derive(Clone, Debug, Default)]
+struct Tally {
+    /// The particles they moved, each once.
     pushed: Vec<u32>,
-    /// Its pushes this pass.
     pushes: usize,
 }
 
@@ -130,7 +135,7 @@ impl Sweep<'_> {
     fn push(
         &self,
         reach: &Reach,
-        group: &mut Group,
+        tally: &mut Tally,
         pair: &Pair,
         within: f32,
     ) -> Result<bool, f32> {
@@ -147,12 +152,12 @@ impl Sweep<'_> {
             self.held,
         );
         if outcome == Ok(true) {
-            group.pushes += 1;
+            tally.pushes += 1;
             for (j, &i) in ids.iter().enumerate() {
                 // SAFETY: as for [`Reach`]'s positions.
                 unsafe { *reach.moved.at(i) += reach.pos(i).distance(before[j]) };
                 if !std::mem::replace(unsafe { reach.is_pushed.at(i) }, true) {
-                    group.pushed.push(i as u32);
+                    tally.pushed.push(i as u32);
                 }
             }
         }
@@ -178,23 +183,27 @@ impl Sweep<'_> {
     }
 
     /// The first sweep through `pairs`, out to the reach; keeps the nearer in `near`.
-    fn first(&self, reach: &Reach, group: &mut Group, pairs: impl Iterator<Item = Pair>) {
+    fn first(
+        &self,
+        reach: &Reach,
+        (near, tally): (&mut Vec<Near>, &mut Tally),
+        pairs: impl Iterator<Item = Pair>,
+    ) {
         let within = self.at[2];
         for pair in pairs {
-            let outcome = self.push(reach, group, &pair, within);
+            let outcome = self.push(reach, tally, &pair, within);
             if !matches!(outcome, Err(apart) if apart >= within) {
                 let (slack, since) = self.slack_after(outcome, pair.ids(), reach);
-                group.near.push((pair, slack, since));
+                near.push((pair, slack, since));
             }
         }
     }
 
     /// A later sweep through the group's near pairs, out to the thickness, passing by
     /// those the pushes since they were measured cannot have closed.
-    fn again(&self, reach: &Reach, group: &mut Group) {
+    fn again(&self, reach: &Reach, (near, tally): (&mut Vec<Near>, &mut Tally)) {
         let thickness = self.at[0];
-        let mut near = std::mem::take(&mut group.near);
-        for (pair, slack, since) in &mut near {
+        for (pair, slack, since) in near.iter_mut() {
             let (ids, k) = (pair.ids(), pair.first_side());
             let drift = |r: std::ops::Range<usize>| {
                 r.map(|j| reach.moved(ids[j]) - since[j])
@@ -203,10 +212,9 @@ impl Sweep<'_> {
             if *slack > drift(0..k) + drift(k..4) {
                 continue;
             }
-            let outcome = self.push(reach, group, pair, thickness);
+            let outcome = self.push(reach, tally, pair, thickness);
             (*slack, *since) = self.slack_after(outcome, ids, reach);
         }
-        group.near = near;
     }
 }
 
@@ -236,12 +244,11 @@ impl Sweeps {
         self.is_pushed.resize(n, false);
         let grouped = found.len() >= GROUPED_FROM;
         let groups = if grouped { level_start(LEVELS) } else { 1 };
-        self.groups
-            .resize_with(groups.max(self.groups.len()), Group::default);
+        self.groups.resize_with(level_start(LEVELS), Group::default);
         for group in &mut self.groups {
             group.near.clear();
-            group.pushed.clear();
-            group.pushes = 0;
+            group.tally.pushed.clear();
+            group.tally.pushes = 0;
         }
         if grouped {
             self.group(pairs(found, &model.triangles, owners), &state.pos);
@@ -269,27 +276,27 @@ impl Sweeps {
                     team.run_large_pieces(SLABS >> level, &|_, run| {
                         // SAFETY: each run is one piece, run once.
                         let group = unsafe { groups.at(first + run) };
+                        let lists = (&mut group.near, &mut group.tally);
                         if round == 0 {
-                            let pairs = std::mem::take(&mut group.pairs);
-                            sweep.first(&reach, group, pairs.iter().copied());
-                            group.pairs = pairs;
+                            sweep.first(&reach, lists, group.pairs.iter().copied());
                         } else {
-                            sweep.again(&reach, group);
+                            sweep.again(&reach, lists);
                         }
                     });
                 }
             }
         } else {
             let group = &mut self.groups[0];
-            sweep.first(&reach, group, pairs(found, &model.triangles, owners));
+            let listed = pairs(found, &model.triangles, owners);
+            sweep.first(&reach, (&mut group.near, &mut group.tally), listed);
             for _ in 1..count {
-                sweep.again(&reach, group);
+                sweep.again(&reach, (&mut group.near, &mut group.tally));
             }
         }
         let mut pushes = 0;
         for group in &self.groups[..groups] {
-            pushes += group.pushes;
-            self.pushed.extend_from_slice(&group.pushed);
+            pushes += group.tally.pushes;
+            self.pushed.extend_from_slice(&group.tally.pushed);
         }
         pushes
     }
@@ -313,6 +320,7 @@ impl Sweeps {
         if found.len() < GROUPED_FROM {
             return (listed.collect(), false);
         }
+        self.groups.resize_with(level_start(LEVELS), Group::default);
         self.group(listed, pos);
         let order = self.groups.iter().flat_map(|g| g.pairs.iter().copied());
         (order.collect(), true)
@@ -320,7 +328,6 @@ impl Sweeps {
 
     /// Cuts the particles at `pos` into slabs and puts each of `pairs` in its group.
     fn group(&mut self, pairs: impl Iterator<Item = Pair>, pos: &[Vec3]) {
-        self.groups.resize_with(level_start(LEVELS), Group::default);
         let (lo, hi) = (pos.iter()).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
             (lo.min(*p), hi.max(*p))
         });
@@ -328,12 +335,15 @@ impl Sweeps {
         let n = pos.len();
         self.along.clear();
         self.along.extend(pos.iter().map(|p| p[axis]));
-        // The slabs' bounds: the coordinates at every SLABS-th share of the particles.
-        let mut cuts = [f32::INFINITY; SLABS - 1];
+        // The slabs' bounds: the coordinates at every SLABS-th share of the particles,
+        // each picked from what lies above the one before.
+        let (mut cuts, mut below) = ([f32::INFINITY; SLABS - 1], 0);
         for (k, cut) in cuts.iter_mut().enumerate() {
             let at = (k + 1) * n / SLABS;
             if at < n {
-                *cut = *self.along.select_nth_unstable_by(at, f32::total_cmp).1;
+                let above = &mut self.along[below..];
+                *cut = *above.select_nth_unstable_by(at - below, f32::total_cmp).1;
+                below = at;
             }
         }
         self.slab.clear();
@@ -397,6 +407,9 @@ mod tests {
             });
         }
         let mut sweeps = Sweeps::default();
+        sweeps
+            .groups
+            .resize_with(level_start(LEVELS), Group::default);
         sweeps.group(pairs.iter().copied(), &pos);
         // The slabs: equal counts, in order along z.
         let mut counts = [0usize; SLABS];
