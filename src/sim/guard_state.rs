@@ -53,17 +53,19 @@ pub struct GuardState<S = CpuSnapshot> {
 
 impl<S: Snapshot> GuardState<S> {
     pub fn new(policy: GuardPolicy) -> Self {
-        Self {
-            recover_wait: policy.recover_after,
+        let mut guard = Self {
             policy,
             limits: None,
             checkpoint: None,
             candidate: None,
             spare: None,
             good_frames: 0,
+            recover_wait: 0,
             stepped_down: false,
             events: Vec::new(),
-        }
+        };
+        guard.restart();
+        guard
     }
 
     /// New parameters: a new `policy` starts the guard afresh; either way the limits and
