@@ -1,7 +1,7 @@
 //! The stability guard: what it catches, how it rolls back, refines, falls back and
 //! recovers, and what it records.
 
-use clothsim::scene::{Scene, Simulation};
+use clothsim::scene::{RunSummary, Scene, Simulation};
 use clothsim::sim::{
     Cause, ContactError, Effect, FrameOutcome, GuardAction, GuardEvent, GuardPolicy,
     IntegratorKind, SelfCollision, StepError, Trouble,
@@ -14,6 +14,15 @@ fn hanging(configure: impl FnOnce(&mut Scene)) -> Simulation {
     let mut scene = Scene::builtin("hanging").unwrap();
     configure(&mut scene);
     Simulation::new(scene)
+}
+
+/// The run ended finite and without an error.
+fn assert_ran_through(summary: &RunSummary) {
+    assert!(
+        summary.finite && summary.error.is_none(),
+        "{:?}",
+        summary.error
+    );
 }
 
 fn bits(sim: &Simulation) -> Vec<u32> {
@@ -125,11 +134,7 @@ fn a_cloth_a_handle_spins_is_admitted_by_its_energy() {
     let mut sim = Simulation::new(parsed(SPUN));
     let headroom = f64::from(sim.params().guard.headroom);
     let summary = sim.run(1.0);
-    assert!(
-        summary.finite && summary.error.is_none(),
-        "{:?}",
-        summary.error
-    );
+    assert_ran_through(&summary);
     let events = &summary.guard_events;
     // Each admission by the energy: the energy reached (as the reason rounds it) and the
     // limit raised.
@@ -192,11 +197,7 @@ fn a_blow_up_that_stays_finite_within_the_frame_is_not_admitted() {
         s.params.material.stiffness = s.params.material.stiffness.map(|k| k * 2.5);
     });
     let summary = sim.run(0.1);
-    assert!(
-        summary.finite && summary.error.is_none(),
-        "{:?}",
-        summary.error
-    );
+    assert_ran_through(&summary);
     let events = &summary.guard_events;
     assert_eq!(
         events.first().map(|e| &e.action),
@@ -266,9 +267,7 @@ fn a_blow_up_is_still_caught_while_a_pull_holds_the_cloth_stretched() {
 
 /// `hanging` at 100 × the stiffness with one refinement allowed and `fallback` (the
 /// default's when `None`), run for a second; it must end finite and without an error.
-fn saved_by_a_fallback(
-    fallback: Option<IntegratorKind>,
-) -> (Simulation, clothsim::scene::RunSummary) {
+fn saved_by_a_fallback(fallback: Option<IntegratorKind>) -> (Simulation, RunSummary) {
     let mut sim = hanging(|s| {
         s.params.material.stiffness = s.params.material.stiffness.map(|k| k * 100.0);
         s.params.guard.max_refinements = 1;
@@ -277,11 +276,7 @@ fn saved_by_a_fallback(
         }
     });
     let summary = sim.run(1.0);
-    assert!(
-        summary.finite && summary.error.is_none(),
-        "{:?}",
-        summary.error
-    );
+    assert_ran_through(&summary);
     (sim, summary)
 }
 
