@@ -16,6 +16,9 @@ const MOST: usize = 64;
 pub struct EdgeColours {
     /// Spring numbers (all below the first bend spring), colour after colour.
     pub order: Vec<u32>,
+    /// Each edge's two particles, in the same order (a pass reads them in turn rather than
+    /// looking each spring up).
+    pub ends: Vec<[u32; 2]>,
     /// Each colour's range of `order`, and whether its edges may share a particle (then
     /// they must be taken one after another).
     pub runs: Vec<(Range<usize>, bool)>,
@@ -44,6 +47,11 @@ impl EdgeColours {
                 out.runs.push((start..out.order.len(), colour == MOST));
             }
         }
+        (out.ends).extend(
+            out.order
+                .iter()
+                .map(|&e| [springs.a[e as usize], springs.b[e as usize]]),
+        );
         out
     }
 }

@@ -470,6 +470,13 @@ impl Solid for Deforming<'_> {
         self.contact(from, to, offset, None).map(|(at, _, _)| at)
     }
 
+    /// The move as [`Deforming::contact`] sees it, where the surface moved too little in
+    /// the substep to carry a start (else none is told clear here).
+    #[inline]
+    fn clear_remembered(&self, from: Vec3, to: Vec3, offset: f32, memory: &Gathered) -> bool {
+        self.moment.largest_shift < 0.5 * offset && Surface::clears(from, to, offset, memory)
+    }
+
     /// The move seen from the surface: a start near it is carried by the surface's own
     /// move over the substep (so a particle resting on it stays on its side however the
     /// surface moves), then caught against the surface where the substep ends. A surface
@@ -518,6 +525,14 @@ impl Solid for Posed<'_> {
 
     fn catch(&self, from: Vec3, to: Vec3, offset: f32) -> Option<Vec3> {
         self.contact(from, to, offset, None).map(|(at, _, _)| at)
+    }
+
+    /// The move seen from the obstacle, as [`Posed::contact`] sees it.
+    #[inline]
+    fn clear_remembered(&self, from: Vec3, to: Vec3, offset: f32, memory: &Gathered) -> bool {
+        let pivot = self.placed.pivot;
+        let (a, b) = (self.start.unapply(pivot, from), self.end.unapply(pivot, to));
+        Surface::clears(a, b, offset, memory)
     }
 
     /// The move seen from the obstacle (start and end each in its frame at that time), so

@@ -39,6 +39,14 @@ pub(super) trait Solid {
         false
     }
 
+    /// Whether a particle moving from `from` to `to` is told clear of the surface by what
+    /// its last contact left in `memory` (by default none is): then [`Solid::contact`]
+    /// would find nothing either.
+    #[inline]
+    fn clear_remembered(&self, _from: Vec3, _to: Vec3, _offset: f32, _memory: &Gathered) -> bool {
+        false
+    }
+
     /// Where a caught move ends, with the surface's normal and velocity there: by default
     /// [`Solid::catch`], then [`Solid::surface_at`] where it ends. `memory`: what the
     /// particle's last contact left (what a mesh gathered near it; other solids need none).
@@ -163,6 +171,9 @@ fn resolve_part(
             continue;
         }
         let memory = memory.as_deref_mut().and_then(|m| m.get_mut(i));
+        if (memory.as_deref()).is_some_and(|m| solid.clear_remembered(from, *x, offset, m)) {
+            continue;
+        }
         let Some((caught, n, v_surface)) = solid.contact(from, *x, offset, memory) else {
             continue;
         };

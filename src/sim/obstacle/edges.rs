@@ -33,15 +33,25 @@ pub const LOOK: f32 = 4.0;
 /// at 2, 2.05 at 4, against 1.44–1.48 walking the tree for every question).
 pub const LOOK_DEFORMING: f32 = 0.5;
 
+/// Sharp edges a [`Clearance`] holds by number (more: it holds none).
+const NEAR_EDGES: usize = 3;
+
 /// What the last question about one cloth edge measured
-/// ([`SharpEdges::nearest_remembering`]): where its ends were (in the surface's frame) and
-/// how near at least any sharp edge lay to it then. A fact of the surface alone, as
+/// ([`SharpEdges::nearest_remembering`]): where its ends were (in the surface's frame), how
+/// near at least any sharp edge lay to it then, and the sharp edges found within the
+/// distance it looked to, where they were few. A fact of the surface alone, as
 /// [`super::Gathered`] is.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Clearance {
     ends: [Vec3A; 2],
     /// Metres, less a margin for the rounding; `-∞`: nothing measured.
     clear: f32,
+    /// How far from the segment measured every sharp edge was looked for, m, less a
+    /// margin for the rounding; each one found within it is in `near` (`-∞`: none held).
+    looked: f32,
+    /// How many of `near` are held, in the order the tree gives them.
+    count: u8,
+    near: [u32; NEAR_EDGES],
 }
 
 impl Clearance {
@@ -49,6 +59,9 @@ impl Clearance {
     pub const NONE: Clearance = Clearance {
         ends: [Vec3A::ZERO; 2],
         clear: f32::NEG_INFINITY,
+        looked: f32::NEG_INFINITY,
+        count: 0,
+        near: [0; NEAR_EDGES],
     };
 
     /// The same measure after the sharp edges moved by up to `by` metres (a deforming
@@ -58,6 +71,7 @@ impl Clearance {
     #[inline]
     pub fn surface_moved(&mut self, by: f32) {
         self.clear = less_by_move(self.clear, by);
+        self.looked = less_by_move(self.looked, by);
     }
 
     /// Whether the segment from `a` to `b` is told farther than `reach` from every sharp
@@ -194,13 +208,28 @@ impl SharpEdges {
 
     /// The sharp edge nearest to the segment from `a` to `b`, if one is within `reach`.
     pub fn nearest(&self, a: Vec3, b: Vec3, reach: f32) -> Option<EdgeHit> {
+        self.nearest_with(a, b, reach, |_| {})
+    }
+
+    /// [`SharpEdges::nearest`], calling `within` with each sharp edge within `reach` (by
+    /// number, in the order the tree gives them).
+    fn nearest_with(
+        &self,
+        a: Vec3,
+        b: Vec3,
+        reach: f32,
+        mut within: impl FnMut(u32),
+    ) -> Option<EdgeHit> {
         let pad = Vec3::splat(reach);
         let mut best: Option<EdgeHit> = None;
         self.tree.overlapping(a.min(b) - pad, a.max(b) + pad, |e| {
             let [p, q] = self.edges[e as usize];
             let hit = closest_between(a, b, p, q);
-            if hit.distance <= reach && best.is_none_or(|b| hit.distance < b.distance) {
-                best = Some(hit);
+            if hit.distance <= reach {
+                within(e);
+                if best.is_none_or(|b| hit.distance < b.distance) {
+                    best = Some(hit);
+                }
             }
         });
         best
@@ -226,7 +255,49 @@ impl SharpEdges {
         if memory.clears(segment, reach) {
             return None;
         }
+        if memory.count > 0
+            && let Some(answer) = self.among_held(segment, reach, memory)
+        {
+            return answer;
+        }
         self.measure(segment, [reach, look], memory)
+    }
+
+    /// [`SharpEdges::nearest_remembering`] from the sharp edges `memory` holds, where the
+    /// segment's ends have moved so little since it was measured that every sharp edge
+    /// within `reach` of it now was within the distance looked to then, and one of them
+    /// is within the reach (`None`: else; a segment clear of them all is measured again,
+    /// so that its clearance is measured from where it is). Those are in the same order
+    /// as the tree gives them, so the nearest of them is the same one.
+    #[inline(never)]
+    fn among_held(
+        &self,
+        ends: [Vec3A; 2],
+        reach: f32,
+        memory: &Clearance,
+    ) -> Option<Option<EdgeHit>> {
+        let [a, b] = ends.map(Vec3::from);
+        let rounding = rounding_near(a.abs().max(b.abs()));
+        let room = memory.looked - reach * (1.0 + 1e-4) - rounding;
+        let held = memory.near.get(..usize::from(memory.count))?;
+        if !(room > 0.0 && memory.moved_squared(ends) < room * room) {
+            return None;
+        }
+        // As the walk does: only an edge whose box meets the segment's grown by the reach.
+        let pad = Vec3::splat(reach);
+        let (lo, hi) = (a.min(b) - pad, a.max(b) + pad);
+        let mut best: Option<EdgeHit> = None;
+        for &e in held {
+            let [p, q] = self.edges[e as usize];
+            if !(p.min(q).cmple(hi).all() && p.max(q).cmpge(lo).all()) {
+                continue;
+            }
+            let hit = closest_between(a, b, p, q);
+            if hit.distance <= reach && best.is_none_or(|b| hit.distance < b.distance) {
+                best = Some(hit);
+            }
+        }
+        best.map(Some)
     }
 
     /// [`SharpEdges::nearest_remembering`] where the memory does not tell.
@@ -239,13 +310,27 @@ impl SharpEdges {
     ) -> Option<EdgeHit> {
         let [a, b] = ends.map(Vec3::from);
         let far = (1.0 + look) * reach;
-        let near = self.nearest(a, b, far);
+        let (mut near, mut count) = ([0; NEAR_EDGES], 0);
+        let best = self.nearest_with(a, b, far, |e| {
+            if let Some(slot) = near.get_mut(count) {
+                *slot = e;
+            }
+            count += 1;
+        });
         let rounding = rounding_near(a.abs().max(b.abs()));
+        let held = count <= NEAR_EDGES;
         *memory = Clearance {
             ends,
-            clear: near.map_or(far, |hit| hit.distance) - rounding,
+            clear: best.map_or(far, |hit| hit.distance) - rounding,
+            looked: if held {
+                far - rounding
+            } else {
+                f32::NEG_INFINITY
+            },
+            count: if held { count as u8 } else { 0 },
+            near,
         };
-        near.filter(|hit| hit.distance <= reach)
+        best.filter(|hit| hit.distance <= reach)
     }
 }
 
@@ -393,12 +478,13 @@ mod tests {
     }
 
     /// Questions a cloth edge remembering its clearance asked: those answered `None`, those
-    /// of them that walked the tree, and the others.
+    /// of them that walked the tree, and the others, and those of them that walked it.
     #[derive(Default)]
     struct Asked {
         clear: usize,
         walks: usize,
         near: usize,
+        near_walks: usize,
     }
 
     impl Asked {
@@ -417,6 +503,7 @@ mod tests {
             assert_eq!(remembered, edges.nearest(a, b, reach), "{a} – {b}");
             if remembered.is_some() {
                 self.near += 1;
+                self.near_walks += usize::from(*memory != before);
             } else {
                 self.clear += 1;
                 self.walks += usize::from(*memory != before);
@@ -462,7 +549,9 @@ mod tests {
                 asked.ask(&edges, ends, [0.01, LOOK_DEFORMING], &mut memory);
             }
         }
-        let Asked { clear, walks, near } = asked;
+        let Asked {
+            clear, walks, near, ..
+        } = asked;
         assert!(
             near * 10 > clear && near < clear,
             "{near} near, {clear} clear"
@@ -473,10 +562,30 @@ mod tests {
         );
     }
 
+    /// A cloth edge carried across a box's top, 5 mm above it, from one of its edges to the
+    /// opposite one at 2 mm a step, gets the answer a walk of the tree gives at every step,
+    /// bit for bit: the sharp edges it held near the first do not answer for the second.
+    #[test]
+    fn held_edges_answer_only_as_far_as_they_were_looked_for() {
+        let (v, t, normals) = unit_cube();
+        let edges = SharpEdges::of(&v, &t, &normals);
+        let mut asked = Asked::default();
+        let mut memory = Clearance::NONE;
+        for k in 0..=520 {
+            let x = -0.01 + 0.002 * k as f32;
+            let ends = [Vec3A::new(x, 1.005, 0.4), Vec3A::new(x, 1.005, 0.45)];
+            asked.ask(&edges, ends, [0.01, LOOK], &mut memory);
+        }
+        let Asked { clear, near, .. } = asked;
+        assert!(near >= 12 && clear > 450, "{near} near, {clear} clear");
+    }
+
     /// A cloth edge remembering its clearance gets the answer a walk of the tree gives,
     /// bit for bit, at every step as it wanders in and out of reach of a box's edges, its
     /// ends moving up to 1 mm a step and its reach changing; and where no edge is within
-    /// reach, walks the tree for fewer than one question in four.
+    /// reach, walks the tree for fewer than one question in four. Where one is, it asks
+    /// the few sharp edges the last walk found, and walks the tree for fewer than one
+    /// question in ten.
     #[test]
     fn remembering_the_clearance_changes_nothing() {
         let (v, t, normals) = unit_cube();
@@ -496,7 +605,12 @@ mod tests {
                 asked.ask(&edges, ends, [reach, LOOK], &mut memory);
             }
         }
-        let Asked { clear, walks, near } = asked;
+        let Asked {
+            clear,
+            walks,
+            near,
+            near_walks,
+        } = asked;
         assert!(
             near * 5 > clear && near < clear,
             "{near} near, {clear} clear"
@@ -504,6 +618,10 @@ mod tests {
         assert!(
             walks * 4 < clear,
             "{walks} walks in {clear} questions answered clear"
+        );
+        assert!(
+            near_walks * 10 < near,
+            "{near_walks} walks in {near} questions answered near"
         );
     }
 }

@@ -187,7 +187,13 @@ where
             .iter()
             .map(|&p| Vec3A::from((frame.from_start)(p))),
     );
-    let order = &pass.model.edge_colours.order;
+    let colours = &pass.model.edge_colours;
+    let order = &colours.order;
+    debug_assert_eq!(
+        colours.ends.len(),
+        order.len(),
+        "each edge's ends, in order"
+    );
     let fixed = moved == EdgesMoved::Fixed;
     let reading = memory.take_in(&state.pos, &frame.to_local, order.len(), fixed);
     (memory.clearance).resize(springs.a.len(), Clearance::NONE);
@@ -213,14 +219,12 @@ where
     for _ in 0..EDGE_SWEEPS {
         let mut crossings = 0;
         // In colours (the GPU's order too, a colour's edges side by side there).
-        for (k, &e) in order.iter().enumerate() {
-            let e = e as usize;
-            let (i, j) = (springs.a[e] as usize, springs.b[e] as usize);
+        for (k, (&e, &ends)) in order.iter().zip(&colours.ends).enumerate() {
+            let (e, [i, j]) = (e as usize, ends.map(|p| p as usize));
             // Neither particle has moved farther than its odometer ran on since this cloth
             // edge was last asked, nor (any particle) farther than `reach_most` since the
             // substep began: while the two odometers leave it more than the reach clear, it
             // is not asked.
-            let ends = [i as u32, j as u32];
             let reading_now = reading.as_ref().map(|r| (r, odometers[i] + odometers[j]));
             if let Some((r, at)) = reading_now {
                 let last = asked_at[k];

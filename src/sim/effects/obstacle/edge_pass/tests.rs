@@ -143,6 +143,7 @@ fn a_memory_kept_for_other_edges_passes_none_of_these_by() {
     let (model, mut state) = cloth_over_cube(0.008);
     let mut reversed = model.clone();
     reversed.edge_colours.order.reverse();
+    reversed.edge_colours.ends.reverse();
     let edges = cube_edges(0.0);
     let mut memory = EdgeMemory::default();
     let mut rnd = crate::test_rng::uniform(34);
