@@ -224,12 +224,8 @@ impl SharpEdges {
         let mut best: Option<EdgeHit> = None;
         self.tree.overlapping(a.min(b) - pad, a.max(b) + pad, |e| {
             let [p, q] = self.edges[e as usize];
-            let hit = closest_between(a, b, p, q);
-            if hit.distance <= reach {
+            if keep_nearest(&mut best, closest_between(a, b, p, q), reach) {
                 within(e);
-                if best.is_none_or(|b| hit.distance < b.distance) {
-                    best = Some(hit);
-                }
             }
         });
         best
@@ -256,30 +252,24 @@ impl SharpEdges {
             return None;
         }
         if memory.count > 0
-            && let Some(answer) = self.among_held(segment, reach, memory)
+            && let Some(hit) = self.among_held(segment, reach, memory)
         {
-            return answer;
+            return Some(hit);
         }
         self.measure(segment, [reach, look], memory)
     }
 
-    /// [`SharpEdges::nearest_remembering`] from the sharp edges `memory` holds, where the
-    /// segment's ends have moved so little since it was measured that every sharp edge
-    /// within `reach` of it now was within the distance looked to then, and one of them
-    /// is within the reach (`None`: else; a segment clear of them all is measured again,
-    /// so that its clearance is measured from where it is). Those are in the same order
-    /// as the tree gives them, so the nearest of them is the same one.
+    /// The nearest of the sharp edges `memory` holds to the segment between `ends`, where
+    /// the ends have moved so little since it was measured that every sharp edge within
+    /// `reach` of it now was within the distance looked to then, and one of them is within
+    /// the reach (`None`: else, and the tree is asked; a segment clear of them all is
+    /// measured again, so that its clearance is measured from where it is). Those are in
+    /// the same order as the tree gives them, so the nearest of them is the walk's.
     #[inline(never)]
-    fn among_held(
-        &self,
-        ends: [Vec3A; 2],
-        reach: f32,
-        memory: &Clearance,
-    ) -> Option<Option<EdgeHit>> {
+    fn among_held(&self, ends: [Vec3A; 2], reach: f32, memory: &Clearance) -> Option<EdgeHit> {
         let [a, b] = ends.map(Vec3::from);
         let rounding = rounding_near(a.abs().max(b.abs()));
         let room = memory.looked - reach * (1.0 + 1e-4) - rounding;
-        let held = memory.near.get(..usize::from(memory.count))?;
         if !(room > 0.0 && memory.moved_squared(ends) < room * room) {
             return None;
         }
@@ -287,17 +277,14 @@ impl SharpEdges {
         let pad = Vec3::splat(reach);
         let (lo, hi) = (a.min(b) - pad, a.max(b) + pad);
         let mut best: Option<EdgeHit> = None;
-        for &e in held {
+        for &e in &memory.near[..usize::from(memory.count)] {
             let [p, q] = self.edges[e as usize];
             if !(p.min(q).cmple(hi).all() && p.max(q).cmpge(lo).all()) {
                 continue;
             }
-            let hit = closest_between(a, b, p, q);
-            if hit.distance <= reach && best.is_none_or(|b| hit.distance < b.distance) {
-                best = Some(hit);
-            }
+            keep_nearest(&mut best, closest_between(a, b, p, q), reach);
         }
-        best.map(Some)
+        best
     }
 
     /// [`SharpEdges::nearest_remembering`] where the memory does not tell.
@@ -367,6 +354,16 @@ fn sweep_meets(before: [Vec3; 2], after: [Vec3; 2], p: Vec3, q: Vec3) -> Option<
             let (x, y) = (before[0] + da * t, before[1] + (after[1] - before[1]) * t);
             closest_between(x, y, p, q).distance <= touch
         })
+}
+
+/// Whether `hit` is within `reach`; if so, and nearer than `best` (the first of equals
+/// stays), it is the best now.
+fn keep_nearest(best: &mut Option<EdgeHit>, hit: EdgeHit, reach: f32) -> bool {
+    let within = hit.distance <= reach;
+    if within && best.is_none_or(|b| hit.distance < b.distance) {
+        *best = Some(hit);
+    }
+    within
 }
 
 /// An edge as a degenerate triangle, for the tree.
