@@ -9,6 +9,7 @@ use clothsim::scene::{Scene, SceneFile, Simulation};
 use clothsim::sim::forces::{DihedralBending, hinge_angle};
 use clothsim::sim::{
     BendingModel, ContactError, Effect, ForceTerm, SELF_SETUP, SelfCollision, SelfContacts, Wind,
+    WindForce,
 };
 use glam::{Quat, Vec3};
 
@@ -304,7 +305,14 @@ fn plate(normal: Vec3, vel: Vec3) -> (ClothModel, Vec<Vec3>, Vec<Vec3>) {
 fn wind_force(wind: &Wind, normal: Vec3, vel: Vec3) -> Vec3 {
     let (model, pos, vel) = plate(normal, vel);
     let mut f = vec![Vec3::ZERO; pos.len()];
-    ForceTerm::<f32>::add_forces(wind, &model, &pos, &vel, 0.0, &mut f);
+    ForceTerm::<f32>::add_forces(
+        &WindForce::new(*wind, &model),
+        &model,
+        &pos,
+        &vel,
+        0.0,
+        &mut f,
+    );
     f.iter().sum()
 }
 

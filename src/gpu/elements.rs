@@ -335,7 +335,10 @@ mod tests {
         for e in &scene.effects {
             match e {
                 Effect::Wind(w) => {
-                    ForceTerm::<f32>::add_forces(w, model, &state.pos, &state.vel, time, &mut cpu)
+                    let term = crate::sim::WindForce::new(*w, model);
+                    ForceTerm::<f32>::add_forces(
+                        &term, model, &state.pos, &state.vel, time, &mut cpu,
+                    )
                 }
                 Effect::Bending(BendingModel::Dihedral { .. }) => {
                     let term = (forces.terms().iter()).find_map(Force::get::<DihedralBending>);

@@ -33,4 +33,4 @@ pub use plane::Plane;
 pub use registry::{Addable, Effect};
 pub use self_collision::{SelfCollision, TooThick, shortest_edge};
 pub use sphere::Sphere;
-pub use wind::Wind;
+pub use wind::{Wind, WindForce};

@@ -5,10 +5,13 @@ use glam::Vec3;
 
 use crate::cloth::{ClothModel, Real, Vector};
 use crate::sim::forces::{Force, ForceTerm};
+use crate::sim::kernels::{ElementForces, NOTHING};
 use crate::sim::param_error::ParamError;
 use crate::sim::params::Material;
 
 use super::effect_kind::{ClothBox, EffectKind, GuardShare};
+
+mod lanes;
 
 /// Wind with gusts, and the cloth's aerodynamic coefficients.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -81,9 +84,68 @@ impl Wind {
     }
 }
 
-impl<R: Real> ForceTerm<R> for Wind {
-    /// Adds each triangle's drag and lift (N), a third to each corner, at time `t`.
+/// The wind as a force term: its parameters, and each particle's triangles for the forces
+/// shared with the team.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WindForce {
+    wind: Wind,
+    shared: ElementForces<3>,
+}
+
+impl WindForce {
+    /// `wind` on the triangles of `model`.
+    pub fn new(wind: Wind, model: &ClothModel) -> Self {
+        let particles = model.rest_positions.len();
+        let shared = ElementForces::new(&model.triangles, particles);
+        Self { wind, shared }
+    }
+}
+
+impl<R: Real> ForceTerm<R> for WindForce {
+    /// Adds each triangle's drag and lift (N), a third to each corner, at time `t` (in
+    /// `f32` eight triangles at a time, `wind/lanes.rs`, and from
+    /// [`crate::parallel::PARALLEL_ELEMENTS`] triangles on shared with the team: the same
+    /// bits).
     fn add_forces(
+        &self,
+        model: &ClothModel,
+        pos: &[R::V3],
+        vel: &[R::V3],
+        t: f64,
+        f: &mut [R::V3],
+    ) {
+        let (wind, triangles) = (&self.wind, &model.triangles[..]);
+        let (Some(pos), Some(vel), Some(f)) =
+            (R::f32_slice(pos), R::f32_slice(vel), R::f32_slice_mut(f))
+        else {
+            return wind.add_forces_one_by_one::<R>(model, pos, vel, t, f);
+        };
+        if !ElementForces::<3>::shared(triangles.len()) {
+            return wind.each_share(triangles, [pos, vel], t, |first, shares, adds| {
+                for (k, share) in shares.iter().enumerate() {
+                    if adds & (1 << k) != 0 {
+                        for &i in &triangles[first + k] {
+                            f[i as usize] += *share;
+                        }
+                    }
+                }
+            });
+        }
+        self.shared.add_shared(f, |range, slots| {
+            let base = range.start;
+            wind.each_share(&triangles[range], [pos, vel], t, |first, shares, adds| {
+                for (k, &share) in shares.iter().enumerate() {
+                    let share = if adds & (1 << k) != 0 { share } else { NOTHING };
+                    slots.set(base + first + k, [share; 3]);
+                }
+            });
+        });
+    }
+}
+
+impl Wind {
+    /// The wind's forces a triangle at a time, in either precision.
+    fn add_forces_one_by_one<R: Real>(
         &self,
         model: &ClothModel,
         pos: &[R::V3],
@@ -157,11 +219,11 @@ impl EffectKind for Wind {
 
     fn force<R: Real>(
         &self,
-        _model: &ClothModel,
+        model: &ClothModel,
         _material: &Material,
         _kept: &[Force<R>],
     ) -> Option<Force<R>> {
-        Some(Force::of(Self::NAME, *self))
+        Some(Force::of(Self::NAME, WindForce::new(*self, model)))
     }
 
     fn guard(&self, _up: Vec3) -> GuardShare {

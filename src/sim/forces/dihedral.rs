@@ -7,6 +7,10 @@ use crate::cloth::{ClothModel, Real, Vector};
 
 use super::force_term::ForceTerm;
 
+mod lanes;
+#[cfg(test)]
+mod tests;
+
 /// The hinges of a cloth with their rest angles and weights, and a stiffness (N·m).
 #[derive(Clone, Debug, PartialEq)]
 pub struct DihedralBending {
@@ -129,7 +133,23 @@ impl DihedralBending {
 
     /// Adds `−∂E/∂x = −2k·w·(θ − θ₀)·∂θ/∂x` (N) to `f`, limited for a wing nearly collapsed
     /// onto its hinge (see `wing_limit`).
+    /// In `f32` eight hinges at a time (`dihedral/lanes.rs`).
     pub fn add_forces<R: Real>(&self, model: &ClothModel, pos: &[R::V3], f: &mut [R::V3]) {
+        if let Some(pos) = R::f32_slice(pos)
+            && let Some(f) = R::f32_slice_mut(f)
+        {
+            // On the calling thread: shared with the team like the wind's, the hinges took
+            // as long on two threads as on one (docs/performance.md, "The flag's hinges and
+            // wind").
+            let (rest, weight) = (&self.rest[..], &self.weight[..]);
+            let k = [self.stiffness, MIN_WING];
+            return lanes::add_forces(&model.hinges, [rest, weight], k, pos, f);
+        }
+        self.add_forces_one_by_one::<R>(model, pos, f);
+    }
+
+    /// [`DihedralBending::add_forces`] a hinge at a time, in either precision.
+    fn add_forces_one_by_one<R: Real>(&self, model: &ClothModel, pos: &[R::V3], f: &mut [R::V3]) {
         for (h, (&rest, &w)) in model.hinges.iter().zip(self.rest.iter().zip(&self.weight)) {
             let [x0, x1, a, b] = h.map(|i| pos[i as usize]);
             let Some((theta, grad)) = hinge_angle::<R>(x0, x1, a, b) else {

@@ -3,6 +3,7 @@
 //! threads.
 
 mod components;
+mod elements;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
 mod points;
@@ -17,6 +18,7 @@ pub use crate::cloth::Real;
 pub use components::{
     Blocks, Components, Scratch, blocks_times, join, split, split_blocks, zeroed,
 };
+pub use elements::{ElementForces, NOTHING, Slots};
 pub use points::{leaves, less_into, outside, take_changes, take_moves};
 pub use run_pass::Projectors;
 pub use spring_runs::{SpringRuns, SystemSums};
