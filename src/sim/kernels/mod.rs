@@ -12,6 +12,7 @@ mod spring_runs;
 mod two_passes;
 mod vbd_lanes;
 mod vbd_stencil;
+mod vec3x8;
 mod xpbd_lanes;
 
 pub use crate::cloth::Real;
@@ -25,4 +26,5 @@ pub use spring_runs::{SpringRuns, SystemSums};
 pub use two_passes::{BlockPass, TwoPasses};
 pub use vbd_lanes::{Particle, StepLength, descend_range, descend_range_plain};
 pub use vbd_stencil::Stencil;
+pub use vec3x8::{LANES, Vec3x8, padded};
 pub use xpbd_lanes::{Moved, Scaled, project_range, project_range_plain};

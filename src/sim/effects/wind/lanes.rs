@@ -7,93 +7,9 @@
 use glam::Vec3;
 use wide::f32x8;
 
+use crate::sim::kernels::{LANES, Vec3x8};
+
 use super::Wind;
-
-/// Triangles a chunk holds: the lanes of an `f32x8`.
-const LANES: usize = 8;
-
-/// Eight vectors, one a lane.
-#[derive(Clone, Copy)]
-struct Lanes3 {
-    x: f32x8,
-    y: f32x8,
-    z: f32x8,
-}
-
-impl Lanes3 {
-    fn splat(v: Vec3) -> Lanes3 {
-        Lanes3 {
-            x: f32x8::splat(v.x),
-            y: f32x8::splat(v.y),
-            z: f32x8::splat(v.z),
-        }
-    }
-
-    fn gather(of: &[Vec3], triangles: &[[u32; 3]], corner: usize) -> Lanes3 {
-        let [mut x, mut y, mut z] = [[0.0f32; LANES]; 3];
-        for (lane, t) in triangles.iter().enumerate() {
-            let p = of[t[corner] as usize];
-            (x[lane], y[lane], z[lane]) = (p.x, p.y, p.z);
-        }
-        Lanes3 {
-            x: x.into(),
-            y: y.into(),
-            z: z.into(),
-        }
-    }
-
-    fn add(self, o: Lanes3) -> Lanes3 {
-        Lanes3 {
-            x: self.x + o.x,
-            y: self.y + o.y,
-            z: self.z + o.z,
-        }
-    }
-
-    fn sub(self, o: Lanes3) -> Lanes3 {
-        Lanes3 {
-            x: self.x - o.x,
-            y: self.y - o.y,
-            z: self.z - o.z,
-        }
-    }
-
-    fn scale(self, s: f32x8) -> Lanes3 {
-        Lanes3 {
-            x: self.x * s,
-            y: self.y * s,
-            z: self.z * s,
-        }
-    }
-
-    fn div(self, s: f32x8) -> Lanes3 {
-        Lanes3 {
-            x: self.x / s,
-            y: self.y / s,
-            z: self.z / s,
-        }
-    }
-
-    /// As `glam::Vec3::cross`.
-    fn cross(self, o: Lanes3) -> Lanes3 {
-        Lanes3 {
-            x: self.y * o.z - o.y * self.z,
-            y: self.z * o.x - o.z * self.x,
-            z: self.x * o.y - o.x * self.y,
-        }
-    }
-
-    /// As `glam::Vec3::dot`.
-    fn dot(self, o: Lanes3) -> f32x8 {
-        self.x * o.x + self.y * o.y + self.z * o.z
-    }
-
-    /// The eight vectors, one a lane.
-    fn unpack(self) -> [Vec3; LANES] {
-        let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
-        std::array::from_fn(|lane| Vec3::new(x[lane], y[lane], z[lane]))
-    }
-}
 
 /// The sine of each lane, as `f32::sin` gives it (a lane's own arithmetic costs less
 /// than a whole vector's: the gusts need sines alone, the lanes' kernel makes cosines too).
@@ -110,14 +26,14 @@ fn sin_cos(x: f32x8) -> (f32x8, f32x8) {
 
 impl Wind {
     /// [`Wind::air_velocity`] at eight points.
-    fn air_lanes(&self, x: Lanes3, t: f64) -> Lanes3 {
+    fn air_lanes(&self, x: Vec3x8, t: f64) -> Vec3x8 {
         let speed = self.speed();
         if speed == 0.0 || self.gust == 0.0 {
-            return Lanes3::splat(self.velocity);
+            return Vec3x8::splat(self.velocity);
         }
         let c = f32x8::splat;
         let along = self.velocity / speed;
-        let s = c(t as f32) - x.dot(Lanes3::splat(along)) / c(speed);
+        let s = c(t as f32) - x.dot(Vec3x8::splat(along)) / c(speed);
         let p = self.gust_period.max(1e-3);
         let tau = c(std::f32::consts::TAU);
         let strength = sin(tau * s / c(p)) * c(0.5)
@@ -125,15 +41,13 @@ impl Wind {
             + sin(tau * s / c(0.37 * p) + c(2.1)) * c(0.2);
         let veer = sin(tau * s / c(0.83 * p) + c(0.7)) * c(0.25) * c(self.gust);
         let (sin, cos) = sin_cos(veer);
-        let along3 = Lanes3::splat(along);
-        let turned = Lanes3 {
+        let along3 = Vec3x8::splat(along);
+        let turned = Vec3x8 {
             x: cos * along3.x + sin * along3.z,
             y: along3.y,
             z: -sin * along3.x + cos * along3.z,
         };
-        turned
-            .scale(c(speed))
-            .scale(c(1.0) + c(self.gust) * strength)
+        turned * c(speed) * (c(1.0) + c(self.gust) * strength)
     }
 
     /// Each triangle's drag and lift (N) at time `t`, a third of it, the share each of its
@@ -152,24 +66,24 @@ impl Wind {
         let half_rho = c(0.5 * self.air_density);
         let (third, half) = (c(3.0), c(0.5));
         for (chunk, triangles) in triangles.chunks(LANES).enumerate() {
-            let [a, b, cc] = [0, 1, 2].map(|k| Lanes3::gather(pos, triangles, k));
-            let [va, vb, vc] = [0, 1, 2].map(|k| Lanes3::gather(vel, triangles, k));
-            let normal = b.sub(a).cross(cc.sub(a));
+            let [a, b, cc] = [0, 1, 2].map(|k| Vec3x8::gather(pos, triangles, k));
+            let [va, vb, vc] = [0, 1, 2].map(|k| Vec3x8::gather(vel, triangles, k));
+            let normal = (b - a).cross(cc - a);
             let twice_area = normal.dot(normal).sqrt();
-            let n = normal.div(twice_area);
-            let centre = a.add(b).add(cc).div(third);
+            let n = normal / twice_area;
+            let centre = (a + b + cc) / third;
             let air = self.air_lanes(centre, t);
-            let relative = va.add(vb).add(vc).div(third).sub(air);
+            let relative = (va + vb + vc) / third - air;
             let speed = relative.dot(relative).sqrt();
-            let flow = relative.div(speed);
+            let flow = relative / speed;
             let facing = flow.dot(n);
             let area = half * twice_area;
-            let drag = n.scale(-half_rho * c(self.drag) * area * speed * speed * facing);
-            let across = n.sub(flow.scale(facing));
-            let lift = across.scale(-half_rho * c(self.lift) * area * speed * speed * facing);
+            let drag = n * (-half_rho * c(self.drag) * area * speed * speed * facing);
+            let across = n - flow * facing;
+            let lift = across * (-half_rho * c(self.lift) * area * speed * speed * facing);
             // Lanes past the last triangle hold zeros: a degenerate triangle.
             let skip = (twice_area.simd_le(c(1e-12)) | speed.simd_le(c(1e-6))).to_bitmask();
-            let all = drag.add(lift).div(third).unpack();
+            let all = ((drag + lift) / third).unpack();
             shares(chunk * LANES, &all[..triangles.len()], !skip);
         }
     }
@@ -203,16 +117,7 @@ mod tests {
         .unwrap();
         let model = ClothModel::new(&mesh, 0.2, &[]);
         assert!(!model.triangles.len().is_multiple_of(LANES));
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut jitter = |scale: f32| {
-            let mut unit = || {
-                seed ^= seed << 13;
-                seed ^= seed >> 7;
-                seed ^= seed << 17;
-                (seed >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-            };
-            Vec3::new(unit(), unit(), unit()) * scale
-        };
+        let mut jitter = crate::test_rng::jitter(7);
         let mut pos: Vec<Vec3> = (model.rest_positions.iter())
             .map(|&p| p + jitter(0.03))
             .collect();
@@ -256,16 +161,7 @@ mod tests {
             .unwrap();
         let model = ClothModel::new(&mesh, 0.2, &[]);
         assert!(model.triangles.len() >= crate::parallel::PARALLEL_ELEMENTS);
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut jitter = |scale: f32| {
-            let mut unit = || {
-                seed ^= seed << 13;
-                seed ^= seed >> 7;
-                seed ^= seed << 17;
-                (seed >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-            };
-            Vec3::new(unit(), unit(), unit()) * scale
-        };
+        let mut jitter = crate::test_rng::jitter(14);
         let mut pos: Vec<Vec3> = (model.rest_positions.iter())
             .map(|&p| p + jitter(0.005))
             .collect();

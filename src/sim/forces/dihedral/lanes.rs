@@ -9,83 +9,7 @@
 use glam::Vec3;
 use wide::f32x8;
 
-/// Hinges a chunk holds: the lanes of an `f32x8`.
-const LANES: usize = 8;
-
-/// Eight points' coordinates, one point a lane.
-#[derive(Clone, Copy)]
-struct Points {
-    x: f32x8,
-    y: f32x8,
-    z: f32x8,
-}
-
-impl Points {
-    fn gather(pos: &[Vec3], hinges: &[[u32; 4]], corner: usize) -> Points {
-        let [mut x, mut y, mut z] = [[0.0f32; LANES]; 3];
-        for (lane, h) in hinges.iter().enumerate() {
-            let p = pos[h[corner] as usize];
-            (x[lane], y[lane], z[lane]) = (p.x, p.y, p.z);
-        }
-        Points {
-            x: x.into(),
-            y: y.into(),
-            z: z.into(),
-        }
-    }
-
-    fn sub(self, o: Points) -> Points {
-        Points {
-            x: self.x - o.x,
-            y: self.y - o.y,
-            z: self.z - o.z,
-        }
-    }
-
-    fn add(self, o: Points) -> Points {
-        Points {
-            x: self.x + o.x,
-            y: self.y + o.y,
-            z: self.z + o.z,
-        }
-    }
-
-    fn scale(self, s: f32x8) -> Points {
-        Points {
-            x: self.x * s,
-            y: self.y * s,
-            z: self.z * s,
-        }
-    }
-
-    /// As `glam::Vec3::cross`.
-    fn cross(self, o: Points) -> Points {
-        Points {
-            x: self.y * o.z - o.y * self.z,
-            y: self.z * o.x - o.z * self.x,
-            z: self.x * o.y - o.x * self.y,
-        }
-    }
-
-    /// As `glam::Vec3::dot`.
-    fn dot(self, o: Points) -> f32x8 {
-        self.x * o.x + self.y * o.y + self.z * o.z
-    }
-
-    fn neg(self) -> Points {
-        Points {
-            x: -self.x,
-            y: -self.y,
-            z: -self.z,
-        }
-    }
-
-    /// The eight points, one a lane.
-    fn unpack(self) -> [Vec3; LANES] {
-        let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
-        std::array::from_fn(|lane| Vec3::new(x[lane], y[lane], z[lane]))
-    }
-}
+use crate::sim::kernels::{LANES, Vec3x8, padded};
 
 /// Adds every hinge's force `−2k·w·(θ − θ₀)·∂θ/∂x`, limited for slivers, to `f`: what
 /// [`super::DihedralBending::add_forces`] adds, eight hinges at a time, for each hinge's
@@ -108,33 +32,23 @@ pub(super) fn add_forces(
         .zip(rest.chunks(LANES))
         .zip(weight.chunks(LANES))
     {
-        let [x0, x1, a, b] = [0, 1, 2, 3].map(|k| Points::gather(pos, hinges, k));
-        let lanes = |v: &[f32]| {
-            let mut l = [0.0f32; LANES];
-            l[..v.len()].copy_from_slice(v);
-            f32x8::from(l)
-        };
-        let (rest, weight) = (lanes(rest), lanes(weight));
+        let [x0, x1, a, b] = [0, 1, 2, 3].map(|k| Vec3x8::gather(pos, hinges, k));
+        let (rest, weight) = (padded(rest), padded(weight));
         // `hinge_angle`, lane by lane.
-        let e = x1.sub(x0);
+        let e = x1 - x0;
         let len2 = e.dot(e);
-        let na = e.cross(a.sub(x0));
-        let nb = x0.sub(x1).cross(b.sub(x1));
+        let na = e.cross(a - x0);
+        let nb = (x0 - x1).cross(b - x1);
         let (na2, nb2) = (na.dot(na), nb.dot(nb));
         let degenerate = len2.simd_le(tiny) | na2.simd_le(tiny) | nb2.simd_le(tiny);
         let len = len2.sqrt();
-        let axis = Points {
-            x: e.x / len,
-            y: e.y / len,
-            z: e.z / len,
-        };
-        let theta = na.cross(nb).dot(axis).atan2(na.dot(nb));
-        let ga = na.neg().scale(len / na2);
-        let gb = nb.neg().scale(len / nb2);
-        let alpha_a = a.sub(x0).dot(e) / len2;
-        let alpha_b = b.sub(x0).dot(e) / len2;
-        let g0 = ga.scale(alpha_a - one).add(gb.scale(alpha_b - one));
-        let g1 = ga.scale(-alpha_a).sub(gb.scale(alpha_b));
+        let theta = na.cross(nb).dot(e / len).atan2(na.dot(nb));
+        let ga = -na * (len / na2);
+        let gb = -nb * (len / nb2);
+        let alpha_a = (a - x0).dot(e) / len2;
+        let alpha_b = (b - x0).dot(e) / len2;
+        let g0 = ga * (alpha_a - one) + gb * (alpha_b - one);
+        let g1 = ga * -alpha_a - gb * alpha_b;
         // `wing_limit`.
         let largest = ga.dot(ga).sqrt().max(gb.dot(gb).sqrt());
         let cap = one / (f32x8::splat(min_wing) * len);
@@ -144,7 +58,7 @@ pub(super) fn add_forces(
         let d = d.simd_gt(pi).select(d - tau, d);
         let d = d.simd_lt(-pi).select(d + tau, d);
         let scale = twice * weight * d * limit;
-        let grads = [g0, g1, ga, gb].map(|g| g.scale(scale).unpack());
+        let grads = [g0, g1, ga, gb].map(|g| (g * scale).unpack());
         let skip = degenerate.to_bitmask();
         for (lane, h) in hinges.iter().enumerate() {
             if skip & (1 << lane) == 0 {
