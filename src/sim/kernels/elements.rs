@@ -21,7 +21,7 @@ pub const NOTHING: Vec3 = Vec3::splat(-0.0);
 const PIECES_PER_MEMBER: usize = 4;
 
 /// Elements in a piece are a multiple of this (the lanes the terms take them in).
-const CHUNK: usize = 8;
+const CHUNK: usize = super::vec3x8::LANES;
 
 /// Where each particle's forces from its elements lie: `start[i]..start[i + 1]` of the
 /// slots for particle `i`, in the elements' order, and the slot of each element's corner.
