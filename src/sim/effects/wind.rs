@@ -120,7 +120,7 @@ impl<R: Real> ForceTerm<R> for WindForce {
         else {
             return wind.add_forces_one_by_one::<R>(model, pos, vel, t, f);
         };
-        if !ElementForces::<3>::shared(triangles.len()) {
+        if !self.shared.pays() {
             return wind.each_share(triangles, [pos, vel], t, |first, shares, adds| {
                 for (k, share) in shares.iter().enumerate() {
                     if adds & (1 << k) != 0 {

@@ -80,10 +80,10 @@ impl<const N: usize> ElementForces<N> {
         }
     }
 
-    /// Whether [`ElementForces::add_shared`] pays for `elements` on the current team: from
-    /// [`PARALLEL_ELEMENTS`] on, where the team has helpers.
-    pub fn shared(elements: usize) -> bool {
-        elements >= PARALLEL_ELEMENTS && Team::current().members() > 1
+    /// Whether [`ElementForces::add_shared`] pays on the current team: from
+    /// [`PARALLEL_ELEMENTS`] elements on, where the team has helpers.
+    pub fn pays(&self) -> bool {
+        self.slot.len() >= PARALLEL_ELEMENTS && Team::current().members() > 1
     }
 
     /// Adds the forces of the elements to `f`: `forces(range, slots)` sets every element's
