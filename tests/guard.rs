@@ -165,9 +165,12 @@ fn a_cloth_a_handle_spins_is_admitted_by_its_energy() {
     );
 }
 
-/// What `flag` with the policy `configure`d did in its first `frames` frames.
+/// What `flag` with the policy `configure`d did in its first `frames` frames, without its
+/// self-collision: with it, no refinement keeps the whip at 0.42 s under 30 m/s and that
+/// frame is refused (the question here is only whether a fixed limit is raised).
 fn flag_events(configure: impl FnOnce(&mut GuardPolicy), frames: usize) -> Vec<GuardEvent> {
     let mut scene = Scene::builtin("flag").unwrap();
+    (scene.effects).retain(|e| !matches!(e, Effect::SelfCollision(_)));
     configure(&mut scene.params.guard);
     let mut sim = Simulation::new(scene);
     (0..frames)
