@@ -56,7 +56,7 @@ fn gpu_and_cpu_resolve_the_same_sphere_contacts_at_impact() {
         .state()
         .pos
         .iter()
-        .filter(|&&p| sphere.surface(p).is_some_and(|s| s.0 < offset + 1e-4))
+        .filter(|&&p| sphere.surface(p, 0.0).is_some_and(|s| s.0 < offset + 1e-4))
         .count();
     assert!(
         touching >= 4,

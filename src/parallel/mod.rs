@@ -10,7 +10,7 @@ mod team;
 mod wide;
 
 pub use disjoint::Disjoint;
-pub use parts::{PARALLEL_ELEMENTS, each_part, fold_parts, within};
+pub use parts::{PARALLEL_ELEMENTS, each_part, each_part_from, fold_parts, within};
 pub use ranges::share;
 pub use team::Team;
 pub use wide::{wide, wide_fma};

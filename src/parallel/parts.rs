@@ -22,9 +22,20 @@ pub fn each_part<T: Send, const K: usize>(
     arrays: [&mut [T]; K],
     part: impl Fn(std::ops::Range<usize>, [&mut [T]; K]) + Sync,
 ) {
+    each_part_from(PARALLEL_ELEMENTS, arrays, part);
+}
+
+/// [`each_part`] for a loop whose elements cost enough that sharing it pays from `from`
+/// elements on (a mesh obstacle's particles: a walk of its tree each) rather than from
+/// [`PARALLEL_ELEMENTS`].
+pub fn each_part_from<T: Send, const K: usize>(
+    from: usize,
+    arrays: [&mut [T]; K],
+    part: impl Fn(std::ops::Range<usize>, [&mut [T]; K]) + Sync,
+) {
     let len = arrays.iter().map(|a| a.len()).min().unwrap_or(0);
     let team = Team::current();
-    if len < PARALLEL_ELEMENTS || team.members() == 1 {
+    if len < from || team.members() == 1 {
         part(0..len, arrays.map(|a| &mut a[..len]));
         return;
     }

@@ -38,7 +38,7 @@ impl ContactMeasures {
         if !effects.iter().any(contact) {
             return None;
         }
-        let inside = min_surface_distance(effects, pos).map_or(0.0, |d| (-d).max(0.0));
+        let inside = min_surface_distance(effects, pos, t).map_or(0.0, |d| (-d).max(0.0));
         Some(Self {
             deepest_penetration: inside as f64,
             intersections: intersections(effects, t, triangles, pos).total(),

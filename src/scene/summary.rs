@@ -167,7 +167,7 @@ impl Simulation {
             requested_substeps: self.params().step.substeps,
             finite: state.is_finite(),
             max_speed: state.max_speed(),
-            min_collider_distance: min_surface_distance(self.effects(), &state.pos),
+            min_collider_distance: min_surface_distance(self.effects(), &state.pos, state.time),
             kinetic_energy: state.kinetic_energy(model),
             wall_seconds,
             refined_frames: 0,

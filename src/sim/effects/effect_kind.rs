@@ -93,9 +93,14 @@ pub trait EffectKind: Sized {
         Ok(0)
     }
 
-    /// For a solid: signed distance from `p` to its surface (m, negative inside), the
-    /// outward normal there, and the surface's velocity there (m/s).
-    fn surface(&self, _p: Vec3) -> Option<(f32, Vec3, Vec3)> {
+    /// Whether it is a solid the cloth may not enter: then [`EffectKind::surface`] answers.
+    fn is_solid(&self) -> bool {
+        false
+    }
+
+    /// For a solid: signed distance from `p` to its surface where it is at time `t` (s; m,
+    /// negative inside), the outward normal there, and the surface's velocity there (m/s).
+    fn surface(&self, _p: Vec3, _t: f64) -> Option<(f32, Vec3, Vec3)> {
         None
     }
 

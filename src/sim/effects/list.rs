@@ -76,11 +76,14 @@ pub fn thickness_fits(effects: &[Effect], model: &ClothModel) -> Result<(), TooT
 }
 
 /// Smallest signed distance from any particle to any solid's surface among `effects`,
-/// metres; `None` without solids.
-pub fn min_surface_distance(effects: &[Effect], pos: &[Vec3]) -> Option<f32> {
+/// each where it is at time `t` (s), metres; `None` without solids.
+pub fn min_surface_distance(effects: &[Effect], pos: &[Vec3], t: f64) -> Option<f32> {
     effects
         .iter()
-        .flat_map(|e| pos.iter().filter_map(move |&p| e.surface(p).map(|s| s.0)))
+        .flat_map(|e| {
+            pos.iter()
+                .filter_map(move |&p| e.surface(p, t).map(|s| s.0))
+        })
         .reduce(f32::min)
 }
 

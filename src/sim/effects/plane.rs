@@ -99,7 +99,11 @@ impl EffectKind for Plane {
         Ok(resolve(&self.unit(), pass))
     }
 
-    fn surface(&self, p: Vec3) -> Option<(f32, Vec3, Vec3)> {
+    fn is_solid(&self) -> bool {
+        true
+    }
+
+    fn surface(&self, p: Vec3, _t: f64) -> Option<(f32, Vec3, Vec3)> {
         Some(self.unit().surface_at(p))
     }
 

@@ -84,7 +84,7 @@ macro_rules! effects {
 
             /// Whether it is a solid the cloth may not enter (it has a [surface](EffectKind::surface)).
             pub fn is_solid(&self) -> bool {
-                self.surface(Vec3::ZERO).is_some()
+                match self { $(Effect::$variant(e) => e.is_solid(),)* }
             }
 
             /// Whether it acts after each substep ([`EffectKind::is_contact`]).
@@ -100,10 +100,10 @@ macro_rules! effects {
                 match self { $(Effect::$variant(e) => e.resolve(pass),)* }
             }
 
-            /// A solid's signed distance, normal and surface velocity at `p`
-            /// ([`EffectKind::surface`]).
-            pub fn surface(&self, p: Vec3) -> Option<(f32, Vec3, Vec3)> {
-                match self { $(Effect::$variant(e) => e.surface(p),)* }
+            /// A solid's signed distance, normal and surface velocity at `p`, where it is at
+            /// time `t` ([`EffectKind::surface`]).
+            pub fn surface(&self, p: Vec3, t: f64) -> Option<(f32, Vec3, Vec3)> {
+                match self { $(Effect::$variant(e) => e.surface(p, t),)* }
             }
 
             /// What it adds to the guard's limits ([`EffectKind::guard`]).

@@ -10,7 +10,7 @@ use glam::Vec3;
 
 use super::effect_kind::ContactPass;
 use crate::mesh::bounds;
-use crate::parallel::{Disjoint, each_part, within};
+use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, each_part_from, within};
 use crate::sim::obstacle::Gathered;
 
 /// Coulomb friction of a solid when a scene file gives none (dimensionless).
@@ -23,6 +23,11 @@ pub(super) fn default_friction() -> f32 {
 
 /// A solid's surface, for [`resolve`].
 pub(super) trait Solid {
+    /// Particles from which [`resolve`] shares them out between the team's members: a
+    /// solid whose [`Solid::contact`] walks a tree costs enough a particle to share from
+    /// fewer than [`PARALLEL_ELEMENTS`].
+    const SHARED_FROM: usize = PARALLEL_ELEMENTS;
+
     /// Signed distance from `p` to the surface (metres, negative inside), the outward unit
     /// normal there, and the surface velocity there (m/s).
     fn surface_at(&self, p: Vec3) -> (f32, Vec3, Vec3);
@@ -114,8 +119,8 @@ pub(super) fn resolve_in_boxes(
 /// its part of the particles (with its part of `memory`); where `boxed`, it first takes
 /// its part's box of moves, joins it to the others' (returned: `None` for no particle),
 /// and passes the part by where that box is clear.
-fn resolve_parts(
-    solid: &(impl Solid + Sync),
+fn resolve_parts<S: Solid + Sync>(
+    solid: &S,
     pass: &mut ContactPass<'_>,
     memory: Option<&mut [Gathered]>,
     boxed: bool,
@@ -127,7 +132,8 @@ fn resolve_parts(
     let memory = memory.map(Disjoint::new);
     // The parts' boxes, joined as they come: a least and a greatest, in any order.
     let joined: Mutex<Option<(Vec3, Vec3)>> = Mutex::new(None);
-    each_part([&mut state.pos, &mut state.vel], |range, [pos, vel]| {
+    let arrays = [&mut state.pos[..], &mut state.vel[..]];
+    each_part_from(S::SHARED_FROM, arrays, |range, [pos, vel]| {
         // SAFETY: `each_part`'s ranges are disjoint, so are these parts of the memory.
         let memory = memory.as_ref().map(|m| unsafe { m.part(range.clone()) });
         let (start, inv_mass) = (within(start, range.clone()), within(inv_mass, range));

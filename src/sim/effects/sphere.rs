@@ -212,7 +212,12 @@ impl EffectKind for Sphere {
         Ok(particles + self.keep_faces_out(pass))
     }
 
-    fn surface(&self, p: Vec3) -> Option<(f32, Vec3, Vec3)> {
+    fn is_solid(&self) -> bool {
+        true
+    }
+
+    /// The same at any time: it spins about its centre.
+    fn surface(&self, p: Vec3, _t: f64) -> Option<(f32, Vec3, Vec3)> {
         Some(self.surface_at(p))
     }
 
