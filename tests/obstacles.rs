@@ -21,6 +21,14 @@ fn write_obj(path: &Path, vertices: &[Vec3], triangles: &[[u32; 3]]) {
     std::fs::write(path, text).unwrap();
 }
 
+/// Writes a 1 m square of two triangles, flat at y = 0 and centred on the origin, to
+/// `name` in `dir`.
+fn write_square(dir: &Path, name: &str) {
+    let corners = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)];
+    let square: Vec<Vec3> = corners.iter().map(|&(x, z)| Vec3::new(x, 0.0, z)).collect();
+    write_obj(&dir.join(name), &square, &[[0, 2, 1], [0, 3, 2]]);
+}
+
 /// A scene from `toml` in `dir` (relative paths start there).
 fn scene(dir: &Path, toml: &str) -> Scene {
     let path = dir.join("scene.toml");
@@ -48,13 +56,7 @@ fn stable_substeps(kind: IntegratorKind) -> u32 {
 #[test]
 fn a_cloth_thrown_at_a_thin_square_at_10_m_s_never_passes_it() {
     let dir = tempfile::tempdir().unwrap();
-    let corners = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)];
-    let square: Vec<Vec3> = corners.iter().map(|&(x, z)| Vec3::new(x, 0.0, z)).collect();
-    write_obj(
-        &dir.path().join("square.obj"),
-        &square,
-        &[[0, 2, 1], [0, 3, 2]],
-    );
+    write_square(dir.path(), "square.obj");
     // Three heights, so that some substep of the fast methods ends past the square, not
     // within the offset above it.
     let kinds = IntegratorKind::ALL.into_iter();
@@ -335,13 +337,7 @@ keyframes = [ {{ time = 0.0 }}, {{ time = 10.0, rotate = {{ axis = [0.0, 1.0, 0.
 /// must stay above it after every substep. Returns the cloth's lowest height at the end.
 fn lifted_by_a_plate(speed: f32, height: f32, seconds: f64) -> f32 {
     let dir = tempfile::tempdir().unwrap();
-    let corners = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)];
-    let square: Vec<Vec3> = corners.iter().map(|&(x, z)| Vec3::new(x, 0.0, z)).collect();
-    write_obj(
-        &dir.path().join("plate.obj"),
-        &square,
-        &[[0, 2, 1], [0, 3, 2]],
-    );
+    write_square(dir.path(), "plate.obj");
     let toml = format!(
         r#"
 name = "lifted"
@@ -944,13 +940,7 @@ fn the_distance_to_a_deforming_obstacle_is_where_it_is_then() {
 #[test]
 fn the_distance_to_a_moving_obstacle_is_where_it_is_then() {
     let dir = tempfile::tempdir().unwrap();
-    let corners = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)];
-    let square: Vec<Vec3> = corners.iter().map(|&(x, z)| Vec3::new(x, 0.0, z)).collect();
-    write_obj(
-        &dir.path().join("plate.obj"),
-        &square,
-        &[[0, 2, 1], [0, 3, 2]],
-    );
+    write_square(dir.path(), "plate.obj");
     let toml = r#"
 name = "rising"
 [cloth]
