@@ -84,12 +84,12 @@ impl Wind {
     }
 }
 
-/// The wind as a force term: its parameters, and each particle's triangles for the forces
-/// shared with the team.
+/// The wind as a force term: its parameters, and where the cloth has enough triangles to
+/// share them with the team, each particle's triangles.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WindForce {
     wind: Wind,
-    shared: ElementForces<3>,
+    shared: Option<ElementForces<3>>,
 }
 
 impl WindForce {
@@ -120,7 +120,7 @@ impl<R: Real> ForceTerm<R> for WindForce {
         else {
             return wind.add_forces_one_by_one::<R>(model, pos, vel, t, f);
         };
-        if !self.shared.pays() {
+        let Some(shared) = self.shared.as_ref().filter(|s| s.pays()) else {
             return wind.each_share(triangles, [pos, vel], t, |first, shares, adds| {
                 for (k, share) in shares.iter().enumerate() {
                     if adds & (1 << k) != 0 {
@@ -130,8 +130,8 @@ impl<R: Real> ForceTerm<R> for WindForce {
                     }
                 }
             });
-        }
-        self.shared.add_shared(f, |range, slots| {
+        };
+        shared.add_shared(f, |range, slots| {
             let base = range.start;
             wind.each_share(&triangles[range], [pos, vel], t, |first, shares, adds| {
                 for (k, &share) in shares.iter().enumerate() {

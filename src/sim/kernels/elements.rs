@@ -53,8 +53,12 @@ impl<const N: usize> Slots<'_, N> {
 }
 
 impl<const N: usize> ElementForces<N> {
-    /// For `elements` of `particles`.
-    pub fn new(elements: &[[u32; N]], particles: usize) -> Self {
+    /// For `elements` of `particles`, where they are enough to share: from
+    /// [`PARALLEL_ELEMENTS`] on (`None` for fewer, which nothing shares).
+    pub fn new(elements: &[[u32; N]], particles: usize) -> Option<Self> {
+        if elements.len() < PARALLEL_ELEMENTS {
+            return None;
+        }
         let mut start = vec![0u32; particles + 1];
         for e in elements {
             for &i in e {
@@ -73,17 +77,17 @@ impl<const N: usize> ElementForces<N> {
                 })
             })
             .collect();
-        Self {
+        Some(Self {
             start,
             slot,
             scratch: Scratch::default(),
-        }
+        })
     }
 
-    /// Whether [`ElementForces::add_shared`] pays on the current team: from
-    /// [`PARALLEL_ELEMENTS`] elements on, where the team has helpers.
+    /// Whether [`ElementForces::add_shared`] pays on the current team: where it has
+    /// helpers.
     pub fn pays(&self) -> bool {
-        self.slot.len() >= PARALLEL_ELEMENTS && Team::current().members() > 1
+        Team::current().members() > 1
     }
 
     /// Adds the forces of the elements to `f`: `forces(range, slots)` sets every element's
