@@ -44,6 +44,16 @@ impl Default for Wind {
     }
 }
 
+/// The gusts' strength: three incommensurate tones (no visible period, smooth, in
+/// [−1, 1]), each its period as a share of the gust period, its phase (rad) and its weight.
+/// The air's velocity in lanes (`wind/lanes.rs`) reads these too; the GPU's
+/// `shaders/elements.wgsl` writes them out (held to the CPU's forces by its tests).
+const TONES: [[f32; 3]; 3] = [[1.0, 0.0, 0.5], [0.61, 1.3, 0.3], [0.37, 2.1, 0.2]];
+
+/// The gusts' veer about the vertical: its tone's period share and phase, and its
+/// amplitude (rad for a gust of 1).
+const VEER: [f32; 3] = [0.83, 0.7, 0.25];
+
 impl Wind {
     /// Steady speed, m/s.
     pub fn speed(&self) -> f32 {
@@ -69,11 +79,11 @@ impl Wind {
         let s = R::of_f64(t) - x.dot(along) / speed;
         let p = self.gust_period.max(1e-3);
         let tau = c(std::f32::consts::TAU);
-        // Three incommensurate tones: no visible period, smooth, in [−1, 1].
-        let strength = (tau * s / c(p)).sin() * c(0.5)
-            + (tau * s / c(0.61 * p) + c(1.3)).sin() * c(0.3)
-            + (tau * s / c(0.37 * p) + c(2.1)).sin() * c(0.2);
-        let veer = (tau * s / c(0.83 * p) + c(0.7)).sin() * c(0.25) * c(self.gust);
+        let tone = |[share, phase, weight]: [f32; 3]| {
+            (tau * s / c(share * p) + c(phase)).sin() * c(weight)
+        };
+        let strength = tone(TONES[0]) + tone(TONES[1]) + tone(TONES[2]);
+        let veer = tone(VEER) * c(self.gust);
         let (sin, cos) = veer.sin_cos();
         let turned = R::V3::new(
             cos * along.x() + sin * along.z(),

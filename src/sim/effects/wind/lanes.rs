@@ -9,7 +9,7 @@ use wide::f32x8;
 
 use crate::sim::kernels::{LANES, Vec3x8};
 
-use super::Wind;
+use super::{TONES, VEER, Wind};
 
 /// The sine of each lane, as `f32::sin` gives it: so the forces stay the one-at-a-time
 /// path's bits (the lanes' own `f32x8::sin_cos` saved 4 % of the wind's time and lost them).
@@ -36,10 +36,10 @@ impl Wind {
         let s = c(t as f32) - x.dot(along) / c(speed);
         let p = self.gust_period.max(1e-3);
         let tau = c(std::f32::consts::TAU);
-        let strength = sin(tau * s / c(p)) * c(0.5)
-            + sin(tau * s / c(0.61 * p) + c(1.3)) * c(0.3)
-            + sin(tau * s / c(0.37 * p) + c(2.1)) * c(0.2);
-        let veer = sin(tau * s / c(0.83 * p) + c(0.7)) * c(0.25) * c(self.gust);
+        let tone =
+            |[share, phase, weight]: [f32; 3]| sin(tau * s / c(share * p) + c(phase)) * c(weight);
+        let strength = tone(TONES[0]) + tone(TONES[1]) + tone(TONES[2]);
+        let veer = tone(VEER) * c(self.gust);
         let (sin, cos) = sin_cos(veer);
         let turned = Vec3x8 {
             x: cos * along.x + sin * along.z,
