@@ -908,8 +908,8 @@ fn mesh_obstacle_contacts_give_the_same_bits_on_two_threads_as_on_one() {
 /// The distance to a solid is taken where the solid is at the time asked: the napkin over
 /// the bending arm (an OBJ sequence) keeps at least nine tenths of its thickness from the
 /// arm where the arm is after every frame of its first second, and rests on it (measured
-/// against the arm as it was at the start instead, particles come within 0.2 mm of it, a
-/// hundredth of a millimetre), and the summary's closest particle says the same.
+/// against the arm as it was at the start instead, a particle comes within 7 µm of it),
+/// and the summary's closest particle says the same.
 #[test]
 fn the_distance_to_a_deforming_obstacle_is_where_it_is_then() {
     let mut sim = Simulation::new(Scene::builtin("arm").expect("scene"));
