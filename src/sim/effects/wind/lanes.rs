@@ -14,8 +14,7 @@ use super::{TONES, VEER, Wind};
 /// The sine of each lane, as `f32::sin` gives it: so the forces stay the one-at-a-time
 /// path's bits (the lanes' own `f32x8::sin_cos` saved 4 % of the wind's time and lost them).
 fn sin(x: f32x8) -> f32x8 {
-    let x = x.to_array();
-    f32x8::from(std::array::from_fn::<f32, LANES, _>(|lane| x[lane].sin()))
+    x.to_array().map(f32::sin).into()
 }
 
 /// The sine and the cosine of each lane, as `f32::sin_cos` gives them.
