@@ -120,7 +120,7 @@ impl GuardLimits {
         let lowest = if lowest.is_finite() { lowest } else { 0.0 };
         let mut bottom = lowest;
         let (mut surface, mut wind) = (0.0f32, 0.0f32);
-        for share in effects.iter().map(|e| e.guard(up)) {
+        for share in effects.iter().map(|e| e.guard(up, state)) {
             if let Some(floor) = share.floor {
                 bottom = bottom.min(floor);
             }

@@ -104,8 +104,9 @@ pub trait EffectKind: Sized {
         None
     }
 
-    /// What it adds to the guard's limits, with `up` against gravity.
-    fn guard(&self, _up: Vec3) -> GuardShare {
+    /// What it adds to the guard's limits for `cloth` as it is when they are derived, with
+    /// `up` against gravity.
+    fn guard(&self, _up: Vec3, _cloth: &ClothState) -> GuardShare {
         GuardShare::default()
     }
 

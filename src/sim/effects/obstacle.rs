@@ -10,6 +10,7 @@ use glam::{Quat, Vec3};
 
 use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 use super::solid::{Solid, default_friction, resolve_remembering};
+use crate::cloth::ClothState;
 use crate::mesh::{ObjError, PolygonSoup, parse_obj, read_obj};
 use crate::sim::motion::{AxisAngle, Keyframe, Pose, RigidMotion};
 use crate::sim::obstacle::{Gathered, Moment, Sequence, Surface, SurfaceClock};
@@ -712,7 +713,7 @@ impl EffectKind for Obstacle {
         Some(then.surface_at(p))
     }
 
-    fn guard(&self, up: Vec3) -> GuardShare {
+    fn guard(&self, up: Vec3, _cloth: &ClothState) -> GuardShare {
         let Some(placed) = self.placed() else {
             return GuardShare::default();
         };

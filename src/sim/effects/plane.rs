@@ -4,6 +4,7 @@ use glam::Vec3;
 
 use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 use super::solid::{Solid, default_friction, resolve};
+use crate::cloth::ClothState;
 use crate::sim::param_error::ParamError;
 use crate::sim::self_contacts::ContactError;
 
@@ -107,7 +108,7 @@ impl EffectKind for Plane {
         Some(self.unit().surface_at(p))
     }
 
-    fn guard(&self, up: Vec3) -> GuardShare {
+    fn guard(&self, up: Vec3, _cloth: &ClothState) -> GuardShare {
         GuardShare {
             floor: Some(up.dot(self.point)),
             ..GuardShare::default()

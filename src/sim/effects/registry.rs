@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 
-use crate::cloth::{ClothModel, Real};
+use crate::cloth::{ClothModel, ClothState, Real};
 use crate::sim::forces::Force;
 use crate::sim::param_error::ParamError;
 use crate::sim::params::Material;
@@ -107,8 +107,8 @@ macro_rules! effects {
             }
 
             /// What it adds to the guard's limits ([`EffectKind::guard`]).
-            pub fn guard(&self, up: Vec3) -> GuardShare {
-                match self { $(Effect::$variant(e) => e.guard(up),)* }
+            pub fn guard(&self, up: Vec3, cloth: &ClothState) -> GuardShare {
+                match self { $(Effect::$variant(e) => e.guard(up, cloth),)* }
             }
 
             /// Whether the GPU backend runs it ([`EffectKind::on_gpu`]).

@@ -6,6 +6,7 @@ use super::effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 #[cfg(doc)]
 use super::faces::FacePatches;
 use super::solid::{Solid, default_friction, resolve_in_boxes};
+use crate::cloth::ClothState;
 use crate::sim::obstacle::closest_weights;
 use crate::sim::param_error::ParamError;
 use crate::sim::self_contacts::ContactError;
@@ -221,7 +222,7 @@ impl EffectKind for Sphere {
         Some(self.surface_at(p))
     }
 
-    fn guard(&self, up: Vec3) -> GuardShare {
+    fn guard(&self, up: Vec3, _cloth: &ClothState) -> GuardShare {
         GuardShare {
             floor: Some(up.dot(self.center) - self.radius),
             surface_speed: self.spin.length() * self.radius,

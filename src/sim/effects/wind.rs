@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use crate::cloth::{ClothModel, Real, Vector};
+use crate::cloth::{ClothModel, ClothState, Real, Vector};
 use crate::sim::forces::{Force, ForceTerm};
 use crate::sim::kernels::{ElementForces, NOTHING};
 use crate::sim::param_error::ParamError;
@@ -236,7 +236,7 @@ impl EffectKind for Wind {
         Some(Force::of(Self::NAME, WindForce::new(*self, model)))
     }
 
-    fn guard(&self, _up: Vec3) -> GuardShare {
+    fn guard(&self, _up: Vec3, _cloth: &ClothState) -> GuardShare {
         GuardShare {
             flow_speed: self.peak_speed(),
             ..GuardShare::default()
