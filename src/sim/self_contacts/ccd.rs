@@ -7,7 +7,7 @@
 
 use glam::DVec3;
 
-use super::primitives::{Pair, distance};
+use super::primitives::{Pair, apart_by_planes, distance};
 
 /// Advances stop when the gap above the separation kept has shrunk to this share of what
 /// it was at the start: the motion is cut there.
@@ -40,6 +40,11 @@ pub fn safe_fraction(pair: &Pair, from: [DVec3; 4], moves: [DVec3; 4], keep: f64
     }
     let speed = closing_bound(pair, moves);
     if speed == 0.0 {
+        return 1.0;
+    }
+    // Nor where the sides' planes or lines start farther apart than the motion can close
+    // down to `keep` (most of a stack's pairs; strictly, as the distance is asked below).
+    if apart_by_planes(pair, from, (keep + speed) * (1.0 + 1e-9)) {
         return 1.0;
     }
     let d0 = distance(pair, from);
