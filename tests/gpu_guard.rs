@@ -313,3 +313,40 @@ fn a_flags_whip_stands_on_the_gpu_as_on_the_cpu() {
     assert_eq!(guarded.substeps(), 48);
     assert_eq!(farthest(&guarded.state().pos, &free.state().pos), 0.0);
 }
+
+/// `crumple` at 32² without its self-collision, under XPBD at one 50 ms substep a frame:
+/// where it lands (0.65 s) 8 × the substeps do not save XPBD (a spring stretched 145 %),
+/// and implicit Euler at the requested one substep does not either; refined as the
+/// integrator asked for was, it stands at 8.
+fn crumple_landing_in_long_substeps() -> Scene {
+    let mut scene = Scene::open_resized("crumple", None, &Default::default(), Some(32)).unwrap();
+    (scene.effects).retain(|e| !matches!(e, Effect::SelfCollision(_)));
+    scene.params.step.integrator = IntegratorKind::Xpbd;
+    (scene.params.step.dt, scene.params.step.substeps) = (0.05, 1);
+    scene.params.guard.max_refinements = 3;
+    scene
+}
+
+/// The fallback refined on the GPU as on the CPU: in the same frame, to the same substeps,
+/// and the run goes on under implicit Euler.
+#[test]
+fn the_gpu_refines_its_fallback_as_the_cpu_does() {
+    let (cpu, gpu, on_cpu, on_gpu) = both(crumple_landing_in_long_substeps(), 14);
+    let fell_back = |events: &[GuardEvent]| {
+        (events.iter())
+            .find(|e| matches!(e.action, GuardAction::FellBack { .. }))
+            .map(|e| {
+                (
+                    format!("{:.2}", e.time),
+                    e.substeps_before,
+                    e.substeps_after,
+                )
+            })
+    };
+    let on_cpu = fell_back(&on_cpu).expect("the CPU falls back");
+    assert!(on_cpu.2 > 1, "refined: {on_cpu:?}");
+    assert_eq!(fell_back(&on_gpu), Some(on_cpu));
+    for sim in [&cpu, &gpu] {
+        assert_eq!(sim.integrator_in_effect(), IntegratorKind::ImplicitEuler);
+    }
+}
