@@ -13,6 +13,14 @@ use crate::sim::self_contacts::sweeps::Sweeps;
 
 const THICKNESS: f32 = 0.01;
 
+thread_local! {
+    /// Whether [`SelfContacts::settle`] on this thread checks every pair, as before it
+    /// was narrowed to the particles the solids moved.
+    pub(super) static RECHECK_EVERY_PAIR: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// How many of its calls on this thread were narrowed so.
+    pub(super) static NARROWED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
 /// A 48 × 48-quad cloth (4 608 triangles, so the search is shared out) 1 m wide, crumpled
 /// by random offsets of up to 1.5 cm, so that its particles have many pairs.
 fn crumpled() -> (ClothModel, Vec<Vec3>) {
@@ -625,6 +633,7 @@ fn pairs_judged_by_the_boxes_are_kept_exactly_where_their_balls_come_near() {
 
 mod boxes;
 mod refusals;
+mod settle;
 mod trickle;
 mod windows;
 
