@@ -9,7 +9,8 @@ use crate::cloth::{ClothModel, ClothState, Real};
 use super::backend::StepBackend;
 use super::diagnosis::Cause;
 use super::effects::{
-    ContactPass, Effect, FacePatches, SelfCollision, air_damping_of, gravity_of, shortest_edge,
+    Between, ContactPass, Effect, FacePatches, SelfCollision, air_damping_of, gravity_of,
+    shortest_edge,
 };
 use super::forces::ForceSet;
 use super::guard::{Diverged, FrameOutcome, GuardEvent, GuardLimits, Trouble, check};
@@ -34,6 +35,9 @@ const RECHECKS: usize = 3;
 /// The phase that times the copy of each substep's start positions, from which every
 /// contact's paths run (taken before the integrator's step, where there are contacts).
 pub const CONTACT_START: &str = "contact-start";
+
+/// The phase that times the settling of particles left between two solids ([`Between`]).
+pub const BETWEEN_SOLIDS: &str = "between-solids";
 
 /// Runs `work`, adding its wall time to `spent`.
 fn timed<T>(spent: &mut Duration, work: impl FnOnce() -> T) -> T {
@@ -84,6 +88,8 @@ pub struct CpuStepper<R: Real = f32> {
     before_solids: Vec<glam::Vec3>,
     /// The cloth's triangles in patches, for the solids' face passes.
     faces: FacePatches,
+    /// Where two solids' offsets overlap (their boxes, reused).
+    between: Between,
     /// Air damping in effect, 1/s (0 without the effect; for the guard's diagnosis).
     air_damping: f32,
     /// The state stepped, in a precision other than `f32`.
@@ -139,6 +145,7 @@ impl<R: Real> CpuStepper<R> {
             self_contacts: SelfContacts::default(),
             before_solids: Vec::new(),
             faces: FacePatches::default(),
+            between: Between::default(),
             air_damping: 0.0,
             precise: PreciseState::default(),
             view: ClothState::default(),
@@ -225,8 +232,16 @@ impl<R: Real> CpuStepper<R> {
                 self.before_solids.clone_from(&pass.state.pos)
             });
         }
+        // Where two solids' offsets overlap, what the last left inside another is settled
+        // once every solid has acted: before self-contact (it comes last), or after them.
+        let mut settled = false;
         for c in &self.contacts {
             if matches!(c, Effect::SelfCollision(_)) {
+                let between = &mut self.between;
+                let effects = &self.contacts;
+                contacts +=
+                    (self.timings).time(BETWEEN_SOLIDS, || between.keep(effects, &mut pass));
+                settled = true;
                 // What the solids moved rests on them; self-contact starts from where they
                 // left the cloth (it comes last).
                 let held = &mut pass.self_contacts.held;
@@ -235,6 +250,10 @@ impl<R: Real> CpuStepper<R> {
                 });
             }
             contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
+        }
+        if !settled {
+            let (between, effects) = (&mut self.between, &self.contacts);
+            contacts += (self.timings).time(BETWEEN_SOLIDS, || between.keep(effects, &mut pass));
         }
         // Self-contact may have pushed cloth into a solid (a stack pressing its lowest
         // layer): where it moved anything, the solids act once more, and the cloth's
@@ -250,6 +269,9 @@ impl<R: Real> CpuStepper<R> {
                 for c in self.contacts.iter().filter(|c| c.is_solid()) {
                     contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
                 }
+                let (between, effects) = (&mut self.between, &self.contacts);
+                contacts +=
+                    (self.timings).time(BETWEEN_SOLIDS, || between.keep(effects, &mut pass));
                 // Nothing moved since self-contact: nothing to check.
                 if !timed(&mut upkeep, || self.before_solids != pass.state.pos) {
                     break;

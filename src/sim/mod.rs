@@ -27,7 +27,7 @@ mod timings;
 pub use backend::StepBackend;
 pub use cg::{CgOutcome, ConjugateGradient};
 pub use constraints::{DistanceConstraints, Halves};
-pub use cpu_stepper::{CONTACT_START, CpuStepper, cpu_backend};
+pub use cpu_stepper::{BETWEEN_SOLIDS, CONTACT_START, CpuStepper, cpu_backend};
 pub use diagnosis::{Cause, Vibration, stiffest_vibration};
 pub use effects::{
     AirDamping, BendingModel, ClothBox, ClothSprings, DEFAULT_DIHEDRAL_STIFFNESS, DEFAULT_FPS,

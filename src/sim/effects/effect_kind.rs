@@ -104,6 +104,14 @@ pub trait EffectKind: Sized {
         None
     }
 
+    /// For a solid: a box holding every point within `offset` of its surface or inside it,
+    /// where it is at time `t` (s); a side it does not bound is infinite (a plane's box is
+    /// unbounded along it, and across it unless it faces along an axis; a solid whose box
+    /// is not known cheaply gives an unbounded one). `None` for what is not a solid.
+    fn shell(&self, _t: f64, _offset: f32) -> Option<(Vec3, Vec3)> {
+        None
+    }
+
     /// What it adds to the guard's limits for `cloth` as it is when they are derived, with
     /// `up` against gravity.
     fn guard(&self, _up: Vec3, _cloth: &ClothState) -> GuardShare {

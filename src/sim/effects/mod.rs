@@ -3,6 +3,7 @@
 
 mod air_damping;
 mod bending;
+mod between;
 mod cloth_springs;
 mod effect_kind;
 mod faces;
@@ -19,6 +20,7 @@ mod wind;
 
 pub use air_damping::AirDamping;
 pub use bending::{BendingModel, DEFAULT_DIHEDRAL_STIFFNESS};
+pub use between::Between;
 pub use cloth_springs::ClothSprings;
 pub use effect_kind::{ClothBox, ContactPass, EffectKind, GuardShare};
 pub use faces::FacePatches;

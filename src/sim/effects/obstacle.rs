@@ -713,6 +713,30 @@ impl EffectKind for Obstacle {
         Some(then.surface_at(p))
     }
 
+    /// A rigid obstacle's box at rest carried by its pose at `t` (its eight corners); a
+    /// sequence's is taken as unbounded.
+    fn shell(&self, t: f64, offset: f32) -> Option<(Vec3, Vec3)> {
+        let placed = self.placed()?;
+        let unbounded = Some((Vec3::NEG_INFINITY, Vec3::INFINITY));
+        if placed.sequence.is_some() {
+            return unbounded;
+        }
+        let Some((lo, hi)) = placed.surface.bounds() else {
+            return unbounded;
+        };
+        let pose = placed.motion.at(t);
+        let corner = |k: usize| {
+            let pick = |bit: usize, axis: usize| if k & bit == 0 { lo[axis] } else { hi[axis] };
+            pose.apply(placed.pivot, Vec3::new(pick(1, 0), pick(2, 1), pick(4, 2)))
+        };
+        let (lo, hi) = (0..8)
+            .map(corner)
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), c| {
+                (lo.min(c), hi.max(c))
+            });
+        Some((lo - Vec3::splat(offset), hi + Vec3::splat(offset)))
+    }
+
     fn guard(&self, up: Vec3, _cloth: &ClothState) -> GuardShare {
         let Some(placed) = self.placed() else {
             return GuardShare::default();

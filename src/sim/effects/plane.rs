@@ -108,6 +108,23 @@ impl EffectKind for Plane {
         Some(self.unit().surface_at(p))
     }
 
+    /// Unbounded but across a plane that faces along an axis: there, the points below
+    /// `offset` above it.
+    fn shell(&self, _t: f64, offset: f32) -> Option<(Vec3, Vec3)> {
+        let n = self.unit_normal();
+        let (mut lo, mut hi) = (Vec3::NEG_INFINITY, Vec3::INFINITY);
+        for axis in 0..3 {
+            if n[axis].abs() == 1.0 && n.length_squared() == 1.0 {
+                if n[axis] > 0.0 {
+                    hi[axis] = self.point[axis] + offset;
+                } else {
+                    lo[axis] = self.point[axis] - offset;
+                }
+            }
+        }
+        Some((lo, hi))
+    }
+
     fn guard(&self, up: Vec3, _cloth: &ClothState) -> GuardShare {
         GuardShare {
             floor: Some(up.dot(self.point)),

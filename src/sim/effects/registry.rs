@@ -106,6 +106,12 @@ macro_rules! effects {
                 match self { $(Effect::$variant(e) => e.surface(p, t),)* }
             }
 
+            /// A solid's box of the points within `offset` of it or inside it, at time `t`
+            /// ([`EffectKind::shell`]).
+            pub fn shell(&self, t: f64, offset: f32) -> Option<(Vec3, Vec3)> {
+                match self { $(Effect::$variant(e) => e.shell(t, offset),)* }
+            }
+
             /// What it adds to the guard's limits ([`EffectKind::guard`]).
             pub fn guard(&self, up: Vec3, cloth: &ClothState) -> GuardShare {
                 match self { $(Effect::$variant(e) => e.guard(up, cloth),)* }

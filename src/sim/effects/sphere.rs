@@ -222,6 +222,11 @@ impl EffectKind for Sphere {
         Some(self.surface_at(p))
     }
 
+    fn shell(&self, _t: f64, offset: f32) -> Option<(Vec3, Vec3)> {
+        let reach = Vec3::splat(self.radius + offset);
+        Some((self.center - reach, self.center + reach))
+    }
+
     fn guard(&self, up: Vec3, _cloth: &ClothState) -> GuardShare {
         GuardShare {
             floor: Some(up.dot(self.center) - self.radius),
