@@ -956,3 +956,54 @@ keyframes = [ { time = 0.0 }, { time = 1.0, translate = [0.0, 0.5, 0.0] } ]
     let closest = summary.min_collider_distance.expect("a solid");
     assert!((closest - 0.5).abs() < 1e-4, "{closest} m");
 }
+
+/// A mesh obstacle's box of the distance it keeps (its own thickness here) holds every
+/// vertex where its motion has carried it (a square turned and moved by keyframes, at
+/// several times); a still one's is its vertices' box grown by that distance, no wider
+/// (the table of `tablecloth`, which keeps the scene's offset).
+#[test]
+fn an_obstacles_offset_box_holds_it_where_it_has_moved() {
+    let dir = tempfile::tempdir().unwrap();
+    write_square(dir.path(), "square.obj");
+    let turned = scene(
+        dir.path(),
+        "name = \"turned\"\n[cloth]\ngrid = { quads = 4, size = 0.5 }\ncenter = [0.0, 2.0, 0.0]\n\
+         [[effects]]\ntype = \"obstacle\"\nobj = \"square.obj\"\nthickness = 0.02\n\
+         keyframes = [ { time = 0.0 }, { time = 2.0, translate = [0.3, 0.2, 0.0], \
+         rotate = { axis = [1.0, 0.0, 1.0], degrees = 120.0 } } ]\n",
+    );
+    for (sim, kept, still) in [
+        (Simulation::new(turned), 0.02, false),
+        (
+            Simulation::new(Scene::open("tablecloth").unwrap()),
+            0.01,
+            true,
+        ),
+    ] {
+        let solid = (sim.effects().iter())
+            .find(|e| matches!(e, Effect::Obstacle(_)))
+            .unwrap();
+        let Effect::Obstacle(obstacle) = solid else {
+            unreachable!()
+        };
+        let placed = obstacle.placed().unwrap();
+        assert_eq!(solid.clearance(0.01), kept);
+        for t in [0.0, 0.37, 1.1, 2.5] {
+            let (lo, hi) = solid.shell(t, solid.clearance(0.01)).unwrap();
+            let world = placed.world_vertices(t);
+            let (vlo, vhi) = (world.iter())
+                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| {
+                    (lo.min(*v), hi.max(*v))
+                });
+            let grown = Vec3::splat(kept);
+            assert!(
+                (vlo - grown).cmpge(lo - 1e-5).all() && (vhi + grown).cmple(hi + 1e-5).all(),
+                "at {t} s: vertices {vlo}..{vhi} outside {lo}..{hi}"
+            );
+            if still {
+                let wider = (vlo - grown - lo).abs().max((hi - vhi - grown).abs());
+                assert!(wider.max_element() < 1e-5, "at {t} s: {lo}..{hi}");
+            }
+        }
+    }
+}

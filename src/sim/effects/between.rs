@@ -7,7 +7,8 @@
 //! as its tangent plane where the particle is, a few rounds over (the sphere's curve is
 //! taken up in two or three); in a wedge that is along it, out to where the two offsets
 //! leave room. Between two solids that face each other closer than twice the offset, no
-//! place keeps both: the particle is left halfway, as far from each.
+//! place keeps both: the particle is left halfway, as far from each. Each solid's offset is
+//! the distance it keeps ([`Effect::clearance`]: a mesh obstacle may have its own).
 
 use glam::Vec3;
 
@@ -49,7 +50,7 @@ impl Between {
     /// ([`Effect::shell`]) are asked. Returns how many it moved.
     pub fn keep(&mut self, effects: &[Effect], pass: &mut ContactPass<'_>) -> usize {
         let (t, offset) = (pass.state.time, pass.offset);
-        let shells = || (effects.iter()).filter_map(|e| e.shell(t, offset));
+        let shells = || (effects.iter()).filter_map(|e| e.shell(t, e.clearance(offset)));
         self.regions.clear();
         for (k, (alo, ahi)) in shells().enumerate() {
             for (blo, bhi) in shells().skip(k + 1) {
@@ -93,12 +94,16 @@ struct Near {
 /// `t`, where it touches at least one (`None` for fewer than two touched).
 fn deepest_two(effects: &[Effect], x: Vec3, t: f64, offset: f32) -> Option<[Near; 2]> {
     let mut two: [Option<Near>; 2] = [None, None];
-    for (d, normal, _) in effects.iter().filter_map(|e| e.surface(x, t)) {
+    for e in effects {
+        let Some((d, normal, _)) = e.surface(x, t) else {
+            continue;
+        };
+        let kept = e.clearance(offset);
         let near = Near {
-            depth: offset - d,
+            depth: kept - d,
             normal,
         };
-        if near.depth < -TOUCHING * offset {
+        if near.depth < -TOUCHING * kept {
             continue;
         }
         if two[0].is_none_or(|f| near.depth > f.depth) {
@@ -156,9 +161,12 @@ fn between(effects: &[Effect], (x, v): (Vec3, Vec3), t: f64, offset: f32) -> Opt
     // change that leaves it moving towards neither (each solid's own pass applied its
     // friction); the two it approaches fastest, as the place was settled.
     let mut approach: [Option<Near>; 2] = [None, None];
-    for (d, normal, velocity) in effects.iter().filter_map(|e| e.surface(x, t)) {
+    for e in effects {
+        let Some((d, normal, velocity)) = e.surface(x, t) else {
+            continue;
+        };
         let speed = (velocity - v).dot(normal);
-        if d > offset * (1.0 + LANDED) {
+        if d > e.clearance(offset) * (1.0 + LANDED) {
             continue;
         }
         let near = Near {

@@ -104,6 +104,12 @@ pub trait EffectKind: Sized {
         None
     }
 
+    /// For a solid: how far it keeps the cloth from its surface, m, where the scene's
+    /// collision offset is `offset` (a mesh obstacle may have its own).
+    fn clearance(&self, offset: f32) -> f32 {
+        offset
+    }
+
     /// For a solid: a box holding every point within `offset` of its surface or inside it,
     /// where it is at time `t` (s); a side it does not bound is infinite (a plane's box is
     /// unbounded along it, and across it unless it faces along an axis; a solid whose box

@@ -713,6 +713,10 @@ impl EffectKind for Obstacle {
         Some(then.surface_at(p))
     }
 
+    fn clearance(&self, offset: f32) -> f32 {
+        self.thickness.unwrap_or(offset)
+    }
+
     /// A rigid obstacle's box at rest carried by its pose at `t` (its eight corners); a
     /// sequence's is taken as unbounded.
     fn shell(&self, t: f64, offset: f32) -> Option<(Vec3, Vec3)> {

@@ -106,6 +106,12 @@ macro_rules! effects {
                 match self { $(Effect::$variant(e) => e.surface(p, t),)* }
             }
 
+            /// How far a solid keeps the cloth from its surface where the scene's offset is
+            /// `offset` ([`EffectKind::clearance`]).
+            pub fn clearance(&self, offset: f32) -> f32 {
+                match self { $(Effect::$variant(e) => e.clearance(offset),)* }
+            }
+
             /// A solid's box of the points within `offset` of it or inside it, at time `t`
             /// ([`EffectKind::shell`]).
             pub fn shell(&self, t: f64, offset: f32) -> Option<(Vec3, Vec3)> {
