@@ -9,9 +9,12 @@ use crate::parallel::fold_parts;
 use super::*;
 
 /// The particles' boxes are given room for later substeps only while none moves more
-/// than this share of the thickness in a substep in the moving frame. Room for the slow
-/// particles alone was tried: where `crumple` piles up, it kept 15 000–20 000 pairs at
-/// 64² against a few hundred, and cost more than the searches it saved.
+/// than this share of the thickness in a substep in the moving frame, or so few do that
+/// refreshing their triangles costs less than the whole searches by the motion
+/// ([`SearchCosts::few_refreshed_cheaper`]: in `layers` 10 of 3 125 particles, in `flag`
+/// 2 of 651, held the whole cloth to a whole search every other substep). Room for the
+/// slow particles alone was tried: where `crumple` piles up, it kept 15 000–20 000 pairs
+/// at 64² against a few hundred, and cost more than the searches it saved.
 const REUSE_BELOW: f32 = 0.5;
 
 /// How far, as a share of the thickness, a particle may stray from the path a window
@@ -331,15 +334,23 @@ impl SelfContacts {
         // Room to reuse the pairs only where the cloth moves slowly in the moving frame; a
         // fast substep would leave its boxes at once, and the room would only add pairs.
         let (from, to) = (&self.from, &self.to);
+        // The fastest particle, and how many move at least the share of the thickness.
+        let reuse = (REUSE_BELOW * thickness).powi(2);
         let part = |range: std::ops::Range<usize>| {
             let (from, to) = (within(from, range.clone()), within(to, range));
             (from.iter().zip(to))
                 .map(|(s, p)| s.distance_squared(*p))
-                .fold(0.0f32, f32::max)
+                .fold((0.0f32, 0), |(most, fast), d| {
+                    (most.max(d), fast + usize::from(d >= reuse))
+                })
         };
         let len = from.len().min(to.len());
-        let fastest = fold_parts(len, part, f32::max).unwrap_or(0.0).sqrt();
-        let slow = fastest < REUSE_BELOW * thickness;
+        let join = |(a, m): (f32, usize), (b, n): (f32, usize)| (a.max(b), m + n);
+        let (fastest, fast) = fold_parts(len, part, join).unwrap_or((0.0, 0));
+        // Slow, or so few fast that refreshing their triangles costs less than the whole
+        // searches by the motion would.
+        let few = (self.costs).few_refreshed_cheaper(fast, model.triangles.len(), len);
+        let slow = fastest.sqrt() < REUSE_BELOW * thickness || few;
         // Fast, the pairs are judged by the motion too (see `Boxes::swept`), carried on
         // for a window: twice as long as the last where it ran out, half where it did
         // not.

@@ -58,3 +58,33 @@ fn refreshes_that_go_on_give_way_to_a_whole_search_now_and_then() {
     }
     assert_eq!((runs, refreshes), (vec![10, 13, 12, 12], 9));
 }
+
+/// Where a few particles move fast (in the frame that moves with the cloth) and the rest
+/// keep still, refreshing those few every substep costs less than whole searches by the
+/// motion every other substep: the pairs are judged by the boxes. Where many do, by the
+/// motion. A 24 × 24-quad cloth lying flat, 2 and then 40 of its particles moving two
+/// thicknesses a substep; its first search, with no whole search's cost to go by, judges
+/// by the motion wherever one particle is fast.
+#[test]
+fn a_few_fast_particles_leave_the_pairs_judged_by_the_boxes() {
+    let (model, flat) = grid(24, 1.0);
+    let n = flat.len();
+    for (fast, swept) in [(2, false), (40, true)] {
+        let end: Vec<Vec3> = (flat.iter().enumerate())
+            .map(|(i, &p)| {
+                let moves = (0..fast).any(|k| k * 97 % n == i);
+                p + Vec3::Y * if moves { 2.0 * THICKNESS } else { 0.0 }
+            })
+            .collect();
+        let mut contacts = searched_to(&model, &flat, &end);
+        assert!(contacts.boxes.swept, "{fast}: the first search");
+        // The next substep searches the whole tree again.
+        contacts.found_for = None;
+        let moved = Moved::plain(&flat, &end);
+        contacts
+            .update_pairs(&model, THICKNESS, THICKNESS, Some(moved))
+            .unwrap();
+        assert_eq!(contacts.work.searches, 2);
+        assert_eq!(contacts.boxes.swept, swept, "{fast}: {:?}", contacts.costs);
+    }
+}
