@@ -9,12 +9,22 @@
 const REFRESHED_TRIANGLE: u64 = 12;
 
 /// The pairs are judged by the boxes where the fast particles' refreshes, this many times
-/// over, cost less than a whole search: a whole search by the motion holds for at most
-/// two substeps ([`super::window::LONGEST_WINDOW`]), and the boxes' room keeps more pairs
-/// to push and check. Over the first two seconds of `fast-fold`, `self-fold`, `flag` and
-/// `layers` (one thread), 4 did best or as well as any of 2, 4 and 8 (`fast-fold`'s
-/// self-contact 0.67–0.71 → 0.50–0.56 s, 0.54 at 2 and 0.70–0.73 at 8).
+/// over, cost less than a whole search at the least: a whole search by the motion holds
+/// for at most two substeps ([`super::window::LONGEST_WINDOW`]), and the boxes' room keeps
+/// more pairs to push and check.
 const FAST_SHARE: u64 = 4;
+
+/// Whether refreshing the triangles of `fast` particles every substep, [`FAST_SHARE`]
+/// times over, costs less than the least a whole search of a cloth of `triangles` and
+/// `particles` costs (each triangle once; its pairs tested come on top). Counted from the
+/// cloth alone, not from the searches before (whose count of pairs tested was tried: see
+/// docs/performance.md), so that a frame redone from its start (the stability guard's)
+/// decides as the frame did.
+pub(super) fn few_refreshed_cheaper(fast: usize, triangles: usize, particles: usize) -> bool {
+    let around = (3 * triangles).div_ceil(particles.max(1)) as u64;
+    let each = REFRESHED_TRIANGLE * around * FAST_SHARE;
+    each.saturating_mul(fast as u64) < triangles as u64
+}
 
 /// The work of the searches since the last whole search.
 #[derive(Clone, Copy, Debug, Default)]
@@ -35,20 +45,6 @@ impl SearchCosts {
     /// A refresh of `triangles` that tested `tested` pairs of triangles.
     pub(super) fn refreshed(&mut self, triangles: usize, tested: u64) {
         self.spent += REFRESHED_TRIANGLE * triangles as u64 + tested;
-    }
-
-    /// Whether refreshing the triangles of `fast` particles every substep, of a cloth of
-    /// `triangles` and `particles`, costs less than the last whole search did, [`FAST_SHARE`]
-    /// times over (none before a whole search).
-    pub(super) fn few_refreshed_cheaper(
-        &self,
-        fast: usize,
-        triangles: usize,
-        particles: usize,
-    ) -> bool {
-        let around = (3 * triangles).div_ceil(particles.max(1)) as u64;
-        let each = REFRESHED_TRIANGLE * around * FAST_SHARE;
-        self.whole > 0 && each.saturating_mul(fast as u64) < self.whole
     }
 
     /// Whether the next search should be of the whole tree: the refreshes since the last

@@ -6,13 +6,15 @@ use glam::{Vec3, Vec3A};
 
 use crate::parallel::fold_parts;
 
+use crate::sim::self_contacts::costs::few_refreshed_cheaper;
+
 use super::*;
 
 /// The particles' boxes are given room for later substeps only while none moves more
 /// than this share of the thickness in a substep in the moving frame, or so few do that
 /// refreshing their triangles costs less than the whole searches by the motion
-/// ([`SearchCosts::few_refreshed_cheaper`]: in `layers` 10 of 3 125 particles, in `flag`
-/// 2 of 651, held the whole cloth to a whole search every other substep). Room for the
+/// ([`few_refreshed_cheaper`]: in `layers` 10 of 3 125 particles held the whole cloth to
+/// a whole search every other substep). Room for the
 /// slow particles alone was tried: where `crumple` piles up, it kept 15 000–20 000 pairs
 /// at 64² against a few hundred, and cost more than the searches it saved.
 const REUSE_BELOW: f32 = 0.5;
@@ -349,7 +351,7 @@ impl SelfContacts {
         let (fastest, fast) = fold_parts(len, part, join).unwrap_or((0.0, 0));
         // Slow, or so few fast that refreshing their triangles costs less than the whole
         // searches by the motion would.
-        let few = (self.costs).few_refreshed_cheaper(fast, model.triangles.len(), len);
+        let few = few_refreshed_cheaper(fast, model.triangles.len(), len);
         let slow = fastest.sqrt() < REUSE_BELOW * thickness || few;
         // Fast, the pairs are judged by the motion too (see `Boxes::swept`), carried on
         // for a window: twice as long as the last where it ran out, half where it did
