@@ -111,5 +111,120 @@ fn collide_among(colliders: array<Collider, 4>, count: u32, offset: f32, x: vec3
             nv = touching(nv, v_surface, n, mu, 1.0);
         }
     }
-    return Motion(nx, nv);
+    return settle_between(colliders, count, offset, Motion(nx, nv));
+}
+
+// A collider's surface near `p`: its outward normal (xyz) and signed distance (w, m).
+fn collider_surface(col: Collider, p: vec3<f32>) -> vec4<f32> {
+    if (col.info.x == 1.0) {
+        let r = p - col.a.xyz;
+        return vec4<f32>(unit_or_up(r), length(r) - col.info.y);
+    }
+    return vec4<f32>(col.b.xyz, dot(p - col.a.xyz, col.b.xyz));
+}
+
+// The two colliders a particle at `p` is deepest within `offset` of: each a normal (xyz)
+// and how far inside the offset (w; at least -TOUCHING·offset, else w = -1e30: none).
+struct Deepest {
+    a: vec4<f32>,
+    b: vec4<f32>,
+}
+
+const TOUCHING: f32 = 1e-3;
+
+fn deepest_two(colliders: array<Collider, 4>, count: u32, offset: f32, p: vec3<f32>) -> Deepest {
+    var two = Deepest(vec4<f32>(0.0, 0.0, 0.0, -1e30), vec4<f32>(0.0, 0.0, 0.0, -1e30));
+    var found = 0u;
+    for (var c = 0u; c < count; c = c + 1u) {
+        let s = collider_surface(colliders[c], p);
+        let near = vec4<f32>(s.xyz, offset - s.w);
+        if (near.w < -TOUCHING * offset) {
+            continue;
+        }
+        if (found == 0u || near.w > two.a.w) {
+            two = Deepest(near, two.a);
+        } else if (found == 1u || near.w > two.b.w) {
+            two.b = near;
+        }
+        found = found + 1u;
+    }
+    if (found < 2u) {
+        two.b.w = -1e30;
+    }
+    return two;
+}
+
+// The least move that takes a point `a.w` along unit normal `a.xyz` and `b.w` along
+// `b.xyz` (at least; negative depths count as none), or, facing each other, halfway (the
+// CPU's `between::least_move`).
+fn least_move(a: vec4<f32>, b: vec4<f32>) -> vec3<f32> {
+    let da = max(a.w, 0.0);
+    let db = max(b.w, 0.0);
+    let along_a = da * a.xyz;
+    if (dot(along_a, b.xyz) >= db) {
+        return along_a;
+    }
+    let along_b = db * b.xyz;
+    if (dot(along_b, a.xyz) >= da) {
+        return along_b;
+    }
+    let c = dot(a.xyz, b.xyz);
+    let det = 1.0 - c * c;
+    if (det < 1e-6) {
+        return 0.5 * (da - db) * a.xyz;
+    }
+    return ((da - c * db) / det) * a.xyz + ((db - c * da) / det) * b.xyz;
+}
+
+// A particle left inside one collider's offset while touching another's (a sphere resting
+// on the ground, near where it touches: each acting in turn leaves it where the last put
+// it) is moved by the least that keeps both, a few short rounds over, and its approach to
+// both taken out of its velocity (the CPU's `effects/between.rs`).
+fn settle_between(colliders: array<Collider, 4>, count: u32, offset: f32, m: Motion) -> Motion {
+    var two = deepest_two(colliders, count, offset, m.x);
+    if (two.b.w < -TOUCHING * offset || two.a.w <= TOUCHING * offset) {
+        return m;
+    }
+    var x = m.x;
+    for (var k = 0u; k < 6u; k = k + 1u) {
+        let step = least_move(two.a, two.b);
+        let most = 3.0 * two.a.w;
+        let len = length(step);
+        x = x + select(step, step * (most / len), len > most);
+        two = deepest_two(colliders, count, offset, x);
+        if (two.b.w < -TOUCHING * offset || two.a.w <= TOUCHING * offset) {
+            break;
+        }
+    }
+    // The approach to the two it touches (or nearly) the fastest, the least change that
+    // leaves it moving towards neither.
+    var fa = vec4<f32>(0.0, 0.0, 0.0, -1e30);
+    var fb = vec4<f32>(0.0, 0.0, 0.0, -1e30);
+    for (var c = 0u; c < count; c = c + 1u) {
+        let col = colliders[c];
+        let s = collider_surface(col, x);
+        if (s.w > offset * 1.1) {
+            continue;
+        }
+        var vs = vec3<f32>(0.0);
+        if (col.info.x == 1.0) {
+            vs = cross(col.b.xyz, s.xyz * col.info.y);
+        }
+        let near = vec4<f32>(s.xyz, dot(vs - m.v, s.xyz));
+        if (near.w > fa.w) {
+            fb = fa;
+            fa = near;
+        } else if (near.w > fb.w) {
+            fb = near;
+        }
+    }
+    var v = m.v;
+    if (fa.w > 0.0) {
+        if (fb.w > -1e29) {
+            v = v + least_move(fa, fb);
+        } else {
+            v = v + fa.w * fa.xyz;
+        }
+    }
+    return Motion(x, v);
 }

@@ -10,7 +10,7 @@ use clothsim::sim::{GuardAction, IntegratorKind, SelfContacts};
 use glam::{DVec3, Vec3};
 
 mod common;
-use common::{incline, parsed, slope_acceleration, slope_speed};
+use common::{WEDGE_RADIUS, incline, parsed, slope_acceleration, slope_speed, wedge};
 
 fn d(x: f64, y: f64, z: f64) -> DVec3 {
     DVec3::new(x, y, z)
@@ -616,37 +616,21 @@ fn a_small_sphere_is_warned_of_only_where_triangles_can_pass_over_it() {
     }
 }
 
-/// A small cloth driven along the ground into the wedge under a sphere resting on it. Near
-/// where the two touch, the sphere's collision offset and the ground's overlap, and no
-/// place keeps a particle both offsets clear of both. Acting one after the other, the
-/// ground's push came last and lifted the particle into the sphere. Now after every
-/// substep every particle is outside the sphere and above the ground, and after every
-/// frame no triangle meets either, with and without self-collision (with it, nor itself).
+/// A small cloth driven along the ground into the wedge under a sphere resting on it
+/// ([`wedge`]). Near where the two touch, the sphere's collision offset and the ground's
+/// overlap, and no place keeps a particle both offsets clear of both. Acting one after the
+/// other, the ground's push came last and lifted the particle into the sphere. Now after
+/// every substep every particle keeps both offsets, and after every frame no triangle
+/// meets either, with and without self-collision (with it, nor itself).
 #[test]
 fn a_cloth_driven_into_the_wedge_under_a_sphere_on_the_ground_enters_neither() {
-    const RADIUS: f32 = 0.3;
-    let centre = Vec3::new(0.0, RADIUS, 0.0);
+    let centre = Vec3::new(0.0, WEDGE_RADIUS, 0.0);
     for own in [
         "",
         "[[effects]]\ntype = \"self-collision\"\nthickness = 0.004\n",
     ] {
-        let text = format!(
-            "name = \"wedge\"\n\
-             [cloth]\ngrid = {{ quads = 4, size = 0.06 }}\norientation = \"horizontal\"\n\
-             center = [0.16, 0.015, 0.0]\n\
-             [solver]\nintegrator = \"implicit-euler\"\nsubsteps = 8\n\
-             [[effects]]\ntype = \"sphere\"\ncenter = [0.0, {RADIUS}, 0.0]\nradius = {RADIUS}\n\
-             friction = 0.0\n\
-             [[effects]]\ntype = \"plane\"\nfriction = 0.0\n{own}"
-        );
-        let mut sim = Simulation::new(parsed(&text));
+        let mut sim = Simulation::new(wedge(own));
         assert_eq!(sim.intersections().total(), 0, "the cloth starts clear");
-        // Along the ground towards where the sphere touches it, pressed down a little.
-        sim.modify_state(|s| {
-            s.vel
-                .iter_mut()
-                .for_each(|v| *v = Vec3::new(-3.0, -0.3, 0.0))
-        });
         let (substeps, mut closest) = (sim.substeps() as usize, f32::INFINITY);
         for frame in 1..=30 {
             for substep in 0..substeps {
@@ -656,10 +640,10 @@ fn a_cloth_driven_into_the_wedge_under_a_sphere_on_the_ground_enters_neither() {
                     closest = closest.min(p.x.hypot(p.z));
                     // Both collision offsets (1 cm) kept, to their rounding.
                     assert!(
-                        r >= RADIUS + 0.0099 && y >= 0.0099,
+                        r >= WEDGE_RADIUS + 0.0099 && y >= 0.0099,
                         "frame {frame} substep {substep}: particle {i} at {p} is {} m \
                          from the sphere's surface, {y} m above the ground ({own:?})",
-                        r - RADIUS
+                        r - WEDGE_RADIUS
                     );
                 }
             }

@@ -8,7 +8,7 @@ use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::{Effect, IntegratorKind, Precision};
 
 mod common;
-use common::{farthest, gpu_simulation};
+use common::{WEDGE_RADIUS, farthest, gpu_simulation, wedge};
 
 /// Runs `scene` for `seconds` on both backends; the largest distance between the same
 /// particle's positions, and the largest distance any particle moved (for scale).
@@ -369,4 +369,43 @@ fn a_cloth_is_refused_with_its_size_exactly_where_the_device_cannot_bind_its_spr
         text.contains(&size) && text.contains("spring ends"),
         "{size}: {text}"
     );
+}
+
+/// The CPU's wedge (`tests/contact.rs`) on the GPU: a small cloth driven along the ground
+/// into the wedge under a sphere resting on it keeps both collision offsets after every
+/// frame, and with self-collision (whose cuts come after the colliders) stays outside
+/// both. Its colliders acting one after the other, the ground lifted a squeezed particle
+/// into the sphere.
+#[test]
+fn a_cloth_driven_into_the_wedge_on_the_gpu_keeps_clear_of_the_sphere_and_the_ground() {
+    let centre = glam::Vec3::new(0.0, WEDGE_RADIUS, 0.0);
+    for own in [
+        "",
+        "[[effects]]\ntype = \"self-collision\"\nthickness = 0.004\n",
+    ] {
+        let (mut gpu, _) =
+            gpu_simulation(wedge(own), true).expect("GPU backend on the software adapter");
+        let mut closest = f32::INFINITY;
+        for frame in 1..=30 {
+            gpu.step_frame().expect("gpu frame");
+            gpu.sync_state().expect("read back");
+            // Both offsets (1 cm) to their rounding; with self-collision, whose cuts come
+            // after the colliders here, outside both surfaces.
+            let kept = if own.is_empty() { 0.0099 } else { 0.0 };
+            for (i, p) in gpu.state().pos.iter().enumerate() {
+                closest = closest.min(p.x.hypot(p.z));
+                let (r, y) = (p.distance(centre), p.y);
+                assert!(
+                    r >= WEDGE_RADIUS + kept && y >= kept,
+                    "frame {frame}: particle {i} at {p} is {} m from the sphere's surface, \
+                     {y} m above the ground ({own:?})",
+                    r - WEDGE_RADIUS
+                );
+            }
+        }
+        assert!(
+            closest < 0.111,
+            "the cloth kept {closest} m from the axis ({own:?})"
+        );
+    }
 }

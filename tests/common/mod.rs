@@ -199,3 +199,25 @@ pub fn a_frame_given_up_keeps_its_count(mut sim: clothsim::scene::Simulation) {
     assert!(before > 0, "the jumps forced pairs before");
     assert_eq!(forced(&sim), before);
 }
+
+/// The sphere's radius in [`wedge`], m; it rests on the ground with its centre this high.
+#[allow(dead_code)]
+pub const WEDGE_RADIUS: f32 = 0.3;
+
+/// A small cloth (4 × 4 quads, 6 cm) lying 1.5 cm above the ground beside a sphere that
+/// rests on it, 13 cm from where they touch, set moving at 3 m/s towards that point and a
+/// little down (implicit Euler, 8 substeps, no friction); `own` is added to its effects.
+#[allow(dead_code)]
+pub fn wedge(own: &str) -> clothsim::scene::Scene {
+    let r = WEDGE_RADIUS;
+    let mut scene = parsed(&format!(
+        "name = \"wedge\"\n\
+         [cloth]\ngrid = {{ quads = 4, size = 0.06 }}\norientation = \"horizontal\"\n\
+         center = [0.16, 0.015, 0.0]\n\
+         [solver]\nintegrator = \"implicit-euler\"\nsubsteps = 8\n\
+         [[effects]]\ntype = \"sphere\"\ncenter = [0.0, {r}, 0.0]\nradius = {r}\nfriction = 0.0\n\
+         [[effects]]\ntype = \"plane\"\nfriction = 0.0\n{own}"
+    ));
+    (scene.initial.vel.iter_mut()).for_each(|v| *v = glam::Vec3::new(-3.0, -0.3, 0.0));
+    scene
+}
