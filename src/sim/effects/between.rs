@@ -90,6 +90,15 @@ struct Near {
     normal: Vec3,
 }
 
+/// Takes `near` into `two`, the two deepest so far, deepest first.
+fn deeper_two(two: &mut [Option<Near>; 2], near: Near) {
+    if two[0].is_none_or(|f| near.depth > f.depth) {
+        *two = [Some(near), two[0]];
+    } else if two[1].is_none_or(|s| near.depth > s.depth) {
+        two[1] = Some(near);
+    }
+}
+
 /// The two solids among `effects` whose offsets a particle at `x` is deepest in, at time
 /// `t`, where it touches at least one (`None` for fewer than two touched).
 fn deepest_two(effects: &[Effect], x: Vec3, t: f64, offset: f32) -> Option<[Near; 2]> {
@@ -99,17 +108,14 @@ fn deepest_two(effects: &[Effect], x: Vec3, t: f64, offset: f32) -> Option<[Near
             continue;
         };
         let kept = e.clearance(offset);
-        let near = Near {
-            depth: kept - d,
-            normal,
-        };
-        if near.depth < -TOUCHING * kept {
-            continue;
-        }
-        if two[0].is_none_or(|f| near.depth > f.depth) {
-            two = [Some(near), two[0]];
-        } else if two[1].is_none_or(|s| near.depth > s.depth) {
-            two[1] = Some(near);
+        if kept - d >= -TOUCHING * kept {
+            deeper_two(
+                &mut two,
+                Near {
+                    depth: kept - d,
+                    normal,
+                },
+            );
         }
     }
     Some([two[0]?, two[1]?])
@@ -157,26 +163,18 @@ fn between(effects: &[Effect], (x, v): (Vec3, Vec3), t: f64, offset: f32) -> Opt
             _ => break,
         }
     }
-    // Its approach to the surfaces it now touches (or nearly: [`LANDED`]) is taken out of its velocity, the least
-    // change that leaves it moving towards neither (each solid's own pass applied its
-    // friction); the two it approaches fastest, as the place was settled.
+    // Its approach to the surfaces it now touches (or nearly: [`LANDED`]) is taken out of
+    // its velocity, the least change that leaves it moving towards neither (each solid's
+    // own pass applied its friction): the two it approaches fastest, each approach speed
+    // taken as a depth, as the place was settled.
     let mut approach: [Option<Near>; 2] = [None, None];
     for e in effects {
         let Some((d, normal, velocity)) = e.surface(x, t) else {
             continue;
         };
-        let speed = (velocity - v).dot(normal);
-        if d > e.clearance(offset) * (1.0 + LANDED) {
-            continue;
-        }
-        let near = Near {
-            depth: speed,
-            normal,
-        };
-        if approach[0].is_none_or(|f| speed > f.depth) {
-            approach = [Some(near), approach[0]];
-        } else if approach[1].is_none_or(|s| speed > s.depth) {
-            approach[1] = Some(near);
+        if d <= e.clearance(offset) * (1.0 + LANDED) {
+            let depth = (velocity - v).dot(normal);
+            deeper_two(&mut approach, Near { depth, normal });
         }
     }
     // (One it moves away from counts too: taking out the other's approach may turn it
