@@ -39,6 +39,21 @@ pub const CONTACT_START: &str = "contact-start";
 /// The phase that times the settling of particles left between two solids ([`Between`]).
 pub const BETWEEN_SOLIDS: &str = "between-solids";
 
+/// Settles the particles left between two of the solids among `effects` ([`Between`]),
+/// timed as [`BETWEEN_SOLIDS`]; nothing (and no phase) where fewer than two act. Returns
+/// how many it moved.
+fn settle_between(
+    timings: &mut PhaseTimings,
+    between: &mut Between,
+    effects: &[Effect],
+    pass: &mut ContactPass<'_>,
+) -> usize {
+    if effects.iter().filter(|e| e.is_solid()).nth(1).is_none() {
+        return 0;
+    }
+    timings.time(BETWEEN_SOLIDS, || between.keep(effects, pass))
+}
+
 /// Runs `work`, adding its wall time to `spent`.
 fn timed<T>(spent: &mut Duration, work: impl FnOnce() -> T) -> T {
     let start = Instant::now();
@@ -237,10 +252,8 @@ impl<R: Real> CpuStepper<R> {
         let mut settled = false;
         for c in &self.contacts {
             if matches!(c, Effect::SelfCollision(_)) {
-                let between = &mut self.between;
-                let effects = &self.contacts;
-                contacts +=
-                    (self.timings).time(BETWEEN_SOLIDS, || between.keep(effects, &mut pass));
+                let (timings, between) = (&mut self.timings, &mut self.between);
+                contacts += settle_between(timings, between, &self.contacts, &mut pass);
                 settled = true;
                 // What the solids moved rests on them; self-contact starts from where they
                 // left the cloth (it comes last).
@@ -252,8 +265,8 @@ impl<R: Real> CpuStepper<R> {
             contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
         }
         if !settled {
-            let (between, effects) = (&mut self.between, &self.contacts);
-            contacts += (self.timings).time(BETWEEN_SOLIDS, || between.keep(effects, &mut pass));
+            let (timings, between) = (&mut self.timings, &mut self.between);
+            contacts += settle_between(timings, between, &self.contacts, &mut pass);
         }
         // Self-contact may have pushed cloth into a solid (a stack pressing its lowest
         // layer): where it moved anything, the solids act once more, and the cloth's
@@ -269,9 +282,8 @@ impl<R: Real> CpuStepper<R> {
                 for c in self.contacts.iter().filter(|c| c.is_solid()) {
                     contacts += self.timings.time(c.phase(), || c.resolve(&mut pass))?;
                 }
-                let (between, effects) = (&mut self.between, &self.contacts);
-                contacts +=
-                    (self.timings).time(BETWEEN_SOLIDS, || between.keep(effects, &mut pass));
+                let (timings, between) = (&mut self.timings, &mut self.between);
+                contacts += settle_between(timings, between, &self.contacts, &mut pass);
                 // Nothing moved since self-contact: nothing to check.
                 if !timed(&mut upkeep, || self.before_solids != pass.state.pos) {
                     break;
