@@ -113,13 +113,12 @@ impl EffectKind for Plane {
     fn shell(&self, _t: f64, offset: f32) -> Option<(Vec3, Vec3)> {
         let n = self.unit_normal();
         let (mut lo, mut hi) = (Vec3::NEG_INFINITY, Vec3::INFINITY);
-        for axis in 0..3 {
-            if n[axis].abs() == 1.0 && n.length_squared() == 1.0 {
-                if n[axis] > 0.0 {
-                    hi[axis] = self.point[axis] + offset;
-                } else {
-                    lo[axis] = self.point[axis] - offset;
-                }
+        // Exactly along an axis (its other components exactly zero), or bounded nowhere.
+        if let Some(axis) = (0..3).find(|&k| n[k].abs() == 1.0 && n.length_squared() == 1.0) {
+            if n[axis] > 0.0 {
+                hi[axis] = self.point[axis] + offset;
+            } else {
+                lo[axis] = self.point[axis] - offset;
             }
         }
         Some((lo, hi))

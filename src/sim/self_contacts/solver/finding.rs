@@ -5,7 +5,6 @@
 use glam::{Vec3, Vec3A};
 
 use crate::parallel::fold_parts;
-
 use crate::sim::self_contacts::costs::few_refreshed_cheaper;
 
 use super::*;
@@ -14,9 +13,9 @@ use super::*;
 /// than this share of the thickness in a substep in the moving frame, or so few do that
 /// refreshing their triangles costs less than the whole searches by the motion
 /// ([`few_refreshed_cheaper`]: in `layers` 10 of 3 125 particles held the whole cloth to
-/// a whole search every other substep). Room for the
-/// slow particles alone was tried: where `crumple` piles up, it kept 15 000–20 000 pairs
-/// at 64² against a few hundred, and cost more than the searches it saved.
+/// a whole search every other substep). Room for the slow particles alone was tried:
+/// where `crumple` piles up, it kept 15 000–20 000 pairs at 64² against a few hundred, and
+/// cost more than the searches it saved.
 const REUSE_BELOW: f32 = 0.5;
 
 /// How far, as a share of the thickness, a particle may stray from the path a window
