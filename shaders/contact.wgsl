@@ -123,33 +123,37 @@ fn collider_surface(col: Collider, p: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(col.b.xyz, dot(p - col.a.xyz, col.b.xyz));
 }
 
-// The two colliders a particle at `p` is deepest within `offset` of: each a normal (xyz)
-// and how far inside the offset (w; at least -TOUCHING·offset, else w = -1e30: none).
+// Two surfaces near a particle, the deeper first: each a normal (xyz) and how deep (w; a
+// depth inside the offset, or an approach speed; -1e30: none).
 struct Deepest {
     a: vec4<f32>,
     b: vec4<f32>,
 }
 
+const NONE: vec4<f32> = vec4<f32>(0.0, 0.0, 0.0, -1e30);
+
 const TOUCHING: f32 = 1e-3;
 
+// `two` with `near` taken in where it is deeper than either.
+fn deeper(two: Deepest, near: vec4<f32>) -> Deepest {
+    if (near.w > two.a.w) {
+        return Deepest(near, two.a);
+    }
+    if (near.w > two.b.w) {
+        return Deepest(two.a, near);
+    }
+    return two;
+}
+
+// The two colliders a particle at `p` is deepest within `offset` of (at least
+// -TOUCHING·offset deep; else none).
 fn deepest_two(colliders: array<Collider, 4>, count: u32, offset: f32, p: vec3<f32>) -> Deepest {
-    var two = Deepest(vec4<f32>(0.0, 0.0, 0.0, -1e30), vec4<f32>(0.0, 0.0, 0.0, -1e30));
-    var found = 0u;
+    var two = Deepest(NONE, NONE);
     for (var c = 0u; c < count; c = c + 1u) {
         let s = collider_surface(colliders[c], p);
-        let near = vec4<f32>(s.xyz, offset - s.w);
-        if (near.w < -TOUCHING * offset) {
-            continue;
+        if (offset - s.w >= -TOUCHING * offset) {
+            two = deeper(two, vec4<f32>(s.xyz, offset - s.w));
         }
-        if (found == 0u || near.w > two.a.w) {
-            two = Deepest(near, two.a);
-        } else if (found == 1u || near.w > two.b.w) {
-            two.b = near;
-        }
-        found = found + 1u;
-    }
-    if (found < 2u) {
-        two.b.w = -1e30;
     }
     return two;
 }
@@ -198,8 +202,7 @@ fn settle_between(colliders: array<Collider, 4>, count: u32, offset: f32, m: Mot
     }
     // The approach to the two it touches (or nearly) the fastest, the least change that
     // leaves it moving towards neither.
-    var fa = vec4<f32>(0.0, 0.0, 0.0, -1e30);
-    var fb = vec4<f32>(0.0, 0.0, 0.0, -1e30);
+    var fast = Deepest(NONE, NONE);
     for (var c = 0u; c < count; c = c + 1u) {
         let col = colliders[c];
         let s = collider_surface(col, x);
@@ -210,20 +213,14 @@ fn settle_between(colliders: array<Collider, 4>, count: u32, offset: f32, m: Mot
         if (col.info.x == 1.0) {
             vs = cross(col.b.xyz, s.xyz * col.info.y);
         }
-        let near = vec4<f32>(s.xyz, dot(vs - m.v, s.xyz));
-        if (near.w > fa.w) {
-            fb = fa;
-            fa = near;
-        } else if (near.w > fb.w) {
-            fb = near;
-        }
+        fast = deeper(fast, vec4<f32>(s.xyz, dot(vs - m.v, s.xyz)));
     }
     var v = m.v;
-    if (fa.w > 0.0) {
-        if (fb.w > -1e29) {
-            v = v + least_move(fa, fb);
+    if (fast.a.w > 0.0) {
+        if (fast.b.w > -1e29) {
+            v = v + least_move(fast.a, fast.b);
         } else {
-            v = v + fa.w * fa.xyz;
+            v = v + fast.a.w * fast.a.xyz;
         }
     }
     return Motion(x, v);
