@@ -532,15 +532,16 @@ impl<R: Real> StepBackend for CpuStepper<R> {
             });
             self.effects = effects.to_vec();
             if self.self_collision.is_some() {
-                // Built now, not in the first substep, with the patches a sphere's face
-                // pass takes (it runs only beside self-collision, and only a sphere has
-                // one); timed as its own phase where either was built (not where they were
-                // this cloth's already). A cloth too large for it is refused by the first
-                // substep, with its error.
+                // Built now, not in the first substep, with the patches the face passes
+                // take (a sphere's, and a mesh obstacle's of its tips: they run only beside
+                // self-collision); timed as its own phase where either was built (not
+                // where they were this cloth's already). A cloth too large for it is
+                // refused by the first substep, with its error.
                 let start = std::time::Instant::now();
                 let built = matches!(self.self_contacts.prepare(model), Ok(true));
-                let sphere = effects.iter().any(|e| matches!(e, Effect::Sphere(_)));
-                let cut = sphere && self.faces.prepare(model);
+                let faced =
+                    (effects.iter()).any(|e| matches!(e, Effect::Sphere(_) | Effect::Obstacle(_)));
+                let cut = faced && self.faces.prepare(model);
                 if built || cut {
                     self.timings.add(super::SELF_SETUP, start.elapsed());
                 }

@@ -29,8 +29,9 @@ pub struct FacePatches {
     particle_starts: Vec<usize>,
     /// Each triangle's patch.
     patch_of: Vec<u32>,
-    /// Whether each patch was near in the last call.
+    /// Whether each patch was near in the last call, and its box then.
     flagged: Vec<bool>,
+    boxes: Vec<(Vec3A, Vec3A)>,
     /// The cloth they were cut for: its triangles and particles.
     cut_for: (usize, usize),
     /// The triangles of the patches the last call found near, in the cloth's order.
@@ -83,25 +84,12 @@ impl FacePatches {
         pos: &[Vec3],
         near: impl Fn(Vec3, Vec3) -> bool,
     ) -> &[u32] {
-        self.prepare(model);
+        self.flag(model, |i| Vec3A::from(pos[i as usize]), near);
         self.near.clear();
-        self.flagged.clear();
-        let mut held = 0;
-        for k in 0..self.starts.len() - 1 {
-            let ids = &self.particles[self.particle_starts[k]..self.particle_starts[k + 1]];
-            let (lo, hi) =
-                (ids.iter()).fold((Vec3A::INFINITY, Vec3A::NEG_INFINITY), |(lo, hi), &i| {
-                    let p = Vec3A::from(pos[i as usize]);
-                    (lo.min(p), hi.max(p))
-                });
-            let flagged = near(lo.into(), hi.into());
-            self.flagged.push(flagged);
-            held += if flagged {
-                self.starts[k + 1] - self.starts[k]
-            } else {
-                0
-            };
-        }
+        let held: usize = (self.flagged.iter().enumerate())
+            .filter(|(_, f)| **f)
+            .map(|(k, _)| self.starts[k + 1] - self.starts[k])
+            .sum();
         // In the cloth's order: sorted where they are few, picked out of every triangle
         // where they are many (a cloth draped over a sphere: 2 000 of 8 192 at 64², whose
         // sort took a fifth of the pass).
@@ -117,6 +105,40 @@ impl FacePatches {
             );
         }
         &self.near
+    }
+
+    /// Each patch [`FacePatches::flag`] flagged, patch by patch: its triangles and the box
+    /// of its particles it was flagged for.
+    pub fn flagged(&self) -> impl Iterator<Item = (&[u32], Vec3, Vec3)> {
+        (self.flagged.iter().zip(&self.boxes).enumerate())
+            .filter(|(_, (f, _))| **f)
+            .map(|(k, (_, &(lo, hi)))| {
+                let held = &self.triangles[self.starts[k]..self.starts[k + 1]];
+                (held, lo.into(), hi.into())
+            })
+    }
+
+    /// Flags each patch whose particles, each where `position` puts it (in another frame,
+    /// say), lie in a box for which `near(lo, hi)` holds, and keeps each patch's box.
+    pub fn flag(
+        &mut self,
+        model: &ClothModel,
+        position: impl Fn(u32) -> Vec3A,
+        near: impl Fn(Vec3, Vec3) -> bool,
+    ) {
+        self.prepare(model);
+        self.flagged.clear();
+        self.boxes.clear();
+        for k in 0..self.starts.len() - 1 {
+            let ids = &self.particles[self.particle_starts[k]..self.particle_starts[k + 1]];
+            let (lo, hi) =
+                (ids.iter()).fold((Vec3A::INFINITY, Vec3A::NEG_INFINITY), |(lo, hi), &i| {
+                    let p = position(i);
+                    (lo.min(p), hi.max(p))
+                });
+            self.flagged.push(near(lo.into(), hi.into()));
+            self.boxes.push((lo, hi));
+        }
     }
 }
 

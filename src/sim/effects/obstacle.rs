@@ -18,8 +18,10 @@ use crate::sim::param_error::ParamError;
 use crate::sim::self_contacts::ContactError;
 
 use self::edge_pass::{EdgeFrame, EdgeMemory, EdgesMoved, push_edges};
+use self::tip_pass::push_tips;
 
 mod edge_pass;
+mod tip_pass;
 
 /// A mesh obstacle as a scene file gives it.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -412,7 +414,7 @@ struct Posed<'a> {
 
 impl Posed<'_> {
     /// [`push_edges`] against the obstacle's sharp edges where the substep ends (fixed in
-    /// its frame).
+    /// its frame), then [`push_tips`].
     fn push_edges(&self, pass: &mut ContactPass<'_>, memory: &mut EdgeMemory) -> usize {
         let (pivot, start, end) = (self.placed.pivot, self.start, self.end);
         let frame = EdgeFrame {
@@ -421,13 +423,10 @@ impl Posed<'_> {
             to_world: |n| end.rotation * n,
             velocity: |q| end.velocity_at(pivot, end.apply(pivot, q)),
         };
-        push_edges(
-            self.placed.surface.sharp_edges(),
-            &frame,
-            self.friction,
-            pass,
-            (memory, EdgesMoved::Fixed),
-        )
+        let (surface, mu) = (&self.placed.surface, self.friction);
+        let edges = (surface.sharp_edges(), surface.tips());
+        push_edges(edges, &frame, mu, pass, (memory, EdgesMoved::Fixed))
+            + push_tips(surface.tips(), &frame, mu, pass, memory)
     }
 }
 
@@ -439,7 +438,8 @@ struct Deforming<'a> {
 }
 
 impl Deforming<'_> {
-    /// [`push_edges`] against its sharp edges where the substep ends (which move).
+    /// [`push_edges`] against its sharp edges where the substep ends (which move), then
+    /// [`push_tips`].
     fn push_edges(&self, pass: &mut ContactPass<'_>, memory: &mut EdgeMemory) -> usize {
         let reach = pass.offset;
         // (Its edges are taken where the substep ends for the whole substep.)
@@ -449,9 +449,11 @@ impl Deforming<'_> {
             to_world: |n| n,
             velocity: |q| self.moment.velocity_near(q, reach),
         };
-        let edges = self.moment.surface.sharp_edges();
+        let surface = &self.moment.surface;
+        let (edges, tips) = (surface.sharp_edges(), surface.tips());
         let moved = EdgesMoved::By(memory.clock.moved_to(self.moment));
-        push_edges(edges, &frame, self.friction, pass, (memory, moved))
+        push_edges((edges, tips), &frame, self.friction, pass, (memory, moved))
+            + push_tips(tips, &frame, self.friction, pass, memory)
     }
 }
 

@@ -11,7 +11,7 @@ use super::tree::TriangleTree;
 /// Two faces meeting at less than this cosine between their normals (about 10°) make a
 /// sharp edge; flatter ones are covered by their faces. Unsigned: a mesh whose faces are
 /// not all wound the same way has no false creases.
-const CREASE_COS: f32 = 0.985;
+pub(super) const CREASE_COS: f32 = 0.985;
 
 /// The sharp edges of a surface and a tree over them.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -167,6 +167,11 @@ impl SharpEdges {
     /// The tree over the edges (each a triangle with its second end twice).
     pub fn tree(&self) -> &TriangleTree {
         &self.tree
+    }
+
+    /// Each edge's two vertices.
+    pub fn ends(&self) -> &[[u32; 2]] {
+        &self.ends
     }
 
     pub fn len(&self) -> usize {

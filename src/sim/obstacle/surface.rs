@@ -5,6 +5,7 @@ use glam::Vec3;
 
 use super::edges::SharpEdges;
 use super::geometry::{closest_on_triangle, less_by_move, rounding_near, segment_crosses};
+use super::tips::Tips;
 use super::tree::{Near, Nearest, TriangleTree};
 
 /// How many crossings one move may be caught at (a move that slides on into a second face
@@ -93,6 +94,7 @@ pub struct Surface {
     normals: Vec<Vec3>,
     tree: TriangleTree,
     edges: SharpEdges,
+    tips: Tips,
 }
 
 /// Where a caught move ends and the surface's normal there (pointing to the side the
@@ -118,17 +120,24 @@ impl Surface {
             .collect();
         let tree = TriangleTree::new(&corners);
         let edges = SharpEdges::of(&vertices, &triangles, &normals);
+        let tips = Tips::of(
+            &vertices,
+            &triangles,
+            &normals,
+            edges.ends().iter().copied(),
+        );
         Self {
             vertices,
             triangles,
             normals,
             tree,
             edges,
+            tips,
         }
     }
 
     /// The same triangles over moved `vertices` (as many as before): normals, tree and
-    /// sharp edges refitted, in time linear in the triangles.
+    /// sharp edges and tips refitted, in time linear in the triangles.
     ///
     /// # Panics
     /// When `vertices` is not as long as before.
@@ -147,6 +156,7 @@ impl Surface {
         }
         self.tree.refit(corners);
         self.edges.refit(vertices);
+        self.tips.refit(vertices);
     }
 
     /// Each triangle's unit normal (zero for a degenerate one).
@@ -170,6 +180,11 @@ impl Surface {
     /// Its creases and borders.
     pub fn sharp_edges(&self) -> &SharpEdges {
         &self.edges
+    }
+
+    /// Its tips: where its faces meet at a point.
+    pub fn tips(&self) -> &Tips {
+        &self.tips
     }
 
     /// The box around the surface (`None` without triangles).

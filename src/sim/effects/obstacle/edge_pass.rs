@@ -6,7 +6,7 @@ use glam::{Vec3, Vec3A};
 
 use super::super::effect_kind::ContactPass;
 use super::super::solid::touching;
-use crate::sim::obstacle::{Clearance, LOOK, LOOK_DEFORMING, SharpEdges, SurfaceClock};
+use crate::sim::obstacle::{Clearance, LOOK, LOOK_DEFORMING, SharpEdges, SurfaceClock, Tip, Tips};
 
 /// How the frame of the sharp edges lies in the world: `to_local` takes a world point into
 /// it, `to_world` turns a direction of it into the world's, `velocity` is the surface's
@@ -39,6 +39,12 @@ pub(super) struct EdgeMemory {
     /// pushed.
     pushed: Vec<f32>,
     pushed_list: Vec<u32>,
+    /// The tips near one patch of the cloth (scratch of the tip pass).
+    tips_near: Vec<Tip>,
+    /// The last pass's room for a distance's rounding in the frame, and how far the edges
+    /// moved in it over the substep, m (the tip pass reads them).
+    rounding: f32,
+    moved_by: f32,
     /// Where the edges deform: when the surface the clearances were measured against stood.
     pub(super) clock: SurfaceClock,
     /// Cloth edges asked about (not passed by on the odometers) since the memory was made.
@@ -136,6 +142,38 @@ impl EdgeMemory {
     }
 }
 
+/// What the tip pass after an edge pass reads and moves, in the same frame
+/// ([`EdgeMemory::for_tips`]).
+pub(super) struct ForTips<'a> {
+    /// Each particle where the substep began, and where it is now, in the frame.
+    pub(super) before: &'a [Vec3A],
+    pub(super) local: &'a mut [Vec3A],
+    /// Each particle's odometer, where the edges are fixed in the frame (else none).
+    pub(super) odometers: &'a mut [f64],
+    /// Scratch: the tips near one patch.
+    pub(super) found: &'a mut Vec<Tip>,
+    /// How far the tips moved in the frame over the substep, and the room for a
+    /// distance's rounding there, m.
+    pub(super) moved_by: f32,
+    pub(super) rounding: f32,
+}
+
+impl EdgeMemory {
+    /// What the tip pass reads and moves after [`push_edges`] (which takes every particle
+    /// into the frame where the obstacle has tips, for it): a push it makes runs the
+    /// particle's odometer on too.
+    pub(super) fn for_tips(&mut self) -> ForTips<'_> {
+        ForTips {
+            before: &self.before,
+            local: &mut self.local,
+            odometers: &mut self.odometers,
+            found: &mut self.tips_near,
+            moved_by: self.moved_by,
+            rounding: self.rounding,
+        }
+    }
+}
+
 /// How far the sharp edges moved in the edge pass's frame since its last pass.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) enum EdgesMoved {
@@ -160,10 +198,12 @@ const EDGE_SWEEPS: usize = 4;
 /// ([`SharpEdges::nearest_remembering`]: the same answers); and where the edges are fixed
 /// in the frame, while its two particles' odometers (how far each can have moved since)
 /// have not run on by what was left of it when last asked, less the reach, the cloth edge
-/// is passed by unasked (its answer would be the same: none). Returns how many cloth
-/// edges it moved.
+/// is passed by unasked (its answer would be the same: none). Where the obstacle has
+/// `tips` and the solids keep the cloth's triangles out, every particle is taken into the
+/// frame for the tip pass after it, edges or none ([`EdgeMemory::for_tips`]). Returns how
+/// many cloth edges it moved.
 pub(super) fn push_edges<S, L, W, V>(
-    edges: &SharpEdges,
+    (edges, tips): (&SharpEdges, &Tips),
     frame: &EdgeFrame<S, L, W, V>,
     mu: f32,
     pass: &mut ContactPass<'_>,
@@ -175,7 +215,8 @@ where
     W: Fn(Vec3) -> Vec3,
     V: Fn(Vec3) -> Vec3,
 {
-    if edges.is_empty() {
+    let tipped = !tips.is_empty() && pass.faces.is_some();
+    if edges.is_empty() && !tipped {
         return 0;
     }
     let thickness = pass.offset;
@@ -197,6 +238,10 @@ where
     let fixed = moved == EdgesMoved::Fixed;
     let reading = memory.take_in(&state.pos, &frame.to_local, order.len(), fixed);
     (memory.clearance).resize(springs.a.len(), Clearance::NONE);
+    let moved_by = match moved {
+        EdgesMoved::Fixed => 0.0,
+        EdgesMoved::By(by) => by,
+    };
     let look = match moved {
         EdgesMoved::Fixed => LOOK,
         EdgesMoved::By(by) => {
@@ -216,7 +261,8 @@ where
     let mut moved = 0;
     // A cloth edge put back from a crossing can pull a neighbour across another: the pass
     // repeats (a few times at most) while it finds crossings.
-    for _ in 0..EDGE_SWEEPS {
+    let sweeps = if edges.is_empty() { 0 } else { EDGE_SWEEPS };
+    for _ in 0..sweeps {
         let mut crossings = 0;
         // In colours (the GPU's order too, a colour's edges side by side there).
         for (k, (&e, &ends)) in order.iter().zip(&colours.ends).enumerate() {
@@ -315,6 +361,7 @@ where
             break;
         }
     }
+    (memory.rounding, memory.moved_by) = (rounding, moved_by);
     moved
 }
 

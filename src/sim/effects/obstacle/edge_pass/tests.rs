@@ -3,6 +3,7 @@ use glam::Vec3;
 use super::*;
 use crate::cloth::{ClothModel, ClothState};
 use crate::mesh::{GridOrientation, GridSpec};
+use crate::sim::obstacle::Tips;
 use crate::sim::self_contacts::SelfContacts;
 
 /// The twelve sharp edges of a 20 cm cube about the origin, raised by `lift` m.
@@ -62,7 +63,13 @@ fn pass(
         to_world: |n| n,
         velocity: |_| Vec3::ZERO,
     };
-    push_edges(edges, &frame, 0.3, &mut pass, (memory, moved))
+    push_edges(
+        (edges, &Tips::default()),
+        &frame,
+        0.3,
+        &mut pass,
+        (memory, moved),
+    )
 }
 
 /// A 60 cm cloth 8 mm over a 20 cm cube's top, its parts beyond the top falling and swinging

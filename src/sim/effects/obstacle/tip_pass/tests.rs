@@ -1,0 +1,89 @@
+//! Which way a triangle must move off a tip.
+
+use glam::Vec3;
+
+use super::*;
+
+/// A triangle lying flat (normal up) around the origin, 2 cm across, at height `y`.
+fn flat(y: f32) -> [Vec3; 3] {
+    [
+        Vec3::new(-0.01, y, -0.01),
+        Vec3::new(0.0, y, 0.01),
+        Vec3::new(0.01, y, -0.01),
+    ]
+}
+
+/// How far and which way the triangle `x` (`start` where it began the substep) must move
+/// off `tip`.
+fn missing(tip: Tip, x: [Vec3; 3], start: [Vec3; 3], thickness: f32) -> Option<(f32, Vec3)> {
+    let push = Face::new(x, start).missing(tip, thickness)?;
+    Some((push.gap, push.away))
+}
+
+const APEX: Tip = Tip {
+    point: Vec3::ZERO,
+    inward: Vec3::NEG_Y,
+};
+
+/// A triangle that began the substep above an apex and ended less than the thickness above
+/// it is lifted to the thickness; one that ended through it (the apex above the triangle)
+/// is lifted back over it; one the thickness or more above is left.
+#[test]
+fn a_triangle_over_an_apex_is_lifted_to_the_thickness() {
+    let t = 0.004;
+    let (gap, away) = missing(APEX, flat(0.001), flat(0.01), t).expect("too near");
+    assert!(
+        (gap - 0.003).abs() < 1e-6 && away.abs_diff_eq(Vec3::Y, 1e-6),
+        "{gap} {away}"
+    );
+    let (gap, away) = missing(APEX, flat(-0.002), flat(0.01), t).expect("through");
+    assert!(
+        (gap - 0.006).abs() < 1e-6 && away.abs_diff_eq(Vec3::Y, 1e-6),
+        "{gap} {away}"
+    );
+    assert_eq!(missing(APEX, flat(0.004), flat(0.01), t), None);
+    // Winding does not matter: the same triangle with its normal down.
+    let turn = |[a, b, c]: [Vec3; 3]| [a, c, b];
+    let (gap, away) = missing(APEX, turn(flat(-0.002)), turn(flat(0.01)), t).expect("through");
+    assert!(
+        (gap - 0.006).abs() < 1e-6 && away.abs_diff_eq(Vec3::Y, 1e-6),
+        "{gap} {away}"
+    );
+}
+
+/// The side a triangle began the substep on is kept, whichever way the tip's body lies (a
+/// flat sheet's corner here, its body along the triangle's plane): a triangle that began
+/// below and ended within the thickness above is pushed back down through it.
+#[test]
+fn edge_on_the_side_the_triangle_began_on_is_kept() {
+    let corner = Tip {
+        point: Vec3::ZERO,
+        inward: Vec3::X,
+    };
+    let t = 0.004;
+    let (gap, away) = missing(corner, flat(0.001), flat(-0.01), t).expect("crossed");
+    assert!(
+        (gap - 0.005).abs() < 1e-6 && away.abs_diff_eq(Vec3::NEG_Y, 1e-6),
+        "{gap} {away}"
+    );
+    let (gap, away) = missing(corner, flat(0.001), flat(0.01), t).expect("too near");
+    assert!(
+        (gap - 0.003).abs() < 1e-6 && away.abs_diff_eq(Vec3::Y, 1e-6),
+        "{gap} {away}"
+    );
+}
+
+/// Beside the triangle, the tip keeps a thickness from the nearest point of its edge,
+/// along the line between them; a tip that has gone past the triangle's plane from the
+/// side it began on is left to the edge pass.
+#[test]
+fn beside_a_triangle_the_tip_keeps_off_its_nearest_edge() {
+    let t = 0.004;
+    let x = flat(0.001).map(|p| p + Vec3::new(0.0, 0.0, 0.0115));
+    let (gap, away) = missing(APEX, x, x, t).expect("near the edge");
+    let off = Vec3::new(0.0, 0.001, 0.0015);
+    assert!((gap - (t - off.length())).abs() < 1e-6, "{gap}");
+    assert!(away.abs_diff_eq(off.normalize(), 1e-5), "{away}");
+    let below = flat(-0.001).map(|p| p + Vec3::new(0.0, 0.0, 0.0115));
+    assert_eq!(missing(APEX, below, x, t), None);
+}
