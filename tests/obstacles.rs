@@ -1053,22 +1053,12 @@ fn an_apex_a_corner_and_a_rising_apex_never_pierce_a_coarse_cloth() {
         [0, 2, 1],
     ];
     write_obj(&dir.path().join("pyramid.obj"), &pyramid, &faces);
-    let cube: Vec<Vec3> = (0..8)
-        .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32))
-        .map(|c| (c - Vec3::splat(0.5)) * 0.3)
-        .collect();
-    let quads = [
-        [0, 1, 3, 2],
-        [4, 6, 7, 5],
-        [0, 4, 5, 1],
-        [2, 3, 7, 6],
-        [0, 2, 6, 4],
-        [1, 5, 7, 3],
-    ];
-    let triangles: Vec<[u32; 3]> = (quads.iter())
-        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .collect();
-    write_obj(&dir.path().join("cube.obj"), &cube, &triangles);
+    // A 30 cm cube about its centre, its faces quads as the file gives them.
+    let cube = "v -0.15 -0.15 -0.15\nv 0.15 -0.15 -0.15\nv -0.15 0.15 -0.15\n\
+                v 0.15 0.15 -0.15\nv -0.15 -0.15 0.15\nv 0.15 -0.15 0.15\n\
+                v -0.15 0.15 0.15\nv 0.15 0.15 0.15\n\
+                f 1 2 4 3\nf 5 7 8 6\nf 1 5 6 2\nf 3 4 8 7\nf 1 3 7 5\nf 2 6 8 4\n";
+    std::fs::write(dir.path().join("cube.obj"), cube).unwrap();
     // A pyramid whose apex rises from 0.3 to 0.6 m over two seconds (a sequence: its
     // tips move with the surface).
     for (k, height) in [0.3, 0.45, 0.6].into_iter().enumerate() {
