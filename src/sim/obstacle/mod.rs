@@ -14,6 +14,6 @@ pub use edges::{Clearance, EdgeHit, LOOK, LOOK_DEFORMING, SharpEdges};
 pub(crate) use geometry::{closest_weights, segments_closest};
 pub use sequence::{Moment, Sequence, SurfaceClock};
 pub use surface::{Caught, Gathered, Surface};
-pub use tips::{Tip, Tips};
+pub use tips::Tips;
 pub use tree::{Near, Nearest, TriangleTree};
 pub(crate) use tree::{Split, split_triangles_at_medians};

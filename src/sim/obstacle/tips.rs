@@ -16,22 +16,7 @@ pub struct Tips {
     /// Each tip's vertex, and where it is.
     vertices: Vec<u32>,
     points: Vec<Vec3>,
-    /// Each tip's neighbours (the other corners of its faces, each once), tip by tip:
-    /// tip `k`'s are `around[starts[k]..starts[k + 1]]`.
-    around: Vec<u32>,
-    starts: Vec<u32>,
-    /// The unit direction from each tip to its neighbours' mean: into the body it ends
-    /// (zero where they balance, as round a flat sheet's inner point).
-    inward: Vec<Vec3>,
     tree: TriangleTree,
-}
-
-/// A tip of a surface: where it is, and the unit direction into the body it ends
-/// ([`Tips`]; zero for none).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Tip {
-    pub point: Vec3,
-    pub inward: Vec3,
 }
 
 impl Tips {
@@ -74,60 +59,22 @@ impl Tips {
             };
             tip[v] = fan.iter().any(spread);
         }
-        let (mut around, mut starts) = (Vec::new(), vec![0u32]);
-        let mut ids = Vec::new();
-        for fan in faces.chunk_by(|a, b| a.0 == b.0) {
-            let v = fan[0].0;
-            if !tip[v as usize] {
-                continue;
-            }
-            ids.push(v);
-            let first = around.len();
-            for &(_, t) in fan {
-                for i in triangles[t as usize] {
-                    let i = same[i as usize];
-                    if i != v && !around[first..].contains(&i) {
-                        around.push(i);
-                    }
-                }
-            }
-            starts.push(around.len() as u32);
-        }
-        let mut tips = Self {
+        let ids: Vec<u32> = (0..vertices.len() as u32)
+            .filter(|&v| tip[v as usize])
+            .collect();
+        let points: Vec<Vec3> = ids.iter().map(|&v| vertices[v as usize]).collect();
+        Self {
+            tree: TriangleTree::new(&points.iter().map(|&p| [p; 3]).collect::<Vec<_>>()),
             vertices: ids,
-            around,
-            starts,
-            ..Self::default()
-        };
-        tips.place(vertices);
-        tips.tree = TriangleTree::new(&tips.points.iter().map(|&p| [p; 3]).collect::<Vec<_>>());
-        tips
-    }
-
-    /// Each tip's place and inward direction over `vertices`.
-    fn place(&mut self, vertices: &[Vec3]) {
-        self.points.clear();
-        (self.points).extend(self.vertices.iter().map(|&v| vertices[v as usize]));
-        self.inward.clear();
-        for (k, &p) in self.points.iter().enumerate() {
-            let around = &self.around[self.starts[k] as usize..self.starts[k + 1] as usize];
-            let sum: Vec3 = around.iter().map(|&i| vertices[i as usize] - p).sum();
-            let mean = sum / around.len().max(1) as f32;
-            // Balanced to within a thousandth of the neighbours' reach: no direction.
-            let reach =
-                (around.iter()).fold(0.0f32, |m, &i| m.max(vertices[i as usize].distance(p)));
-            let inward = if mean.length() > 1e-3 * reach {
-                mean.normalize_or_zero()
-            } else {
-                Vec3::ZERO
-            };
-            self.inward.push(inward);
+            points,
         }
     }
 
     /// The same tips over moved `vertices` (which vertices are tips stays as first found).
     pub fn refit(&mut self, vertices: &[Vec3]) {
-        self.place(vertices);
+        for (point, &v) in self.points.iter_mut().zip(&self.vertices) {
+            *point = vertices[v as usize];
+        }
         let points = &self.points;
         self.tree.refit(|k| [points[k]; 3]);
     }
@@ -141,14 +88,9 @@ impl Tips {
     }
 
     /// Calls `visit` with every tip in the box `lo..hi`.
-    pub fn in_box(&self, lo: Vec3, hi: Vec3, mut visit: impl FnMut(Tip)) {
-        self.tree.overlapping(lo, hi, |k| {
-            let k = k as usize;
-            visit(Tip {
-                point: self.points[k],
-                inward: self.inward[k],
-            })
-        });
+    pub fn in_box(&self, lo: Vec3, hi: Vec3, mut visit: impl FnMut(Vec3)) {
+        self.tree
+            .overlapping(lo, hi, |k| visit(self.points[k as usize]));
     }
 
     /// Whether a tip lies in the box `lo..hi`.

@@ -6,7 +6,7 @@ use glam::{Vec3, Vec3A};
 
 use super::super::effect_kind::ContactPass;
 use super::super::solid::touching;
-use crate::sim::obstacle::{Clearance, LOOK, LOOK_DEFORMING, SharpEdges, SurfaceClock, Tip, Tips};
+use crate::sim::obstacle::{Clearance, LOOK, LOOK_DEFORMING, SharpEdges, SurfaceClock, Tips};
 
 /// How the frame of the sharp edges lies in the world: `to_local` takes a world point into
 /// it, `to_world` turns a direction of it into the world's, `velocity` is the surface's
@@ -40,7 +40,7 @@ pub(super) struct EdgeMemory {
     pushed: Vec<f32>,
     pushed_list: Vec<u32>,
     /// The tips near one patch of the cloth (scratch of the tip pass).
-    tips_near: Vec<Tip>,
+    tips_near: Vec<Vec3>,
     /// The last pass's room for a distance's rounding in the frame, and how far the edges
     /// moved in it over the substep, m (the tip pass reads them).
     rounding: f32,
@@ -151,7 +151,7 @@ pub(super) struct ForTips<'a> {
     /// Each particle's odometer, where the edges are fixed in the frame (else none).
     pub(super) odometers: &'a mut [f64],
     /// Scratch: the tips near one patch.
-    pub(super) found: &'a mut Vec<Tip>,
+    pub(super) found: &'a mut Vec<Vec3>,
     /// How far the tips moved in the frame over the substep, and the room for a
     /// distance's rounding there, m.
     pub(super) moved_by: f32,

@@ -9,13 +9,7 @@ use glam::{Vec3, Vec3A};
 use super::super::effect_kind::ContactPass;
 use super::super::solid::touching;
 use super::edge_pass::{EdgeFrame, EdgeMemory, ForTips};
-use crate::sim::obstacle::{Tip, Tips, closest_weights};
-
-/// A tip's inward direction decides the side a triangle must keep of it where it meets
-/// the triangle's normal at a cosine of at least this; more nearly along the triangle's
-/// plane (a flat sheet's corner met edge-on), the side the tip lay on when the substep
-/// began does.
-const SIDED_COS: f32 = 0.1;
+use crate::sim::obstacle::{Tips, closest_weights};
 
 /// Keeps every cloth triangle of the patches near a tip `pass.offset` off each tip within
 /// reach, in the edge pass's frame, after it (`memory`, [`EdgeMemory::for_tips`]): a tip
@@ -87,7 +81,7 @@ where
             );
             let free = ids.map(|i| f32::from(model.inv_mass[i] > 0.0));
             for &tip in found.iter() {
-                if !(tip.point.cmpge(lo) & tip.point.cmple(hi)).all() {
+                if !(tip.cmpge(lo) & tip.cmple(hi)).all() {
                     continue;
                 }
                 let Some(Push { gap, away, w }) = face.missing(tip, thickness) else {
@@ -98,7 +92,7 @@ where
                     continue;
                 }
                 let (n, by) = ((frame.to_world)(away), (frame.to_world)(gap * away));
-                let v_surface = (frame.velocity)(tip.point);
+                let v_surface = (frame.velocity)(tip);
                 for k in 0..3 {
                     let (i, part) = (ids[k], w[k] * free[k]);
                     if part <= 0.0 {
@@ -152,31 +146,27 @@ impl Face {
 
     /// How the triangle must move to keep `thickness` off `tip` on the side it must keep
     /// (see [`push_tips`]); `None` where it keeps it already.
-    fn missing(&self, tip: Tip, thickness: f32) -> Option<Push> {
+    fn missing(&self, tip: Vec3, thickness: f32) -> Option<Push> {
         let (x, normal) = (self.x, self.normal);
         if normal == Vec3::ZERO {
             return None;
         }
         // The side of the triangle the tip must keep: the side of its plane the tip began
-        // the substep on; where it began in the plane, the side of the body the tip ends,
-        // or that it ends on.
-        let over = (tip.point - self.start).dot(self.began);
-        let plane = (tip.point - x[0]).dot(normal);
+        // the substep on (where it began in the plane, the side it ends on).
+        let over = (tip - self.start).dot(self.began);
+        let plane = (tip - x[0]).dot(normal);
         if over * plane > 0.0 && plane.abs() >= thickness {
             // On its side of the plane, and the thickness off it: off every point of it.
             return None;
         }
-        let facing = tip.inward.dot(normal);
         let side = if over != 0.0 {
             over.signum()
-        } else if facing.abs() >= SIDED_COS {
-            facing.signum()
         } else {
             plane.signum()
         };
-        let w = closest_weights(tip.point, x);
+        let w = closest_weights(tip, x);
         let q = w[0] * x[0] + w[1] * x[1] + w[2] * x[2];
-        let height = side * (tip.point - q).dot(normal);
+        let height = side * (tip - q).dot(normal);
         if w.iter().all(|&w| w > 0.0) {
             // Inside: the triangle goes to the far side of the tip.
             let away = -side * normal;
@@ -187,7 +177,7 @@ impl Face {
             });
         }
         // Nearest an edge or a corner: kept a thickness off, where on its side.
-        let (off, distance) = (q - tip.point, q.distance(tip.point));
+        let (off, distance) = (q - tip, q.distance(tip));
         let room = distance > thickness * 1e-3 && height >= 0.0;
         (room && distance < thickness).then(|| Push {
             gap: thickness - distance,

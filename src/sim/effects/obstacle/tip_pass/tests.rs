@@ -15,15 +15,12 @@ fn flat(y: f32) -> [Vec3; 3] {
 
 /// How far and which way the triangle `x` (`start` where it began the substep) must move
 /// off `tip`.
-fn missing(tip: Tip, x: [Vec3; 3], start: [Vec3; 3], thickness: f32) -> Option<(f32, Vec3)> {
+fn missing(tip: Vec3, x: [Vec3; 3], start: [Vec3; 3], thickness: f32) -> Option<(f32, Vec3)> {
     let push = Face::new(x, start).missing(tip, thickness)?;
     Some((push.gap, push.away))
 }
 
-const APEX: Tip = Tip {
-    point: Vec3::ZERO,
-    inward: Vec3::NEG_Y,
-};
+const APEX: Vec3 = Vec3::ZERO;
 
 /// A triangle that began the substep above an apex and ended less than the thickness above
 /// it is lifted to the thickness; one that ended through it (the apex above the triangle)
@@ -51,15 +48,12 @@ fn a_triangle_over_an_apex_is_lifted_to_the_thickness() {
     );
 }
 
-/// The side a triangle began the substep on is kept, whichever way the tip's body lies (a
-/// flat sheet's corner here, its body along the triangle's plane): a triangle that began
-/// below and ended within the thickness above is pushed back down through it.
+/// The side a triangle began the substep on is kept, whichever it was: a triangle that
+/// began below a tip and ended within the thickness above it is pushed back down through
+/// it; one that began above, up.
 #[test]
-fn edge_on_the_side_the_triangle_began_on_is_kept() {
-    let corner = Tip {
-        point: Vec3::ZERO,
-        inward: Vec3::X,
-    };
+fn the_side_the_triangle_began_on_is_kept() {
+    let corner = Vec3::ZERO;
     let t = 0.004;
     let (gap, away) = missing(corner, flat(0.001), flat(-0.01), t).expect("crossed");
     assert!(
