@@ -10,13 +10,52 @@ use glam::Vec3;
 use super::edges::CREASE_COS;
 use super::tree::TriangleTree;
 
-/// The tips of a surface and a tree over them.
+/// The tips of a surface and a tree over them; and the rest of its vertices (its smooth
+/// parts'), with a tree, and how sharply those parts curve at most.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Tips {
-    /// Each tip's vertex, and where it is.
+    tips: Points,
+    smooth: Points,
+    /// The largest curvature of the smooth parts, 1/m: at each smooth vertex, the angle
+    /// between the two of its faces that turn most from each other over the distance
+    /// between their centroids (an estimate: a sliver's centroid lies off its normal's
+    /// point, and a cube-sphere's corners read three times their true curvature).
+    curvature: f32,
+}
+
+/// Some vertices of a surface, where they are, and a tree over them; for the smooth
+/// vertices, each one's curvature too (1/m; none for the tips).
+#[derive(Clone, Debug, Default, PartialEq)]
+struct Points {
     vertices: Vec<u32>,
     points: Vec<Vec3>,
+    curvatures: Vec<f32>,
     tree: TriangleTree,
+}
+
+impl Points {
+    fn of(ids: Vec<u32>, curvatures: Vec<f32>, vertices: &[Vec3]) -> Self {
+        let points: Vec<Vec3> = ids.iter().map(|&v| vertices[v as usize]).collect();
+        Points {
+            tree: TriangleTree::new(&points.iter().map(|&p| [p; 3]).collect::<Vec<_>>()),
+            vertices: ids,
+            points,
+            curvatures,
+        }
+    }
+
+    fn refit(&mut self, vertices: &[Vec3]) {
+        for (point, &v) in self.points.iter_mut().zip(&self.vertices) {
+            *point = vertices[v as usize];
+        }
+        let points = &self.points;
+        self.tree.refit(|k| [points[k]; 3]);
+    }
+
+    fn in_box(&self, lo: Vec3, hi: Vec3, mut visit: impl FnMut(Vec3)) {
+        self.tree
+            .overlapping(lo, hi, |k| visit(self.points[k as usize]));
+    }
 }
 
 impl Tips {
@@ -48,64 +87,100 @@ impl Tips {
             .flat_map(|(t, tri)| tri.map(|i| (same[i as usize], t as u32)))
             .collect();
         faces.sort_unstable();
+        let (mut smooth, mut curvatures) = (Vec::new(), Vec::new());
+        let centroid = |t: u32| {
+            triangles[t as usize]
+                .map(|i| vertices[i as usize])
+                .iter()
+                .sum::<Vec3>()
+                / 3.0
+        };
         for fan in faces.chunk_by(|a, b| a.0 == b.0) {
-            let v = fan[0].0 as usize;
-            if tip[v] {
+            let v = fan[0].0;
+            if tip[v as usize] {
                 continue;
             }
-            let spread = |&(_, s): &(u32, u32)| {
-                let n = normals[s as usize];
-                (fan.iter()).any(|&(_, t)| n.dot(normals[t as usize]).abs() < CREASE_COS)
-            };
-            tip[v] = fan.iter().any(spread);
+            // The two faces that turn most from each other.
+            let mut most = (1.0f32, fan[0].1, fan[0].1);
+            for (k, &(_, s)) in fan.iter().enumerate() {
+                for &(_, t) in &fan[k + 1..] {
+                    let cos = normals[s as usize].dot(normals[t as usize]).abs();
+                    if cos < most.0 {
+                        most = (cos, s, t);
+                    }
+                }
+            }
+            if most.0 < CREASE_COS {
+                tip[v as usize] = true;
+                continue;
+            }
+            smooth.push(v);
+            let apart = centroid(most.1).distance(centroid(most.2));
+            let turn = most.0.clamp(0.0, 1.0).acos();
+            curvatures.push(if apart > 0.0 { turn / apart } else { 0.0 });
         }
         let ids: Vec<u32> = (0..vertices.len() as u32)
             .filter(|&v| tip[v as usize])
             .collect();
-        let points: Vec<Vec3> = ids.iter().map(|&v| vertices[v as usize]).collect();
+        let curvature = curvatures.iter().copied().fold(0.0, f32::max);
         Self {
-            tree: TriangleTree::new(&points.iter().map(|&p| [p; 3]).collect::<Vec<_>>()),
-            vertices: ids,
-            points,
+            tips: Points::of(ids, Vec::new(), vertices),
+            smooth: Points::of(smooth, curvatures, vertices),
+            curvature,
         }
     }
 
-    /// The same tips over moved `vertices` (which vertices are tips stays as first found).
+    /// The same tips and smooth vertices over moved `vertices` (which vertices are tips,
+    /// and the curvature, stay as first found).
     pub fn refit(&mut self, vertices: &[Vec3]) {
-        for (point, &v) in self.points.iter_mut().zip(&self.vertices) {
-            *point = vertices[v as usize];
-        }
-        let points = &self.points;
-        self.tree.refit(|k| [points[k]; 3]);
+        self.tips.refit(vertices);
+        self.smooth.refit(vertices);
     }
 
+    /// How many tips.
     pub fn len(&self) -> usize {
-        self.points.len()
+        self.tips.points.len()
     }
 
+    /// No tips, and no smooth vertices either.
     pub fn is_empty(&self) -> bool {
-        self.points.is_empty()
+        self.tips.points.is_empty() && self.smooth.points.is_empty()
     }
 
     /// Calls `visit` with every tip in the box `lo..hi`.
-    pub fn in_box(&self, lo: Vec3, hi: Vec3, mut visit: impl FnMut(Vec3)) {
-        self.tree
-            .overlapping(lo, hi, |k| visit(self.points[k as usize]));
+    pub fn in_box(&self, lo: Vec3, hi: Vec3, visit: impl FnMut(Vec3)) {
+        self.tips.in_box(lo, hi, visit);
     }
 
-    /// Whether a tip lies in the box `lo..hi`.
-    pub fn any_in_box(&self, lo: Vec3, hi: Vec3) -> bool {
-        let mut any = false;
-        self.tree.overlapping_while(lo, hi, |_| {
-            any = true;
-            false
+    /// Calls `visit` with every smooth vertex in the box `lo..hi` and its curvature (1/m).
+    pub fn smooth_in_box(&self, lo: Vec3, hi: Vec3, mut visit: impl FnMut(Vec3, f32)) {
+        let smooth = &self.smooth;
+        (smooth.tree).overlapping(lo, hi, |k| {
+            visit(smooth.points[k as usize], smooth.curvatures[k as usize])
         });
-        any
+    }
+
+    /// The largest curvature of the smooth parts, 1/m (see [`Tips`]).
+    pub fn curvature(&self) -> f32 {
+        self.curvature
+    }
+
+    /// Whether a tip lies in the box `lo..hi`, or (`smooth`) any vertex.
+    pub fn any_in_box(&self, lo: Vec3, hi: Vec3, smooth: bool) -> bool {
+        let any = |points: &Points| {
+            let mut found = false;
+            points.tree.overlapping_while(lo, hi, |_| {
+                found = true;
+                false
+            });
+            found
+        };
+        any(&self.tips) || (smooth && any(&self.smooth))
     }
 
     /// The box around every tip (`None` for none).
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        self.tree.bounds()
+        self.tips.tree.bounds()
     }
 }
 

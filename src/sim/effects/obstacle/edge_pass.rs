@@ -39,8 +39,10 @@ pub(super) struct EdgeMemory {
     /// pushed.
     pushed: Vec<f32>,
     pushed_list: Vec<u32>,
-    /// The tips near one patch of the cloth (scratch of the tip pass).
+    /// The tips near one patch of the cloth, and the vertices near one of its triangles
+    /// (scratch of the tip pass).
     tips_near: Vec<Vec3>,
+    tips_close: Vec<Vec3>,
     /// The last pass's room for a distance's rounding in the frame, and how far the edges
     /// moved in it over the substep, m (the tip pass reads them).
     rounding: f32,
@@ -150,8 +152,9 @@ pub(super) struct ForTips<'a> {
     pub(super) local: &'a mut [Vec3A],
     /// Each particle's odometer, where the edges are fixed in the frame (else none).
     pub(super) odometers: &'a mut [f64],
-    /// Scratch: the tips near one patch.
+    /// Scratch: the tips near one patch, and the vertices near one triangle.
     pub(super) found: &'a mut Vec<Vec3>,
+    pub(super) close: &'a mut Vec<Vec3>,
     /// How far the tips moved in the frame over the substep, and the room for a
     /// distance's rounding there, m.
     pub(super) moved_by: f32,
@@ -168,6 +171,7 @@ impl EdgeMemory {
             local: &mut self.local,
             odometers: &mut self.odometers,
             found: &mut self.tips_near,
+            close: &mut self.tips_close,
             moved_by: self.moved_by,
             rounding: self.rounding,
         }

@@ -11,6 +11,27 @@ use super::super::solid::touching;
 use super::edge_pass::{EdgeFrame, EdgeMemory, ForTips};
 use crate::sim::obstacle::{Tips, closest_weights};
 
+/// A cloth triangle is tested against the smooth parts' vertices too where a ball of their
+/// largest curvature would rise under it by this share of the thickness or more
+/// ([`sag`]), and against each vertex whose own curvature would: its particles keep the
+/// thickness off the surface, so a bulge of less cannot reach through it.
+const RISK: f32 = 1.0;
+
+/// How far a ball of `curvature` rises under the triangle `x` above the circle its corners
+/// lie on (for a curvature `κ` and a least enclosing circle of radius `ρ`, `κρ²/2`).
+fn sag(x: [Vec3; 3], curvature: f32) -> f32 {
+    let [a, b, c] = [x[1] - x[0], x[2] - x[1], x[0] - x[2]].map(|e| e.length_squared());
+    let longest = a.max(b).max(c);
+    // Right or obtuse: the longest edge is the circle's diameter; acute: the circumcircle.
+    let radius_squared = if 2.0 * longest >= a + b + c {
+        0.25 * longest
+    } else {
+        let twice_area = (x[1] - x[0]).cross(x[2] - x[0]).length_squared();
+        a * b * c / (4.0 * twice_area).max(f32::MIN_POSITIVE)
+    };
+    0.5 * curvature * radius_squared
+}
+
 /// Keeps every cloth triangle of the patches near a tip `pass.offset` off each tip within
 /// reach, in the edge pass's frame, after it (`memory`, [`EdgeMemory::for_tips`]): a tip
 /// whose nearest point of the triangle lies inside it must stay a thickness off on the
@@ -45,6 +66,7 @@ where
         local,
         odometers,
         found,
+        close,
         moved_by,
         rounding,
     } = memory.for_tips();
@@ -54,7 +76,8 @@ where
         .fold(0.0f32, |m, (b, l)| m.max(b.distance_squared(*l)))
         .sqrt();
     let most = Vec3::splat(thickness + travel + moved_by + rounding);
-    let near = |lo: Vec3, hi: Vec3| tips.any_in_box(lo - most, hi + most);
+    let (curvature, smooth) = (tips.curvature(), tips.curvature() > 0.0);
+    let near = |lo: Vec3, hi: Vec3| tips.any_in_box(lo - most, hi + most, smooth);
     faces.flag(model, |i| local[i as usize], near);
     let counted = odometers.len() == local.len();
     let mut pushed = 0;
@@ -62,28 +85,42 @@ where
         // The tips near the patch, then those near each of its triangles.
         found.clear();
         tips.in_box(lo - most, hi + most, |tip| found.push(tip));
-        if found.is_empty() {
-            continue;
-        }
         for &t in triangles {
             let ids = model.triangles[t as usize].map(|i| i as usize);
             let corners = |local: &[Vec3A]| ids.map(|i| Vec3::from(local[i]));
+            let x = corners(local);
+            // Wide enough that the smooth parts could bulge through it.
+            let risky = smooth && sag(x, curvature) >= RISK * thickness;
+            let wide = sag(x, 1.0);
+            if found.is_empty() && !risky {
+                continue;
+            }
             let start = corners(before);
-            let mut face = Face::new(corners(local), start);
+            let mut face = Face::new(x, start);
             // Its own corners' moves bound its points' (and the tips' own move).
             let moves = ids.map(|i| before[i].distance_squared(local[i]));
             let moved = moves[0].max(moves[1]).max(moves[2]).sqrt();
             let reach = Vec3::splat(thickness + moved + moved_by + rounding);
-            let x = face.x;
             let (lo, hi) = (
                 x[0].min(x[1]).min(x[2]) - reach,
                 x[0].max(x[1]).max(x[2]) + reach,
             );
+            close.clear();
+            close.extend(
+                found
+                    .iter()
+                    .filter(|tip| (tip.cmpge(lo) & tip.cmple(hi)).all()),
+            );
+            if risky {
+                // Each vertex where its own curvature could bulge that far.
+                tips.smooth_in_box(lo, hi, |p, curvature| {
+                    if wide * curvature >= RISK * thickness {
+                        close.push(p);
+                    }
+                });
+            }
             let free = ids.map(|i| f32::from(model.inv_mass[i] > 0.0));
-            for &tip in found.iter() {
-                if !(tip.cmpge(lo) & tip.cmple(hi)).all() {
-                    continue;
-                }
+            for &tip in close.iter() {
                 let Some(Push { gap, away, w }) = face.missing(tip, thickness) else {
                     continue;
                 };

@@ -102,3 +102,41 @@ fn tips_are_found_across_faces_written_apart_and_move_with_a_refit() {
     assert_eq!(count, surface.tips().len());
     assert_eq!(surface.tips().bounds().map(|b| b.0.x), Some(2.0));
 }
+
+/// A smooth bowl-shaped cap `y = c (x² + z²) / 2`, finely cut (its faces turn by under 10°
+/// round every vertex): no tips but its open border's, and the curvature read from its
+/// faces not below `c` by more than a fifth, nor above twice it (the estimate takes the
+/// sharpest turn of each fan over the distance between its faces' centroids, which reads
+/// high across a grid's diagonals: up to 1.5 `c` here).
+#[test]
+fn a_smooth_caps_vertices_are_smooth_and_its_curvature_is_read_from_its_faces() {
+    let (n, c) = (40u32, 4.0f32);
+    let at = |i: u32, j: u32| i * (n + 1) + j;
+    let vertices: Vec<Vec3> = (0..=n)
+        .flat_map(|i| (0..=n).map(move |j| (i, j)))
+        .map(|(i, j)| {
+            let (x, z) = (i as f32 / n as f32 - 0.5, j as f32 / n as f32 - 0.5);
+            Vec3::new(x, 0.5 * c * (x * x + z * z), z)
+        })
+        .collect();
+    let triangles: Vec<[u32; 3]> = (0..n)
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .flat_map(|(i, j)| {
+            let (a, b, d, e) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            [[a, d, b], [a, e, d]]
+        })
+        .collect();
+    let surface = Surface::new(vertices, triangles);
+    let tips = surface.tips();
+    // Its border is open (sharp): only the border's vertices are tips.
+    assert_eq!(tips.len(), 4 * n as usize);
+    let curvature = tips.curvature();
+    assert!((0.8 * c..2.0 * c).contains(&curvature), "{curvature}");
+    let mut middle = Vec::new();
+    let near = Vec3::splat(0.05);
+    tips.smooth_in_box(-near, near, |p, k| middle.push((p, k)));
+    assert!(!middle.is_empty());
+    for (p, k) in middle {
+        assert!((0.8 * c..2.0 * c).contains(&k), "{k} at {p}");
+    }
+}
