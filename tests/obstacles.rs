@@ -1109,35 +1109,19 @@ fn an_apex_a_corner_and_a_rising_apex_never_pierce_a_coarse_cloth() {
     }
 }
 
-/// A ball of radius `radius` resting on the ground, its surface a cube's faces cut into
-/// `cuts` × `cuts` squares pushed out onto it (`12 cuts²` triangles, none a sliver).
-fn write_ball(path: &Path, radius: f32, cuts: u32) {
-    let mut vertices = Vec::new();
-    let mut triangles = Vec::new();
-    for (axis, sign) in (0..3).flat_map(|a| [(a, -1.0f32), (a, 1.0)]) {
-        let first = vertices.len() as u32;
-        for i in 0..=cuts {
-            for j in 0..=cuts {
-                let (u, v) = (
-                    2.0 * i as f32 / cuts as f32 - 1.0,
-                    2.0 * j as f32 / cuts as f32 - 1.0,
-                );
-                let mut p = Vec3::ZERO;
-                (p[axis], p[(axis + 1) % 3], p[(axis + 2) % 3]) = (sign, u, v);
-                vertices.push(p.normalize() * radius + Vec3::Y * radius);
-            }
-        }
-        let at = |i: u32, j: u32| first + i * (cuts + 1) + j;
-        for (i, j) in (0..cuts).flat_map(|i| (0..cuts).map(move |j| (i, j))) {
-            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-            if sign > 0.0 {
-                triangles.extend([[a, b, c], [a, c, d]]);
-            } else {
-                triangles.extend([[a, c, b], [a, d, c]]);
-            }
-        }
-    }
-    write_obj(path, &vertices, &triangles);
+/// A ball of radius `radius` and about `triangles` triangles resting on the ground (the
+/// benchmark's cube-sphere: a cube's faces cut into even squares pushed out onto it).
+fn write_ball(path: &Path, radius: f32, triangles: usize) {
+    let soup = clothsim::bench_contact::cube_sphere(radius, triangles);
+    let up = |p: &Vec3| *p + Vec3::Y * radius;
+    let faces: Vec<[u32; 3]> = (soup.face_indices.chunks_exact(3))
+        .map(|f| [f[0], f[1], f[2]])
+        .collect();
+    write_obj(
+        path,
+        &soup.positions.iter().map(up).collect::<Vec<_>>(),
+        &faces,
+    );
 }
 
 /// A coarse cloth (6 × 6 quads of 17 cm, a 1 cm thickness) dropped on a 20 cm ball of
@@ -1149,7 +1133,7 @@ fn write_ball(path: &Path, radius: f32, cuts: u32) {
 #[test]
 fn a_smooth_ball_never_comes_through_a_coarse_cloth() {
     let dir = tempfile::tempdir().unwrap();
-    write_ball(&dir.path().join("ball.obj"), 0.2, 40);
+    write_ball(&dir.path().join("ball.obj"), 0.2, 19_200);
     let ball = "[[effects]]\ntype = \"obstacle\"\nobj = \"ball.obj\"\n";
     for integrator in ["semi-implicit-euler", "implicit-euler", "xpbd", "vbd"] {
         let mut sim = Simulation::new(coarse_drop(dir.path(), ball, integrator));
