@@ -1,8 +1,9 @@
 //! The tip pass of a mesh obstacle: every cloth triangle kept a thickness off the
 //! obstacle's tips (a pyramid's apex, a table's corners), which can poke through a
-//! triangle whose particles and edges all keep clear of the faces and the sharp edges.
-//! It runs where the solids keep the cloth's triangles out (beside self-contact, as a
-//! sphere's face pass does), in the edge pass's frame and after it.
+//! triangle whose particles and edges all keep clear of the faces and the sharp edges;
+//! and, under a triangle wide enough for the surface's curve to rise through it, off the
+//! other vertices too. It runs where the solids keep the cloth's triangles out (beside
+//! self-contact, as a sphere's face pass does), in the edge pass's frame and after it.
 
 use glam::{Vec3, Vec3A};
 
@@ -33,7 +34,8 @@ fn sag(x: [Vec3; 3], curvature: f32) -> f32 {
 }
 
 /// Keeps every cloth triangle of the patches near a tip `pass.offset` off each tip within
-/// reach, in the edge pass's frame, after it (`memory`, [`EdgeMemory::for_tips`]): a tip
+/// reach, and off each smooth vertex within reach where the surface could rise through it
+/// ([`RISK`]), in the edge pass's frame, after it (`memory`, [`EdgeMemory::for_tips`]): a tip
 /// whose nearest point of the triangle lies inside it must stay a thickness off on the
 /// side of the triangle's plane it began the substep on; one nearest an edge or a corner
 /// of the triangle must stay a thickness from that point. What is missing moves the
