@@ -1,7 +1,7 @@
 //! Running a loop compiled for AVX2 where the CPU has it.
 //!
 //! The crate is built for the baseline x86-64 (SSE2), so its loops over component arrays
-//! go four floats at a time. [`wide`] runs a piece of work through a function compiled
+//! go four floats at a time. [`wide()`] runs a piece of work through a function compiled
 //! for AVX2, picked at run time, where the compiler can go eight at a time. A loop that
 //! should benefit must be inlined all the way into the closure: write it in an
 //! `#[inline(always)]` function and pass an `#[inline(always)]` closure. Without FMA the

@@ -159,7 +159,7 @@ impl<R: Real> CpuStepper<R> {
     }
 
     /// A speed or kinetic-energy limit crossed: the frame redone from its start against the
-    /// limits raised to admit what it reached ([`GuardLimits::admitting`]), with the
+    /// limits raised to admit what it reached ([`GuardLimits::admitting`](crate::sim::guard::GuardLimits::admitting)), with the
     /// substeps in effect and then with twice as many. Where both stand and their
     /// velocities agree ([`resolved`]), the motion is the scene's: the first stands, and so
     /// do the raised limits. A blow-up outgrows the raised limits within the frame, so its

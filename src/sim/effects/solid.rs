@@ -86,7 +86,7 @@ pub(super) trait Solid {
 /// most `friction` × the removed normal speed. Returns how many particles it moved.
 ///
 /// Each particle's contact is its own, so a large cloth's particles are shared out between
-/// the team's members ([`each_part`]); the result is the same however they are cut.
+/// the team's members ([`each_part`](crate::parallel::each_part)); the result is the same however they are cut.
 pub(super) fn resolve(solid: &(impl Solid + Sync), pass: &mut ContactPass<'_>) -> usize {
     resolve_remembering(solid, pass, None)
 }
