@@ -81,3 +81,33 @@ fn beside_a_triangle_the_tip_keeps_off_its_nearest_edge() {
     let below = flat(-0.001).map(|p| p + Vec3::new(0.0, 0.0, 0.0115));
     assert_eq!(missing(APEX, below, x, t), None);
 }
+
+/// A ball's rise under a triangle is taken over its least enclosing circle: a right
+/// triangle's has its hypotenuse for a diameter, an obtuse one's its longest edge, an
+/// equilateral one's is its circumcircle (radius `L/√3`); `κρ²/2` for curvature `κ`.
+#[test]
+fn the_rise_under_a_triangle_is_over_its_least_enclosing_circle() {
+    let right = [
+        Vec3::ZERO,
+        Vec3::new(0.3, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 0.4),
+    ];
+    assert!((sag(right, 2.0) - 0.0625).abs() < 1e-6, "{}", sag(right, 2.0));
+    let obtuse = [
+        Vec3::ZERO,
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.5, 0.0, 0.1),
+    ];
+    assert!(
+        (sag(obtuse, 2.0) - 0.25).abs() < 1e-6,
+        "{}",
+        sag(obtuse, 2.0)
+    );
+    let h = 3f32.sqrt() / 2.0;
+    let equilateral = [Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.5, 0.0, h)];
+    assert!(
+        (sag(equilateral, 2.0) - 1.0 / 3.0).abs() < 1e-5,
+        "{}",
+        sag(equilateral, 2.0)
+    );
+}
