@@ -242,17 +242,13 @@ where
     let fixed = moved == EdgesMoved::Fixed;
     let reading = memory.take_in(&state.pos, &frame.to_local, order.len(), fixed);
     (memory.clearance).resize(springs.a.len(), Clearance::NONE);
-    let moved_by = match moved {
-        EdgesMoved::Fixed => 0.0,
-        EdgesMoved::By(by) => by,
-    };
-    let look = match moved {
-        EdgesMoved::Fixed => LOOK,
+    let (look, moved_by) = match moved {
+        EdgesMoved::Fixed => (LOOK, 0.0),
         EdgesMoved::By(by) => {
             if by > 0.0 {
                 (memory.clearance.iter_mut()).for_each(|c| c.surface_moved(by));
             }
-            LOOK_DEFORMING
+            (LOOK_DEFORMING, by)
         }
     };
     let (clearance, asked_at) = (&mut memory.clearance, &mut memory.asked_at);

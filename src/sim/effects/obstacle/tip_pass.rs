@@ -92,8 +92,9 @@ where
             let corners = |local: &[Vec3A]| ids.map(|i| Vec3::from(local[i]));
             let x = corners(local);
             // Wide enough that the smooth parts could bulge through it.
-            let risky = smooth && sag(x, curvature) >= RISK * thickness;
+            // How far a ball of unit curvature rises under it.
             let wide = sag(x, 1.0);
+            let risky = smooth && wide * curvature >= RISK * thickness;
             if found.is_empty() && !risky {
                 continue;
             }
