@@ -177,11 +177,6 @@ impl Tips {
         };
         any(&self.tips) || (smooth && any(&self.smooth))
     }
-
-    /// The box around every tip (`None` for none).
-    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        self.tips.tree.bounds()
-    }
 }
 
 #[cfg(test)]
