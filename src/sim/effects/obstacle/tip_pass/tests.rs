@@ -92,7 +92,11 @@ fn the_rise_under_a_triangle_is_over_its_least_enclosing_circle() {
         Vec3::new(0.3, 0.0, 0.0),
         Vec3::new(0.0, 0.0, 0.4),
     ];
-    assert!((sag(right, 2.0) - 0.0625).abs() < 1e-6, "{}", sag(right, 2.0));
+    assert!(
+        (sag(right, 2.0) - 0.0625).abs() < 1e-6,
+        "{}",
+        sag(right, 2.0)
+    );
     let obtuse = [
         Vec3::ZERO,
         Vec3::new(1.0, 0.0, 0.0),
