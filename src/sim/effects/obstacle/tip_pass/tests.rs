@@ -87,31 +87,24 @@ fn beside_a_triangle_the_tip_keeps_off_its_nearest_edge() {
 /// equilateral one's is its circumcircle (radius `L/√3`); `κρ²/2` for curvature `κ`.
 #[test]
 fn the_rise_under_a_triangle_is_over_its_least_enclosing_circle() {
-    let right = [
-        Vec3::ZERO,
-        Vec3::new(0.3, 0.0, 0.0),
-        Vec3::new(0.0, 0.0, 0.4),
-    ];
-    assert!(
-        (sag(right, 2.0) - 0.0625).abs() < 1e-6,
-        "{}",
-        sag(right, 2.0)
-    );
-    let obtuse = [
-        Vec3::ZERO,
-        Vec3::new(1.0, 0.0, 0.0),
-        Vec3::new(0.5, 0.0, 0.1),
-    ];
-    assert!(
-        (sag(obtuse, 2.0) - 0.25).abs() < 1e-6,
-        "{}",
-        sag(obtuse, 2.0)
-    );
     let h = 3f32.sqrt() / 2.0;
-    let equilateral = [Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.5, 0.0, h)];
-    assert!(
-        (sag(equilateral, 2.0) - 1.0 / 3.0).abs() < 1e-5,
-        "{}",
-        sag(equilateral, 2.0)
-    );
+    let cases = [
+        // Right: legs 0.3 and 0.4, radius 0.25.
+        (
+            [
+                Vec3::ZERO,
+                Vec3::new(0.3, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, 0.4),
+            ],
+            0.0625,
+        ),
+        // Obtuse: longest edge 1, radius 0.5.
+        ([Vec3::ZERO, Vec3::X, Vec3::new(0.5, 0.0, 0.1)], 0.25),
+        // Equilateral of side 1: radius 1/√3.
+        ([Vec3::ZERO, Vec3::X, Vec3::new(0.5, 0.0, h)], 1.0 / 3.0),
+    ];
+    for (x, rise) in cases {
+        let got = sag(x, 2.0);
+        assert!((got - rise).abs() < 1e-5, "{x:?}: {got} against {rise}");
+    }
 }
