@@ -9,7 +9,10 @@
 // to the thickness through the obstacle's box tree, and answers with an inelastic velocity
 // response and Coulomb friction against the surface's own velocity. Then `edges`, one
 // dispatch per colour of the cloth's edges, keeps each cloth edge off the obstacle's sharp
-// edges (creases and open borders) as the CPU's sweep over them does.
+// edges (creases and open borders) as the CPU's sweep over them does. Beside
+// self-contact, `tips`, one dispatch per colour of the cloth's triangles, keeps each
+// triangle off the obstacle's tips (and, where it is wide enough for the surface to bulge
+// through it, off its smooth vertices) as the CPU's tip pass does.
 
 struct Obstacle {
     // In `surface`'s entries: where its tree's nodes, its places (triangles in the tree's
@@ -24,10 +27,16 @@ struct Obstacle {
     // velocities (bits; two entries a vertex, after `starts` as they are); w: 1 when it
     // deforms.
     info: vec4<f32>,
+    // Where its tips' tree's nodes, its tips (a point each, w unused), its smooth vertices'
+    // tree's nodes and its smooth vertices (w: the curvature, 1/m) start, as `starts`.
+    tips: vec4<u32>,
+    // x: the tips' tree's nodes; y: the smooth vertices' tree's nodes; z: the largest
+    // curvature (bits).
+    tip_counts: vec4<u32>,
 }
 
 struct ObstacleParams {
-    // x: particles.
+    // x: particles; y: where the cloth's triangles start in `cloth_edges`.
     counts: vec4<u32>,
     obstacles: array<Obstacle, 4>,
 }
@@ -41,7 +50,9 @@ struct ObstacleParams {
 // unit normal); a sharp edge's place two (its ends); a deforming obstacle's vertex two (its
 // move over the substep, its velocity).
 @group(0) @binding(3) var<storage, read> surface: array<vec4<f32>>;
-// The cloth's edges (structural and shear springs' ends) in colour order.
+// The cloth's edges (structural and shear springs' ends) in colour order; after them,
+// where the tip pass runs, its triangles in colour order (two entries each: two corners,
+// then the third).
 @group(0) @binding(4) var<storage, read> cloth_edges: array<vec2<u32>>;
 // Crossings each sweep of the edge pass found (`catch_moves` zeroes them).
 @group(0) @binding(5) var<storage, read_write> crossings: array<atomic<u32>, SWEEPS>;
@@ -684,6 +695,244 @@ fn edges(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         if (part.y > 0.0) {
             moved(e.y, pj.v.xyz - before[1]);
+        }
+    }
+}
+
+// A ball of `curvature` rises this far under the triangle x0 x1 x2 above the circle its
+// corners lie on (κρ²/2 over its least enclosing circle: the CPU's `sag`).
+fn sag(x0: vec3<f32>, x1: vec3<f32>, x2: vec3<f32>, curvature: f32) -> f32 {
+    let a = dot(x1 - x0, x1 - x0);
+    let b = dot(x2 - x1, x2 - x1);
+    let c = dot(x0 - x2, x0 - x2);
+    let longest = max(a, max(b, c));
+    // Right or obtuse: the longest edge is the circle's diameter; acute: the circumcircle.
+    var r2 = 0.25 * longest;
+    if (2.0 * longest < a + b + c) {
+        let n = cross(x1 - x0, x2 - x0);
+        r2 = a * b * c / max(4.0 * dot(n, n), 1.17549435e-38);
+    }
+    return 0.5 * curvature * r2;
+}
+
+// What a cloth triangle's nearest point to a tip must move by (`gap`, m; 0: nothing),
+// which way, and its corners' weights in that point (the CPU's `Push`).
+struct TipPush {
+    gap: f32,
+    away: vec3<f32>,
+    w: vec3<f32>,
+}
+
+// How triangle x (its unit normal `normal`, zero when degenerate) must move to keep
+// `thickness` off `tip` on the side of the plane it began the substep in (a corner
+// `began_at`, a normal `began`) that the tip began on: the CPU's `Face::missing`.
+fn tip_missing(x: array<vec3<f32>, 3>, normal: vec3<f32>, began_at: vec3<f32>, began: vec3<f32>, tip: vec3<f32>, thickness: f32) -> TipPush {
+    let none = TipPush(0.0, vec3<f32>(0.0), vec3<f32>(0.0));
+    if (all(normal == vec3<f32>(0.0))) {
+        return none;
+    }
+    let over = dot(tip - began_at, began);
+    let plane = dot(tip - x[0], normal);
+    if (over * plane > 0.0 && abs(plane) >= thickness) {
+        return none;
+    }
+    var side = select(-1.0, 1.0, plane >= 0.0);
+    if (over != 0.0) {
+        side = sign(over);
+    }
+    let w = closest_weights(tip, x[0], x[1], x[2]);
+    let q = w.x * x[0] + w.y * x[1] + w.z * x[2];
+    let height = side * dot(tip - q, normal);
+    if (all(w > vec3<f32>(0.0))) {
+        // Inside: the triangle goes to the far side of the tip.
+        if (height < thickness) {
+            return TipPush(thickness - height, -side * normal, w);
+        }
+        return none;
+    }
+    // Nearest an edge or a corner: kept a thickness off, where on its side.
+    let distance = length(q - tip);
+    if (distance > thickness * 1e-3 && height >= 0.0 && distance < thickness) {
+        return TipPush(thickness - distance, (q - tip) / distance, w);
+    }
+    return none;
+}
+
+fn unit_or_zero(v: vec3<f32>) -> vec3<f32> {
+    let l = length(v);
+    if (l > 0.0 && l < 3.4e38) {
+        return v / l;
+    }
+    return vec3<f32>(0.0);
+}
+
+// A cloth triangle of the tip pass: its particles, their places in the obstacle's frame,
+// which are free, and the plane it began the substep in.
+struct TipFace {
+    ids: vec3<u32>,
+    p: array<Particle, 3>,
+    x: array<vec3<f32>, 3>,
+    free: vec3<f32>,
+    normal: vec3<f32>,
+    began_at: vec3<f32>,
+    began: vec3<f32>,
+    pushed: u32,
+}
+
+// Keeps face `f` the thickness off `tip` (in the frame), as the CPU's `push_tips` does:
+// the nearest point moves by what is missing, the corners by their weights in it, and
+// their velocity towards the tip is removed, with Coulomb friction.
+fn push_off_tip(f: ptr<function, TipFace>, o: u32, tip: vec3<f32>) {
+    let ob = op.obstacles[o];
+    let thickness = ob.info.x;
+    let push = tip_missing((*f).x, (*f).normal, (*f).began_at, (*f).began, tip, thickness);
+    if (push.gap <= 0.0) {
+        return;
+    }
+    let part = push.w * (*f).free;
+    let weight = dot(push.w * push.w, (*f).free);
+    if (weight <= 0.0) {
+        return;
+    }
+    let pivot = ob.pivot.xyz;
+    let end = pose(true);
+    let n = rotate(end.rotation, push.away);
+    let by = rotate(end.rotation, push.gap * push.away);
+    var vs = velocity_at(end, pivot, apply(end, pivot, tip));
+    if (deforming(o)) {
+        vs = vec3<f32>(0.0);
+        let near = nearest(o, tip, thickness);
+        if (near.place != 0xffffffffu) {
+            vs = field_at(o, near.place, near.point, 1u);
+        }
+    }
+    for (var k = 0u; k < 3u; k++) {
+        if (part[k] <= 0.0) {
+            continue;
+        }
+        var p = (*f).p[k];
+        p.x = vec4<f32>(p.x.xyz + by * (part[k] / weight), p.x.w);
+        p.v = vec4<f32>(touching(p.v.xyz, vs, n, ob.info.y, part[k]), p.v.w);
+        (*f).p[k] = p;
+        (*f).x[k] = unapply(end, pivot, p.x.xyz);
+        (*f).pushed |= 1u << k;
+    }
+    (*f).normal = unit_or_zero(cross((*f).x[1] - (*f).x[0], (*f).x[2] - (*f).x[0]));
+}
+
+// Keeps each cloth triangle of this dispatch's colour the thickness off this dispatch's
+// obstacle's tips within reach, and, where a ball of the smooth parts' largest curvature
+// would rise a thickness under it, off each smooth vertex within reach whose own
+// curvature would (the CPU's `push_tips`, which runs beside self-contact).
+@compute @workgroup_size(64)
+fn tips(@builtin(global_invocation_id) id: vec3<u32>) {
+    var stride = colour.w;
+    if ((colour.z & 1u) == 1u) {
+        if (id.x > 0u) {
+            return;
+        }
+        stride = 1u;
+    }
+    let o = obstacle();
+    let ob = op.obstacles[o];
+    let tc = ob.tip_counts;
+    if (tc.x == 0u && tc.y == 0u) {
+        return;
+    }
+    let at = ob.tips + vec4<u32>(bitcast<u32>(poses[7].x));
+    let curvature = bitcast<f32>(tc.z);
+    let thickness = ob.info.x;
+    let pivot = ob.pivot.xyz;
+    let begin = pose(false);
+    let end = pose(true);
+    // How far the surface moved over the substep (a deforming obstacle's largest move).
+    var moved_by = 0.0;
+    if (deforming(o)) {
+        moved_by = poses[7].y;
+    }
+    for (var k = id.x; k < colour.y; k += stride) {
+        let entry = op.counts.y + 2u * (colour.x + k);
+        let ab = cloth_edges[entry];
+        var f: TipFace;
+        f.ids = vec3<u32>(ab.x, ab.y, cloth_edges[entry + 1u].x);
+        f.pushed = 0u;
+        var s: array<vec3<f32>, 3>;
+        var travel = 0.0;
+        var scale = 0.0;
+        for (var j = 0u; j < 3u; j++) {
+            f.p[j] = state[f.ids[j]];
+            f.x[j] = unapply(end, pivot, f.p[j].x.xyz);
+            s[j] = unapply(begin, pivot, start[f.ids[j]].x.xyz);
+            f.free[j] = select(0.0, 1.0, f.p[j].x.w > 0.0);
+            travel = max(travel, length(f.x[j] - s[j]));
+            let a = abs(f.x[j]);
+            scale = max(scale, max(a.x, max(a.y, a.z)));
+        }
+        if (all(f.free == vec3<f32>(0.0))) {
+            continue;
+        }
+        f.normal = unit_or_zero(cross(f.x[1] - f.x[0], f.x[2] - f.x[0]));
+        f.began_at = s[0];
+        f.began = cross(s[1] - s[0], s[2] - s[0]);
+        // Its own corners' moves bound its points' (and the tips' own move).
+        let rounding = 4.0 * 1.1920929e-7 * (1.0 + scale);
+        let reach = vec3<f32>(thickness + travel + moved_by + rounding);
+        let lo = min(f.x[0], min(f.x[1], f.x[2])) - reach;
+        let hi = max(f.x[0], max(f.x[1], f.x[2])) + reach;
+        // How far a ball of unit curvature rises under it.
+        let wide = sag(f.x[0], f.x[1], f.x[2], 1.0);
+        let risky = tc.y > 0u && curvature > 0.0 && wide * curvature >= thickness;
+        // The tips' tree, then (where it is at risk) the smooth vertices'.
+        for (var tree = 0u; tree < 2u; tree++) {
+            if (tree == 1u && !risky) {
+                break;
+            }
+            let base = select(at.x, at.z, tree == 1u);
+            let points = select(at.y, at.w, tree == 1u);
+            let count = select(tc.x, tc.y, tree == 1u);
+            var stack: array<u32, 64>;
+            var top = 0u;
+            if (count > 0u) {
+                let root = node(base, 0u);
+                if (boxes_meet(root.lo, root.hi, lo, hi)) {
+                    stack[0] = 0u;
+                    top = 1u;
+                }
+            }
+            while (top > 0u) {
+                top -= 1u;
+                let here = stack[top];
+                let n = node(base, here);
+                if (n.count > 0u) {
+                    for (var place = n.first; place < n.first + n.count; place++) {
+                        let e = surface[points + place];
+                        if (any(e.xyz < lo) || any(e.xyz > hi)) {
+                            continue;
+                        }
+                        // A smooth vertex where its own curvature could bulge that far.
+                        if (tree == 1u && wide * e.w < thickness) {
+                            continue;
+                        }
+                        push_off_tip(&f, o, e.xyz);
+                    }
+                    continue;
+                }
+                for (var c = 0u; c < 2u; c++) {
+                    let child = select(here + 1u, n.first, c == 0u);
+                    let cn = node(base, child);
+                    if (boxes_meet(cn.lo, cn.hi, lo, hi) && top < STACK) {
+                        stack[top] = child;
+                        top += 1u;
+                    }
+                }
+            }
+        }
+        for (var j = 0u; j < 3u; j++) {
+            if ((f.pushed & (1u << j)) != 0u) {
+                let before = state[f.ids[j]].v.xyz;
+                state[f.ids[j]] = f.p[j];
+                moved(f.ids[j], f.p[j].v.xyz - before);
+            }
         }
     }
 }

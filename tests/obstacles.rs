@@ -9,17 +9,8 @@ use glam::Vec3;
 use clothsim::scene::{Scene, SceneFile, Simulation};
 use clothsim::sim::{Effect, IntegratorKind};
 
-/// Writes an OBJ of `vertices` and triangles (0-based) to `path`.
-fn write_obj(path: &Path, vertices: &[Vec3], triangles: &[[u32; 3]]) {
-    let mut text = String::new();
-    for v in vertices {
-        text += &format!("v {} {} {}\n", v.x, v.y, v.z);
-    }
-    for t in triangles {
-        text += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
-    }
-    std::fs::write(path, text).unwrap();
-}
+mod common;
+use common::tips::{coarse_drop, scene_in as scene, tipped_obstacles, write_ball, write_obj};
 
 /// Writes a 1 m square of two triangles, flat at y = 0 and centred on the origin, to
 /// `name` in `dir`.
@@ -27,13 +18,6 @@ fn write_square(dir: &Path, name: &str) {
     let corners = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)];
     let square: Vec<Vec3> = corners.iter().map(|&(x, z)| Vec3::new(x, 0.0, z)).collect();
     write_obj(&dir.join(name), &square, &[[0, 2, 1], [0, 3, 2]]);
-}
-
-/// A scene from `toml` in `dir` (relative paths start there).
-fn scene(dir: &Path, toml: &str) -> Scene {
-    let path = dir.join("scene.toml");
-    std::fs::write(&path, toml).unwrap();
-    Scene::open(&path.display().to_string()).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Substeps per frame that keep each method stable on a 0.8 m, 16-quad cloth of the
@@ -1008,24 +992,6 @@ fn an_obstacles_offset_box_holds_it_where_it_has_moved() {
     }
 }
 
-/// A scene of a coarse cloth (6 × 6 quads of 17 cm, far wider than the obstacle's tip)
-/// dropped under `integrator` onto the obstacle `obstacle` (a TOML effect), with the ground
-/// and self-collision (whose guarantee covers the cloth's surface, not only its
-/// particles).
-fn coarse_drop(dir: &Path, obstacle: &str, integrator: &str) -> Scene {
-    scene(
-        dir,
-        &format!(
-            "name = \"tip\"\n[cloth]\ngrid = {{ quads = 6, size = 1.0 }}\n\
-             orientation = \"horizontal\"\ncenter = [0.03, 0.8, 0.02]\n\
-             [solver]\nintegrator = \"{integrator}\"\nsubsteps = 16\n\
-             [[effects]]\ntype = \"gravity\"\n{obstacle}\n\
-             [[effects]]\ntype = \"plane\"\nfriction = 0.4\n\
-             [[effects]]\ntype = \"self-collision\"\nthickness = 0.01\n"
-        ),
-    )
-}
-
 /// A pyramid's apex, a cube's corner (a cube standing on one) and the apex of a pyramid
 /// that rises (an OBJ sequence) point up into a coarse cloth's triangles, whose particles
 /// and edges all keep clear of the faces and the sharp edges: the obstacle's tips are kept
@@ -1037,59 +1003,11 @@ fn coarse_drop(dir: &Path, obstacle: &str, integrator: &str) -> Scene {
 #[test]
 fn an_apex_a_corner_and_a_rising_apex_never_pierce_a_coarse_cloth() {
     let dir = tempfile::tempdir().unwrap();
-    let pyramid = [
-        Vec3::new(-0.2, 0.0, -0.2),
-        Vec3::new(0.2, 0.0, -0.2),
-        Vec3::new(0.2, 0.0, 0.2),
-        Vec3::new(-0.2, 0.0, 0.2),
-        Vec3::new(0.0, 0.5, 0.0),
-    ];
-    let faces = [
-        [0, 1, 4],
-        [1, 2, 4],
-        [2, 3, 4],
-        [3, 0, 4],
-        [0, 3, 2],
-        [0, 2, 1],
-    ];
-    write_obj(&dir.path().join("pyramid.obj"), &pyramid, &faces);
-    // A 30 cm cube about its centre, its faces quads as the file gives them.
-    let cube = "v -0.15 -0.15 -0.15\nv 0.15 -0.15 -0.15\nv -0.15 0.15 -0.15\n\
-                v 0.15 0.15 -0.15\nv -0.15 -0.15 0.15\nv 0.15 -0.15 0.15\n\
-                v -0.15 0.15 0.15\nv 0.15 0.15 0.15\n\
-                f 1 2 4 3\nf 5 7 8 6\nf 1 5 6 2\nf 3 4 8 7\nf 1 3 7 5\nf 2 6 8 4\n";
-    std::fs::write(dir.path().join("cube.obj"), cube).unwrap();
-    // A pyramid whose apex rises from 0.3 to 0.6 m over two seconds (a sequence: its
-    // tips move with the surface).
-    for (k, height) in [0.3, 0.45, 0.6].into_iter().enumerate() {
-        let mut rising = pyramid;
-        rising[4].y = height;
-        write_obj(&dir.path().join(format!("rising_{k}.obj")), &rising, &faces);
-    }
-    // The tip's height (the apex at 0.5 m; the corner, its diagonal turned upright, at
-    // 0.3 + 0.26 m; the rising apex at 0.6 m when the run ends).
-    let obstacles = [
-        (
-            "pyramid",
-            "[[effects]]\ntype = \"obstacle\"\nobj = \"pyramid.obj\"\n",
-            0.5,
-        ),
-        (
-            "cube",
-            "[[effects]]\ntype = \"obstacle\"\nobj = \"cube.obj\"\n\
-             rotate = { axis = [1.0, 0.0, -1.0], degrees = 54.7356 }\n\
-             translate = [0.0, 0.3, 0.0]\n",
-            0.3 + 0.15 * 3f32.sqrt(),
-        ),
-        (
-            "rising",
-            "[[effects]]\ntype = \"obstacle\"\nframes = \"rising_%d.obj\"\nfps = 1.0\n",
-            0.6,
-        ),
-    ];
-    for (name, obstacle, tip) in obstacles {
+    for obstacle in tipped_obstacles(dir.path()) {
+        let (name, tip) = (obstacle.name, obstacle.tip_at(2.0));
         for integrator in ["semi-implicit-euler", "implicit-euler", "xpbd", "vbd"] {
-            let mut sim = Simulation::new(coarse_drop(dir.path(), obstacle, integrator));
+            let scene = coarse_drop(dir.path(), &obstacle.effect, integrator, 6);
+            let mut sim = Simulation::new(scene);
             let mut highest = f32::NEG_INFINITY;
             for frame in 0..120 {
                 sim.step_frame()
@@ -1109,21 +1027,6 @@ fn an_apex_a_corner_and_a_rising_apex_never_pierce_a_coarse_cloth() {
     }
 }
 
-/// A ball of radius `radius` and about `triangles` triangles resting on the ground (the
-/// benchmark's cube-sphere: a cube's faces cut into even squares pushed out onto it).
-fn write_ball(path: &Path, radius: f32, triangles: usize) {
-    let soup = clothsim::bench_contact::cube_sphere(radius, triangles);
-    let up = |p: &Vec3| *p + Vec3::Y * radius;
-    let faces: Vec<[u32; 3]> = (soup.face_indices.chunks_exact(3))
-        .map(|f| [f[0], f[1], f[2]])
-        .collect();
-    write_obj(
-        path,
-        &soup.positions.iter().map(up).collect::<Vec<_>>(),
-        &faces,
-    );
-}
-
 /// A coarse cloth (6 × 6 quads of 17 cm, a 1 cm thickness) dropped on a 20 cm ball of
 /// 19 200 triangles, so smooth that no vertex is a tip: under a cell the ball rises about
 /// 1.7 cm above its corners' circle, more than the thickness its particles keep, so its
@@ -1136,7 +1039,7 @@ fn a_smooth_ball_never_comes_through_a_coarse_cloth() {
     write_ball(&dir.path().join("ball.obj"), 0.2, 19_200);
     let ball = "[[effects]]\ntype = \"obstacle\"\nobj = \"ball.obj\"\n";
     for integrator in ["semi-implicit-euler", "implicit-euler", "xpbd", "vbd"] {
-        let mut sim = Simulation::new(coarse_drop(dir.path(), ball, integrator));
+        let mut sim = Simulation::new(coarse_drop(dir.path(), ball, integrator, 6));
         for frame in 0..120 {
             sim.step_frame()
                 .unwrap_or_else(|e| panic!("{integrator}: {e}"));

@@ -8,7 +8,7 @@ mod springs;
 mod state;
 
 pub use adjacency::Adjacency;
-pub use edge_colours::EdgeColours;
+pub use edge_colours::{EdgeColours, colour_greedily};
 pub use model::{ClothModel, MASS_FLOOR, MassDistribution};
 pub use real::{Matrix, Real, Vector};
 pub use springs::Springs;

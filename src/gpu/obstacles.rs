@@ -1,17 +1,18 @@
 //! Mesh obstacles on the GPU (`shaders/obstacle.wgsl`): the CPU's contact with a rigid
 //! obstacle, placed and moved by its keyframes, or a deforming one (an OBJ sequence), after
 //! each substep of every integrator the GPU runs.
-//! Each rigid obstacle's box tree, triangles and sharp edges go to the device once, in the
-//! CPU's tree order, so a walk visits what the CPU's visits; the obstacles' poses at each
-//! substep's start and end are written before each submission, and a deforming obstacle's
-//! surface where each substep ends (the CPU's, refitted), after the rigid ones'. The cloth's edges (its
-//! structural and shear springs) are coloured so that a dispatch per colour sweeps them as
-//! the CPU's loop does, in another order.
+//! Each rigid obstacle's box tree, triangles, sharp edges and tips go to the device once,
+//! in the CPU's tree order, so a walk visits what the CPU's visits; the obstacles' poses at
+//! each substep's start and end are written before each submission, and a deforming
+//! obstacle's surface where each substep ends (the CPU's, refitted), after the rigid ones'.
+//! The cloth's edges (its structural and shear springs) are coloured so that a dispatch per
+//! colour sweeps them as the CPU's loop does; beside self-contact its triangles are too, for
+//! the tip pass (in another order than the CPU's, which goes patch by patch).
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Quat, Vec3};
 
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, colour_greedily};
 use crate::sim::obstacle::{Moment, Surface, TriangleTree};
 use crate::sim::{ContactConfig, Effect, Obstacle, RigidMotion};
 
@@ -43,6 +44,12 @@ struct GpuObstacle {
     counts: [u32; 4],
     pivot: [f32; 4],
     info: [f32; 4],
+    /// Where its tips' tree's nodes, its tips, its smooth vertices' tree's nodes and its
+    /// smooth vertices start (as `starts`).
+    tips: [u32; 4],
+    /// How many nodes the tips' tree has, and the smooth vertices'; the largest curvature
+    /// (1/m, as bits).
+    tip_counts: [u32; 4],
 }
 
 /// The pass's uniform (the shader's `ObstacleParams`).
@@ -57,12 +64,16 @@ struct ObstacleParams {
 pub(super) struct ObstaclePass {
     catch: wgpu::ComputePipeline,
     edges: wgpu::ComputePipeline,
+    tips: wgpu::ComputePipeline,
     keep: wgpu::ComputePipeline,
     /// By [`Start`]: `groups[i]` reads the substep's start from `particles[i]` and moves
     /// the other; `groups[2 + i]` reads it from the kept copy and moves `particles[i]`;
     /// `groups[4 + i]` copies `particles[i]` into the kept copy.
     groups: [wgpu::BindGroup; 6],
     colours: Colours,
+    /// The cloth's triangles' colours, for the tip pass, where it runs: beside
+    /// self-contact (as on the CPU), with an obstacle that has tips or smooth vertices.
+    tip_colours: Option<Colours>,
     poses_layout: wgpu::BindGroupLayout,
     poses: wgpu::Buffer,
     poses_group: wgpu::BindGroup,
@@ -101,9 +112,10 @@ fn push_nodes(tree: &TriangleTree, out: &mut Vec<[f32; 4]>) -> (u32, u32) {
 }
 
 /// Appends `surface` to `out` as the shader reads it: its tree's nodes, its places (each
-/// corner with its vertex's number, then the normal), its sharp edges' nodes and places;
-/// returns where each starts and how many there are.
-fn push_surface(s: &Surface, out: &mut Vec<[f32; 4]>) -> ([u32; 4], [u32; 4]) {
+/// corner with its vertex's number, then the normal), its sharp edges' nodes and places,
+/// its tips' nodes and tips, its smooth vertices' nodes and vertices (each with its
+/// curvature); returns the obstacle with where each starts and how many there are.
+fn push_surface(s: &Surface, out: &mut Vec<[f32; 4]>) -> GpuObstacle {
     let (nodes, node_count) = push_nodes(s.tree(), out);
     let places = out.len() as u32;
     for (corners, t) in s.tree().places() {
@@ -122,23 +134,43 @@ fn push_surface(s: &Surface, out: &mut Vec<[f32; 4]>) -> ([u32; 4], [u32; 4]) {
         out.push([q.x, q.y, q.z, 0.0]);
     }
     let edge_count = s.sharp_edges().tree().len() as u32;
-    (
-        [nodes, places, edge_nodes, edge_places],
-        [node_count, place_count, edge_node_count, edge_count],
-    )
+    let (tips, smooth, curvatures) = s.tips().trees();
+    let mut points = |tree: &TriangleTree, curvature: &dyn Fn(u32) -> f32| {
+        let (nodes, count) = push_nodes(tree, out);
+        let places = out.len() as u32;
+        for ([p, _, _], k) in tree.places() {
+            out.push([p.x, p.y, p.z, curvature(k)]);
+        }
+        (nodes, count, places)
+    };
+    let (tip_nodes, tip_node_count, tip_places) = points(tips, &|_| 0.0);
+    let (smooth_nodes, smooth_node_count, smooth_places) =
+        points(smooth, &|k| curvatures[k as usize]);
+    GpuObstacle {
+        starts: [nodes, places, edge_nodes, edge_places],
+        counts: [node_count, place_count, edge_node_count, edge_count],
+        tips: [tip_nodes, tip_places, smooth_nodes, smooth_places],
+        tip_counts: [
+            tip_node_count,
+            smooth_node_count,
+            s.tips().curvature().to_bits(),
+            0,
+        ],
+        ..GpuObstacle::default()
+    }
 }
 
 /// Appends a deforming obstacle's surface where a substep ends, then each vertex's move
-/// over the substep and velocity after it; returns where its parts start (the fields
-/// last) and how many there are.
-fn push_moment(moment: &Moment, out: &mut Vec<[f32; 4]>) -> ([u32; 4], [u32; 4], u32) {
-    let (starts, counts) = push_surface(&moment.surface, out);
+/// over the substep and velocity after it; returns where its parts start and how many
+/// there are, and where the fields start.
+fn push_moment(moment: &Moment, out: &mut Vec<[f32; 4]>) -> (GpuObstacle, u32) {
+    let packed = push_surface(&moment.surface, out);
     let fields = out.len() as u32;
     for (shift, velocity) in moment.shift.iter().zip(&moment.velocity) {
         out.push([shift.x, shift.y, shift.z, 0.0]);
         out.push([velocity.x, velocity.y, velocity.z, 0.0]);
     }
-    (starts, counts, fields)
+    (packed, fields)
 }
 
 /// How an obstacle moves.
@@ -168,32 +200,45 @@ fn pack(
     for (slot, (obstacle, placed)) in placed.take(MAX_OBSTACLES).enumerate() {
         let thickness = obstacle.thickness.unwrap_or(contact.offset);
         let mut info = [thickness, obstacle.friction, 0.0, 0.0];
-        let (starts, counts, pivot) = match &placed.sequence {
+        let (packed, pivot) = match &placed.sequence {
             None => {
                 moving.push(Motion::Rigid(placed.motion.clone()));
-                let (starts, counts) = push_surface(&placed.surface, &mut surface);
-                (starts, counts, placed.pivot)
+                (push_surface(&placed.surface, &mut surface), placed.pivot)
             }
             Some(sequence) => {
                 // Laid out from 0: each substep's copy starts where its poses say.
                 let mut layout = Vec::new();
-                let (starts, counts, fields) = push_moment(&sequence.moment(0.0, 0.0), &mut layout);
+                let (packed, fields) = push_moment(&sequence.moment(0.0, 0.0), &mut layout);
                 info[2] = f32::from_bits(fields);
                 info[3] = 1.0;
                 let entries = layout.len() as u32;
                 let obstacle = Box::new(obstacle.clone());
                 moving.push(Motion::Deforming { obstacle, entries });
-                (starts, counts, Vec3::ZERO)
+                (packed, Vec3::ZERO)
             }
         };
         params.obstacles[slot] = GpuObstacle {
-            starts,
-            counts,
             pivot: [pivot.x, pivot.y, pivot.z, 0.0],
             info,
+            ..packed
         };
     }
     (!moving.is_empty()).then_some((params, surface, moving))
+}
+
+/// Appends the cloth's triangles to `out` (two entries each: two corners, then the third),
+/// coloured so that a dispatch per colour keeps them off the tips; returns each colour's
+/// record (`[first, count, serial, invocations]`, from the first triangle).
+fn push_triangles(model: &ClothModel, out: &mut Vec<[u32; 2]>) -> Vec<[u32; 4]> {
+    let triangles = &model.triangles;
+    let (order, runs) = colour_greedily(model.particle_count(), triangles.iter().copied());
+    for t in order {
+        let [a, b, c] = triangles[t as usize];
+        out.extend([[a, b], [c, 0]]);
+    }
+    (runs.iter())
+        .map(|(range, shared)| colour_record(range.start, range.len(), *shared))
+        .collect()
 }
 
 /// The cloth's edges (their two particles) in the model's colour order, and each sweep's
@@ -231,13 +276,18 @@ impl ObstaclePass {
         let Some((mut params, fixed, moving)) = pack(effects, contact) else {
             return Ok(None);
         };
-        let (edges, records) = sweeps_of(model);
+        let (mut edges, records) = sweeps_of(model);
+        // The tip pass runs where the CPU's does: beside self-contact.
+        let own = (effects.iter()).any(|e| matches!(e, Effect::SelfCollision(_)));
+        let tipped = own && (params.obstacles.iter()).any(|o| o.tip_counts[..2] != [0, 0]);
+        params.counts[1] = edges.len() as u32;
+        let triangles = tipped.then(|| push_triangles(model, &mut edges));
         let bytes = |n: usize, each: usize| (n * each) as u64;
         fits(
             &device.limits(),
             &[
                 (bytes(fixed.len(), 16), "obstacle surfaces"),
-                (bytes(edges.len(), 8), "cloth edges"),
+                (bytes(edges.len(), 8), "cloth edges and triangles"),
             ],
             &format!("{} surface entries", fixed.len()),
         )?;
@@ -268,11 +318,16 @@ impl ObstaclePass {
         let main = layout(device, "obstacles", &slots);
         let poses_layout = layout(device, "obstacle poses", &[Dynamic]);
         let all: &[&wgpu::BindGroupLayout] = &[&main, &kernel.colour_layout, &poses_layout];
-        let [catch, edges_pipeline, keep] = pipelines(
+        let [catch, edges_pipeline, tips, keep] = pipelines(
             device,
             "obstacles",
             &format!("{LAYOUT}{CONTACT}{GEOMETRY}{SOURCE}"),
-            [("catch_moves", all), ("edges", all), ("keep_start", all)],
+            [
+                ("catch_moves", all),
+                ("edges", all),
+                ("tips", all),
+                ("keep_start", all),
+            ],
         );
         // The substep's start, for an integrator that writes its end over it (XPBD, VBD).
         let kept = device.create_buffer(&wgpu::BufferDescriptor {
@@ -287,9 +342,11 @@ impl ObstaclePass {
         Ok(Some(Self {
             catch,
             edges: edges_pipeline,
+            tips,
             keep,
             groups,
             colours: Colours::new(device, queue, kernel, &records),
+            tip_colours: triangles.map(|records| Colours::new(device, queue, kernel, &records)),
             poses_layout,
             poses,
             poses_group,
@@ -515,7 +572,7 @@ impl ObstaclePass {
 
     /// Records substep `k`'s contacts, where `start` says its start and end are: each
     /// obstacle in turn (as the CPU's effects, in the scene's order) catches the particles'
-    /// moves, then sweeps the cloth's edges.
+    /// moves, then sweeps the cloth's edges, then (beside self-contact) its triangles.
     pub(super) fn encode(&self, pass: &mut wgpu::ComputePass<'_>, k: u32, start: Start) {
         let group = &self.groups[match start {
             Start::In(i) => i,
@@ -530,6 +587,9 @@ impl ObstaclePass {
             pass.set_bind_group(1, self.colours.group(), &[0]);
             pass.dispatch_workgroups(self.count.div_ceil(WORKGROUP), 1, 1);
             self.colours.sweep(pass, &self.edges, group);
+            if let Some(colours) = &self.tip_colours {
+                colours.sweep(pass, &self.tips, group);
+            }
         }
     }
 }

@@ -1,5 +1,7 @@
 //! What the test files share (the GPU's, and the contact tests).
 
+pub mod tips;
+
 /// [`clothsim::gpu::gpu_simulation`] on the software adapter (Mesa's llvmpipe through GL
 /// where there is one), as the golden images: the tests' bounds are its rounding.
 #[allow(dead_code)] // Not every test file steps on the GPU.

@@ -160,6 +160,12 @@ impl Tips {
         });
     }
 
+    /// The tips' tree, and the smooth vertices' with each one's curvature (1/m, by the
+    /// number the tree holds it under): as the GPU takes them.
+    pub fn trees(&self) -> (&TriangleTree, &TriangleTree, &[f32]) {
+        (&self.tips.tree, &self.smooth.tree, &self.smooth.curvatures)
+    }
+
     /// The largest curvature of the smooth parts, 1/m (see [`Tips`]).
     pub fn curvature(&self) -> f32 {
         self.curvature

@@ -1,0 +1,135 @@
+//! Obstacles whose tips or gentle curves reach up into a coarse cloth's triangles, where
+//! every particle and edge of it keeps clear of the faces and the sharp edges (the CPU's
+//! tests and the GPU's drop cloth on them alike).
+#![allow(dead_code)] // Not every test file drops cloth on tips.
+
+use std::path::Path;
+
+use glam::Vec3;
+
+use clothsim::scene::Scene;
+
+/// Writes an OBJ of `vertices` and triangles (0-based) to `path`.
+pub fn write_obj(path: &Path, vertices: &[Vec3], triangles: &[[u32; 3]]) {
+    let mut text = String::new();
+    for v in vertices {
+        text += &format!("v {} {} {}\n", v.x, v.y, v.z);
+    }
+    for t in triangles {
+        text += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+/// A scene from `toml` in `dir` (relative paths start there).
+pub fn scene_in(dir: &Path, toml: &str) -> Scene {
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, toml).unwrap();
+    Scene::open(&path.display().to_string()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A scene of a coarse cloth (1 m square of `quads` × `quads` quads, 6: 17 cm, far wider
+/// than the obstacle's tip) dropped under `integrator` onto the obstacle `obstacle` (a TOML
+/// effect), with the ground and self-collision (whose guarantee covers the cloth's
+/// surface, not only its particles).
+pub fn coarse_drop(dir: &Path, obstacle: &str, integrator: &str, quads: u32) -> Scene {
+    scene_in(
+        dir,
+        &format!(
+            "name = \"tip\"\n[cloth]\ngrid = {{ quads = {quads}, size = 1.0 }}\n\
+             orientation = \"horizontal\"\ncenter = [0.03, 0.8, 0.02]\n\
+             [solver]\nintegrator = \"{integrator}\"\nsubsteps = 16\n\
+             [[effects]]\ntype = \"gravity\"\n{obstacle}\n\
+             [[effects]]\ntype = \"plane\"\nfriction = 0.4\n\
+             [[effects]]\ntype = \"self-collision\"\nthickness = 0.01\n"
+        ),
+    )
+}
+
+/// An obstacle with a tip that points up.
+pub struct Tipped {
+    pub name: &'static str,
+    /// Its TOML effect.
+    pub effect: String,
+    /// How high its tip is at the start (m), and how fast it rises (m/s).
+    pub tip: f32,
+    pub rise: f32,
+}
+
+impl Tipped {
+    /// How high its tip is `seconds` in (up to two seconds).
+    pub fn tip_at(&self, seconds: f32) -> f32 {
+        self.tip + self.rise * seconds
+    }
+}
+
+/// Writes into `dir` a pyramid (its apex 0.5 m up), a 30 cm cube standing on a corner
+/// (0.56 m up) and a pyramid whose apex rises from 0.3 to 0.6 m over two seconds (an OBJ
+/// sequence: its tips move with the surface), and returns them.
+pub fn tipped_obstacles(dir: &Path) -> [Tipped; 3] {
+    let pyramid = [
+        Vec3::new(-0.2, 0.0, -0.2),
+        Vec3::new(0.2, 0.0, -0.2),
+        Vec3::new(0.2, 0.0, 0.2),
+        Vec3::new(-0.2, 0.0, 0.2),
+        Vec3::new(0.0, 0.5, 0.0),
+    ];
+    let faces = [
+        [0, 1, 4],
+        [1, 2, 4],
+        [2, 3, 4],
+        [3, 0, 4],
+        [0, 3, 2],
+        [0, 2, 1],
+    ];
+    write_obj(&dir.join("pyramid.obj"), &pyramid, &faces);
+    // About its centre, its faces quads as the file gives them.
+    let cube = "v -0.15 -0.15 -0.15\nv 0.15 -0.15 -0.15\nv -0.15 0.15 -0.15\n\
+                v 0.15 0.15 -0.15\nv -0.15 -0.15 0.15\nv 0.15 -0.15 0.15\n\
+                v -0.15 0.15 0.15\nv 0.15 0.15 0.15\n\
+                f 1 2 4 3\nf 5 7 8 6\nf 1 5 6 2\nf 3 4 8 7\nf 1 3 7 5\nf 2 6 8 4\n";
+    std::fs::write(dir.join("cube.obj"), cube).unwrap();
+    for (k, height) in [0.3, 0.45, 0.6].into_iter().enumerate() {
+        let mut rising = pyramid;
+        rising[4].y = height;
+        write_obj(&dir.join(format!("rising_{k}.obj")), &rising, &faces);
+    }
+    let tipped = |name, rest: &str, tip, rise| Tipped {
+        name,
+        effect: format!("[[effects]]\ntype = \"obstacle\"\n{rest}"),
+        tip,
+        rise,
+    };
+    [
+        tipped("pyramid", "obj = \"pyramid.obj\"\n", 0.5, 0.0),
+        // Its diagonal turned upright: the corner at 0.3 + 0.26 m.
+        tipped(
+            "cube",
+            "obj = \"cube.obj\"\nrotate = { axis = [1.0, 0.0, -1.0], degrees = 54.7356 }\n\
+             translate = [0.0, 0.3, 0.0]\n",
+            0.3 + 0.15 * 3f32.sqrt(),
+            0.0,
+        ),
+        tipped(
+            "rising",
+            "frames = \"rising_%d.obj\"\nfps = 1.0\n",
+            0.3,
+            0.15,
+        ),
+    ]
+}
+
+/// A ball of radius `radius` and about `triangles` triangles resting on the ground (the
+/// benchmark's cube-sphere: a cube's faces cut into even squares pushed out onto it).
+pub fn write_ball(path: &Path, radius: f32, triangles: usize) {
+    let soup = clothsim::bench_contact::cube_sphere(radius, triangles);
+    let up = |p: &Vec3| *p + Vec3::Y * radius;
+    let faces: Vec<[u32; 3]> = (soup.face_indices.chunks_exact(3))
+        .map(|f| [f[0], f[1], f[2]])
+        .collect();
+    write_obj(
+        path,
+        &soup.positions.iter().map(up).collect::<Vec<_>>(),
+        &faces,
+    );
+}
