@@ -41,7 +41,7 @@ impl EdgeColours {
 /// `items` (each the particles it moves, of `particles`) coloured greedily in their order:
 /// each takes the lowest colour none of its particles has yet. Returns their numbers colour
 /// after colour, and each colour's range of them with whether its items may share a
-/// particle (the last, past [`MOST`] colours).
+/// particle (the last, past 64 colours).
 pub fn colour_greedily<const K: usize>(
     particles: usize,
     items: impl Iterator<Item = [u32; K]>,
