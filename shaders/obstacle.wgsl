@@ -548,55 +548,78 @@ fn sharp_edges(o: u32, lo: vec3<f32>, hi: vec3<f32>, a: vec3<f32>, b: vec3<f32>,
     let base = starts(o).z;
     var out = EdgeFound(false, EdgeHit(0.0, vec3<f32>(0.0), vec3<f32>(0.0), 0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     var first_t = 2.0;
-    var stack: array<u32, 64>;
-    var top = 0u;
-    if (op.obstacles[o].counts.z > 0u) {
-        let root = node(base, 0u);
-        if (boxes_meet(root.lo, root.hi, lo, hi)) {
-            stack[0] = 0u;
-            top = 1u;
+    var walk = box_walk(base, op.obstacles[o].counts.z, lo, hi);
+    loop {
+        let n = next_leaf(&walk, base, lo, hi);
+        if (n.count == 0u) {
+            break;
         }
-    }
-    while (top > 0u) {
-        top -= 1u;
-        let at = stack[top];
-        let n = node(base, at);
-        if (n.count > 0u) {
-            for (var place = n.first; place < n.first + n.count; place++) {
-                let p = edge_end(o, place, 0u);
-                let q = edge_end(o, place, 1u);
-                if (!boxes_meet(min(p, q), max(p, q), lo, hi)) {
+        for (var place = n.first; place < n.first + n.count; place++) {
+            let p = edge_end(o, place, 0u);
+            let q = edge_end(o, place, 1u);
+            if (!boxes_meet(min(p, q), max(p, q), lo, hi)) {
+                continue;
+            }
+            if (nearest_one) {
+                let h = between(a, b, p, q);
+                if (h.distance <= reach && (!out.found || h.distance < out.hit.distance)) {
+                    out = EdgeFound(true, h, p, q, vec3<f32>(0.0));
+                }
+            } else {
+                let t = sweep_meets(b0, b1, a, b, p, q);
+                if (t < 0.0 || (out.found && first_t <= t)) {
                     continue;
                 }
-                if (nearest_one) {
-                    let h = between(a, b, p, q);
-                    if (h.distance <= reach && (!out.found || h.distance < out.hit.distance)) {
-                        out = EdgeFound(true, h, p, q, vec3<f32>(0.0));
-                    }
-                } else {
-                    let t = sweep_meets(b0, b1, a, b, p, q);
-                    if (t < 0.0 || (out.found && first_t <= t)) {
-                        continue;
-                    }
-                    let s = between(b0, b1, p, q);
-                    if (s.distance > 0.0) {
-                        first_t = t;
-                        out = EdgeFound(true, s, p, q, (s.on_segment - s.on_edge) / s.distance);
-                    }
+                let s = between(b0, b1, p, q);
+                if (s.distance > 0.0) {
+                    first_t = t;
+                    out = EdgeFound(true, s, p, q, (s.on_segment - s.on_edge) / s.distance);
                 }
-            }
-            continue;
-        }
-        for (var k = 0u; k < 2u; k++) {
-            let child = select(at + 1u, n.first, k == 0u);
-            let c = node(base, child);
-            if (boxes_meet(c.lo, c.hi, lo, hi) && top < STACK) {
-                stack[top] = child;
-                top += 1u;
             }
         }
     }
     return out;
+}
+
+// A depth-first walk of a box tree (its nodes from `base`, `count` of them) for the
+// leaves whose boxes meet lo..hi, the child after its node first (the CPU's order).
+struct BoxWalk {
+    stack: array<u32, 64>,
+    top: u32,
+}
+
+fn box_walk(base: u32, count: u32, lo: vec3<f32>, hi: vec3<f32>) -> BoxWalk {
+    var w: BoxWalk;
+    w.top = 0u;
+    if (count > 0u) {
+        let root = node(base, 0u);
+        if (boxes_meet(root.lo, root.hi, lo, hi)) {
+            w.stack[0] = 0u;
+            w.top = 1u;
+        }
+    }
+    return w;
+}
+
+// The walk's next leaf whose box meets lo..hi (a count of 0 when none is left).
+fn next_leaf(w: ptr<function, BoxWalk>, base: u32, lo: vec3<f32>, hi: vec3<f32>) -> Node {
+    while ((*w).top > 0u) {
+        (*w).top -= 1u;
+        let at = (*w).stack[(*w).top];
+        let n = node(base, at);
+        if (n.count > 0u) {
+            return n;
+        }
+        for (var k = 0u; k < 2u; k++) {
+            let child = select(at + 1u, n.first, k == 0u);
+            let c = node(base, child);
+            if (boxes_meet(c.lo, c.hi, lo, hi) && (*w).top < STACK) {
+                (*w).stack[(*w).top] = child;
+                (*w).top += 1u;
+            }
+        }
+    }
+    return Node(vec3<f32>(0.0), vec3<f32>(0.0), 0u, 0u);
 }
 
 // Keeps each cloth edge of this dispatch's colour the thickness off this dispatch's
@@ -890,40 +913,22 @@ fn tips(@builtin(global_invocation_id) id: vec3<u32>) {
             let base = select(at.x, at.z, tree == 1u);
             let points = select(at.y, at.w, tree == 1u);
             let count = select(tc.x, tc.y, tree == 1u);
-            var stack: array<u32, 64>;
-            var top = 0u;
-            if (count > 0u) {
-                let root = node(base, 0u);
-                if (boxes_meet(root.lo, root.hi, lo, hi)) {
-                    stack[0] = 0u;
-                    top = 1u;
+            var walk = box_walk(base, count, lo, hi);
+            loop {
+                let n = next_leaf(&walk, base, lo, hi);
+                if (n.count == 0u) {
+                    break;
                 }
-            }
-            while (top > 0u) {
-                top -= 1u;
-                let here = stack[top];
-                let n = node(base, here);
-                if (n.count > 0u) {
-                    for (var place = n.first; place < n.first + n.count; place++) {
-                        let e = surface[points + place];
-                        if (any(e.xyz < lo) || any(e.xyz > hi)) {
-                            continue;
-                        }
-                        // A smooth vertex where its own curvature could bulge that far.
-                        if (tree == 1u && wide * e.w < thickness) {
-                            continue;
-                        }
-                        push_off_tip(&f, o, e.xyz);
+                for (var place = n.first; place < n.first + n.count; place++) {
+                    let e = surface[points + place];
+                    if (any(e.xyz < lo) || any(e.xyz > hi)) {
+                        continue;
                     }
-                    continue;
-                }
-                for (var c = 0u; c < 2u; c++) {
-                    let child = select(here + 1u, n.first, c == 0u);
-                    let cn = node(base, child);
-                    if (boxes_meet(cn.lo, cn.hi, lo, hi) && top < STACK) {
-                        stack[top] = child;
-                        top += 1u;
+                    // A smooth vertex where its own curvature could bulge that far.
+                    if (tree == 1u && wide * e.w < thickness) {
+                        continue;
                     }
+                    push_off_tip(&f, o, e.xyz);
                 }
             }
         }
