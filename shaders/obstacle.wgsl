@@ -36,7 +36,8 @@ struct Obstacle {
 }
 
 struct ObstacleParams {
-    // x: particles; y: where the cloth's triangles start in `cloth_edges`.
+    // x: particles; y: where the cloth's triangles start in `cloth_edges`; z: the word of
+    // self-contact's counters that says whether its pushes moved anything.
     counts: vec4<u32>,
     obstacles: array<Obstacle, 4>,
 }
@@ -62,6 +63,10 @@ struct ObstacleParams {
 // whose memory of each particle's last acceleration takes the contacts' change of
 // velocity too (the CPU's reads the velocity after the contacts).
 @group(0) @binding(6) var<storage, read_write> solver: array<u32>;
+// Self-contact's counters, whose word `op.counts.z` says whether its pushes moved anything
+// this substep: the pass's second run in a substep, after them, acts only then, as the
+// CPU's solids do.
+@group(0) @binding(7) var<storage, read> pushed: array<u32>;
 // The colour one dispatch of `edges` takes: x its first edge, y how many, z 1 when they
 // may share a particle plus twice the sweep, w the invocations dispatched.
 @group(1) @binding(0) var<uniform> colour: vec4<u32>;
@@ -70,7 +75,8 @@ struct ObstacleParams {
 // contacts tell the solver (y: 0 nothing, 1 implicit Euler's flag, the word in z; 2 VBD's
 // memory, from the word in z) and the substep's length (w); then, for a deforming obstacle
 // (whose poses are the identity), where its surface at the substep's end starts in
-// `surface` (x, as bits) and the largest move of a vertex over the substep (y).
+// `surface` (x, as bits) and the largest move of a vertex over the substep (y); and 1 (z)
+// for the pass's second run in the substep, after self-contact's pushes.
 @group(2) @binding(0) var<uniform> poses: array<vec4<f32>, 16>;
 
 // Corners a move may be caught at in one substep, and pushes of its end out of the
@@ -101,6 +107,12 @@ struct Pose {
 fn pose(end: bool) -> Pose {
     let at = select(0u, 2u, end);
     return Pose(poses[at].xyz, poses[at + 1u], poses[4].xyz, poses[5].xyz);
+}
+
+// The pass's second run in the substep, after self-contact's pushes, where they moved
+// nothing: it leaves the cloth as it is.
+fn not_again() -> bool {
+    return poses[7].z > 0.5 && pushed[op.counts.z] == 0u;
 }
 
 // The obstacle this dispatch takes.
@@ -426,7 +438,7 @@ fn catch_move(o: u32, origin: vec3<f32>, to: vec3<f32>, thickness: f32) -> Caugh
 @compute @workgroup_size(64)
 fn catch_moves(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
-    if (i >= op.counts.x) {
+    if (i >= op.counts.x || not_again()) {
         return;
     }
     if (i == 0u) {
@@ -630,7 +642,7 @@ fn next_leaf(w: ptr<function, BoxWalk>, base: u32, lo: vec3<f32>, hi: vec3<f32>)
 fn edges(@builtin(global_invocation_id) id: vec3<u32>) {
     // A sweep runs only after one that found a crossing (the first always).
     let sweep = colour.z >> 1u;
-    if (sweep > 0u && atomicLoad(&crossings[sweep - 1u]) == 0u) {
+    if ((sweep > 0u && atomicLoad(&crossings[sweep - 1u]) == 0u) || not_again()) {
         return;
     }
     // A colour whose edges may share a particle is taken in order by one invocation.
@@ -849,6 +861,9 @@ fn push_off_tip(f: ptr<function, TipFace>, o: u32, tip: vec3<f32>) {
 // curvature would (the CPU's `push_tips`, which runs beside self-contact).
 @compute @workgroup_size(64)
 fn tips(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (not_again()) {
+        return;
+    }
     var stride = colour.w;
     if ((colour.z & 1u) == 1u) {
         if (id.x > 0u) {

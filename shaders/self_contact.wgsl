@@ -84,7 +84,10 @@ const MOST_ENTRIES: u32 = 34u;
 const MOST_PAIRS: u32 = 35u;
 const FORCED: u32 = 36u;
 const FASTEST: u32 = 37u;
-const COUNTERS: u32 = 38u;
+// 1 where the substep's pushes moved anything (`obstacles_moved` zeroes it): the mesh
+// obstacles act again after them only then, as the CPU's solids do.
+const PUSHES_MOVED: u32 = 38u;
+const COUNTERS: u32 = 39u;
 // Rounds of cuts by the safe fraction; later rounds cut to the start (the CPU's).
 const SCALED_ROUNDS: u32 = 4u;
 // Cells a triangle's box may cover and still go into the grid.

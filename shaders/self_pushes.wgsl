@@ -244,6 +244,7 @@ fn push_alone_one(p: u32, sweep: u32) {
         q.v = vec4<f32>(q.v.xyz + push.dv[k], q.v.w);
         state[i] = q;
         tell_solver(i, push.dv[k]);
+        atomicStore(&atomics[PUSHES_MOVED], 1u);
     }
 }
 
@@ -329,6 +330,10 @@ fn take_pushes(i: u32, share: f32) {
     q.v = vec4<f32>(q.v.xyz + dv * average, q.v.w);
     state[i] = q;
     tell_solver(i, dv * average);
+    // The pairs' pushes (not the spheres' on the triangles, a solid's own).
+    if (share > 0.0) {
+        atomicStore(&atomics[PUSHES_MOVED], 1u);
+    }
 }
 
 // Each particle takes its share of the side-by-side pushes.
@@ -432,6 +437,9 @@ fn before_obstacles(@builtin(global_invocation_id) id: vec3<u32>) {
 @compute @workgroup_size(64)
 fn obstacles_moved(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
+    if (i == 0u) {
+        atomicStore(&atomics[PUSHES_MOVED], 0u);
+    }
     if (i < sp.counts.x && any(boxes[2u * i].xyz != state[i].x.xyz)) {
         atomicOr(&atomics[pushes_at() + PUSH_WORDS * i + HELD], MOVED);
     }

@@ -42,7 +42,17 @@ impl Contacts {
             Some(own) => SelfPass::new(device, queue, particles, model, own)?,
             None => None,
         };
-        Ok(Self { obstacles, own })
+        let mut contacts = Self { obstacles, own };
+        contacts.tell_pushes(device);
+        Ok(contacts)
+    }
+
+    /// Binds to the obstacles' second run where self-contact says whether its pushes
+    /// moved anything (its counters, which a grown room replaces).
+    fn tell_pushes(&mut self, device: &wgpu::Device) {
+        if let (Some(obstacles), Some(own)) = (self.obstacles.as_mut(), self.own.as_ref()) {
+            obstacles.attach_pushed(device, own.counters());
+        }
     }
 
     /// These passes, with self-contact's settings for tests as in `old`: how often its
@@ -78,6 +88,7 @@ impl Contacts {
         if let Some(own) = self.own.as_mut() {
             own.prepare(device, queue, substep, memory, cloth)?;
         }
+        self.tell_pushes(device);
         Ok(())
     }
 
@@ -121,13 +132,14 @@ impl Contacts {
             if let Some(own) = &self.own {
                 own.before_obstacles(pass, start);
             }
-            obstacles.encode(pass, k, start);
+            obstacles.encode(pass, (k, false), start);
         }
         if let Some(own) = &self.own {
             own.encode_pushes(pass, start, self.obstacles.is_some());
-            // What the pushes pressed into a mesh obstacle goes back out, before the cuts.
+            // What the pushes pressed into a mesh obstacle goes back out, before the cuts
+            // (where they moved something, as on the CPU).
             if let Some(obstacles) = &self.obstacles {
-                obstacles.encode(pass, k, start);
+                obstacles.encode(pass, (k, true), start);
             }
             own.encode_cuts(pass, start);
         }
@@ -184,9 +196,11 @@ impl Contacts {
         device: &wgpu::Device,
         asked: [u32; 2],
     ) -> Result<bool, GpuError> {
-        match self.own.as_mut() {
-            Some(own) => own.make_room(device, asked),
-            None => Ok(false),
-        }
+        let grown = match self.own.as_mut() {
+            Some(own) => own.make_room(device, asked)?,
+            None => false,
+        };
+        self.tell_pushes(device);
+        Ok(grown)
     }
 }

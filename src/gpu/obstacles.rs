@@ -21,6 +21,7 @@ use super::kernel::{
     CONTACT, GEOMETRY, LAYOUT, Slot, SubstepKernel, WORKGROUP, layout, pipelines, start_end_groups,
 };
 use super::packing::MAX_OBSTACLES;
+use super::self_contact::PUSHES_MOVED;
 use super::substep_ends::{Memory, Start};
 use super::support::fits;
 use super::xpbd::{Colours, colour_record};
@@ -90,10 +91,15 @@ pub(super) struct ObstaclePass {
     moments: Vec<[f32; 4]>,
     surface_room: usize,
     /// What the bind groups bind besides the particles: the uniform, the surfaces, the
-    /// cloth's edges, the crossings, the kept start, and a stand-in for the solver's words
-    /// the contacts tell of what they moved (see [`Memory`]), and their layout, and the
+    /// cloth's edges, the crossings, the kept start, a stand-in for the solver's words
+    /// the contacts tell of what they moved (see [`Memory`]) and self-contact's counters
+    /// ([`ObstaclePass::attach_pushed`]; a stand-in without), and their layout, and the
     /// solver's words bound instead.
-    buffers: [wgpu::Buffer; 6],
+    buffers: [wgpu::Buffer; 7],
+    /// Whether the pass acts a second time each substep, after self-contact's pushes
+    /// (where the scene has self-contact): its poses then come twice, the second time
+    /// saying so.
+    again: bool,
     layout: wgpu::BindGroupLayout,
     solve: Option<wgpu::Buffer>,
     particles: [wgpu::Buffer; 2],
@@ -292,7 +298,7 @@ impl ObstaclePass {
             &format!("{} surface entries", fixed.len()),
         )?;
         let count = model.particle_count() as u32;
-        params.counts[0] = count;
+        (params.counts[0], params.counts[2]) = (count, PUSHES_MOVED);
         let buffer = |label: &str, data: &[u8], usage: wgpu::BufferUsages| {
             let buffer = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -313,8 +319,10 @@ impl ObstaclePass {
         let cloth_edges = buffer("cloth edges", bytemuck::cast_slice(&edges), U::STORAGE);
         let crossings = buffer("edge crossings", &[0; 4 * EDGE_SWEEPS], U::STORAGE);
         let no_solve = buffer("no solver words", &[0; 48], U::STORAGE);
+        // Self-contact's counters, where it runs (`attach_pushed`).
+        let pushed = buffer("no pushes", &[0; 16], U::STORAGE);
         use Slot::{Dynamic, Read, Uniform, Write};
-        let slots = [Uniform, Read, Write, Read, Read, Write, Write];
+        let slots = [Uniform, Read, Write, Read, Read, Write, Write, Read];
         let main = layout(device, "obstacles", &slots);
         let poses_layout = layout(device, "obstacle poses", &[Dynamic]);
         let all: &[&wgpu::BindGroupLayout] = &[&main, &kernel.colour_layout, &poses_layout];
@@ -336,7 +344,15 @@ impl ObstaclePass {
             usage: U::STORAGE,
             mapped_at_creation: false,
         });
-        let buffers = [uniform, surface, cloth_edges, crossings, kept, no_solve];
+        let buffers = [
+            uniform,
+            surface,
+            cloth_edges,
+            crossings,
+            kept,
+            no_solve,
+            pushed,
+        ];
         let groups = Self::groups_for(device, &main, particles, &buffers, None);
         let (poses, poses_group) = Self::poses_for(device, &poses_layout, 1);
         Ok(Some(Self {
@@ -361,6 +377,7 @@ impl ObstaclePass {
             solve: None,
             particles: particles.clone(),
             count,
+            again: own,
         }))
     }
 
@@ -370,10 +387,24 @@ impl ObstaclePass {
         device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,
         particles: &[wgpu::Buffer; 2],
-        [uniform, surface, cloth_edges, crossings, kept, no_solve]: &[wgpu::Buffer; 6],
+        [
+            uniform,
+            surface,
+            cloth_edges,
+            crossings,
+            kept,
+            no_solve,
+            pushed,
+        ]: &[wgpu::Buffer; 7],
         solve: Option<&wgpu::Buffer>,
     ) -> [wgpu::BindGroup; 6] {
-        let rest = [surface, cloth_edges, crossings, solve.unwrap_or(no_solve)];
+        let rest = [
+            surface,
+            cloth_edges,
+            crossings,
+            solve.unwrap_or(no_solve),
+            pushed,
+        ];
         start_end_groups(
             device,
             "obstacles",
@@ -443,7 +474,9 @@ impl ObstaclePass {
         (substeps, time, substep): (u32, f64, f32),
         memory: Memory,
     ) -> Result<(), GpuError> {
-        let blocks = substeps * self.moving.len() as u32;
+        // Twice where the pass acts again after self-contact's pushes, the second saying so.
+        let runs = 1 + usize::from(self.again);
+        let blocks = substeps * self.moving.len() as u32 * runs as u32;
         if blocks > self.room {
             (self.poses, self.poses_group) = Self::poses_for(device, &self.poses_layout, blocks);
             self.room = blocks;
@@ -459,7 +492,7 @@ impl ObstaclePass {
             Memory::Guess(at) => (1.0, at),
             Memory::Accelerations(at) => (2.0, at),
         };
-        let mut blocks = data.chunks_mut(entries);
+        let mut blocks = data.chunks_mut(entries * runs);
         // The times as the CPU's clock reaches them: a substep added at a time.
         let mut t = time;
         for _ in 0..substeps {
@@ -467,9 +500,10 @@ impl ObstaclePass {
             t += f64::from(substep);
             for (o, motion) in self.moving.iter().enumerate() {
                 let v = |v: Vec3| [v.x, v.y, v.z, 0.0];
-                let Some(block) = blocks.next() else {
+                let Some(both) = blocks.next() else {
                     break;
                 };
+                let (block, second) = both.split_at_mut(entries);
                 let which = [f32::from_bits(o as u32), mode, f32::from_bits(at), substep];
                 match motion {
                     Motion::Rigid(motion) => {
@@ -505,6 +539,10 @@ impl ObstaclePass {
                             [f32::from_bits(at), moment.largest_shift, 0.0, 0.0],
                         ]);
                     }
+                }
+                if !second.is_empty() {
+                    second.copy_from_slice(block);
+                    second[7][2] = 1.0;
                 }
             }
         }
@@ -555,6 +593,16 @@ impl ObstaclePass {
         Ok(())
     }
 
+    /// Binds self-contact's counters, whose word [`PUSHES_MOVED`] says whether a substep's
+    /// pushes moved something: the pass's second run in the substep acts only then, as the
+    /// CPU's solids act again after its self-contact only where it moved something.
+    pub(super) fn attach_pushed(&mut self, device: &wgpu::Device, counters: &wgpu::Buffer) {
+        if self.buffers[6] != *counters {
+            self.buffers[6] = counters.clone();
+            self.regroup(device);
+        }
+    }
+
     /// The copy [`ObstaclePass::keep_start`] makes.
     pub(super) fn kept(&self) -> &wgpu::Buffer {
         &self.buffers[4]
@@ -573,14 +621,23 @@ impl ObstaclePass {
     /// Records substep `k`'s contacts, where `start` says its start and end are: each
     /// obstacle in turn (as the CPU's effects, in the scene's order) catches the particles'
     /// moves, then sweeps the cloth's edges, then (beside self-contact) its triangles.
-    pub(super) fn encode(&self, pass: &mut wgpu::ComputePass<'_>, k: u32, start: Start) {
+    /// `again`: the second time in the substep, after self-contact's pushes, which acts
+    /// only where they moved something ([`ObstaclePass::attach_pushed`]).
+    pub(super) fn encode(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        (k, again): (u32, bool),
+        start: Start,
+    ) {
         let group = &self.groups[match start {
             Start::In(i) => i,
             Start::Kept(i) => 2 + i,
         }];
         let obstacles = self.moving.len() as u32;
+        let runs = 1 + u32::from(self.again);
         for o in 0..obstacles {
-            let offset = (u64::from(k * obstacles + o) * POSE_STRIDE) as u32;
+            let block = (k * obstacles + o) * runs + u32::from(again && self.again);
+            let offset = (u64::from(block) * POSE_STRIDE) as u32;
             pass.set_bind_group(2, &self.poses_group, &[offset]);
             pass.set_pipeline(&self.catch);
             pass.set_bind_group(0, group, &[]);

@@ -54,7 +54,11 @@ const ROUND_STRIDE: u64 = 256;
 const PUSH_WORDS: u64 = 9;
 
 /// The shader's counters before the buckets (its `COUNTERS`).
-const COUNTERS: u32 = 38;
+const COUNTERS: u32 = 39;
+
+/// The counter that says whether a substep's pushes moved anything (the shader's
+/// `PUSHES_MOVED`), which the mesh obstacles read ([`SelfPass::counters`]).
+pub(super) const PUSHES_MOVED: u32 = 38;
 
 /// Where the shader keeps the most grid entries and pairs a substep of the submission
 /// asked for, the pairs its substeps forced and its fastest particle before the cuts
@@ -574,6 +578,12 @@ impl SelfPass {
             self.regroup(device);
         }
         Ok(())
+    }
+
+    /// The buffer of the counters, whose word [`PUSHES_MOVED`] says whether a substep's
+    /// pushes moved anything (a new one where the room grows).
+    pub(super) fn counters(&self) -> &wgpu::Buffer {
+        &self.buffers[3]
     }
 
     /// The copy [`SelfPass::keep_start`] makes.

@@ -18,7 +18,8 @@ use crate::sim::{FrameOutcome, StepBackend};
 /// and its fastest particle are read from; each round of cuts has its two counters, clear
 /// of those; the pair kernels' indirect dispatches are sized by the workgroup they run in;
 /// a particle has as many push words, and the number of every push round of a substep
-/// fits above a key's depth and hash.
+/// fits above a key's depth and hash; the word that says whether the pushes moved anything
+/// is where the mesh obstacles read it, and `clear` does not zero it.
 #[test]
 fn the_host_and_the_shader_agree_on_the_counters() {
     let c = |name: &str| shader_const(super::SOURCE, name);
@@ -30,6 +31,9 @@ fn the_host_and_the_shader_agree_on_the_counters() {
     let read = c("FASTEST") + 1 - c("MOST_ENTRIES");
     assert_eq!(super::MOST_BYTES, 4 * u64::from(read));
     assert!(c("FASTEST") < c("COUNTERS"));
+    // The mesh obstacles read whether the pushes moved anything; `clear` leaves it.
+    assert_eq!(c("PUSHES_MOVED"), super::PUSHES_MOVED);
+    assert!(c("MOST_ENTRIES") <= c("PUSHES_MOVED") && c("PUSHES_MOVED") < c("COUNTERS"));
     assert!(
         c("IMPACTS") + super::ROUNDS <= c("STUCK"),
         "the rounds' impacts fit"
