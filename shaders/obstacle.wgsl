@@ -115,6 +115,16 @@ fn not_again() -> bool {
     return poses[7].z > 0.5 && pushed[op.counts.z] == 0u;
 }
 
+// How far apart invocation `id`'s entries of this dispatch's colour lie: the invocations
+// dispatched; where the colour's entries may share a particle, 1 for the first invocation,
+// which takes them all in order, and 0 (none) for the rest.
+fn colour_stride(id: u32) -> u32 {
+    if ((colour.z & 1u) == 1u) {
+        return select(0u, 1u, id == 0u);
+    }
+    return colour.w;
+}
+
 // The obstacle this dispatch takes.
 fn obstacle() -> u32 {
     return bitcast<u32>(poses[6].x);
@@ -645,13 +655,9 @@ fn edges(@builtin(global_invocation_id) id: vec3<u32>) {
     if ((sweep > 0u && atomicLoad(&crossings[sweep - 1u]) == 0u) || not_again()) {
         return;
     }
-    // A colour whose edges may share a particle is taken in order by one invocation.
-    var stride = colour.w;
-    if ((colour.z & 1u) == 1u) {
-        if (id.x > 0u) {
-            return;
-        }
-        stride = 1u;
+    let stride = colour_stride(id.x);
+    if (stride == 0u) {
+        return;
     }
     for (var k = id.x; k < colour.y; k += stride) {
         let e = cloth_edges[colour.x + k];
@@ -864,12 +870,9 @@ fn tips(@builtin(global_invocation_id) id: vec3<u32>) {
     if (not_again()) {
         return;
     }
-    var stride = colour.w;
-    if ((colour.z & 1u) == 1u) {
-        if (id.x > 0u) {
-            return;
-        }
-        stride = 1u;
+    let stride = colour_stride(id.x);
+    if (stride == 0u) {
+        return;
     }
     let o = obstacle();
     let ob = op.obstacles[o];
