@@ -41,8 +41,8 @@ pub(super) struct EdgeMemory {
     pushed_list: Vec<u32>,
     /// The tips near one patch of the cloth, and the vertices near one of its triangles
     /// (scratch of the tip pass).
-    tips_near: Vec<Vec3>,
-    tips_close: Vec<Vec3>,
+    tips_near: Vec<Vec3A>,
+    tips_close: Vec<Vec3A>,
     /// The last pass's room for a distance's rounding in the frame, and how far the edges
     /// moved in it over the substep, m (the tip pass reads them).
     rounding: f32,
@@ -153,8 +153,8 @@ pub(super) struct ForTips<'a> {
     /// Each particle's odometer, where the edges are fixed in the frame (else none).
     pub(super) odometers: &'a mut [f64],
     /// Scratch: the tips near one patch, and the vertices near one triangle.
-    pub(super) found: &'a mut Vec<Vec3>,
-    pub(super) close: &'a mut Vec<Vec3>,
+    pub(super) found: &'a mut Vec<Vec3A>,
+    pub(super) close: &'a mut Vec<Vec3A>,
     /// How far the tips moved in the frame over the substep, and the room for a
     /// distance's rounding there, m.
     pub(super) moved_by: f32,

@@ -86,20 +86,18 @@ where
     for (triangles, lo, hi) in faces.flagged() {
         // The tips near the patch, then those near each of its triangles.
         found.clear();
-        tips.in_box(lo - most, hi + most, |tip| found.push(tip));
+        tips.in_box(lo - most, hi + most, |tip| found.push(tip.into()));
         for &t in triangles {
             let ids = model.triangles[t as usize].map(|i| i as usize);
             let corners = |local: &[Vec3A]| ids.map(|i| Vec3::from(local[i]));
             let x = corners(local);
             // Wide enough that the smooth parts could bulge through it.
             // How far a ball of unit curvature rises under it.
-            let wide = sag(x, 1.0);
+            let wide = if smooth { sag(x, 1.0) } else { 0.0 };
             let risky = smooth && wide * curvature >= RISK * thickness;
             if found.is_empty() && !risky {
                 continue;
             }
-            let start = corners(before);
-            let mut face = Face::new(x, start);
             // Its own corners' moves bound its points' (and the tips' own move).
             let moves = ids.map(|i| before[i].distance_squared(local[i]));
             let moved = moves[0].max(moves[1]).max(moves[2]).sqrt();
@@ -108,22 +106,29 @@ where
                 x[0].min(x[1]).min(x[2]) - reach,
                 x[0].max(x[1]).max(x[2]) + reach,
             );
+            // In lanes: the tips are many, and each is told in or out at once.
+            let (lo_lanes, hi_lanes) = (Vec3A::from(lo), Vec3A::from(hi));
             close.clear();
             close.extend(
                 found
                     .iter()
-                    .filter(|tip| (tip.cmpge(lo) & tip.cmple(hi)).all()),
+                    .filter(|tip| (tip.cmpge(lo_lanes) & tip.cmple(hi_lanes)).all()),
             );
             if risky {
                 // Each vertex where its own curvature could bulge that far.
                 tips.smooth_in_box(lo, hi, |p, curvature| {
                     if wide * curvature >= RISK * thickness {
-                        close.push(p);
+                        close.push(p.into());
                     }
                 });
             }
+            if close.is_empty() {
+                continue;
+            }
+            let start = corners(before);
+            let mut face = Face::new(x, start);
             let free = ids.map(|i| f32::from(model.inv_mass[i] > 0.0));
-            for &tip in close.iter() {
+            for tip in close.iter().map(|&tip| Vec3::from(tip)) {
                 let Some(Push { gap, away, w }) = face.missing(tip, thickness) else {
                     continue;
                 };
