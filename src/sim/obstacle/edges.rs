@@ -5,7 +5,7 @@ use std::collections::HashMap;
 
 use glam::{Vec3, Vec3A};
 
-use super::geometry::{less_by_move, rounding_near, segments_closest};
+use super::geometry::{less_by_move, rounding_near, segments_closest, welded};
 use super::tree::TriangleTree;
 
 /// Two faces meeting at less than this cosine between their normals (about 10°) make a
@@ -118,12 +118,7 @@ impl SharpEdges {
     /// a box with its own corners, a sphere cut along seams) has its creases where its
     /// faces bend, not a border wherever a vertex was written twice.
     pub fn of(vertices: &[Vec3], triangles: &[[u32; 3]], normals: &[Vec3]) -> Self {
-        // The bits of each coordinate, −0 as +0.
-        let place = |v: &Vec3| v.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() });
-        let mut first_at: HashMap<[u32; 3], u32> = HashMap::with_capacity(vertices.len());
-        let same: Vec<u32> = (vertices.iter().enumerate())
-            .map(|(i, v)| *first_at.entry(place(v)).or_insert(i as u32))
-            .collect();
+        let same = welded(vertices);
         let mut faces: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
         for (t, tri) in triangles.iter().enumerate() {
             let tri = tri.map(|i| same[i as usize]);

@@ -1,7 +1,19 @@
 //! Points, segments and triangles: the closest point of a triangle to a point, and where a
 //! segment crosses a triangle.
 
+use std::collections::HashMap;
+
 use glam::{DVec3, Vec3};
+
+/// Each vertex's number as the first vertex at its place (the same bits in every
+/// coordinate, −0 as +0): a surface written with its faces apart is one surface.
+pub fn welded(vertices: &[Vec3]) -> Vec<u32> {
+    let place = |v: &Vec3| v.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+    let mut first_at: HashMap<[u32; 3], u32> = HashMap::with_capacity(vertices.len());
+    (vertices.iter().enumerate())
+        .map(|(i, v)| *first_at.entry(place(v)).or_insert(i as u32))
+        .collect()
+}
 
 /// A margin for the rounding of distances measured among points no farther from the
 /// origin than `p` is along any axis: ten times it (f32 rounds a distance to about a

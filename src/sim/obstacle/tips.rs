@@ -3,11 +3,10 @@
 //! which can poke through a cloth triangle whose particles and edges all keep clear of
 //! the faces and the sharp edges.
 
-use std::collections::HashMap;
-
 use glam::Vec3;
 
 use super::edges::CREASE_COS;
+use super::geometry::welded;
 use super::tree::TriangleTree;
 
 /// The tips of a surface and a tree over them; and the rest of its vertices (its smooth
@@ -70,12 +69,7 @@ impl Tips {
         normals: &[Vec3],
         sharp: impl IntoIterator<Item = [u32; 2]>,
     ) -> Self {
-        // The bits of each coordinate, −0 as +0.
-        let place = |v: &Vec3| v.to_array().map(|c| if c == 0.0 { 0 } else { c.to_bits() });
-        let mut first_at: HashMap<[u32; 3], u32> = HashMap::with_capacity(vertices.len());
-        let same: Vec<u32> = (vertices.iter().enumerate())
-            .map(|(i, v)| *first_at.entry(place(v)).or_insert(i as u32))
-            .collect();
+        let same = welded(vertices);
         let mut tip = vec![false; vertices.len()];
         for [a, b] in sharp {
             tip[same[a as usize] as usize] = true;
