@@ -139,3 +139,16 @@ fn a_smooth_caps_vertices_are_smooth_and_its_curvature_is_read_from_its_faces() 
         assert!((0.8 * c..2.0 * c).contains(&k), "{k} at {p}");
     }
 }
+
+/// A face collapsed to a point (its three corners written at one place, as some exporters
+/// write them) has no normal and says nothing: the flat sheet's middle vertex it lies on
+/// stays smooth, and only the border's vertices are tips.
+#[test]
+fn a_face_collapsed_to_a_point_makes_no_tip() {
+    let (mut v, mut t) = grid(4, 0.0);
+    let (middle, k) = (v[12], v.len() as u32);
+    assert_eq!(middle, Vec3::new(2.0, 0.0, 2.0));
+    v.extend([middle; 3]);
+    t.push([k, k + 1, k + 2]);
+    assert_eq!(tips_of(v, t).len(), 16, "the border's vertices only");
+}

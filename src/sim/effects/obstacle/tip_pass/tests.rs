@@ -108,3 +108,12 @@ fn the_rise_under_a_triangle_is_over_its_least_enclosing_circle() {
         assert!((got - rise).abs() < 1e-5, "{x:?}: {got} against {rise}");
     }
 }
+
+/// A cloth triangle collapsed to a segment has no plane and no side: it is not pushed off
+/// an apex even where it passes within the thickness of it (its edges are the edge pass's).
+#[test]
+fn a_triangle_collapsed_to_a_segment_is_not_pushed() {
+    let (a, b) = (Vec3::new(-0.01, 0.001, 0.0), Vec3::new(0.01, 0.001, 0.0));
+    let segment = [a, b, (a + b) * 0.5];
+    assert_eq!(missing(APEX, segment, segment, 0.004), None);
+}
