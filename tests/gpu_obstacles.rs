@@ -11,7 +11,7 @@ use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::IntegratorKind;
 
 mod common;
-use common::tips::{Tipped, coarse_drop, tipped_obstacles, write_ball};
+use common::tips::{ball, coarse_drop, drop_through_nothing, tipped_obstacles};
 use common::{farthest, gpu_simulation};
 
 /// The built-in scene `name` at `quads` quads.
@@ -291,15 +291,8 @@ fn a_napkin_on_a_bending_arm_moves_as_on_the_cpu() {
 #[test]
 fn tips_never_pierce_a_coarse_cloth_on_the_gpu() {
     let dir = tempfile::tempdir().expect("a temporary folder");
-    write_ball(&dir.path().join("ball.obj"), 0.2, 3072);
-    let ball = Tipped {
-        name: "ball",
-        effect: "[[effects]]\ntype = \"obstacle\"\nobj = \"ball.obj\"\n".to_string(),
-        tip: 0.4,
-        rise: 0.0,
-    };
     let mut cases: Vec<_> = tipped_obstacles(dir.path()).into_iter().collect();
-    cases.push(ball);
+    cases.push(ball(dir.path(), 3072));
     let integrators = ["semi-implicit-euler", "implicit-euler", "xpbd", "vbd"];
     for obstacle in cases {
         let name = obstacle.name;
@@ -307,15 +300,7 @@ fn tips_never_pierce_a_coarse_cloth_on_the_gpu() {
         for integrator in &integrators[..others] {
             let scene = coarse_drop(dir.path(), &obstacle.effect, integrator, 6);
             let (mut gpu, _) = gpu_simulation(scene, true).expect("GPU backend");
-            for frame in 0..60 {
-                gpu.step_frame()
-                    .unwrap_or_else(|e| panic!("{name} {integrator}: {e}"));
-                let met = gpu.intersections().obstacles[0];
-                assert_eq!(met, 0, "{name} {integrator}: frame {frame}");
-            }
-            let pos = &gpu.state().pos;
-            assert!(pos.iter().all(|p| p.is_finite()), "{name} {integrator}");
-            let highest = pos.iter().map(|p| p.y).fold(f32::MIN, f32::max);
+            let highest = drop_through_nothing(&mut gpu, 60, &format!("{name} {integrator}"));
             let tip = obstacle.tip_at(1.0);
             assert!(
                 highest > tip,

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use clothsim::scene::Scene;
+use clothsim::scene::{Scene, Simulation};
 
 /// Writes an OBJ of `vertices` and triangles (0-based) to `path`.
 pub fn write_obj(path: &Path, vertices: &[Vec3], triangles: &[[u32; 3]]) {
@@ -117,6 +117,32 @@ pub fn tipped_obstacles(dir: &Path) -> [Tipped; 3] {
             0.15,
         ),
     ]
+}
+
+/// A 20 cm ball of about `triangles` triangles on the ground (its top 0.4 m up), written
+/// into `dir` as `ball.obj`.
+pub fn ball(dir: &Path, triangles: usize) -> Tipped {
+    write_ball(&dir.join("ball.obj"), 0.2, triangles);
+    Tipped {
+        name: "ball",
+        effect: "[[effects]]\ntype = \"obstacle\"\nobj = \"ball.obj\"\n".to_string(),
+        tip: 0.4,
+        rise: 0.0,
+    }
+}
+
+/// Steps `sim` `frames` frames, after each of which no cloth triangle meets the obstacle
+/// (the exact check), and returns how high the cloth's highest point then is (m), every
+/// particle finite; `case` names it in a failure.
+pub fn drop_through_nothing(sim: &mut Simulation, frames: usize, case: &str) -> f32 {
+    for frame in 0..frames {
+        sim.step_frame().unwrap_or_else(|e| panic!("{case}: {e}"));
+        let met = sim.intersections().obstacles[0];
+        assert_eq!(met, 0, "{case}: frame {frame}");
+    }
+    let pos = &sim.state().pos;
+    assert!(pos.iter().all(|p| p.is_finite()), "{case}");
+    pos.iter().map(|p| p.y).fold(f32::MIN, f32::max)
 }
 
 /// A ball of radius `radius` and about `triangles` triangles resting on the ground (the
