@@ -316,7 +316,12 @@ impl ObstaclePass {
             bytemuck::cast_slice(&fixed),
             U::STORAGE,
         );
-        let cloth_edges = buffer("cloth edges", bytemuck::cast_slice(&edges), U::STORAGE);
+        // The cloth's edges, then (for the tip pass) its triangles.
+        let cloth = buffer(
+            "cloth edges and triangles",
+            bytemuck::cast_slice(&edges),
+            U::STORAGE,
+        );
         let crossings = buffer("edge crossings", &[0; 4 * EDGE_SWEEPS], U::STORAGE);
         let no_solve = buffer("no solver words", &[0; 48], U::STORAGE);
         // Self-contact's counters, where it runs (`attach_pushed`).
@@ -344,15 +349,7 @@ impl ObstaclePass {
             usage: U::STORAGE,
             mapped_at_creation: false,
         });
-        let buffers = [
-            uniform,
-            surface,
-            cloth_edges,
-            crossings,
-            kept,
-            no_solve,
-            pushed,
-        ];
+        let buffers = [uniform, surface, cloth, crossings, kept, no_solve, pushed];
         let groups = Self::groups_for(device, &main, particles, &buffers, None);
         let (poses, poses_group) = Self::poses_for(device, &poses_layout, 1);
         Ok(Some(Self {
@@ -387,24 +384,10 @@ impl ObstaclePass {
         device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,
         particles: &[wgpu::Buffer; 2],
-        [
-            uniform,
-            surface,
-            cloth_edges,
-            crossings,
-            kept,
-            no_solve,
-            pushed,
-        ]: &[wgpu::Buffer; 7],
+        [uniform, surface, cloth, crossings, kept, no_solve, pushed]: &[wgpu::Buffer; 7],
         solve: Option<&wgpu::Buffer>,
     ) -> [wgpu::BindGroup; 6] {
-        let rest = [
-            surface,
-            cloth_edges,
-            crossings,
-            solve.unwrap_or(no_solve),
-            pushed,
-        ];
+        let rest = [surface, cloth, crossings, solve.unwrap_or(no_solve), pushed];
         start_end_groups(
             device,
             "obstacles",
