@@ -197,6 +197,22 @@ fn unapply(p: Pose, pivot: vec3<f32>, moved: vec3<f32>) -> vec3<f32> {
     return pivot + unrotate(p.rotation, moved - pivot - p.translation);
 }
 
+// The surface's velocity (world) at `point` of obstacle `o` (its frame where the substep
+// ends): a rigid one's motion there; a deforming one's vertices' velocity at its point
+// nearest within `reach` (none beyond: the CPU's `Moment::velocity_near`).
+fn velocity_near(o: u32, point: vec3<f32>, reach: f32) -> vec3<f32> {
+    if (deforming(o)) {
+        let near = nearest(o, point, reach);
+        if (near.place == 0xffffffffu) {
+            return vec3<f32>(0.0);
+        }
+        return field_at(o, near.place, near.point, 1u);
+    }
+    let end = pose(true);
+    let pivot = op.obstacles[o].pivot.xyz;
+    return velocity_at(end, pivot, apply(end, pivot, point));
+}
+
 fn velocity_at(p: Pose, pivot: vec3<f32>, moved: vec3<f32>) -> vec3<f32> {
     return p.velocity + cross(p.spin, moved - pivot - p.translation);
 }
@@ -709,16 +725,7 @@ fn edges(@builtin(global_invocation_id) id: vec3<u32>) {
         if (weight <= 0.0) {
             continue;
         }
-        var vs = velocity_at(end, pivot, apply(end, pivot, hit.on_edge));
-        if (deforming(o)) {
-            // The surface's velocity at the point of it nearest to the edge's (the CPU's
-            // `Moment::velocity_near`).
-            vs = vec3<f32>(0.0);
-            let near = nearest(o, hit.on_edge, thickness);
-            if (near.place != 0xffffffffu) {
-                vs = field_at(o, near.place, near.point, 1u);
-            }
-        }
+        let vs = velocity_near(o, hit.on_edge, thickness);
         let part = share * free;
         let before = array<vec3<f32>, 2>(pi.v.xyz, pj.v.xyz);
         if (part.x > 0.0) {
@@ -839,14 +846,7 @@ fn push_off_tip(f: ptr<function, TipFace>, o: u32, tip: vec3<f32>) {
     let end = pose(true);
     let n = rotate(end.rotation, push.away);
     let by = rotate(end.rotation, push.gap * push.away);
-    var vs = velocity_at(end, pivot, apply(end, pivot, tip));
-    if (deforming(o)) {
-        vs = vec3<f32>(0.0);
-        let near = nearest(o, tip, thickness);
-        if (near.place != 0xffffffffu) {
-            vs = field_at(o, near.place, near.point, 1u);
-        }
-    }
+    let vs = velocity_near(o, tip, thickness);
     for (var k = 0u; k < 3u; k++) {
         if (part[k] <= 0.0) {
             continue;
