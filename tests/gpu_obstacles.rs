@@ -11,7 +11,9 @@ use clothsim::scene::{Scene, Simulation};
 use clothsim::sim::IntegratorKind;
 
 mod common;
-use common::tips::{ball, coarse_drop, drop_through_nothing, tipped_obstacles};
+use common::tips::{
+    ball, coarse_drop, coarse_drop_at, drop_through_nothing, gentle_obstacles, tipped_obstacles,
+};
 use common::{farthest, gpu_simulation};
 
 /// The built-in scene `name` at `quads` quads.
@@ -275,14 +277,15 @@ fn a_napkin_on_a_bending_arm_moves_as_on_the_cpu() {
 
 /// A coarse cloth (6 × 6 quads of 17 cm, a 1 cm thickness, self-collision) dropped on a
 /// pyramid's apex, a cube's corner, a rising apex (an OBJ sequence) and a 20 cm ball of
-/// 3 072 triangles (1 508 of its 1 538 vertices smooth; the 30 in the middles of the
-/// cube's faces, whose faces turn a little more, are tips), which rises 1.7 cm under a
-/// cell: on the GPU, as on the CPU (`tests/obstacles.rs`), the tip pass keeps the tips
-/// (and, under triangles that wide, the ball's vertices) a thickness off the cloth's
-/// triangles, so none meets the obstacle after any frame of the first second, and the
-/// cloth rests on the tip; under semi-implicit Euler, and on the pyramid under implicit
-/// Euler, XPBD and VBD too (whose substep's start the contacts read from a copy). Without the GPU's pass the pyramid's apex came through at frame 15 (4
-/// pairs); with the ball's vertices left out, the ball at frame 18 (26 pairs). The GPU's
+/// 3 072 triangles (1 508 of its 1 538 vertices smooth by their faces; the 30 in the
+/// middles of the cube's faces, whose faces turn a little more, are tips), which rises
+/// 1.7 cm under a cell: on the GPU, as on the CPU (`tests/obstacles.rs`), the tip pass
+/// keeps the tips a thickness off the cloth's triangles (the ball's edges and vertices are
+/// within this cloth's reach, and so kept off as creases and tips, as on the CPU), so none
+/// meets the obstacle after any frame of the first second, and the cloth rests on the tip;
+/// under semi-implicit Euler, and on the pyramid under implicit Euler, XPBD and VBD too
+/// (whose substep's start the contacts read from a copy). Without the GPU's pass the
+/// pyramid's apex came through at frame 15 (4 pairs). The GPU's
 /// pass takes the triangles in colours, the CPU's patch by patch: where two triangles push
 /// one particle in a substep the two part (at 6 quads by millimetres within a few frames
 /// of meeting the apex; at 2 quads, 17–24 frames after), so a one-quad cloth on each is
@@ -310,6 +313,31 @@ fn tips_never_pierce_a_coarse_cloth_on_the_gpu() {
         let scene = coarse_drop(dir.path(), &obstacle.effect, "semi-implicit-euler", 1);
         let (apart, _) = compare_checking(scene, (0, 45), |_, _| {});
         eprintln!("{name}, one quad: {apart:e} m apart");
-        assert!(apart < 2e-5, "{name}: GPU and CPU differ by {apart} m");
+        // Every vertex of the ball is a tip to a one-quad cloth: its two triangles push the
+        // particles they share in the same substeps, in the GPU's order and the CPU's.
+        let within = if name == "ball" { 1e-4 } else { 2e-5 };
+        assert!(apart < within, "{name}: GPU and CPU differ by {apart} m");
+    }
+}
+
+/// A rail of narrow faces and a roof with a low apex (`gentle_obstacles`), whose faces all
+/// meet at less than a crease, under a coarse cloth: on the GPU, as on the CPU, each is
+/// fitted to the cloth (its gentle edges and vertices within the cloth's reach kept off as
+/// creases and tips are), so no triangle of the cloth meets either after any frame of the
+/// first second under semi-implicit Euler, and the cloth rests on top. (Not fitted, the
+/// rail came through at frame 12, the roof's apex at frame 17.)
+#[test]
+fn gentle_curves_never_come_through_a_coarse_cloth_on_the_gpu() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    for (obstacle, quads, centre) in gentle_obstacles(dir.path()) {
+        let (effect, sie) = (&obstacle.effect, "semi-implicit-euler");
+        let scene = coarse_drop_at(dir.path(), effect, sie, quads, centre);
+        let (mut gpu, _) = gpu_simulation(scene, true).expect("GPU backend");
+        let highest = drop_through_nothing(&mut gpu, 60, obstacle.name);
+        assert!(
+            highest > obstacle.tip,
+            "{}: the cloth is not on top ({highest} m)",
+            obstacle.name
+        );
     }
 }

@@ -3,7 +3,7 @@
 //! last so that nothing after them can undo its guarantee.
 
 use crate::cloth::ClothModel;
-use crate::sim::{ContactConfig, Effect};
+use crate::sim::{Effect, Reach, SimParams};
 
 use super::error::GpuError;
 use super::kernel::SubstepKernel;
@@ -20,8 +20,9 @@ pub(super) struct Contacts {
 }
 
 impl Contacts {
-    /// The passes for `model` under `effects` and `contact`, over the particles in
-    /// `particles`.
+    /// The passes for `model` under `effects` and `params`, over the particles in
+    /// `particles`: each mesh obstacle as this cloth meets it at rest, as on the CPU
+    /// ([`Reach::fit`]; the CPU fits them again where the cloth outgrows that).
     ///
     /// # Errors
     /// As [`ObstaclePass::new`] and [`SelfPass::new`].
@@ -30,9 +31,10 @@ impl Contacts {
         queue: &wgpu::Queue,
         kernel: &SubstepKernel,
         particles: &[wgpu::Buffer; 2],
-        (model, effects, contact): (&ClothModel, &[Effect], &ContactConfig),
+        (model, effects, params): (&ClothModel, &[Effect], &SimParams),
     ) -> Result<Self, GpuError> {
-        let scene = (model, effects, contact);
+        let fitted = Reach::default().fit(effects, model, params.contact.offset);
+        let scene = (model, &fitted[..], &params.contact);
         let obstacles = ObstaclePass::new(device, queue, kernel, particles, scene)?;
         let own = effects.iter().find_map(|e| match e {
             Effect::SelfCollision(own) => Some(own),

@@ -670,7 +670,7 @@ impl StepBackend for GpuStepper {
             }
         }
         if changes.intersects(Changes::EFFECTS | Changes::CONTACT) && self.unsupported.is_none() {
-            let scene = (model, effects, &params.contact);
+            let scene = (model, effects, params);
             let (device, queue) = (&self.device, &self.queue);
             match Contacts::new(device, queue, &self.kernel, &self.particles, scene) {
                 Ok(contacts) => self.contacts = contacts.tuned_as(&self.contacts),

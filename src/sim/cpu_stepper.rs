@@ -9,7 +9,7 @@ use crate::cloth::{ClothModel, ClothState, Real};
 use super::backend::StepBackend;
 use super::diagnosis::Cause;
 use super::effects::{
-    Between, ContactPass, Effect, FacePatches, SelfCollision, air_damping_of, gravity_of,
+    Between, ContactPass, Effect, FacePatches, Reach, SelfCollision, air_damping_of, gravity_of,
     shortest_edge,
 };
 use super::forces::ForceSet;
@@ -73,8 +73,11 @@ pub struct CpuStepper<R: Real = f32> {
     /// The effects that act after each substep: solids in the scene's order, then
     /// self-collision.
     contacts: Vec<Effect>,
-    /// The scene's effects, for the guard's limits.
+    /// The scene's effects, for the guard's limits, each mesh obstacle as this cloth meets
+    /// it.
     effects: Vec<Effect>,
+    /// What the mesh obstacles were fitted to.
+    reach: Reach,
     solver: SolverConfig,
     gravity: glam::Vec3,
     dt: f32,
@@ -143,6 +146,7 @@ impl<R: Real> CpuStepper<R> {
             forces: ForceSet::default(),
             contacts: Vec::new(),
             effects: Vec::new(),
+            reach: Reach::default(),
             solver: params.solver,
             gravity: glam::Vec3::ZERO,
             dt: params.step.dt,
@@ -316,6 +320,16 @@ impl<R: Real> CpuStepper<R> {
     /// substeps per frame, and with `fallback` where the guard tried it: a self-collision
     /// thickness the cloth cannot take, an explicit integrator past its stable step, or
     /// else the stiffness.
+    /// Takes `effects` (each mesh obstacle fitted to the cloth) as the scene's, their
+    /// contacts as the ones that act after each substep.
+    fn take_effects(&mut self, effects: Vec<Effect>) {
+        self.contacts = effects.iter().filter(|e| e.is_contact()).cloned().collect();
+        // Self-collision last, after the solids have moved what they touch.
+        self.contacts
+            .sort_by_key(|e| matches!(e, Effect::SelfCollision(_)));
+        self.effects = effects;
+    }
+
     fn diagnose(
         &self,
         model: &ClothModel,
@@ -521,16 +535,17 @@ impl<R: Real> StepBackend for CpuStepper<R> {
             return;
         }
         let forces_changed = (self.forces).apply(model, &params.material, effects, changes);
+        if changes.intersects(Changes::EFFECTS | Changes::CONTACT) {
+            // Each mesh obstacle as this cloth meets it: what its edges and triangles can
+            // reach between their particles.
+            let fitted = self.reach.fit(effects, model, params.contact.offset);
+            self.take_effects(fitted);
+        }
         if changes.contains(Changes::EFFECTS) {
-            self.contacts = effects.iter().filter(|e| e.is_contact()).cloned().collect();
-            // Self-collision last, after the solids have moved what they touch.
-            self.contacts
-                .sort_by_key(|e| matches!(e, Effect::SelfCollision(_)));
             self.self_collision = effects.iter().find_map(|e| match e {
                 Effect::SelfCollision(s) => Some(*s),
                 _ => None,
             });
-            self.effects = effects.to_vec();
             if self.self_collision.is_some() {
                 // Built now, not in the first substep, with the patches the face passes
                 // take (a sphere's, and a mesh obstacle's of its tips: they run only beside
@@ -614,6 +629,10 @@ impl<R: Real> StepBackend for CpuStepper<R> {
     ) -> Result<FrameOutcome, Diverged> {
         let stepped = self.on_state(state, |stepper, state| stepper.guarded_frame(model, state));
         self.outside = None;
+        // A cloth grown past what the obstacles were fitted to has them fitted again.
+        if let Some(fitted) = (self.reach).outgrown(&self.effects, model, &state.pos) {
+            self.take_effects(fitted);
+        }
         stepped
     }
 

@@ -33,11 +33,22 @@ pub fn scene_in(dir: &Path, toml: &str) -> Scene {
 /// effect), with the ground and self-collision (whose guarantee covers the cloth's
 /// surface, not only its particles).
 pub fn coarse_drop(dir: &Path, obstacle: &str, integrator: &str, quads: u32) -> Scene {
+    coarse_drop_at(dir, obstacle, integrator, quads, [0.03, 0.02])
+}
+
+/// As [`coarse_drop`], the cloth's centre over `[x, z]`.
+pub fn coarse_drop_at(
+    dir: &Path,
+    obstacle: &str,
+    integrator: &str,
+    quads: u32,
+    [x, z]: [f32; 2],
+) -> Scene {
     scene_in(
         dir,
         &format!(
             "name = \"tip\"\n[cloth]\ngrid = {{ quads = {quads}, size = 1.0 }}\n\
-             orientation = \"horizontal\"\ncenter = [0.03, 0.8, 0.02]\n\
+             orientation = \"horizontal\"\ncenter = [{x}, 0.8, {z}]\n\
              [solver]\nintegrator = \"{integrator}\"\nsubsteps = 16\n\
              [[effects]]\ntype = \"gravity\"\n{obstacle}\n\
              [[effects]]\ntype = \"plane\"\nfriction = 0.4\n\
@@ -117,6 +128,77 @@ pub fn tipped_obstacles(dir: &Path) -> [Tipped; 3] {
             0.15,
         ),
     ]
+}
+
+/// Obstacles whose faces all meet at less than a crease, yet whose surface falls away under
+/// a coarse cloth's edge or triangle by more than its thickness, written into `dir`, with
+/// where the cloth's centre goes ([`coarse_drop_at`]) and how many quads it has:
+///
+/// - `rail`: a prism of 72 narrow faces (each turning 5° from the next) along the x axis,
+///   30 cm in radius, its top 0.6 m up, under a cloth of 6 quads: a cloth edge across it
+///   (a 24 cm diagonal) sinks some 2.5 cm below its particles' offset;
+/// - `roof`: a 1.6 m square block 30 cm high whose top rises 4.7° to an apex 6.6 cm
+///   higher in the middle, under a cloth of 4 quads whose centre is placed so that the
+///   apex lies inside a triangle (its circumradius 18 cm), which it rises 1.5 cm into.
+pub fn gentle_obstacles(dir: &Path) -> [(Tipped, u32, [f32; 2]); 2] {
+    write_prism(&dir.join("rail.obj"), 72, 0.3, 0.3);
+    let (half, base) = (0.8f32, 0.3f32);
+    let apex = base + half * 4.7f32.to_radians().tan();
+    let mut roof = Vec::new();
+    for y in [0.0, base] {
+        roof.extend(
+            [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]
+                .map(|[x, z]| Vec3::new(half * x, y, half * z)),
+        );
+    }
+    roof.push(Vec3::new(0.0, apex, 0.0));
+    let faces = [
+        [0, 1, 2],
+        [0, 2, 3],
+        [4, 5, 1],
+        [4, 1, 0],
+        [5, 6, 2],
+        [5, 2, 1],
+        [6, 7, 3],
+        [6, 3, 2],
+        [7, 4, 0],
+        [7, 0, 3],
+        [4, 8, 5],
+        [5, 8, 6],
+        [6, 8, 7],
+        [7, 8, 4],
+    ];
+    write_obj(&dir.join("roof.obj"), &roof, &faces);
+    let obstacle = |name, file: &str, tip| Tipped {
+        name,
+        effect: format!("[[effects]]\ntype = \"obstacle\"\nobj = \"{file}\"\n"),
+        tip,
+        rise: 0.0,
+    };
+    [
+        (obstacle("rail", "rail.obj", 0.6), 6, [0.03, 0.02]),
+        (obstacle("roof", "roof.obj", apex), 4, [0.083, 0.167]),
+    ]
+}
+
+/// Writes to `path` a closed prism of `sides` narrow faces along the x axis, 2 m long, its
+/// corners `radius` from the line `y = axis`, `z = 0`.
+fn write_prism(path: &Path, sides: u32, radius: f32, axis: f32) {
+    let mut corners = Vec::new();
+    for k in 0..sides {
+        let a = std::f32::consts::TAU * k as f32 / sides as f32;
+        let (y, z) = (axis + radius * a.sin(), radius * a.cos());
+        corners.extend([Vec3::new(-1.0, y, z), Vec3::new(1.0, y, z)]);
+    }
+    corners.extend([Vec3::new(-1.0, axis, 0.0), Vec3::new(1.0, axis, 0.0)]);
+    let (left, right) = (2 * sides, 2 * sides + 1);
+    let mut faces = Vec::new();
+    for k in 0..sides {
+        let [a, b] = [2 * k, 2 * k + 1];
+        let [c, d] = [2 * ((k + 1) % sides), 2 * ((k + 1) % sides) + 1];
+        faces.extend([[a, c, d], [a, d, b], [left, c, a], [right, b, d]]);
+    }
+    write_obj(path, &corners, &faces);
 }
 
 /// A 20 cm ball of about `triangles` triangles on the ground (its top 0.4 m up), written

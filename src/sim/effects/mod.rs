@@ -12,6 +12,7 @@ mod handle;
 mod list;
 mod obstacle;
 mod plane;
+mod reach;
 mod registry;
 mod self_collision;
 mod solid;
@@ -32,6 +33,7 @@ pub use list::{
 };
 pub use obstacle::{DEFAULT_FPS, Obstacle, ObstacleError, Placed, Shape, frame_path};
 pub use plane::Plane;
+pub use reach::{GROWTH, Reach, fitted_to_cloth};
 pub use registry::{Addable, Effect};
 pub use self_collision::{SelfCollision, TooThick, shortest_edge};
 pub use sphere::Sphere;

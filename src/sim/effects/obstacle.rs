@@ -13,7 +13,7 @@ use super::solid::{Solid, default_friction, resolve_remembering};
 use crate::cloth::ClothState;
 use crate::mesh::{ObjError, PolygonSoup, parse_obj, read_obj};
 use crate::sim::motion::{AxisAngle, Keyframe, Pose, RigidMotion};
-use crate::sim::obstacle::{Gathered, Moment, Sequence, Surface, SurfaceClock};
+use crate::sim::obstacle::{ClothSpan, Gathered, Moment, Sequence, Surface, SurfaceClock};
 use crate::sim::param_error::ParamError;
 use crate::sim::self_contacts::ContactError;
 
@@ -21,6 +21,7 @@ use self::edge_pass::{EdgeFrame, EdgeMemory, EdgesMoved, push_edges};
 use self::tip_pass::push_tips;
 
 mod edge_pass;
+mod reach;
 mod tip_pass;
 
 /// A mesh obstacle as a scene file gives it.
@@ -134,6 +135,8 @@ pub struct Placed {
     memory: std::sync::Mutex<(Vec<Gathered>, SurfaceClock)>,
     /// What its edge pass keeps from one substep to the next.
     edge_memory: std::sync::Mutex<EdgeMemory>,
+    /// The last cloth span it was fitted to and what that gave ([`Obstacle::reaching`]).
+    reached: std::sync::Mutex<Option<(ClothSpan, Option<Arc<Placed>>)>>,
 }
 
 impl Placed {
@@ -384,6 +387,7 @@ impl Obstacle {
             sequence,
             memory: std::sync::Mutex::new((Vec::new(), SurfaceClock::default())),
             edge_memory: std::sync::Mutex::new(EdgeMemory::default()),
+            reached: Default::default(),
         })));
         Ok(())
     }

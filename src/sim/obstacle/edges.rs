@@ -118,6 +118,17 @@ impl SharpEdges {
     /// a box with its own corners, a sphere cut along seams) has its creases where its
     /// faces bend, not a border wherever a vertex was written twice.
     pub fn of(vertices: &[Vec3], triangles: &[[u32; 3]], normals: &[Vec3]) -> Self {
+        Self::of_or(vertices, triangles, normals, |_, _| false)
+    }
+
+    /// As [`SharpEdges::of`], and also every edge between two faces that `also` says is
+    /// one (given its two vertices, welded, and its two faces).
+    pub fn of_or(
+        vertices: &[Vec3],
+        triangles: &[[u32; 3]],
+        normals: &[Vec3],
+        also: impl Fn([u32; 2], [usize; 2]) -> bool,
+    ) -> Self {
         let same = welded(vertices);
         let mut faces: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
         for (t, tri) in triangles.iter().enumerate() {
@@ -128,8 +139,11 @@ impl SharpEdges {
             }
         }
         let mut keys: Vec<(u32, u32)> = (faces.iter())
-            .filter(|(_, f)| match f.as_slice() {
-                [one, two] => normals[*one].dot(normals[*two]).abs() < CREASE_COS,
+            .filter(|((a, b), f)| match f.as_slice() {
+                [one, two] => {
+                    normals[*one].dot(normals[*two]).abs() < CREASE_COS
+                        || also([*a, *b], [*one, *two])
+                }
                 _ => true,
             })
             .map(|(k, _)| *k)

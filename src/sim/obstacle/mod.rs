@@ -1,6 +1,7 @@
 //! Obstacles of any shape: triangle surfaces the cloth may not pass, with the tree that
 //! finds what a particle's move comes near, and the frames of one that deforms.
 
+mod coarse;
 mod edges;
 mod geometry;
 mod sequence;
@@ -8,6 +9,7 @@ mod surface;
 mod tips;
 mod tree;
 
+pub use coarse::ClothSpan;
 #[cfg(test)]
 pub(crate) use edges::unit_cube;
 pub use edges::{Clearance, EdgeHit, LOOK, LOOK_DEFORMING, SharpEdges};

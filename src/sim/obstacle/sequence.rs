@@ -110,6 +110,12 @@ impl Sequence {
         }
     }
 
+    /// The same frames over `surface` (frame 0's, as [`Sequence::new`] takes it: the
+    /// same vertices, its edges and tips told apart another way).
+    pub fn over(&self, surface: Surface) -> Self {
+        Self::new(surface, self.frames.clone(), self.fps, self.looped)
+    }
+
     pub fn len(&self) -> usize {
         self.frames.len()
     }

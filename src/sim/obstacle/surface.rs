@@ -3,6 +3,7 @@
 
 use glam::Vec3;
 
+use super::coarse::{ClothSpan, FLAT_COS, Faces};
 use super::edges::SharpEdges;
 use super::geometry::{closest_on_triangle, less_by_move, rounding_near, segment_crosses};
 use super::tips::Tips;
@@ -95,6 +96,9 @@ pub struct Surface {
     tree: TriangleTree,
     edges: SharpEdges,
     tips: Tips,
+    /// Whether two of its faces meet at an edge neither flat nor a crease (a cloth coarse
+    /// enough may reach it: [`ClothSpan`]).
+    gentle: bool,
 }
 
 /// Where a caught move ends and the surface's normal there (pointing to the side the
@@ -119,7 +123,11 @@ impl Surface {
             .map(|[a, b, c]| (*b - *a).cross(*c - *a).normalize_or_zero())
             .collect();
         let tree = TriangleTree::new(&corners);
-        let edges = SharpEdges::of(&vertices, &triangles, &normals);
+        let gentle = std::cell::Cell::new(false);
+        let edges = SharpEdges::of_or(&vertices, &triangles, &normals, |_, [n, m]| {
+            gentle.set(gentle.get() || normals[n].dot(normals[m]).abs() < FLAT_COS);
+            false
+        });
         let tips = Tips::of(
             &vertices,
             &triangles,
@@ -133,7 +141,30 @@ impl Surface {
             tree,
             edges,
             tips,
+            gentle: gentle.get(),
         }
+    }
+
+    /// This surface with every gentle edge and vertex that a cloth of `span` can reach
+    /// kept off as its creases and tips are ([`ClothSpan`]: a coarse cloth over a rail of
+    /// narrow faces); `None` where that adds none.
+    pub fn reaching(&self, span: &ClothSpan) -> Option<Surface> {
+        let (vertices, triangles, normals) = (&self.vertices, &self.triangles, &self.normals);
+        let faces = Faces::new(vertices, triangles, normals);
+        let reached = faces.reachable_edges(span, vertices);
+        let edges = SharpEdges::of_or(vertices, triangles, normals, |[a, b], _| {
+            reached.contains(&(a.min(b), a.max(b)))
+        });
+        let sharp = edges.ends().iter().copied();
+        let reached = faces.reachable_vertices(span, vertices);
+        let tips = Tips::of_or(vertices, triangles, normals, sharp, |v| {
+            reached.contains(&v)
+        });
+        (edges != self.edges || tips != self.tips).then(|| Surface {
+            edges,
+            tips,
+            ..self.clone()
+        })
     }
 
     /// The same triangles over moved `vertices` (as many as before): normals, tree and
@@ -180,6 +211,11 @@ impl Surface {
     /// Its creases and borders.
     pub fn sharp_edges(&self) -> &SharpEdges {
         &self.edges
+    }
+
+    /// Whether two of its faces meet at an edge neither flat nor a crease.
+    pub fn is_gentle(&self) -> bool {
+        self.gentle
     }
 
     /// Its tips: where its faces meet at a point.

@@ -69,6 +69,18 @@ impl Tips {
         normals: &[Vec3],
         sharp: impl IntoIterator<Item = [u32; 2]>,
     ) -> Self {
+        Self::of_or(vertices, triangles, normals, sharp, |_| false)
+    }
+
+    /// As [`Tips::of`], and also every vertex that `also` says is one (given the vertex,
+    /// welded: the first at its place).
+    pub fn of_or(
+        vertices: &[Vec3],
+        triangles: &[[u32; 3]],
+        normals: &[Vec3],
+        sharp: impl IntoIterator<Item = [u32; 2]>,
+        also: impl Fn(u32) -> bool,
+    ) -> Self {
         let same = welded(vertices);
         let mut tip = vec![false; vertices.len()];
         for [a, b] in sharp {
@@ -104,7 +116,7 @@ impl Tips {
                     }
                 }
             }
-            if most.0 < CREASE_COS {
+            if most.0 < CREASE_COS || also(v) {
                 tip[v as usize] = true;
                 continue;
             }

@@ -1,0 +1,53 @@
+//! A mesh obstacle as one cloth meets it: its gentle edges and vertices that the cloth's
+//! edges and triangles can reach between their particles kept off as its creases and tips
+//! are ([`ClothSpan`]).
+
+use std::sync::Arc;
+
+use super::{Obstacle, Placed, Shape};
+use crate::sim::obstacle::ClothSpan;
+
+impl Obstacle {
+    /// This obstacle as a cloth of `span` meets it (the same file, placement and motion;
+    /// a surface that keeps that cloth off what it can reach, with memories of its own),
+    /// or `None` where its creases and tips already hold all of it. The last span asked
+    /// for is remembered with its answer: asked again (another stepper for the same
+    /// scene), the answer is the same reading.
+    pub fn reaching(&self, span: &ClothSpan) -> Option<Obstacle> {
+        let placed = self.placed()?;
+        let mut reached = placed.reached.lock().ok();
+        let known = (reached.as_deref())
+            .and_then(|r| r.as_ref())
+            .filter(|(asked, _)| asked == span)
+            .map(|(_, answer)| answer.clone());
+        let answer = known.unwrap_or_else(|| {
+            let answer = placed.reaching(span).map(Arc::new);
+            if let Some(reached) = reached.as_deref_mut() {
+                *reached = Some((*span, answer.clone()));
+            }
+            answer
+        });
+        answer.map(|placed| Obstacle {
+            shape: Shape(Some(placed)),
+            ..self.clone()
+        })
+    }
+}
+
+impl Placed {
+    /// This placement with its surface fitted to a cloth of `span`, or `None` where that
+    /// adds nothing.
+    fn reaching(&self, span: &ClothSpan) -> Option<Placed> {
+        let surface = self.surface.reaching(span)?;
+        let sequence = (self.sequence.as_ref()).map(|s| s.over(surface.clone()));
+        Some(Placed {
+            surface,
+            motion: self.motion.clone(),
+            pivot: self.pivot,
+            sequence,
+            memory: Default::default(),
+            edge_memory: Default::default(),
+            reached: Default::default(),
+        })
+    }
+}

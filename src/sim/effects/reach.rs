@@ -1,0 +1,144 @@
+//! Each mesh obstacle as the cloth meets it: the gentle edges and vertices of its surface
+//! that the cloth's edges and triangles can reach between their particles, kept off as its
+//! creases and tips are ([`ClothSpan`]). Fitted to the cloth's rest shape grown by
+//! [`GROWTH`], and again wherever a frame ends with the cloth grown past what they were
+//! fitted to.
+
+use glam::Vec3;
+
+use super::registry::Effect;
+use crate::cloth::ClothModel;
+use crate::sim::obstacle::ClothSpan;
+
+/// How much longer than measured the cloth's edges (and its triangles' levers) may grow
+/// before the obstacles must be fitted to it again.
+pub const GROWTH: f32 = 1.25;
+
+/// `effects` with each mesh obstacle fitted to a cloth of `span` (its own thickness where
+/// it has one, else `span`'s), [`super::Obstacle::reaching`]: the same effects (the same
+/// readings) where nothing more is within reach.
+pub fn fitted_to_cloth(effects: &[Effect], span: ClothSpan) -> Vec<Effect> {
+    (effects.iter())
+        .map(|e| match e {
+            Effect::Obstacle(o) if o.is_loaded() => {
+                let thickness = o.thickness.unwrap_or(span.thickness);
+                let span = ClothSpan { thickness, ..span };
+                o.reaching(&span)
+                    .map_or_else(|| e.clone(), Effect::Obstacle)
+            }
+            _ => e.clone(),
+        })
+        .collect()
+}
+
+/// The span a stepper's obstacles were last fitted to, and whether any of them has gentle
+/// parts (else nothing is ever fitted again).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Reach {
+    span: Option<ClothSpan>,
+    gentle: bool,
+}
+
+impl Reach {
+    /// `effects` fitted to `model`'s rest shape grown by [`GROWTH`], keeping `offset` (where
+    /// an obstacle has no thickness of its own).
+    pub fn fit(&mut self, effects: &[Effect], model: &ClothModel, offset: f32) -> Vec<Effect> {
+        let span = ClothSpan::of(&model.rest_positions, &model.triangles, GROWTH, offset);
+        self.fit_to(effects, span)
+    }
+
+    /// `effects` (as last fitted) fitted again where the cloth of `model` at `pos` has
+    /// grown past the span they were fitted to: to the larger of the two grown by
+    /// [`GROWTH`]; `None` where it has not, or no obstacle has gentle parts.
+    pub fn outgrown(
+        &mut self,
+        effects: &[Effect],
+        model: &ClothModel,
+        pos: &[Vec3],
+    ) -> Option<Vec<Effect>> {
+        let fitted = self.span.filter(|_| self.gentle)?;
+        let now = ClothSpan::of(pos, &model.triangles, 1.0, fitted.thickness);
+        if now.edge <= fitted.edge && now.lever <= fitted.lever {
+            return None;
+        }
+        let span = ClothSpan {
+            edge: now.edge.max(fitted.edge) * GROWTH,
+            lever: now.lever.max(fitted.lever) * GROWTH,
+            ..fitted
+        };
+        Some(self.fit_to(effects, span))
+    }
+
+    fn fit_to(&mut self, effects: &[Effect], span: ClothSpan) -> Vec<Effect> {
+        self.span = Some(span);
+        self.gentle = effects.iter().any(|e| match e {
+            Effect::Obstacle(o) => o.placed().is_some_and(|p| p.surface.is_gentle()),
+            _ => false,
+        });
+        fitted_to_cloth(effects, span)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{GridOrientation, GridSpec, PolygonSoup};
+    use crate::sim::Obstacle;
+
+    /// A prism of 40 narrow faces (each turning 9° from the next), 30 cm in radius, along
+    /// the x axis: a rail.
+    fn rail() -> Effect {
+        let mut positions = Vec::new();
+        for k in 0..40 {
+            let a = std::f32::consts::TAU * k as f32 / 40.0;
+            let (y, z) = (0.3 * a.sin(), 0.3 * a.cos());
+            positions.extend([Vec3::new(-1.0, y, z), Vec3::new(1.0, y, z)]);
+        }
+        let mut face_indices = Vec::new();
+        for k in 0..40 {
+            let [a, b, c, d] = [2 * k, 2 * k + 1, 2 * ((k + 1) % 40), 2 * ((k + 1) % 40) + 1];
+            face_indices.extend([a, c, d, a, d, b]);
+        }
+        let face_arities = vec![3; face_indices.len() / 3];
+        let soup = PolygonSoup {
+            positions,
+            uvs: None,
+            face_indices,
+            face_arities,
+        };
+        let mut rail = Obstacle::new("rail.obj");
+        rail.load_mesh(&soup).unwrap();
+        Effect::Obstacle(rail)
+    }
+
+    fn kept_off(effects: &[Effect]) -> usize {
+        match &effects[0] {
+            Effect::Obstacle(o) => o.placed().unwrap().surface.sharp_edges().len(),
+            _ => unreachable!(),
+        }
+    }
+
+    /// A cloth of 10 cm quads and a 4 cm thickness cannot reach the rail's ridges at rest
+    /// (its diagonals, 14 cm, grown by a quarter, dip at most 2.3 cm into it by the bound,
+    /// under three quarters of the thickness), so only the rail's open ends are kept off.
+    /// Grown to twice its size it can, and the frame's end fits the rail to it again: its
+    /// 40 ridges kept off too. Grown by a tenth (within the quarter it was fitted with) or
+    /// not at all, nothing is fitted again.
+    #[test]
+    fn a_cloth_grown_past_its_fit_has_the_obstacles_fitted_again() {
+        let mesh = GridSpec::square(10, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
+            .build()
+            .unwrap();
+        let model = ClothModel::new(&mesh, 0.2, &[]);
+        let mut reach = Reach::default();
+        let fitted = reach.fit(&[rail()], &model, 0.04);
+        assert_eq!(kept_off(&fitted), 80, "the ends' rims");
+        let grown = |by: f32| mesh.positions.iter().map(|&p| p * by).collect::<Vec<_>>();
+        assert!(reach.outgrown(&fitted, &model, &mesh.positions).is_none());
+        assert!(reach.outgrown(&fitted, &model, &grown(1.1)).is_none());
+        let refitted = reach.outgrown(&fitted, &model, &grown(2.0)).unwrap();
+        assert_eq!(kept_off(&refitted), 120);
+        // Fitted to the grown cloth, the same growth asks for nothing more.
+        assert!(reach.outgrown(&refitted, &model, &grown(2.0)).is_none());
+    }
+}

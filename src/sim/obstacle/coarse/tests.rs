@@ -1,0 +1,169 @@
+use super::*;
+use crate::sim::obstacle::Surface;
+
+/// A grid cloth's span: its diagonals are its longest edges, and a right triangle's
+/// circumradius is half its hypotenuse.
+#[test]
+fn a_grids_span_is_its_diagonal_and_half_of_it() {
+    let rest = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 0.0, 1.0), Vec3::Z];
+    let span = ClothSpan::of(&rest, &[[0, 1, 2], [0, 2, 3]], 2.0, 0.01);
+    assert!((span.edge - 2.0 * 2f32.sqrt()).abs() < 1e-6, "{span:?}");
+    assert!((span.lever - 2f32.sqrt()).abs() < 1e-6, "{span:?}");
+}
+
+/// A closed prism of `sides` narrow faces round the x axis, radius `radius`, 2 m long:
+/// a rail. Its only vertices are at its two ends.
+fn rail(sides: u32, radius: f32) -> Surface {
+    let mut vertices = Vec::new();
+    for k in 0..sides {
+        let a = std::f32::consts::TAU * k as f32 / sides as f32;
+        let (y, z) = (radius * a.sin(), radius * a.cos());
+        vertices.extend([Vec3::new(-1.0, y, z), Vec3::new(1.0, y, z)]);
+    }
+    vertices.extend([Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0)]);
+    let (left, right) = (2 * sides, 2 * sides + 1);
+    let mut triangles = Vec::new();
+    for k in 0..sides {
+        let [a, b] = [2 * k, 2 * k + 1];
+        let [c, d] = [2 * ((k + 1) % sides), 2 * ((k + 1) % sides) + 1];
+        triangles.extend([[a, c, d], [a, d, b], [left, c, a], [right, b, d]]);
+    }
+    Surface::new(vertices, triangles)
+}
+
+fn span(edge: f32, thickness: f32) -> ClothSpan {
+    ClothSpan {
+        edge,
+        lever: 0.5 * edge,
+        thickness,
+    }
+}
+
+/// How many of the surface's edges a cloth of `span` is kept off.
+fn kept_off(surface: &Surface, span: &ClothSpan) -> usize {
+    surface
+        .reaching(span)
+        .map_or(surface.sharp_edges().len(), |s| s.sharp_edges().len())
+}
+
+/// How far a regular polygon of `sides` corners on a circle of `radius` falls below the
+/// line through one corner square to its radius, at `d` along that line (the bisecting
+/// plane of a rail's ridge, seen end on): where a cloth edge of length `2d` laid across
+/// the ridge, its two particles alike, comes into the surface.
+fn polygon_falls(sides: u32, radius: f32, d: f32) -> f32 {
+    let step = std::f32::consts::TAU / sides as f32;
+    let corner = |k: u32| {
+        let a = step * k as f32;
+        (radius * a.cos(), radius * a.sin())
+    };
+    for k in 0..sides / 4 {
+        let ((x0, y0), (x1, y1)) = (corner(k), corner(k + 1));
+        if (y0..=y1).contains(&d) {
+            return radius - (x0 + (x1 - x0) * (d - y0) / (y1 - y0));
+        }
+    }
+    panic!("{d} m is beyond a quarter of the rail");
+}
+
+/// A rail of 40 faces (each turning 9° from the next, under the creases' 10°) of 30 cm
+/// radius: for cloth edges of 5, 12 and 24 cm laid across a ridge, the bound on how far
+/// they come into it is at least how far they do (2.0, 6.8 and 26.0 mm) and at most
+/// twice that (3.1, 11.4 and 48.2 mm). Counting the ridge alone (no slopes growing
+/// farther out), it would be below how far the 12 and 24 cm edges come in.
+#[test]
+fn the_bound_on_a_rails_dip_holds_and_is_within_twice_it() {
+    let (sides, radius) = (40, 0.3);
+    let rail = rail(sides, radius);
+    let faces = Faces::new(rail.vertices(), rail.triangles(), rail.normals());
+    // The ridge between facets 4 and 5: the edge from vertex 10 to 11, between the first
+    // triangle of facet 4 and the second of facet 5.
+    let ends = [rail.vertices()[10], rail.vertices()[11]];
+    let (lo, hi) = (ends[0].min(ends[1]), ends[0].max(ends[1]));
+    for length in [0.05, 0.12, 0.24] {
+        let span = span(length, 0.01);
+        let half = 0.5 * length;
+        let walk = &mut Walk::over(&faces);
+        let bound = span.dip(
+            (&faces, walk),
+            (lo, hi),
+            [16, 21],
+            (half, half * half),
+            f32::INFINITY,
+        );
+        let dips = polygon_falls(sides, radius, half);
+        assert!(
+            dips <= bound && bound <= 2.0 * dips,
+            "{length} m: dips {dips} m, bound {bound} m"
+        );
+    }
+}
+
+/// The same rail and a 1 cm thickness: a cloth edge of 12 cm laid across it comes in by
+/// 6.8 mm, within three quarters of the thickness by the bound (what counts as reached);
+/// so the 12 cm cloth is kept off the 40 ridges along the rail as well as its two rims'
+/// 80 edges, the 5 cm one off the rims alone, and the 12 cm one off the rims alone with a
+/// thickness of 2 cm.
+#[test]
+fn a_rails_ridges_are_within_a_coarse_cloths_reach_only() {
+    let rail = rail(40, 0.3);
+    assert_eq!(rail.sharp_edges().len(), 80, "the rims");
+    assert_eq!(kept_off(&rail, &span(0.05, 0.01)), 80);
+    assert_eq!(kept_off(&rail, &span(0.12, 0.01)), 120);
+    assert_eq!(kept_off(&rail, &span(0.12, 0.02)), 80);
+}
+
+/// The faces of a box meet at creases or lie in one plane: nothing more is within any
+/// cloth's reach (its faces' diagonals are flat), however long its edges.
+#[test]
+fn flat_faces_are_beyond_every_cloths_reach() {
+    let (v, t, _) = crate::sim::obstacle::unit_cube();
+    let cube = Surface::new(v, t);
+    assert_eq!(cube.reaching(&span(10.0, 1e-4)), None);
+}
+
+/// A roof of four faces rising 4.7° to an apex 1.6 m across (the faces turn 9.4° from
+/// each other there, under the creases' 10°; it is not a tip). A cloth triangle of 18 cm
+/// lever over the apex dips into it by about 15 mm (`λ·tan 4.7°`) against a 1 cm
+/// thickness, one of 5 cm lever by about 4 mm: the coarse cloth is kept off the apex as
+/// a tip, the fine one not. The vertex's own bound decides it: with the cloth's edges
+/// held to 10 cm (too short to reach the ridges, 6.6 mm at most) and the lever at 18 cm,
+/// the apex is still reached.
+#[test]
+fn a_low_apex_is_a_tip_to_a_coarse_cloth_only() {
+    let rise = 0.8 * 4.7f32.to_radians().tan();
+    let vertices = vec![
+        Vec3::new(-0.8, 0.0, -0.8),
+        Vec3::new(0.8, 0.0, -0.8),
+        Vec3::new(0.8, 0.0, 0.8),
+        Vec3::new(-0.8, 0.0, 0.8),
+        Vec3::new(0.0, rise, 0.0),
+    ];
+    let triangles = vec![[0, 4, 1], [1, 4, 2], [2, 4, 3], [3, 4, 0]];
+    let roof = Surface::new(vertices, triangles);
+    let apex = |surface: &Surface| {
+        let mut found = false;
+        let at = Vec3::new(0.0, rise, 0.0);
+        surface.tips().in_box(at, at, |_| found = true);
+        found
+    };
+    assert!(!apex(&roof));
+    let span = |edge, lever| ClothSpan {
+        edge,
+        lever,
+        thickness: 0.01,
+    };
+    assert!(roof.reaching(&span(0.1, 0.05)).is_none_or(|r| !apex(&r)));
+    assert!(roof.reaching(&span(0.36, 0.18)).is_some_and(|r| apex(&r)));
+    let faces = Faces::new(roof.vertices(), roof.triangles(), roof.normals());
+    let long_lever = span(0.1, 0.18);
+    assert!(
+        faces
+            .reachable_edges(&long_lever, roof.vertices())
+            .is_empty()
+    );
+    assert!(
+        faces
+            .reachable_vertices(&long_lever, roof.vertices())
+            .contains(&4)
+    );
+}
