@@ -59,10 +59,20 @@ pub struct ClothSpan {
 pub(super) struct Faces<'a> {
     triangles: &'a [[u32; 3]],
     normals: &'a [Vec3],
-    boxes: Vec<[Vec3; 2]>,
-    across: Vec<[u32; 3]>,
+    /// What a walk reads of each face, side by side.
+    walked: Vec<Walked>,
     /// Each vertex's first at its place.
     same: Vec<u32>,
+}
+
+/// A face as the walks read it: its box, its unit normal, and its neighbours across its
+/// three edges.
+#[derive(Clone, Copy)]
+struct Walked {
+    lo: Vec3,
+    hi: Vec3,
+    normal: Vec3,
+    across: [u32; 3],
 }
 
 /// No neighbour across an edge.
@@ -115,17 +125,22 @@ impl<'a> Faces<'a> {
                 across[t as usize][k as usize] = s;
             }
         }
-        let boxes = (triangles.iter())
-            .map(|t| {
+        let walked = (triangles.iter().zip(normals).zip(across))
+            .map(|((t, &normal), across)| {
                 let [p, q, r] = t.map(|i| vertices[i as usize]);
-                [p.min(q).min(r), p.max(q).max(r)]
+                let (lo, hi) = (p.min(q).min(r), p.max(q).max(r));
+                Walked {
+                    lo,
+                    hi,
+                    normal,
+                    across,
+                }
             })
             .collect();
         Self {
             triangles,
             normals,
-            boxes,
-            across,
+            walked,
             same,
         }
     }
@@ -150,7 +165,7 @@ impl<'a> Faces<'a> {
                 let mut walk = Walk::over(self);
                 let mut reached = Vec::new();
                 for s in piece * PIECE..count.min((piece + 1) * PIECE) {
-                    for (k, &t) in self.across[s].iter().enumerate() {
+                    for (k, &t) in self.walked[s].across.iter().enumerate() {
                         if t == NONE || (t as usize) < s {
                             continue;
                         }
@@ -307,18 +322,18 @@ impl ClothSpan {
         let mut at = 0;
         while let Some(&t) = walk.met.get(at) {
             at += 1;
-            let [flo, fhi] = faces.boxes[t as usize];
-            let apart = (flo - hi).max(lo - fhi).max(Vec3::ZERO).length();
+            let face = faces.walked[t as usize];
+            let apart = (face.lo - hi).max(lo - face.hi).max(Vec3::ZERO).length();
             if apart > reach {
                 continue;
             }
             let ring = ((apart / reach * RINGS as f32) as usize).min(RINGS - 1);
-            let cos = faces.normals[t as usize].dot(reference).abs();
+            let cos = face.normal.dot(reference).abs();
             least[ring] = least[ring].min(cos);
             if least[0] <= stop_cos {
                 return slope(least[0]) * first;
             }
-            for u in faces.across[t as usize] {
+            for u in face.across {
                 if u != NONE && walk.seen[u as usize] != walked {
                     walk.seen[u as usize] = walked;
                     walk.met.push(u);
