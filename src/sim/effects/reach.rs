@@ -84,27 +84,17 @@ mod tests {
     use super::*;
     use crate::mesh::{GridOrientation, GridSpec, PolygonSoup};
     use crate::sim::Obstacle;
+    use crate::sim::obstacle::prism;
 
-    /// A prism of 40 narrow faces (each turning 9° from the next), 30 cm in radius, along
-    /// the x axis: a rail.
+    /// A closed prism of 40 narrow faces (each turning 9° from the next), 30 cm in
+    /// radius, along the x axis: a rail.
     fn rail() -> Effect {
-        let mut positions = Vec::new();
-        for k in 0..40 {
-            let a = std::f32::consts::TAU * k as f32 / 40.0;
-            let (y, z) = (0.3 * a.sin(), 0.3 * a.cos());
-            positions.extend([Vec3::new(-1.0, y, z), Vec3::new(1.0, y, z)]);
-        }
-        let mut face_indices = Vec::new();
-        for k in 0..40 {
-            let [a, b, c, d] = [2 * k, 2 * k + 1, 2 * ((k + 1) % 40), 2 * ((k + 1) % 40) + 1];
-            face_indices.extend([a, c, d, a, d, b]);
-        }
-        let face_arities = vec![3; face_indices.len() / 3];
+        let (positions, triangles) = prism(40, 0.3);
         let soup = PolygonSoup {
             positions,
             uvs: None,
-            face_indices,
-            face_arities,
+            face_indices: triangles.iter().flatten().copied().collect(),
+            face_arities: vec![3; triangles.len()],
         };
         let mut rail = Obstacle::new("rail.obj");
         rail.load_mesh(&soup).unwrap();
@@ -120,7 +110,8 @@ mod tests {
 
     /// A cloth of 10 cm quads and a 4 cm thickness cannot reach the rail's ridges at rest
     /// (its diagonals, 14 cm, grown by a quarter, dip at most 2.3 cm into it by the bound,
-    /// under three quarters of the thickness), so only the rail's open ends are kept off.
+    /// under three quarters of the thickness), so only the creases round its ends are kept
+    /// off.
     /// Grown to twice its size it can, and the frame's end fits the rail to it again: its
     /// 40 ridges kept off too. Grown by a tenth (within the quarter it was fitted with) or
     /// not at all, nothing is fitted again.

@@ -365,5 +365,27 @@ fn slope(cos: f32) -> f32 {
     }
 }
 
+/// A closed prism of `sides` narrow faces round the x axis, `radius` from it and 2 m long,
+/// with flat ends (a rail: its only vertices are at its ends), as vertices and triangles:
+/// for tests.
+#[cfg(test)]
+pub(crate) fn prism(sides: u32, radius: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let mut vertices = Vec::new();
+    for k in 0..sides {
+        let a = std::f32::consts::TAU * k as f32 / sides as f32;
+        let (y, z) = (radius * a.sin(), radius * a.cos());
+        vertices.extend([Vec3::new(-1.0, y, z), Vec3::new(1.0, y, z)]);
+    }
+    vertices.extend([Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0)]);
+    let (left, right) = (2 * sides, 2 * sides + 1);
+    let mut triangles = Vec::new();
+    for k in 0..sides {
+        let [a, b] = [2 * k, 2 * k + 1];
+        let [c, d] = [2 * ((k + 1) % sides), 2 * ((k + 1) % sides) + 1];
+        triangles.extend([[a, c, d], [a, d, b], [left, c, a], [right, b, d]]);
+    }
+    (vertices, triangles)
+}
+
 #[cfg(test)]
 mod tests;

@@ -11,6 +11,8 @@ mod tree;
 
 pub use coarse::ClothSpan;
 #[cfg(test)]
+pub(crate) use coarse::prism;
+#[cfg(test)]
 pub(crate) use edges::unit_cube;
 pub use edges::{Clearance, EdgeHit, LOOK, LOOK_DEFORMING, SharpEdges};
 pub(crate) use geometry::{closest_weights, segments_closest};

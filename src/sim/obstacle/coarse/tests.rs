@@ -11,23 +11,9 @@ fn a_grids_span_is_its_diagonal_and_half_of_it() {
     assert!((span.lever - 2f32.sqrt()).abs() < 1e-6, "{span:?}");
 }
 
-/// A closed prism of `sides` narrow faces round the x axis, radius `radius`, 2 m long:
-/// a rail. Its only vertices are at its two ends.
+/// A rail: [`prism`] as a surface.
 fn rail(sides: u32, radius: f32) -> Surface {
-    let mut vertices = Vec::new();
-    for k in 0..sides {
-        let a = std::f32::consts::TAU * k as f32 / sides as f32;
-        let (y, z) = (radius * a.sin(), radius * a.cos());
-        vertices.extend([Vec3::new(-1.0, y, z), Vec3::new(1.0, y, z)]);
-    }
-    vertices.extend([Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0)]);
-    let (left, right) = (2 * sides, 2 * sides + 1);
-    let mut triangles = Vec::new();
-    for k in 0..sides {
-        let [a, b] = [2 * k, 2 * k + 1];
-        let [c, d] = [2 * ((k + 1) % sides), 2 * ((k + 1) % sides) + 1];
-        triangles.extend([[a, c, d], [a, d, b], [left, c, a], [right, b, d]]);
-    }
+    let (vertices, triangles) = prism(sides, radius);
     Surface::new(vertices, triangles)
 }
 
