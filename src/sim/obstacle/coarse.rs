@@ -21,6 +21,8 @@
 
 use std::collections::{HashMap, HashSet};
 
+use std::f32::consts::FRAC_PI_2;
+
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -151,13 +153,42 @@ impl<'a> Faces<'a> {
     }
 
     /// The edges between two faces (by their two vertices, each the first at its place,
-    /// the lesser first) that a cloth of `span` can reach (at `vertices`), taken face by
-    /// face, in pieces shared among the threads.
-    pub(super) fn reachable_edges(
+    /// the lesser first) and the vertices whose faces turn from each other by less than a
+    /// crease (each the first at its place) that a cloth of `span` can reach (at
+    /// `vertices`). Each vertex's walk serves the edges round it (a face is at most an
+    /// edge's length nearer the edge than its end, and turns from the edge's faces at most
+    /// as far again as the end's reference does from them); an edge longer than the reach,
+    /// or with an end its walk did not measure, walks on its own. In pieces shared among
+    /// the threads.
+    pub(super) fn reached(
         &self,
         span: &ClothSpan,
         vertices: &[Vec3],
-    ) -> HashSet<(u32, u32)> {
+    ) -> (HashSet<(u32, u32)>, HashSet<u32>) {
+        let fans = self.fans();
+        let fans: Vec<&[(u32, u32)]> = fans.chunk_by(|a, b| a.0 == b.0).collect();
+        let walked: Vec<Vec<(u32, Result<Around, ()>)>> = (fans.par_chunks(PIECE))
+            .map(|piece| {
+                let mut walk = Walk::over(self);
+                let around = |fan| span.around(self, &mut walk, vertices, fan);
+                piece.iter().filter_map(around).collect()
+            })
+            .collect();
+        let mut around = vec![None; vertices.len()];
+        let mut reached_vertices = HashSet::new();
+        for (v, found) in walked.into_iter().flatten() {
+            match found {
+                Ok(found) => {
+                    if found.reached {
+                        reached_vertices.insert(v);
+                    }
+                    around[v as usize] = Some(found);
+                }
+                Err(()) => {
+                    reached_vertices.insert(v);
+                }
+            }
+        }
         let count = self.triangles.len();
         let pieces: Vec<Vec<(u32, u32)>> = (0..count.div_ceil(PIECE))
             .into_par_iter()
@@ -170,9 +201,11 @@ impl<'a> Faces<'a> {
                             continue;
                         }
                         let tri = self.triangles[s];
-                        let [a, b] = [tri[k], tri[(k + 1) % 3]].map(|i| self.same[i as usize]);
-                        let ends = [a, b].map(|i| vertices[i as usize]);
-                        if span.reaches_edge(self, &mut walk, ends, [s as u32, t]) {
+                        let ends = [tri[k], tri[(k + 1) % 3]].map(|i| self.same[i as usize]);
+                        let faces = [s as u32, t];
+                        let walks = ends.map(|v| around[v as usize].as_ref());
+                        if span.reaches_edge((self, &mut walk), vertices, ends, faces, walks) {
+                            let [a, b] = ends;
                             reached.push((a.min(b), a.max(b)));
                         }
                     }
@@ -180,46 +213,95 @@ impl<'a> Faces<'a> {
                 reached
             })
             .collect();
-        pieces.into_iter().flatten().collect()
+        (pieces.into_iter().flatten().collect(), reached_vertices)
     }
 
-    /// The vertices (each the first at its place) whose faces turn from each other, by
-    /// less than a crease, that a cloth of `span` can reach (at `vertices`), in pieces
-    /// shared among the threads.
-    pub(super) fn reachable_vertices(&self, span: &ClothSpan, vertices: &[Vec3]) -> HashSet<u32> {
-        // Each vertex's faces, by vertex.
+    /// Each vertex's faces (the vertex first at its place, a face), by vertex.
+    fn fans(&self) -> Vec<(u32, u32)> {
         let mut fans: Vec<(u32, u32)> = (self.triangles.iter().enumerate())
             .filter(|&(t, _)| self.normals[t] != Vec3::ZERO)
             .flat_map(|(t, tri)| tri.map(|i| (self.same[i as usize], t as u32)))
             .collect();
         fans.sort_unstable();
-        let fans: Vec<&[(u32, u32)]> = fans.chunk_by(|a, b| a.0 == b.0).collect();
-        let pieces: Vec<Vec<u32>> = (fans.par_chunks(PIECE))
-            .map(|piece| {
-                let mut walk = Walk::over(self);
-                let mut reached = Vec::new();
-                for fan in piece {
-                    // The two faces that turn most from each other.
-                    let mut most = (1.0f32, fan[0].1, fan[0].1);
-                    for (k, &(_, s)) in fan.iter().enumerate() {
-                        for &(_, t) in &fan[k + 1..] {
-                            let cos = self.turn([s, t]);
-                            if cos < most.0 {
-                                most = (cos, s, t);
-                            }
-                        }
-                    }
-                    let (v, (cos, s, t)) = (fan[0].0, most);
-                    let at = vertices[v as usize];
-                    if cos >= CREASE_COS && span.reaches_vertex(self, &mut walk, at, [s, t], cos) {
-                        reached.push(v);
-                    }
-                }
-                reached
-            })
-            .collect();
-        pieces.into_iter().flatten().collect()
+        fans
     }
+
+    /// Walks from the faces `starts` across gentle and flat edges (nearest first) the
+    /// faces whose boxes lie within `least.len()` rings of `width` of the box `lo..hi`,
+    /// keeping each ring's least cosine (unsigned) to `reference` in `least`; stops, and
+    /// says so, as soon as the first ring's is `stop` or less.
+    fn walk_rings(
+        &self,
+        walk: &mut Walk,
+        starts: impl IntoIterator<Item = u32>,
+        ((lo, hi), reference): ((Vec3, Vec3), Vec3),
+        (width, least): (f32, &mut [f32]),
+        stop: f32,
+    ) -> bool {
+        let rings = least.len();
+        let reach = width * rings as f32;
+        least.fill(1.0);
+        walk.walks += 1;
+        let walked = walk.walks;
+        walk.met.clear();
+        for s in starts {
+            if walk.seen[s as usize] != walked {
+                walk.seen[s as usize] = walked;
+                walk.met.push(s);
+            }
+        }
+        let mut at = 0;
+        while let Some(&t) = walk.met.get(at) {
+            at += 1;
+            let face = self.walked[t as usize];
+            let apart = (face.lo - hi).max(lo - face.hi).max(Vec3::ZERO).length();
+            if apart > reach {
+                continue;
+            }
+            let ring = ((apart / width) as usize).min(rings - 1);
+            least[ring] = least[ring].min(face.normal.dot(reference).abs());
+            if least[0] <= stop {
+                return true;
+            }
+            for u in face.across {
+                if u != NONE && walk.seen[u as usize] != walked {
+                    walk.seen[u as usize] = walked;
+                    walk.met.push(u);
+                }
+            }
+        }
+        false
+    }
+}
+
+/// What one vertex's walk measured: the steepest turn (radians) from its reference of the
+/// faces within each ring and every ring nearer, out to the reach and as far again as its
+/// longest edge, and that reference; and whether the vertex itself is reached.
+#[derive(Clone)]
+struct Around {
+    steepest: [f32; 2 * RINGS],
+    rings: usize,
+    reference: Vec3,
+    reached: bool,
+}
+
+/// The bisecting plane's normal of two faces' normals (unsigned).
+fn bisector(n: Vec3, m: Vec3) -> Vec3 {
+    (n + m * n.dot(m).signum()).normalize_or(n)
+}
+
+/// How far at most (m) a cloth whose weighted distances from a point are at most `first`
+/// (`Σ wᵢdᵢ`) and `second` (`Σ wᵢdᵢ²`) comes below its particles' offset from the surface
+/// there, where the steepest slope of the faces within each ring of `width` and every ring
+/// nearer is `slopes`: `f(d) ≤ a·d + b·d²`, the slope at distance s being at most the
+/// steepest within s, which `a + 2b·s` bounds from each ring's inner radius on.
+fn dip_of(slopes: [f32; RINGS], width: f32, (first, second): (f32, f32)) -> f32 {
+    let a = slopes[0];
+    let mut b = 0.0f32;
+    for (k, &slope) in slopes.iter().enumerate().skip(1) {
+        b = b.max((slope - a) / (2.0 * width * k as f32));
+    }
+    a * first + b * second
 }
 
 impl ClothSpan {
@@ -248,35 +330,10 @@ impl ClothSpan {
         }
     }
 
-    /// Whether a cloth edge can reach the surface's edge from `a` to `b` between the faces
-    /// `s` and `t`.
-    fn reaches_edge(
-        &self,
-        faces: &Faces<'_>,
-        walk: &mut Walk,
-        [a, b]: [Vec3; 2],
-        [s, t]: [u32; 2],
-    ) -> bool {
-        let half = 0.5 * self.edge;
-        let flat = faces.turn([s, t]) >= FLAT_COS;
-        let (need, box_) = (self.need(), (a.min(b), a.max(b)));
-        !flat && self.dip((faces, walk), box_, [s, t], (half, half * half), need) >= need
-    }
-
-    /// Whether a cloth triangle can reach the surface's vertex at `v`, whose faces turn
-    /// from each other by at most the angle of cosine `turn` (unsigned), `s` and `t` the
-    /// two that turn most.
-    fn reaches_vertex(
-        &self,
-        faces: &Faces<'_>,
-        walk: &mut Walk,
-        v: Vec3,
-        [s, t]: [u32; 2],
-        turn: f32,
-    ) -> bool {
-        let (lever, need) = (self.lever, self.need());
-        let bound = (lever, lever * lever);
-        turn < FLAT_COS && self.dip((faces, walk), (v, v), [s, t], bound, need) >= need
+    /// The width of the rings the slopes are gathered in: the reach (the cloth's longest
+    /// edge) over [`RINGS`].
+    fn width(&self) -> f32 {
+        self.edge / RINGS as f32
     }
 
     /// How far the bound lets a cloth come into a surface: the thickness less a margin.
@@ -284,85 +341,159 @@ impl ClothSpan {
         MARGIN * self.thickness
     }
 
-    /// How far at most (m) a cloth whose weighted distances from a point of the box
-    /// `lo..hi` are at most `first` (`Σ wᵢdᵢ`) and `second` (`Σ wᵢdᵢ²`) comes below its
-    /// particles' offset from the surface there: the surface within the cloth's longest
-    /// edge, walked from the faces `s` and `t` (whose bisecting plane the slopes are
-    /// measured from), falls away that far under it. Infinite where a face there stands
-    /// at a right angle to that plane. As soon as the slopes nearest the box alone take it
-    /// to `enough`, what they take it to.
-    fn dip(
+    /// Whether a cloth edge can reach the surface's edge between the vertices `ends` (at
+    /// `vertices`) and the faces `sides` ([`ClothSpan::edge_dip`]): what a walk of its own
+    /// says, asked only where its ends' walks do not already leave it short.
+    fn reaches_edge(
         &self,
         (faces, walk): (&Faces<'_>, &mut Walk),
-        (lo, hi): (Vec3, Vec3),
-        [s, t]: [u32; 2],
-        (first, second): (f32, f32),
+        vertices: &[Vec3],
+        ends: [u32; 2],
+        sides: [u32; 2],
+        walks: [Option<&Around>; 2],
+    ) -> bool {
+        let need = self.need();
+        if faces.turn(sides) >= FLAT_COS {
+            return false;
+        }
+        // The ends' walks bound it from above: where they leave it short, it is; else its
+        // own walk decides.
+        let edge = (ends, sides);
+        let measured = walks.iter().all(Option::is_some);
+        if measured && self.edge_dip((faces, walk), vertices, edge, walks, need) < need {
+            return false;
+        }
+        self.edge_dip((faces, walk), vertices, edge, [None; 2], need) >= need
+    }
+
+    /// How far at most (m) a cloth edge comes into the surface at its edge between the
+    /// vertices `ends` (at `vertices`) and the faces `[s, t]`: from its ends' walks where
+    /// both measured them and it is no longer than the reach, else by a walk of its own,
+    /// which stops as soon as the faces nearest it alone take it to `enough` (and says
+    /// what they take it to).
+    fn edge_dip(
+        &self,
+        (faces, walk): (&Faces<'_>, &mut Walk),
+        vertices: &[Vec3],
+        (ends, [s, t]): ([u32; 2], [u32; 2]),
+        walks: [Option<&Around>; 2],
         enough: f32,
     ) -> f32 {
-        let reach = self.edge;
-        if !(reach > 0.0 && reach.is_finite()) {
+        let (half, width) = (0.5 * self.edge, self.width());
+        if !(width > 0.0 && width.is_finite()) {
             return 0.0;
         }
-        let (n, m) = (faces.normals[s as usize], faces.normals[t as usize]);
-        let reference = (n + m * n.dot(m).signum()).normalize_or(n);
-        // The steepest slope in each ring (as the least cosine), from the faces met walking
-        // out from `s` across gentle and flat edges (nearest first), as far as the reach.
+        let bound = (half, half * half);
+        let [a, b] = ends.map(|v| vertices[v as usize]);
+        let reference = bisector(faces.normals[s as usize], faces.normals[t as usize]);
+        let length = a.distance(b);
+        if let [Some(one), Some(two)] = walks
+            && length <= self.edge
+        {
+            // A face in the edge's ring `i` lies in its end's rings `i + shift` or nearer.
+            let shift = (length / width).ceil() as usize;
+            let mut slopes = [f32::INFINITY; RINGS];
+            for end in [one, two] {
+                let off = end.reference.dot(reference).abs().min(1.0).acos();
+                for (i, slope) in slopes.iter_mut().enumerate() {
+                    let turn = end.steepest[(i + shift).min(end.rings - 1)] + off;
+                    let by_end = if turn < FRAC_PI_2 {
+                        turn.tan()
+                    } else {
+                        f32::INFINITY
+                    };
+                    *slope = slope.min(by_end);
+                }
+            }
+            return dip_of(slopes, width, bound);
+        }
         let mut least = [1.0f32; RINGS];
-        let stop = if first > 0.0 {
-            enough / first
-        } else {
-            f32::INFINITY
-        };
-        let stop_cos = 1.0 / (1.0 + stop * stop).sqrt();
-        walk.walks += 1;
-        let walked = walk.walks;
-        walk.met.clear();
-        walk.met.push(s);
-        walk.seen[s as usize] = walked;
-        let mut at = 0;
-        while let Some(&t) = walk.met.get(at) {
-            at += 1;
-            let face = faces.walked[t as usize];
-            let apart = (face.lo - hi).max(lo - face.hi).max(Vec3::ZERO).length();
-            if apart > reach {
-                continue;
-            }
-            let ring = ((apart / reach * RINGS as f32) as usize).min(RINGS - 1);
-            let cos = face.normal.dot(reference).abs();
-            least[ring] = least[ring].min(cos);
-            if least[0] <= stop_cos {
-                return slope(least[0]) * first;
-            }
-            for u in face.across {
-                if u != NONE && walk.seen[u as usize] != walked {
-                    walk.seen[u as usize] = walked;
-                    walk.met.push(u);
+        let stop = slope_cos(enough / half);
+        let box_ = (a.min(b), a.max(b));
+        if faces.walk_rings(walk, [s], (box_, reference), (width, &mut least), stop) {
+            return steepest(least)[0].tan() * half;
+        }
+        dip_of(steepest(least).map(f32::tan), width, bound)
+    }
+
+    /// The walk of the vertex of `fan` (its faces, by the vertex, first at its place, at
+    /// `vertices`) and whether a cloth triangle reaches it; `Err` where it is reached by
+    /// the faces nearest it alone (its walk stopped there); `None` for a vertex at a crease
+    /// (a tip already) or whose faces lie in one plane.
+    fn around(
+        &self,
+        faces: &Faces<'_>,
+        walk: &mut Walk,
+        vertices: &[Vec3],
+        fan: &&[(u32, u32)],
+    ) -> Option<(u32, Result<Around, ()>)> {
+        let width = self.width();
+        if !(width > 0.0 && width.is_finite()) {
+            return None;
+        }
+        // The two faces that turn most from each other.
+        let mut most = (1.0f32, fan[0].1, fan[0].1);
+        for (k, &(_, s)) in fan.iter().enumerate() {
+            for &(_, t) in &fan[k + 1..] {
+                let cos = faces.turn([s, t]);
+                if cos < most.0 {
+                    most = (cos, s, t);
                 }
             }
         }
-        // f(d) ≤ a·d + b·d²: the slope at distance s is at most the steepest within s,
-        // which `a + 2b·s` bounds from each ring's inner radius on.
-        let slopes = least.map(slope);
-        let a = slopes[0];
-        let mut steepest = a;
-        let mut b = 0.0f32;
-        for (k, &slope) in slopes.iter().enumerate().skip(1) {
-            steepest = steepest.max(slope);
-            let inner = reach * k as f32 / RINGS as f32;
-            b = b.max((steepest - a) / (2.0 * inner));
+        let (v, (cos, s, t)) = (fan[0].0, most);
+        if !(CREASE_COS..FLAT_COS).contains(&cos) {
+            return None;
         }
-        a * first + b * second
+        let at = vertices[v as usize];
+        // As far again as its longest edge, for the edges round it.
+        let longest = (fan.iter())
+            .flat_map(|&(_, f)| faces.triangles[f as usize])
+            .map(|i| at.distance(vertices[i as usize]))
+            .fold(0.0f32, f32::max);
+        let rings = RINGS + ((longest.min(self.edge) / width).ceil() as usize).min(RINGS);
+        let (lever, need) = (self.lever, self.need());
+        let reference = bisector(faces.normals[s as usize], faces.normals[t as usize]);
+        let mut least = [1.0f32; 2 * RINGS];
+        let starts = fan.iter().map(|&(_, f)| f);
+        let stop = slope_cos(need / lever);
+        let within = &mut least[..rings];
+        if faces.walk_rings(walk, starts, ((at, at), reference), (width, within), stop) {
+            return Some((v, Err(())));
+        }
+        let mut steepest = [0.0f32; 2 * RINGS];
+        let mut most = 0.0f32;
+        for (k, &cos) in least[..rings].iter().enumerate() {
+            most = most.max(cos.min(1.0).acos());
+            steepest[k] = most;
+        }
+        let near: [f32; RINGS] = std::array::from_fn(|k| steepest[k].tan());
+        let reached = dip_of(near, width, (lever, lever * lever)) >= need;
+        Some((
+            v,
+            Ok(Around {
+                steepest,
+                rings,
+                reference,
+                reached,
+            }),
+        ))
     }
 }
 
-/// The slope of a face at the angle of cosine `cos` (unsigned) from a plane: infinite at
-/// a right angle.
-fn slope(cos: f32) -> f32 {
-    if cos > 0.0 {
-        (1.0 - cos * cos).max(0.0).sqrt() / cos
-    } else {
-        f32::INFINITY
-    }
+/// Each ring's steepest turn (radians) of it and every ring nearer, from each ring's least
+/// cosine.
+fn steepest(least: [f32; RINGS]) -> [f32; RINGS] {
+    let mut most = 0.0f32;
+    least.map(|cos| {
+        most = most.max(cos.min(1.0).acos());
+        most
+    })
+}
+
+/// The cosine of the angle whose slope is `slope`.
+fn slope_cos(slope: f32) -> f32 {
+    1.0 / (1.0 + slope * slope).sqrt()
 }
 
 /// A closed prism of `sides` narrow faces round the x axis, `radius` from it and 2 m long,

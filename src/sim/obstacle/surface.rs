@@ -151,14 +151,13 @@ impl Surface {
     pub fn reaching(&self, span: &ClothSpan) -> Option<Surface> {
         let (vertices, triangles, normals) = (&self.vertices, &self.triangles, &self.normals);
         let faces = Faces::new(vertices, triangles, normals);
-        let reached = faces.reachable_edges(span, vertices);
+        let (reached_edges, reached_vertices) = faces.reached(span, vertices);
         let edges = SharpEdges::of_or(vertices, triangles, normals, |[a, b], _| {
-            reached.contains(&(a.min(b), a.max(b)))
+            reached_edges.contains(&(a.min(b), a.max(b)))
         });
         let sharp = edges.ends().iter().copied();
-        let reached = faces.reachable_vertices(span, vertices);
         let tips = Tips::of_or(vertices, triangles, normals, sharp, |v| {
-            reached.contains(&v)
+            reached_vertices.contains(&v)
         });
         (edges != self.edges || tips != self.tips).then(|| Surface {
             edges,

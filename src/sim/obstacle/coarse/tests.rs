@@ -63,19 +63,13 @@ fn the_bound_on_a_rails_dip_holds_and_is_within_twice_it() {
     let faces = Faces::new(rail.vertices(), rail.triangles(), rail.normals());
     // The ridge between facets 4 and 5: the edge from vertex 10 to 11, between the first
     // triangle of facet 4 and the second of facet 5.
-    let ends = [rail.vertices()[10], rail.vertices()[11]];
-    let (lo, hi) = (ends[0].min(ends[1]), ends[0].max(ends[1]));
     for length in [0.05, 0.12, 0.24] {
         let span = span(length, 0.01);
         let half = 0.5 * length;
         let walk = &mut Walk::over(&faces);
-        let bound = span.dip(
-            (&faces, walk),
-            (lo, hi),
-            [16, 21],
-            (half, half * half),
-            f32::INFINITY,
-        );
+        let ridge = ([10, 11], [16, 21]);
+        let vertices = rail.vertices();
+        let bound = span.edge_dip((&faces, walk), vertices, ridge, [None; 2], f32::INFINITY);
         let dips = polygon_falls(sides, radius, half);
         assert!(
             dips <= bound && bound <= 2.0 * dips,
@@ -141,15 +135,75 @@ fn a_low_apex_is_a_tip_to_a_coarse_cloth_only() {
     assert!(roof.reaching(&span(0.1, 0.05)).is_none_or(|r| !apex(&r)));
     assert!(roof.reaching(&span(0.36, 0.18)).is_some_and(|r| apex(&r)));
     let faces = Faces::new(roof.vertices(), roof.triangles(), roof.normals());
-    let long_lever = span(0.1, 0.18);
-    assert!(
-        faces
-            .reachable_edges(&long_lever, roof.vertices())
-            .is_empty()
+    let (edges, vertices) = faces.reached(&span(0.1, 0.18), roof.vertices());
+    assert!(edges.is_empty());
+    assert!(vertices.contains(&4));
+}
+
+/// A ball of 3 072 triangles under cloths of 2, 5 and 12 cm edges (a 1 cm thickness): for
+/// every edge between two faces whose ends' walks measured it (4 464 of 4 608 edges, and
+/// 1 668 under the 12 cm cloth, which reaches most vertices from their nearest faces
+/// alone), the bound taken from its ends' walks is never below the bound of a walk of its
+/// own, and at most three times it (on average 1.41, 1.63 and 1.59 times).
+#[test]
+fn an_edges_bound_from_its_ends_walks_holds_its_own() {
+    let soup = crate::bench_contact::cube_sphere(0.2, 3072);
+    let triangles: Vec<[u32; 3]> = (soup.face_indices.chunks_exact(3))
+        .map(|f| [f[0], f[1], f[2]])
+        .collect();
+    let ball = Surface::new(soup.positions, triangles);
+    let (vertices, faces) = (
+        ball.vertices(),
+        Faces::new(ball.vertices(), ball.triangles(), ball.normals()),
     );
-    assert!(
-        faces
-            .reachable_vertices(&long_lever, roof.vertices())
-            .contains(&4)
-    );
+    let fans = faces.fans();
+    for edge in [0.02, 0.05, 0.12] {
+        let span = span(edge, 0.01);
+        let mut walk = Walk::over(&faces);
+        let mut around = vec![None; vertices.len()];
+        for fan in fans.chunk_by(|a, b| a.0 == b.0) {
+            if let Some((v, Ok(found))) = span.around(&faces, &mut walk, vertices, &fan) {
+                around[v as usize] = Some(found);
+            }
+        }
+        let (mut derived, mut compared, mut ratios) = (0, 0, 0.0);
+        for s in 0..faces.walked.len() {
+            for (k, &t) in faces.walked[s].across.iter().enumerate() {
+                if t == NONE || (t as usize) < s {
+                    continue;
+                }
+                let tri = ball.triangles()[s];
+                let ends = [tri[k], tri[(k + 1) % 3]].map(|i| faces.same[i as usize]);
+                let sides = ([ends[0], ends[1]], [s as u32, t]);
+                let walks = ends.map(|v| around[v as usize].as_ref());
+                let mut dip = |walks| {
+                    span.edge_dip((&faces, &mut walk), vertices, sides, walks, f32::INFINITY)
+                };
+                let own = dip([None; 2]);
+                if walks.iter().all(Option::is_some) {
+                    let from_ends = dip(walks);
+                    assert!(
+                        from_ends >= own,
+                        "{edge} m, edge {ends:?}: {from_ends} < {own}"
+                    );
+                    assert!(
+                        from_ends <= 3.0 * own + 1e-9,
+                        "{edge} m, edge {ends:?}: {from_ends} against {own}"
+                    );
+                    derived += 1;
+                    ratios += f64::from(from_ends / own.max(1e-12));
+                }
+                compared += 1;
+            }
+        }
+        assert!(
+            derived * 4 > compared,
+            "{edge} m: {derived} of {compared} from their ends"
+        );
+        let mean = ratios / derived as f64;
+        assert!(
+            mean < 1.75,
+            "{edge} m: on average {mean}× the own walk's bound"
+        );
+    }
 }
