@@ -677,3 +677,6 @@ impl<R: Real> StepBackend for CpuStepper<R> {
         self.self_collision.map(|_| self.self_contacts.work)
     }
 }
+
+#[cfg(test)]
+mod tests;
