@@ -630,7 +630,11 @@ impl<R: Real> StepBackend for CpuStepper<R> {
         let stepped = self.on_state(state, |stepper, state| stepper.guarded_frame(model, state));
         self.outside = None;
         // A cloth grown past what the obstacles were fitted to has them fitted again.
-        if let Some(fitted) = (self.reach).outgrown(&self.effects, model, &state.pos) {
+        let grown = stepped.is_ok().then(|| {
+            let effects = &self.effects;
+            self.reach.outgrown(effects, model, &state.pos)
+        });
+        if let Some(fitted) = grown.flatten() {
             self.take_effects(fitted);
         }
         stepped

@@ -58,7 +58,8 @@ impl Reach {
     ) -> Option<Vec<Effect>> {
         let fitted = self.span.filter(|_| self.gentle)?;
         let now = ClothSpan::of(pos, &model.triangles, 1.0, fitted.thickness);
-        if now.edge <= fitted.edge && now.lever <= fitted.lever {
+        // (A cloth gone non-finite has outgrown nothing: the guard deals with it.)
+        if !(now.edge > fitted.edge || now.lever > fitted.lever) {
             return None;
         }
         let span = ClothSpan {
@@ -113,8 +114,8 @@ mod tests {
     /// under three quarters of the thickness), so only the creases round its ends are kept
     /// off.
     /// Grown to twice its size it can, and the frame's end fits the rail to it again: its
-    /// 40 ridges kept off too. Grown by a tenth (within the quarter it was fitted with) or
-    /// not at all, nothing is fitted again.
+    /// 40 ridges kept off too. Grown by a tenth (within the quarter it was fitted with), not
+    /// at all, or gone non-finite, nothing is fitted again.
     #[test]
     fn a_cloth_grown_past_its_fit_has_the_obstacles_fitted_again() {
         let mesh = GridSpec::square(10, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
@@ -127,6 +128,7 @@ mod tests {
         let grown = |by: f32| mesh.positions.iter().map(|&p| p * by).collect::<Vec<_>>();
         assert!(reach.outgrown(&fitted, &model, &mesh.positions).is_none());
         assert!(reach.outgrown(&fitted, &model, &grown(1.1)).is_none());
+        assert!(reach.outgrown(&fitted, &model, &grown(f32::NAN)).is_none());
         let refitted = reach.outgrown(&fitted, &model, &grown(2.0)).unwrap();
         assert_eq!(kept_off(&refitted), 120);
         // Fitted to the grown cloth, the same growth asks for nothing more.

@@ -6,8 +6,9 @@
 //! faces in one plane); so an edge of the surface that the cloth can reach is kept off as
 //! the creases are, and a vertex as the tips are.
 //!
-//! The bound. Take a point `x` of the surface's edge or vertex and the plane through it of
-//! one of its faces. Where the surface within distance `d` of `x` falls below that plane by
+//! The bound. Take a point `x` of the surface's edge or vertex and the plane through it
+//! that bisects two of its faces (the edge's two; the vertex's two that turn most from each
+//! other). Where the surface within distance `d` of `x` falls below that plane by
 //! at most `f(d)`, a particle at distance `dᵢ` and at least the thickness `h` off the
 //! surface lies at least `h − f(dᵢ)` above the plane. A cloth edge through `x` has `x` at
 //! weights `wᵢ` of its two particles, and a cloth triangle over a vertex at its barycentric
@@ -80,7 +81,7 @@ struct Walked {
 /// No neighbour across an edge.
 const NONE: u32 = u32::MAX;
 
-/// Faces a piece of the work takes at once (each piece walks with scratch of its own).
+/// Faces (or vertices) a piece of the work takes at once.
 const PIECE: usize = 2048;
 
 /// The scratch of the bound's walks over a surface's faces: each face's last walk, the
@@ -167,12 +168,15 @@ impl<'a> Faces<'a> {
     ) -> (HashSet<(u32, u32)>, HashSet<u32>) {
         let fans = self.fans();
         let fans: Vec<&[(u32, u32)]> = fans.chunk_by(|a, b| a.0 == b.0).collect();
+        // Each thread's scratch serves the pieces it takes.
         let walked: Vec<Vec<(u32, Result<Around, ()>)>> = (fans.par_chunks(PIECE))
-            .map(|piece| {
-                let mut walk = Walk::over(self);
-                let around = |fan| span.around(self, &mut walk, vertices, fan);
-                piece.iter().filter_map(around).collect()
-            })
+            .map_init(
+                || Walk::over(self),
+                |walk, piece| {
+                    let around = |fan| span.around(self, walk, vertices, fan);
+                    piece.iter().filter_map(around).collect()
+                },
+            )
             .collect();
         let mut around = vec![None; vertices.len()];
         let mut reached_vertices = HashSet::new();
@@ -192,26 +196,28 @@ impl<'a> Faces<'a> {
         let count = self.triangles.len();
         let pieces: Vec<Vec<(u32, u32)>> = (0..count.div_ceil(PIECE))
             .into_par_iter()
-            .map(|piece| {
-                let mut walk = Walk::over(self);
-                let mut reached = Vec::new();
-                for s in piece * PIECE..count.min((piece + 1) * PIECE) {
-                    for (k, &t) in self.walked[s].across.iter().enumerate() {
-                        if t == NONE || (t as usize) < s {
-                            continue;
-                        }
-                        let tri = self.triangles[s];
-                        let ends = [tri[k], tri[(k + 1) % 3]].map(|i| self.same[i as usize]);
-                        let faces = [s as u32, t];
-                        let walks = ends.map(|v| around[v as usize].as_ref());
-                        if span.reaches_edge((self, &mut walk), vertices, ends, faces, walks) {
-                            let [a, b] = ends;
-                            reached.push((a.min(b), a.max(b)));
+            .map_init(
+                || Walk::over(self),
+                |walk, piece| {
+                    let mut reached = Vec::new();
+                    for s in piece * PIECE..count.min((piece + 1) * PIECE) {
+                        for (k, &t) in self.walked[s].across.iter().enumerate() {
+                            if t == NONE || (t as usize) < s {
+                                continue;
+                            }
+                            let tri = self.triangles[s];
+                            let ends = [tri[k], tri[(k + 1) % 3]].map(|i| self.same[i as usize]);
+                            let faces = [s as u32, t];
+                            let walks = ends.map(|v| around[v as usize].as_ref());
+                            if span.reaches_edge((self, walk), vertices, ends, faces, walks) {
+                                let [a, b] = ends;
+                                reached.push((a.min(b), a.max(b)));
+                            }
                         }
                     }
-                }
-                reached
-            })
+                    reached
+                },
+            )
             .collect();
         (pieces.into_iter().flatten().collect(), reached_vertices)
     }
@@ -313,6 +319,10 @@ impl ClothSpan {
             let [a, b, c] = t.map(|i| rest[i as usize]);
             let lengths = [a.distance(b), b.distance(c), c.distance(a)];
             let longest = lengths[0].max(lengths[1]).max(lengths[2]);
+            if !lengths.iter().all(|l| l.is_finite()) {
+                // A triangle gone non-finite spans nothing measurable.
+                continue;
+            }
             let twice_area = (b - a).cross(c - a).length();
             let circumradius = if twice_area > 0.0 {
                 lengths[0] * lengths[1] * lengths[2] / (2.0 * twice_area)
