@@ -320,12 +320,13 @@ fn tips_never_pierce_a_coarse_cloth_on_the_gpu() {
     }
 }
 
-/// A rail of narrow faces and a roof with a low apex (`gentle_obstacles`), whose faces all
-/// meet at less than a crease, under a coarse cloth: on the GPU, as on the CPU, each is
-/// fitted to the cloth (its gentle edges and vertices within the cloth's reach kept off as
-/// creases and tips are), so no triangle of the cloth meets either after any frame of the
-/// first second under semi-implicit Euler, and the cloth rests on top. (Not fitted, the
-/// rail came through at frame 12, the roof's apex at frame 17.)
+/// A rail of narrow faces, a roof with a low apex and the roof rising from flat
+/// (`gentle_obstacles`), whose faces all meet at less than a crease, under a coarse cloth:
+/// on the GPU, as on the CPU, each is fitted to the cloth (its gentle edges and vertices
+/// within the cloth's reach, in any frame, kept off as creases and tips are), so no
+/// triangle of the cloth meets any after any frame of the first second under
+/// semi-implicit Euler, and the cloth rests on top. (Not fitted, the rail came through at
+/// frame 12, the roof's apex at frame 17.)
 #[test]
 fn gentle_curves_never_come_through_a_coarse_cloth_on_the_gpu() {
     let dir = tempfile::tempdir().expect("a temporary folder");

@@ -139,8 +139,10 @@ pub fn tipped_obstacles(dir: &Path) -> [Tipped; 3] {
 ///   (a 24 cm diagonal) sinks some 2.5 cm below its particles' offset;
 /// - `roof`: a 1.6 m square block 30 cm high whose top rises 4.7° to an apex 6.6 cm
 ///   higher in the middle, under a cloth of 4 quads whose centre is placed so that the
-///   apex lies inside a triangle (its circumradius 18 cm), which it rises 1.5 cm into.
-pub fn gentle_obstacles(dir: &Path) -> [(Tipped, u32, [f32; 2]); 2] {
+///   apex lies inside a triangle (its circumradius 18 cm), which it rises 1.5 cm into;
+/// - `rising roof`: the same as an OBJ sequence whose frame 0 is flat, the apex rising to
+///   its height over the first second (under the cloth, which lands at 0.3 s).
+pub fn gentle_obstacles(dir: &Path) -> [(Tipped, u32, [f32; 2]); 3] {
     write_prism(&dir.join("rail.obj"), 72, 0.3, 0.3);
     let (half, base) = (0.8f32, 0.3f32);
     let apex = base + half * 4.7f32.to_radians().tan();
@@ -169,15 +171,29 @@ pub fn gentle_obstacles(dir: &Path) -> [(Tipped, u32, [f32; 2]); 2] {
         [7, 8, 4],
     ];
     write_obj(&dir.join("roof.obj"), &roof, &faces);
-    let obstacle = |name, file: &str, tip| Tipped {
+    // The same roof flat at first, its apex rising over a second: frame 0 has no gentle
+    // part at all.
+    write_obj(&dir.join("roof_1.obj"), &roof, &faces);
+    roof[8].y = base;
+    write_obj(&dir.join("roof_0.obj"), &roof, &faces);
+    let obstacle = |name, source: &str, tip| Tipped {
         name,
-        effect: format!("[[effects]]\ntype = \"obstacle\"\nobj = \"{file}\"\n"),
+        effect: format!("[[effects]]\ntype = \"obstacle\"\n{source}\n"),
         tip,
         rise: 0.0,
     };
     [
-        (obstacle("rail", "rail.obj", 0.6), 6, [0.03, 0.02]),
-        (obstacle("roof", "roof.obj", apex), 4, [0.083, 0.167]),
+        (obstacle("rail", "obj = \"rail.obj\"", 0.6), 6, [0.03, 0.02]),
+        (
+            obstacle("roof", "obj = \"roof.obj\"", apex),
+            4,
+            [0.083, 0.167],
+        ),
+        (
+            obstacle("rising roof", "frames = \"roof_%d.obj\"\nfps = 1.0", apex),
+            4,
+            [0.083, 0.167],
+        ),
     ]
 }
 

@@ -28,7 +28,6 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::edges::CREASE_COS;
-use super::geometry::welded;
 
 /// A part of the surface counts as reachable where the bound leaves less than this share
 /// of the thickness: room for the rounding, the rings' coarseness, and the particles'
@@ -103,10 +102,16 @@ impl Walk {
 }
 
 impl<'a> Faces<'a> {
-    /// The faces `triangles` over `vertices` (vertices at one place are one), each with
-    /// its unit normal in `normals` (zero for a degenerate one, which has no neighbours).
-    pub(super) fn new(vertices: &[Vec3], triangles: &'a [[u32; 3]], normals: &'a [Vec3]) -> Self {
-        let same = welded(vertices);
+    /// The faces `triangles` over `vertices`, each with its unit normal in `normals` (zero
+    /// for a degenerate one, which has no neighbours); `same` gives each vertex the first at
+    /// its place (`welded`), which is one vertex with it.
+    pub(super) fn new(
+        vertices: &[Vec3],
+        triangles: &'a [[u32; 3]],
+        normals: &'a [Vec3],
+        same: &[u32],
+    ) -> Self {
+        let same = same.to_vec();
         let mut sides: HashMap<(u32, u32), Vec<(u32, u8)>> = HashMap::new();
         for (t, tri) in triangles.iter().enumerate() {
             if normals[t] == Vec3::ZERO {

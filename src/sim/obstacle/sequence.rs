@@ -116,6 +116,11 @@ impl Sequence {
         Self::new(surface, self.frames.clone(), self.fps, self.looped)
     }
 
+    /// Each frame's vertices, placed.
+    pub fn frames(&self) -> impl Iterator<Item = &[Vec3]> {
+        self.frames.iter().map(Vec::as_slice)
+    }
+
     pub fn len(&self) -> usize {
         self.frames.len()
     }

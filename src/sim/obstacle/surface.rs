@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::coarse::{ClothSpan, FLAT_COS, Faces};
 use super::edges::SharpEdges;
-use super::geometry::{closest_on_triangle, less_by_move, rounding_near, segment_crosses};
+use super::geometry::{closest_on_triangle, less_by_move, rounding_near, segment_crosses, welded};
 use super::tips::Tips;
 use super::tree::{Near, Nearest, TriangleTree};
 
@@ -113,15 +113,23 @@ pub struct Caught {
     pub on_surface: Vec3,
 }
 
+/// Each of `triangles`' unit normal over `vertices` (zero for a degenerate one).
+fn face_normals(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    (triangles.iter())
+        .map(|t| {
+            let [a, b, c] = t.map(|i| vertices[i as usize]);
+            (b - a).cross(c - a).normalize_or_zero()
+        })
+        .collect()
+}
+
 impl Surface {
     /// The surface of `triangles` over `vertices` (every index must be in range).
     pub fn new(vertices: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Self {
         let corners: Vec<[Vec3; 3]> = (triangles.iter())
             .map(|t| t.map(|i| vertices[i as usize]))
             .collect();
-        let normals: Vec<Vec3> = (corners.iter())
-            .map(|[a, b, c]| (*b - *a).cross(*c - *a).normalize_or_zero())
-            .collect();
+        let normals = face_normals(&vertices, &triangles);
         let tree = TriangleTree::new(&corners);
         let gentle = std::cell::Cell::new(false);
         let edges = SharpEdges::of_or(&vertices, &triangles, &normals, |_, [n, m]| {
@@ -149,9 +157,29 @@ impl Surface {
     /// kept off as its creases and tips are ([`ClothSpan`]: a coarse cloth over a rail of
     /// narrow faces); `None` where that adds none.
     pub fn reaching(&self, span: &ClothSpan) -> Option<Surface> {
+        self.reaching_over(span, std::iter::empty())
+    }
+
+    /// As [`Surface::reaching`], where the surface also takes the places `frames` (the
+    /// frames of a sequence, each as many vertices as the surface): what a cloth can reach
+    /// in any of them is kept off in all.
+    pub fn reaching_over<'f>(
+        &self,
+        span: &ClothSpan,
+        frames: impl IntoIterator<Item = &'f [Vec3]>,
+    ) -> Option<Surface> {
         let (vertices, triangles, normals) = (&self.vertices, &self.triangles, &self.normals);
-        let faces = Faces::new(vertices, triangles, normals);
-        let (reached_edges, reached_vertices) = faces.reached(span, vertices);
+        // Vertices at one place are one, by where the surface has them.
+        let same = welded(vertices);
+        let (mut reached_edges, mut reached_vertices) =
+            Faces::new(vertices, triangles, normals, &same).reached(span, vertices);
+        for frame in frames {
+            let normals = face_normals(frame, triangles);
+            let faces = Faces::new(frame, triangles, &normals, &same);
+            let (edges, vertices) = faces.reached(span, frame);
+            reached_edges.extend(edges);
+            reached_vertices.extend(vertices);
+        }
         let edges = SharpEdges::of_or(vertices, triangles, normals, |[a, b], _| {
             reached_edges.contains(&(a.min(b), a.max(b)))
         });

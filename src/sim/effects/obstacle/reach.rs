@@ -35,10 +35,11 @@ impl Obstacle {
 }
 
 impl Placed {
-    /// This placement with its surface fitted to a cloth of `span`, or `None` where that
-    /// adds nothing.
+    /// This placement with its surface fitted to a cloth of `span` (a sequence's to what
+    /// the cloth can reach in any of its frames), or `None` where that adds nothing.
     fn reaching(&self, span: &ClothSpan) -> Option<Placed> {
-        let surface = self.surface.reaching(span)?;
+        let frames = self.sequence.iter().flat_map(|s| s.frames());
+        let surface = self.surface.reaching_over(span, frames)?;
         let sequence = (self.sequence.as_ref()).map(|s| s.over(surface.clone()));
         Some(Placed {
             surface,

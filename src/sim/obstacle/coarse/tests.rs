@@ -1,5 +1,6 @@
 use super::*;
 use crate::sim::obstacle::Surface;
+use crate::sim::obstacle::geometry::welded;
 
 /// A grid cloth's span: its diagonals are its longest edges, and a right triangle's
 /// circumradius is half its hypotenuse.
@@ -60,7 +61,12 @@ fn polygon_falls(sides: u32, radius: f32, d: f32) -> f32 {
 fn the_bound_on_a_rails_dip_holds_and_is_within_twice_it() {
     let (sides, radius) = (40, 0.3);
     let rail = rail(sides, radius);
-    let faces = Faces::new(rail.vertices(), rail.triangles(), rail.normals());
+    let faces = Faces::new(
+        rail.vertices(),
+        rail.triangles(),
+        rail.normals(),
+        &welded(rail.vertices()),
+    );
     // The ridge between facets 4 and 5: the edge from vertex 10 to 11, between the first
     // triangle of facet 4 and the second of facet 5.
     for length in [0.05, 0.12, 0.24] {
@@ -134,7 +140,12 @@ fn a_low_apex_is_a_tip_to_a_coarse_cloth_only() {
     };
     assert!(roof.reaching(&span(0.1, 0.05)).is_none_or(|r| !apex(&r)));
     assert!(roof.reaching(&span(0.36, 0.18)).is_some_and(|r| apex(&r)));
-    let faces = Faces::new(roof.vertices(), roof.triangles(), roof.normals());
+    let faces = Faces::new(
+        roof.vertices(),
+        roof.triangles(),
+        roof.normals(),
+        &welded(roof.vertices()),
+    );
     let (edges, vertices) = faces.reached(&span(0.1, 0.18), roof.vertices());
     assert!(edges.is_empty());
     assert!(vertices.contains(&4));
@@ -154,7 +165,12 @@ fn an_edges_bound_from_its_ends_walks_holds_its_own() {
     let ball = Surface::new(soup.positions, triangles);
     let (vertices, faces) = (
         ball.vertices(),
-        Faces::new(ball.vertices(), ball.triangles(), ball.normals()),
+        Faces::new(
+            ball.vertices(),
+            ball.triangles(),
+            ball.normals(),
+            &welded(ball.vertices()),
+        ),
     );
     let fans = faces.fans();
     for edge in [0.02, 0.05, 0.12] {
