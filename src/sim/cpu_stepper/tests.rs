@@ -1,9 +1,9 @@
 use glam::Vec3;
 
 use super::*;
-use crate::mesh::{GridOrientation, GridSpec, PolygonSoup};
-use crate::sim::obstacle::prism;
-use crate::sim::{Obstacle, SimParams};
+use crate::mesh::{GridOrientation, GridSpec};
+use crate::sim::SimParams;
+use crate::sim::effects::rail;
 
 /// How many sharp edges the stepper's first mesh obstacle keeps the cloth off.
 fn kept_off(stepper: &CpuStepper) -> usize {
@@ -26,18 +26,9 @@ fn a_frame_that_ends_with_the_cloth_grown_fits_the_obstacles_again() {
         .build()
         .unwrap();
     let model = ClothModel::new(&mesh, 0.2, &[]);
-    let (positions, triangles) = prism(40, 0.3);
-    let soup = PolygonSoup {
-        positions,
-        uvs: None,
-        face_indices: triangles.iter().flatten().copied().collect(),
-        face_arities: vec![3; triangles.len()],
-    };
-    let mut rail = Obstacle::new("rail.obj");
-    rail.load_mesh(&soup).unwrap();
     let mut params = SimParams::default();
     params.contact.offset = 0.04;
-    let mut stepper = CpuStepper::new(&model, &params, &[Effect::Obstacle(rail)]);
+    let mut stepper = CpuStepper::new(&model, &params, &[rail()]);
     assert_eq!(kept_off(&stepper), 80);
     let mut state = ClothState::at_rest(&model);
     for p in &mut state.pos {

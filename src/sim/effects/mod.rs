@@ -33,6 +33,8 @@ pub use list::{
 };
 pub use obstacle::{DEFAULT_FPS, Obstacle, ObstacleError, Placed, Shape, frame_path};
 pub use plane::Plane;
+#[cfg(test)]
+pub(crate) use reach::rail;
 pub use reach::{GROWTH, Reach, fitted_to_cloth};
 pub use registry::{Addable, Effect};
 pub use self_collision::{SelfCollision, TooThick, shortest_edge};

@@ -80,27 +80,26 @@ impl Reach {
     }
 }
 
+/// A closed prism of 40 narrow faces (each turning 9° from the next), 30 cm in radius, along
+/// the x axis (`obstacle::prism`), as a mesh obstacle: a rail, for tests.
+#[cfg(test)]
+pub(crate) fn rail() -> Effect {
+    let (positions, triangles) = crate::sim::obstacle::prism(40, 0.3);
+    let soup = crate::mesh::PolygonSoup {
+        positions,
+        uvs: None,
+        face_indices: triangles.iter().flatten().copied().collect(),
+        face_arities: vec![3; triangles.len()],
+    };
+    let mut rail = super::Obstacle::new("rail.obj");
+    rail.load_mesh(&soup).unwrap();
+    Effect::Obstacle(rail)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::{GridOrientation, GridSpec, PolygonSoup};
-    use crate::sim::Obstacle;
-    use crate::sim::obstacle::prism;
-
-    /// A closed prism of 40 narrow faces (each turning 9° from the next), 30 cm in
-    /// radius, along the x axis: a rail.
-    fn rail() -> Effect {
-        let (positions, triangles) = prism(40, 0.3);
-        let soup = PolygonSoup {
-            positions,
-            uvs: None,
-            face_indices: triangles.iter().flatten().copied().collect(),
-            face_arities: vec![3; triangles.len()],
-        };
-        let mut rail = Obstacle::new("rail.obj");
-        rail.load_mesh(&soup).unwrap();
-        Effect::Obstacle(rail)
-    }
+    use crate::mesh::{GridOrientation, GridSpec};
 
     fn kept_off(effects: &[Effect]) -> usize {
         match &effects[0] {
