@@ -316,10 +316,6 @@ impl<R: Real> CpuStepper<R> {
         Ok(())
     }
 
-    /// The likely cause of a frame that failed from positions `pos` at up to `tried`
-    /// substeps per frame, and with `fallback` where the guard tried it: a self-collision
-    /// thickness the cloth cannot take, an explicit integrator past its stable step, or
-    /// else the stiffness.
     /// Takes `effects` (each mesh obstacle fitted to the cloth) as the scene's, their
     /// contacts as the ones that act after each substep.
     fn take_effects(&mut self, effects: Vec<Effect>) {
@@ -330,6 +326,10 @@ impl<R: Real> CpuStepper<R> {
         self.effects = effects;
     }
 
+    /// The likely cause of a frame that failed from positions `pos` at up to `tried`
+    /// substeps per frame, and with `fallback` where the guard tried it: a self-collision
+    /// thickness the cloth cannot take, an explicit integrator past its stable step, or
+    /// else the stiffness.
     fn diagnose(
         &self,
         model: &ClothModel,
