@@ -64,7 +64,7 @@ pub(super) struct Faces<'a> {
     /// What a walk reads of each face, side by side.
     walked: Vec<Walked>,
     /// Each vertex's first at its place.
-    same: Vec<u32>,
+    same: &'a [u32],
 }
 
 /// A face as the walks read it: its box, its unit normal, and its neighbours across its
@@ -109,9 +109,8 @@ impl<'a> Faces<'a> {
         vertices: &[Vec3],
         triangles: &'a [[u32; 3]],
         normals: &'a [Vec3],
-        same: &[u32],
+        same: &'a [u32],
     ) -> Self {
-        let same = same.to_vec();
         let mut sides: HashMap<(u32, u32), Vec<(u32, u8)>> = HashMap::new();
         for (t, tri) in triangles.iter().enumerate() {
             if normals[t] == Vec3::ZERO {

@@ -173,7 +173,8 @@ impl Surface {
         let same = welded(vertices);
         let (mut reached_edges, mut reached_vertices) =
             Faces::new(vertices, triangles, normals, &same).reached(span, vertices);
-        for frame in frames {
+        // A frame where the surface already is (a sequence's frame 0) tells nothing more.
+        for frame in frames.into_iter().filter(|&f| f != vertices.as_slice()) {
             let normals = face_normals(frame, triangles);
             let faces = Faces::new(frame, triangles, &normals, &same);
             let (edges, vertices) = faces.reached(span, frame);

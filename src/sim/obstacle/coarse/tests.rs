@@ -12,6 +12,16 @@ fn a_grids_span_is_its_diagonal_and_half_of_it() {
     assert!((span.lever - 2f32.sqrt()).abs() < 1e-6, "{span:?}");
 }
 
+/// The faces of `surface` as the bound reads them, its vertices welded as `same`.
+fn faces_of<'a>(surface: &'a Surface, same: &'a [u32]) -> Faces<'a> {
+    Faces::new(
+        surface.vertices(),
+        surface.triangles(),
+        surface.normals(),
+        same,
+    )
+}
+
 /// A rail: [`prism`] as a surface.
 fn rail(sides: u32, radius: f32) -> Surface {
     let (vertices, triangles) = prism(sides, radius);
@@ -61,12 +71,8 @@ fn polygon_falls(sides: u32, radius: f32, d: f32) -> f32 {
 fn the_bound_on_a_rails_dip_holds_and_is_within_twice_it() {
     let (sides, radius) = (40, 0.3);
     let rail = rail(sides, radius);
-    let faces = Faces::new(
-        rail.vertices(),
-        rail.triangles(),
-        rail.normals(),
-        &welded(rail.vertices()),
-    );
+    let same = welded(rail.vertices());
+    let faces = faces_of(&rail, &same);
     // The ridge between facets 4 and 5: the edge from vertex 10 to 11, between the first
     // triangle of facet 4 and the second of facet 5.
     for length in [0.05, 0.12, 0.24] {
@@ -140,12 +146,8 @@ fn a_low_apex_is_a_tip_to_a_coarse_cloth_only() {
     };
     assert!(roof.reaching(&span(0.1, 0.05)).is_none_or(|r| !apex(&r)));
     assert!(roof.reaching(&span(0.36, 0.18)).is_some_and(|r| apex(&r)));
-    let faces = Faces::new(
-        roof.vertices(),
-        roof.triangles(),
-        roof.normals(),
-        &welded(roof.vertices()),
-    );
+    let same = welded(roof.vertices());
+    let faces = faces_of(&roof, &same);
     let (edges, vertices) = faces.reached(&span(0.1, 0.18), roof.vertices());
     assert!(edges.is_empty());
     assert!(vertices.contains(&4));
@@ -163,15 +165,8 @@ fn an_edges_bound_from_its_ends_walks_holds_its_own() {
         .map(|f| [f[0], f[1], f[2]])
         .collect();
     let ball = Surface::new(soup.positions, triangles);
-    let (vertices, faces) = (
-        ball.vertices(),
-        Faces::new(
-            ball.vertices(),
-            ball.triangles(),
-            ball.normals(),
-            &welded(ball.vertices()),
-        ),
-    );
+    let same = welded(ball.vertices());
+    let (vertices, faces) = (ball.vertices(), faces_of(&ball, &same));
     let fans = faces.fans();
     for edge in [0.02, 0.05, 0.12] {
         let span = span(edge, 0.01);
