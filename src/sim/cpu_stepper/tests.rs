@@ -2,8 +2,8 @@ use glam::Vec3;
 
 use super::*;
 use crate::mesh::{GridOrientation, GridSpec};
-use crate::sim::SimParams;
 use crate::sim::effects::rail;
+use crate::sim::{Obstacle, SimParams};
 
 /// How many sharp edges the stepper's first mesh obstacle keeps the cloth off.
 fn kept_off(stepper: &CpuStepper) -> usize {
@@ -36,4 +36,49 @@ fn a_frame_that_ends_with_the_cloth_grown_fits_the_obstacles_again() {
     }
     stepper.frame(&model, &mut state).unwrap();
     assert_eq!(kept_off(&stepper), 120);
+}
+
+/// A block whose top is flat in frame 0 and rises 4.7° to an apex in frame 1 (an OBJ
+/// sequence, one frame a second), 2 m under a cloth of 10 cm quads (2 cm thickness): at
+/// rest the cloth reaches no part of the roof in any frame, so the stepper keeps it off
+/// the block's 12 creases. Started at twice its rest size, the first frame ends with it
+/// grown, and the stepper fits the sequence again, though its frame 0 has no gentle part:
+/// the roof's four ridges, which the grown cloth reaches in frame 1, are kept off too.
+/// (With a sequence counted gentle by its frame 0 alone, 12 still.)
+#[test]
+fn a_sequence_flat_at_first_is_fitted_again_as_the_cloth_grows() {
+    let dir = tempfile::tempdir().unwrap();
+    let (half, base) = (0.8f32, 0.3f32);
+    for (k, rise) in [0.0, half * 4.7f32.to_radians().tan()]
+        .into_iter()
+        .enumerate()
+    {
+        let mut text = String::new();
+        for y in [0.0, base] {
+            for [x, z] in [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]] {
+                text += &format!("v {} {y} {}\n", half * x, half * z);
+            }
+        }
+        text += &format!("v 0 {} 0\n", base + rise);
+        text += "f 1 2 3\nf 1 3 4\nf 5 6 2\nf 5 2 1\nf 6 7 3\nf 6 3 2\nf 7 8 4\nf 7 4 3\n\
+                 f 8 5 1\nf 8 1 4\nf 5 9 6\nf 6 9 7\nf 7 9 8\nf 8 9 5\n";
+        std::fs::write(dir.path().join(format!("roof_{k}.obj")), text).unwrap();
+    }
+    let mut roof = Obstacle::sequence("roof_%d.obj", 1.0, false);
+    roof.load(Some(dir.path())).unwrap();
+    let at = Vec3::new(0.0, 2.0, 0.0);
+    let mesh = GridSpec::square(10, 1.0, GridOrientation::Horizontal, at)
+        .build()
+        .unwrap();
+    let model = ClothModel::new(&mesh, 0.2, &[]);
+    let mut params = SimParams::default();
+    params.contact.offset = 0.02;
+    let mut stepper = CpuStepper::new(&model, &params, &[Effect::Obstacle(roof)]);
+    assert_eq!(kept_off(&stepper), 12);
+    let mut state = ClothState::at_rest(&model);
+    for p in &mut state.pos {
+        *p = at + (*p - at) * 2.0;
+    }
+    stepper.frame(&model, &mut state).unwrap();
+    assert_eq!(kept_off(&stepper), 16);
 }

@@ -73,7 +73,7 @@ impl Reach {
     fn fit_to(&mut self, effects: &[Effect], span: ClothSpan) -> Vec<Effect> {
         self.span = Some(span);
         self.gentle = effects.iter().any(|e| match e {
-            Effect::Obstacle(o) => o.placed().is_some_and(|p| p.surface.is_gentle()),
+            Effect::Obstacle(o) => o.placed().is_some_and(|p| p.is_gentle()),
             _ => false,
         });
         fitted_to_cloth(effects, span)

@@ -35,6 +35,13 @@ impl Obstacle {
 }
 
 impl Placed {
+    /// Whether a cloth may ever reach more of it than its creases and tips: two of its
+    /// faces meet at an edge neither flat nor a crease, or it is a sequence (whose later
+    /// frames may bend where frame 0 is flat).
+    pub fn is_gentle(&self) -> bool {
+        self.sequence.is_some() || self.surface.is_gentle()
+    }
+
     /// This placement with its surface fitted to a cloth of `span` (a sequence's to what
     /// the cloth can reach in any of its frames), or `None` where that adds nothing.
     fn reaching(&self, span: &ClothSpan) -> Option<Placed> {
