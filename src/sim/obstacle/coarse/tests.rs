@@ -28,6 +28,15 @@ fn rail(sides: u32, radius: f32) -> Surface {
     Surface::new(vertices, triangles)
 }
 
+/// A cloth span with its own lever, 1 cm thick.
+fn span_with(edge: f32, lever: f32) -> ClothSpan {
+    ClothSpan {
+        edge,
+        lever,
+        thickness: 0.01,
+    }
+}
+
 fn span(edge: f32, thickness: f32) -> ClothSpan {
     ClothSpan {
         edge,
@@ -141,16 +150,17 @@ fn a_low_apex_is_a_tip_to_a_coarse_cloth_only() {
         found
     };
     assert!(!apex(&roof));
-    let span = |edge, lever| ClothSpan {
-        edge,
-        lever,
-        thickness: 0.01,
-    };
-    assert!(roof.reaching(&span(0.1, 0.05)).is_none_or(|r| !apex(&r)));
-    assert!(roof.reaching(&span(0.36, 0.18)).is_some_and(|r| apex(&r)));
+    assert!(
+        roof.reaching(&span_with(0.1, 0.05))
+            .is_none_or(|r| !apex(&r))
+    );
+    assert!(
+        roof.reaching(&span_with(0.36, 0.18))
+            .is_some_and(|r| apex(&r))
+    );
     let same = welded(roof.vertices());
     let faces = faces_of(&roof, &same);
-    let (edges, vertices) = faces.reached(&span(0.1, 0.18), roof.vertices());
+    let (edges, vertices) = faces.reached(&span_with(0.1, 0.18), roof.vertices());
     assert!(edges.is_empty());
     assert!(vertices.contains(&4));
 }
@@ -219,4 +229,30 @@ fn an_edges_bound_from_its_ends_walks_holds_its_own() {
             "{edge} m: on average {mean}× the own walk's bound"
         );
     }
+}
+
+/// A face collapsed to a point at the low roof's apex and another to a segment from it
+/// change nothing a cloth reaches: they have no plane, so no neighbours, no slope and no
+/// turn at the apex (which a long lever still reaches, and nothing else).
+#[test]
+fn degenerate_faces_change_nothing_a_cloth_reaches() {
+    let rise = 0.8 * 4.7f32.to_radians().tan();
+    let mut vertices: Vec<Vec3> = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]
+        .map(|[x, z]| Vec3::new(0.8 * x, 0.0, 0.8 * z))
+        .to_vec();
+    vertices.push(Vec3::new(0.0, rise, 0.0));
+    let triangles = vec![
+        [0, 4, 1],
+        [1, 4, 2],
+        [2, 4, 3],
+        [3, 4, 0],
+        [4, 4, 4],
+        [4, 0, 4],
+    ];
+    let roof = Surface::new(vertices, triangles);
+    let same = welded(roof.vertices());
+    let faces = faces_of(&roof, &same);
+    let (edges, vertices) = faces.reached(&span_with(0.1, 0.18), roof.vertices());
+    assert!(edges.is_empty(), "{edges:?}");
+    assert!(vertices.contains(&4), "{vertices:?}");
 }
