@@ -14,6 +14,27 @@ fn kept_off(stepper: &CpuStepper) -> usize {
     obstacle.map_or(0, |p| p.surface.sharp_edges().len())
 }
 
+/// How many sharp edges a stepper keeps a cloth of 10 cm quads off `obstacle` (the cloth
+/// 2 m up, `thickness` off solids): at rest, and after a frame started at twice the
+/// cloth's rest size (forces none, so it stays so grown).
+fn kept_off_at_rest_and_grown(obstacle: Effect, thickness: f32) -> (usize, usize) {
+    let at = Vec3::new(0.0, 2.0, 0.0);
+    let mesh = GridSpec::square(10, 1.0, GridOrientation::Horizontal, at)
+        .build()
+        .unwrap();
+    let model = ClothModel::new(&mesh, 0.2, &[]);
+    let mut params = SimParams::default();
+    params.contact.offset = thickness;
+    let mut stepper = CpuStepper::new(&model, &params, &[obstacle]);
+    let at_rest = kept_off(&stepper);
+    let mut state = ClothState::at_rest(&model);
+    for p in &mut state.pos {
+        *p = at + (*p - at) * 2.0;
+    }
+    stepper.frame(&model, &mut state).unwrap();
+    (at_rest, kept_off(&stepper))
+}
+
 /// A cloth of 10 cm quads (4 cm thickness) 2 m above a rail of 40 narrow faces: at rest it
 /// cannot reach the rail's ridges, so the stepper keeps it off the 80 creases round the
 /// rail's ends alone. Started at twice its rest size, the first frame ends with it grown
@@ -21,21 +42,7 @@ fn kept_off(stepper: &CpuStepper) -> usize {
 /// are kept off too. (With the frame's end not asking, 80 still.)
 #[test]
 fn a_frame_that_ends_with_the_cloth_grown_fits_the_obstacles_again() {
-    let at = Vec3::new(0.0, 2.0, 0.0);
-    let mesh = GridSpec::square(10, 1.0, GridOrientation::Horizontal, at)
-        .build()
-        .unwrap();
-    let model = ClothModel::new(&mesh, 0.2, &[]);
-    let mut params = SimParams::default();
-    params.contact.offset = 0.04;
-    let mut stepper = CpuStepper::new(&model, &params, &[rail()]);
-    assert_eq!(kept_off(&stepper), 80);
-    let mut state = ClothState::at_rest(&model);
-    for p in &mut state.pos {
-        *p = at + (*p - at) * 2.0;
-    }
-    stepper.frame(&model, &mut state).unwrap();
-    assert_eq!(kept_off(&stepper), 120);
+    assert_eq!(kept_off_at_rest_and_grown(rail(), 0.04), (80, 120));
 }
 
 /// A block whose top is flat in frame 0 and rises 4.7° to an apex in frame 1 (an OBJ
@@ -66,19 +73,6 @@ fn a_sequence_flat_at_first_is_fitted_again_as_the_cloth_grows() {
     }
     let mut roof = Obstacle::sequence("roof_%d.obj", 1.0, false);
     roof.load(Some(dir.path())).unwrap();
-    let at = Vec3::new(0.0, 2.0, 0.0);
-    let mesh = GridSpec::square(10, 1.0, GridOrientation::Horizontal, at)
-        .build()
-        .unwrap();
-    let model = ClothModel::new(&mesh, 0.2, &[]);
-    let mut params = SimParams::default();
-    params.contact.offset = 0.02;
-    let mut stepper = CpuStepper::new(&model, &params, &[Effect::Obstacle(roof)]);
-    assert_eq!(kept_off(&stepper), 12);
-    let mut state = ClothState::at_rest(&model);
-    for p in &mut state.pos {
-        *p = at + (*p - at) * 2.0;
-    }
-    stepper.frame(&model, &mut state).unwrap();
-    assert_eq!(kept_off(&stepper), 16);
+    let roof = Effect::Obstacle(roof);
+    assert_eq!(kept_off_at_rest_and_grown(roof, 0.02), (12, 16));
 }
