@@ -2,8 +2,10 @@
 //! (`obstacles.rs`), then the cloth against itself (`self_contact.rs`), whose cuts come
 //! last so that nothing after them can undo its guarantee.
 
+use glam::Vec3;
+
 use crate::cloth::ClothModel;
-use crate::sim::{Effect, Reach, SimParams};
+use crate::sim::{ContactConfig, Effect, Reach, SimParams};
 
 use super::error::GpuError;
 use super::kernel::SubstepKernel;
@@ -17,12 +19,16 @@ use super::substep_ends::{Memory, Start};
 pub(super) struct Contacts {
     pub(super) obstacles: Option<ObstaclePass>,
     pub(super) own: Option<SelfPass>,
+    /// What the mesh obstacles were last fitted to, and the contacts' settings they were
+    /// packed with.
+    reach: Reach,
+    contact: ContactConfig,
 }
 
 impl Contacts {
     /// The passes for `model` under `effects` and `params`, over the particles in
     /// `particles`: each mesh obstacle as this cloth meets it at rest, as on the CPU
-    /// ([`Reach::fit`]; the CPU fits them again where the cloth outgrows that).
+    /// ([`Reach::fit`]), until the cloth outgrows that ([`Contacts::refit`]).
     ///
     /// # Errors
     /// As [`ObstaclePass::new`] and [`SelfPass::new`].
@@ -33,7 +39,8 @@ impl Contacts {
         particles: &[wgpu::Buffer; 2],
         (model, effects, params): (&ClothModel, &[Effect], &SimParams),
     ) -> Result<Self, GpuError> {
-        let fitted = Reach::default().fit(effects, model, params.contact.offset);
+        let mut reach = Reach::default();
+        let fitted = reach.fit(effects, model, params.contact.offset);
         let scene = (model, &fitted[..], &params.contact);
         let obstacles = ObstaclePass::new(device, queue, kernel, particles, scene)?;
         let own = effects.iter().find_map(|e| match e {
@@ -44,9 +51,46 @@ impl Contacts {
             Some(own) => SelfPass::new(device, queue, particles, model, own)?,
             None => None,
         };
-        let mut contacts = Self { obstacles, own };
+        let contact = params.contact;
+        let mut contacts = Self {
+            obstacles,
+            own,
+            reach,
+            contact,
+        };
         contacts.tell_pushes(device);
         Ok(contacts)
+    }
+
+    /// Whether a frame's end must show the cloth to [`Contacts::refit`]: some mesh
+    /// obstacle has gentle parts that a grown cloth could reach.
+    pub(super) fn watch_growth(&self) -> bool {
+        self.reach.watches()
+    }
+
+    /// The mesh obstacles of `effects` fitted again where the cloth of `model` at `pos`
+    /// has outgrown their last fit, as on the CPU ([`Reach::outgrown`]): their pass built
+    /// anew over `particles`, binding the solver's words `solve`. Whether it was.
+    ///
+    /// # Errors
+    /// As [`ObstaclePass::new`].
+    pub(super) fn refit(
+        &mut self,
+        (device, queue, kernel): (&wgpu::Device, &wgpu::Queue, &SubstepKernel),
+        particles: &[wgpu::Buffer; 2],
+        (model, effects, pos): (&ClothModel, &[Effect], &[Vec3]),
+        solve: Option<&wgpu::Buffer>,
+    ) -> Result<bool, GpuError> {
+        let Some(fitted) = self.reach.outgrown(effects, model, pos) else {
+            return Ok(false);
+        };
+        let scene = (model, &fitted[..], &self.contact);
+        self.obstacles = ObstaclePass::new(device, queue, kernel, particles, scene)?;
+        if let Some(obstacles) = self.obstacles.as_mut() {
+            obstacles.attach_solve(device, particles, solve);
+        }
+        self.tell_pushes(device);
+        Ok(true)
     }
 
     /// Binds to the obstacles' second run where self-contact says whether its pushes

@@ -61,16 +61,21 @@ impl GpuStepper {
         state: &mut ClothState,
     ) -> Result<FrameOutcome, Diverged> {
         let end = state.time + self.dt as f64;
-        if !self.guard.policy.enabled {
+        let outcome = if self.guard.policy.enabled {
+            let start = Instant::now();
+            let outcome = self.checked_frame(model, state, end);
+            self.timings.add("gpu", start.elapsed());
+            outcome?
+        } else {
             self.timed_run(model, state, self.substeps)
                 .map_err(|e| self.device_failure(state.time, e.to_string()))?;
             state.time = end;
-            return Ok(FrameOutcome::Stepped);
-        }
-        let start = Instant::now();
-        let outcome = self.checked_frame(model, state, end);
-        self.timings.add("gpu", start.elapsed());
-        outcome
+            FrameOutcome::Stepped
+        };
+        // A cloth grown past what the mesh obstacles were fitted to has them fitted again.
+        (self.refit_obstacles(model, state))
+            .map_err(|e| self.device_failure(state.time, e.to_string()))?;
+        Ok(outcome)
     }
 
     fn checked_frame(

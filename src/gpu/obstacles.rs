@@ -104,6 +104,9 @@ pub(super) struct ObstaclePass {
     solve: Option<wgpu::Buffer>,
     particles: [wgpu::Buffer; 2],
     count: u32,
+    /// What the uniform holds (read by tests).
+    #[cfg(test)]
+    params: ObstacleParams,
 }
 
 /// Appends `tree`'s nodes to `out` (two entries each) and returns where they start and
@@ -374,6 +377,8 @@ impl ObstaclePass {
             solve: None,
             particles: particles.clone(),
             count,
+            #[cfg(test)]
+            params,
             again: own,
         }))
     }
@@ -584,6 +589,14 @@ impl ObstaclePass {
             self.buffers[6] = counters.clone();
             self.regroup(device);
         }
+    }
+
+    /// How many sharp edges each obstacle keeps the cloth off, as packed (a deforming one's
+    /// at its start).
+    #[cfg(test)]
+    pub(super) fn sharp_edges(&self) -> Vec<u32> {
+        let obstacles = self.params.obstacles.iter().take(self.moving.len());
+        obstacles.map(|o| o.counts[3]).collect()
     }
 
     /// The copy [`ObstaclePass::keep_start`] makes.

@@ -170,6 +170,31 @@ impl GpuStepper {
         self.elements.tune(effects);
     }
 
+    /// After a frame that stood: the mesh obstacles fitted again where the cloth of
+    /// `model` has outgrown their fit ([`Contacts::refit`](super::contacts::Contacts::refit)),
+    /// the cloth read back into `state` for it where the frame left it behind.
+    ///
+    /// # Errors
+    /// [`GpuError::Readback`] when the cloth cannot be read; as
+    /// [`ObstaclePass::new`](super::obstacles::ObstaclePass::new).
+    pub(super) fn refit_obstacles(
+        &mut self,
+        model: &ClothModel,
+        state: &mut ClothState,
+    ) -> Result<(), GpuError> {
+        if !self.contacts.watch_growth() || self.unsupported.is_some() {
+            return Ok(());
+        }
+        if self.behind {
+            self.read_back(state)?;
+        }
+        let solve = self.contact_memory().1.cloned();
+        let gpu = (&self.device, &self.queue, &self.kernel);
+        let cloth = (model, &self.effects[..], &state.pos[..]);
+        (self.contacts).refit(gpu, &self.particles, cloth, solve.as_ref())?;
+        Ok(())
+    }
+
     /// `built`, or the reason it could not be, kept (every later frame fails with it).
     fn refuse_unless<T>(&mut self, built: Result<T, GpuError>) -> Result<T, StepError> {
         built.map_err(|e| {
@@ -177,5 +202,56 @@ impl GpuStepper {
             self.unsupported = Some(why.clone());
             StepError::Unsupported(why)
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::GpuStepper;
+    use crate::device::{AdapterPreference, HeadlessDevice};
+    use crate::sim::effects::{growing_cloth, rail, rising_roof};
+    use crate::sim::{Effect, StepBackend};
+
+    /// How many sharp edges the device keeps a cloth of 10 cm quads off `obstacle` (the
+    /// cloth 2 m up, `thickness` off solids): at rest, and after a frame that ends with the
+    /// cloth grown to 1.8 times its rest size (`growing_cloth`), the state read back every
+    /// frame or not.
+    fn kept_off_at_rest_and_grown(
+        obstacle: Effect,
+        thickness: f32,
+        read_every_frame: bool,
+    ) -> (u32, u32) {
+        let gpu = HeadlessDevice::open(AdapterPreference::Software).expect("an adapter");
+        let (model, params, mut state) = growing_cloth(thickness);
+        let (device, queue) = (&gpu.device, &gpu.queue);
+        let effects = [obstacle];
+        let mut stepper =
+            GpuStepper::new(device, queue, &model, &params, &effects, read_every_frame)
+                .expect("stepper");
+        let kept_off = |stepper: &GpuStepper| {
+            let obstacles = stepper
+                .contacts
+                .obstacles
+                .as_ref()
+                .expect("a mesh obstacle");
+            obstacles.sharp_edges()[0]
+        };
+        let at_rest = kept_off(&stepper);
+        stepper.frame(&model, &mut state).expect("a frame");
+        (at_rest, kept_off(&stepper))
+    }
+
+    /// The device fits its mesh obstacles again as the CPU does
+    /// (`a_frame_that_ends_with_the_cloth_grown_fits_the_obstacles_again` and
+    /// `a_sequence_flat_at_first_is_fitted_again_as_the_cloth_grows`): the rail's 40
+    /// ridges kept off beside its 80 end creases once the cloth has grown past its fit,
+    /// with the state left on the device (read back for the fit); the rising roof's 4
+    /// ridges beside the block's 12 creases, with the state read back every frame.
+    #[test]
+    fn a_frame_that_ends_with_the_cloth_grown_fits_the_obstacles_again_on_the_device() {
+        assert_eq!(kept_off_at_rest_and_grown(rail(), 0.04, false), (80, 120));
+        let dir = tempfile::tempdir().expect("a temporary folder");
+        let roof = rising_roof(dir.path());
+        assert_eq!(kept_off_at_rest_and_grown(roof, 0.02, true), (12, 16));
     }
 }

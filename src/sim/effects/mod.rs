@@ -33,9 +33,9 @@ pub use list::{
 };
 pub use obstacle::{DEFAULT_FPS, Obstacle, ObstacleError, Placed, Shape, frame_path};
 pub use plane::Plane;
-#[cfg(test)]
-pub(crate) use reach::rail;
 pub use reach::{GROWTH, Reach, fitted_to_cloth};
+#[cfg(test)]
+pub(crate) use reach::{growing_cloth, rail, rising_roof};
 pub use registry::{Addable, Effect};
 pub use self_collision::{SelfCollision, TooThick, shortest_edge};
 pub use sphere::Sphere;

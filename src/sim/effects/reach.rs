@@ -70,6 +70,12 @@ impl Reach {
         Some(self.fit_to(effects, span))
     }
 
+    /// Whether a cloth growing could ever have the obstacles fitted again: they were
+    /// fitted, and some has gentle parts.
+    pub fn watches(&self) -> bool {
+        self.gentle && self.span.is_some()
+    }
+
     fn fit_to(&mut self, effects: &[Effect], span: ClothSpan) -> Vec<Effect> {
         self.span = Some(span);
         self.gentle = effects.iter().any(|e| match e {
@@ -94,6 +100,54 @@ pub(crate) fn rail() -> Effect {
     let mut rail = super::Obstacle::new("rail.obj");
     rail.load_mesh(&soup).unwrap();
     Effect::Obstacle(rail)
+}
+
+/// A block 1.6 m square and 30 cm tall whose top is flat in frame 0 and rises 4.7° to an
+/// apex in frame 1 (an OBJ sequence of one frame a second, written into `dir`), as a mesh
+/// obstacle: a roof that rises, for tests.
+#[cfg(test)]
+pub(crate) fn rising_roof(dir: &std::path::Path) -> Effect {
+    let (half, base) = (0.8f32, 0.3f32);
+    for (k, rise) in [0.0, half * 4.7f32.to_radians().tan()]
+        .into_iter()
+        .enumerate()
+    {
+        let mut text = String::new();
+        for y in [0.0, base] {
+            for [x, z] in [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]] {
+                text += &format!("v {} {y} {}\n", half * x, half * z);
+            }
+        }
+        text += &format!("v 0 {} 0\n", base + rise);
+        text += "f 1 2 3\nf 1 3 4\nf 5 6 2\nf 5 2 1\nf 6 7 3\nf 6 3 2\nf 7 8 4\nf 7 4 3\n\
+                 f 8 5 1\nf 8 1 4\nf 5 9 6\nf 6 9 7\nf 7 9 8\nf 8 9 5\n";
+        std::fs::write(dir.join(format!("roof_{k}.obj")), text).unwrap();
+    }
+    let mut roof = super::Obstacle::sequence("roof_%d.obj", 1.0, false);
+    roof.load(Some(dir)).unwrap();
+    Effect::Obstacle(roof)
+}
+
+/// A cloth of 10 cm quads, 1 m square and 2 m up, kept `thickness` off solids, and its
+/// state at rest but moving out from its middle so fast that a frame (forces none) ends
+/// with it at 1.8 times its size (within the guard's limits), for tests.
+#[cfg(test)]
+pub(crate) fn growing_cloth(
+    thickness: f32,
+) -> (ClothModel, crate::sim::SimParams, crate::cloth::ClothState) {
+    use crate::mesh::{GridOrientation, GridSpec};
+    let at = Vec3::new(0.0, 2.0, 0.0);
+    let mesh = GridSpec::square(10, 1.0, GridOrientation::Horizontal, at)
+        .build()
+        .unwrap();
+    let model = ClothModel::new(&mesh, 0.2, &[]);
+    let mut params = crate::sim::SimParams::default();
+    params.contact.offset = thickness;
+    let mut state = crate::cloth::ClothState::at_rest(&model);
+    for (v, p) in state.vel.iter_mut().zip(&state.pos) {
+        *v = (*p - at) * 0.8 / params.step.dt;
+    }
+    (model, params, state)
 }
 
 #[cfg(test)]
