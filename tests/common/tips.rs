@@ -144,38 +144,12 @@ pub fn tipped_obstacles(dir: &Path) -> [Tipped; 3] {
 ///   its height over the first second (under the cloth, which lands at 0.3 s).
 pub fn gentle_obstacles(dir: &Path) -> [(Tipped, u32, [f32; 2]); 3] {
     write_prism(&dir.join("rail.obj"), 72, 0.3, 0.3);
-    let (half, base) = (0.8f32, 0.3f32);
-    let apex = base + half * 4.7f32.to_radians().tan();
-    let mut roof = Vec::new();
-    for y in [0.0, base] {
-        roof.extend(
-            [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]
-                .map(|[x, z]| Vec3::new(half * x, y, half * z)),
-        );
-    }
-    roof.push(Vec3::new(0.0, apex, 0.0));
-    let faces = [
-        [0, 1, 2],
-        [0, 2, 3],
-        [4, 5, 1],
-        [4, 1, 0],
-        [5, 6, 2],
-        [5, 2, 1],
-        [6, 7, 3],
-        [6, 3, 2],
-        [7, 4, 0],
-        [7, 0, 3],
-        [4, 8, 5],
-        [5, 8, 6],
-        [6, 8, 7],
-        [7, 8, 4],
-    ];
-    write_obj(&dir.join("roof.obj"), &roof, &faces);
+    let apex = ROOF_BASE + ROOF_HALF * 4.7f32.to_radians().tan();
+    write_obj(&dir.join("roof.obj"), &roof(apex), &ROOF_FACES);
     // The same roof flat at first, its apex rising over a second: frame 0 has no gentle
     // part at all.
-    write_obj(&dir.join("roof_1.obj"), &roof, &faces);
-    roof[8].y = base;
-    write_obj(&dir.join("roof_0.obj"), &roof, &faces);
+    write_obj(&dir.join("roof_1.obj"), &roof(apex), &ROOF_FACES);
+    write_obj(&dir.join("roof_0.obj"), &roof(ROOF_BASE), &ROOF_FACES);
     let obstacle = |name, source: &str, tip| Tipped {
         name,
         effect: format!("[[effects]]\ntype = \"obstacle\"\n{source}\n"),
@@ -195,6 +169,63 @@ pub fn gentle_obstacles(dir: &Path) -> [(Tipped, u32, [f32; 2]); 3] {
             [0.083, 0.167],
         ),
     ]
+}
+
+/// Half the width of the roof's block (m), and its height under the roof.
+const ROOF_HALF: f32 = 0.8;
+const ROOF_BASE: f32 = 0.3;
+
+/// The roof's faces: the block's bottom and sides, then the roof's four, which meet at
+/// its apex.
+const ROOF_FACES: [[u32; 3]; 14] = [
+    [0, 1, 2],
+    [0, 2, 3],
+    [4, 5, 1],
+    [4, 1, 0],
+    [5, 6, 2],
+    [5, 2, 1],
+    [6, 7, 3],
+    [6, 3, 2],
+    [7, 4, 0],
+    [7, 0, 3],
+    [4, 8, 5],
+    [5, 8, 6],
+    [6, 8, 7],
+    [7, 8, 4],
+];
+
+/// The roof's vertices, its apex `apex` m up over the middle of the block's top.
+fn roof(apex: f32) -> Vec<Vec3> {
+    let mut roof = Vec::new();
+    for y in [0.0, ROOF_BASE] {
+        roof.extend(
+            [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]
+                .map(|[x, z]| Vec3::new(ROOF_HALF * x, y, ROOF_HALF * z)),
+        );
+    }
+    roof.push(Vec3::new(0.0, apex, 0.0));
+    roof
+}
+
+/// The roof's block with a top flat in frame 0 that rises to a steep apex over two seconds
+/// (an OBJ sequence of three frames, one a second, written into `dir`: the apex 0.3, 0.45
+/// and 0.6 m up), as an obstacle: its four ridges creases and its apex a tip from frame 1
+/// (the faces turn 15° across a ridge there, 29° in frame 2), though frame 0 has neither.
+pub fn sprouting_roof(dir: &Path) -> Tipped {
+    for (k, apex) in [ROOF_BASE, 0.45, 0.6].into_iter().enumerate() {
+        write_obj(
+            &dir.join(format!("sprouting_{k}.obj")),
+            &roof(apex),
+            &ROOF_FACES,
+        );
+    }
+    Tipped {
+        name: "sprouting roof",
+        effect: "[[effects]]\ntype = \"obstacle\"\nframes = \"sprouting_%d.obj\"\nfps = 1.0\n"
+            .to_string(),
+        tip: ROOF_BASE,
+        rise: 0.15,
+    }
 }
 
 /// Writes to `path` a closed prism of `sides` narrow faces along the x axis, 2 m long, its

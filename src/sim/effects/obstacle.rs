@@ -376,7 +376,10 @@ impl Obstacle {
             .collect();
         let motion = RigidMotion::new(&self.keyframes)
             .map_err(|e| setting(ParamError::new("keyframes", e.index, e.to_string())))?;
-        let surface = Surface::new(vertices, triangles);
+        let surface = match frames.is_empty() {
+            true => Surface::new(vertices, triangles),
+            false => Surface::of_frames(vertices, triangles, &frames),
+        };
         let fps = f64::from(self.fps.unwrap_or(DEFAULT_FPS));
         let sequence =
             (!frames.is_empty()).then(|| Sequence::new(surface.clone(), frames, fps, self.looped));

@@ -183,6 +183,12 @@ impl SharpEdges {
         &self.ends
     }
 
+    /// Whether the edge between the vertices `a < b` (welded: each the first at its place)
+    /// is one of these.
+    pub fn has(&self, [a, b]: [u32; 2]) -> bool {
+        self.ends.binary_search(&[a, b]).is_ok()
+    }
+
     pub fn len(&self) -> usize {
         self.edges.len()
     }

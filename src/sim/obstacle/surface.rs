@@ -1,6 +1,8 @@
 //! An obstacle's surface in its own frame: its triangles, their normals and the tree over
 //! them, and where a particle's move across it ends.
 
+use std::collections::HashSet;
+
 use glam::Vec3;
 
 use super::coarse::{ClothSpan, FLAT_COS, Faces};
@@ -153,6 +155,45 @@ impl Surface {
         }
     }
 
+    /// An OBJ sequence's surface: frame 0's (`vertices` over `triangles`), with every edge
+    /// where the faces crease in any of `frames` (each as many vertices) a sharp edge, every
+    /// vertex where they meet at a point in any a tip, and each smooth vertex's curvature
+    /// the largest it has in any: a ridge that rises later in the sequence is kept off
+    /// from the start.
+    pub fn of_frames(vertices: Vec<Vec3>, triangles: Vec<[u32; 3]>, frames: &[Vec<Vec3>]) -> Self {
+        let surface = Self::new(vertices, triangles);
+        let (vertices, triangles) = (&surface.vertices, &surface.triangles);
+        // Vertices at one place are one, by where frame 0 has them.
+        let same = welded(vertices);
+        let one = |v: &u32| same[*v as usize];
+        let (mut creased, mut pointed, mut others) = (HashSet::new(), HashSet::new(), Vec::new());
+        for frame in frames.iter().filter(|&f| f != vertices) {
+            let normals = face_normals(frame, triangles);
+            let edges = SharpEdges::of(frame, triangles, &normals);
+            creased.extend(edges.ends().iter().map(|[a, b]| {
+                let (a, b) = (one(a), one(b));
+                (a.min(b), a.max(b))
+            }));
+            let tips = Tips::of(frame, triangles, &normals, edges.ends().iter().copied());
+            pointed.extend(tips.vertices().iter().map(one));
+            others.push(tips);
+        }
+        let normals = &surface.normals;
+        let edges = SharpEdges::of_or(vertices, triangles, normals, |[a, b], _| {
+            creased.contains(&(a, b))
+        });
+        let sharp = edges.ends().iter().copied();
+        let tips = Tips::of_or(vertices, triangles, normals, sharp, |v| {
+            pointed.contains(&v)
+        });
+        let tips = tips.curving_as_much_as(&others);
+        Self {
+            edges,
+            tips,
+            ..surface
+        }
+    }
+
     /// This surface with every gentle edge and vertex that a cloth of `span` can reach
     /// kept off as its creases and tips are ([`ClothSpan`]: a coarse cloth over a rail of
     /// narrow faces); `None` where that adds none.
@@ -181,13 +222,15 @@ impl Surface {
             reached_edges.extend(edges);
             reached_vertices.extend(vertices);
         }
+        // What the surface keeps off already (a sequence's every frame's) stays.
         let edges = SharpEdges::of_or(vertices, triangles, normals, |[a, b], _| {
-            reached_edges.contains(&(a.min(b), a.max(b)))
+            reached_edges.contains(&(a.min(b), a.max(b))) || self.edges.has([a, b])
         });
         let sharp = edges.ends().iter().copied();
         let tips = Tips::of_or(vertices, triangles, normals, sharp, |v| {
-            reached_vertices.contains(&v)
-        });
+            reached_vertices.contains(&v) || self.tips.has(v)
+        })
+        .curving_as_much_as([&self.tips]);
         (edges != self.edges || tips != self.tips).then(|| Surface {
             edges,
             tips,

@@ -143,6 +143,33 @@ impl Tips {
         self.smooth.refit(vertices);
     }
 
+    /// Whether the vertex `v` (welded: the first at its place) is a tip.
+    pub fn has(&self, v: u32) -> bool {
+        self.tips.vertices.binary_search(&v).is_ok()
+    }
+
+    /// The tips' vertices (welded: each the first at its place), in order.
+    pub fn vertices(&self) -> &[u32] {
+        &self.tips.vertices
+    }
+
+    /// These tips, each smooth vertex's curvature raised to the largest it has among
+    /// `others` (the same surface elsewhere: a sequence's other frames) where it is smooth
+    /// there too.
+    pub fn curving_as_much_as<'t>(mut self, others: impl IntoIterator<Item = &'t Tips>) -> Self {
+        for other in others {
+            let (theirs, curvatures) = (&other.smooth.vertices, &other.smooth.curvatures);
+            let ours = self.smooth.vertices.iter();
+            for (v, k) in ours.zip(&mut self.smooth.curvatures) {
+                if let Ok(i) = theirs.binary_search(v) {
+                    *k = k.max(curvatures[i]);
+                }
+            }
+        }
+        self.curvature = self.smooth.curvatures.iter().copied().fold(0.0, f32::max);
+        self
+    }
+
     /// How many tips.
     pub fn len(&self) -> usize {
         self.tips.points.len()
