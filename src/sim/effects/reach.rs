@@ -1,8 +1,8 @@
 //! Each mesh obstacle as the cloth meets it: the gentle edges and vertices of its surface
 //! that the cloth's edges and triangles can reach between their particles, kept off as its
 //! creases and tips are ([`ClothSpan`]). Fitted to the cloth's rest shape grown by
-//! [`GROWTH`], and again wherever a frame ends with the cloth grown past what they were
-//! fitted to.
+//! [`GROWTH`], its triangles taken as if folded flat (no fold outgrows the fit), and again
+//! wherever a frame ends with the cloth stretched past what they were fitted to.
 
 use glam::Vec3;
 
@@ -31,6 +31,17 @@ pub fn fitted_to_cloth(effects: &[Effect], span: ClothSpan) -> Vec<Effect> {
         .collect()
 }
 
+/// `span` with its triangles' lever as long as its longest edge: how far a triangle folded
+/// flat reaches without stretching (its lever, the lesser of its circumradius and its
+/// longest edge, grows as it flattens). A fit to it holds however the cloth folds: only a
+/// stretch outgrows it.
+fn folded(span: ClothSpan) -> ClothSpan {
+    ClothSpan {
+        lever: span.lever.max(span.edge),
+        ..span
+    }
+}
+
 /// The span a stepper's obstacles were last fitted to, and whether any of them has gentle
 /// parts (else nothing is ever fitted again).
 #[derive(Clone, Copy, Debug, Default)]
@@ -40,16 +51,16 @@ pub struct Reach {
 }
 
 impl Reach {
-    /// `effects` fitted to `model`'s rest shape grown by [`GROWTH`], keeping `offset` (where
-    /// an obstacle has no thickness of its own).
+    /// `effects` fitted to `model`'s rest shape grown by [`GROWTH`] and folded (`folded`),
+    /// keeping `offset` (where an obstacle has no thickness of its own).
     pub fn fit(&mut self, effects: &[Effect], model: &ClothModel, offset: f32) -> Vec<Effect> {
         let span = ClothSpan::of(&model.rest_positions, &model.triangles, GROWTH, offset);
-        self.fit_to(effects, span)
+        self.fit_to(effects, folded(span))
     }
 
     /// `effects` (as last fitted) fitted again where the cloth of `model` at `pos` has
-    /// grown past the span they were fitted to: to the larger of the two grown by
-    /// [`GROWTH`]; `None` where it has not, or no obstacle has gentle parts.
+    /// stretched past the span they were fitted to: to its longest edge grown by
+    /// [`GROWTH`], folded; `None` where it has not, or no obstacle has gentle parts.
     pub fn outgrown(
         &mut self,
         effects: &[Effect],
@@ -58,16 +69,13 @@ impl Reach {
     ) -> Option<Vec<Effect>> {
         let fitted = self.span.filter(|_| self.gentle)?;
         let now = ClothSpan::of(pos, &model.triangles, 1.0, fitted.thickness);
-        // (A cloth gone non-finite has outgrown nothing: the guard deals with it.)
-        if !(now.edge > fitted.edge || now.lever > fitted.lever) {
+        // Only a stretch outgrows a fit: no triangle's lever exceeds its longest edge. (A
+        // cloth gone non-finite spans nothing and outgrows nothing: the guard deals with it.)
+        if now.edge <= fitted.edge {
             return None;
         }
-        let span = ClothSpan {
-            edge: now.edge.max(fitted.edge) * GROWTH,
-            lever: now.lever.max(fitted.lever) * GROWTH,
-            ..fitted
-        };
-        Some(self.fit_to(effects, span))
+        let edge = now.edge * GROWTH;
+        Some(self.fit_to(effects, folded(ClothSpan { edge, ..fitted })))
     }
 
     /// Whether a cloth growing could ever have the obstacles fitted again: they were
@@ -186,5 +194,70 @@ mod tests {
         assert_eq!(kept_off(&refitted), 120);
         // Fitted to the grown cloth, the same growth asks for nothing more.
         assert!(reach.outgrown(&refitted, &model, &grown(2.0)).is_none());
+    }
+
+    /// A roof of four faces rising 4.7° to an apex 1.6 m across (no crease, no tip by its
+    /// faces), as a mesh obstacle.
+    fn low_roof() -> Effect {
+        let rise = 0.8 * 4.7f32.to_radians().tan();
+        let soup = crate::mesh::PolygonSoup {
+            positions: vec![
+                Vec3::new(-0.8, 0.0, -0.8),
+                Vec3::new(0.8, 0.0, -0.8),
+                Vec3::new(0.8, 0.0, 0.8),
+                Vec3::new(-0.8, 0.0, 0.8),
+                Vec3::new(0.0, rise, 0.0),
+            ],
+            uvs: None,
+            face_indices: vec![0, 4, 1, 1, 4, 2, 2, 4, 3, 3, 4, 0],
+            face_arities: vec![3; 4],
+        };
+        let mut roof = crate::sim::Obstacle::new("roof.obj");
+        roof.load_mesh(&soup).unwrap();
+        Effect::Obstacle(roof)
+    }
+
+    /// Whether the roof's apex is kept off as a tip.
+    fn apex_kept_off(effects: &[Effect]) -> bool {
+        let Effect::Obstacle(o) = &effects[0] else {
+            unreachable!()
+        };
+        let mut found = false;
+        let (lo, hi) = (Vec3::new(-0.01, 0.0, -0.01), Vec3::new(0.01, 0.1, 0.01));
+        o.placed()
+            .unwrap()
+            .surface
+            .tips()
+            .in_box(lo, hi, |_| found = true);
+        found
+    }
+
+    /// A cloth of 10 cm quads over the low roof, 1.6 cm thick. At rest its triangles'
+    /// lever is 7.1 cm (half a diagonal), and by the bound one over the apex leaves more
+    /// than three quarters of the thickness; but a triangle folded flat across its
+    /// diagonal, stretched nowhere, has a lever of 14.1 cm, and leaves less. So the fit
+    /// takes each triangle's lever as long as the cloth's longest edge and keeps the apex
+    /// off from the start, and a cloth folded flat (its triangles' lever up to 14.1 cm, no
+    /// edge longer) outgrows nothing: nothing is fitted again in the middle of a run. (With
+    /// the rest lever fitted, the apex is not kept off; with the lever's growth outgrowing
+    /// the fit, the folded cloth is fitted again.)
+    #[test]
+    fn a_fit_holds_however_the_cloth_folds() {
+        let mesh = GridSpec::square(10, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
+            .build()
+            .unwrap();
+        let model = ClothModel::new(&mesh, 0.2, &[]);
+        let mut reach = Reach::default();
+        let fitted = reach.fit(&[low_roof()], &model, 0.016);
+        assert!(apex_kept_off(&fitted));
+        // Folded like an accordion onto the line of one diagonal: no edge longer, every
+        // triangle flat, the lever of those along it the diagonal's length.
+        let along = Vec3::new(1.0, 0.0, 1.0).normalize();
+        let folded: Vec<Vec3> = (mesh.positions.iter())
+            .map(|p| along * p.dot(along))
+            .collect();
+        let lever = ClothSpan::of(&folded, &model.triangles, 1.0, 0.016).lever;
+        assert!((lever - 0.1f32.hypot(0.1)).abs() < 1e-4, "{lever}");
+        assert!(reach.outgrown(&fitted, &model, &folded).is_none());
     }
 }
