@@ -163,6 +163,15 @@ mod tests {
     use super::*;
     use crate::mesh::{GridOrientation, GridSpec};
 
+    /// A horizontal cloth 1 m square of 10 cm quads about the origin: its mesh and model.
+    fn metre_of_10_cm_quads() -> (crate::mesh::ClothMesh, ClothModel) {
+        let mesh = GridSpec::square(10, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
+            .build()
+            .unwrap();
+        let model = ClothModel::new(&mesh, 0.2, &[]);
+        (mesh, model)
+    }
+
     fn kept_off(effects: &[Effect]) -> usize {
         match &effects[0] {
             Effect::Obstacle(o) => o.placed().unwrap().surface.sharp_edges().len(),
@@ -179,10 +188,7 @@ mod tests {
     /// at all, or gone non-finite, nothing is fitted again.
     #[test]
     fn a_cloth_grown_past_its_fit_has_the_obstacles_fitted_again() {
-        let mesh = GridSpec::square(10, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
-            .build()
-            .unwrap();
-        let model = ClothModel::new(&mesh, 0.2, &[]);
+        let (mesh, model) = metre_of_10_cm_quads();
         let mut reach = Reach::default();
         let fitted = reach.fit(&[rail()], &model, 0.04);
         assert_eq!(kept_off(&fitted), 80, "the ends' rims");
@@ -243,10 +249,7 @@ mod tests {
     /// the fit, the folded cloth is fitted again.)
     #[test]
     fn a_fit_holds_however_the_cloth_folds() {
-        let mesh = GridSpec::square(10, 1.0, GridOrientation::Horizontal, Vec3::ZERO)
-            .build()
-            .unwrap();
-        let model = ClothModel::new(&mesh, 0.2, &[]);
+        let (mesh, model) = metre_of_10_cm_quads();
         let mut reach = Reach::default();
         let fitted = reach.fit(&[low_roof()], &model, 0.016);
         assert!(apex_kept_off(&fitted));
