@@ -81,7 +81,7 @@ impl Contacts {
         (model, effects, pos): (&ClothModel, &[Effect], &[Vec3]),
         solve: Option<&wgpu::Buffer>,
     ) -> Result<bool, GpuError> {
-        let Some(fitted) = self.reach.outgrown(effects, model, pos) else {
+        let Some(fitted) = self.reach.outgrown(effects, pos) else {
             return Ok(false);
         };
         let scene = (model, &fitted[..], &self.contact);

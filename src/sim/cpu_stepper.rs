@@ -234,6 +234,11 @@ impl<R: Real> CpuStepper<R> {
         model: &ClothModel,
         state: &mut ClothState,
     ) -> Result<(), StepError> {
+        // A cloth stretched past what the mesh obstacles were fitted to has them fitted
+        // again, before any contact meets it.
+        if let Some(fitted) = self.reach.outgrown(&self.effects, &state.pos) {
+            self.take_effects(fitted);
+        }
         let mut contacts = 0;
         let mut pass = ContactPass {
             model,
@@ -629,14 +634,6 @@ impl<R: Real> StepBackend for CpuStepper<R> {
     ) -> Result<FrameOutcome, Diverged> {
         let stepped = self.on_state(state, |stepper, state| stepper.guarded_frame(model, state));
         self.outside = None;
-        // A cloth grown past what the obstacles were fitted to has them fitted again.
-        let grown = stepped.is_ok().then(|| {
-            let effects = &self.effects;
-            self.reach.outgrown(effects, model, &state.pos)
-        });
-        if let Some(fitted) = grown.flatten() {
-            self.take_effects(fitted);
-        }
         stepped
     }
 

@@ -2,7 +2,7 @@
 //! that the cloth's edges and triangles can reach between their particles, kept off as its
 //! creases and tips are ([`ClothSpan`]). Fitted to the cloth's rest shape grown by
 //! [`GROWTH`], its triangles taken as if folded flat (no fold outgrows the fit), and again
-//! wherever a frame ends with the cloth stretched past what they were fitted to.
+//! wherever the cloth is stretched past what they were fitted to.
 
 use glam::Vec3;
 
@@ -42,12 +42,14 @@ fn folded(span: ClothSpan) -> ClothSpan {
     }
 }
 
-/// The span a stepper's obstacles were last fitted to, and whether any of them has gentle
-/// parts (else nothing is ever fitted again).
-#[derive(Clone, Copy, Debug, Default)]
+/// The span a stepper's obstacles were last fitted to, whether any of them has gentle parts
+/// (else nothing is ever fitted again), and the cloth's triangle edges, by their particles
+/// (what a stretch is measured on).
+#[derive(Clone, Debug, Default)]
 pub struct Reach {
     span: Option<ClothSpan>,
     gentle: bool,
+    edges: Vec<[u32; 2]>,
 }
 
 impl Reach {
@@ -55,26 +57,34 @@ impl Reach {
     /// keeping `offset` (where an obstacle has no thickness of its own).
     pub fn fit(&mut self, effects: &[Effect], model: &ClothModel, offset: f32) -> Vec<Effect> {
         let span = ClothSpan::of(&model.rest_positions, &model.triangles, GROWTH, offset);
+        let mut edges: Vec<[u32; 2]> = (model.triangles.iter())
+            .flat_map(|&[a, b, c]| [[a, b], [b, c], [c, a]])
+            .map(|[a, b]| [a.min(b), a.max(b)])
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        self.edges = edges;
         self.fit_to(effects, folded(span))
     }
 
-    /// `effects` (as last fitted) fitted again where the cloth of `model` at `pos` has
-    /// stretched past the span they were fitted to: to its longest edge grown by
-    /// [`GROWTH`], folded; `None` where it has not, or no obstacle has gentle parts.
-    pub fn outgrown(
-        &mut self,
-        effects: &[Effect],
-        model: &ClothModel,
-        pos: &[Vec3],
-    ) -> Option<Vec<Effect>> {
+    /// `effects` (as last fitted) fitted again where the cloth at `pos` has stretched past
+    /// the span they were fitted to (its longest edge, measured on the edges of the model
+    /// last fitted to): to its longest edge grown by [`GROWTH`], folded; `None` where it
+    /// has not, or no obstacle has gentle parts. Cheap enough for every substep: a pass
+    /// over the cloth's edges.
+    pub fn outgrown(&mut self, effects: &[Effect], pos: &[Vec3]) -> Option<Vec<Effect>> {
         let fitted = self.span.filter(|_| self.gentle)?;
-        let now = ClothSpan::of(pos, &model.triangles, 1.0, fitted.thickness);
         // Only a stretch outgrows a fit: no triangle's lever exceeds its longest edge. (A
         // cloth gone non-finite spans nothing and outgrows nothing: the guard deals with it.)
-        if now.edge <= fitted.edge {
+        let at = |i: u32| pos.get(i as usize).copied();
+        let longest = (self.edges.iter())
+            .filter_map(|&[a, b]| Some(at(a)?.distance_squared(at(b)?)))
+            .fold(0.0f32, f32::max)
+            .sqrt();
+        if longest <= fitted.edge {
             return None;
         }
-        let edge = now.edge * GROWTH;
+        let edge = longest * GROWTH;
         Some(self.fit_to(effects, folded(ClothSpan { edge, ..fitted })))
     }
 
@@ -183,7 +193,7 @@ mod tests {
     /// (its diagonals, 14 cm, grown by a quarter, dip at most 2.3 cm into it by the bound,
     /// under three quarters of the thickness), so only the creases round its ends are kept
     /// off.
-    /// Grown to twice its size it can, and the frame's end fits the rail to it again: its
+    /// Grown to twice its size it can, and the rail is fitted to it again: its
     /// 40 ridges kept off too. Grown by a tenth (within the quarter it was fitted with), not
     /// at all, or gone non-finite, nothing is fitted again.
     #[test]
@@ -193,13 +203,13 @@ mod tests {
         let fitted = reach.fit(&[rail()], &model, 0.04);
         assert_eq!(kept_off(&fitted), 80, "the ends' rims");
         let grown = |by: f32| mesh.positions.iter().map(|&p| p * by).collect::<Vec<_>>();
-        assert!(reach.outgrown(&fitted, &model, &mesh.positions).is_none());
-        assert!(reach.outgrown(&fitted, &model, &grown(1.1)).is_none());
-        assert!(reach.outgrown(&fitted, &model, &grown(f32::NAN)).is_none());
-        let refitted = reach.outgrown(&fitted, &model, &grown(2.0)).unwrap();
+        assert!(reach.outgrown(&fitted, &mesh.positions).is_none());
+        assert!(reach.outgrown(&fitted, &grown(1.1)).is_none());
+        assert!(reach.outgrown(&fitted, &grown(f32::NAN)).is_none());
+        let refitted = reach.outgrown(&fitted, &grown(2.0)).unwrap();
         assert_eq!(kept_off(&refitted), 120);
         // Fitted to the grown cloth, the same growth asks for nothing more.
-        assert!(reach.outgrown(&refitted, &model, &grown(2.0)).is_none());
+        assert!(reach.outgrown(&refitted, &grown(2.0)).is_none());
     }
 
     /// A roof of four faces rising 4.7° to an apex 1.6 m across (no crease, no tip by its
@@ -261,6 +271,6 @@ mod tests {
             .collect();
         let lever = ClothSpan::of(&folded, &model.triangles, 1.0, 0.016).lever;
         assert!((lever - 0.1f32.hypot(0.1)).abs() < 1e-4, "{lever}");
-        assert!(reach.outgrown(&fitted, &model, &folded).is_none());
+        assert!(reach.outgrown(&fitted, &folded).is_none());
     }
 }
