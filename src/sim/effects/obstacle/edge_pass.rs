@@ -1,11 +1,13 @@
 //! The edge pass of a mesh obstacle: every cloth edge kept off the obstacle's sharp edges
 //! (a table's rim), where a cloth edge can rest across one with both its particles clear of
-//! the faces.
+//! the faces. Colour by colour, a large colour's edges shared out between the team.
 
 use glam::{Vec3, Vec3A};
 
 use super::super::effect_kind::ContactPass;
 use super::super::solid::touching;
+use crate::cloth::EdgeColours;
+use crate::parallel::{Disjoint, Team};
 use crate::sim::obstacle::{Clearance, LOOK, LOOK_DEFORMING, SharpEdges, SurfaceClock, Tips};
 
 /// How the frame of the sharp edges lies in the world: `to_local` takes a world point into
@@ -35,10 +37,8 @@ pub(super) struct EdgeMemory {
     /// For each cloth edge, in the colour order the pass takes them in, what it was when
     /// last asked.
     asked_at: Vec<Asked>,
-    /// Each particle's pushes in this pass added up (in the frame), m, and the particles
-    /// pushed.
+    /// Each particle's pushes in this pass added up (in the frame), m.
     pushed: Vec<f32>,
-    pushed_list: Vec<u32>,
     /// The tips near one patch of the cloth, and the vertices near one of its triangles
     /// (scratch of the tip pass).
     tips_near: Vec<Vec3A>,
@@ -96,12 +96,7 @@ impl EdgeMemory {
         edges: usize,
         fixed: bool,
     ) -> Option<Reading> {
-        for &i in &self.pushed_list {
-            self.pushed[i as usize] = 0.0;
-        }
-        self.pushed_list.clear();
-        // Room for every particle once: a pass lists each at most once.
-        self.pushed_list.reserve(pos.len());
+        self.pushed.clear();
         self.pushed.resize(pos.len(), 0.0);
         if !fixed {
             // No odometers: every cloth edge is asked.
@@ -161,6 +156,123 @@ pub(super) struct ForTips<'a> {
     pub(super) rounding: f32,
 }
 
+impl<S, L, W, V> Shared<'_, S, L, W, V>
+where
+    S: Fn(Vec3) -> Vec3,
+    L: Fn(Vec3) -> Vec3,
+    W: Fn(Vec3) -> Vec3,
+    V: Fn(Vec3) -> Vec3,
+{
+    /// The turn of the cloth edge at `k` in the colour order, where no particle's pushes
+    /// of this pass add up to more than `most_pushed` before it: its two particles kept
+    /// off the sharp edges ([`push_edges`]), what it did added to `tally`.
+    ///
+    /// # Safety
+    /// No other turn at the same time may move either of its particles, its spring or its
+    /// place in the order (a colour's edges share none).
+    unsafe fn edge_turn(&self, slices: &Slices<'_>, k: usize, most_pushed: f32, tally: &mut Tally) {
+        let (colours, thickness) = (self.colours, self.thickness);
+        let (e, ends) = (colours.order[k] as usize, colours.ends[k]);
+        let [i, j] = ends.map(|p| p as usize);
+        // SAFETY (every access below): the particles `i` and `j`, the spring `e` and the
+        // place `k` are this turn's alone, by the caller's contract.
+        let (odometers, local) = (&slices.odometers, &slices.local);
+        let clearance = unsafe { slices.clearance.at(e) };
+        let rounding = self.reading.map_or(0.0, |r| r.rounding);
+        // Neither particle has moved farther than its odometer ran on since this cloth edge
+        // was last asked, nor (any particle) farther than `reach_most` since the substep
+        // began: while the two odometers leave it more than the reach clear, it is not
+        // asked.
+        let reading_now =
+            (self.reading).map(|r| (r, unsafe { *odometers.at(i) + *odometers.at(j) }));
+        if let Some((r, at)) = reading_now {
+            // (Where there is a reading, every cloth edge has its last asking.)
+            let last = unsafe { *slices.asked_at.at(k) };
+            let reach_most = thickness.max(r.travel + most_pushed);
+            let wanted = reach_most * (1.0 + 2e-4) + 2.0 * rounding;
+            if last.ends == ends && (at - last.reading) + f64::from(wanted) < f64::from(last.left) {
+                return;
+            }
+        }
+        let free = [self.inv_mass[i] > 0.0, self.inv_mass[j] > 0.0].map(f32::from);
+        if free == [0.0, 0.0] {
+            return;
+        }
+        let now = unsafe { [*local.at(i), *local.at(j)] };
+        let then = [self.before[i], self.before[j]];
+        // An edge the cloth edge passed through in the substep puts it back on the side it
+        // came from; else one it ends within the thickness of pushes it out. Every point of
+        // the cloth edge moved at most `travel`: one that passed through a sharp edge ends
+        // within that of it, so an edge with none that near is not asked.
+        let travel = (now[0] - then[0]).length().max((now[1] - then[1]).length());
+        let reach = thickness.max(travel);
+        let edges = self.edges;
+        let near = edges.nearest_remembering(now, [reach, self.look], clearance);
+        #[cfg(test)]
+        {
+            tally.asked += 1;
+        }
+        // What is left of its clearance, from the odometers' reading now.
+        if let Some((_, at)) = reading_now {
+            let left = clearance.left(now) - rounding;
+            *unsafe { slices.asked_at.at(k) } = Asked {
+                ends,
+                reading: at,
+                left,
+            };
+        }
+        let Some(near) = near else {
+            return;
+        };
+        let (now, then) = (now.map(Vec3::from), then.map(Vec3::from));
+        let crossed = (near.distance <= travel)
+            .then(|| edges.crossed(then, now))
+            .flatten();
+        let (hit, side) = match crossed {
+            Some((edge, side)) => {
+                tally.crossings += 1;
+                (SharpEdges::between(now[0], now[1], edge), side)
+            }
+            None => {
+                if near.distance <= thickness * 1e-3 || near.distance >= thickness {
+                    return;
+                }
+                (near, (near.on_segment - near.on_edge) / near.distance)
+            }
+        };
+        // What the nearest point of the cloth edge must move by, in the frame.
+        let frame = self.frame;
+        let gap = side * thickness - (hit.on_segment - hit.on_edge);
+        let n = (frame.to_world)(side);
+        let gap = (frame.to_world)(gap);
+        let share = [1.0 - hit.along, hit.along];
+        let weight = share[0] * share[0] * free[0] + share[1] * share[1] * free[1];
+        if weight <= 0.0 {
+            return;
+        }
+        let v_surface = (frame.velocity)(hit.on_edge);
+        for (end, p) in [i, j].into_iter().enumerate() {
+            let part = share[end] * free[end];
+            if part <= 0.0 {
+                continue;
+            }
+            let (pos, vel) = unsafe { (slices.pos.at(p), slices.vel.at(p)) };
+            *pos += gap * (part / weight);
+            *vel = touching(*vel, v_surface, n, self.mu, part);
+            let local = unsafe { local.at(p) };
+            let was = std::mem::replace(local, (frame.to_local)(*pos).into());
+            if self.reading.is_some() {
+                let (pushed, odometer) = unsafe { (slices.pushed.at(p), odometers.at(p)) };
+                let push = local.distance(was) + rounding;
+                *pushed += push;
+                *odometer += f64::from(push);
+                tally.most_pushed = tally.most_pushed.max(*pushed);
+            }
+        }
+        tally.moved += 1;
+    }
+}
+
 impl EdgeMemory {
     /// What the tip pass reads and moves after [`push_edges`] (which takes every particle
     /// into the frame where the obstacle has tips, for it): a push it makes runs the
@@ -190,6 +302,62 @@ pub(super) enum EdgesMoved {
 /// How many times at most the edge pass runs in one substep.
 const EDGE_SWEEPS: usize = 4;
 
+/// Cloth edges a member of the team takes at once; a colour of fewer is taken by one.
+const PIECE: usize = 256;
+
+/// Members of the team whose tallies a colour keeps (a larger team takes each colour alone).
+const TALLIES: usize = 16;
+
+/// What the edge pass's turns of some cloth edges did: crossings put back, cloth edges
+/// moved, the most any particle's pushes of the pass added up to after them, and (for
+/// tests) the cloth edges asked.
+#[derive(Clone, Copy, Debug, Default)]
+struct Tally {
+    crossings: usize,
+    moved: usize,
+    most_pushed: f32,
+    #[cfg(test)]
+    asked: usize,
+}
+
+impl Tally {
+    fn join(self, other: Tally) -> Tally {
+        Tally {
+            crossings: self.crossings + other.crossings,
+            moved: self.moved + other.moved,
+            most_pushed: self.most_pushed.max(other.most_pushed),
+            #[cfg(test)]
+            asked: self.asked + other.asked,
+        }
+    }
+}
+
+/// What every turn of the edge pass reads.
+struct Shared<'a, S, L, W, V> {
+    edges: &'a SharpEdges,
+    frame: &'a EdgeFrame<S, L, W, V>,
+    mu: f32,
+    thickness: f32,
+    look: f32,
+    inv_mass: &'a [f32],
+    before: &'a [Vec3A],
+    reading: Option<&'a Reading>,
+    colours: &'a EdgeColours,
+}
+
+/// What the turns of the edge pass move: each particle's position, velocity, place in the
+/// frame, odometer and pushes, and each cloth edge's clearance (by spring) and last asking
+/// (by its place in the order).
+struct Slices<'a> {
+    pos: Disjoint<'a, Vec3>,
+    vel: Disjoint<'a, Vec3>,
+    local: Disjoint<'a, Vec3A>,
+    odometers: Disjoint<'a, f64>,
+    pushed: Disjoint<'a, f32>,
+    clearance: Disjoint<'a, Clearance>,
+    asked_at: Disjoint<'a, Asked>,
+}
+
 /// Keeps every cloth edge (its structural and shear springs, in the model's colour order)
 /// `pass.offset` from the sharp `edges` where it ends the substep: the two particles are
 /// moved apart from the edge in proportion to how near each is to the nearest point, which
@@ -204,7 +372,9 @@ const EDGE_SWEEPS: usize = 4;
 /// have not run on by what was left of it when last asked, less the reach, the cloth edge
 /// is passed by unasked (its answer would be the same: none). Where the obstacle has
 /// `tips` and the solids keep the cloth's triangles out, every particle is taken into the
-/// frame for the tip pass after it, edges or none ([`EdgeMemory::for_tips`]). Returns how
+/// frame for the tip pass after it, edges or none ([`EdgeMemory::for_tips`]). A colour of
+/// more than [`PIECE`] cloth edges is shared out between the team's members in pieces
+/// (its edges share no particle); the result is the same however it is cut. Returns how
 /// many cloth edges it moved.
 pub(super) fn push_edges<S, L, W, V>(
     (edges, tips): (&SharpEdges, &Tips),
@@ -214,10 +384,10 @@ pub(super) fn push_edges<S, L, W, V>(
     (memory, moved): (&mut EdgeMemory, EdgesMoved),
 ) -> usize
 where
-    S: Fn(Vec3) -> Vec3,
-    L: Fn(Vec3) -> Vec3,
-    W: Fn(Vec3) -> Vec3,
-    V: Fn(Vec3) -> Vec3,
+    S: Fn(Vec3) -> Vec3 + Sync,
+    L: Fn(Vec3) -> Vec3 + Sync,
+    W: Fn(Vec3) -> Vec3 + Sync,
+    V: Fn(Vec3) -> Vec3 + Sync,
 {
     let tipped = !tips.is_empty() && pass.faces.is_some();
     if edges.is_empty() && !tipped {
@@ -251,12 +421,29 @@ where
             (LOOK_DEFORMING, by)
         }
     };
-    let (clearance, asked_at) = (&mut memory.clearance, &mut memory.asked_at);
-    let (before, local) = (&memory.before, &mut memory.local);
-    let odometers = &mut memory.odometers;
-    let (pushed, pushed_list) = (&mut memory.pushed, &mut memory.pushed_list);
-    let rounding = reading.as_ref().map_or(0.0, |r| r.rounding);
-    // The most any particle's pushes of this pass have added up to yet.
+    let shared = Shared {
+        edges,
+        frame,
+        mu,
+        thickness,
+        look,
+        inv_mass,
+        before: &memory.before,
+        reading: reading.as_ref(),
+        colours,
+    };
+    let slices = Slices {
+        pos: Disjoint::new(&mut state.pos),
+        vel: Disjoint::new(&mut state.vel),
+        local: Disjoint::new(&mut memory.local),
+        odometers: Disjoint::new(&mut memory.odometers),
+        pushed: Disjoint::new(&mut memory.pushed),
+        clearance: Disjoint::new(&mut memory.clearance),
+        asked_at: Disjoint::new(&mut memory.asked_at),
+    };
+    let team = Team::current();
+    // The most any particle's pushes of this pass have added up to, as each colour began
+    // (a colour's edges share no particle: none of its pushes moves another's ends).
     let mut most_pushed = 0.0f32;
     let mut moved = 0;
     // A cloth edge put back from a crossing can pull a neighbour across another: the pass
@@ -264,103 +451,39 @@ where
     let sweeps = if edges.is_empty() { 0 } else { EDGE_SWEEPS };
     for _ in 0..sweeps {
         let mut crossings = 0;
-        // In colours (the GPU's order too, a colour's edges side by side there).
-        for (k, (&e, &ends)) in order.iter().zip(&colours.ends).enumerate() {
-            let (e, [i, j]) = (e as usize, ends.map(|p| p as usize));
-            // Neither particle has moved farther than its odometer ran on since this cloth
-            // edge was last asked, nor (any particle) farther than `reach_most` since the
-            // substep began: while the two odometers leave it more than the reach clear, it
-            // is not asked.
-            let reading_now = reading.as_ref().map(|r| (r, odometers[i] + odometers[j]));
-            if let Some((r, at)) = reading_now {
-                let last = asked_at[k];
-                let reach_most = thickness.max(r.travel + most_pushed);
-                let wanted = reach_most * (1.0 + 2e-4) + 2.0 * rounding;
-                if last.ends == ends
-                    && (at - last.reading) + f64::from(wanted) < f64::from(last.left)
-                {
-                    continue;
+        // In colours (the GPU's order too, a colour's edges side by side there), a large
+        // colour's edges shared out between the team's members: each edge's turn reads and
+        // moves only its own particles, so the result is the same however they are cut.
+        for (range, may_share) in &colours.runs {
+            let mut tallies = [Tally::default(); TALLIES];
+            let pieces = range.len().div_ceil(PIECE);
+            let parallel = !may_share && pieces > 1 && team.members() <= TALLIES;
+            let slots = Disjoint::new(&mut tallies);
+            team.run_pieces_if(parallel, pieces, &|member, piece| {
+                let first = range.start + piece * PIECE;
+                let edges = first..(first + PIECE).min(range.end);
+                // SAFETY: each member adds to its own tally; the edges of a colour share no
+                // particle, and each is its own spring and place in the order (a run whose
+                // edges may share one is taken by one member, in order).
+                let tally = unsafe { slots.at(member) };
+                for k in edges {
+                    unsafe { shared.edge_turn(&slices, k, most_pushed, tally) };
                 }
-            }
-            let free = [inv_mass[i] > 0.0, inv_mass[j] > 0.0].map(f32::from);
-            if free == [0.0, 0.0] {
-                continue;
-            }
-            let (now, then) = ([local[i], local[j]], [before[i], before[j]]);
-            // An edge the cloth edge passed through in the substep puts it back on the side
-            // it came from; else one it ends within the thickness of pushes it out. Every
-            // point of the cloth edge moved at most `travel`: one that passed through a
-            // sharp edge ends within that of it, so an edge with none that near is not
-            // asked.
-            let travel = (now[0] - then[0]).length().max((now[1] - then[1]).length());
-            let reach = thickness.max(travel);
-            let near = edges.nearest_remembering(now, [reach, look], &mut clearance[e]);
+            });
+            let tally = tallies.into_iter().fold(Tally::default(), Tally::join);
+            crossings += tally.crossings;
+            moved += tally.moved;
+            most_pushed = most_pushed.max(tally.most_pushed);
             #[cfg(test)]
             {
-                memory.asked += 1;
+                memory.asked += tally.asked;
             }
-            // What is left of its clearance, from the odometers' reading now.
-            if let Some((_, at)) = reading_now {
-                let left = clearance[e].left(now) - rounding;
-                asked_at[k] = Asked {
-                    ends,
-                    reading: at,
-                    left,
-                };
-            }
-            let Some(near) = near else {
-                continue;
-            };
-            let (now, then) = (now.map(Vec3::from), then.map(Vec3::from));
-            let crossed = (near.distance <= travel)
-                .then(|| edges.crossed(then, now))
-                .flatten();
-            let (hit, side) = match crossed {
-                Some((edge, side)) => {
-                    crossings += 1;
-                    (SharpEdges::between(now[0], now[1], edge), side)
-                }
-                None => {
-                    if near.distance <= thickness * 1e-3 || near.distance >= thickness {
-                        continue;
-                    }
-                    (near, (near.on_segment - near.on_edge) / near.distance)
-                }
-            };
-            // What the nearest point of the cloth edge must move by, in the frame.
-            let gap = side * thickness - (hit.on_segment - hit.on_edge);
-            let n = (frame.to_world)(side);
-            let gap = (frame.to_world)(gap);
-            let share = [1.0 - hit.along, hit.along];
-            let weight = share[0] * share[0] * free[0] + share[1] * share[1] * free[1];
-            if weight <= 0.0 {
-                continue;
-            }
-            let v_surface = (frame.velocity)(hit.on_edge);
-            for (k, p) in [i, j].into_iter().enumerate() {
-                let part = share[k] * free[k];
-                if part <= 0.0 {
-                    continue;
-                }
-                state.pos[p] += gap * (part / weight);
-                state.vel[p] = touching(state.vel[p], v_surface, n, mu, part);
-                let was = std::mem::replace(&mut local[p], (frame.to_local)(state.pos[p]).into());
-                if reading.is_some() {
-                    if pushed[p] == 0.0 {
-                        pushed_list.push(p as u32);
-                    }
-                    let push = local[p].distance(was) + rounding;
-                    pushed[p] += push;
-                    odometers[p] += f64::from(push);
-                    most_pushed = most_pushed.max(pushed[p]);
-                }
-            }
-            moved += 1;
         }
         if crossings == 0 {
             break;
         }
     }
+    let rounding = reading.as_ref().map_or(0.0, |r| r.rounding);
     (memory.rounding, memory.moved_by) = (rounding, moved_by);
     moved
 }
