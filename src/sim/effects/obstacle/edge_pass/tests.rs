@@ -80,9 +80,19 @@ fn pass(
 /// as a pass with no memory at all (every cloth edge asked, every tree walked) leaves them,
 /// to the bit; and so must they where the cube rises into a still cloth from 3 cm below
 /// it (as a deforming surface's edges move: every cloth edge asked, the clearances worn
-/// down by the move).
+/// down by the move). The remembering pass on one thread and on a team of two (whose
+/// colours of more than 256 cloth edges are shared out) asks as many cloth edges and ends
+/// in the same bits, and the pass with no memory asks every cloth edge in every sweep.
+/// (With the last edge of each piece of a colour left out, red.)
 #[test]
 fn cloth_edges_passed_by_on_their_odometers_end_where_every_one_asked_ends() {
+    let on = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a pool")
+    };
+    let (alone, team) = (on(1), on(2));
     // Fixed under a moving cloth 8 mm above its top, or rising 1 mm a substep (as a
     // deforming surface's edges move) into a still one 3 cm above it.
     for (moved, rise, above) in [
@@ -91,7 +101,7 @@ fn cloth_edges_passed_by_on_their_odometers_end_where_every_one_asked_ends() {
     ] {
         let mut rnd = crate::test_rng::uniform(33);
         let (model, mut state) = cloth_over_cube(above);
-        let mut memory = EdgeMemory::default();
+        let (mut memory, mut shared_memory) = (EdgeMemory::default(), EdgeMemory::default());
         let (mut asked_fresh, mut pushes, mut earlier) = (0, 0, Vec::new());
         for substep in 0..160 {
             let start = state.pos.clone();
@@ -110,7 +120,12 @@ fn cloth_edges_passed_by_on_their_odometers_end_where_every_one_asked_ends() {
             let mut fresh = state.clone();
             let mut none = EdgeMemory::default();
             let expected = pass(&edges, &model, &start, &mut fresh, (&mut none, moved));
-            let got = pass(&edges, &model, &start, &mut state, (&mut memory, moved));
+            let mut shared = state.clone();
+            let got =
+                alone.install(|| pass(&edges, &model, &start, &mut state, (&mut memory, moved)));
+            let twin = (&mut shared_memory, moved);
+            let by_two = team.install(|| pass(&edges, &model, &start, &mut shared, twin));
+            assert_eq!(by_two, got, "{moved:?}, substep {substep}: shared");
             assert_eq!(
                 got, expected,
                 "{moved:?}, substep {substep}: cloth edges moved"
@@ -124,11 +139,27 @@ fn cloth_edges_passed_by_on_their_odometers_end_where_every_one_asked_ends() {
                 bits(&state) == bits(&fresh),
                 "{moved:?}, substep {substep}: states differ"
             );
+            assert!(
+                bits(&shared) == bits(&state),
+                "{moved:?}, substep {substep}: shared, the states differ"
+            );
+            // With no memory, every sweep asks every cloth edge: none left out of a colour
+            // however it is cut.
+            let edges_of_cloth = model.edge_colours.order.len();
+            assert!(
+                none.asked >= edges_of_cloth && none.asked % edges_of_cloth == 0,
+                "{moved:?}, substep {substep}: {} asked of {edges_of_cloth}",
+                none.asked
+            );
             asked_fresh += none.asked;
             pushes += got;
         }
         // Not a test that could pass by asking every cloth edge, or by pushing none: where
         // the edges are fixed, most are passed by; where they move, none is.
+        assert_eq!(
+            shared_memory.asked, memory.asked,
+            "{moved:?}: shared, asked"
+        );
         let asked = match moved {
             EdgesMoved::Fixed => 2 * memory.asked < asked_fresh,
             EdgesMoved::By(_) => memory.asked == asked_fresh,
