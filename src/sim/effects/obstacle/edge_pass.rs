@@ -92,7 +92,7 @@ impl EdgeMemory {
     fn take_in(
         &mut self,
         pos: &[Vec3],
-        to_local: impl Fn(Vec3) -> Vec3,
+        to_local: impl Fn(Vec3) -> Vec3 + Sync,
         edges: usize,
         fixed: bool,
     ) -> Option<Reading> {
@@ -116,17 +116,36 @@ impl EdgeMemory {
             self.asked_at.clear();
             self.asked_at.resize(edges, Asked::NOT);
         }
-        let (mut travel, mut scale) = (0.0f32, 0.0f32);
-        let moves =
-            (self.local.iter_mut().zip(&mut self.odometers)).zip(pos.iter().zip(&self.before));
-        for ((local, odometer), (&p, before)) in moves {
-            let now = Vec3A::from(to_local(p));
-            // The sum of the move's components: never less than its length, and no root.
-            *odometer += f64::from((now - *local).abs().element_sum());
-            travel = travel.max(now.distance_squared(*before));
-            scale = scale.max(now.abs().max_element());
-            *local = now;
-        }
+        // Each particle's own, so a large cloth's are shared out between the team in
+        // pieces (the farthest move and the largest coordinate are the same however cut).
+        let team = Team::current();
+        let pieces = pos.len().div_ceil(PIECE);
+        let parallel = pos.len() > SHARED_FROM && team.members() <= TALLIES;
+        let mut most = [(0.0f32, 0.0f32); TALLIES];
+        let slots = Disjoint::new(&mut most);
+        let (locals, odometers) = (
+            Disjoint::new(&mut self.local),
+            Disjoint::new(&mut self.odometers),
+        );
+        let before = &self.before;
+        team.run_pieces_if(parallel, pieces, &|member, piece| {
+            let (mut travel, mut scale) = (0.0f32, 0.0f32);
+            for i in piece * PIECE..pos.len().min((piece + 1) * PIECE) {
+                let now = Vec3A::from(to_local(pos[i]));
+                // SAFETY: particle `i` is this piece's alone.
+                let (local, odometer) = unsafe { (locals.at(i), odometers.at(i)) };
+                // The sum of the move's components: never less than its length, and no root.
+                *odometer += f64::from((now - *local).abs().element_sum());
+                travel = travel.max(now.distance_squared(before[i]));
+                scale = scale.max(now.abs().max_element());
+                *local = now;
+            }
+            // SAFETY: each member keeps its own.
+            let slot = unsafe { slots.at(member) };
+            *slot = (slot.0.max(travel), slot.1.max(scale));
+        });
+        let (travel, scale) =
+            (most.iter()).fold((0.0f32, 0.0f32), |(t, s), &(mt, ms)| (t.max(mt), s.max(ms)));
         // A distance between two points of this size is rounded by far less.
         let rounding = 4.0 * f32::EPSILON * (1.0 + scale);
         for odometer in &mut self.odometers {
@@ -302,8 +321,12 @@ pub(super) enum EdgesMoved {
 /// How many times at most the edge pass runs in one substep.
 const EDGE_SWEEPS: usize = 4;
 
-/// Cloth edges a member of the team takes at once; a colour of fewer is taken by one.
+/// Cloth edges (or particles) a member of the team takes at once; a colour of fewer is
+/// taken by one.
 const PIECE: usize = 256;
+
+/// Particles from which the pass takes them into its frame shared out between the team.
+const SHARED_FROM: usize = 1024;
 
 /// Members of the team whose tallies a colour keeps (a larger team takes each colour alone).
 const TALLIES: usize = 16;
