@@ -57,14 +57,18 @@ impl Reach {
     /// keeping `offset` (where an obstacle has no thickness of its own).
     pub fn fit(&mut self, effects: &[Effect], model: &ClothModel, offset: f32) -> Vec<Effect> {
         let span = ClothSpan::of(&model.rest_positions, &model.triangles, GROWTH, offset);
-        let mut edges: Vec<[u32; 2]> = (model.triangles.iter())
-            .flat_map(|&[a, b, c]| [[a, b], [b, c], [c, a]])
-            .map(|[a, b]| [a.min(b), a.max(b)])
-            .collect();
-        edges.sort_unstable();
-        edges.dedup();
-        self.edges = edges;
-        self.fit_to(effects, folded(span))
+        let fitted = self.fit_to(effects, folded(span));
+        // The cloth's edges, to measure its stretch on, only where it is measured.
+        self.edges.clear();
+        if self.gentle {
+            let edges = (model.triangles.iter())
+                .flat_map(|&[a, b, c]| [[a, b], [b, c], [c, a]])
+                .map(|[a, b]| [a.min(b), a.max(b)]);
+            self.edges.extend(edges);
+            self.edges.sort_unstable();
+            self.edges.dedup();
+        }
+        fitted
     }
 
     /// `effects` (as last fitted) fitted again where the cloth at `pos` has stretched past
