@@ -231,21 +231,9 @@ pub fn sprouting_roof(dir: &Path) -> Tipped {
 /// Writes to `path` a closed prism of `sides` narrow faces along the x axis, 2 m long, its
 /// corners `radius` from the line `y = axis`, `z = 0`.
 fn write_prism(path: &Path, sides: u32, radius: f32, axis: f32) {
-    let mut corners = Vec::new();
-    for k in 0..sides {
-        let a = std::f32::consts::TAU * k as f32 / sides as f32;
-        let (y, z) = (axis + radius * a.sin(), radius * a.cos());
-        corners.extend([Vec3::new(-1.0, y, z), Vec3::new(1.0, y, z)]);
-    }
-    corners.extend([Vec3::new(-1.0, axis, 0.0), Vec3::new(1.0, axis, 0.0)]);
-    let (left, right) = (2 * sides, 2 * sides + 1);
-    let mut faces = Vec::new();
-    for k in 0..sides {
-        let [a, b] = [2 * k, 2 * k + 1];
-        let [c, d] = [2 * ((k + 1) % sides), 2 * ((k + 1) % sides) + 1];
-        faces.extend([[a, c, d], [a, d, b], [left, c, a], [right, b, d]]);
-    }
-    write_obj(path, &corners, &faces);
+    let (corners, faces) = clothsim::sim::obstacle::prism(sides, radius);
+    let raised: Vec<Vec3> = corners.iter().map(|&c| c + Vec3::Y * axis).collect();
+    write_obj(path, &raised, &faces);
 }
 
 /// A 20 cm ball of about `triangles` triangles on the ground (its top 0.4 m up), written

@@ -9,9 +9,7 @@ mod surface;
 mod tips;
 mod tree;
 
-pub use coarse::ClothSpan;
-#[cfg(test)]
-pub(crate) use coarse::prism;
+pub use coarse::{ClothSpan, prism};
 #[cfg(test)]
 pub(crate) use edges::unit_cube;
 pub use edges::{Clearance, EdgeHit, LOOK, LOOK_DEFORMING, SharpEdges};
