@@ -2,7 +2,7 @@
 //! triangles in every frame), each vertex moving in a straight line from one frame to the
 //! next, and the surface refitted (not rebuilt) to wherever a substep ends.
 
-use std::sync::{Mutex, MutexGuard, PoisonError};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use glam::Vec3;
 
@@ -13,8 +13,8 @@ use super::tree::Nearest;
 /// The frames of a deforming obstacle and its surface at the last substep asked for.
 #[derive(Debug)]
 pub struct Sequence {
-    /// Each frame's vertices, placed.
-    frames: Vec<Vec<Vec3>>,
+    /// Each frame's vertices, placed (shared by the same sequence over another surface).
+    frames: Arc<[Vec<Vec3>]>,
     /// Frames per second (> 0).
     fps: f64,
     /// After the last frame: back to the first (over one frame's time) and on, or hold.
@@ -90,6 +90,11 @@ impl Sequence {
     /// # Panics
     /// When `frames` is empty or differ in length from `surface`.
     pub fn new(surface: Surface, frames: Vec<Vec<Vec3>>, fps: f64, looped: bool) -> Self {
+        Self::sharing(surface, frames.into(), fps, looped)
+    }
+
+    /// [`Sequence::new`] over frames it may share.
+    fn sharing(surface: Surface, frames: Arc<[Vec<Vec3>]>, fps: f64, looped: bool) -> Self {
         assert!(
             frames.iter().all(|f| f.len() == surface.vertices().len()),
             "frames of other lengths"
@@ -110,10 +115,11 @@ impl Sequence {
         }
     }
 
-    /// The same frames over `surface` (frame 0's, as [`Sequence::new`] takes it: the
-    /// same vertices, its edges and tips told apart another way).
+    /// The same frames (shared, not copied) over `surface` (frame 0's, as
+    /// [`Sequence::new`] takes it: the same vertices, its edges and tips told apart
+    /// another way).
     pub fn over(&self, surface: Surface) -> Self {
-        Self::new(surface, self.frames.clone(), self.fps, self.looped)
+        Self::sharing(surface, Arc::clone(&self.frames), self.fps, self.looped)
     }
 
     /// Each frame's vertices, placed.
