@@ -13,7 +13,7 @@ use super::solid::{Solid, default_friction, resolve_remembering};
 use crate::cloth::ClothState;
 use crate::mesh::{ObjError, PolygonSoup, parse_obj, read_obj};
 use crate::sim::motion::{AxisAngle, Keyframe, Pose, RigidMotion};
-use crate::sim::obstacle::{ClothSpan, Gathered, Moment, Sequence, Surface, SurfaceClock};
+use crate::sim::obstacle::{Fitted, Gathered, Moment, Sequence, Surface, SurfaceClock};
 use crate::sim::param_error::ParamError;
 use crate::sim::self_contacts::ContactError;
 
@@ -135,8 +135,8 @@ pub struct Placed {
     memory: std::sync::Mutex<(Vec<Gathered>, SurfaceClock)>,
     /// What its edge pass keeps from one substep to the next.
     edge_memory: std::sync::Mutex<EdgeMemory>,
-    /// The last cloth span it was fitted to and what that gave ([`Obstacle::reaching`]).
-    reached: std::sync::Mutex<Option<(ClothSpan, Option<Arc<Placed>>)>>,
+    /// What fitting it to a cloth measured and gave last ([`Obstacle::reaching`]).
+    reached: std::sync::Mutex<Fitted<Placed>>,
 }
 
 impl Placed {

@@ -216,6 +216,37 @@ mod tests {
         assert!(reach.outgrown(&refitted, &grown(2.0)).is_none());
     }
 
+    /// The rail fitted to a cloth of 12 cm edges (6 cm lever) 1 cm thick keeps off its 40
+    /// ridges besides the 80 edges of its rims; 1.01 cm thick, the cloth reaches the same
+    /// edges, and the fit is the same one, not built again (a slider dragged a little); 2
+    /// cm thick, it reaches none, and the rail is its own; back to 9 mm, the ridges again,
+    /// in a fit of its own. Red with the answer built again wherever the span changed.
+    #[test]
+    fn a_thickness_that_changes_nothing_reached_keeps_the_fit() {
+        let rail = [rail()];
+        let fitted = |thickness| {
+            let span = ClothSpan {
+                edge: 0.12,
+                lever: 0.06,
+                thickness,
+            };
+            fitted_to_cloth(&rail, span)
+        };
+        let placed = |effects: &[Effect]| match &effects[0] {
+            Effect::Obstacle(o) => o.placed().unwrap() as *const _,
+            _ => unreachable!(),
+        };
+        let (one, more, two) = (fitted(0.01), fitted(0.0101), fitted(0.02));
+        assert_eq!(kept_off(&one), 120);
+        assert_eq!(kept_off(&more), 120);
+        assert!(std::ptr::eq(placed(&one), placed(&more)));
+        assert_eq!(kept_off(&two), 80);
+        assert!(std::ptr::eq(placed(&two), placed(&rail)));
+        let back = fitted(0.009);
+        assert_eq!(kept_off(&back), 120);
+        assert!(!std::ptr::eq(placed(&back), placed(&one)));
+    }
+
     /// A roof of four faces rising 4.7° to an apex 1.6 m across (no crease, no tip by its
     /// faces), as a mesh obstacle.
     fn low_roof() -> Effect {

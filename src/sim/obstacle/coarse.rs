@@ -20,7 +20,7 @@
 //! at most its longest edge and its square), the cloth reaches `x` only where
 //! `a·Σ wᵢdᵢ + b·Σ wᵢdᵢ² ≥ h`.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
 use std::f32::consts::FRAC_PI_2;
 
@@ -61,8 +61,8 @@ pub struct ClothSpan {
 pub(super) struct Faces<'a> {
     triangles: &'a [[u32; 3]],
     normals: &'a [Vec3],
-    /// What a walk reads of each face, side by side.
-    walked: Vec<Walked>,
+    /// What a walk reads of each face, side by side ([`walked_faces`]).
+    walked: &'a [Walked],
     /// Each vertex's first at its place.
     same: &'a [u32],
 }
@@ -101,129 +101,55 @@ impl Walk {
     }
 }
 
-impl<'a> Faces<'a> {
-    /// The faces `triangles` over `vertices`, each with its unit normal in `normals` (zero
-    /// for a degenerate one, which has no neighbours); `same` gives each vertex the first at
-    /// its place (`welded`), which is one vertex with it.
-    pub(super) fn new(
-        vertices: &[Vec3],
-        triangles: &'a [[u32; 3]],
-        normals: &'a [Vec3],
-        same: &'a [u32],
-    ) -> Self {
-        let mut sides: HashMap<(u32, u32), Vec<(u32, u8)>> = HashMap::new();
-        for (t, tri) in triangles.iter().enumerate() {
-            if normals[t] == Vec3::ZERO {
-                continue;
-            }
-            let tri = tri.map(|i| same[i as usize]);
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                let side = (t as u32, k as u8);
-                sides.entry((a.min(b), a.max(b))).or_default().push(side);
-            }
+/// What the bound's walks read of each of the faces `triangles` over `vertices`, each
+/// with its unit normal in `normals` (zero for a degenerate one, which has no
+/// neighbours); `same` gives each vertex the first at its place (`welded`), which is one
+/// vertex with it.
+fn walked_faces(
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+    normals: &[Vec3],
+    same: &[u32],
+) -> Vec<Walked> {
+    let mut sides: HashMap<(u32, u32), Vec<(u32, u8)>> = HashMap::new();
+    for (t, tri) in triangles.iter().enumerate() {
+        if normals[t] == Vec3::ZERO {
+            continue;
         }
-        let mut across = vec![[NONE; 3]; triangles.len()];
-        for faces in sides.values() {
-            if let [(s, j), (t, k)] = faces[..]
-                && normals[s as usize].dot(normals[t as usize]).abs() >= CREASE_COS
-            {
-                across[s as usize][j as usize] = t;
-                across[t as usize][k as usize] = s;
-            }
-        }
-        let walked = (triangles.iter().zip(normals).zip(across))
-            .map(|((t, &normal), across)| {
-                let [p, q, r] = t.map(|i| vertices[i as usize]);
-                let (lo, hi) = (p.min(q).min(r), p.max(q).max(r));
-                Walked {
-                    lo,
-                    hi,
-                    normal,
-                    across,
-                }
-            })
-            .collect();
-        Self {
-            triangles,
-            normals,
-            walked,
-            same,
+        let tri = tri.map(|i| same[i as usize]);
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            let side = (t as u32, k as u8);
+            sides.entry((a.min(b), a.max(b))).or_default().push(side);
         }
     }
+    let mut across = vec![[NONE; 3]; triangles.len()];
+    for faces in sides.values() {
+        if let [(s, j), (t, k)] = faces[..]
+            && normals[s as usize].dot(normals[t as usize]).abs() >= CREASE_COS
+        {
+            across[s as usize][j as usize] = t;
+            across[t as usize][k as usize] = s;
+        }
+    }
+    (triangles.iter().zip(normals).zip(across))
+        .map(|((t, &normal), across)| {
+            let [p, q, r] = t.map(|i| vertices[i as usize]);
+            let (lo, hi) = (p.min(q).min(r), p.max(q).max(r));
+            Walked {
+                lo,
+                hi,
+                normal,
+                across,
+            }
+        })
+        .collect()
+}
 
+impl Faces<'_> {
     /// The cosine of the angle between the faces `s` and `t` (unsigned).
     fn turn(&self, [s, t]: [u32; 2]) -> f32 {
         self.normals[s as usize].dot(self.normals[t as usize]).abs()
-    }
-
-    /// The edges between two faces (by their two vertices, each the first at its place,
-    /// the lesser first) and the vertices whose faces turn from each other by less than a
-    /// crease (each the first at its place) that a cloth of `span` can reach (at
-    /// `vertices`). Each vertex's walk serves the edges round it (a face is at most an
-    /// edge's length nearer the edge than its end, and turns from the edge's faces at most
-    /// as far again as the end's reference does from them); an edge longer than the reach,
-    /// or with an end its walk did not measure, walks on its own. In pieces shared among
-    /// the threads.
-    pub(super) fn reached(
-        &self,
-        span: &ClothSpan,
-        vertices: &[Vec3],
-    ) -> (HashSet<(u32, u32)>, HashSet<u32>) {
-        let fans = self.fans();
-        let fans: Vec<&[(u32, u32)]> = fans.chunk_by(|a, b| a.0 == b.0).collect();
-        // Each thread's scratch serves the pieces it takes.
-        let walked: Vec<Vec<(u32, Result<Around, ()>)>> = (fans.par_chunks(PIECE))
-            .map_init(
-                || Walk::over(self),
-                |walk, piece| {
-                    let around = |fan| span.around(self, walk, vertices, fan);
-                    piece.iter().filter_map(around).collect()
-                },
-            )
-            .collect();
-        let mut around = vec![None; vertices.len()];
-        let mut reached_vertices = HashSet::new();
-        for (v, found) in walked.into_iter().flatten() {
-            match found {
-                Ok(found) => {
-                    if found.reached {
-                        reached_vertices.insert(v);
-                    }
-                    around[v as usize] = Some(found);
-                }
-                Err(()) => {
-                    reached_vertices.insert(v);
-                }
-            }
-        }
-        let count = self.triangles.len();
-        let pieces: Vec<Vec<(u32, u32)>> = (0..count.div_ceil(PIECE))
-            .into_par_iter()
-            .map_init(
-                || Walk::over(self),
-                |walk, piece| {
-                    let mut reached = Vec::new();
-                    for s in piece * PIECE..count.min((piece + 1) * PIECE) {
-                        for (k, &t) in self.walked[s].across.iter().enumerate() {
-                            if t == NONE || (t as usize) < s {
-                                continue;
-                            }
-                            let tri = self.triangles[s];
-                            let ends = [tri[k], tri[(k + 1) % 3]].map(|i| self.same[i as usize]);
-                            let faces = [s as u32, t];
-                            let walks = ends.map(|v| around[v as usize].as_ref());
-                            if span.reaches_edge((self, walk), vertices, ends, faces, walks) {
-                                let [a, b] = ends;
-                                reached.push((a.min(b), a.max(b)));
-                            }
-                        }
-                    }
-                    reached
-                },
-            )
-            .collect();
-        (pieces.into_iter().flatten().collect(), reached_vertices)
     }
 
     /// Each vertex's faces (the vertex first at its place, a face), by vertex.
@@ -238,16 +164,14 @@ impl<'a> Faces<'a> {
 
     /// Walks from the faces `starts` across gentle and flat edges (nearest first) the
     /// faces whose boxes lie within `least.len()` rings of `width` of the box `lo..hi`,
-    /// keeping each ring's least cosine (unsigned) to `reference` in `least`; stops, and
-    /// says so, as soon as the first ring's is `stop` or less.
+    /// keeping each ring's least cosine (unsigned) to `reference` in `least`.
     fn walk_rings(
         &self,
         walk: &mut Walk,
         starts: impl IntoIterator<Item = u32>,
         ((lo, hi), reference): ((Vec3, Vec3), Vec3),
         (width, least): (f32, &mut [f32]),
-        stop: f32,
-    ) -> bool {
+    ) {
         let rings = least.len();
         let reach = width * rings as f32;
         least.fill(1.0);
@@ -270,9 +194,6 @@ impl<'a> Faces<'a> {
             }
             let ring = ((apart / width) as usize).min(rings - 1);
             least[ring] = least[ring].min(face.normal.dot(reference).abs());
-            if least[0] <= stop {
-                return true;
-            }
             for u in face.across {
                 if u != NONE && walk.seen[u as usize] != walked {
                     walk.seen[u as usize] = walked;
@@ -280,19 +201,214 @@ impl<'a> Faces<'a> {
                 }
             }
         }
-        false
+    }
+}
+
+/// The gentle edges (their two vertices, each the first at its place, the lesser first)
+/// and vertices (each the first at its place) of a surface that a cloth reaches, each in
+/// order ([`super::Surface::reached_over`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Reached {
+    pub edges: Vec<[u32; 2]>,
+    pub vertices: Vec<u32>,
+}
+
+/// What the bound's walks over a surface measured for a cloth's reach (its longest edge
+/// and its triangles' lever), whatever thickness the cloth keeps: how far a cloth
+/// triangle over each gentle vertex, and a cloth edge across each gentle edge, can come
+/// into the surface. A thickness then only draws the line (`Dips::reached`), so a cloth
+/// keeping another thickness (a slider dragged) is answered without walking again.
+///
+/// Each vertex's walk serves the edges round it (a face is at most an edge's length nearer
+/// the edge than its end, and turns from the edge's faces at most as far again as the
+/// end's reference does from them): a bound from above. An edge that bound leaves within
+/// the line, or longer than the reach, or with an end its walk did not measure, takes a
+/// walk of its own, the first time a line asks for it; its answer is kept too.
+pub struct Dips {
+    /// The span measured for (its thickness aside).
+    edge: f32,
+    lever: f32,
+    /// Each vertex's first at its place.
+    same: Vec<u32>,
+    walked: Vec<Walked>,
+    /// Each gentle vertex (the first at its place; not at a crease, its faces not in one
+    /// plane) and how far a cloth triangle over it comes in, m.
+    vertices: Vec<(u32, f32)>,
+    edges: Vec<EdgeDip>,
+}
+
+/// An edge between two faces not in one plane (its ends the first at their places, the
+/// lesser first; its faces), the bound its ends' walks give (infinite where they give
+/// none), and its own walk's, once taken.
+struct EdgeDip {
+    ends: [u32; 2],
+    faces: [u32; 2],
+    by_ends: f32,
+    own: Option<f32>,
+}
+
+impl std::fmt::Debug for Dips {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Dips")
+            .field("edge", &self.edge)
+            .field("lever", &self.lever)
+            .field("vertices", &self.vertices.len())
+            .field("edges", &self.edges.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl Dips {
+    /// The walks over the faces `triangles` at `vertices`, with their unit normals
+    /// `normals`, for a cloth of `span` (its thickness aside); `same` gives each vertex
+    /// the first at its place. In pieces shared among the threads.
+    pub(super) fn measure(
+        (vertices, triangles, normals): (&[Vec3], &[[u32; 3]], &[Vec3]),
+        same: Vec<u32>,
+        span: &ClothSpan,
+    ) -> Self {
+        let walked = walked_faces(vertices, triangles, normals, &same);
+        let faces = Faces {
+            triangles,
+            normals,
+            walked: &walked,
+            same: &same,
+        };
+        let fans = faces.fans();
+        let fans: Vec<&[(u32, u32)]> = fans.chunk_by(|a, b| a.0 == b.0).collect();
+        // Each thread's scratch serves the pieces it takes.
+        let found: Vec<Vec<(u32, Around)>> = (fans.par_chunks(PIECE))
+            .map_init(
+                || Walk::over(&faces),
+                |walk, piece| {
+                    let around = |fan| span.around(&faces, walk, vertices, fan);
+                    piece.iter().filter_map(around).collect()
+                },
+            )
+            .collect();
+        let mut around = vec![None; vertices.len()];
+        let mut dips = Vec::new();
+        for (v, found) in found.into_iter().flatten() {
+            dips.push((v, found.dip));
+            around[v as usize] = Some(found);
+        }
+        let count = triangles.len();
+        let edges: Vec<Vec<EdgeDip>> = (0..count.div_ceil(PIECE))
+            .into_par_iter()
+            .map_init(
+                || Walk::over(&faces),
+                |walk, piece| {
+                    let mut edges = Vec::new();
+                    for s in piece * PIECE..count.min((piece + 1) * PIECE) {
+                        for (k, &t) in walked[s].across.iter().enumerate() {
+                            if t == NONE
+                                || (t as usize) < s
+                                || faces.turn([s as u32, t]) >= FLAT_COS
+                            {
+                                continue;
+                            }
+                            let tri = triangles[s];
+                            let ends = [tri[k], tri[(k + 1) % 3]].map(|i| same[i as usize]);
+                            let sides = [s as u32, t];
+                            let walks = ends.map(|v| around[v as usize].as_ref());
+                            let by_ends = match walks {
+                                [Some(_), Some(_)] => {
+                                    span.edge_dip((&faces, walk), vertices, (ends, sides), walks)
+                                }
+                                _ => f32::INFINITY,
+                            };
+                            let [a, b] = ends;
+                            edges.push(EdgeDip {
+                                ends: [a.min(b), a.max(b)],
+                                faces: sides,
+                                by_ends,
+                                own: None,
+                            });
+                        }
+                    }
+                    edges
+                },
+            )
+            .collect();
+        Self {
+            edge: span.edge,
+            lever: span.lever,
+            same,
+            walked,
+            vertices: dips,
+            edges: edges.into_iter().flatten().collect(),
+        }
+    }
+
+    /// Whether these walks were taken for a cloth of `span`'s reach (of any thickness).
+    pub(super) fn measures(&self, span: &ClothSpan) -> bool {
+        (self.edge, self.lever) == (span.edge, span.lever)
+    }
+
+    /// How many edges have taken a walk of their own so far.
+    #[cfg(test)]
+    fn own_walks(&self) -> usize {
+        self.edges.iter().filter(|e| e.own.is_some()).count()
+    }
+
+    /// Each vertex's first at its place, as [`Dips::measure`] was given.
+    pub(super) fn same(&self) -> &[u32] {
+        &self.same
+    }
+
+    /// The edges (by their two vertices, each the first at its place, the lesser first)
+    /// and the vertices (each the first at its place) that a cloth of `span` reaches: where
+    /// it comes into the surface by what `span` needs of the thickness or more. The
+    /// surface is the one measured (`vertices`, `triangles`, `normals`); the edges that
+    /// need a walk of their own for this line and had none take it now, shared among the
+    /// threads.
+    pub(super) fn reached(
+        &mut self,
+        (vertices, triangles, normals): (&[Vec3], &[[u32; 3]], &[Vec3]),
+        span: &ClothSpan,
+    ) -> (Vec<[u32; 2]>, Vec<u32>) {
+        let need = span.need();
+        let faces = Faces {
+            triangles,
+            normals,
+            walked: &self.walked,
+            same: &self.same,
+        };
+        let measuring = ClothSpan {
+            edge: self.edge,
+            lever: self.lever,
+            ..*span
+        };
+        (self.edges.par_chunks_mut(PIECE)).for_each_init(
+            || Walk::over(&faces),
+            |walk, piece| {
+                for e in piece
+                    .iter_mut()
+                    .filter(|e| e.by_ends >= need && e.own.is_none())
+                {
+                    let edge = (e.ends, e.faces);
+                    e.own = Some(measuring.edge_dip((&faces, walk), vertices, edge, [None; 2]));
+                }
+            },
+        );
+        let edges = (self.edges.iter())
+            .filter(|e| e.by_ends >= need && e.own.is_some_and(|own| own >= need))
+            .map(|e| e.ends);
+        let vertices = (self.vertices.iter()).filter(|&&(_, dip)| dip >= need);
+        (edges.collect(), vertices.map(|&(v, _)| v).collect())
     }
 }
 
 /// What one vertex's walk measured: the steepest turn (radians) from its reference of the
 /// faces within each ring and every ring nearer, out to the reach and as far again as its
-/// longest edge, and that reference; and whether the vertex itself is reached.
+/// longest edge, and that reference; and how far a cloth triangle over the vertex comes
+/// into the surface (m).
 #[derive(Clone)]
 struct Around {
     steepest: [f32; 2 * RINGS],
     rings: usize,
     reference: Vec3,
-    reached: bool,
+    dip: f32,
 }
 
 /// The bisecting plane's normal of two faces' normals (unsigned).
@@ -355,43 +471,15 @@ impl ClothSpan {
         MARGIN * self.thickness
     }
 
-    /// Whether a cloth edge can reach the surface's edge between the vertices `ends` (at
-    /// `vertices`) and the faces `sides` ([`ClothSpan::edge_dip`]): what a walk of its own
-    /// says, asked only where its ends' walks do not already leave it short.
-    fn reaches_edge(
-        &self,
-        (faces, walk): (&Faces<'_>, &mut Walk),
-        vertices: &[Vec3],
-        ends: [u32; 2],
-        sides: [u32; 2],
-        walks: [Option<&Around>; 2],
-    ) -> bool {
-        let need = self.need();
-        if faces.turn(sides) >= FLAT_COS {
-            return false;
-        }
-        // The ends' walks bound it from above: where they leave it short, it is; else its
-        // own walk decides.
-        let edge = (ends, sides);
-        let measured = walks.iter().all(Option::is_some);
-        if measured && self.edge_dip((faces, walk), vertices, edge, walks, need) < need {
-            return false;
-        }
-        self.edge_dip((faces, walk), vertices, edge, [None; 2], need) >= need
-    }
-
     /// How far at most (m) a cloth edge comes into the surface at its edge between the
     /// vertices `ends` (at `vertices`) and the faces `[s, t]`: from its ends' walks where
-    /// both measured them and it is no longer than the reach, else by a walk of its own,
-    /// which stops as soon as the faces nearest it alone take it to `enough` (and says
-    /// what they take it to).
+    /// both measured them and it is no longer than the reach, else by a walk of its own.
     fn edge_dip(
         &self,
         (faces, walk): (&Faces<'_>, &mut Walk),
         vertices: &[Vec3],
         (ends, [s, t]): ([u32; 2], [u32; 2]),
         walks: [Option<&Around>; 2],
-        enough: f32,
     ) -> f32 {
         let (half, width) = (0.5 * self.edge, self.width());
         if !(width > 0.0 && width.is_finite()) {
@@ -422,25 +510,21 @@ impl ClothSpan {
             return dip_of(slopes, width, bound);
         }
         let mut least = [1.0f32; RINGS];
-        let stop = slope_cos(enough / half);
         let box_ = (a.min(b), a.max(b));
-        if faces.walk_rings(walk, [s], (box_, reference), (width, &mut least), stop) {
-            return steepest(least)[0].tan() * half;
-        }
+        faces.walk_rings(walk, [s], (box_, reference), (width, &mut least));
         dip_of(steepest(least).map(f32::tan), width, bound)
     }
 
     /// The walk of the vertex of `fan` (its faces, by the vertex, first at its place, at
-    /// `vertices`) and whether a cloth triangle reaches it; `Err` where it is reached by
-    /// the faces nearest it alone (its walk stopped there); `None` for a vertex at a crease
-    /// (a tip already) or whose faces lie in one plane.
+    /// `vertices`); `None` for a vertex at a crease (a tip already) or whose faces lie in
+    /// one plane.
     fn around(
         &self,
         faces: &Faces<'_>,
         walk: &mut Walk,
         vertices: &[Vec3],
         fan: &&[(u32, u32)],
-    ) -> Option<(u32, Result<Around, ()>)> {
+    ) -> Option<(u32, Around)> {
         let width = self.width();
         if !(width > 0.0 && width.is_finite()) {
             return None;
@@ -466,15 +550,16 @@ impl ClothSpan {
             .map(|i| at.distance(vertices[i as usize]))
             .fold(0.0f32, f32::max);
         let rings = RINGS + ((longest.min(self.edge) / width).ceil() as usize).min(RINGS);
-        let (lever, need) = (self.lever, self.need());
+        let lever = self.lever;
         let reference = bisector(faces.normals[s as usize], faces.normals[t as usize]);
         let mut least = [1.0f32; 2 * RINGS];
         let starts = fan.iter().map(|&(_, f)| f);
-        let stop = slope_cos(need / lever);
-        let within = &mut least[..rings];
-        if faces.walk_rings(walk, starts, ((at, at), reference), (width, within), stop) {
-            return Some((v, Err(())));
-        }
+        faces.walk_rings(
+            walk,
+            starts,
+            ((at, at), reference),
+            (width, &mut least[..rings]),
+        );
         let mut steepest = [0.0f32; 2 * RINGS];
         let mut most = 0.0f32;
         for (k, &cos) in least[..rings].iter().enumerate() {
@@ -482,15 +567,15 @@ impl ClothSpan {
             steepest[k] = most;
         }
         let near: [f32; RINGS] = std::array::from_fn(|k| steepest[k].tan());
-        let reached = dip_of(near, width, (lever, lever * lever)) >= need;
+        let dip = dip_of(near, width, (lever, lever * lever));
         Some((
             v,
-            Ok(Around {
+            Around {
                 steepest,
                 rings,
                 reference,
-                reached,
-            }),
+                dip,
+            },
         ))
     }
 }
@@ -503,11 +588,6 @@ fn steepest(least: [f32; RINGS]) -> [f32; RINGS] {
         most = most.max(cos.min(1.0).acos());
         most
     })
-}
-
-/// The cosine of the angle whose slope is `slope`.
-fn slope_cos(slope: f32) -> f32 {
-    1.0 / (1.0 + slope * slope).sqrt()
 }
 
 /// A closed prism of `sides` narrow faces round the x axis, `radius` from it and 2 m long,

@@ -2,10 +2,11 @@
 //! them, and where a particle's move across it ends.
 
 use std::collections::HashSet;
+use std::sync::Arc;
 
 use glam::Vec3;
 
-use super::coarse::{ClothSpan, FLAT_COS, Faces};
+use super::coarse::{ClothSpan, Dips, FLAT_COS, Reached};
 use super::edges::SharpEdges;
 use super::geometry::{closest_on_triangle, less_by_move, rounding_near, segment_crosses, welded};
 use super::tips::Tips;
@@ -125,6 +126,51 @@ fn face_normals(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
         .collect()
 }
 
+/// What fitting a surface to a cloth measured and gave last: the walks over it for the
+/// last reach asked for ([`Dips`]), and the last span asked for with what it reached and
+/// the answer made of that (a mesh obstacle's placement that keeps the cloth off it).
+#[derive(Debug)]
+pub struct Fitted<T> {
+    dips: Option<Dips>,
+    last: Option<(ClothSpan, Reached, Option<Arc<T>>)>,
+}
+
+impl<T> Default for Fitted<T> {
+    fn default() -> Self {
+        Self {
+            dips: None,
+            last: None,
+        }
+    }
+}
+
+impl<T> Fitted<T> {
+    /// What `surface` (taking the places `frames` too: [`Surface::reached_over`]) keeps
+    /// off a cloth of `span`, made into an answer by `answer` (`None` where it adds
+    /// nothing): the last answer where the span is the last one's, or where it reaches
+    /// what the last one did (a thickness changed that changes nothing reached), the walks
+    /// taken for the last reach read again where they serve.
+    pub fn answer<'f>(
+        &mut self,
+        (surface, frames): (&Surface, impl IntoIterator<Item = &'f [Vec3]>),
+        span: &ClothSpan,
+        answer: impl FnOnce(&Reached) -> Option<T>,
+    ) -> Option<Arc<T>> {
+        if let Some((asked, _, answered)) = &self.last
+            && asked == span
+        {
+            return answered.clone();
+        }
+        let reached = surface.reached_over(span, frames, &mut self.dips);
+        let answered = match self.last.take() {
+            Some((_, last, answered)) if last == reached => answered,
+            _ => answer(&reached).map(Arc::new),
+        };
+        self.last = Some((*span, reached, answered.clone()));
+        answered
+    }
+}
+
 impl Surface {
     /// The surface of `triangles` over `vertices` (every index must be in range).
     pub fn new(vertices: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Self {
@@ -198,37 +244,62 @@ impl Surface {
     /// kept off as its creases and tips are ([`ClothSpan`]: a coarse cloth over a rail of
     /// narrow faces); `None` where that adds none.
     pub fn reaching(&self, span: &ClothSpan) -> Option<Surface> {
-        self.reaching_over(span, std::iter::empty())
+        self.keeping_off(&self.reached_over(span, std::iter::empty(), &mut None))
     }
 
-    /// As [`Surface::reaching`], where the surface also takes the places `frames` (the
-    /// frames of a sequence, each as many vertices as the surface): what a cloth can reach
-    /// in any of them is kept off in all.
-    pub fn reaching_over<'f>(
+    /// The gentle edges and vertices that a cloth of `span` can reach, where the surface
+    /// also takes the places `frames` (the frames of a sequence, each as many vertices as
+    /// the surface): what it can reach in any of them. `measured` keeps the walks over the
+    /// surface's own place ([`Dips`]): where it holds walks for `span`'s reach they are
+    /// read, not taken again, so a cloth of another thickness is answered at once; else
+    /// they are taken and left there.
+    pub fn reached_over<'f>(
         &self,
         span: &ClothSpan,
         frames: impl IntoIterator<Item = &'f [Vec3]>,
-    ) -> Option<Surface> {
-        let (vertices, triangles, normals) = (&self.vertices, &self.triangles, &self.normals);
-        // Vertices at one place are one, by where the surface has them.
-        let same = welded(vertices);
-        let (mut reached_edges, mut reached_vertices) =
-            Faces::new(vertices, triangles, normals, &same).reached(span, vertices);
+        measured: &mut Option<Dips>,
+    ) -> Reached {
+        let surface = (&self.vertices[..], &self.triangles[..], &self.normals[..]);
+        let dips = match measured {
+            Some(dips) if dips.measures(span) => dips,
+            // Vertices at one place are one, by where the surface has them.
+            _ => measured.insert(Dips::measure(surface, welded(&self.vertices), span)),
+        };
+        let (mut edges, mut vertices) = dips.reached(surface, span);
         // A frame where the surface already is (a sequence's frame 0) tells nothing more.
-        for frame in frames.into_iter().filter(|&f| f != vertices.as_slice()) {
-            let normals = face_normals(frame, triangles);
-            let faces = Faces::new(frame, triangles, &normals, &same);
-            let (edges, vertices) = faces.reached(span, frame);
-            reached_edges.extend(edges);
-            reached_vertices.extend(vertices);
+        for frame in frames
+            .into_iter()
+            .filter(|&f| f != self.vertices.as_slice())
+        {
+            let normals = face_normals(frame, &self.triangles);
+            let place = (frame, &self.triangles[..], &normals[..]);
+            let (more, most) =
+                Dips::measure(place, dips.same().to_vec(), span).reached(place, span);
+            edges.extend(more);
+            vertices.extend(most);
         }
-        // What the surface keeps off already (a sequence's every frame's) stays.
-        let edges = SharpEdges::of_or(vertices, triangles, normals, |[a, b], _| {
-            reached_edges.contains(&(a.min(b), a.max(b))) || self.edges.has([a, b])
+        edges.sort_unstable();
+        edges.dedup();
+        vertices.sort_unstable();
+        vertices.dedup();
+        Reached { edges, vertices }
+    }
+
+    /// This surface with the edges and vertices `reached` kept off as its creases and tips
+    /// are, besides those it keeps off already; `None` where that adds none.
+    pub fn keeping_off(&self, reached: &Reached) -> Option<Surface> {
+        let Reached { edges, vertices } = reached;
+        let new_edge = |&[a, b]: &[u32; 2]| !self.edges.has([a, b]);
+        if !edges.iter().any(new_edge) && !vertices.iter().any(|&v| !self.tips.has(v)) {
+            return None;
+        }
+        let (triangles, normals) = (&self.triangles, &self.normals);
+        let edges = SharpEdges::of_or(&self.vertices, triangles, normals, |[a, b], _| {
+            edges.binary_search(&[a.min(b), a.max(b)]).is_ok() || self.edges.has([a, b])
         });
         let sharp = edges.ends().iter().copied();
-        let tips = Tips::of_or(vertices, triangles, normals, sharp, |v| {
-            reached_vertices.contains(&v) || self.tips.has(v)
+        let tips = Tips::of_or(&self.vertices, triangles, normals, sharp, |v| {
+            vertices.binary_search(&v).is_ok() || self.tips.has(v)
         })
         .curving_as_much_as([&self.tips]);
         (edges != self.edges || tips != self.tips).then(|| Surface {

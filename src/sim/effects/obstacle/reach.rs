@@ -2,31 +2,25 @@
 //! edges and triangles can reach between their particles kept off as its creases and tips
 //! are ([`ClothSpan`]).
 
-use std::sync::Arc;
-
 use super::{Obstacle, Placed, Shape};
-use crate::sim::obstacle::ClothSpan;
+use crate::sim::obstacle::{ClothSpan, Fitted, Reached};
 
 impl Obstacle {
     /// This obstacle as a cloth of `span` meets it (the same file, placement and motion;
     /// a surface that keeps that cloth off what it can reach, with memories of its own),
-    /// or `None` where its creases and tips already hold all of it. The last span asked
-    /// for is remembered with its answer: asked again (another stepper for the same
-    /// scene), the answer is the same reading.
+    /// or `None` where its creases and tips already hold all of it. What it measured and
+    /// gave is remembered ([`Fitted`]): asked again for the same span (another stepper for
+    /// the same scene) the answer is the same reading, and asked for another thickness it
+    /// takes no walk again.
     pub fn reaching(&self, span: &ClothSpan) -> Option<Obstacle> {
         let placed = self.placed()?;
-        let mut reached = placed.reached.lock().ok();
-        let known = (reached.as_deref())
-            .and_then(|r| r.as_ref())
-            .filter(|(asked, _)| asked == span)
-            .map(|(_, answer)| answer.clone());
-        let answer = known.unwrap_or_else(|| {
-            let answer = placed.reaching(span).map(Arc::new);
-            if let Some(reached) = reached.as_deref_mut() {
-                *reached = Some((*span, answer.clone()));
-            }
-            answer
-        });
+        let frames = placed.sequence.iter().flat_map(|s| s.frames());
+        let keeping_off = |reached: &Reached| placed.keeping_off(reached);
+        // A fit that panicked elsewhere leaves nothing to trust: fit anew, remember nothing.
+        let answer = match placed.reached.lock() {
+            Ok(mut fitted) => fitted.answer((&placed.surface, frames), span, keeping_off),
+            Err(_) => Fitted::default().answer((&placed.surface, frames), span, keeping_off),
+        };
         answer.map(|placed| Obstacle {
             shape: Shape(Some(placed)),
             ..self.clone()
@@ -42,11 +36,10 @@ impl Placed {
         self.sequence.is_some() || self.surface.is_gentle()
     }
 
-    /// This placement with its surface fitted to a cloth of `span` (a sequence's to what
-    /// the cloth can reach in any of its frames), or `None` where that adds nothing.
-    fn reaching(&self, span: &ClothSpan) -> Option<Placed> {
-        let frames = self.sequence.iter().flat_map(|s| s.frames());
-        let surface = self.surface.reaching_over(span, frames)?;
+    /// This placement with its surface keeping off the edges and vertices `reached` (a
+    /// sequence's in all its frames), or `None` where that adds nothing.
+    fn keeping_off(&self, reached: &Reached) -> Option<Placed> {
+        let surface = self.surface.keeping_off(reached)?;
         let sequence = (self.sequence.as_ref()).map(|s| s.over(surface.clone()));
         Some(Placed {
             surface,
