@@ -1,8 +1,6 @@
 //! An obstacle's sharp edges (its creases and its open borders), where a cloth edge can
 //! rest across it with both ends clear of its faces: a table's rim under a tablecloth.
 
-use std::collections::HashMap;
-
 use glam::{Vec3, Vec3A};
 
 use super::geometry::{less_by_move, rounding_near, segments_closest, welded};
@@ -130,27 +128,28 @@ impl SharpEdges {
         also: impl Fn([u32; 2], [usize; 2]) -> bool,
     ) -> Self {
         let same = welded(vertices);
-        let mut faces: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-        for (t, tri) in triangles.iter().enumerate() {
-            let tri = tri.map(|i| same[i as usize]);
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                faces.entry((a.min(b), a.max(b))).or_default().push(t);
-            }
-        }
-        let mut keys: Vec<(u32, u32)> = (faces.iter())
-            .filter(|((a, b), f)| match f.as_slice() {
-                [one, two] => {
-                    normals[*one].dot(normals[*two]).abs() < CREASE_COS
-                        || also([*a, *b], [*one, *two])
+        // Each edge (its welded ends, the lesser first) with each face it borders, by edge.
+        let mut sides: Vec<([u32; 2], u32)> = (triangles.iter().enumerate())
+            .flat_map(|(t, tri)| {
+                let tri = tri.map(|i| same[i as usize]);
+                [0, 1, 2].map(|k| {
+                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                    ([a.min(b), a.max(b)], t as u32)
+                })
+            })
+            .collect();
+        sides.sort_unstable();
+        let keys: Vec<[u32; 2]> = (sides.chunk_by(|x, y| x.0 == y.0))
+            .filter(|faces| match *faces {
+                [(ends, one), (_, two)] => {
+                    let [one, two] = [*one as usize, *two as usize];
+                    normals[one].dot(normals[two]).abs() < CREASE_COS || also(*ends, [one, two])
                 }
                 _ => true,
             })
-            .map(|(k, _)| *k)
+            .map(|faces| faces[0].0)
             .collect();
-        keys.sort_unstable();
-        let ends: Vec<[u32; 2]> = (keys.iter())
-            .map(|&(a, b)| [a, b])
+        let ends: Vec<[u32; 2]> = (keys.into_iter())
             .filter(|[a, b]| vertices[*a as usize] != vertices[*b as usize])
             .collect();
         let edges: Vec<[Vec3; 2]> = ends
