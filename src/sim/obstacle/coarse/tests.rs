@@ -39,6 +39,16 @@ fn reached(surface: &Surface, span: &ClothSpan) -> (Vec<[u32; 2]>, Vec<u32>) {
     Dips::measure(place, welded(surface.vertices()), span).reached(place, span)
 }
 
+/// A ball of 3 072 triangles, 20 cm in radius (a cube's faces cut into squares pushed
+/// onto it).
+fn ball() -> Surface {
+    let soup = crate::bench_contact::cube_sphere(0.2, 3072);
+    let triangles: Vec<[u32; 3]> = (soup.face_indices.chunks_exact(3))
+        .map(|f| [f[0], f[1], f[2]])
+        .collect();
+    Surface::new(soup.positions, triangles)
+}
+
 /// A rail: [`prism`] as a surface.
 fn rail(sides: u32, radius: f32) -> Surface {
     let (vertices, triangles) = prism(sides, radius);
@@ -188,11 +198,7 @@ fn a_low_apex_is_a_tip_to_a_coarse_cloth_only() {
 /// own, and at most three times it (on average 1.41, 1.63 and 1.59 times).
 #[test]
 fn an_edges_bound_from_its_ends_walks_holds_its_own() {
-    let soup = crate::bench_contact::cube_sphere(0.2, 3072);
-    let triangles: Vec<[u32; 3]> = (soup.face_indices.chunks_exact(3))
-        .map(|f| [f[0], f[1], f[2]])
-        .collect();
-    let ball = Surface::new(soup.positions, triangles);
+    let ball = ball();
     let same = welded(ball.vertices());
     let walked = walked_of(&ball, &same);
     let (vertices, faces) = (ball.vertices(), faces_of(&ball, &same, &walked));
@@ -359,11 +365,7 @@ fn a_sequence_keeps_off_what_creases_in_any_frame() {
 /// walk taken at once (4 584 at 2 cm), or with none taken (nothing kept off at 8 mm).
 #[test]
 fn one_measure_answers_every_thickness() {
-    let soup = crate::bench_contact::cube_sphere(0.2, 3072);
-    let triangles: Vec<[u32; 3]> = (soup.face_indices.chunks_exact(3))
-        .map(|f| [f[0], f[1], f[2]])
-        .collect();
-    let surface = Surface::new(soup.positions, triangles);
+    let surface = ball();
     let mut measured = None;
     let mut fit = |thickness: f32| {
         let span = span(0.05, thickness);
