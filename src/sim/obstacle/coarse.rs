@@ -28,6 +28,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::edges::CREASE_COS;
+use super::geometry::face_normals;
 
 /// A part of the surface counts as reachable where the bound leaves less than this share
 /// of the thickness: room for the rounding, the rings' coarseness, and the particles'
@@ -216,30 +217,33 @@ pub struct Reached {
 /// What the bound's walks over a surface measured for a cloth's reach (its longest edge
 /// and its triangles' lever), whatever thickness the cloth keeps: how far a cloth
 /// triangle over each gentle vertex, and a cloth edge across each gentle edge, can come
-/// into the surface. A thickness then only draws the line (`Dips::reached`), so a cloth
-/// keeping another thickness (a slider dragged) is answered without walking again.
+/// into the surface, the most in any of its places (a sequence's frames). A thickness then
+/// only draws the line (`Dips::reached`), so a cloth keeping another thickness (a slider
+/// dragged) is answered without walking again.
 ///
 /// Each vertex's walk serves the edges round it (a face is at most an edge's length nearer
 /// the edge than its end, and turns from the edge's faces at most as far again as the
 /// end's reference does from them): a bound from above. An edge that bound leaves within
 /// the line, or longer than the reach, or with an end its walk did not measure, takes a
-/// walk of its own, the first time a line asks for it; its answer is kept too.
+/// walk of its own in each place, the first time a line asks for it; its answer is kept
+/// too. (An edge reached in some place is reached there by its own walk, which its ends'
+/// bound there holds: the most of each over the places keeps the verdict.)
 pub struct Dips {
     /// The span measured for (its thickness aside).
     edge: f32,
     lever: f32,
     /// Each vertex's first at its place.
     same: Vec<u32>,
-    walked: Vec<Walked>,
     /// Each gentle vertex (the first at its place; not at a crease, its faces not in one
-    /// plane) and how far a cloth triangle over it comes in, m.
+    /// plane, in some place) and how far a cloth triangle over it comes in, m, in order.
     vertices: Vec<(u32, f32)>,
+    /// By their ends, in order.
     edges: Vec<EdgeDip>,
 }
 
-/// An edge between two faces not in one plane (its ends the first at their places, the
-/// lesser first; its faces), the bound its ends' walks give (infinite where they give
-/// none), and its own walk's, once taken.
+/// An edge between two faces neither at a crease nor in one plane in some place (its ends
+/// the first at their places, the lesser first; its faces), the bound its ends' walks give
+/// (infinite where they give none), and its own walk's, once taken.
 struct EdgeDip {
     ends: [u32; 2],
     faces: [u32; 2],
@@ -259,61 +263,182 @@ impl std::fmt::Debug for Dips {
 }
 
 impl Dips {
-    /// The walks over the faces `triangles` at `vertices`, with their unit normals
-    /// `normals`, for a cloth of `span` (its thickness aside); `same` gives each vertex
-    /// the first at its place. In pieces shared among the threads.
-    pub(super) fn measure(
-        (vertices, triangles, normals): (&[Vec3], &[[u32; 3]], &[Vec3]),
+    /// The walks over `triangles` in each of `places` (each as many vertices: a surface,
+    /// then a sequence's other frames) for a cloth of `span` (its thickness aside); `same`
+    /// gives each vertex the first at its place (by the first place). Each place's walks
+    /// in pieces shared among the threads.
+    pub(super) fn measure<'p>(
+        places: impl IntoIterator<Item = &'p [Vec3]>,
+        triangles: &[[u32; 3]],
         same: Vec<u32>,
         span: &ClothSpan,
     ) -> Self {
-        let walked = walked_faces(vertices, triangles, normals, &same);
-        let faces = Faces {
-            triangles,
-            normals,
-            walked: &walked,
-            same: &same,
-        };
-        let fans = faces.fans();
+        let (mut vertices, mut edges) = (Vec::new(), Vec::new());
+        for place in places {
+            let normals = face_normals(place, triangles);
+            let walked = walked_faces(place, triangles, &normals, &same);
+            let faces = Faces {
+                triangles,
+                normals: &normals,
+                walked: &walked,
+                same: &same,
+            };
+            let around = faces.vertex_walks(place, span);
+            vertices.extend((around.iter().enumerate()).filter_map(|(v, a)| {
+                let around = a.as_ref()?;
+                Some((v as u32, around.dip))
+            }));
+            edges.extend(faces.edge_bounds(place, &around, span));
+        }
+        // The most of each over the places.
+        vertices.sort_unstable_by_key(|&(v, _)| v);
+        vertices.dedup_by(|next, kept| {
+            let same_vertex = next.0 == kept.0;
+            if same_vertex {
+                kept.1 = kept.1.max(next.1);
+            }
+            same_vertex
+        });
+        edges.sort_unstable_by_key(|e| e.ends);
+        edges.dedup_by(|next, kept| {
+            let same_edge = next.ends == kept.ends;
+            if same_edge {
+                kept.by_ends = kept.by_ends.max(next.by_ends);
+            }
+            same_edge
+        });
+        Self {
+            edge: span.edge,
+            lever: span.lever,
+            same,
+            vertices,
+            edges,
+        }
+    }
+
+    /// Whether these walks were taken for a cloth of `span`'s reach (of any thickness).
+    pub(super) fn measures(&self, span: &ClothSpan) -> bool {
+        (self.edge, self.lever) == (span.edge, span.lever)
+    }
+
+    /// How many edges have taken a walk of their own so far.
+    #[cfg(test)]
+    fn own_walks(&self) -> usize {
+        self.edges.iter().filter(|e| e.own.is_some()).count()
+    }
+
+    /// The edges (by their two vertices, each the first at its place, the lesser first)
+    /// and the vertices (each the first at its place) that a cloth of `span` reaches: where
+    /// it comes into the surface by what `span` needs of the thickness or more, in some
+    /// place. `places` and `triangles` are those measured; the edges that need a walk of
+    /// their own for this line and had none take it now, in each place where they lie
+    /// between two faces neither at a crease nor in one plane, shared among the threads.
+    pub(super) fn reached<'p>(
+        &mut self,
+        places: impl IntoIterator<Item = &'p [Vec3]>,
+        triangles: &[[u32; 3]],
+        span: &ClothSpan,
+    ) -> (Vec<[u32; 2]>, Vec<u32>) {
+        let need = span.need();
+        let asked: Vec<usize> = (self.edges.iter().enumerate())
+            .filter(|(_, e)| e.by_ends >= need && e.own.is_none())
+            .map(|(k, _)| k)
+            .collect();
+        if !asked.is_empty() {
+            let measuring = ClothSpan {
+                edge: self.edge,
+                lever: self.lever,
+                ..*span
+            };
+            let mut most = vec![f32::NEG_INFINITY; asked.len()];
+            for place in places {
+                let normals = face_normals(place, triangles);
+                let walked = walked_faces(place, triangles, &normals, &self.same);
+                let faces = Faces {
+                    triangles,
+                    normals: &normals,
+                    walked: &walked,
+                    same: &self.same,
+                };
+                let edges = &self.edges;
+                (most.par_chunks_mut(PIECE).zip(asked.par_chunks(PIECE))).for_each_init(
+                    || Walk::over(&faces),
+                    |walk, (most, asked)| {
+                        for (most, &k) in most.iter_mut().zip(asked) {
+                            let e = &edges[k];
+                            if (CREASE_COS..FLAT_COS).contains(&faces.turn(e.faces)) {
+                                let edge = (e.ends, e.faces);
+                                let own =
+                                    measuring.edge_dip((&faces, walk), place, edge, [None; 2]);
+                                *most = most.max(own);
+                            }
+                        }
+                    },
+                );
+            }
+            for (&k, most) in asked.iter().zip(most) {
+                self.edges[k].own = Some(most);
+            }
+        }
+        let edges = (self.edges.iter())
+            .filter(|e| e.by_ends >= need && e.own.is_some_and(|own| own >= need))
+            .map(|e| e.ends);
+        let vertices = (self.vertices.iter()).filter(|&&(_, dip)| dip >= need);
+        (edges.collect(), vertices.map(|&(v, _)| v).collect())
+    }
+}
+
+impl Faces<'_> {
+    /// Each vertex's walk (by the vertex, the first at its place; `None` for a vertex not
+    /// walked: [`ClothSpan::around`]) over these faces at `vertices`, in pieces shared
+    /// among the threads.
+    fn vertex_walks(&self, vertices: &[Vec3], span: &ClothSpan) -> Vec<Option<Around>> {
+        let fans = self.fans();
         let fans: Vec<&[(u32, u32)]> = fans.chunk_by(|a, b| a.0 == b.0).collect();
         // Each thread's scratch serves the pieces it takes.
         let found: Vec<Vec<(u32, Around)>> = (fans.par_chunks(PIECE))
             .map_init(
-                || Walk::over(&faces),
+                || Walk::over(self),
                 |walk, piece| {
-                    let around = |fan| span.around(&faces, walk, vertices, fan);
+                    let around = |fan| span.around(self, walk, vertices, fan);
                     piece.iter().filter_map(around).collect()
                 },
             )
             .collect();
         let mut around = vec![None; vertices.len()];
-        let mut dips = Vec::new();
         for (v, found) in found.into_iter().flatten() {
-            dips.push((v, found.dip));
             around[v as usize] = Some(found);
         }
-        let count = triangles.len();
-        let edges: Vec<Vec<EdgeDip>> = (0..count.div_ceil(PIECE))
+        around
+    }
+
+    /// Each edge between two faces neither at a crease nor in one plane here, with the
+    /// bound its ends' walks `around` give, in pieces shared among the threads.
+    fn edge_bounds(
+        &self,
+        vertices: &[Vec3],
+        around: &[Option<Around>],
+        span: &ClothSpan,
+    ) -> Vec<EdgeDip> {
+        let count = self.triangles.len();
+        let pieces: Vec<Vec<EdgeDip>> = (0..count.div_ceil(PIECE))
             .into_par_iter()
             .map_init(
-                || Walk::over(&faces),
+                || Walk::over(self),
                 |walk, piece| {
                     let mut edges = Vec::new();
                     for s in piece * PIECE..count.min((piece + 1) * PIECE) {
-                        for (k, &t) in walked[s].across.iter().enumerate() {
-                            if t == NONE
-                                || (t as usize) < s
-                                || faces.turn([s as u32, t]) >= FLAT_COS
-                            {
+                        for (k, &t) in self.walked[s].across.iter().enumerate() {
+                            let sides = [s as u32, t];
+                            if t == NONE || (t as usize) < s || self.turn(sides) >= FLAT_COS {
                                 continue;
                             }
-                            let tri = triangles[s];
-                            let ends = [tri[k], tri[(k + 1) % 3]].map(|i| same[i as usize]);
-                            let sides = [s as u32, t];
+                            let tri = self.triangles[s];
+                            let ends = [tri[k], tri[(k + 1) % 3]].map(|i| self.same[i as usize]);
                             let walks = ends.map(|v| around[v as usize].as_ref());
                             let by_ends = match walks {
                                 [Some(_), Some(_)] => {
-                                    span.edge_dip((&faces, walk), vertices, (ends, sides), walks)
+                                    span.edge_dip((self, walk), vertices, (ends, sides), walks)
                                 }
                                 _ => f32::INFINITY,
                             };
@@ -330,72 +455,7 @@ impl Dips {
                 },
             )
             .collect();
-        Self {
-            edge: span.edge,
-            lever: span.lever,
-            same,
-            walked,
-            vertices: dips,
-            edges: edges.into_iter().flatten().collect(),
-        }
-    }
-
-    /// Whether these walks were taken for a cloth of `span`'s reach (of any thickness).
-    pub(super) fn measures(&self, span: &ClothSpan) -> bool {
-        (self.edge, self.lever) == (span.edge, span.lever)
-    }
-
-    /// How many edges have taken a walk of their own so far.
-    #[cfg(test)]
-    fn own_walks(&self) -> usize {
-        self.edges.iter().filter(|e| e.own.is_some()).count()
-    }
-
-    /// Each vertex's first at its place, as [`Dips::measure`] was given.
-    pub(super) fn same(&self) -> &[u32] {
-        &self.same
-    }
-
-    /// The edges (by their two vertices, each the first at its place, the lesser first)
-    /// and the vertices (each the first at its place) that a cloth of `span` reaches: where
-    /// it comes into the surface by what `span` needs of the thickness or more. The
-    /// surface is the one measured (`vertices`, `triangles`, `normals`); the edges that
-    /// need a walk of their own for this line and had none take it now, shared among the
-    /// threads.
-    pub(super) fn reached(
-        &mut self,
-        (vertices, triangles, normals): (&[Vec3], &[[u32; 3]], &[Vec3]),
-        span: &ClothSpan,
-    ) -> (Vec<[u32; 2]>, Vec<u32>) {
-        let need = span.need();
-        let faces = Faces {
-            triangles,
-            normals,
-            walked: &self.walked,
-            same: &self.same,
-        };
-        let measuring = ClothSpan {
-            edge: self.edge,
-            lever: self.lever,
-            ..*span
-        };
-        (self.edges.par_chunks_mut(PIECE)).for_each_init(
-            || Walk::over(&faces),
-            |walk, piece| {
-                for e in piece
-                    .iter_mut()
-                    .filter(|e| e.by_ends >= need && e.own.is_none())
-                {
-                    let edge = (e.ends, e.faces);
-                    e.own = Some(measuring.edge_dip((&faces, walk), vertices, edge, [None; 2]));
-                }
-            },
-        );
-        let edges = (self.edges.iter())
-            .filter(|e| e.by_ends >= need && e.own.is_some_and(|own| own >= need))
-            .map(|e| e.ends);
-        let vertices = (self.vertices.iter()).filter(|&&(_, dip)| dip >= need);
-        (edges.collect(), vertices.map(|&(v, _)| v).collect())
+        pieces.into_iter().flatten().collect()
     }
 }
 

@@ -176,6 +176,16 @@ pub fn segment_meets_box(from: Vec3, to: Vec3, lo: Vec3, hi: Vec3) -> bool {
     true
 }
 
+/// Each of `triangles`' unit normal over `vertices` (zero for a degenerate one).
+pub(super) fn face_normals(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    (triangles.iter())
+        .map(|t| {
+            let [a, b, c] = t.map(|i| vertices[i as usize]);
+            (b - a).cross(c - a).normalize_or_zero()
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

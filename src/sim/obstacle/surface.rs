@@ -8,7 +8,9 @@ use glam::Vec3;
 
 use super::coarse::{ClothSpan, Dips, FLAT_COS, Reached};
 use super::edges::SharpEdges;
-use super::geometry::{closest_on_triangle, less_by_move, rounding_near, segment_crosses, welded};
+use super::geometry::{
+    closest_on_triangle, face_normals, less_by_move, rounding_near, segment_crosses, welded,
+};
 use super::tips::Tips;
 use super::tree::{Near, Nearest, TriangleTree};
 
@@ -114,16 +116,6 @@ pub struct Caught {
     /// is the surface's, for a surface that deforms).
     pub triangle: u32,
     pub on_surface: Vec3,
-}
-
-/// Each of `triangles`' unit normal over `vertices` (zero for a degenerate one).
-fn face_normals(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
-    (triangles.iter())
-        .map(|t| {
-            let [a, b, c] = t.map(|i| vertices[i as usize]);
-            (b - a).cross(c - a).normalize_or_zero()
-        })
-        .collect()
 }
 
 /// What fitting a surface to a cloth measured and gave last: the walks over it for the
@@ -249,39 +241,34 @@ impl Surface {
 
     /// The gentle edges and vertices that a cloth of `span` can reach, where the surface
     /// also takes the places `frames` (the frames of a sequence, each as many vertices as
-    /// the surface): what it can reach in any of them. `measured` keeps the walks over the
-    /// surface's own place ([`Dips`]): where it holds walks for `span`'s reach they are
-    /// read, not taken again, so a cloth of another thickness is answered at once; else
-    /// they are taken and left there.
+    /// the surface): what it can reach in any of them, each in order. `measured` keeps the
+    /// walks over the surface and those frames ([`Dips`]; given again, always with the same
+    /// frames): where it holds walks for `span`'s reach they are read, not taken again, so
+    /// a cloth of another thickness is answered at once; else they are taken and left
+    /// there.
     pub fn reached_over<'f>(
         &self,
         span: &ClothSpan,
         frames: impl IntoIterator<Item = &'f [Vec3]>,
         measured: &mut Option<Dips>,
     ) -> Reached {
-        let surface = (&self.vertices[..], &self.triangles[..], &self.normals[..]);
+        // A frame where the surface already is (a sequence's frame 0) tells nothing more.
+        let others: Vec<&[Vec3]> = (frames.into_iter())
+            .filter(|&f| f != self.vertices.as_slice())
+            .collect();
+        let places = || std::iter::once(&self.vertices[..]).chain(others.iter().copied());
+        let triangles = &self.triangles;
         let dips = match measured {
             Some(dips) if dips.measures(span) => dips,
             // Vertices at one place are one, by where the surface has them.
-            _ => measured.insert(Dips::measure(surface, welded(&self.vertices), span)),
+            _ => measured.insert(Dips::measure(
+                places(),
+                triangles,
+                welded(&self.vertices),
+                span,
+            )),
         };
-        let (mut edges, mut vertices) = dips.reached(surface, span);
-        // A frame where the surface already is (a sequence's frame 0) tells nothing more.
-        for frame in frames
-            .into_iter()
-            .filter(|&f| f != self.vertices.as_slice())
-        {
-            let normals = face_normals(frame, &self.triangles);
-            let place = (frame, &self.triangles[..], &normals[..]);
-            let (more, most) =
-                Dips::measure(place, dips.same().to_vec(), span).reached(place, span);
-            edges.extend(more);
-            vertices.extend(most);
-        }
-        edges.sort_unstable();
-        edges.dedup();
-        vertices.sort_unstable();
-        vertices.dedup();
+        let (edges, vertices) = dips.reached(places(), triangles, span);
         Reached { edges, vertices }
     }
 
