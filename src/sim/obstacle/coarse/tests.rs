@@ -356,6 +356,23 @@ fn a_sequence_keeps_off_what_creases_in_any_frame() {
     assert!(!apex_is_a_tip(&curving, 5.0) && !apex_is_a_tip(&curving, 10.0));
 }
 
+/// How many edges `surface` (taking the places `frames` too) keeps a cloth of `span` off
+/// by the walks kept in `measured`, and how many of them have walked on their own so far;
+/// the surface kept off the same as by walks taken for `span` alone.
+fn fit_kept(
+    surface: &Surface,
+    frames: &[Vec<Vec3>],
+    span: &ClothSpan,
+    measured: &mut Option<Dips>,
+) -> (usize, usize) {
+    let frames = || frames.iter().map(Vec::as_slice);
+    let kept = surface.keeping_off(&surface.reached_over(span, frames(), measured));
+    let fresh = surface.keeping_off(&surface.reached_over(span, frames(), &mut None));
+    assert_eq!(kept, fresh, "{span:?}");
+    let edges = kept.map_or(surface.sharp_edges().len(), |s| s.sharp_edges().len());
+    (edges, measured.as_ref().map_or(0, Dips::own_walks))
+}
+
 /// The ball of `an_edges_bound_from_its_ends_walks_holds_its_own`, measured once for a
 /// cloth of 5 cm edges, answers it at thicknesses from 2 cm down to 6 mm and back as a
 /// measure of each thickness's own does: none of its 4 584 edges kept off at 2 and 1 cm,
@@ -368,15 +385,7 @@ fn a_sequence_keeps_off_what_creases_in_any_frame() {
 fn one_measure_answers_every_thickness() {
     let surface = ball();
     let mut measured = None;
-    let mut fit = |thickness: f32| {
-        let span = span(0.05, thickness);
-        let reached = surface.reached_over(&span, std::iter::empty(), &mut measured);
-        let kept = surface.keeping_off(&reached);
-        assert_eq!(kept, surface.reaching(&span), "{thickness} m");
-        let edges = kept.map_or(surface.sharp_edges().len(), |s| s.sharp_edges().len());
-        let walks = measured.as_ref().map_or(0, Dips::own_walks);
-        (edges, walks)
-    };
+    let mut fit = |thickness| fit_kept(&surface, &[], &span(0.05, thickness), &mut measured);
     assert_eq!(fit(0.02), (0, 120));
     assert_eq!(fit(0.01), (0, 4062));
     assert_eq!(fit(0.008), (408, 4584));
@@ -398,17 +407,8 @@ fn one_measure_of_a_sequence_answers_every_thickness() {
     let risen = rail_roof_and_cone(0.3).0;
     let frames = [flat.clone(), risen];
     let sequence = Surface::of_frames(flat, triangles, &frames);
-    let frames = || frames.iter().map(Vec::as_slice);
     let mut measured = None;
-    let mut fit = |thickness: f32| {
-        let span = span(0.12, thickness);
-        let kept = sequence.keeping_off(&sequence.reached_over(&span, frames(), &mut measured));
-        let fresh = sequence.keeping_off(&sequence.reached_over(&span, frames(), &mut None));
-        assert_eq!(kept, fresh, "{thickness} m");
-        let edges = kept.map_or(sequence.sharp_edges().len(), |s| s.sharp_edges().len());
-        let walks = measured.as_ref().map_or(0, Dips::own_walks);
-        (edges, walks)
-    };
+    let mut fit = |thickness| fit_kept(&sequence, &frames, &span(0.12, thickness), &mut measured);
     assert_eq!(fit(0.03), (168, 80));
     assert_eq!(fit(0.015), (208, 80));
     assert_eq!(fit(0.005), (208, 80));
