@@ -199,7 +199,9 @@ mod tests {
     /// off.
     /// Grown to twice its size it can, and the rail is fitted to it again: its
     /// 40 ridges kept off too. Grown by a tenth (within the quarter it was fitted with), not
-    /// at all, or gone non-finite, nothing is fitted again.
+    /// at all, or gone non-finite, nothing is fitted again. The scene's rail keeps the
+    /// walks it was measured by (for another thickness); a rail fitted already, fitted
+    /// again as the cloth grows on to three times its size, keeps none (red where it does).
     #[test]
     fn a_cloth_grown_past_its_fit_has_the_obstacles_fitted_again() {
         let (mesh, model) = metre_of_10_cm_quads();
@@ -214,6 +216,12 @@ mod tests {
         assert_eq!(kept_off(&refitted), 120);
         // Fitted to the grown cloth, the same growth asks for nothing more.
         assert!(reach.outgrown(&refitted, &grown(2.0)).is_none());
+        let holds_walks = |effects: &[Effect]| match &effects[0] {
+            Effect::Obstacle(o) => o.placed().unwrap().holds_walks(),
+            _ => unreachable!(),
+        };
+        assert!(reach.outgrown(&refitted, &grown(3.0)).is_some());
+        assert!(holds_walks(&fitted) && !holds_walks(&refitted));
     }
 
     /// The rail fitted to a cloth of 12 cm edges (6 cm lever) 1 cm thick keeps off its 40

@@ -119,10 +119,12 @@ pub struct Caught {
 }
 
 /// What fitting a surface to a cloth measured and gave last: the walks over it for the
-/// last reach asked for ([`Dips`]), and the last span asked for with what it reached and
-/// the answer made of that (a mesh obstacle's placement that keeps the cloth off it).
+/// last reach asked for ([`Dips`]; by default, else none: [`Fitted::passing`]), and the
+/// last span asked for with what it reached and the answer made of that (a mesh
+/// obstacle's placement that keeps the cloth off it).
 #[derive(Debug)]
 pub struct Fitted<T> {
+    keeps: bool,
     dips: Option<Dips>,
     last: Option<(ClothSpan, Reached, Option<Arc<T>>)>,
 }
@@ -130,6 +132,7 @@ pub struct Fitted<T> {
 impl<T> Default for Fitted<T> {
     fn default() -> Self {
         Self {
+            keeps: true,
             dips: None,
             last: None,
         }
@@ -137,6 +140,21 @@ impl<T> Default for Fitted<T> {
 }
 
 impl<T> Fitted<T> {
+    /// One that keeps no walks, only its last answer: for a surface fitted already, which
+    /// is fitted again only as the cloth outgrows it (each time to a new reach), never to
+    /// another thickness (that fits the scene's own surface again).
+    pub fn passing() -> Self {
+        Self {
+            keeps: false,
+            ..Self::default()
+        }
+    }
+
+    /// Whether it holds walks now.
+    pub fn holds_walks(&self) -> bool {
+        self.dips.is_some()
+    }
+
     /// What `surface` (taking the places `frames` too: [`Surface::reached_over`]) keeps
     /// off a cloth of `span`, made into an answer by `answer` (`None` where it adds
     /// nothing): the last answer where the span is the last one's, or where it reaches
@@ -153,7 +171,13 @@ impl<T> Fitted<T> {
         {
             return answered.clone();
         }
-        let reached = surface.reached_over(span, frames, &mut self.dips);
+        let mut passing = None;
+        let dips = if self.keeps {
+            &mut self.dips
+        } else {
+            &mut passing
+        };
+        let reached = surface.reached_over(span, frames, dips);
         let answered = match self.last.take() {
             Some((_, last, answered)) if last == reached => answered,
             _ => answer(&reached).map(Arc::new),

@@ -36,6 +36,12 @@ impl Placed {
         self.sequence.is_some() || self.surface.is_gentle()
     }
 
+    /// Whether fitting it to a cloth left walks kept ([`Fitted::holds_walks`]).
+    #[cfg(test)]
+    pub(crate) fn holds_walks(&self) -> bool {
+        self.reached.lock().is_ok_and(|f| f.holds_walks())
+    }
+
     /// This placement with its surface keeping off the edges and vertices `reached` (a
     /// sequence's in all its frames), or `None` where that adds nothing.
     fn keeping_off(&self, reached: &Reached) -> Option<Placed> {
@@ -48,7 +54,7 @@ impl Placed {
             sequence,
             memory: Default::default(),
             edge_memory: Default::default(),
-            reached: Default::default(),
+            reached: std::sync::Mutex::new(Fitted::passing()),
         })
     }
 }
