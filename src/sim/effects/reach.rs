@@ -44,7 +44,7 @@ fn folded(span: ClothSpan) -> ClothSpan {
 
 /// The span a stepper's obstacles were last fitted to, whether any of them has gentle parts
 /// (else nothing is ever fitted again), and the cloth's triangle edges, by their particles
-/// (what a stretch is measured on).
+/// (what a stretch is measured on: the model's mesh edges).
 #[derive(Clone, Debug, Default)]
 pub struct Reach {
     span: Option<ClothSpan>,
@@ -58,15 +58,13 @@ impl Reach {
     pub fn fit(&mut self, effects: &[Effect], model: &ClothModel, offset: f32) -> Vec<Effect> {
         let span = ClothSpan::of(&model.rest_positions, &model.triangles, GROWTH, offset);
         let fitted = self.fit_to(effects, folded(span));
-        // The cloth's edges, to measure its stretch on, only where it is measured.
+        // The cloth's edges (its first springs), to measure its stretch on, only where it
+        // is measured.
         self.edges.clear();
         if self.gentle {
-            let edges = (model.triangles.iter())
-                .flat_map(|&[a, b, c]| [[a, b], [b, c], [c, a]])
-                .map(|[a, b]| [a.min(b), a.max(b)]);
+            let (a, b) = (&model.springs.a, &model.springs.b);
+            let edges = (a.iter().zip(b).take(model.mesh_edges)).map(|(&a, &b)| [a, b]);
             self.edges.extend(edges);
-            self.edges.sort_unstable();
-            self.edges.dedup();
         }
         fitted
     }
