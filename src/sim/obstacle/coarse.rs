@@ -208,7 +208,7 @@ impl Faces<'_> {
 /// The gentle edges (their two vertices, each the first at its place, the lesser first)
 /// and vertices (each the first at its place) of a surface that a cloth reaches, each in
 /// order ([`super::Surface::reached_over`]).
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Reached {
     pub edges: Vec<[u32; 2]>,
     pub vertices: Vec<u32>,

@@ -151,7 +151,8 @@ impl<T> Fitted<T> {
     }
 
     /// Whether it holds walks now.
-    pub fn holds_walks(&self) -> bool {
+    #[cfg(test)]
+    pub(crate) fn holds_walks(&self) -> bool {
         self.dips.is_some()
     }
 
