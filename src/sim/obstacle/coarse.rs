@@ -20,15 +20,16 @@
 //! at most its longest edge and its square), the cloth reaches `x` only where
 //! `a·Σ wᵢdᵢ + b·Σ wᵢdᵢ² ≥ h`.
 
-use std::collections::HashMap;
-
 use std::f32::consts::FRAC_PI_2;
 
 use glam::Vec3;
 use rayon::prelude::*;
 
+use self::walks::{Faces, NONE, Walk, Walker, walked_faces};
 use super::edges::CREASE_COS;
 use super::geometry::face_normals;
+
+mod walks;
 
 /// A part of the surface counts as reachable where the bound leaves less than this share
 /// of the thickness: room for the rounding, the rings' coarseness, and the particles'
@@ -55,155 +56,17 @@ pub struct ClothSpan {
     pub thickness: f32,
 }
 
-/// A surface's faces as the bound reads them: each one's unit normal and box, and its
-/// neighbours across its edges where the two meet neither at a crease nor at a border.
-/// The bound follows the surface from a point through those alone: beyond a crease (a
-/// table's rim, a drum's cap) the crease itself keeps the cloth off.
-pub(super) struct Faces<'a> {
-    triangles: &'a [[u32; 3]],
-    normals: &'a [Vec3],
-    /// What a walk reads of each face, side by side ([`walked_faces`]).
-    walked: &'a [Walked],
-    /// Each vertex's first at its place.
-    same: &'a [u32],
-}
-
-/// A face as the walks read it: its box, its unit normal, and its neighbours across its
-/// three edges.
-#[derive(Clone, Copy)]
-struct Walked {
-    lo: Vec3,
-    hi: Vec3,
-    normal: Vec3,
-    across: [u32; 3],
-}
-
-/// No neighbour across an edge.
-const NONE: u32 = u32::MAX;
-
 /// Faces (or vertices) a piece of the work takes at once.
 const PIECE: usize = 2048;
 
-/// The scratch of the bound's walks over a surface's faces: each face's last walk, the
-/// walks so far, and the faces met in the current one, in order.
-struct Walk {
-    seen: Vec<u32>,
-    walks: u32,
-    met: Vec<u32>,
-}
+/// Which group a vertex walks in: its piece, its cell, and (where it walks alone) itself.
+type GroupKey = (u32, [i64; 3], u32);
 
-impl Walk {
-    fn over(faces: &Faces<'_>) -> Self {
-        Walk {
-            seen: vec![0; faces.normals.len()],
-            walks: 0,
-            met: Vec::new(),
-        }
-    }
-}
+/// Vertices whose walks are taken together at most ([`Faces::walk_together`]).
+const TOGETHER: usize = 8;
 
-/// What the bound's walks read of each of the faces `triangles` over `vertices`, each
-/// with its unit normal in `normals` (zero for a degenerate one, which has no
-/// neighbours); `same` gives each vertex the first at its place (`welded`), which is one
-/// vertex with it.
-fn walked_faces(
-    vertices: &[Vec3],
-    triangles: &[[u32; 3]],
-    normals: &[Vec3],
-    same: &[u32],
-) -> Vec<Walked> {
-    let mut sides: HashMap<(u32, u32), Vec<(u32, u8)>> = HashMap::new();
-    for (t, tri) in triangles.iter().enumerate() {
-        if normals[t] == Vec3::ZERO {
-            continue;
-        }
-        let tri = tri.map(|i| same[i as usize]);
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            let side = (t as u32, k as u8);
-            sides.entry((a.min(b), a.max(b))).or_default().push(side);
-        }
-    }
-    let mut across = vec![[NONE; 3]; triangles.len()];
-    for faces in sides.values() {
-        if let [(s, j), (t, k)] = faces[..]
-            && normals[s as usize].dot(normals[t as usize]).abs() >= CREASE_COS
-        {
-            across[s as usize][j as usize] = t;
-            across[t as usize][k as usize] = s;
-        }
-    }
-    (triangles.iter().zip(normals).zip(across))
-        .map(|((t, &normal), across)| {
-            let [p, q, r] = t.map(|i| vertices[i as usize]);
-            let (lo, hi) = (p.min(q).min(r), p.max(q).max(r));
-            Walked {
-                lo,
-                hi,
-                normal,
-                across,
-            }
-        })
-        .collect()
-}
-
-impl Faces<'_> {
-    /// The cosine of the angle between the faces `s` and `t` (unsigned).
-    fn turn(&self, [s, t]: [u32; 2]) -> f32 {
-        self.normals[s as usize].dot(self.normals[t as usize]).abs()
-    }
-
-    /// Each vertex's faces (the vertex first at its place, a face), by vertex.
-    fn fans(&self) -> Vec<(u32, u32)> {
-        let mut fans: Vec<(u32, u32)> = (self.triangles.iter().enumerate())
-            .filter(|&(t, _)| self.normals[t] != Vec3::ZERO)
-            .flat_map(|(t, tri)| tri.map(|i| (self.same[i as usize], t as u32)))
-            .collect();
-        fans.sort_unstable();
-        fans
-    }
-
-    /// Walks from the faces `starts` across gentle and flat edges (nearest first) the
-    /// faces whose boxes lie within `least.len()` rings of `width` of the box `lo..hi`,
-    /// keeping each ring's least cosine (unsigned) to `reference` in `least`.
-    fn walk_rings(
-        &self,
-        walk: &mut Walk,
-        starts: impl IntoIterator<Item = u32>,
-        ((lo, hi), reference): ((Vec3, Vec3), Vec3),
-        (width, least): (f32, &mut [f32]),
-    ) {
-        let rings = least.len();
-        let reach = width * rings as f32;
-        least.fill(1.0);
-        walk.walks += 1;
-        let walked = walk.walks;
-        walk.met.clear();
-        for s in starts {
-            if walk.seen[s as usize] != walked {
-                walk.seen[s as usize] = walked;
-                walk.met.push(s);
-            }
-        }
-        let mut at = 0;
-        while let Some(&t) = walk.met.get(at) {
-            at += 1;
-            let face = self.walked[t as usize];
-            let apart = (face.lo - hi).max(lo - face.hi).max(Vec3::ZERO).length();
-            if apart > reach {
-                continue;
-            }
-            let ring = ((apart / width) as usize).min(rings - 1);
-            least[ring] = least[ring].min(face.normal.dot(reference).abs());
-            for u in face.across {
-                if u != NONE && walk.seen[u as usize] != walked {
-                    walk.seen[u as usize] = walked;
-                    walk.met.push(u);
-                }
-            }
-        }
-    }
-}
+/// The side of the cells vertices are grouped in for their walks, in rings' widths.
+const CELL: f32 = 4.0;
 
 /// The gentle edges (their two vertices, each the first at its place, the lesser first)
 /// and vertices (each the first at its place) of a surface that a cloth reaches, each in
@@ -390,18 +253,31 @@ impl Dips {
 
 impl Faces<'_> {
     /// Each vertex's walk (by the vertex, the first at its place; `None` for a vertex not
-    /// walked: [`ClothSpan::around`]) over these faces at `vertices`, in pieces shared
-    /// among the threads.
+    /// walked: [`ClothSpan::walker`]) over these faces at `vertices`, taken in groups
+    /// ([`Faces::groups`]: one walk over the faces a group reaches, each vertex gathering
+    /// what its own would) shared among the threads.
     fn vertex_walks(&self, vertices: &[Vec3], span: &ClothSpan) -> Vec<Option<Around>> {
         let fans = self.fans();
         let fans: Vec<&[(u32, u32)]> = fans.chunk_by(|a, b| a.0 == b.0).collect();
+        let walkers = (fans.par_iter()).filter_map(|fan| span.walker(self, vertices, fan));
+        let (walkers, groups) = self.groups(walkers.collect(), CELL * span.width());
         // Each thread's scratch serves the pieces it takes.
-        let found: Vec<Vec<(u32, Around)>> = (fans.par_chunks(PIECE))
+        let width = span.width();
+        let found: Vec<Vec<(u32, Around)>> = (groups.par_chunks(PIECE / TOGETHER))
             .map_init(
-                || Walk::over(self),
-                |walk, piece| {
-                    let around = |fan| span.around(self, walk, vertices, fan);
-                    piece.iter().filter_map(around).collect()
+                || (Walk::over(self), Vec::new()),
+                |(walk, least), piece| {
+                    let mut found = Vec::new();
+                    for group in piece {
+                        let group = &walkers[group.clone()];
+                        least.resize(group.len(), [1.0f32; 2 * RINGS]);
+                        self.walk_together(walk, group, width, &mut least[..group.len()]);
+                        let each = group.iter().zip(least.iter());
+                        found.extend(
+                            each.map(|(w, least)| (w.vertex, span.around_of(w, &least[..w.rings]))),
+                        );
+                    }
+                    found
                 },
             )
             .collect();
@@ -410,6 +286,44 @@ impl Faces<'_> {
             around[v as usize] = Some(found);
         }
         around
+    }
+
+    /// `walkers` in groups that walk together: those of one piece of the surface
+    /// ([`Faces::pieces`]: no walk leaves its starts' piece) whose places lie in one cube
+    /// of a grid of `side`, up to [`TOGETHER`] a group; a vertex whose faces lie on
+    /// several pieces walks alone. Returns the walkers in groups' order and the groups.
+    fn groups<'f>(
+        &self,
+        walkers: Vec<Walker<'f>>,
+        side: f32,
+    ) -> (Vec<Walker<'f>>, Vec<std::ops::Range<usize>>) {
+        let piece = self.pieces();
+        let mut keyed: Vec<(GroupKey, Walker<'f>)> = (walkers.into_iter())
+            .map(|w| {
+                let first = piece[w.fan[0].1 as usize];
+                let key = if w.fan.iter().all(|&(_, f)| piece[f as usize] == first) {
+                    let cell = (w.at / side).floor().to_array().map(|c| c as i64);
+                    (first, cell, 0)
+                } else {
+                    (NONE, [0; 3], w.vertex)
+                };
+                (key, w)
+            })
+            .collect();
+        keyed.sort_unstable_by_key(|(key, _)| *key);
+        let (keys, walkers): (Vec<_>, Vec<_>) = keyed.into_iter().unzip();
+        let mut groups = Vec::new();
+        let mut at = 0;
+        for same in keys.chunk_by(|a, b| a == b) {
+            let end = at + same.len();
+            groups.extend(
+                (at..end)
+                    .step_by(TOGETHER)
+                    .map(|s| s..(s + TOGETHER).min(end)),
+            );
+            at = end;
+        }
+        (walkers, groups)
     }
 
     /// Each edge between two faces neither at a crease nor in one plane here, with the
@@ -463,7 +377,7 @@ impl Faces<'_> {
 /// faces within each ring and every ring nearer, out to the reach and as far again as its
 /// longest edge, and that reference; and how far a cloth triangle over the vertex comes
 /// into the surface (m).
-#[derive(Clone)]
+#[derive(Clone, Debug, PartialEq)]
 struct Around {
     steepest: [f32; 2 * RINGS],
     rings: usize,
@@ -575,16 +489,17 @@ impl ClothSpan {
         dip_of(steepest(least).map(f32::tan), width, bound)
     }
 
-    /// The walk of the vertex of `fan` (its faces, by the vertex, first at its place, at
-    /// `vertices`); `None` for a vertex at a crease (a tip already) or whose faces lie in
-    /// one plane.
-    fn around(
+    /// The walk the vertex of `fan` takes (its faces, by the vertex, first at its place,
+    /// at `vertices`): from its place, measured from the plane that bisects its two faces
+    /// that turn most from each other, out to the reach and as far again as its longest
+    /// edge; `None` for a vertex at a crease (a tip already) or whose faces lie in one
+    /// plane.
+    fn walker<'f>(
         &self,
         faces: &Faces<'_>,
-        walk: &mut Walk,
         vertices: &[Vec3],
-        fan: &&[(u32, u32)],
-    ) -> Option<(u32, Around)> {
+        fan: &'f [(u32, u32)],
+    ) -> Option<Walker<'f>> {
         let width = self.width();
         if !(width > 0.0 && width.is_finite()) {
             return None;
@@ -609,33 +524,54 @@ impl ClothSpan {
             .flat_map(|&(_, f)| faces.triangles[f as usize])
             .map(|i| at.distance(vertices[i as usize]))
             .fold(0.0f32, f32::max);
-        let rings = RINGS + ((longest.min(self.edge) / width).ceil() as usize).min(RINGS);
-        let lever = self.lever;
-        let reference = bisector(faces.normals[s as usize], faces.normals[t as usize]);
-        let mut least = [1.0f32; 2 * RINGS];
-        let starts = fan.iter().map(|&(_, f)| f);
-        faces.walk_rings(
-            walk,
-            starts,
-            ((at, at), reference),
-            (width, &mut least[..rings]),
-        );
+        Some(Walker {
+            vertex: v,
+            at,
+            reference: bisector(faces.normals[s as usize], faces.normals[t as usize]),
+            rings: RINGS + ((longest.min(self.edge) / width).ceil() as usize).min(RINGS),
+            fan,
+        })
+    }
+
+    /// What the walk of `walker` measured, from the least cosine it gathered in each of
+    /// its rings (`least`).
+    fn around_of(&self, walker: &Walker<'_>, least: &[f32]) -> Around {
         let mut steepest = [0.0f32; 2 * RINGS];
         let mut most = 0.0f32;
-        for (k, &cos) in least[..rings].iter().enumerate() {
+        for (k, &cos) in least.iter().enumerate() {
             most = most.max(cos.min(1.0).acos());
             steepest[k] = most;
         }
         let near: [f32; RINGS] = std::array::from_fn(|k| steepest[k].tan());
-        let dip = dip_of(near, width, (lever, lever * lever));
+        let lever = self.lever;
+        Around {
+            steepest,
+            rings: least.len(),
+            reference: walker.reference,
+            dip: dip_of(near, self.width(), (lever, lever * lever)),
+        }
+    }
+
+    /// The walk of the vertex of `fan` on its own ([`ClothSpan::walker`]).
+    #[cfg(test)]
+    fn around(
+        &self,
+        faces: &Faces<'_>,
+        walk: &mut Walk,
+        vertices: &[Vec3],
+        fan: &[(u32, u32)],
+    ) -> Option<(u32, Around)> {
+        let walker = self.walker(faces, vertices, fan)?;
+        let mut least = [[1.0f32; 2 * RINGS]];
+        faces.walk_together(
+            walk,
+            std::slice::from_ref(&walker),
+            self.width(),
+            &mut least,
+        );
         Some((
-            v,
-            Around {
-                steepest,
-                rings,
-                reference,
-                dip,
-            },
+            walker.vertex,
+            self.around_of(&walker, &least[0][..walker.rings]),
         ))
     }
 }
