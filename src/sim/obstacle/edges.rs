@@ -3,7 +3,7 @@
 
 use glam::{Vec3, Vec3A};
 
-use super::geometry::{less_by_move, rounding_near, segments_closest, welded};
+use super::geometry::{less_by_move, rounding_near, segments_closest, sides_by_edge, welded};
 use super::tree::TriangleTree;
 
 /// Two faces meeting at less than this cosine between their normals (about 10°) make a
@@ -128,26 +128,17 @@ impl SharpEdges {
         also: impl Fn([u32; 2], [usize; 2]) -> bool,
     ) -> Self {
         let same = welded(vertices);
-        // Each edge (its welded ends, the lesser first) with each face it borders, by edge.
-        let mut sides: Vec<([u32; 2], u32)> = (triangles.iter().enumerate())
-            .flat_map(|(t, tri)| {
-                let tri = tri.map(|i| same[i as usize]);
-                [0, 1, 2].map(|k| {
-                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                    ([a.min(b), a.max(b)], t as u32)
-                })
-            })
-            .collect();
-        sides.sort_unstable();
+        // Each edge (its welded ends) with the sides of the faces it borders.
+        let sides = sides_by_edge(triangles, &same, |_| true);
         let keys: Vec<[u32; 2]> = (sides.chunk_by(|x, y| x.0 == y.0))
-            .filter(|faces| match *faces {
+            .filter(|sides| match *sides {
                 [(ends, one), (_, two)] => {
-                    let [one, two] = [*one as usize, *two as usize];
+                    let [one, two] = [*one as usize / 3, *two as usize / 3];
                     normals[one].dot(normals[two]).abs() < CREASE_COS || also(*ends, [one, two])
                 }
                 _ => true,
             })
-            .map(|faces| faces[0].0)
+            .map(|sides| sides[0].0)
             .collect();
         let ends: Vec<[u32; 2]> = (keys.into_iter())
             .filter(|[a, b]| vertices[*a as usize] != vertices[*b as usize])

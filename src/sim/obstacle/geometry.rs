@@ -4,6 +4,7 @@
 use std::collections::HashMap;
 
 use glam::{DVec3, Vec3};
+use rayon::slice::ParallelSliceMut;
 
 /// Each vertex's number as the first vertex at its place (the same bits in every
 /// coordinate, −0 as +0): a surface written with its faces apart is one surface.
@@ -174,6 +175,28 @@ pub fn segment_meets_box(from: Vec3, to: Vec3, lo: Vec3, hi: Vec3) -> bool {
         }
     }
     true
+}
+
+/// Each side of each of `triangles` that `keep` keeps (by triangle number), as its two
+/// ends by `same` (each vertex's first at its place, the lesser first) and `3 × triangle +
+/// side`, in order: the sides along one edge together, by their triangles.
+pub(super) fn sides_by_edge(
+    triangles: &[[u32; 3]],
+    same: &[u32],
+    keep: impl Fn(usize) -> bool,
+) -> Vec<([u32; 2], u32)> {
+    let mut sides: Vec<([u32; 2], u32)> = (triangles.iter().enumerate())
+        .filter(|&(t, _)| keep(t))
+        .flat_map(|(t, tri)| {
+            let tri = tri.map(|i| same[i as usize]);
+            [0, 1, 2].map(|k| {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                ([a.min(b), a.max(b)], 3 * t as u32 + k as u32)
+            })
+        })
+        .collect();
+    sides.par_sort_unstable();
+    sides
 }
 
 /// Each of `triangles`' unit normal over `vertices` (zero for a degenerate one).

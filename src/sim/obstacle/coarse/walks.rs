@@ -4,10 +4,10 @@
 //! faces any of them reaches.
 
 use glam::Vec3;
-use rayon::prelude::*;
 use wide::f32x8;
 
 use super::super::edges::CREASE_COS;
+use super::super::geometry::sides_by_edge;
 use crate::sim::kernels::{LANES, Vec3x8};
 
 /// A surface's faces as the bound reads them: each one's unit normal and box, and its
@@ -75,23 +75,11 @@ pub(super) fn walked_faces(
     normals: &[Vec3],
     same: &[u32],
 ) -> Vec<Walked> {
-    // Each side of a face (its welded ends, the lesser first; the face and which side),
-    // by its ends: a sort rather than a map of lists, the same links.
-    let mut sides: Vec<(u64, u32)> = (triangles.iter().enumerate())
-        .filter(|&(t, _)| normals[t] != Vec3::ZERO)
-        .flat_map(|(t, tri)| {
-            let tri = tri.map(|i| same[i as usize]);
-            [0, 1, 2].map(|k| {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                let ends = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
-                (ends, 3 * t as u32 + k as u32)
-            })
-        })
-        .collect();
-    sides.par_sort_unstable();
+    // The sides of the faces along each edge; a degenerate face has none.
+    let sides = sides_by_edge(triangles, same, |t| normals[t] != Vec3::ZERO);
     let mut across = vec![[NONE; 3]; triangles.len()];
-    for faces in sides.chunk_by(|x, y| x.0 == y.0) {
-        if let [(_, one), (_, two)] = *faces {
+    for sides in sides.chunk_by(|x, y| x.0 == y.0) {
+        if let [(_, one), (_, two)] = *sides {
             let ([s, j], [t, k]) = ([one / 3, one % 3], [two / 3, two % 3]);
             if normals[s as usize].dot(normals[t as usize]).abs() >= CREASE_COS {
                 across[s as usize][j as usize] = t;
