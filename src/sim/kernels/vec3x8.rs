@@ -51,6 +51,13 @@ impl Vec3x8 {
         }
     }
 
+    /// Eight vectors, one a lane (what [`Vec3x8::unpack`] gives back).
+    #[inline(always)]
+    pub fn pack(v: [Vec3; LANES]) -> Self {
+        let [x, y, z] = [0, 1, 2].map(|c| f32x8::from(v.map(|p| p[c])));
+        Self { x, y, z }
+    }
+
     /// The eight vectors, one a lane.
     pub fn unpack(self) -> [Vec3; LANES] {
         let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
@@ -60,6 +67,16 @@ impl Vec3x8 {
     /// As `Vec3::dot`.
     pub fn dot(self, o: Self) -> f32x8 {
         self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// As `Vec3::max` (for numbers).
+    #[inline(always)]
+    pub fn max(self, o: Self) -> Self {
+        Self {
+            x: self.x.max(o.x),
+            y: self.y.max(o.y),
+            z: self.z.max(o.z),
+        }
     }
 
     /// As `Vec3::cross`.

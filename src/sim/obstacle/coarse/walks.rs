@@ -216,12 +216,8 @@ impl Faces<'_> {
             reach = reach.max(reaches[k]);
             (at[k], towards[k], last[k]) = (w.at, w.reference, w.rings - 1);
         }
-        let lanes = |v: [Vec3; LANES]| {
-            let [x, y, z] = [0, 1, 2].map(|c| f32x8::from(v.map(|p| p[c])));
-            Vec3x8 { x, y, z }
-        };
-        let (at, towards, reaches) = (lanes(at), lanes(towards), f32x8::from(reaches));
-        let (zero, across) = (f32x8::ZERO, f32x8::splat(width));
+        let (at, towards) = (Vec3x8::pack(at), Vec3x8::pack(towards));
+        let (reaches, across) = (f32x8::from(reaches), f32x8::splat(width));
         least.iter_mut().for_each(|l| l.fill(1.0));
         let starts = walkers.iter().flat_map(|w| w.fan.iter().map(|&(_, f)| f));
         let walk_from = (starts, (lo, hi), reach);
@@ -231,12 +227,7 @@ impl Faces<'_> {
             #[inline(always)]
             |face: &Walked, _| {
                 let (flo, fhi) = (Vec3x8::splat(face.lo), Vec3x8::splat(face.hi));
-                let (below, above) = (flo - at, at - fhi);
-                let gap = Vec3x8 {
-                    x: below.x.max(above.x).max(zero),
-                    y: below.y.max(above.y).max(zero),
-                    z: below.z.max(above.z).max(zero),
-                };
+                let gap = (flo - at).max(at - fhi).max(Vec3x8::splat(Vec3::ZERO));
                 let apart = gap.dot(gap).sqrt();
                 let within = apart.simd_gt(reaches).to_bitmask() ^ 0xff;
                 if within == 0 {
