@@ -25,9 +25,8 @@ use std::f32::consts::FRAC_PI_2;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use self::walks::{Faces, NONE, Walk, Walker, walked_faces};
+use self::walks::{Faces, FacesAt, NONE, Walk, Walker};
 use super::edges::CREASE_COS;
-use super::geometry::face_normals;
 
 mod walks;
 
@@ -62,8 +61,9 @@ const PIECE: usize = 2048;
 /// Which group a vertex walks in: its piece, its cell, and (where it walks alone) itself.
 type GroupKey = (u32, [i64; 3], u32);
 
-/// Vertices whose walks are taken together at most ([`Faces::walk_together`]).
-const TOGETHER: usize = 8;
+/// Vertices whose walks are taken together at most ([`Faces::walk_together`]): a lane
+/// each.
+const TOGETHER: usize = crate::sim::kernels::LANES;
 
 /// The side of the cells vertices are grouped in for their walks, in rings' widths.
 const CELL: f32 = 4.0;
@@ -138,14 +138,8 @@ impl Dips {
     ) -> Self {
         let (mut vertices, mut edges) = (Vec::new(), Vec::new());
         for place in places {
-            let normals = face_normals(place, triangles);
-            let walked = walked_faces(place, triangles, &normals, &same);
-            let faces = Faces {
-                triangles,
-                normals: &normals,
-                walked: &walked,
-                same: &same,
-            };
+            let read = FacesAt::of(place, triangles, &same);
+            let faces = read.faces(triangles, &same);
             let around = faces.vertex_walks(place, span);
             vertices.extend((around.iter().enumerate()).filter_map(|(v, a)| {
                 let around = a.as_ref()?;
@@ -215,14 +209,8 @@ impl Dips {
             };
             let mut most = vec![f32::NEG_INFINITY; asked.len()];
             for place in places {
-                let normals = face_normals(place, triangles);
-                let walked = walked_faces(place, triangles, &normals, &self.same);
-                let faces = Faces {
-                    triangles,
-                    normals: &normals,
-                    walked: &walked,
-                    same: &self.same,
-                };
+                let read = FacesAt::of(place, triangles, &self.same);
+                let faces = read.faces(triangles, &self.same);
                 let edges = &self.edges;
                 (most.par_chunks_mut(PIECE).zip(asked.par_chunks(PIECE))).for_each_init(
                     || Walk::over(&faces),

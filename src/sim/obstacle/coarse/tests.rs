@@ -1,4 +1,4 @@
-use super::walks::Walked;
+use super::walks::FacesAt;
 use super::*;
 use crate::sim::obstacle::Surface;
 use crate::sim::obstacle::geometry::welded;
@@ -14,24 +14,8 @@ fn a_grids_span_is_its_diagonal_and_half_of_it() {
 }
 
 /// What the bound's walks read of `surface`'s faces, its vertices welded as `same`.
-fn walked_of(surface: &Surface, same: &[u32]) -> Vec<Walked> {
-    walked_faces(
-        surface.vertices(),
-        surface.triangles(),
-        surface.normals(),
-        same,
-    )
-}
-
-/// The faces of `surface` as the bound reads them, its vertices welded as `same` and its
-/// faces read as `walked`.
-fn faces_of<'a>(surface: &'a Surface, same: &'a [u32], walked: &'a [Walked]) -> Faces<'a> {
-    Faces {
-        triangles: surface.triangles(),
-        normals: surface.normals(),
-        walked,
-        same,
-    }
+fn read_of(surface: &Surface, same: &[u32]) -> FacesAt {
+    FacesAt::of(surface.vertices(), surface.triangles(), same)
 }
 
 /// The edges and vertices of `surface` that a cloth of `span` reaches.
@@ -110,8 +94,8 @@ fn the_bound_on_a_rails_dip_holds_and_is_within_twice_it() {
     let (sides, radius) = (40, 0.3);
     let rail = rail(sides, radius);
     let same = welded(rail.vertices());
-    let walked = walked_of(&rail, &same);
-    let faces = faces_of(&rail, &same, &walked);
+    let read = read_of(&rail, &same);
+    let faces = read.faces(rail.triangles(), &same);
     // The ridge between facets 4 and 5: the edge from vertex 10 to 11, between the first
     // triangle of facet 4 and the second of facet 5.
     for length in [0.05, 0.12, 0.24] {
@@ -202,8 +186,8 @@ fn a_low_apex_is_a_tip_to_a_coarse_cloth_only() {
 fn an_edges_bound_from_its_ends_walks_holds_its_own() {
     let ball = ball();
     let same = welded(ball.vertices());
-    let walked = walked_of(&ball, &same);
-    let (vertices, faces) = (ball.vertices(), faces_of(&ball, &same, &walked));
+    let read = read_of(&ball, &same);
+    let (vertices, faces) = (ball.vertices(), read.faces(ball.triangles(), &same));
     let fans = faces.fans();
     for edge in [0.02, 0.05, 0.12] {
         let span = span(edge, 0.01);
@@ -463,8 +447,8 @@ fn walks_taken_together_gather_what_each_ones_own_does() {
     ];
     for (name, surface, edges) in cases {
         let same = welded(surface.vertices());
-        let walked = walked_of(&surface, &same);
-        let (vertices, faces) = (surface.vertices(), faces_of(&surface, &same, &walked));
+        let read = read_of(&surface, &same);
+        let (vertices, faces) = (surface.vertices(), read.faces(surface.triangles(), &same));
         let fans = faces.fans();
         for &edge in edges {
             let span = span(edge, 0.01);

@@ -7,7 +7,7 @@ use glam::Vec3;
 use wide::f32x8;
 
 use super::super::edges::CREASE_COS;
-use super::super::geometry::sides_by_edge;
+use super::super::geometry::{face_normals, sides_by_edge};
 use crate::sim::kernels::{LANES, Vec3x8};
 
 /// A surface's faces as the bound reads them: each one's unit normal and box, and its
@@ -44,6 +44,32 @@ pub(super) struct Walker<'f> {
     pub(super) fan: &'f [(u32, u32)],
 }
 
+/// What the walks read of a surface's faces in one place: each face's unit normal, and
+/// its box and neighbours ([`walked_faces`]).
+pub(super) struct FacesAt {
+    normals: Vec<Vec3>,
+    walked: Vec<Walked>,
+}
+
+impl FacesAt {
+    /// The faces `triangles` at `place`, `same` giving each vertex the first at its place.
+    pub(super) fn of(place: &[Vec3], triangles: &[[u32; 3]], same: &[u32]) -> Self {
+        let normals = face_normals(place, triangles);
+        let walked = walked_faces(place, triangles, &normals, same);
+        Self { normals, walked }
+    }
+
+    /// These faces as the walks read them.
+    pub(super) fn faces<'a>(&'a self, triangles: &'a [[u32; 3]], same: &'a [u32]) -> Faces<'a> {
+        Faces {
+            triangles,
+            normals: &self.normals,
+            walked: &self.walked,
+            same,
+        }
+    }
+}
+
 /// No neighbour across an edge.
 pub(super) const NONE: u32 = u32::MAX;
 
@@ -69,7 +95,7 @@ impl Walk {
 /// with its unit normal in `normals` (zero for a degenerate one, which has no
 /// neighbours); `same` gives each vertex the first at its place (`welded`), which is one
 /// vertex with it.
-pub(super) fn walked_faces(
+fn walked_faces(
     vertices: &[Vec3],
     triangles: &[[u32; 3]],
     normals: &[Vec3],
