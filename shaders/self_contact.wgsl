@@ -751,8 +751,8 @@ fn cut_apply(@builtin(global_invocation_id) id: vec3<u32>) {
     cut_apply_one(id.x);
 }
 
-// Each particle ends at its share of its motion, moving at the average velocity of what
-// it kept. Every free particle goes back to its start where the last round recorded
+// Each particle ends at its share of its motion, keeping that share of its velocity (its
+// motion may hold the pushes' moves, which are no velocity). Every free particle goes back to its start where the last round recorded
 // still cut something, or the grid's or the pairs' room ran out.
 fn finish_one(i: u32) {
     if (i == 0u) {
@@ -776,7 +776,7 @@ fn finish_one(i: u32) {
     var p = state[i];
     let v = p.v.xyz;
     let to = moved_to(i, s);
-    p.v = vec4<f32>((to - start[i].x.xyz) / sp.lengths.w, p.v.w);
+    p.v = vec4<f32>(v * s, p.v.w);
     p.x = vec4<f32>(to, p.x.w);
     state[i] = p;
     tell_solver(i, p.v.xyz - v);

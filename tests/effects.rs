@@ -642,12 +642,7 @@ fn one_pass(
     state: &mut ClothState,
 ) -> Result<usize, ContactError> {
     let start = state.pos.clone();
-    solver.resolve(
-        [params.thickness, params.friction, 1.0 / 240.0],
-        model,
-        &start,
-        state,
-    )
+    solver.resolve([params.thickness, params.friction], model, &start, state)
 }
 
 /// A square cloth of `quads`² quads folded in half: the back half lies over the front half
@@ -804,13 +799,8 @@ fn a_cloth_flung_farther_keeps_fewer_pairs() {
     state.pos[7].y = 1e9;
     let end = state.pos.clone();
     let thickness = params.thickness;
-    let err = (solver.resolve(
-        [thickness, params.friction, 1.0 / 240.0],
-        &model,
-        &rest.pos,
-        &mut state,
-    ))
-    .unwrap_err();
+    let err =
+        (solver.resolve([thickness, params.friction], &model, &rest.pos, &mut state)).unwrap_err();
     // In the frame of the cloth's mean motion every particle moves by 1/289 of 10⁹ m:
     // the first triangle already spans more than a million cells.
     let ContactError::Extent {

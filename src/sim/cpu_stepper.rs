@@ -297,10 +297,10 @@ impl<R: Real> CpuStepper<R> {
                 if !timed(&mut upkeep, || self.before_solids != pass.state.pos) {
                     break;
                 }
-                let (placed, h) = (&self.before_solids, pass.substep);
+                let placed = &self.before_solids;
                 let settle = || {
                     let motion = [pass.start, &placed[..]];
-                    (pass.self_contacts).settle(own.thickness, h, model, motion, pass.state)
+                    (pass.self_contacts).settle(own.thickness, model, motion, pass.state)
                 };
                 if self.timings.time(super::SELF_RECHECK, settle)? == 0 {
                     break;

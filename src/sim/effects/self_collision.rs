@@ -108,7 +108,7 @@ impl EffectKind for SelfCollision {
 
     fn resolve(&self, pass: &mut ContactPass<'_>) -> Result<usize, ContactError> {
         let (model, start) = (pass.model, pass.start);
-        let settings = [self.thickness, self.friction, pass.substep];
+        let settings = [self.thickness, self.friction];
         (pass.self_contacts).resolve(settings, model, start, pass.state)
     }
 

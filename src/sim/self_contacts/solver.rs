@@ -192,7 +192,7 @@ const REFRESHED_PER_PIECE: usize = 16;
 const PARALLEL_REFRESHED: usize = 2 * REFRESHED_PER_PIECE;
 
 impl SelfContacts {
-    /// Keeps the cloth off itself after a substep of `substep` seconds that moved it from
+    /// Keeps the cloth off itself after a substep that moved it from
     /// `start` to `state`: pairs closer than `thickness` (m) are pushed apart on the side
     /// they started on, with Coulomb `friction`; then no pair's sides may meet anywhere along
     /// the substep's straight-line motion. Returns the pushes.
@@ -202,7 +202,7 @@ impl SelfContacts {
     /// a million times wider than the cloth's scale); nothing is moved then.
     pub fn resolve(
         &mut self,
-        [thickness, friction, substep]: [f32; 3],
+        [thickness, friction]: [f32; 2],
         model: &ClothModel,
         start: &[Vec3],
         state: &mut ClothState,
@@ -262,7 +262,7 @@ impl SelfContacts {
         self.shift += mean;
         self.mean = mean;
         self.fixed.clear();
-        self.keep_apart(model, start, state, thickness, substep)?;
+        self.keep_apart(model, start, state, thickness)?;
         Ok(contacts)
     }
 
@@ -356,7 +356,6 @@ impl SelfContacts {
     pub fn settle(
         &mut self,
         thickness: f32,
-        substep: f32,
         model: &ClothModel,
         [start, placed]: [&[Vec3]; 2],
         state: &mut ClothState,
@@ -396,7 +395,7 @@ impl SelfContacts {
             tests::NARROWED.set(tests::NARROWED.get() + 1);
             self.changed.copy_from_slice(&self.fixed);
         }
-        let kept = self.keep_apart(model, start, state, thickness, substep);
+        let kept = self.keep_apart(model, start, state, thickness);
         if self.cuts_whole {
             // Where nothing was cut every particle's motion stays whole, and the next check
             // starts from every pair.
@@ -551,15 +550,14 @@ impl SelfContacts {
     }
 
     /// Cuts the free particles' motion short until no pair's sides can meet along the
-    /// substep (see the module's notes); cut particles move at their remaining motion's
-    /// average velocity.
+    /// substep (see the module's notes); a cut particle keeps the share of its velocity
+    /// that it keeps of its motion.
     fn keep_apart(
         &mut self,
         model: &ClothModel,
         start: &[Vec3],
         state: &mut ClothState,
         thickness: f32,
-        substep: f32,
     ) -> Result<(), ContactError> {
         // No pair: nothing to cut (most substeps of a cloth falling free).
         if self.found.len() == 0 {
@@ -588,7 +586,11 @@ impl SelfContacts {
                         let to = from + s * (pos.as_dvec3() - from);
                         moved |= to.as_vec3() != *pos;
                         *pos = to.as_vec3();
-                        *vel = ((to - from) / f64::from(substep)).as_vec3();
+                        // The same share of its velocity: its motion may hold the pushes'
+                        // moves, which are no velocity (their impulses are in it already),
+                        // and a cut that made them one would give a particle pressed in a
+                        // stack a push's depth a substep as speed.
+                        *vel *= s as f32;
                     }
                 }
             }

@@ -488,7 +488,7 @@ fn a_cloth_large_enough_to_share_its_particles_resolves_the_same_on_two_threads(
                 state.pos = (from.iter())
                     .map(|&p| p + Vec3::new(0.0, -0.02 + ripple(p), 0.0))
                     .collect();
-                (contacts.resolve([THICKNESS, 0.3, 0.01], &model, &from, &mut state)).unwrap();
+                (contacts.resolve([THICKNESS, 0.3], &model, &from, &mut state)).unwrap();
                 from.clone_from(&state.pos);
                 ends.push(state.pos);
             }
@@ -523,7 +523,7 @@ fn a_solver_handed_another_cloth_forgets_the_first() {
             let side = |p: Vec3| if p.x < 0.0 { -1.0 } else { 1.0 };
             state.pos = start.iter().map(|&p| p + side(p) * motion).collect();
             solver
-                .resolve([THICKNESS, 0.3, 0.01], model, &start, &mut state)
+                .resolve([THICKNESS, 0.3], model, &start, &mut state)
                 .unwrap();
             (state, solver.work)
         };
@@ -632,6 +632,7 @@ fn pairs_judged_by_the_boxes_are_kept_exactly_where_their_balls_come_near() {
 }
 
 mod boxes;
+mod cuts;
 mod refusals;
 mod settle;
 mod trickle;
@@ -721,7 +722,7 @@ fn resolved_once(
         *p = *s + motion + Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * jitter;
     }
     let mut contacts = SelfContacts::default();
-    (contacts.resolve([THICKNESS, 0.3, 0.01], &model, &start, &mut state)).unwrap();
+    (contacts.resolve([THICKNESS, 0.3], &model, &start, &mut state)).unwrap();
     (model, start, state, contacts)
 }
 

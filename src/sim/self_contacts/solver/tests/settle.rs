@@ -18,7 +18,7 @@ fn two_sheets_resolved() -> (ClothModel, Vec<Vec3>, ClothState, SelfContacts) {
     let mut state = ClothState::at_rest(&model);
     state.pos.iter_mut().for_each(|p| p.y -= 0.001);
     let mut contacts = SelfContacts::default();
-    (contacts.resolve([THICKNESS, 0.3, 0.01], &model, &start, &mut state)).unwrap();
+    (contacts.resolve([THICKNESS, 0.3], &model, &start, &mut state)).unwrap();
     assert_eq!((contacts.work.contacts, contacts.work.impacts), (0, 0));
     (model, start, state, contacts)
 }
@@ -31,7 +31,7 @@ fn the_recheck_cuts_a_particle_a_solid_moved_through_the_cloth() {
     let (model, start, mut state, mut contacts) = two_sheets_resolved();
     let placed = state.pos.clone();
     state.pos[12].y = 0.06;
-    let cut = (contacts.settle(THICKNESS, 0.01, &model, [&start, &placed], &mut state)).unwrap();
+    let cut = (contacts.settle(THICKNESS, &model, [&start, &placed], &mut state)).unwrap();
     assert!(cut > 0);
     assert!(
         state.pos[12].y < 0.03 - 0.1 * THICKNESS,
@@ -59,14 +59,13 @@ fn a_narrowed_recheck_checks_the_pairs_of_what_the_solids_moved() {
     let recheck = |every_pair: bool| {
         let mut state = ClothState::at_rest(&model);
         let mut contacts = SelfContacts::default();
-        (contacts.resolve([THICKNESS, 0.3, 0.01], &model, &start, &mut state)).unwrap();
+        (contacts.resolve([THICKNESS, 0.3], &model, &start, &mut state)).unwrap();
         assert!(contacts.cuts_whole && contacts.found.len() > 0);
         let placed = state.pos.clone();
         state.pos[12].y += 0.2 * THICKNESS;
         RECHECK_EVERY_PAIR.set(every_pair);
         NARROWED.set(0);
-        let cut =
-            (contacts.settle(THICKNESS, 0.01, &model, [&start, &placed], &mut state)).unwrap();
+        let cut = (contacts.settle(THICKNESS, &model, [&start, &placed], &mut state)).unwrap();
         RECHECK_EVERY_PAIR.set(false);
         (cut, contacts.work.forced, NARROWED.get())
     };
