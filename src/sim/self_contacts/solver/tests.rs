@@ -44,6 +44,18 @@ fn grid(quads: u32, size: f32) -> (ClothModel, Vec<Vec3>) {
     (ClothModel::new(&mesh, 0.2, &[]), mesh.positions)
 }
 
+/// Two 4 × 4-quad sheets 20 cm wide, one `apart` above the other (particles 0–24 below,
+/// 25–49 above), all pinned or none, and their positions.
+fn two_sheets(apart: f32, pinned: bool) -> (ClothModel, Vec<Vec3>) {
+    let sheet = GridSpec::square(4, 0.2, GridOrientation::Horizontal, Vec3::ZERO)
+        .build()
+        .unwrap();
+    let mesh = sheet.stacked(2, apart * Vec3::Y);
+    let all: Vec<u32> = (0..mesh.positions.len() as u32).collect();
+    let model = ClothModel::new(&mesh, 0.2, if pinned { &all } else { &[] });
+    (model, mesh.positions)
+}
+
 /// A solver for `model` with the pairs found for every particle moving by `motion` from
 /// `start`.
 fn searched(model: &ClothModel, start: &[Vec3], motion: Vec3) -> SelfContacts {

@@ -11,12 +11,7 @@ use super::*;
 /// a 240th of a second, or none). Returns where its middle particle's motion was cut to,
 /// as a share, and its velocity after.
 fn middle_cut(speed: f32) -> (f32, Vec3) {
-    let sheet = GridSpec::square(4, 0.2, GridOrientation::Horizontal, Vec3::ZERO)
-        .build()
-        .unwrap();
-    let mesh = sheet.stacked(2, 0.03 * Vec3::Y);
-    let model = ClothModel::new(&mesh, 0.2, &[]);
-    let start = mesh.positions;
+    let (model, start) = two_sheets(0.03, false);
     let middle = 25 + 12;
     let mut state = ClothState::at_rest(&model);
     for i in 25..50 {

@@ -9,12 +9,7 @@ use crate::sim::intersections::self_intersections;
 /// a solver and state after one substep in which every particle sank 1 mm (no pair near:
 /// nothing pushed, nothing cut).
 fn two_sheets_resolved() -> (ClothModel, Vec<Vec3>, ClothState, SelfContacts) {
-    let sheet = GridSpec::square(4, 0.2, GridOrientation::Horizontal, Vec3::ZERO)
-        .build()
-        .unwrap();
-    let mesh = sheet.stacked(2, 0.03 * Vec3::Y);
-    let model = ClothModel::new(&mesh, 0.2, &[]);
-    let start = mesh.positions;
+    let (model, start) = two_sheets(0.03, false);
     let mut state = ClothState::at_rest(&model);
     state.pos.iter_mut().for_each(|p| p.y -= 0.001);
     let mut contacts = SelfContacts::default();
@@ -49,13 +44,7 @@ fn the_recheck_cuts_a_particle_a_solid_moved_through_the_cloth() {
 /// pair counts them.
 #[test]
 fn a_narrowed_recheck_checks_the_pairs_of_what_the_solids_moved() {
-    let sheet = GridSpec::square(4, 0.2, GridOrientation::Horizontal, Vec3::ZERO)
-        .build()
-        .unwrap();
-    let mesh = sheet.stacked(2, 0.25 * THICKNESS * Vec3::Y);
-    let all: Vec<u32> = (0..mesh.positions.len() as u32).collect();
-    let model = ClothModel::new(&mesh, 0.2, &all);
-    let start = mesh.positions;
+    let (model, start) = two_sheets(0.25 * THICKNESS, true);
     let recheck = |every_pair: bool| {
         let mut state = ClothState::at_rest(&model);
         let mut contacts = SelfContacts::default();
