@@ -752,8 +752,9 @@ fn cut_apply(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Each particle ends at its share of its motion, keeping that share of its velocity (its
-// motion may hold the pushes' moves, which are no velocity). Every free particle goes back to its start where the last round recorded
-// still cut something, or the grid's or the pairs' room ran out.
+// motion may hold the pushes' moves, which are no velocity). Every free particle goes back
+// to its start where the last round recorded still cut something, or the grid's or the
+// pairs' room ran out.
 fn finish_one(i: u32) {
     if (i == 0u) {
         count_forced();

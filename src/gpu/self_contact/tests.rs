@@ -393,8 +393,9 @@ fn one_workgroup_and_the_wide_path_give_the_same_bits() {
 }
 
 /// [`same_bits`] with the cuts alone, which press the layers together (measured: 145 µm
-/// apart by frame 16, a fortieth of the thickness), so that the rounds of cuts run on: one workgroup's end after a round
-/// that cut nothing (stopped after the second round instead, frame 16 differs).
+/// apart by frame 16, a fortieth of the thickness), so that the rounds of cuts run on: one
+/// workgroup's end after a round that cut nothing (stopped after the second round instead,
+/// frame 16 differs).
 #[test]
 fn one_workgroup_and_the_wide_path_give_the_same_bits_with_the_cuts_alone() {
     let closest = same_bits(false);
