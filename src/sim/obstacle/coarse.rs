@@ -540,7 +540,8 @@ impl ClothSpan {
         }
     }
 
-    /// The walk of the vertex of `fan` on its own ([`ClothSpan::walker`]).
+    /// The walk of the vertex of `fan` on its own ([`ClothSpan::walker`]), one face after
+    /// another ([`Faces::walk_rings`]): what the lanes of a group's walk must gather.
     #[cfg(test)]
     fn around(
         &self,
@@ -550,17 +551,16 @@ impl ClothSpan {
         fan: &[(u32, u32)],
     ) -> Option<(u32, Around)> {
         let walker = self.walker(faces, vertices, fan)?;
-        let mut least = [[1.0f32; 2 * RINGS]];
-        faces.walk_together(
+        let mut least = [1.0f32; 2 * RINGS];
+        let (place, starts) = ((walker.at, walker.at), fan.iter().map(|&(_, f)| f));
+        let least = &mut least[..walker.rings];
+        faces.walk_rings(
             walk,
-            std::slice::from_ref(&walker),
-            self.width(),
-            &mut least,
+            starts,
+            (place, walker.reference),
+            (self.width(), least),
         );
-        Some((
-            walker.vertex,
-            self.around_of(&walker, &least[0][..walker.rings]),
-        ))
+        Some((walker.vertex, self.around_of(&walker, least)))
     }
 }
 
