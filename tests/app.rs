@@ -165,6 +165,31 @@ fn dropping_a_malformed_obj_shows_an_error_and_keeps_the_cloth() {
     harness.get_by_label_contains("broken.obj:4:");
 }
 
+/// With no message the status bar offers nothing to dismiss; a message brings a Dismiss
+/// button that clears it, and the bar keeps its height throughout, so the view above it does
+/// not jump.
+#[test]
+fn a_message_is_dismissed_and_the_status_bar_keeps_its_height() {
+    let mut harness = harness();
+    // The height of the label of simulated time (its width follows the frame rate's before).
+    let time_label =
+        |h: &Harness<'static, ClothApp>| h.get_by_label_contains("t = ").rect().y_range();
+    let quiet = time_label(&harness);
+    assert!(harness.query_by_label("Dismiss").is_none());
+    drop_obj(&mut harness, "broken.obj", "v 0 0 0\nf 1 2 3\n");
+    last_error(&harness);
+    assert_eq!(
+        time_label(&harness),
+        quiet,
+        "a message moved the status bar"
+    );
+    harness.get_by_label("Dismiss").click();
+    harness.run_steps(2);
+    assert!(harness.state().messages.is_empty());
+    assert!(harness.query_by_label("Dismiss").is_none());
+    assert_eq!(time_label(&harness), quiet);
+}
+
 #[test]
 fn pause_and_step_advances_exactly_one_frame() {
     let mut harness = harness();

@@ -47,9 +47,11 @@ impl Panel for StatusBar {
                 ui.label("loading…");
             }
         });
-        // The message row is always there, so the 3D view does not jump when one appears.
-        ui.horizontal(|ui| match status.message {
-            Some(m) => {
+        // The message row is always there, as tall as its button, so the 3D view does not
+        // jump when a message appears; with none, it holds nothing to press.
+        ui.horizontal(|ui| {
+            ui.set_min_height(ui.spacing().interact_size.y);
+            if let Some(m) = status.message {
                 let color = match m.level {
                     Level::Info => ui.visuals().text_color(),
                     Level::Warning => egui::Color32::from_rgb(230, 160, 40),
@@ -59,9 +61,6 @@ impl Panel for StatusBar {
                 if ui.small_button("Dismiss").clicked() {
                     ctx.ask(Action::DismissMessages);
                 }
-            }
-            None => {
-                ui.add_enabled(false, egui::Button::new("Dismiss").small());
             }
         });
     }
