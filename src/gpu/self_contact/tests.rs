@@ -744,3 +744,5 @@ fn a_blow_up_hidden_by_the_room_running_out_is_caught_on_the_gpu() {
     );
     assert_eq!(room(&gpu), before, "the room a blown-up try asked for");
 }
+
+mod cuts;
