@@ -20,6 +20,17 @@ use crate::sim::{
 /// The simulated seconds timed.
 pub const CRUMPLE_SECONDS: f64 = 1.0;
 
+/// The grid the speed targets are set at: quads along each side of the cloth.
+pub const TARGET_QUADS: u32 = 64;
+
+/// The contact phases a substep at [`TARGET_QUADS`] at most this many times the spring
+/// forces of the same substeps.
+pub const CONTACT_TARGET: f64 = 10.0;
+
+/// The threads on which [`TARGET_QUADS`] should run in real time (at most a second of
+/// wall a simulated second).
+pub const REAL_TIME_THREADS: usize = 2;
+
 /// One row of the crumple bench.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct CrumpleRow {
@@ -151,6 +162,39 @@ fn phase_times(timings: &PhaseTimings) -> [Duration; 3] {
     ]
 }
 
+impl CrumpleRow {
+    /// What the row reached beside the speed targets, where they are set for it (at
+    /// [`TARGET_QUADS`]): its contact phases over the springs against [`CONTACT_TARGET`]
+    /// (where it has springs to compare with), and on [`REAL_TIME_THREADS`] its wall a
+    /// simulated second against real time; each said met or not.
+    pub fn beside_targets(&self) -> Option<String> {
+        if self.quads != TARGET_QUADS {
+            return None;
+        }
+        let met = |yes: bool| if yes { "met" } else { "not met" };
+        let contact = if self.springs_us > 0.0 {
+            format!(
+                "contact {:.1}× the springs (at most {CONTACT_TARGET}×: {})",
+                self.contact_per_springs,
+                met(self.contact_per_springs <= CONTACT_TARGET)
+            )
+        } else {
+            "no spring forces to set the contact against".to_string()
+        };
+        let wall = (self.threads == REAL_TIME_THREADS).then(|| {
+            format!(
+                "; {:.2} s of wall a simulated second (at most 1 on {REAL_TIME_THREADS} threads: {})",
+                self.wall_per_second,
+                met(self.wall_per_second <= 1.0)
+            )
+        });
+        Some(format!(
+            "beside the targets at {TARGET_QUADS}²: {contact}{}",
+            wall.unwrap_or_default()
+        ))
+    }
+}
+
 /// One row for several runs of the same: each time, and the ratio of the contact phases to
 /// the springs, the runs' median (of an even count, the mean of the middle two); the
 /// counts as the first run's (the same in every run: a run's pairs and searches do not
@@ -246,5 +290,49 @@ mod tests {
         let even = median_row(&runs[..2]).unwrap();
         assert_eq!((even.contact_us, even.contact_per_springs), (400.0, 15.0));
         assert_eq!(median_row(&runs[..1]), Some(runs[0].clone()));
+    }
+
+    /// A row at the targets' grid says what it reached beside each target, met or not:
+    /// the contact against the springs where there are springs, the wall on two threads.
+    #[test]
+    fn a_row_at_the_targets_grid_says_what_it_reached_beside_them() {
+        let at = |contact_us: f64, springs_us: f64, threads: usize| CrumpleRow {
+            quads: TARGET_QUADS,
+            threads,
+            ..row(contact_us, springs_us)
+        };
+        assert_eq!(row(300.0, 30.0).beside_targets(), None);
+        assert_eq!(
+            at(450.0, 30.0, 2).beside_targets().unwrap(),
+            "beside the targets at 64²: contact 15.0× the springs (at most 10×: not met); \
+             4.50 s of wall a simulated second (at most 1 on 2 threads: not met)"
+        );
+        assert_eq!(
+            at(90.0, 10.0, 2).beside_targets().unwrap(),
+            "beside the targets at 64²: contact 9.0× the springs (at most 10×: met); \
+             0.90 s of wall a simulated second (at most 1 on 2 threads: met)"
+        );
+        // Exactly at a target is within it.
+        let edge = CrumpleRow {
+            wall_per_second: 1.0,
+            ..at(100.0, 10.0, 2)
+        };
+        assert!(!edge.beside_targets().unwrap().contains("not met"));
+        // Real time is asked of two threads: on others the wall is not set beside it.
+        for threads in [1, 4] {
+            assert_eq!(
+                at(90.0, 10.0, threads).beside_targets().unwrap(),
+                "beside the targets at 64²: contact 9.0× the springs (at most 10×: met)"
+            );
+        }
+        let xpbd = CrumpleRow {
+            springs_us: 0.0,
+            contact_per_springs: 0.0,
+            ..at(90.0, 10.0, 1)
+        };
+        assert_eq!(
+            xpbd.beside_targets().unwrap(),
+            "beside the targets at 64²: no spring forces to set the contact against"
+        );
     }
 }

@@ -285,6 +285,46 @@ fn crumple_bench_prints_a_row_per_size_and_integrator() {
     assert!(rows.iter().all(|r| r.get("fell_back_to").is_none()));
 }
 
+/// At the targets' grid (64²), a row's text says what it reached beside them, met or
+/// not; at another grid, nothing of them.
+#[test]
+fn a_crumple_row_at_64_quads_says_what_it_reached_beside_the_targets() {
+    let text = |quads: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_clothsim"))
+            .args([
+                "bench",
+                "--crumple",
+                "--quads",
+                quads,
+                "--threads",
+                "2",
+                "--repeat",
+                "1",
+            ])
+            .output()
+            .expect("runs");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).to_string()
+    };
+    let at_64 = text("64");
+    let line = (at_64.lines())
+        .find(|l| l.contains("beside the targets"))
+        .unwrap_or_else(|| panic!("{at_64}"));
+    assert!(
+        line.contains("at 64²: contact") && line.contains("× the springs (at most 10×: "),
+        "{line}"
+    );
+    assert!(
+        line.contains("of wall a simulated second (at most 1 on 2 threads: "),
+        "{line}"
+    );
+    assert!(!text("8").contains("beside the targets"));
+}
+
 /// A row is named by the integrator asked for, and says where the stability guard fell
 /// back from it: semi-implicit Euler at 48², the scene's 4 substeps a frame, is refined in
 /// vain in the first frame and the rest of the second is implicit Euler's.

@@ -261,6 +261,9 @@ pub fn crumple_bench(
                      substeps too)"
                 );
             }
+            if let Some(line) = row.beside_targets() {
+                println!("       {line}");
+            }
         }
     }
     Ok(())
