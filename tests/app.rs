@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use egui_kittest::Harness;
-use egui_kittest::kittest::Queryable;
+use egui_kittest::kittest::{NodeT, Queryable};
 
 use clothsim::app::ClothApp;
 use clothsim::mesh::{GridOrientation, GridSpec};
@@ -188,6 +188,62 @@ fn a_message_is_dismissed_and_the_status_bar_keeps_its_height() {
     assert!(harness.state().messages.is_empty());
     assert!(harness.query_by_label("Dismiss").is_none());
     assert_eq!(time_label(&harness), quiet);
+}
+
+/// The intersection check, turned on in the View panel: the status bar says nothing of it
+/// while it is off; on, it says none were found after the frames of a cloth that keeps
+/// clear, and the counts after those of a cloth of two strips through each other (a new
+/// cloth starts the count again); off again, it says nothing.
+#[test]
+fn the_intersection_check_shows_its_counts_in_the_status_bar() {
+    // Tall enough that the View section is on screen.
+    let mut harness = harness_sized(1280.0, 2000.0);
+    let said = |h: &Harness<'static, ClothApp>| {
+        h.query_by_label_contains("intersections: ").map(|n| {
+            n.value()
+                .or_else(|| n.accesskit_node().label())
+                .unwrap_or_default()
+        })
+    };
+    assert_eq!(said(&harness), None);
+    harness.get_by_label("Check intersections").click();
+    harness.run_steps(2);
+    assert_eq!(
+        said(&harness).as_deref(),
+        Some("intersections: no frame checked yet")
+    );
+    harness.get_by_label("Step").click();
+    run_settled(&mut harness, 2);
+    assert_eq!(said(&harness).as_deref(), Some("intersections: none"));
+    // A strip 2 m long, and a square 0.4 m across through its middle at right angles.
+    let crossed = "v -1 0 -0.2\nv 1 0 -0.2\nv 1 0 0.2\nv -1 0 0.2\n\
+                   v -0.2 -0.2 0\nv 0.2 -0.2 0\nv 0.2 0.2 0\nv -0.2 0.2 0\n\
+                   f 1 2 3\nf 1 3 4\nf 5 6 7\nf 5 7 8\n";
+    drop_obj(&mut harness, "crossed.obj", crossed);
+    assert_eq!(
+        said(&harness).as_deref(),
+        Some("intersections: no frame checked yet")
+    );
+    harness.get_by_label("Step").click();
+    run_settled(&mut harness, 2);
+    let text = said(&harness).expect("the counts");
+    let found = harness
+        .state()
+        .check
+        .found()
+        .expect("a frame checked")
+        .clone();
+    assert!(found.last.self_pairs > 0, "{text}");
+    assert_eq!(
+        text,
+        format!(
+            "intersections: {} self, 0 with solids (most {}, 0)",
+            found.last.self_pairs, found.most.self_pairs
+        )
+    );
+    harness.get_by_label("Check intersections").click();
+    harness.run_steps(2);
+    assert_eq!(said(&harness), None);
 }
 
 #[test]

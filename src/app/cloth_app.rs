@@ -11,6 +11,7 @@ use crate::view;
 
 use super::accuracy::{AccuracyWindow, Start};
 use super::background::{Load, PngWriter};
+use super::intersection_check::IntersectionCheck;
 use super::messages::{Level, Message, forced_pairs};
 use super::panel::{Action, Panel, PanelContext, Status};
 use super::panels::{SidePanel, StatusBar, TransportBar, drop_hint};
@@ -113,6 +114,8 @@ pub struct ClothApp {
     pub panels: Panels,
     /// The accuracy-versus-cost sweep of the current scene.
     pub accuracy: AccuracyWindow,
+    /// The intersection check after every frame, where the user turned it on.
+    pub check: IntersectionCheck,
 }
 
 impl ClothApp {
@@ -162,6 +165,7 @@ impl ClothApp {
             last_update: None,
             panels: Panels::default(),
             accuracy: AccuracyWindow::default(),
+            check: IntersectionCheck::default(),
         };
         if app.view.render_state.is_none() {
             app.message(
@@ -253,6 +257,7 @@ impl ClothApp {
     pub(super) fn replace_sim(&mut self, sim: Simulation) {
         let copy = sim.fork();
         self.sim = sim;
+        self.check.restart();
         // The new copy steps on the CPU.
         self.view.gpu_display = None;
         let sent = self.stepping.edit_state(Box::new(move |s| {
@@ -403,6 +408,7 @@ impl ClothApp {
     }
 
     pub fn reset(&mut self) {
+        self.check.restart();
         self.edit_state(Simulation::reset);
     }
 
@@ -427,7 +433,10 @@ impl ClothApp {
             failed,
             notes,
             behind,
+            checked,
+            ..
         } = news;
+        self.check.take(checked);
         let forced_before = self.in_effect.forced;
         self.in_effect = in_effect;
         if in_effect.forced > forced_before
@@ -577,6 +586,7 @@ impl ClothApp {
             custom_cloth: self.loading.custom_cloth.is_some(),
             samples_in_use: samples_in_use(&self.view.sample_choices, self.view.samples),
             sample_choices: &self.view.sample_choices,
+            check: (self.check.is_on(), self.check.found()),
         };
         let mut ctx = PanelContext::new(&self.sim, status, &mut self.view.options, &mut actions);
         which(&mut self.panels).ui(ui, &mut ctx);
@@ -614,6 +624,7 @@ impl ClothApp {
             Action::SetSamples(samples) => self.view.samples = samples,
             Action::ResetCamera => self.reset_camera(),
             Action::DismissMessages => self.messages.clear(),
+            Action::CheckIntersections(on) => self.check.set(on, &self.stepping),
             Action::TogglePin(p) => self.edit(move |s| s.toggle_pin(p)),
             Action::Grab { particle, target } => self.edit(move |s| s.grab(particle, target)),
             Action::Release => self.edit(Simulation::release),
@@ -784,11 +795,3 @@ fn samples_in_use(choices: &[u32], asked: u32) -> u32 {
 
 /// Width / height assumed for framing before the 3D view was first drawn.
 const DEFAULT_ASPECT: f32 = 1.4;
-
-/// `dir/prefix-NNNN<suffix>` with the first number not yet taken.
-pub(super) fn next_free(dir: &Path, prefix: &str, suffix: &str) -> PathBuf {
-    (1..)
-        .map(|n| dir.join(format!("{prefix}-{n:04}{suffix}")))
-        .find(|p| !p.exists())
-        .unwrap_or_else(|| dir.join(format!("{prefix}{suffix}")))
-}

@@ -7,9 +7,10 @@ use crate::scene::{Scene, Simulation};
 use crate::sim::{Effect, Obstacle};
 
 use super::background::{Load, Loaded};
-use super::cloth_app::{ClothApp, next_free};
+use super::cloth_app::ClothApp;
 use super::messages::Level;
 use super::panel::Action;
+use super::record::next_free;
 
 impl ClothApp {
     /// Starts loading `path` in the background: a `.toml` scene file replaces the scene, an

@@ -6,6 +6,7 @@ mod accuracy_extras;
 mod background;
 mod cloth_app;
 mod files;
+mod intersection_check;
 mod messages;
 mod panel;
 mod panels;
@@ -18,12 +19,13 @@ mod window;
 
 pub use accuracy::AccuracyWindow;
 pub use cloth_app::{ClothApp, Loading, Panels, Recording, Stats, ViewState};
+pub use intersection_check::{IntersectionCheck, intersections_text};
 pub use messages::{Level, Message};
 pub use panel::{Action, Panel, PanelContext, Status};
 pub use panels::{
     EffectsPanel, MaterialPanel, ScenePanel, SidePanel, SolverPanel, StatusBar, TransportBar,
     ViewPanel,
 };
-pub use stepping::InEffect;
+pub use stepping::{Checked, InEffect};
 pub use transport::Transport;
 pub use window::{run, with_compute_limits};

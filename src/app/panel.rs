@@ -13,7 +13,7 @@ use crate::scene::Simulation;
 use crate::sim::{Effect, SimParams};
 
 use super::messages::{Level, Message};
-use super::stepping::InEffect;
+use super::stepping::{Checked, InEffect};
 
 /// Something a panel (or the pointer) asks the app to do.
 #[derive(Clone, Debug, PartialEq)]
@@ -60,6 +60,8 @@ pub enum Action {
     ResetCamera,
     /// Clear the status messages.
     DismissMessages,
+    /// Check every frame for intersections (the cloth's own and with each solid), or not.
+    CheckIntersections(bool),
     /// Pin particle `p`, or free it.
     TogglePin(u32),
     /// Hold a particle at a point (metres) until released.
@@ -97,6 +99,8 @@ pub struct Status<'a> {
     /// MSAA samples in use and those the adapter offers.
     pub samples_in_use: u32,
     pub sample_choices: &'a [u32],
+    /// Whether every frame is checked for intersections, and what the check found.
+    pub check: (bool, Option<&'a Checked>),
 }
 
 /// What a panel draws from, and where it puts what it asks for.

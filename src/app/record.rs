@@ -1,10 +1,11 @@
 //! Capture: one PNG, a PNG sequence, or an animated GIF of what the view shows. Encoding
 //! and writing happen on the writer thread.
 
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::background::Written;
-use super::cloth_app::{ClothApp, next_free};
+use super::cloth_app::ClothApp;
 use super::messages::Level;
 
 impl ClothApp {
@@ -129,4 +130,12 @@ impl ClothApp {
                 .gif_frame(image, path.clone(), seconds);
         }
     }
+}
+
+/// `dir/prefix-NNNN<suffix>` with the first number not yet taken.
+pub(super) fn next_free(dir: &Path, prefix: &str, suffix: &str) -> PathBuf {
+    (1..)
+        .map(|n| dir.join(format!("{prefix}-{n:04}{suffix}")))
+        .find(|p| !p.exists())
+        .unwrap_or_else(|| dir.join(format!("{prefix}{suffix}")))
 }

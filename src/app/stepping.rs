@@ -9,7 +9,11 @@
 //! directly) is read back only now and then: every [`SYNC_EVERY`] while running and once
 //! the stepping stops (for the kinetic energy shown), after every edit, and when the UI asks
 //! ([`SimThread::catch_up`]: picking, export).
+//!
+//! Where the user turned the exact intersection check on, the thread runs it after every
+//! frame it steps (reading a GPU backend's copy back first), so the UI never waits for it.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender, TryRecvError};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
@@ -17,7 +21,7 @@ use std::time::{Duration, Instant};
 
 use crate::cloth::ClothState;
 use crate::scene::Simulation;
-use crate::sim::{GuardEvent, IntegratorKind, PhaseTimings};
+use crate::sim::{GuardEvent, IntegratorKind, Intersections, PhaseTimings};
 
 /// Frames the stepping thread may owe at most; beyond, the backlog is dropped and the run
 /// is reported as slower than real time (a quarter of a second at 60 frames per second).
@@ -105,11 +109,46 @@ pub(super) struct News {
     /// Frames became due while more than one was still owed, or a backlog was dropped:
     /// the simulation runs slower than real time.
     pub behind: bool,
+    /// What the intersection check found after the frames it checked (none: it checked
+    /// none since the UI last looked, or only frames of a run since replaced).
+    pub checked: Option<Checked>,
+    /// The jobs done when the first and the last of those frames were checked.
+    checked_at: [u64; 2],
+}
+
+/// What the exact intersection check found after some frames.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Checked {
+    /// After the latest of them.
+    pub last: Intersections,
+    /// The most of each count after any of them.
+    pub most: Intersections,
+}
+
+impl Checked {
+    /// `self` and then the frame after which `found` was found.
+    pub fn then(self, found: Intersections) -> Checked {
+        Checked {
+            most: self.most.max(&found),
+            last: found,
+        }
+    }
+}
+
+impl From<Intersections> for Checked {
+    fn from(found: Intersections) -> Checked {
+        Checked {
+            most: found.clone(),
+            last: found,
+        }
+    }
 }
 
 struct Shared {
     report: Mutex<Report>,
     changed: Condvar,
+    /// Whether the frames stepped from now on are checked for intersections.
+    check: AtomicBool,
 }
 
 impl Shared {
@@ -145,6 +184,7 @@ impl SimThread {
                 in_effect: InEffect::of(&sim),
             }),
             changed: Condvar::new(),
+            check: AtomicBool::new(false),
         });
         let (jobs, rx) = mpsc::channel();
         let worker = Arc::clone(&shared);
@@ -200,7 +240,16 @@ impl SimThread {
             adopt(&r.state, r.frames);
             r.fresh = false;
         }
-        (std::mem::take(&mut r.news), r.in_effect)
+        let mut news = std::mem::take(&mut r.news);
+        // What was found in a run since replaced is not this one's: where the frames
+        // checked run across the replacement, only the last is kept.
+        let [first, last] = news.checked_at;
+        if first < self.barrier {
+            news.checked = (news.checked.take())
+                .filter(|_| last >= self.barrier)
+                .map(|c| c.last.into());
+        }
+        (news, r.in_effect)
     }
 
     /// Has the thread bring its state up to date with its backend's own copy (after the
@@ -213,6 +262,11 @@ impl SimThread {
         let sent = self.sent;
         self.wait_until(|r| r.done >= sent);
         Ok(())
+    }
+
+    /// Checks every frame stepped from now on for intersections, or none (`on` false).
+    pub fn check_intersections(&self, on: bool) {
+        self.shared.check.store(on, Ordering::Relaxed);
     }
 
     /// What the stepping copy has in effect, as last published.
@@ -304,10 +358,15 @@ fn run(mut sim: Simulation, jobs: &Receiver<Job>, shared: &Shared) {
                 let outcome = sim.step_frame();
                 published.stepped = true;
                 published.state = true;
+                let check = shared.check.load(Ordering::Relaxed);
                 if let Err(e) = outcome {
                     published.failed = Some(format!("{e} Paused."));
-                } else if synced.elapsed() >= SYNC_EVERY {
+                } else if check || synced.elapsed() >= SYNC_EVERY {
+                    // The check reads the state: a backend's own copy is read back first.
                     sync(&mut sim, &mut synced, &mut published);
+                }
+                if check && published.failed.is_none() {
+                    published.checked = Some(sim.intersections());
                 }
             }
         }
@@ -336,6 +395,7 @@ struct Published {
     behind: bool,
     failed: Option<String>,
     note: Option<String>,
+    checked: Option<Intersections>,
 }
 
 impl Published {
@@ -366,6 +426,16 @@ impl Published {
             }
             news.notes.extend(self.note);
             news.behind |= self.behind;
+            if let Some(found) = self.checked {
+                news.checked = Some(match news.checked.take() {
+                    Some(before) => before.then(found),
+                    None => {
+                        news.checked_at[0] = done;
+                        found.into()
+                    }
+                });
+                news.checked_at[1] = done;
+            }
             r.in_effect = InEffect::of(sim);
         }
         shared.changed.notify_all();
@@ -398,6 +468,34 @@ mod tests {
     fn settled(thread: &mut SimThread, replica: &mut Simulation) -> (News, InEffect) {
         thread.settle();
         thread.take(|state, frames| replica.adopt_state(state, frames))
+    }
+
+    /// Frames are checked for intersections only while the check is on (the hanging
+    /// cloth: none found, and no solid); what was checked in a run replaced since is not
+    /// reported.
+    #[test]
+    fn the_thread_checks_the_frames_it_steps_while_asked() {
+        let mut replica = hanging();
+        let mut thread = SimThread::start(replica.fork());
+        thread.advance(2).unwrap();
+        assert_eq!(settled(&mut thread, &mut replica).0.checked, None);
+        thread.check_intersections(true);
+        thread.advance(3).unwrap();
+        let (news, _) = settled(&mut thread, &mut replica);
+        assert_eq!((news.stepped, news.checked), (3, Some(Checked::default())));
+        // Checked, then the run replaced before the UI looked.
+        thread.advance(1).unwrap();
+        thread.settle();
+        thread
+            .edit_state(Box::new(|s| {
+                s.reset();
+                None
+            }))
+            .unwrap();
+        assert_eq!(settled(&mut thread, &mut replica).0.checked, None);
+        thread.check_intersections(false);
+        thread.advance(2).unwrap();
+        assert_eq!(settled(&mut thread, &mut replica).0.checked, None);
     }
 
     #[test]

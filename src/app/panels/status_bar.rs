@@ -4,8 +4,12 @@ use egui::RichText;
 
 use crate::mesh::SpringKind;
 
+use super::super::intersection_check::intersections_text;
 use super::super::messages::Level;
 use super::super::panel::{Action, Panel, PanelContext};
+
+/// The colour of an error, and of intersections found.
+const ERROR: egui::Color32 = egui::Color32::from_rgb(240, 80, 70);
 
 /// The bar along the bottom of the window.
 #[derive(Default)]
@@ -30,6 +34,17 @@ impl Panel for StatusBar {
             ui.separator();
             ui.label(format!("KE {:.3e} J", sim.state().kinetic_energy(model)));
             ui.separator();
+            if let (true, found) = status.check {
+                let text = RichText::new(intersections_text(found));
+                let met = found.is_some_and(|f| f.most.total() > 0);
+                let text = if met { text.color(ERROR) } else { text };
+                ui.label(text).on_hover_text(
+                    "After every frame: the cloth's own pairs of triangles that meet, and its \
+                     triangles that meet a solid (after the last frame; the most after any \
+                     since the check began or the run started)",
+                );
+                ui.separator();
+            }
             let phases: Vec<String> = (status.phase_ms.iter())
                 .map(|(n, ms)| format!("{n} {ms:.2}"))
                 .collect();
@@ -55,7 +70,7 @@ impl Panel for StatusBar {
                 let color = match m.level {
                     Level::Info => ui.visuals().text_color(),
                     Level::Warning => egui::Color32::from_rgb(230, 160, 40),
-                    Level::Error => egui::Color32::from_rgb(240, 80, 70),
+                    Level::Error => ERROR,
                 };
                 ui.label(RichText::new(&m.text).color(color));
                 if ui.small_button("Dismiss").clicked() {

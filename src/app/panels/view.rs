@@ -37,6 +37,17 @@ impl Panel for ViewPanel {
         ui.checkbox(&mut o.particles, "Particles");
         ui.checkbox(&mut o.colliders, "Colliders");
         let status = ctx.status;
+        let mut check = status.check.0;
+        let hover = "After every frame, the exact test of every pair of the cloth's triangles, \
+                     and of the cloth's against each solid; the counts show in the status bar. \
+                     A few milliseconds a frame, on the simulation's thread.";
+        if ui
+            .checkbox(&mut check, "Check intersections")
+            .on_hover_text(hover)
+            .changed()
+        {
+            ctx.ask(Action::CheckIntersections(check));
+        }
         ui.horizontal(|ui| {
             ui.label("Antialiasing")
                 .on_hover_text("MSAA samples per pixel: fewer draw faster on a software adapter");
