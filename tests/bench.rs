@@ -290,25 +290,16 @@ fn crumple_bench_prints_a_row_per_size_and_integrator() {
 #[test]
 fn a_crumple_row_at_64_quads_says_what_it_reached_beside_the_targets() {
     let text = |quads: &str| {
-        let out = Command::new(env!("CARGO_BIN_EXE_clothsim"))
-            .args([
-                "bench",
-                "--crumple",
-                "--quads",
-                quads,
-                "--threads",
-                "2",
-                "--repeat",
-                "1",
-            ])
-            .output()
-            .expect("runs");
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8_lossy(&out.stdout).to_string()
+        output_of(&[
+            "bench",
+            "--crumple",
+            "--quads",
+            quads,
+            "--threads",
+            "2",
+            "--repeat",
+            "1",
+        ])
     };
     let at_64 = text("64");
     let line = (at_64.lines())
