@@ -498,6 +498,39 @@ mod tests {
         assert_eq!(settled(&mut thread, &mut replica).0.checked, None);
     }
 
+    /// Frames checked on both sides of a run's replacement before the UI looked: only the
+    /// last frame's counts are reported (the most would mix the two runs): a strip with a
+    /// square through it (the hanging scene with that cloth), then the plain hanging cloth.
+    #[test]
+    fn counts_checked_across_a_replacement_keep_only_the_last() {
+        let dir = tempfile::tempdir().unwrap();
+        let obj = dir.path().join("crossed.obj");
+        let crossed = "v -1 0 -0.2\nv 1 0 -0.2\nv 1 0 0.2\nv -1 0 0.2\n\
+                       v -0.2 -0.2 0\nv 0.2 -0.2 0\nv 0.2 0.2 0\nv -0.2 0.2 0\n\
+                       f 1 2 3\nf 1 3 4\nf 5 6 7\nf 5 7 8\n";
+        std::fs::write(&obj, crossed).unwrap();
+        let options = crate::mesh::ImportOptions::default();
+        let scene = Scene::open_resized("hanging", Some(&obj), &options, None).unwrap();
+        let mut replica = Simulation::new(scene);
+        let mut thread = SimThread::start(replica.fork());
+        thread.check_intersections(true);
+        thread.advance(1).unwrap();
+        let (news, _) = settled(&mut thread, &mut replica);
+        let through = news.checked.expect("checked").last;
+        assert!(through.self_pairs > 0, "{through:?}");
+        thread.advance(2).unwrap();
+        thread.settle();
+        thread
+            .edit_state(Box::new(|s| {
+                *s = hanging();
+                None
+            }))
+            .unwrap();
+        thread.advance(1).unwrap();
+        let (news, _) = settled(&mut thread, &mut replica);
+        assert_eq!(news.checked, Some(Checked::default()));
+    }
+
     #[test]
     fn frames_stepped_on_the_thread_are_the_frames_a_direct_run_steps() {
         let mut direct = hanging();
