@@ -34,10 +34,7 @@ impl IntersectionCheck {
     pub(super) fn take(&mut self, checked: Option<Checked>) {
         if let Some(new) = checked {
             self.found = Some(match self.found.take() {
-                Some(before) => Checked {
-                    most: before.most.max(&new.most),
-                    last: new.last,
-                },
+                Some(before) => before.then(new),
                 None => new,
             });
         }
@@ -97,7 +94,7 @@ mod tests {
         assert_eq!(intersections_text(check.found()), "intersections: none");
         check.take(None);
         check.take(Some(
-            Checked::from(counts(4, &[1, 0])).then(counts(2, &[0, 3])),
+            Checked::from(counts(4, &[1, 0])).then(counts(2, &[0, 3]).into()),
         ));
         check.take(Some(counts(1, &[0, 0]).into()));
         assert_eq!(

@@ -19,7 +19,7 @@ mod window;
 
 pub use accuracy::AccuracyWindow;
 pub use cloth_app::{ClothApp, Loading, Panels, Recording, Stats, ViewState};
-pub use intersection_check::{IntersectionCheck, intersections_text};
+pub use intersection_check::IntersectionCheck;
 pub use messages::{Level, Message};
 pub use panel::{Action, Panel, PanelContext, Status};
 pub use panels::{

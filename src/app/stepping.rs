@@ -126,11 +126,11 @@ pub struct Checked {
 }
 
 impl Checked {
-    /// `self` and then the frame after which `found` was found.
-    pub fn then(self, found: Intersections) -> Checked {
+    /// `self`, and then `later`: what was found after frames checked after these.
+    pub fn then(self, later: Checked) -> Checked {
         Checked {
-            most: self.most.max(&found),
-            last: found,
+            most: self.most.max(&later.most),
+            last: later.last,
         }
     }
 }
@@ -428,7 +428,7 @@ impl Published {
             news.behind |= self.behind;
             if let Some(found) = self.checked {
                 news.checked = Some(match news.checked.take() {
-                    Some(before) => before.then(found),
+                    Some(before) => before.then(found.into()),
                     None => {
                         news.checked_at[0] = done;
                         found.into()

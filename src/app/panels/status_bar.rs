@@ -36,8 +36,8 @@ impl Panel for StatusBar {
             ui.separator();
             if let (true, found) = status.check {
                 let text = RichText::new(intersections_text(found));
-                let met = found.is_some_and(|f| f.most.total() > 0);
-                let text = if met { text.color(ERROR) } else { text };
+                let any = found.is_some_and(|f| f.most.total() > 0);
+                let text = if any { text.color(ERROR) } else { text };
                 ui.label(text).on_hover_text(
                     "After every frame: the cloth's own pairs of triangles that meet, and its \
                      triangles that meet a solid (after the last frame; the most after any \
