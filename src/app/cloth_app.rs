@@ -244,27 +244,33 @@ impl ClothApp {
             change(s);
             None
         });
-        let sent = if replaces_state {
-            self.stepping.edit_state(job)
+        if replaces_state {
+            self.send_new_run(job);
         } else {
-            self.stepping.edit(job)
-        };
-        self.report_sent(sent);
+            let sent = self.stepping.edit(job);
+            self.report_sent(sent);
+        }
         out
+    }
+
+    /// Sends `job`, which replaces the state outright: nothing the run before it stepped is
+    /// shown afterwards, neither its states nor what the intersection check found in it.
+    fn send_new_run(&mut self, job: super::stepping::Edit) {
+        self.check.restart();
+        let sent = self.stepping.edit_state(job);
+        self.report_sent(sent);
     }
 
     /// Makes `sim` the simulation, shown and stepped from its state (a new scene or cloth).
     pub(super) fn replace_sim(&mut self, sim: Simulation) {
         let copy = sim.fork();
         self.sim = sim;
-        self.check.restart();
         // The new copy steps on the CPU.
         self.view.gpu_display = None;
-        let sent = self.stepping.edit_state(Box::new(move |s| {
+        self.send_new_run(Box::new(move |s| {
             *s = copy;
             None
         }));
-        self.report_sent(sent);
     }
 
     pub(super) fn report_sent(&mut self, sent: Result<(), String>) {
@@ -408,7 +414,6 @@ impl ClothApp {
     }
 
     pub fn reset(&mut self) {
-        self.check.restart();
         self.edit_state(Simulation::reset);
     }
 
@@ -490,9 +495,11 @@ impl ClothApp {
             .collect();
     }
 
-    /// The MSAA count in use: the one asked for, or the largest supported below it.
+    /// The MSAA count in use: the one asked for, or the largest supported below it (1 if
+    /// none is).
     pub fn samples_in_use(&self) -> u32 {
-        samples_in_use(&self.view.sample_choices, self.view.samples)
+        let fits = (self.view.sample_choices.iter()).filter(|&&n| n <= self.view.samples);
+        fits.max().copied().unwrap_or(1)
     }
 
     /// Whether the 3D view was last drawn straight from the GPU backend's buffer (the
@@ -584,7 +591,7 @@ impl ClothApp {
             recording: self.recording.sequence.is_some(),
             recording_gif: self.recording.gif.is_some(),
             custom_cloth: self.loading.custom_cloth.is_some(),
-            samples_in_use: samples_in_use(&self.view.sample_choices, self.view.samples),
+            samples_in_use: self.samples_in_use(),
             sample_choices: &self.view.sample_choices,
             check: (self.check.is_on(), self.check.found()),
         };
@@ -785,12 +792,6 @@ fn default_samples(rs: &egui_wgpu::RenderState) -> u32 {
     } else {
         DEFAULT_SAMPLES
     }
-}
-
-/// The largest of `choices` at most `asked` (1 if none is).
-fn samples_in_use(choices: &[u32], asked: u32) -> u32 {
-    let fits = choices.iter().filter(|&&n| n <= asked);
-    fits.max().copied().unwrap_or(1)
 }
 
 /// Width / height assumed for framing before the 3D view was first drawn.
