@@ -596,6 +596,20 @@ fn vbd_on_two_threads_gives_the_same_bits_as_on_one() {
     });
 }
 
+/// From 64 × 64 particles implicit Euler's conjugate gradients share each iteration's
+/// loops over particles between threads in pieces of whole blocks, and the dot products add
+/// the blocks' sums in order; so two threads give the same bits as one, frame after frame.
+#[test]
+fn implicit_euler_on_two_threads_gives_the_same_bits_as_on_one() {
+    let n = 72;
+    assert!((n * n) as usize >= clothsim::parallel::PARALLEL_ELEMENTS);
+    same_bits_on_two_threads(n, IntegratorKind::ImplicitEuler, |sim| {
+        for _ in 0..3 {
+            sim.step_frame().unwrap();
+        }
+    });
+}
+
 /// From 64 × 64 particles semi-implicit Euler shares out its per-particle loops
 /// (forces of gravity and air, the update) as well as the springs between threads; each
 /// particle's work is its own, so two threads give the same bits as one, frame after frame.

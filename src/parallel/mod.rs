@@ -2,6 +2,7 @@
 //! the slices its members share, and loops compiled for wider vector units. Nothing here
 //! knows what it computes.
 
+mod block_sums;
 mod disjoint;
 mod pace;
 mod parts;
@@ -9,6 +10,7 @@ mod ranges;
 mod team;
 mod wide;
 
+pub use block_sums::{each_block, sum_blocks};
 pub use disjoint::Disjoint;
 pub use parts::{PARALLEL_ELEMENTS, each_part, each_part_from, fold_parts, within};
 pub use ranges::share;

@@ -1,11 +1,14 @@
 //! Preconditioned conjugate gradients on the implicit system, with pinned particles
 //! filtered out of the solve (their unknowns stay zero) and a block-Jacobi preconditioner.
 
+use std::ops::Range;
+
 use crate::cloth::{ClothModel, Matrix, Real, Vector};
+use crate::parallel::{Disjoint, each_block, sum_blocks};
 
 use super::forces::SystemMatrix;
 use super::integrator::StepError;
-use super::kernels::{Blocks, Components, blocks_times, split, split_blocks, zeroed};
+use super::kernels::{Blocks, Components, split, zeroed};
 
 /// How a solve ended.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,36 +32,79 @@ pub struct ConjugateGradient<R: Real = f32> {
     /// The preconditioner's 3×3 blocks, one array per entry (column-major).
     precond: Blocks<R>,
     free: Vec<bool>,
+    /// Each block's partial sums in a section ([`sum_blocks`]).
+    partials: Vec<[f64; 2]>,
 }
 
-/// `Σ a_i·b_i`: eight f32 lanes sum a block of 64 particles (eight each, side by side in
-/// the vector units), and the blocks' sums add up in f64. (One f64 running sum was a chain
-/// of dependent additions, an eighth of an implicit step's time.)
-fn dot<R: Real>(a: &Components<R>, b: &Components<R>) -> f64 {
+/// Particles of a block of the dot products: its partial sum is the unit the sums add up
+/// by, whoever runs it.
+const BLOCK: usize = 64;
+
+/// `Σ a_i·b_i` over one block of at most [`BLOCK`] particles (`a` and `b` its elements):
+/// eight f32 lanes, eight particles each, side by side in the vector units, then the lanes
+/// in f64. The blocks' sums add up in f64 ([`sum_blocks`]); one f64 running sum was a
+/// chain of dependent additions, an eighth of an implicit step's time.
+#[inline(always)]
+fn block_dot<R: Real>(a: [&[R]; 3], b: [&[R]; 3]) -> f64 {
     const LANES: usize = 8;
-    const BLOCK: usize = 8 * LANES;
     let zero = [R::ZERO; LANES];
-    let n = a[0].len().min(b[0].len());
     let lanes_of = |v: &[R]| -> [R; LANES] { v.try_into().unwrap_or(zero) };
-    let mut total = 0.0f64;
-    for start in (0..n).step_by(BLOCK) {
-        let end = (start + BLOCK).min(n);
-        let whole = start + (end - start) / LANES * LANES;
-        let mut sum = zero;
-        for k in (start..whole).step_by(LANES) {
-            for c in 0..3 {
-                let (u, v) = (lanes_of(&a[c][k..k + LANES]), lanes_of(&b[c][k..k + LANES]));
-                for l in 0..LANES {
-                    sum[l] += u[l] * v[l];
-                }
+    let len = a.iter().chain(&b).map(|v| v.len()).min().unwrap_or(0);
+    let whole = len / LANES * LANES;
+    let mut sum = zero;
+    for k in (0..whole).step_by(LANES) {
+        for c in 0..3 {
+            let (u, v) = (lanes_of(&a[c][k..k + LANES]), lanes_of(&b[c][k..k + LANES]));
+            for l in 0..LANES {
+                sum[l] += u[l] * v[l];
             }
         }
-        for i in whole..end {
-            sum[0] += a[0][i] * b[0][i] + a[1][i] * b[1][i] + a[2][i] * b[2][i];
-        }
-        total += sum.iter().map(|s| s.to_f64()).sum::<f64>();
     }
-    total
+    for i in whole..len {
+        sum[0] += a[0][i] * b[0][i] + a[1][i] * b[1][i] + a[2][i] * b[2][i];
+    }
+    sum.iter().map(|s| s.to_f64()).sum::<f64>()
+}
+
+/// The elements `range` of each of three arrays.
+#[inline(always)]
+fn at<'a, R>(v: [&'a [R]; 3], range: &Range<usize>) -> [&'a [R]; 3] {
+    v.map(|c| &c[range.clone()])
+}
+
+/// The three components of `v`, for disjoint parts taken by the pieces of a section.
+fn disjoint<R>(v: &mut Components<R>) -> [Disjoint<'_, R>; 3] {
+    let [x, y, z] = v;
+    [x, y, z].map(|c| Disjoint::new(&mut c[..]))
+}
+
+/// Elements `range` of each of `v`'s components.
+///
+/// # Safety
+/// As [`Disjoint::part`]: no other piece uses these elements meanwhile.
+#[allow(clippy::mut_from_ref)]
+unsafe fn parts<'a, R>(v: &'a [Disjoint<'_, R>; 3], range: &Range<usize>) -> [&'a mut [R]; 3] {
+    // SAFETY: by the caller's contract.
+    v.each_ref().map(|c| unsafe { c.part(range.clone()) })
+}
+
+/// [`blocks_times`] for one range of particles: `m`, `u` and `out` that range's elements.
+#[inline(always)]
+fn blocks_times_in<R: Real>(
+    m: [&[R]; 9],
+    u: [&[R]; 3],
+    out: [&mut [R]; 3],
+    combine: impl Fn(R, R) -> R,
+) {
+    let [ux, uy, uz] = u;
+    for (r, out) in out.into_iter().enumerate() {
+        let (c0, c1, c2) = (m[r], m[3 + r], m[6 + r]);
+        let len = out.len().min(ux.len());
+        let out = &mut out[..len];
+        for i in 0..len {
+            out[i] = combine(c0[i] * ux[i] + c1[i] * uy[i] + c2[i] * uz[i], out[i]);
+        }
+    }
 }
 
 impl<R: Real> ConjugateGradient<R> {
@@ -105,44 +151,99 @@ impl<R: Real> ConjugateGradient<R> {
                 converged: true,
             });
         }
-        let inverse = |(p, &free)| {
-            if free {
-                sys.diag_block(p).inverse()
-            } else {
-                R::M3::ZERO
-            }
-        };
-        split_blocks((0..n).zip(free).map(inverse), &mut self.precond);
-        for v in [&mut self.r, &mut self.z, &mut self.p, &mut self.q] {
-            zeroed(v, n);
+        for v in [&mut self.r, &mut self.z, &mut self.p] {
+            v.iter_mut().for_each(|c| c.resize(n, R::ZERO));
         }
+        self.precond.iter_mut().for_each(|e| e.resize(n, R::ZERO));
+        zeroed(&mut self.q, n);
         split(x, &mut self.x, n);
-        // r = b − A·x for the starting guess.
-        sys.apply_components(&self.x, &mut self.q);
-        for (c, r) in self.r.iter_mut().enumerate() {
-            for (i, r) in r.iter_mut().enumerate() {
-                *r = if free[i] {
-                    b[i].to_array()[c] - self.q[c][i]
-                } else {
-                    R::ZERO
-                };
-            }
-        }
-        blocks_times(&self.precond, &self.r, &mut self.z, |z, _| z);
-        self.p.clone_from(&self.z);
-        let mut rz = dot(&self.r, &self.z);
-        let target = tolerance as f64 * b_norm;
-        let mut residual = dot(&self.r, &self.r).sqrt();
-        let mut iterations = 0;
-        while iterations < max_iterations && residual > target {
-            iterations += 1;
-            sys.apply_components(&self.p, &mut self.q);
-            for q in &mut self.q {
-                for (q, &free) in q.iter_mut().zip(free) {
-                    *q = if free { *q } else { R::ZERO };
+        // r = b − A·x for the starting guess, the preconditioner M⁻¹ (the diagonal blocks'
+        // inverses), z = M⁻¹·r, p = z, and r·z, r·r; q cleared for the first product.
+        sys.add_coupling(&self.x, &mut self.q);
+        let (diagonal, x_start) = (sys.diagonal(), &self.x);
+        let [q, r, z, p] = [&mut self.q, &mut self.r, &mut self.z, &mut self.p].map(disjoint);
+        let precond = self.precond.each_mut().map(|e| Disjoint::new(&mut e[..]));
+        let [mut rz, rr] = sum_blocks(n, BLOCK, &mut self.partials, |range, sums| {
+            let (free, b) = (&free[range.clone()], &b[range.clone()]);
+            // SAFETY: each piece's elements are its own.
+            let [mut q, mut r, mut z, p] = [&q, &r, &z, &p].map(|v| unsafe { parts(v, &range) });
+            let mut m = precond.each_ref().map(|e| unsafe { e.part(range.clone()) });
+            let d = diagonal.each_ref().map(|e| &e[range.clone()]);
+            blocks_times_in(
+                d,
+                x_start.each_ref().map(|c| &c[range.clone()]),
+                q.each_mut().map(|c| &mut **c),
+                |d, s| d - s,
+            );
+            for (c, r) in r.iter_mut().enumerate() {
+                for (i, r) in r.iter_mut().enumerate() {
+                    *r = if free[i] {
+                        b[i].to_array()[c] - q[c][i]
+                    } else {
+                        R::ZERO
+                    };
                 }
             }
-            let curvature = dot(&self.p, &self.q);
+            for (i, &free) in free.iter().enumerate() {
+                let inverse = if free {
+                    sys.diag_block(range.start + i).inverse()
+                } else {
+                    R::M3::ZERO
+                };
+                for (e, entry) in m.iter_mut().enumerate() {
+                    entry[i] = inverse.col(e / 3).to_array()[e % 3];
+                }
+            }
+            let r = r.each_mut().map(|c| &**c);
+            blocks_times_in(
+                m.each_mut().map(|e| &**e),
+                r,
+                z.each_mut().map(|c| &mut **c),
+                |z, _| z,
+            );
+            for ((p, z), q) in p.into_iter().zip(&z).zip(q) {
+                p.copy_from_slice(z);
+                q.fill(R::ZERO);
+            }
+            let z = z.each_mut().map(|c| &**c);
+            each_block(range.len(), BLOCK, sums, |b| {
+                let r = at(r, &b);
+                [block_dot(r, at(z, &b)), block_dot(r, r)]
+            });
+        });
+        let target = tolerance as f64 * b_norm;
+        let mut residual = rr.sqrt();
+        let mut iterations = 0;
+        // Each iteration's loops over particles run a block at a time on the team, in three
+        // sections around the springs' products (which share the team themselves); the
+        // sums come out the same on any number of threads.
+        while iterations < max_iterations && residual > target {
+            iterations += 1;
+            // q = A·p, zero at pinned particles, and p·q.
+            sys.add_coupling(&self.p, &mut self.q);
+            let (diagonal, p) = (sys.diagonal(), &self.p);
+            let q = disjoint(&mut self.q);
+            let [curvature, _] = sum_blocks(n, BLOCK, &mut self.partials, |range, sums| {
+                let p = p.each_ref().map(|c| &c[range.clone()]);
+                // SAFETY: each piece's elements are its own.
+                let mut q = unsafe { parts(&q, &range) };
+                blocks_times_in(
+                    diagonal.each_ref().map(|e| &e[range.clone()]),
+                    p,
+                    q.each_mut().map(|c| &mut **c),
+                    |d, sums| d - sums,
+                );
+                let free = &free[range.clone()];
+                for q in q.iter_mut() {
+                    q.iter_mut().zip(free).for_each(|(q, &free)| {
+                        *q = if free { *q } else { R::ZERO };
+                    });
+                }
+                let q = q.each_mut().map(|c| &**c);
+                each_block(range.len(), BLOCK, sums, |b| {
+                    [block_dot(at(p, &b), at(q, &b)), 0.0]
+                });
+            });
             if !curvature.is_finite() {
                 return Err(StepError::NonFinite { iterations });
             }
@@ -150,20 +251,53 @@ impl<R: Real> ConjugateGradient<R> {
                 return Err(StepError::Breakdown { iterations });
             }
             let alpha = R::of_f64(rz / curvature);
-            for (x, p) in self.x.iter_mut().zip(&self.p) {
-                x.iter_mut().zip(p).for_each(|(x, &p)| *x += p * alpha);
-            }
-            for (r, q) in self.r.iter_mut().zip(&self.q) {
-                r.iter_mut().zip(q).for_each(|(r, &q)| *r -= q * alpha);
-            }
-            blocks_times(&self.precond, &self.r, &mut self.z, |z, _| z);
-            residual = dot(&self.r, &self.r).sqrt();
-            let rz_next = dot(&self.r, &self.z);
+            // x += α·p, r −= α·q, z = M⁻¹·r, and r·r, r·z.
+            let (p, q, precond) = (&self.p, &self.q, &self.precond);
+            let (x, r, z) = (
+                disjoint(&mut self.x),
+                disjoint(&mut self.r),
+                disjoint(&mut self.z),
+            );
+            let [rr, rz_next] = sum_blocks(n, BLOCK, &mut self.partials, |range, sums| {
+                let p = p.each_ref().map(|c| &c[range.clone()]);
+                let q = q.each_ref().map(|c| &c[range.clone()]);
+                // SAFETY: each piece's elements are its own.
+                let (x, mut r, mut z) =
+                    unsafe { (parts(&x, &range), parts(&r, &range), parts(&z, &range)) };
+                for (x, p) in x.into_iter().zip(p) {
+                    x.iter_mut().zip(p).for_each(|(x, &p)| *x += p * alpha);
+                }
+                for (r, q) in r.iter_mut().zip(q) {
+                    r.iter_mut().zip(q).for_each(|(r, &q)| *r -= q * alpha);
+                }
+                let r = r.each_mut().map(|c| &**c);
+                blocks_times_in(
+                    precond.each_ref().map(|e| &e[range.clone()]),
+                    r,
+                    z.each_mut().map(|c| &mut **c),
+                    |z, _| z,
+                );
+                let z = z.each_mut().map(|c| &**c);
+                each_block(range.len(), BLOCK, sums, |b| {
+                    let r = at(r, &b);
+                    [block_dot(r, r), block_dot(r, at(z, &b))]
+                });
+            });
+            residual = rr.sqrt();
             let beta = R::of_f64(rz_next / rz);
             rz = rz_next;
-            for (p, z) in self.p.iter_mut().zip(&self.z) {
-                p.iter_mut().zip(z).for_each(|(p, &z)| *p = z + *p * beta);
-            }
+            // p = z + β·p, and q cleared for the next product.
+            let z = &self.z;
+            let (p, q) = (disjoint(&mut self.p), disjoint(&mut self.q));
+            sum_blocks(n, BLOCK, &mut self.partials, |range, _| {
+                // SAFETY: each piece's elements are its own.
+                let (p, q) = unsafe { (parts(&p, &range), parts(&q, &range)) };
+                for (p, z) in p.into_iter().zip(z) {
+                    let z = &z[range.clone()];
+                    p.iter_mut().zip(z).for_each(|(p, &z)| *p = z + *p * beta);
+                }
+                q.into_iter().for_each(|q| q.fill(R::ZERO));
+            });
         }
         let [x0, x1, x2] = &self.x;
         for (i, xi) in x.iter_mut().enumerate() {
@@ -184,11 +318,12 @@ impl<R: Real> ConjugateGradient<R> {
 mod tests {
     use super::*;
 
-    /// The blocked dot product equals the plain f64 sum: over lengths that end inside a
-    /// lane group and inside a block, with every component weighing in.
+    /// A block's dot product equals the plain f64 sum: over lengths that end inside a
+    /// lane group, a whole block, and a shorter last block, with every component weighing
+    /// in.
     #[test]
-    fn dot_sums_every_particle_of_every_component() {
-        for n in [0, 1, 7, 8, 63, 64, 65, 203] {
+    fn a_blocks_dot_sums_every_particle_of_every_component() {
+        for n in [0, 1, 7, 8, 63, 64] {
             let wave = |seed: f32| -> Vec<f32> {
                 (0..n).map(|i| (seed * (i as f32 + 1.0)).sin()).collect()
             };
@@ -198,7 +333,7 @@ mod tests {
                 .flat_map(|c| (0..n).map(move |i| (c, i)))
                 .map(|(c, i)| a[c][i] as f64 * b[c][i] as f64)
                 .sum();
-            let got = dot(&a, &b);
+            let got = block_dot(a.each_ref().map(|c| &c[..]), b.each_ref().map(|c| &c[..]));
             assert!(
                 (got - exact).abs() <= 1e-6 * (1.0 + exact.abs()),
                 "n = {n}: {got} vs {exact}"

@@ -184,8 +184,20 @@ impl<R: Real> SystemMatrix<R> {
         for o in out.iter_mut() {
             o[..n].fill(R::ZERO);
         }
-        self.springs.add_products(u, out);
+        self.add_coupling(u, out);
         blocks_times(&self.diag, u, out, |diagonal, sums| diagonal - sums);
+    }
+
+    /// Adds `Σ_e S_e·u_other` at both ends of every spring to `out`: the product's
+    /// off-diagonal part, negated, so that `A·u` is [`SystemMatrix::diagonal`]`·u` less
+    /// these sums (for a solver that takes the diagonal part in its own loops).
+    pub fn add_coupling(&self, u: &Components<R>, out: &mut Components<R>) {
+        self.springs.add_products(u, out);
+    }
+
+    /// The diagonal blocks, one array per entry.
+    pub fn diagonal(&self) -> &Blocks<R> {
+        &self.diag
     }
 
     /// The whole matrix, dense and row-major (`3n × 3n`), for tests on small systems.
