@@ -498,11 +498,8 @@ mod tests {
         assert_eq!(settled(&mut thread, &mut replica).0.checked, None);
     }
 
-    /// Frames checked on both sides of a run's replacement before the UI looked: only the
-    /// last frame's counts are reported (the most would mix the two runs): a strip with a
-    /// square through it (the hanging scene with that cloth), then the plain hanging cloth.
-    #[test]
-    fn counts_checked_across_a_replacement_keep_only_the_last() {
+    /// The hanging scene with a strip (held by two corners) and a free square through it.
+    fn crossed() -> Scene {
         let dir = tempfile::tempdir().unwrap();
         let obj = dir.path().join("crossed.obj");
         let crossed = "v -1 0 -0.2\nv 1 0 -0.2\nv 1 0 0.2\nv -1 0 0.2\n\
@@ -510,7 +507,15 @@ mod tests {
                        f 1 2 3\nf 1 3 4\nf 5 6 7\nf 5 7 8\n";
         std::fs::write(&obj, crossed).unwrap();
         let options = crate::mesh::ImportOptions::default();
-        let scene = Scene::open_resized("hanging", Some(&obj), &options, None).unwrap();
+        Scene::open_resized("hanging", Some(&obj), &options, None).unwrap()
+    }
+
+    /// Frames checked on both sides of a run's replacement before the UI looked: only the
+    /// last frame's counts are reported (the most would mix the two runs): a strip with a
+    /// square through it (the hanging scene with that cloth), then the plain hanging cloth.
+    #[test]
+    fn counts_checked_across_a_replacement_keep_only_the_last() {
+        let scene = crossed();
         let mut replica = Simulation::new(scene);
         let mut thread = SimThread::start(replica.fork());
         thread.check_intersections(true);
@@ -657,6 +662,32 @@ mod tests {
         assert!(failed.ends_with("Paused."), "{failed}");
         assert!(taken.stepped < 10, "it stopped at the failing frame");
         assert!(replica.state().is_finite(), "the last good state is shown");
+    }
+
+    /// On the GPU backend, as the window runs it (its state not read back every frame),
+    /// each frame checked is the GPU's: a square starts through a strip and flies out of it
+    /// at 10 m/s (two frames of 1/60 s take it past its half-width), so the first frame is
+    /// counted crossed and the third clear (checking the state at the start, not read
+    /// back, counts all three crossed).
+    #[test]
+    fn the_thread_checks_the_gpus_frames() {
+        let mut scene = crossed();
+        // The square (the last four particles, free; the strip hangs by two corners).
+        for p in 4..8 {
+            assert!(scene.model.inv_mass[p] > 0.0, "particle {p} is free");
+            scene.initial.vel[p] = glam::Vec3::new(0.0, 10.0, 0.0);
+        }
+        let mut replica = Simulation::new(scene.clone());
+        let software = crate::device::AdapterPreference::Software;
+        let (gpu, _) = crate::gpu::gpu_simulation_on(scene, false, software).expect("GPU backend");
+        let mut thread = SimThread::start(gpu);
+        thread.check_intersections(true);
+        thread.advance(3).unwrap();
+        let (news, _) = settled(&mut thread, &mut replica);
+        let checked = news.checked.expect("checked");
+        assert_eq!(news.stepped, 3);
+        assert!(checked.most.self_pairs > 0, "{checked:?}");
+        assert_eq!(checked.last, Default::default(), "{checked:?}");
     }
 
     /// On a backend that steps its own copy (the GPU, not read back every frame),
