@@ -88,7 +88,8 @@ unsafe fn parts<'a, R>(v: &'a [Disjoint<'_, R>; 3], range: &Range<usize>) -> [&'
     v.each_ref().map(|c| unsafe { c.part(range.clone()) })
 }
 
-/// [`blocks_times`] for one range of particles: `m`, `u` and `out` that range's elements.
+/// [`blocks_times`](super::kernels::blocks_times) for one range of particles: `m`, `u` and
+/// `out` that range's elements.
 #[inline(always)]
 fn blocks_times_in<R: Real>(
     m: [&[R]; 9],
