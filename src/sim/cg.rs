@@ -66,10 +66,13 @@ fn block_dot<R: Real>(a: [&[R]; 3], b: [&[R]; 3]) -> f64 {
     sum.iter().map(|s| s.to_f64()).sum::<f64>()
 }
 
-/// The elements `range` of each of three arrays.
+/// The elements `range` of each of `N` arrays (a vector's components, a block's entries).
 #[inline(always)]
-fn at<'a, R>(v: [&'a [R]; 3], range: &Range<usize>) -> [&'a [R]; 3] {
-    v.map(|c| &c[range.clone()])
+fn at<'a, R: 'a, V: AsRef<[R]>, const N: usize>(
+    v: &'a [V; N],
+    range: &Range<usize>,
+) -> [&'a [R]; N] {
+    v.each_ref().map(|c| &c.as_ref()[range.clone()])
 }
 
 /// The three components of `v`, for disjoint parts taken by the pieces of a section.
@@ -169,10 +172,10 @@ impl<R: Real> ConjugateGradient<R> {
             // SAFETY: each piece's elements are its own.
             let [mut q, mut r, mut z, p] = [&q, &r, &z, &p].map(|v| unsafe { parts(v, &range) });
             let mut m = precond.each_ref().map(|e| unsafe { e.part(range.clone()) });
-            let d = diagonal.each_ref().map(|e| &e[range.clone()]);
+            let d = at(diagonal, &range);
             blocks_times_in(
                 d,
-                x_start.each_ref().map(|c| &c[range.clone()]),
+                at(x_start, &range),
                 q.each_mut().map(|c| &mut **c),
                 |d, s| d - s,
             );
@@ -208,8 +211,8 @@ impl<R: Real> ConjugateGradient<R> {
             }
             let z = z.each_mut().map(|c| &**c);
             each_block(range.len(), BLOCK, sums, |b| {
-                let r = at(r, &b);
-                [block_dot(r, at(z, &b)), block_dot(r, r)]
+                let r = at(&r, &b);
+                [block_dot(r, at(&z, &b)), block_dot(r, r)]
             });
         });
         let target = tolerance as f64 * b_norm;
@@ -225,11 +228,11 @@ impl<R: Real> ConjugateGradient<R> {
             let (diagonal, p) = (sys.diagonal(), &self.p);
             let q = disjoint(&mut self.q);
             let [curvature, _] = sum_blocks(n, BLOCK, &mut self.partials, |range, sums| {
-                let p = p.each_ref().map(|c| &c[range.clone()]);
+                let p = at(p, &range);
                 // SAFETY: each piece's elements are its own.
                 let mut q = unsafe { parts(&q, &range) };
                 blocks_times_in(
-                    diagonal.each_ref().map(|e| &e[range.clone()]),
+                    at(diagonal, &range),
                     p,
                     q.each_mut().map(|c| &mut **c),
                     |d, sums| d - sums,
@@ -242,7 +245,7 @@ impl<R: Real> ConjugateGradient<R> {
                 }
                 let q = q.each_mut().map(|c| &**c);
                 each_block(range.len(), BLOCK, sums, |b| {
-                    [block_dot(at(p, &b), at(q, &b)), 0.0]
+                    [block_dot(at(&p, &b), at(&q, &b)), 0.0]
                 });
             });
             if !curvature.is_finite() {
@@ -260,8 +263,8 @@ impl<R: Real> ConjugateGradient<R> {
                 disjoint(&mut self.z),
             );
             let [rr, rz_next] = sum_blocks(n, BLOCK, &mut self.partials, |range, sums| {
-                let p = p.each_ref().map(|c| &c[range.clone()]);
-                let q = q.each_ref().map(|c| &c[range.clone()]);
+                let p = at(p, &range);
+                let q = at(q, &range);
                 // SAFETY: each piece's elements are its own.
                 let (x, mut r, mut z) =
                     unsafe { (parts(&x, &range), parts(&r, &range), parts(&z, &range)) };
@@ -273,15 +276,15 @@ impl<R: Real> ConjugateGradient<R> {
                 }
                 let r = r.each_mut().map(|c| &**c);
                 blocks_times_in(
-                    precond.each_ref().map(|e| &e[range.clone()]),
+                    at(precond, &range),
                     r,
                     z.each_mut().map(|c| &mut **c),
                     |z, _| z,
                 );
                 let z = z.each_mut().map(|c| &**c);
                 each_block(range.len(), BLOCK, sums, |b| {
-                    let r = at(r, &b);
-                    [block_dot(r, r), block_dot(r, at(z, &b))]
+                    let r = at(&r, &b);
+                    [block_dot(r, r), block_dot(r, at(&z, &b))]
                 });
             });
             residual = rr.sqrt();
