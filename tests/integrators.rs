@@ -596,18 +596,23 @@ fn vbd_on_two_threads_gives_the_same_bits_as_on_one() {
     });
 }
 
+/// [`same_bits_on_two_threads`] over three frames of an `n` × `n` cloth, large enough for
+/// the per-particle loops to be shared.
+fn frames_on_two_threads(n: u32, kind: IntegratorKind) {
+    assert!((n * n) as usize >= clothsim::parallel::PARALLEL_ELEMENTS);
+    same_bits_on_two_threads(n, kind, |sim| {
+        for _ in 0..3 {
+            sim.step_frame().unwrap();
+        }
+    });
+}
+
 /// From 64 × 64 particles implicit Euler's conjugate gradients share each iteration's
 /// loops over particles between threads in pieces of whole blocks, and the dot products add
 /// the blocks' sums in order; so two threads give the same bits as one, frame after frame.
 #[test]
 fn implicit_euler_on_two_threads_gives_the_same_bits_as_on_one() {
-    let n = 72;
-    assert!((n * n) as usize >= clothsim::parallel::PARALLEL_ELEMENTS);
-    same_bits_on_two_threads(n, IntegratorKind::ImplicitEuler, |sim| {
-        for _ in 0..3 {
-            sim.step_frame().unwrap();
-        }
-    });
+    frames_on_two_threads(72, IntegratorKind::ImplicitEuler);
 }
 
 /// From 64 × 64 particles semi-implicit Euler shares out its per-particle loops
@@ -615,13 +620,7 @@ fn implicit_euler_on_two_threads_gives_the_same_bits_as_on_one() {
 /// particle's work is its own, so two threads give the same bits as one, frame after frame.
 #[test]
 fn semi_implicit_euler_on_two_threads_gives_the_same_bits_as_on_one() {
-    let n = 96;
-    assert!((n * n) as usize >= clothsim::parallel::PARALLEL_ELEMENTS);
-    same_bits_on_two_threads(n, IntegratorKind::SemiImplicitEuler, |sim| {
-        for _ in 0..3 {
-            sim.step_frame().unwrap();
-        }
-    });
+    frames_on_two_threads(96, IntegratorKind::SemiImplicitEuler);
 }
 
 /// The explicit integrators get their accelerations through `StepContext::accelerations`,
