@@ -163,7 +163,9 @@ impl<R: Real> SystemMatrix<R> {
     }
 
     /// `out = A·u`, gathered per particle over `model.adjacency`, one block at a time
-    /// (for tests: the solver multiplies with [`SystemMatrix::apply_components`]).
+    /// (for tests: the solver multiplies with [`SystemMatrix::add_coupling`] and the
+    /// [`SystemMatrix::diagonal`] blocks, which [`SystemMatrix::apply_components`] puts
+    /// together).
     pub fn apply(&self, model: &ClothModel, u: &[R::V3], out: &mut [R::V3]) {
         let adj = &model.adjacency;
         let spring = self.spring_blocks(model.springs.len());
@@ -177,8 +179,9 @@ impl<R: Real> SystemMatrix<R> {
     }
 
     /// `out = A·u` with `u` and `out` stored one array per component (`out` as long as
-    /// `u`): the springs' products in their runs, with the threads of the spring forces.
-    /// The same as [`SystemMatrix::apply`] up to rounding.
+    /// `u`): the springs' products in their runs, with the threads of the spring forces,
+    /// then the diagonal blocks' — the two halves the solver takes in its own passes. The
+    /// same as [`SystemMatrix::apply`] up to rounding.
     pub fn apply_components(&self, u: &Components<R>, out: &mut Components<R>) {
         let n = u[0].len().min(self.particles());
         for o in out.iter_mut() {
