@@ -8,7 +8,7 @@ use crate::parallel::{Disjoint, each_block, sum_blocks};
 
 use super::forces::SystemMatrix;
 use super::integrator::StepError;
-use super::kernels::{Blocks, Components, split, zeroed};
+use super::kernels::{Blocks, Components, at, split, zeroed};
 
 /// How a solve ended.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -64,15 +64,6 @@ fn block_dot<R: Real>(a: [&[R]; 3], b: [&[R]; 3]) -> f64 {
         sum[0] += a[0][i] * b[0][i] + a[1][i] * b[1][i] + a[2][i] * b[2][i];
     }
     sum.iter().map(|s| s.to_f64()).sum::<f64>()
-}
-
-/// The elements `range` of each of `N` arrays (a vector's components, a block's entries).
-#[inline(always)]
-fn at<'a, R: 'a, V: AsRef<[R]>, const N: usize>(
-    v: &'a [V; N],
-    range: &Range<usize>,
-) -> [&'a [R]; N] {
-    v.each_ref().map(|c| &c.as_ref()[range.clone()])
 }
 
 /// The three components of `v`, for disjoint parts taken by the pieces of a section.

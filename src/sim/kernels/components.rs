@@ -5,7 +5,7 @@ use std::sync::{Mutex, MutexGuard};
 
 use crate::parallel::each_part;
 
-use crate::cloth::{Matrix, Real, Vector};
+use crate::cloth::{Real, Vector};
 
 /// x, y and z of a list of vectors, one array each (all the same length), in `f32` unless
 /// said otherwise.
@@ -47,23 +47,13 @@ pub fn zeroed<R: Real>(out: &mut Components<R>, n: usize) {
 /// entry `3c + r` is row `r` of column `c`.
 pub type Blocks<R = f32> = [Vec<R>; 9];
 
-/// Sets `out` to `blocks`, one array per entry (sized first, then written in place: nine
-/// pushes a block, each checking its vector's capacity, cost more than making the blocks).
-pub fn split_blocks<R: Real>(blocks: impl ExactSizeIterator<Item = R::M3>, out: &mut Blocks<R>) {
-    let n = blocks.len();
-    for entry in out.iter_mut() {
-        entry.clear();
-        entry.resize(n, R::ZERO);
-    }
-    let [e0, e1, e2, e3, e4, e5, e6, e7, e8] = out;
-    let entries = [e0, e1, e2, e3, e4, e5, e6, e7, e8].map(|e| &mut e[..n]);
-    let [e0, e1, e2, e3, e4, e5, e6, e7, e8] = entries;
-    for (i, m) in blocks.enumerate().take(n) {
-        let [c0, c1, c2] = [0, 1, 2].map(|c| m.col(c).to_array());
-        (e0[i], e1[i], e2[i]) = (c0[0], c0[1], c0[2]);
-        (e3[i], e4[i], e5[i]) = (c1[0], c1[1], c1[2]);
-        (e6[i], e7[i], e8[i]) = (c2[0], c2[1], c2[2]);
-    }
+/// The elements `range` of each of `N` arrays (a vector's components, a block's entries).
+#[inline(always)]
+pub fn at<'a, R: 'a, V: AsRef<[R]>, const N: usize>(
+    arrays: &'a [V; N],
+    range: &std::ops::Range<usize>,
+) -> [&'a [R]; N] {
+    arrays.each_ref().map(|a| &a.as_ref()[range.clone()])
 }
 
 /// `out_i = combine(M_i·u_i, out_i)` for every particle `i` (`M` one block per particle).

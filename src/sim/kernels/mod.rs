@@ -16,9 +16,7 @@ mod vec3x8;
 mod xpbd_lanes;
 
 pub use crate::cloth::Real;
-pub use components::{
-    Blocks, Components, Scratch, blocks_times, join, split, split_blocks, zeroed,
-};
+pub use components::{Blocks, Components, Scratch, at, blocks_times, join, split, zeroed};
 pub use elements::{ElementForces, NOTHING, Slots};
 pub use points::{leaves, less_into, outside, take_changes, take_moves};
 pub use run_pass::Projectors;

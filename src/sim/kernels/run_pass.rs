@@ -4,7 +4,7 @@
 
 use std::ops::Range;
 
-use super::components::Components;
+use super::components::{Components, at};
 use crate::cloth::Real;
 use crate::parallel::Disjoint;
 
@@ -106,16 +106,6 @@ impl<R: Real> RunPass<R> for ProductPass<'_, R> {
             t2[j] = was(t2[j]) - (al * a[2] + da * u[2]);
         }
     }
-}
-
-/// The particles `range` of each component.
-#[inline(always)]
-pub(super) fn at<'a, R>(c: &'a Components<R>, range: &Range<usize>) -> [&'a [R]; 3] {
-    [
-        &c[0][range.clone()],
-        &c[1][range.clone()],
-        &c[2][range.clone()],
-    ]
 }
 
 /// The force on each spring's first end, for springs whose ends' positions and velocities

@@ -20,8 +20,9 @@ use glam::Vec3;
 use crate::parallel::{Disjoint, PARALLEL_ELEMENTS, Team};
 use crate::parallel::{wide, wide_fma};
 
+use super::components::at;
 use super::components::{Components, Scratch, split};
-use super::run_pass::{ForcePass, ProductPass, Projectors, RunPass, at};
+use super::run_pass::{ForcePass, ProductPass, Projectors, RunPass};
 use crate::cloth::Real;
 
 mod system;
