@@ -33,10 +33,7 @@ impl IntersectionCheck {
     /// Takes in what the stepping thread found since the window last looked.
     pub(super) fn take(&mut self, checked: Option<Checked>) {
         if let Some(new) = checked {
-            self.found = Some(match self.found.take() {
-                Some(before) => before.then(new),
-                None => new,
-            });
+            Checked::add(&mut self.found, new);
         }
     }
 

@@ -133,6 +133,15 @@ impl Checked {
             last: later.last,
         }
     }
+
+    /// Sets `found` to what it held, and then `later` ([`Checked::then`]; `later` alone
+    /// where it held nothing).
+    pub fn add(found: &mut Option<Checked>, later: Checked) {
+        *found = Some(match found.take() {
+            Some(before) => before.then(later),
+            None => later,
+        });
+    }
 }
 
 impl From<Intersections> for Checked {
@@ -427,13 +436,10 @@ impl Published {
             news.notes.extend(self.note);
             news.behind |= self.behind;
             if let Some(found) = self.checked {
-                news.checked = Some(match news.checked.take() {
-                    Some(before) => before.then(found.into()),
-                    None => {
-                        news.checked_at[0] = done;
-                        found.into()
-                    }
-                });
+                if news.checked.is_none() {
+                    news.checked_at[0] = done;
+                }
+                Checked::add(&mut news.checked, found.into());
                 news.checked_at[1] = done;
             }
             r.in_effect = InEffect::of(sim);
