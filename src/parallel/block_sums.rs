@@ -6,9 +6,9 @@ use super::disjoint::Disjoint;
 use super::parts::PARALLEL_ELEMENTS;
 use super::team::Team;
 
-/// Blocks in a piece of a team section of [`sum_blocks`]: about five hundred elements, a
-/// few microseconds of vector loops, so that a 64 × 64 cloth's loop is eight or nine
-/// pieces for two members to share.
+/// Blocks in a piece of a team section of [`sum_blocks`]: with the solve's blocks of 64
+/// particles, about five hundred, a few microseconds of vector loops, so that a 64 × 64
+/// cloth's loop is nine pieces for two members to share.
 const PIECE_BLOCKS: usize = 8;
 
 /// Runs `work(range, sums)` over `0..len`: once over the whole range, or, from

@@ -185,8 +185,9 @@ impl<R: Real> ConjugateGradient<R> {
                 } else {
                     R::M3::ZERO
                 };
+                let columns = [0, 1, 2].map(|c| inverse.col(c).to_array());
                 for (e, entry) in m.iter_mut().enumerate() {
-                    entry[i] = inverse.col(e / 3).to_array()[e % 3];
+                    entry[i] = columns[e / 3][e % 3];
                 }
             }
             let r = r.each_mut().map(|c| &**c);
