@@ -347,7 +347,9 @@ fn push_apply(@builtin(global_invocation_id) id: vec3<u32>) {
 // over a small sphere dips in between its corners however far out they are): a triangle
 // whose point nearest a centre is within the sphere and the offset is pushed out along
 // the line from the centre, its corners by their weights and inverse masses, their
-// velocities losing what points in; side by side, each corner taking the average.
+// velocities losing what points in and their sliding slowed by the sphere's friction (the
+// push lifts a draped face's corners past the offset, where the colliders' pass no longer
+// touches them); side by side, each corner taking the average.
 fn faces_one(t: u32) {
     if (t >= sp.counts.y) {
         return;
@@ -381,16 +383,20 @@ fn faces_one(t: u32) {
         }
         let n = gap / d;
         let lambda = (reach - d) / weight;
+        // The surface there, spinning or not: a corner of a face it holds up slides on it
+        // as a particle resting on it would (Coulomb, the sphere's friction).
+        let v_surface = cross(col.b.xyz, n * col.info.y);
         for (var k = 0u; k < 3u; k++) {
             if (inv[k] == 0.0 || w[k] == 0.0) {
                 continue;
             }
             let slot = pushes_at() + PUSH_WORDS * tri[k];
             let dx = (w[k] * inv[k] * lambda) * n;
-            let inward = min(dot(state[tri[k]].v.xyz, n), 0.0);
+            let v = state[tri[k]].v.xyz;
+            let dv = touching(v, v_surface, n, col.info.z, 1.0) - v;
             for (var e = 0u; e < 3u; e++) {
                 add_fixed(slot + e, dx[e], MOVE_UNIT);
-                add_fixed(slot + 4u + e, -inward * n[e], SPEED_UNIT);
+                add_fixed(slot + 4u + e, dv[e], SPEED_UNIT);
             }
             atomicAdd(&atomics[slot + 3u], 1u);
         }
