@@ -264,6 +264,16 @@ mod tests {
     use super::*;
     use crate::mesh::bounds;
 
+    /// A horizontal grid cloth of `quads` quads a side, `size` metres across, centred at
+    /// `center`.
+    fn grid(quads: u32, size: f32, center: Vec3) -> crate::cloth::ClothModel {
+        use crate::mesh::{GridOrientation, GridSpec};
+        let mesh = GridSpec::square(quads, size, GridOrientation::Horizontal, center)
+            .build()
+            .unwrap();
+        crate::cloth::ClothModel::new(&mesh, 0.2, &[])
+    }
+
     /// A substep of 10 ms of `model` from `start` to `state`, an offset of 1 cm, no faces.
     fn pass_of<'a>(
         model: &'a crate::cloth::ClothModel,
@@ -289,13 +299,9 @@ mod tests {
     /// stays above moves nothing.
     #[test]
     fn a_cloth_that_falls_past_the_sphere_within_a_substep_is_caught() {
-        use crate::cloth::{ClothModel, ClothState};
-        use crate::mesh::{GridOrientation, GridSpec};
+        use crate::cloth::ClothState;
         use crate::sim::self_contacts::SelfContacts;
-        let mesh = GridSpec::square(4, 1.0, GridOrientation::Horizontal, Vec3::Y)
-            .build()
-            .unwrap();
-        let model = ClothModel::new(&mesh, 0.2, &[]);
+        let model = grid(4, 1.0, Vec3::Y);
         let sphere = Sphere {
             center: Vec3::ZERO,
             radius: 0.1,
@@ -336,13 +342,9 @@ mod tests {
     /// moves.
     #[test]
     fn the_particles_caught_in_parts_are_those_caught_in_one_and_the_box_is_every_moves() {
-        use crate::cloth::{ClothModel, ClothState};
-        use crate::mesh::{GridOrientation, GridSpec};
+        use crate::cloth::ClothState;
         use crate::sim::self_contacts::SelfContacts;
-        let mesh = GridSpec::square(64, 1.0, GridOrientation::Horizontal, Vec3::Y)
-            .build()
-            .unwrap();
-        let model = ClothModel::new(&mesh, 0.2, &[]);
+        let model = grid(64, 1.0, Vec3::Y);
         assert!(model.particle_count() >= crate::parallel::PARALLEL_ELEMENTS);
         let sphere = Sphere {
             center: Vec3::new(0.3, 0.0, 0.3),
@@ -420,14 +422,10 @@ mod tests {
     /// cloth draped over a sphere beside self-contact slid off it.
     #[test]
     fn a_face_the_sphere_holds_up_slides_by_coulombs_law() {
-        use crate::cloth::{ClothModel, ClothState};
-        use crate::mesh::{GridOrientation, GridSpec};
+        use crate::cloth::ClothState;
         use crate::sim::effects::faces::FacePatches;
         use crate::sim::self_contacts::SelfContacts;
-        let mesh = GridSpec::square(1, 0.2, GridOrientation::Horizontal, Vec3::ZERO)
-            .build()
-            .unwrap();
-        let model = ClothModel::new(&mesh, 0.2, &[]);
+        let model = grid(1, 0.2, Vec3::ZERO);
         let sphere = Sphere {
             center: Vec3::new(0.07, 0.0, 0.0),
             radius: 0.1,
