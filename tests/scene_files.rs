@@ -118,6 +118,7 @@ fn out_of_range_values_name_the_key_and_its_line() {
         ("[solver]\ndt = -0.01\n", 6, "`dt`"),
         ("[solver]\nsubsteps = 0\n", 6, "`substeps`"),
         ("[material]\ndensity = 0.0\n", 6, "`density`"),
+        ("[material]\ndensity = 1e-38\n", 6, "`density`"),
         (
             "[material]\nstiffness = { structural = -5.0, shear = 1.0, bend = 1.0 }\n",
             6,
@@ -127,6 +128,21 @@ fn out_of_range_values_name_the_key_and_its_line() {
             "[[effects]]\ntype = \"gravity\"\n\n[[effects]]\ntype = \"air-damping\"\nrate = -1.0\n",
             10,
             "`rate`",
+        ),
+        (
+            "[[effects]]\ntype = \"gravity\"\n\n[[effects]]\ntype = \"air-damping\"\nrate = 1e30\n",
+            10,
+            "`rate`",
+        ),
+        (
+            "[[effects]]\ntype = \"gravity\"\nacceleration = [0.0, -1e30, 0.0]\n",
+            7,
+            "`acceleration`",
+        ),
+        (
+            "[[effects]]\ntype = \"wind\"\nvelocity = [1e30, 0.0, 0.0]\n",
+            7,
+            "`velocity`",
         ),
         (
             "[[effects]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 0.0\n",

@@ -187,6 +187,11 @@ impl Default for SolverConfig {
     }
 }
 
+/// The areal densities a cloth may have, kg/m²: from far lighter than any film to a plate
+/// of lead a metre thick. Much lighter, the particles' masses leave what `f32` holds (at
+/// 1e-38 a cloth hung in the air under gravity, and the run said nothing).
+const DENSITY: std::ops::RangeInclusive<f32> = 1e-9..=1e5;
+
 impl SimParams {
     /// Checks that every number is finite and in range.
     ///
@@ -204,8 +209,8 @@ impl SimParams {
             (
                 "density",
                 self.material.density,
-                self.material.density > 0.0,
-                "> 0 kg/m²",
+                DENSITY.contains(&self.material.density),
+                "1e-9 to 1e5 kg/m²",
             ),
             (
                 "collision_offset",
@@ -282,13 +287,14 @@ mod tests {
     #[test]
     fn each_bad_value_is_named() {
         type Spoil = fn(&mut SimParams);
-        let cases: [(&str, Spoil); 6] = [
+        let cases: [(&str, Spoil); 7] = [
             ("dt", |p| p.step.dt = 0.0),
             ("dt", |p| p.step.dt = f32::NAN),
             ("substeps", |p| p.step.substeps = 0),
             ("stiffness", |p| p.material.stiffness[1] = -1.0),
             ("damping", |p| p.material.damping[2] = f32::NAN),
             ("density", |p| p.material.density = 0.0),
+            ("density", |p| p.material.density = 1e-38),
         ];
         for (name, spoil) in cases {
             let mut p = SimParams::default();

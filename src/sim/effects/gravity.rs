@@ -103,11 +103,12 @@ impl EffectKind for Gravity {
     const ADDABLE: bool = true;
 
     fn check(&self) -> Result<(), ParamError> {
+        // A hundred thousand times the Earth's and more: speeds past what `f32` squares.
         ParamError::require(
-            self.acceleration.is_finite(),
+            self.acceleration.is_finite() && self.acceleration.length() <= 1e6,
             "acceleration",
             self.acceleration,
-            "is out of range (finite)",
+            "is out of range (at most 1e6 m/s²)",
         )
     }
 

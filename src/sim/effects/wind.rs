@@ -204,11 +204,12 @@ impl EffectKind for Wind {
     const ADDABLE: bool = true;
 
     fn check(&self) -> Result<(), ParamError> {
+        // Thirty times the speed of sound; at 1e30 m/s its drag left what `f32` holds.
         ParamError::require(
-            self.velocity.is_finite(),
+            self.velocity.is_finite() && self.velocity.length() <= 1e4,
             "velocity",
             self.velocity,
-            "must be finite m/s",
+            "must be at most 1e4 m/s",
         )?;
         ParamError::require(
             self.gust_period.is_finite() && self.gust_period > 0.0,
