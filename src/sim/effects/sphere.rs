@@ -97,9 +97,10 @@ impl Sphere {
     /// corners by their weights and inverse masses, and their velocities lose what points
     /// in, their sliding slowed by Coulomb friction as a particle's on the sphere is (the
     /// push lifts the corners of a face draped over it past the offset, where the
-    /// particles' own pass no longer touches them); only the triangles of the patches whose box comes that near are tested
-    /// ([`FacePatches`]), and of those only the ones a bound on their distance does not
-    /// tell clear are measured. Returns the triangles pushed.
+    /// particles' own pass no longer touches them); only the triangles of the patches
+    /// whose box comes that near are tested ([`FacePatches`]), and of those only the ones
+    /// a bound on their distance does not tell clear are measured. Returns the triangles
+    /// pushed.
     fn keep_faces_out(&self, pass: &mut ContactPass<'_>) -> usize {
         let reach = self.radius + pass.offset;
         let (model, state) = (pass.model, &mut *pass.state);
