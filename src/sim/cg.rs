@@ -8,7 +8,7 @@ use crate::parallel::{Disjoint, each_block, sum_blocks};
 
 use super::forces::SystemMatrix;
 use super::integrator::StepError;
-use super::kernels::{Blocks, Components, at, split, zeroed};
+use super::kernels::{Blocks, Components, at, blocks_times_in, split, zeroed};
 
 /// How a solve ended.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,26 +80,6 @@ fn disjoint<R>(v: &mut Components<R>) -> [Disjoint<'_, R>; 3] {
 unsafe fn parts<'a, R>(v: &'a [Disjoint<'_, R>; 3], range: &Range<usize>) -> [&'a mut [R]; 3] {
     // SAFETY: by the caller's contract.
     v.each_ref().map(|c| unsafe { c.part(range.clone()) })
-}
-
-/// [`blocks_times`](super::kernels::blocks_times) for one range of particles: `m`, `u` and
-/// `out` that range's elements.
-#[inline(always)]
-fn blocks_times_in<R: Real>(
-    m: [&[R]; 9],
-    u: [&[R]; 3],
-    out: [&mut [R]; 3],
-    combine: impl Fn(R, R) -> R,
-) {
-    let [ux, uy, uz] = u;
-    for (r, out) in out.into_iter().enumerate() {
-        let (c0, c1, c2) = (m[r], m[3 + r], m[6 + r]);
-        let len = out.len().min(ux.len());
-        let out = &mut out[..len];
-        for i in 0..len {
-            out[i] = combine(c0[i] * ux[i] + c1[i] * uy[i] + c2[i] * uz[i], out[i]);
-        }
-    }
 }
 
 impl<R: Real> ConjugateGradient<R> {

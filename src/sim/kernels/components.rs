@@ -64,9 +64,29 @@ pub fn blocks_times<R: Real>(
     out: &mut Components<R>,
     combine: impl Fn(R, R) -> R,
 ) {
-    let n = u[0].len().min(m[0].len());
-    let (ux, uy, uz) = (&u[0][..n], &u[1][..n], &u[2][..n]);
-    for (r, out) in out.iter_mut().enumerate() {
+    blocks_times_in(
+        m.each_ref().map(|e| &e[..]),
+        u.each_ref().map(|c| &c[..]),
+        out.each_mut().map(|o| &mut o[..]),
+        combine,
+    );
+}
+
+/// [`blocks_times`] over slices: `m`, `u` and `out` one range of particles' elements (as
+/// many particles as all of them hold).
+#[inline(always)]
+pub fn blocks_times_in<R: Real>(
+    m: [&[R]; 9],
+    u: [&[R]; 3],
+    out: [&mut [R]; 3],
+    combine: impl Fn(R, R) -> R,
+) {
+    let n = (u.iter().chain(&m).map(|v| v.len()))
+        .chain(out.iter().map(|o| o.len()))
+        .min()
+        .unwrap_or(0);
+    let [ux, uy, uz] = u.map(|c| &c[..n]);
+    for (r, out) in out.into_iter().enumerate() {
         let (c0, c1, c2) = (&m[r][..n], &m[3 + r][..n], &m[6 + r][..n]);
         let out = &mut out[..n];
         for i in 0..n {

@@ -16,7 +16,9 @@ mod vec3x8;
 mod xpbd_lanes;
 
 pub use crate::cloth::Real;
-pub use components::{Blocks, Components, Scratch, at, blocks_times, join, split, zeroed};
+pub use components::{
+    Blocks, Components, Scratch, at, blocks_times, blocks_times_in, join, split, zeroed,
+};
 pub use elements::{ElementForces, NOTHING, Slots};
 pub use points::{leaves, less_into, outside, take_changes, take_moves};
 pub use run_pass::Projectors;
