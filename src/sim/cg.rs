@@ -4,7 +4,7 @@
 use std::ops::Range;
 
 use crate::cloth::{ClothModel, Matrix, Real, Vector};
-use crate::parallel::{Disjoint, each_block, sum_blocks};
+use crate::parallel::{Disjoint, each_block, each_part, sum_blocks};
 
 use super::forces::SystemMatrix;
 use super::integrator::StepError;
@@ -262,18 +262,20 @@ impl<R: Real> ConjugateGradient<R> {
             residual = rr.sqrt();
             let beta = R::of_f64(rz_next / rz);
             rz = rz_next;
-            // p = z + β·p, and q cleared for the next product.
+            // p = z + β·p, and q cleared for the next product (no sums: shared as any
+            // loop over particles is).
             let z = &self.z;
-            let (p, q) = (disjoint(&mut self.p), disjoint(&mut self.q));
-            sum_blocks(n, BLOCK, &mut self.partials, |range, _| {
-                // SAFETY: each piece's elements are its own.
-                let (p, q) = unsafe { (parts(&p, &range), parts(&q, &range)) };
-                for (p, z) in p.into_iter().zip(z) {
-                    let z = &z[range.clone()];
-                    p.iter_mut().zip(z).for_each(|(p, &z)| *p = z + *p * beta);
-                }
-                q.into_iter().for_each(|q| q.fill(R::ZERO));
-            });
+            let ([p0, p1, p2], [q0, q1, q2]) = (&mut self.p, &mut self.q);
+            each_part(
+                [p0, p1, p2, q0, q1, q2],
+                |range, [p0, p1, p2, q0, q1, q2]| {
+                    for (p, z) in [p0, p1, p2].into_iter().zip(z) {
+                        let z = &z[range.clone()];
+                        p.iter_mut().zip(z).for_each(|(p, &z)| *p = z + *p * beta);
+                    }
+                    [q0, q1, q2].into_iter().for_each(|q| q.fill(R::ZERO));
+                },
+            );
         }
         let [x0, x1, x2] = &self.x;
         for (i, xi) in x.iter_mut().enumerate() {
