@@ -119,6 +119,7 @@ fn out_of_range_values_name_the_key_and_its_line() {
         ("[solver]\nsubsteps = 0\n", 6, "`substeps`"),
         ("[material]\ndensity = 0.0\n", 6, "`density`"),
         ("[material]\ndensity = 1e-38\n", 6, "`density`"),
+        ("[material]\ndensity = 1e6\n", 6, "`density`"),
         (
             "[material]\nstiffness = { structural = -5.0, shear = 1.0, bend = 1.0 }\n",
             6,
