@@ -9,10 +9,10 @@
 // to the thickness through the obstacle's box tree, and answers with an inelastic velocity
 // response and Coulomb friction against the surface's own velocity. Then `edges`, one
 // dispatch per colour of the cloth's edges, keeps each cloth edge off the obstacle's sharp
-// edges (creases and open borders) as the CPU's sweep over them does. Beside
-// self-contact, `tips`, one dispatch per colour of the cloth's triangles, keeps each
-// triangle off the obstacle's tips (and, where it is wide enough for the surface to bulge
-// through it, off its smooth vertices) as the CPU's tip pass does.
+// edges (creases and open borders) as the CPU's sweep over them does. Then `tips`, one
+// dispatch per colour of the cloth's triangles, keeps each triangle off the obstacle's
+// tips (and, where it is wide enough for the surface to bulge through it, off its smooth
+// vertices) as the CPU's tip pass does.
 
 struct Obstacle {
     // In `surface`'s entries: where its tree's nodes, its places (triangles in the tree's
@@ -864,7 +864,7 @@ fn push_off_tip(f: ptr<function, TipFace>, o: u32, tip: vec3<f32>) {
 // Keeps each cloth triangle of this dispatch's colour the thickness off this dispatch's
 // obstacle's tips within reach, and, where a ball of the smooth parts' largest curvature
 // would rise a thickness under it, off each smooth vertex within reach whose own
-// curvature would (the CPU's `push_tips`, which runs beside self-contact).
+// curvature would (the CPU's `push_tips`).
 @compute @workgroup_size(64)
 fn tips(@builtin(global_invocation_id) id: vec3<u32>) {
     if (not_again()) {

@@ -343,31 +343,37 @@ fn push_apply(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Each triangle's interior is kept out of the spheres too, not only its corners (the
-// CPU's `keep_faces_out`: self-contact's guarantee covers the surface, and a triangle
-// over a small sphere dips in between its corners however far out they are): a triangle
-// whose point nearest a centre is within the sphere and the offset is pushed out along
-// the line from the centre, its corners by their weights and inverse masses, their
-// velocities losing what points in and their sliding slowed by the sphere's friction (the
-// push lifts a draped face's corners past the offset, where the colliders' pass no longer
-// touches them); side by side, each corner taking the average.
-fn faces_one(t: u32) {
+// CPU's `keep_faces_out`: the guarantee covers the surface, and a triangle over a small
+// sphere dips in between its corners however far out they are): a triangle whose point
+// nearest a centre is within the sphere and the offset is pushed out along the line from
+// the centre, its corners by their weights and inverse masses, and that point's velocity
+// loses what points in, its sliding slowed by the sphere's friction (the push lifts a
+// draped face's corners past the offset, where the colliders' pass no longer touches
+// them), the change shared among the corners as the push is; side by side, each corner
+// taking the average.
+// A face whose nearest point lies within this share of the offset inside the reach
+// touches it and is left as it is (the CPU's `FACE_TOUCHING`).
+const FACE_TOUCHING: f32 = 1e-4;
+
+fn faces_one(t: u32, alone: bool) {
     if (t >= sp.counts.y) {
         return;
     }
     let tri = triangles[t];
-    var x: array<vec3<f32>, 3>;
-    var inv: array<f32, 3>;
-    for (var k = 0u; k < 3u; k++) {
-        let q = state[tri[k]].x;
-        x[k] = q.xyz;
-        inv[k] = q.w;
-    }
-    let longest = max(distance(x[0], x[1]), max(distance(x[1], x[2]), distance(x[2], x[0])));
     for (var c = 0u; c < sp.passes.x; c++) {
         let col = sp.colliders[c];
         if (col.info.x != 1.0) {
             continue;
         }
+        // Where the last sphere left the corners (the same where they are summed).
+        var x: array<vec3<f32>, 3>;
+        var inv: array<f32, 3>;
+        for (var k = 0u; k < 3u; k++) {
+            let q = state[tri[k]].x;
+            x[k] = q.xyz;
+            inv[k] = q.w;
+        }
+        let longest = max(distance(x[0], x[1]), max(distance(x[1], x[2]), distance(x[2], x[0])));
         let centre = col.a.xyz;
         let reach = col.info.y + sp.contact.y;
         let near = min(distance(x[0], centre), min(distance(x[1], centre), distance(x[2], centre)));
@@ -378,25 +384,37 @@ fn faces_one(t: u32) {
         let gap = w.x * x[0] + w.y * x[1] + w.z * x[2] - centre;
         let d = length(gap);
         let weight = w.x * w.x * inv[0] + w.y * w.y * inv[1] + w.z * w.z * inv[2];
-        if (d >= reach || d < 1e-9 || weight <= 0.0) {
+        if (d >= reach - FACE_TOUCHING * sp.contact.y || d < 1e-9 || weight <= 0.0) {
             continue;
         }
         let n = gap / d;
         let lambda = (reach - d) / weight;
-        // The surface there, spinning or not: a corner of a face it holds up slides on it
-        // as a particle resting on it would (Coulomb, the sphere's friction).
+        // The surface there, spinning or not: the face's nearest point slides on it as a
+        // particle resting on it would (Coulomb, the sphere's friction), the change of its
+        // velocity shared among the corners as the push is.
         let v_surface = cross(col.b.xyz, n * col.info.y);
+        let v = w.x * state[tri[0]].v.xyz + w.y * state[tri[1]].v.xyz + w.z * state[tri[2]].v.xyz;
+        let change = (touching(v, v_surface, n, col.info.z, 1.0) - v) / weight;
         for (var k = 0u; k < 3u; k++) {
-            if (inv[k] == 0.0 || w[k] == 0.0) {
+            let share = w[k] * inv[k];
+            if (share <= 0.0) {
                 continue;
             }
             let slot = pushes_at() + PUSH_WORDS * tri[k];
-            let dx = (w[k] * inv[k] * lambda) * n;
-            let v = state[tri[k]].v.xyz;
-            let dv = touching(v, v_surface, n, col.info.z, 1.0) - v;
-            for (var e = 0u; e < 3u; e++) {
-                add_fixed(slot + e, dx[e], MOVE_UNIT);
-                add_fixed(slot + 4u + e, dv[e], SPEED_UNIT);
+            let dx = (share * lambda) * n;
+            let dv = share * change;
+            if (alone) {
+                // Its colour's only triangle at this corner: moved at once, and marked.
+                var q = state[tri[k]];
+                q.x = vec4<f32>(q.x.xyz + dx, q.x.w);
+                q.v = vec4<f32>(q.v.xyz + dv, q.v.w);
+                state[tri[k]] = q;
+                tell_solver(tri[k], dv);
+            } else {
+                for (var e = 0u; e < 3u; e++) {
+                    add_fixed(slot + e, dx[e], MOVE_UNIT);
+                    add_fixed(slot + 4u + e, dv[e], SPEED_UNIT);
+                }
             }
             atomicAdd(&atomics[slot + 3u], 1u);
         }
@@ -405,13 +423,67 @@ fn faces_one(t: u32) {
 
 @compute @workgroup_size(64)
 fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
-    faces_one(id.x);
+    faces_one(id.x, false);
 }
 
 // Each corner takes the average of its triangles' pushes out of the spheres.
 @compute @workgroup_size(64)
 fn faces_apply(@builtin(global_invocation_id) id: vec3<u32>) {
     take_pushes(id.x, 0.0);
+}
+
+// Without self-contact (src/gpu/self_contact/faces.rs), after the step's colliders: the
+// triangles of one colour, which share no particle (`this_round`: the first in the pass's
+// triangles, which are in colour order, how many, and 1 where they may share one and one
+// invocation takes them in turn), each pushed out of the spheres at once, a colour after
+// another, as the CPU's pass takes them one after another in the same order.
+@compute @workgroup_size(64)
+fn faces_coloured(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (this_round.z == 1u) {
+        if (id.x == 0u) {
+            for (var k = 0u; k < this_round.y; k++) {
+                faces_one(this_round.x + k, true);
+            }
+        }
+        return;
+    }
+    if (id.x < this_round.y) {
+        faces_one(this_round.x + id.x, true);
+    }
+}
+
+// Then the planes act again on a corner the pass moved, from where it was pushed to (no
+// path: it was pushed, not carried), and what lies within two offsets is settled, as the
+// CPU's ground after a sphere acts on what the sphere's face pass moved: a corner pushed
+// off a sphere into the ground's offset, in the wedge under it, goes back out. (Not the
+// spheres: a corner the particles' pass left a rounding inside one would take its
+// friction twice.)
+@compute @workgroup_size(64)
+fn faces_settle(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if (i >= sp.counts.x) {
+        return;
+    }
+    let count = pushes_at() + PUSH_WORDS * i + 3u;
+    if (atomicLoad(&atomics[count]) == 0u) {
+        return;
+    }
+    atomicStore(&atomics[count], 0u);
+    var q = state[i];
+    var m = Motion(q.x.xyz, q.v.xyz);
+    let offset = sp.contact.y;
+    for (var c = 0u; c < sp.passes.x; c++) {
+        let col = sp.colliders[c];
+        let depth = offset - dot(m.x - col.a.xyz, col.b.xyz);
+        if (col.info.x == 2.0 && depth > 0.0) {
+            let v = touching(m.v, vec3<f32>(0.0), col.b.xyz, col.info.z, 1.0);
+            m = Motion(m.x + depth * col.b.xyz, v);
+        }
+    }
+    m = settle_between(sp.colliders, sp.passes.x, offset, m);
+    q.x = vec4<f32>(m.x, q.x.w);
+    q.v = vec4<f32>(m.v, q.v.w);
+    state[i] = q;
 }
 
 // The same before the pushes, and what it moved rests on a sphere (the pushes move it only

@@ -117,7 +117,7 @@ fn solids_together(@builtin(local_invocation_index) l: u32) {
     }
     storageBarrier();
     for (var t = l; t < sp.counts.y; t += WIDTH) {
-        faces_one(t);
+        faces_one(t, false);
     }
     storageBarrier();
     take_pushes_together(l, 0.0);

@@ -81,9 +81,12 @@ fn passes_through_nothing(frame: usize, sim: &Simulation) {
 
 /// `carousel`'s drum, turning at 1 rad/s: the cloth lands on it and is carried round by
 /// friction with the drum's surface, and kept off the drum's rim (on the GPU from frame 8,
-/// two before it lands). Measured: 4.2 µm apart after 15 frames, when the cloth has lain
+/// two before it lands). Measured: 0.18 mm apart after 15 frames, when the cloth has lain
 /// on the turning drum for five; without the surface's velocity in the catch's response,
-/// 6.4 mm; without the edge pass, 14 cm; with every sweep of it run, 5 mm.
+/// 6.4 mm; without the edge pass, 14 cm; with every sweep of it run, 5 mm. (The tip pass
+/// keeps the rim's vertices off the cloth's triangles, and where two triangles push one
+/// particle in a substep the GPU's colour order and the CPU's patch order part the two:
+/// without the tip pass they agreed to 4.2 µm.)
 #[test]
 fn a_turning_drum_carries_the_cloth_as_on_the_cpu() {
     let (apart, cpu) = compare_checking(scene("carousel", 8), (8, 15), |_, _| {});
@@ -94,7 +97,7 @@ fn a_turning_drum_carries_the_cloth_as_on_the_cpu() {
         "the cloth is on the drum: {lowest}"
     );
     eprintln!("carousel: {apart:e} m apart");
-    assert!(apart < 2e-5, "GPU and CPU differ by {apart} m");
+    assert!(apart < 5e-4, "GPU and CPU differ by {apart} m");
 }
 
 /// `tablecloth` (9 quads, so that no row of particles lies exactly over the table's rim,
@@ -171,6 +174,23 @@ fn a_tablecloth_on_the_gpu_never_passes_through_the_table() {
     }
     let lowest = lowest(&gpu);
     assert!(lowest < 0.5, "the cloth hangs over the rim: {lowest}");
+}
+
+/// `tablecloth` at 6 quads (27 cm), whose table's corners poke up between the cloth's
+/// particles as it falls over the rim, without self-collision: on the GPU, as on the CPU,
+/// the tip pass keeps them off its triangles, and no triangle meets the table after any
+/// frame. The CPU steps it to frame 24, 25 cm above the top; the GPU from there to frame
+/// 48. (Kept out by the particles and edges alone, 10 triangles met the table by frame
+/// 42 on both.)
+#[test]
+fn a_coarse_tablecloth_on_the_gpu_never_meets_the_tables_corners() {
+    let (_, mut gpu) = on_the_gpu_from(scene("tablecloth", 6), 24);
+    for frame in 24..48 {
+        gpu.step_frame().expect("gpu frame");
+        passes_through_nothing(frame, &gpu);
+    }
+    let lowest = lowest(&gpu);
+    assert!(lowest < 0.6, "the cloth hangs over the rim: {lowest}");
 }
 
 /// `tablecloth` at 8 quads, the cloth 0.5 m across (it lands inside the table's top, away

@@ -233,10 +233,12 @@ fn rms(a: &[Vec3], b: &[Vec3]) -> f32 {
 }
 
 /// A 0.4 m cloth let go just above a sphere of radius 0.4 m settles, after 2 s, within
-/// 2.5 mm (rms) of where it settles on the analytic sphere when the sphere is a mesh of
-/// 5 120 triangles with its corners on the sphere (measured 2026-11-25: 1.5 mm; the faces
-/// lie up to 0.15 mm inside the sphere, the rest is where friction held the cloth); a sphere
-/// 1 cm smaller moves it more than four times as far (measured: 11 mm).
+/// 5 mm (rms) of where it settles on the analytic sphere when the sphere is a mesh of
+/// 5 120 triangles with its corners on the sphere (measured 2026-12-08: 3.7 mm; the faces
+/// lie up to 0.15 mm inside the sphere, the rest is where friction held the cloth, which
+/// on the analytic sphere holds the cloth's faces as well as its particles since it keeps
+/// them out too: 1.5 mm when it kept only the particles out); a sphere 1 cm smaller moves
+/// it more than 2.5 times as far (measured: 10.8 mm).
 #[test]
 fn a_cloth_rests_on_a_mesh_sphere_as_on_the_sphere() {
     let dir = tempfile::tempdir().unwrap();
@@ -253,12 +255,9 @@ fn a_cloth_rests_on_a_mesh_sphere_as_on_the_sphere() {
     let on_mesh = settled(dir.path(), mesh_toml, 120);
     let on_smaller = settled(dir.path(), &analytic(0.39), 120);
     let (mesh, smaller) = (rms(&on_mesh, &on_sphere), rms(&on_smaller, &on_sphere));
+    assert!(mesh < 5e-3, "mesh {mesh} m from where the sphere holds it");
     assert!(
-        mesh < 2.5e-3,
-        "mesh {mesh} m from where the sphere holds it"
-    );
-    assert!(
-        smaller > 4.0 * mesh,
+        smaller > 2.5 * mesh,
         "a 1 cm smaller sphere: only {smaller} m"
     );
 }

@@ -294,8 +294,8 @@ impl RunArgs {
             );
         }
         // The import's warnings before anything can fail, then those the simulation adds
-        // about the start (a cloth that meets itself or a solid, a sphere smaller than the
-        // spacing), which follow them in its list.
+        // about the start (a cloth that meets itself or a solid), which follow them in its
+        // list.
         let imported = scene.warnings.len();
         for w in &scene.warnings {
             eprintln!("warning: {}: {w}", scene.cloth_name);

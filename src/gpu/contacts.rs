@@ -1,6 +1,7 @@
-//! The contacts that run after each substep on the GPU, in order: the mesh obstacles
-//! (`obstacles.rs`), then the cloth against itself (`self_contact.rs`), whose cuts come
-//! last so that nothing after them can undo its guarantee.
+//! The contacts that run after each substep on the GPU, in order: the spheres' faces
+//! where self-contact does not keep them out (`self_contact/faces.rs`), the mesh
+//! obstacles (`obstacles.rs`), then the cloth against itself (`self_contact.rs`), whose
+//! cuts come last so that nothing after them can undo its guarantee.
 
 use glam::Vec3;
 
@@ -11,7 +12,7 @@ use super::error::GpuError;
 use super::kernel::SubstepKernel;
 use super::obstacles::ObstaclePass;
 use super::packing::Params;
-use super::self_contact::{Counters, SelfPass};
+use super::self_contact::{Counters, FacePass, SelfPass};
 use super::substep_ends::{Memory, Start};
 
 /// The scene's mesh obstacles and self-contact on the device, where it has them.
@@ -19,6 +20,9 @@ use super::substep_ends::{Memory, Start};
 pub(super) struct Contacts {
     pub(super) obstacles: Option<ObstaclePass>,
     pub(super) own: Option<SelfPass>,
+    /// The spheres' face pass, in a scene with a sphere and no self-contact (whose pushes
+    /// keep the faces out themselves).
+    faces: Option<FacePass>,
     /// What the mesh obstacles were last fitted to, and the contacts' settings they were
     /// packed with.
     reach: Reach,
@@ -47,14 +51,17 @@ impl Contacts {
             Effect::SelfCollision(own) => Some(own),
             _ => None,
         });
-        let own = match own {
-            Some(own) => SelfPass::new(device, queue, particles, model, own)?,
-            None => None,
+        let sphere = (effects.iter()).any(|e| matches!(e, Effect::Sphere(_)));
+        let (own, faces) = match own {
+            Some(own) => (SelfPass::new(device, queue, particles, model, own)?, None),
+            None if sphere => (None, FacePass::new(device, queue, particles, model)),
+            None => (None, None),
         };
         let contact = params.contact;
         let mut contacts = Self {
             obstacles,
             own,
+            faces,
             reach,
             contact,
         };
@@ -114,9 +121,9 @@ impl Contacts {
     }
 
     /// Before a submission of `substeps` substeps of `substep` seconds from `time`: the
-    /// obstacles' poses, self-contact's room and uniform (with the step's colliders, from
-    /// `cloth`, its uniform), and what the integrator keeps that the contacts change
-    /// (`memory`).
+    /// obstacles' poses, self-contact's room, its uniform and the face pass's (with the
+    /// step's colliders, from `cloth`, its uniform), and what the integrator keeps that the
+    /// contacts change (`memory`).
     ///
     /// # Errors
     /// As [`ObstaclePass::write_poses`] and [`SelfPass::prepare`].
@@ -134,6 +141,9 @@ impl Contacts {
         if let Some(own) = self.own.as_mut() {
             own.prepare(device, queue, substep, memory, cloth)?;
         }
+        if let Some(faces) = self.faces.as_mut() {
+            faces.prepare(queue, substep, memory, cloth);
+        }
         self.tell_pushes(device);
         Ok(())
     }
@@ -150,6 +160,9 @@ impl Contacts {
         }
         if let Some(own) = self.own.as_mut() {
             own.attach_solve(device, particles, solve);
+        }
+        if let Some(faces) = self.faces.as_mut() {
+            faces.attach_solve(device, particles, solve);
         }
     }
 
@@ -174,6 +187,9 @@ impl Contacts {
 
     /// Records substep `k`'s contacts, where `start` says its start and end are.
     pub(super) fn encode(&self, pass: &mut wgpu::ComputePass<'_>, k: u32, start: Start) {
+        if let Some(faces) = &self.faces {
+            faces.encode(pass, start);
+        }
         if let Some(obstacles) = &self.obstacles {
             if let Some(own) = &self.own {
                 own.before_obstacles(pass, start);

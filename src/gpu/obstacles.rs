@@ -6,8 +6,8 @@
 //! each substep's start and end are written before each submission, and a deforming
 //! obstacle's surface where each substep ends (the CPU's, refitted), after the rigid ones'.
 //! The cloth's edges (its structural and shear springs) are coloured so that a dispatch per
-//! colour sweeps them as the CPU's loop does; beside self-contact its triangles are too, for
-//! the tip pass (in another order than the CPU's, which goes patch by patch).
+//! colour sweeps them as the CPU's loop does; its triangles are too, for the tip pass (in
+//! another order than the CPU's, which goes patch by patch).
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Quat, Vec3};
@@ -72,8 +72,8 @@ pub(super) struct ObstaclePass {
     /// `groups[4 + i]` copies `particles[i]` into the kept copy.
     groups: [wgpu::BindGroup; 6],
     colours: Colours,
-    /// The cloth's triangles' colours, for the tip pass, where it runs: beside
-    /// self-contact (as on the CPU), with an obstacle that has tips or smooth vertices.
+    /// The cloth's triangles' colours, for the tip pass, where it runs (as on the CPU):
+    /// with an obstacle that has tips or smooth vertices.
     tip_colours: Option<Colours>,
     poses_layout: wgpu::BindGroupLayout,
     poses: wgpu::Buffer,
@@ -286,9 +286,10 @@ impl ObstaclePass {
             return Ok(None);
         };
         let (mut edges, records) = sweeps_of(model);
-        // The tip pass runs where the CPU's does: beside self-contact.
+        // The pass acts again after self-contact's pushes, where the scene has it.
         let own = (effects.iter()).any(|e| matches!(e, Effect::SelfCollision(_)));
-        let tipped = own && (params.obstacles.iter()).any(|o| o.tip_counts[..2] != [0, 0]);
+        // The tip pass runs where the CPU's does: wherever an obstacle has tips.
+        let tipped = (params.obstacles.iter()).any(|o| o.tip_counts[..2] != [0, 0]);
         params.counts[1] = edges.len() as u32;
         let triangles = tipped.then(|| push_triangles(model, &mut edges));
         let bytes = |n: usize, each: usize| (n * each) as u64;
@@ -616,7 +617,7 @@ impl ObstaclePass {
 
     /// Records substep `k`'s contacts, where `start` says its start and end are: each
     /// obstacle in turn (as the CPU's effects, in the scene's order) catches the particles'
-    /// moves, then sweeps the cloth's edges, then (beside self-contact) its triangles.
+    /// moves, then sweeps the cloth's edges, then (where it has tips) its triangles.
     /// `again`: the second time in the substep, after self-contact's pushes, which acts
     /// only where they moved something ([`ObstaclePass::attach_pushed`]).
     pub(super) fn encode(

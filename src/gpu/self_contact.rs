@@ -27,6 +27,10 @@ use super::packing::{GpuCollider, MAX_COLLIDERS, Params, SPHERE};
 use super::substep_ends::{Memory, Start};
 use super::support::fits;
 
+mod faces;
+
+pub(super) use faces::FacePass;
+
 const SOURCE: &str = concat!(
     include_str!("../../shaders/self_contact.wgsl"),
     include_str!("../../shaders/self_pushes.wgsl"),
@@ -91,6 +95,27 @@ struct SelfParams {
     passes: [u32; 4],
     /// The step's sphere and plane colliders.
     colliders: [GpuCollider; MAX_COLLIDERS],
+}
+
+impl SelfParams {
+    /// The step's part: the substep, the colliders' offset and the colliders (from
+    /// `cloth`, the step's uniform), and what the contacts tell the solver (`memory`).
+    fn for_step(&mut self, substep: f32, memory: Memory, cloth: &Params) {
+        self.lengths[3] = substep;
+        self.contact[1] = cloth.drag[1];
+        self.passes[0] = cloth.counts[1];
+        self.colliders = cloth.colliders;
+        (self.more[1], self.more[2]) = match memory {
+            Memory::None => (0, 0),
+            Memory::Guess(at) => (1, at),
+            Memory::Accelerations(at) => (2, at),
+        };
+    }
+}
+
+/// The shader: its bindings and helpers, then the kernels.
+fn shader() -> String {
+    format!("{LAYOUT}{CONTACT}{GEOMETRY}{SOURCE}")
 }
 
 /// Where the workgroup counts of `pairs_of_triangles` start in the pair kernels' (bytes:
@@ -312,7 +337,7 @@ impl SelfPass {
         let kernels = pipelines(
             device,
             "self-contact",
-            &format!("{LAYOUT}{CONTACT}{GEOMETRY}{SOURCE}"),
+            &shader(),
             ENTRY_POINTS.map(|entry| {
                 (
                     entry,
@@ -492,17 +517,9 @@ impl SelfPass {
             self.resize(device, shrunk)?;
         }
         self.together = self.forced.unwrap_or(self.together);
-        self.params.lengths[3] = substep;
-        self.params.contact[1] = cloth.drag[1];
-        self.params.passes[0] = cloth.counts[1];
+        self.params.for_step(substep, memory, cloth);
         self.params.passes[1] = self.sweeps.min(PUSH_SWEEPS);
         self.params.passes[2] = self.push_rounds.min(PUSH_ROUNDS);
-        self.params.colliders = cloth.colliders;
-        (self.params.more[1], self.params.more[2]) = match memory {
-            Memory::None => (0, 0),
-            Memory::Guess(at) => (1, at),
-            Memory::Accelerations(at) => (2, at),
-        };
         queue.write_buffer(&self.buffers[0], 0, bytemuck::bytes_of(&self.params));
         queue.write_buffer(&self.buffers[3], MOST_AT, &[0; MOST_BYTES as usize]);
         Ok(())

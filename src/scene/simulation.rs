@@ -6,8 +6,7 @@ use crate::cloth::{ClothModel, ClothState};
 use crate::sim::{
     Cause, Changes, Diverged, Effect, ForceSet, FrameOutcome, GuardEvent, IntegratorKind,
     Intersections, ParamError, PhaseTimings, SimParams, StepBackend, StepError, StepReport,
-    StepStats, cpu_backend, intersections, obstacle_overlap_warnings, small_sphere_warnings,
-    thickness_fits,
+    StepStats, cpu_backend, intersections, obstacle_overlap_warnings, thickness_fits,
 };
 
 use super::error::SceneError;
@@ -93,7 +92,6 @@ impl Simulation {
     /// The simulation of `scene` on `backend`, configured for it.
     fn assemble(scene: Scene, backend: Box<dyn StepBackend>) -> Self {
         let mut warnings = scene.warnings;
-        warnings.extend(small_sphere_warnings(&scene.effects, &scene.model));
         let offset = scene.params.contact.offset;
         warnings.extend(obstacle_overlap_warnings(
             &scene.effects,
@@ -188,8 +186,8 @@ impl Simulation {
         &self.cloth_name
     }
 
-    /// Notes from importing the cloth, then about the scene's start: a sphere smaller than
-    /// the cloth's spacing, a solid the cloth already meets, a cloth that intersects itself.
+    /// Notes from importing the cloth, then about the scene's start: a solid the cloth
+    /// already meets, a cloth that intersects itself.
     pub fn warnings(&self) -> &[String] {
         &self.warnings
     }
@@ -399,8 +397,8 @@ impl Simulation {
     }
 
     /// Replaces the effect list (switches forces on or off, moves or retunes colliders).
-    /// Returns warnings about it (a sphere smaller than the particle spacing). The state,
-    /// and a backend's copy of it, are left as they are.
+    /// Returns warnings about it (a mesh obstacle added where the cloth already meets it).
+    /// The state, and a backend's copy of it, are left as they are.
     ///
     /// # Errors
     /// [`SceneError::Effect`] for a value out of range, [`SceneError::Thickness`] for a
@@ -444,14 +442,8 @@ impl Simulation {
             .cloned()
             .collect();
         self.effects = effects;
-        let mut warnings = small_sphere_warnings(&self.effects, &self.model);
         let offset = self.params.contact.offset;
-        warnings.extend(obstacle_overlap_warnings(
-            &added,
-            &self.model,
-            &self.state.pos,
-            offset,
-        ));
+        let warnings = obstacle_overlap_warnings(&added, &self.model, &self.state.pos, offset);
         (self.backend).configure(&self.model, &self.params, &self.effects, Changes::EFFECTS);
         Ok(warnings)
     }

@@ -66,8 +66,8 @@ pub struct RunSummary {
     /// Set when the run stopped early because it diverged.
     pub error: Option<String>,
     /// What [`Simulation::warnings`] says about the cloth and the scene's start (the
-    /// import's notes, a cloth that starts through itself or a solid, a sphere smaller
-    /// than the spacing); left out where there is none.
+    /// import's notes, a cloth that starts through itself or a solid); left out where
+    /// there is none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
 }

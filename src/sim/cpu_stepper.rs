@@ -247,7 +247,7 @@ impl<R: Real> CpuStepper<R> {
             state,
             offset: self.offset,
             self_contacts: &mut self.self_contacts,
-            faces: (self.self_collision.is_some()).then_some(&mut self.faces),
+            faces: Some(&mut self.faces),
         };
         // Self-contact's upkeep between the effects, timed as a phase of its own.
         let mut upkeep = Duration::ZERO;
@@ -551,17 +551,18 @@ impl<R: Real> StepBackend for CpuStepper<R> {
                 Effect::SelfCollision(s) => Some(*s),
                 _ => None,
             });
+            // The patches the solids' face passes take (a sphere's, and a mesh obstacle's
+            // of its tips), cut now for a cloth among solids, with self-contact's setup
+            // where it runs: built now, not in the first substep, and timed as its own
+            // phase where either was built (not where they were this cloth's already). A
+            // cloth too large for self-contact is refused by the first substep, with its
+            // error.
+            let start = std::time::Instant::now();
+            let solids =
+                (effects.iter()).any(|e| matches!(e, Effect::Sphere(_) | Effect::Obstacle(_)));
+            let cut = solids && self.faces.prepare(model);
             if self.self_collision.is_some() {
-                // Built now, not in the first substep, with the patches the face passes
-                // take (a sphere's, and a mesh obstacle's of its tips: they run only beside
-                // self-collision); timed as its own phase where either was built (not
-                // where they were this cloth's already). A cloth too large for it is
-                // refused by the first substep, with its error.
-                let start = std::time::Instant::now();
                 let built = matches!(self.self_contacts.prepare(model), Ok(true));
-                let faced =
-                    (effects.iter()).any(|e| matches!(e, Effect::Sphere(_) | Effect::Obstacle(_)));
-                let cut = faced && self.faces.prepare(model);
                 if built || cut {
                     self.timings.add(super::SELF_SETUP, start.elapsed());
                 }

@@ -31,10 +31,10 @@ pub use cpu_stepper::{BETWEEN_SOLIDS, CONTACT_START, CpuStepper, cpu_backend};
 pub use diagnosis::{Cause, Vibration, stiffest_vibration};
 pub use effects::{
     AirDamping, BendingModel, ClothBox, ClothSprings, DEFAULT_DIHEDRAL_STIFFNESS, DEFAULT_FPS,
-    Effect, GROWTH, Gravity, Handle, ListedTwice, Obstacle, ObstacleError, Plane, Reach,
-    SelfCollision, Sphere, TooThick, Wind, WindForce, air_damping_of, fitted_to_cloth, frame_path,
-    gravity_of, listed_twice, min_surface_distance, obstacle_overlap_warnings, shortest_edge,
-    small_sphere_warnings, thickness_fits,
+    Effect, FACE_TOUCHING, GROWTH, Gravity, Handle, ListedTwice, Obstacle, ObstacleError, Plane,
+    Reach, SelfCollision, Sphere, TooThick, Wind, WindForce, air_damping_of, fitted_to_cloth,
+    frame_path, gravity_of, listed_twice, min_surface_distance, obstacle_overlap_warnings,
+    shortest_edge, thickness_fits,
 };
 pub use forces::{Force, ForceSet, ForceTerm, JacobianMode, SystemMatrix};
 pub use guard::{

@@ -23,9 +23,11 @@ pub struct ContactPass<'a> {
     pub offset: f32,
     /// Self-collision's buffers, kept between substeps.
     pub self_contacts: &'a mut SelfContacts,
-    /// Where solids keep the cloth's triangles out too, not only its particles (with
-    /// self-contact, whose guarantee covers the surface): the triangles in patches, so a
-    /// solid tests the triangles of the patches near it only.
+    /// Where solids keep the cloth's triangles out too, not only its particles (the
+    /// stepper's always: the guarantee covers the surface, and a coarse cloth's triangle
+    /// dips into a sphere or over a tip between its corners): the triangles in patches,
+    /// so a solid tests the triangles of the patches near it only. `None` keeps only the
+    /// particles and edges out (tests of those passes alone).
     pub faces: Option<&'a mut FacePatches>,
 }
 

@@ -3,11 +3,13 @@
 //! triangles of the patches near the solid one by one. The patches are cut once per cloth
 //! from where its triangles lie at rest (halved at the medians of their centres, as the
 //! trees are), so each is a piece of cloth that stays together however it folds and its
-//! box stays small.
+//! box stays small. The triangles near come in the order of their colours (greedy, by the
+//! particles they share: [`colour_greedily`]), the order in which the GPU's face pass
+//! takes them, a dispatch a colour.
 
 use glam::{Vec3, Vec3A};
 
-use crate::cloth::ClothModel;
+use crate::cloth::{ClothModel, colour_greedily};
 use crate::sim::obstacle::split_triangles_at_medians;
 
 /// Triangles in a patch at most (at least half as many, but for a cloth with fewer).
@@ -34,7 +36,10 @@ pub struct FacePatches {
     boxes: Vec<(Vec3A, Vec3A)>,
     /// The cloth they were cut for: its triangles and particles.
     cut_for: (usize, usize),
-    /// The triangles of the patches the last call found near, in the cloth's order.
+    /// The triangles colour after colour, and each triangle's place in that order.
+    coloured: Vec<u32>,
+    rank: Vec<u32>,
+    /// The triangles of the patches the last call found near, in colour order.
     near: Vec<u32>,
 }
 
@@ -53,6 +58,11 @@ impl FacePatches {
             patch_of: vec![0; triangles.len()],
             ..FacePatches::default()
         };
+        (self.coloured, _) = colour_greedily(model.particle_count(), triangles.iter().copied());
+        self.rank = vec![0; triangles.len()];
+        for (k, &t) in self.coloured.iter().enumerate() {
+            self.rank[t as usize] = k as u32;
+        }
         let mut seen = vec![usize::MAX; model.particle_count()];
         self.starts.push(0);
         self.particle_starts.push(0);
@@ -74,10 +84,10 @@ impl FacePatches {
         true
     }
 
-    /// The triangles, in the cloth's order, of every patch whose particles at `pos` lie in
-    /// a box for which `near(lo, hi)` holds: a triangle lies in the box of its corners, so
-    /// one that a solid could touch is among them when `near` holds for every box the
-    /// solid comes within its reach of.
+    /// The triangles, in colour order, of every patch whose particles at `pos` lie in a box
+    /// for which `near(lo, hi)` holds: a triangle lies in the box of its corners, so one
+    /// that a solid could touch is among them when `near` holds for every box the solid
+    /// comes within its reach of.
     pub fn near(
         &mut self,
         model: &ClothModel,
@@ -90,18 +100,19 @@ impl FacePatches {
             .filter(|(_, f)| **f)
             .map(|(k, _)| self.starts[k + 1] - self.starts[k])
             .sum();
-        // In the cloth's order: sorted where they are few, picked out of every triangle
-        // where they are many (a cloth draped over a sphere: 2 000 of 8 192 at 64², whose
-        // sort took a fifth of the pass).
+        // In colour order: sorted where they are few, picked out of every triangle where
+        // they are many (a cloth draped over a sphere: 2 000 of 8 192 at 64², whose sort
+        // took a fifth of the pass).
         if held * SORTED_BELOW < self.patch_of.len() {
             for (k, _) in self.flagged.iter().enumerate().filter(|(_, f)| **f) {
                 (self.near).extend_from_slice(&self.triangles[self.starts[k]..self.starts[k + 1]]);
             }
-            self.near.sort_unstable();
+            let rank = &self.rank;
+            self.near.sort_unstable_by_key(|&t| rank[t as usize]);
         } else {
             let (flagged, patch_of) = (&self.flagged, &self.patch_of);
             (self.near).extend(
-                (0..patch_of.len() as u32).filter(|&t| flagged[patch_of[t as usize] as usize]),
+                (self.coloured.iter().copied()).filter(|&t| flagged[patch_of[t as usize] as usize]),
             );
         }
         &self.near

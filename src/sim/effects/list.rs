@@ -125,29 +125,3 @@ pub fn obstacle_overlap_warnings(
     }
     out
 }
-
-/// A warning for each sphere smaller than the cloth's particle spacing (its median spring
-/// rest length): collisions are per particle, so such a sphere can pass between particles
-/// and the cloth's triangles over it. None with self-collision, whose contacts push out
-/// the triangles that dip into a sphere as well.
-pub fn small_sphere_warnings(effects: &[Effect], model: &ClothModel) -> Vec<String> {
-    let faces_kept_out = (effects.iter()).any(|e| matches!(e, Effect::SelfCollision(_)));
-    if faces_kept_out || model.springs.rest.is_empty() {
-        return Vec::new();
-    }
-    let mut rest = model.springs.rest.clone();
-    rest.sort_by(f32::total_cmp);
-    let spacing = rest[rest.len() / 2];
-    effects
-        .iter()
-        .filter_map(|e| match e {
-            Effect::Sphere(s) if s.radius < spacing => Some(format!(
-                "a sphere of radius {:.3} m is smaller than the cloth's particle spacing \
-                 ({spacing:.3} m): collisions are per particle, so the cloth's triangles can pass \
-                 over it; use a finer cloth or a larger sphere",
-                s.radius
-            )),
-            _ => None,
-        })
-        .collect()
-}

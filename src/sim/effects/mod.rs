@@ -29,7 +29,7 @@ pub use gravity::Gravity;
 pub use handle::Handle;
 pub use list::{
     ListedTwice, air_damping_of, gravity_of, listed_twice, min_surface_distance,
-    obstacle_overlap_warnings, small_sphere_warnings, thickness_fits,
+    obstacle_overlap_warnings, thickness_fits,
 };
 pub use obstacle::{DEFAULT_FPS, Obstacle, ObstacleError, Placed, Shape, frame_path};
 pub use plane::Plane;
@@ -38,5 +38,5 @@ pub use reach::{GROWTH, Reach, fitted_to_cloth};
 pub(crate) use reach::{growing_cloth, rail, rising_roof};
 pub use registry::{Addable, Effect};
 pub use self_collision::{SelfCollision, TooThick, shortest_edge};
-pub use sphere::Sphere;
+pub use sphere::{FACE_TOUCHING, Sphere};
 pub use wind::{Wind, WindForce};

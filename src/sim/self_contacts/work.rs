@@ -2,8 +2,8 @@
 //! times its setup for a cloth.
 
 /// The phase that times self-contact's setup for a cloth ([`super::SelfContacts::prepare`],
-/// and, beside a sphere, the patches of its face pass, which runs only beside
-/// self-contact), when a stepper takes self-collision on: once, before the substeps.
+/// and, among solids, the patches of their face passes, cut with it), when a stepper
+/// takes self-collision on: once, before the substeps.
 pub const SELF_SETUP: &str = "self-setup";
 
 /// The phase that times self-contact's recheck after the solids moved the cloth again

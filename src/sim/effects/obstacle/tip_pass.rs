@@ -2,8 +2,8 @@
 //! obstacle's tips (a pyramid's apex, a table's corners), which can poke through a
 //! triangle whose particles and edges all keep clear of the faces and the sharp edges;
 //! and, under a triangle wide enough for the surface's curve to rise through it, off the
-//! other vertices too. It runs where the solids keep the cloth's triangles out (beside
-//! self-contact, as a sphere's face pass does), in the edge pass's frame and after it.
+//! other vertices too. It runs where the solids keep the cloth's triangles out (as a
+//! sphere's face pass does: in every stepper), in the edge pass's frame and after it.
 
 use glam::{Vec3, Vec3A};
 
@@ -41,8 +41,8 @@ fn sag(x: [Vec3; 3], curvature: f32) -> f32 {
 /// of the triangle must stay a thickness from that point. What is missing moves the
 /// nearest point by exactly that, its corners in proportion to their weights in it; their
 /// velocity towards the tip is removed, with Coulomb friction `mu` across it. Nothing
-/// where the obstacle has no tips or the solids keep only the cloth's particles out
-/// (no self-contact). Returns how many pushes it made.
+/// where the obstacle has no tips or the pass keeps only the cloth's particles and edges
+/// out (no patches). Returns how many pushes it made.
 pub(super) fn push_tips<S, L, W, V>(
     tips: &Tips,
     frame: &EdgeFrame<S, L, W, V>,
