@@ -433,10 +433,12 @@ fn faces_apply(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Without self-contact (src/gpu/self_contact/faces.rs), after the step's colliders: the
-// triangles of one colour, which share no particle (`this_round`: the first in the pass's
-// triangles, which are in colour order, how many, and 1 where they may share one and one
-// invocation takes them in turn), each pushed out of the spheres at once, a colour after
-// another, as the CPU's pass takes them one after another in the same order.
+// triangles of one colour, which share no particle (`this_round`, a colour's record as the
+// coloured solvers read theirs: the first in the pass's triangles, which are in colour
+// order, how many, 1 where they may share one and one invocation takes them in turn, and
+// how many invocations take them, each every so many), each pushed out of the spheres at
+// once, a colour after another, as the CPU's pass takes them one after another in the
+// same order.
 @compute @workgroup_size(64)
 fn faces_coloured(@builtin(global_invocation_id) id: vec3<u32>) {
     if (this_round.z == 1u) {
@@ -447,8 +449,8 @@ fn faces_coloured(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         return;
     }
-    if (id.x < this_round.y) {
-        faces_one(this_round.x + id.x, true);
+    for (var k = id.x; k < this_round.y; k += this_round.w) {
+        faces_one(this_round.x + k, true);
     }
 }
 

@@ -54,7 +54,10 @@ impl Contacts {
         let sphere = (effects.iter()).any(|e| matches!(e, Effect::Sphere(_)));
         let (own, faces) = match own {
             Some(own) => (SelfPass::new(device, queue, particles, model, own)?, None),
-            None if sphere => (None, FacePass::new(device, queue, particles, model)),
+            None if sphere => (
+                None,
+                FacePass::new((device, queue, kernel), particles, model),
+            ),
             None => (None, None),
         };
         let contact = params.contact;

@@ -113,6 +113,39 @@ impl SelfParams {
     }
 }
 
+/// A buffer of `size` bytes (at least 32, a multiple of 16) for `usage`, written to by the
+/// host.
+fn sized_buffer(
+    device: &wgpu::Device,
+    label: &str,
+    size: u64,
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(32).next_multiple_of(16),
+        usage: usage | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// A pass's uniform (`label params`, a [`SelfParams`]) and its triangles (`label
+/// triangles`, four words each), written.
+fn uniform_and_triangles(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    triangles: &[[u32; 4]],
+) -> [wgpu::Buffer; 2] {
+    use wgpu::BufferUsages as U;
+    let size = std::mem::size_of::<SelfParams>() as u64;
+    let uniform = sized_buffer(device, &format!("{label} params"), size, U::UNIFORM);
+    let bytes = 16 * triangles.len() as u64;
+    let tris = sized_buffer(device, &format!("{label} triangles"), bytes, U::STORAGE);
+    queue.write_buffer(&tris, 0, bytemuck::cast_slice(triangles));
+    [uniform, tris]
+}
+
 /// The shader: its bindings and helpers, then the kernels.
 fn shader() -> String {
     format!("{LAYOUT}{CONTACT}{GEOMETRY}{SOURCE}")
@@ -297,18 +330,8 @@ impl SelfPass {
             colliders: [GpuCollider::zeroed(); MAX_COLLIDERS],
         };
         use wgpu::BufferUsages as U;
-        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: size.max(32).next_multiple_of(16),
-                usage: usage | U::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
-        let size = std::mem::size_of::<SelfParams>() as u64;
-        let uniform = buffer("self-contact params", size, U::UNIFORM);
-        let tris = buffer("self-contact triangles", u64::from(n) * 16, U::STORAGE);
-        queue.write_buffer(&tris, 0, bytemuck::cast_slice(&triangles));
+        let buffer = |label: &str, size: u64, usage| sized_buffer(device, label, size, usage);
+        let [uniform, tris] = uniform_and_triangles(device, queue, "self-contact", &triangles);
         let boxes = buffer(
             "self-contact boxes",
             u64::from(2 * (count + n)) * 16,

@@ -11,10 +11,11 @@ use bytemuck::Zeroable;
 
 use crate::cloth::{ClothModel, colour_greedily};
 
-use super::super::kernel::{Slot, WORKGROUP, bind, layout, pipelines};
+use super::super::kernel::{Slot, SubstepKernel, WORKGROUP, bind, layout, pipelines};
 use super::super::packing::{Params, SPHERE};
 use super::super::substep_ends::{Memory, Start};
-use super::{COUNTERS, PUSH_WORDS, ROUND_STRIDE, SelfParams, shader};
+use super::super::xpbd::{Colours, colour_record};
+use super::{COUNTERS, PUSH_WORDS, SelfParams, shader, sized_buffer, uniform_and_triangles};
 
 /// The triangles kept out of the spheres after each substep, without self-contact.
 pub(in crate::gpu) struct FacePass {
@@ -24,10 +25,9 @@ pub(in crate::gpu) struct FacePass {
     /// `groups[j]` moves `particles[j]` (the start is bound to the other, which the
     /// kernels do not read).
     groups: [wgpu::BindGroup; 2],
-    /// Each colour's first triangle, how many, and whether they may share a particle, at
-    /// its own offset; and each colour's workgroups.
-    colours: wgpu::BindGroup,
-    workgroups: Vec<u32>,
+    /// Each colour's first triangle, how many, whether they may share a particle and how
+    /// many invocations take them.
+    colours: Colours,
     /// What the groups bind: the uniform, the triangles (colour after colour), each
     /// particle's count of pushes, two words for the bindings the kernels do not use, and
     /// a stand-in for the solver's words.
@@ -41,8 +41,7 @@ pub(in crate::gpu) struct FacePass {
 impl FacePass {
     /// The pass over `model`'s triangles, or `None` where it has none.
     pub(in crate::gpu) fn new(
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        (device, queue, kernel): (&wgpu::Device, &wgpu::Queue, &SubstepKernel),
         particles: &[wgpu::Buffer; 2],
         model: &ClothModel,
     ) -> Option<Self> {
@@ -59,81 +58,39 @@ impl FacePass {
             })
             .collect();
         let count = model.particle_count() as u32;
-        let n = triangles.len() as u32;
         // No buckets: each particle's count follows the counters and its (unused) cut.
         let params = SelfParams {
-            counts: [count, n, 0, 0],
+            counts: [count, triangles.len() as u32, 0, 0],
             ..SelfParams::zeroed()
         };
-        use wgpu::BufferUsages as U;
-        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: size.max(32).next_multiple_of(16),
-                usage: usage | U::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
-        let size = std::mem::size_of::<SelfParams>() as u64;
-        let uniform = buffer("sphere faces params", size, U::UNIFORM);
-        let tris = buffer("sphere faces triangles", u64::from(n) * 16, U::STORAGE);
-        queue.write_buffer(&tris, 0, bytemuck::cast_slice(&triangles));
+        let [uniform, tris] = uniform_and_triangles(device, queue, "sphere faces", &triangles);
         let words = u64::from(COUNTERS) + (1 + PUSH_WORDS) * u64::from(count);
-        let counts = buffer("sphere faces pushes", 4 * words, U::STORAGE);
-        let unused = [0, 1].map(|_| buffer("sphere faces unused", 32, U::STORAGE));
-        let no_solve = buffer("no solver words", 48, U::STORAGE);
-        let [boxes, lists] = unused;
+        let storage = |label: &str, bytes: u64| {
+            sized_buffer(device, label, bytes, wgpu::BufferUsages::STORAGE)
+        };
+        let counts = storage("sphere faces pushes", 4 * words);
+        let [boxes, lists] = [0, 1].map(|_| storage("sphere faces unused", 32));
+        let no_solve = storage("no solver words", 48);
         let buffers = [uniform, tris, counts, boxes, lists, no_solve];
-        use Slot::{Dynamic, Read, Uniform, Write};
+        use Slot::{Read, Uniform, Write};
         let slots = [Uniform, Read, Write, Read, Write, Write, Write, Write];
         let main = layout(device, "sphere faces", &slots);
-        let colour_layout = layout(device, "sphere faces colour", &[Dynamic]);
-        let both: &[&wgpu::BindGroupLayout] = &[&main, &colour_layout];
+        let both: &[&wgpu::BindGroupLayout] = &[&main, &kernel.colour_layout];
         let kernels = pipelines(
             device,
             "sphere faces",
             &shader(),
             [("faces_coloured", both), ("faces_settle", both)],
         );
-        let stride = ROUND_STRIDE as usize / 4;
-        let mut words = vec![0u32; runs.len().max(1) * stride];
-        for (k, (range, shared)) in runs.iter().enumerate() {
-            let at = k * stride;
-            words[at..at + 3].copy_from_slice(&[
-                range.start as u32,
-                range.len() as u32,
-                u32::from(*shared),
-            ]);
-        }
-        let records = buffer("sphere faces colours", 4 * words.len() as u64, U::UNIFORM);
-        queue.write_buffer(&records, 0, bytemuck::cast_slice(&words));
-        let colours = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("sphere faces colours"),
-            layout: &colour_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &records,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(16),
-                }),
-            }],
-        });
-        let workgroups = (runs.iter())
-            .map(|(range, shared)| {
-                if *shared {
-                    1
-                } else {
-                    (range.len() as u32).div_ceil(WORKGROUP)
-                }
-            })
+        let records: Vec<[u32; 4]> = (runs.iter())
+            .map(|(range, shared)| colour_record(range.start, range.len(), *shared))
             .collect();
+        let colours = Colours::new(device, queue, kernel, &records);
         let groups = Self::groups_for(device, &main, particles, &buffers, None);
         Some(Self {
             kernels,
             groups,
             colours,
-            workgroups,
             buffers,
             solve: None,
             particles: particles.clone(),
@@ -195,13 +152,8 @@ impl FacePass {
             Start::In(i) => 1 - i,
             Start::Kept(i) => i,
         };
-        pass.set_bind_group(0, &self.groups[end], &[]);
-        pass.set_pipeline(&self.kernels[0]);
-        for (k, &groups) in self.workgroups.iter().enumerate() {
-            let offset = (k as u64 * ROUND_STRIDE) as u32;
-            pass.set_bind_group(1, &self.colours, &[offset]);
-            pass.dispatch_workgroups(groups, 1, 1);
-        }
+        self.colours
+            .sweep(pass, &self.kernels[0], &self.groups[end]);
         pass.set_pipeline(&self.kernels[1]);
         pass.dispatch_workgroups(self.params.counts[0].div_ceil(WORKGROUP), 1, 1);
     }
