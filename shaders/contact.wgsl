@@ -66,6 +66,17 @@ struct Motion {
     v: vec3<f32>,
 }
 
+// `m` kept `offset` above the plane `col`, where it is nearer: moved straight out, its
+// approach taken out of its velocity and its sliding slowed by the plane's friction.
+fn onto_plane(col: Collider, offset: f32, m: Motion) -> Motion {
+    let normal = col.b.xyz;
+    let depth = offset - dot(m.x - col.a.xyz, normal);
+    if (depth <= 0.0) {
+        return m;
+    }
+    return Motion(m.x + depth * normal, touching(m.v, vec3<f32>(0.0), normal, col.info.z, 1.0));
+}
+
 // `end` (position and velocity after a substep that started at `x`) with the first `count`
 // of `colliders` (spheres and planes, the cloth kept `offset` off them) resolved against
 // the substep's path, with friction.
@@ -74,10 +85,6 @@ fn collide_among(colliders: array<Collider, 4>, count: u32, offset: f32, x: vec3
     var nv = end.v;
     for (var c = 0u; c < count; c = c + 1u) {
         let col = colliders[c];
-        let mu = col.info.z;
-        var caught = false;
-        var n = vec3<f32>(0.0, 1.0, 0.0);
-        var v_surface = vec3<f32>(0.0);
         if (col.info.x == 1.0) {
             let centre = col.a.xyz;
             let radius = col.info.y;
@@ -93,22 +100,14 @@ fn collide_among(colliders: array<Collider, 4>, count: u32, offset: f32, x: vec3
                     moved = hit + rest - min(dot(rest, hn), 0.0) * hn;
                 }
                 let len = length(moved);
-                n = unit_or_up(moved);
+                let n = unit_or_up(moved);
                 nx = centre + n * max(reach, len);
-                v_surface = cross(col.b.xyz, n * radius);
-                caught = true;
+                nv = touching(nv, cross(col.b.xyz, n * radius), n, col.info.z, 1.0);
             }
         } else if (col.info.x == 2.0) {
-            let normal = col.b.xyz;
-            let depth = offset - dot(nx - col.a.xyz, normal);
-            if (depth > 0.0) {
-                nx = nx + depth * normal;
-                n = normal;
-                caught = true;
-            }
-        }
-        if (caught) {
-            nv = touching(nv, v_surface, n, mu, 1.0);
+            let m = onto_plane(col, offset, Motion(nx, nv));
+            nx = m.x;
+            nv = m.v;
         }
     }
     return settle_between(colliders, count, offset, Motion(nx, nv));

@@ -342,6 +342,10 @@ fn push_apply(@builtin(global_invocation_id) id: vec3<u32>) {
     take_pushes(id.x, LEFT_SHARE);
 }
 
+// A face whose nearest point lies within this share of the offset inside the reach
+// touches it and is left as it is (the CPU's `FACE_TOUCHING`).
+const FACE_TOUCHING: f32 = 1e-4;
+
 // Each triangle's interior is kept out of the spheres too, not only its corners (the
 // CPU's `keep_faces_out`: the guarantee covers the surface, and a triangle over a small
 // sphere dips in between its corners however far out they are): a triangle whose point
@@ -351,10 +355,6 @@ fn push_apply(@builtin(global_invocation_id) id: vec3<u32>) {
 // draped face's corners past the offset, where the colliders' pass no longer touches
 // them), the change shared among the corners as the push is; side by side, each corner
 // taking the average.
-// A face whose nearest point lies within this share of the offset inside the reach
-// touches it and is left as it is (the CPU's `FACE_TOUCHING`).
-const FACE_TOUCHING: f32 = 1e-4;
-
 fn faces_one(t: u32, alone: bool) {
     if (t >= sp.counts.y) {
         return;
@@ -475,11 +475,8 @@ fn faces_settle(@builtin(global_invocation_id) id: vec3<u32>) {
     var m = Motion(q.x.xyz, q.v.xyz);
     let offset = sp.contact.y;
     for (var c = 0u; c < sp.passes.x; c++) {
-        let col = sp.colliders[c];
-        let depth = offset - dot(m.x - col.a.xyz, col.b.xyz);
-        if (col.info.x == 2.0 && depth > 0.0) {
-            let v = touching(m.v, vec3<f32>(0.0), col.b.xyz, col.info.z, 1.0);
-            m = Motion(m.x + depth * col.b.xyz, v);
+        if (sp.colliders[c].info.x == 2.0) {
+            m = onto_plane(sp.colliders[c], offset, m);
         }
     }
     m = settle_between(sp.colliders, sp.passes.x, offset, m);

@@ -113,10 +113,9 @@ impl Sphere {
     /// them, a colour at once: two of a colour share no particle), each from where the last
     /// left its corners. (Each corner taking the average of its triangles' pushes, found
     /// from where the pass found the cloth, a draped cloth jittered on and a frictionless
-    /// spinning sphere turned it.) Only the triangles of the patches
-    /// whose box comes that near are tested ([`FacePatches`]), and of those only the ones
-    /// a bound on their distance does not tell clear are measured. Returns the triangles
-    /// pushed.
+    /// spinning sphere turned it.) Only the triangles of the patches whose box comes that
+    /// near are tested ([`FacePatches`]), and of those only the ones a bound on their
+    /// distance does not tell clear are measured. Returns the triangles pushed.
     fn keep_faces_out(&self, pass: &mut ContactPass<'_>) -> usize {
         let reach = self.radius + pass.offset;
         let (model, state) = (pass.model, &mut *pass.state);
