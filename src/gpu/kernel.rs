@@ -124,6 +124,22 @@ pub(super) fn pipelines<const N: usize>(
     })
 }
 
+/// A buffer of `size` bytes (at least 32, a multiple of 16) for `usage`, written to by the
+/// host.
+pub(super) fn sized_buffer(
+    device: &wgpu::Device,
+    label: &str,
+    size: u64,
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(32).next_multiple_of(16),
+        usage: usage | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
 /// A bind group of `layout` with `buffers` at bindings 0, 1, ….
 pub(super) fn bind(
     device: &wgpu::Device,

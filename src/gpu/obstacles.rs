@@ -18,7 +18,8 @@ use crate::sim::{ContactConfig, Effect, Obstacle, RigidMotion};
 
 use super::error::GpuError;
 use super::kernel::{
-    CONTACT, GEOMETRY, LAYOUT, Slot, SubstepKernel, WORKGROUP, layout, pipelines, start_end_groups,
+    CONTACT, GEOMETRY, LAYOUT, Slot, SubstepKernel, WORKGROUP, layout, pipelines, sized_buffer,
+    start_end_groups,
 };
 use super::packing::MAX_OBSTACLES;
 use super::self_contact::PUSHES_MOVED;
@@ -304,12 +305,7 @@ impl ObstaclePass {
         let count = model.particle_count() as u32;
         (params.counts[0], params.counts[2]) = (count, PUSHES_MOVED);
         let buffer = |label: &str, data: &[u8], usage: wgpu::BufferUsages| {
-            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: (data.len() as u64).max(32).next_multiple_of(16),
-                usage: usage | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
+            let buffer = sized_buffer(device, label, data.len() as u64, usage);
             queue.write_buffer(&buffer, 0, data);
             buffer
         };

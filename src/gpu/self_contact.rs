@@ -21,7 +21,8 @@ use crate::sim::{SelfCollision, owned_parts};
 
 use super::error::GpuError;
 use super::kernel::{
-    CONTACT, GEOMETRY, LAYOUT, Slot, WORKGROUP, bind, layout, pipelines, start_end_groups,
+    CONTACT, GEOMETRY, LAYOUT, Slot, WORKGROUP, bind, layout, pipelines, sized_buffer,
+    start_end_groups,
 };
 use super::packing::{GpuCollider, MAX_COLLIDERS, Params, SPHERE};
 use super::substep_ends::{Memory, Start};
@@ -111,22 +112,6 @@ impl SelfParams {
             Memory::Accelerations(at) => (2, at),
         };
     }
-}
-
-/// A buffer of `size` bytes (at least 32, a multiple of 16) for `usage`, written to by the
-/// host.
-fn sized_buffer(
-    device: &wgpu::Device,
-    label: &str,
-    size: u64,
-    usage: wgpu::BufferUsages,
-) -> wgpu::Buffer {
-    device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: size.max(32).next_multiple_of(16),
-        usage: usage | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    })
 }
 
 /// A pass's uniform (`label params`, a [`SelfParams`]) and its triangles (`label

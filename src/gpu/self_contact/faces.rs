@@ -11,11 +11,11 @@ use bytemuck::Zeroable;
 
 use crate::cloth::{ClothModel, colour_greedily};
 
-use super::super::kernel::{Slot, SubstepKernel, WORKGROUP, bind, layout, pipelines};
+use super::super::kernel::{Slot, SubstepKernel, WORKGROUP, bind, layout, pipelines, sized_buffer};
 use super::super::packing::{Params, SPHERE};
 use super::super::substep_ends::{Memory, Start};
 use super::super::xpbd::{Colours, colour_record};
-use super::{COUNTERS, PUSH_WORDS, SelfParams, shader, sized_buffer, uniform_and_triangles};
+use super::{COUNTERS, PUSH_WORDS, SelfParams, shader, uniform_and_triangles};
 
 /// The triangles kept out of the spheres after each substep, without self-contact.
 pub(in crate::gpu) struct FacePass {
